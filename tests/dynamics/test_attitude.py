@@ -1,0 +1,334 @@
+"""Attitude kinematics against the seed's numbers and independent references.
+
+Independent truths used here: the seed's printed Gemini example (Sec. 4.4), the axis-angle
+rotation matrix (Eqs. 4.46-4.54), products of elementary rotations, scipy's
+``Rotation`` (a peer library; its matrix is the *active* rotation, i.e. ``A^T``), and the
+matrix exponential of the kinematics (Eq. 4.70).
+"""
+import itertools
+
+import casadi as ca
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+from scipy.linalg import expm
+from scipy.spatial.transform import Rotation
+
+from dynamics import attitude as at
+
+GEMINI = np.array([[4560.7, 31.2, -43.4], [31.2, 4545.0, -270.7], [-43.4, -270.7, 1567.4]])
+
+finite = dict(allow_nan=False, allow_infinity=False)
+unit_vectors = st.tuples(*[st.floats(-1, 1, **finite)] * 3).map(np.array).filter(
+    lambda v: np.linalg.norm(v) > 1e-3
+)
+
+
+def unit_quat(v):
+    v = np.asarray(v, float)
+    return v / np.linalg.norm(v)
+
+
+quats = st.tuples(*[st.floats(-1, 1, **finite)] * 4).filter(
+    lambda v: np.linalg.norm(v) > 1e-3
+).map(unit_quat)
+
+
+def same_rotation(q, p, tol=1e-12):
+    """Quaternions q and p describe the same attitude (q = +/- p)."""
+    return min(np.max(np.abs(q - p)), np.max(np.abs(q + p))) <= tol
+
+
+# ------------------------------------------------------------------- Gemini (Sec. 4.4)
+def test_gemini_principal_moments_match_seed():
+    moments, A = at.principal_axes(GEMINI)
+    np.testing.assert_allclose(moments, [4530.11944, 4600.531811, 1542.448749], atol=6e-6)
+    np.testing.assert_allclose(A @ GEMINI @ A.T, np.diag(moments), atol=1e-9)
+    assert np.linalg.det(A) == pytest.approx(1.0, abs=1e-12)
+
+
+def test_gemini_rotation_matches_seed_matrix_and_angle():
+    _, A = at.principal_axes(GEMINI)
+    seed_A = np.array(
+        [[0.74693, -0.66305, 0.04964], [0.66477, 0.74319, -0.07584], [0.01339, 0.08965, 0.99588]]
+    )
+    np.testing.assert_allclose(A, seed_A, atol=6e-6)
+    delta = np.degrees(np.arccos((np.trace(A) - 1) / 2))
+    assert round(delta, 2) == 42.01
+    # The seed's other sign choices give larger angles (138.34, 178.88, 174.19 deg).
+    assert delta < 138.34
+
+
+def test_gemini_minor_axis_direction_matches_seed():
+    _, A = at.principal_axes(GEMINI)
+    psi, theta, phi = np.degrees(at.euler313_from_dcm(A))
+    assert round(theta, 1) == 5.2
+    assert round(phi, 1) == 146.8  # second quadrant: tan^-1(0.04964 / -0.07584)
+
+
+@pytest.mark.parametrize("order", ["ascending", "descending"])
+def test_principal_axes_fixed_order(order):
+    moments, A = at.principal_axes(GEMINI, order=order)
+    expected = np.sort(np.linalg.eigvalsh(GEMINI))
+    np.testing.assert_allclose(moments, expected if order == "ascending" else expected[::-1])
+    np.testing.assert_allclose(A @ GEMINI @ A.T, np.diag(moments), atol=1e-9)
+    assert np.linalg.det(A) == pytest.approx(1.0)
+
+
+def test_principal_axes_is_minimum_rotation_over_all_proper_choices():
+    rng = np.random.default_rng(3)
+    for _ in range(20):
+        R = Rotation.random(random_state=rng).as_matrix()
+        I = R @ np.diag(rng.uniform(1, 2, 3)) @ R.T
+        _, A = at.principal_axes(I)
+        # brute force over signed permutations with det +1
+        vals, vecs = np.linalg.eigh(I)
+        best = max(
+            np.trace(vecs[:, list(p)] * s)
+            for p in itertools.permutations(range(3))
+            for s in itertools.product([1, -1], repeat=3)
+            if np.linalg.det(vecs[:, list(p)] * s) > 0
+        )
+        assert np.trace(A) == pytest.approx(best, abs=1e-12)
+
+
+# ----------------------------------------------------------- quaternion <-> DCM (4.63)
+@given(unit_vectors, st.floats(-np.pi, np.pi, **finite))
+def test_dcm_from_quat_equals_axis_angle_form(axis, angle):
+    """Eq. 4.63 with Eqs. 4.55-4.58 against the direct elements 4.46-4.54."""
+    A1 = at.dcm_from_quat(at.quat_from_axis_angle(axis, angle))
+    A2 = at.dcm_from_axis_angle(axis, angle)
+    np.testing.assert_allclose(A1, A2, atol=1e-14)
+
+
+@given(quats)
+def test_dcm_matches_scipy_passive_convention(q):
+    """scipy's as_matrix is the active rotation R with x_inertial = R x_body, so A = R^T."""
+    R = Rotation.from_quat(q).as_matrix()  # scipy is scalar-last too
+    np.testing.assert_allclose(at.dcm_from_quat(q), R.T, atol=1e-14)
+
+
+@given(quats, quats)
+def test_quat_mul_composes_dcms(q, p):
+    np.testing.assert_allclose(
+        at.dcm_from_quat(at.quat_mul(q, p)), at.dcm_from_quat(q) @ at.dcm_from_quat(p), atol=1e-14
+    )
+
+
+@given(quats)
+def test_conj_is_inverse(q):
+    np.testing.assert_allclose(at.quat_mul(q, at.quat_conj(q)), [0, 0, 0, 1], atol=1e-15)
+
+
+@given(quats)
+def test_quat_dcm_round_trip(q):
+    q_back = at.quat_from_dcm(at.dcm_from_quat(q))
+    assert q_back[3] >= 0
+    assert same_rotation(q_back, q, 2e-14)
+
+
+@given(unit_vectors, st.floats(np.pi - 1e-6, np.pi, **finite))
+def test_quat_from_dcm_near_180_degrees(axis, angle):
+    """Near delta = pi, q4 -> 0: the largest-diagonal pivot keeps full accuracy."""
+    q = at.quat_from_axis_angle(axis, angle)
+    q_back = at.quat_from_dcm(at.dcm_from_quat(q))
+    assert same_rotation(q_back, q, 1e-14)
+    assert q_back[3] >= 0
+
+
+def test_quat_from_dcm_matches_scipy_and_seed_sign_rule():
+    rng = np.random.default_rng(0)
+    R = Rotation.random(200, random_state=rng)
+    A = np.stack([r.T for r in R.as_matrix()], axis=-1)
+    q = at.quat_from_dcm(A)
+    q_ref = R.as_quat().T * np.sign(R.as_quat()[:, 3])
+    np.testing.assert_allclose(q, q_ref, atol=1e-14)
+    assert np.all(q[3] >= 0)
+
+
+def test_rotation_angle_from_trace():
+    """Eq. 4.64: tr A = 1 + 2 cos(delta)."""
+    rng = np.random.default_rng(1)
+    for q in Rotation.random(50, random_state=rng).as_quat():
+        A = at.dcm_from_quat(q)
+        assert np.cos(at.rotation_angle(q)) == pytest.approx((np.trace(A) - 1) / 2, abs=1e-14)
+        axis, angle = at.axis_angle_from_quat(q)
+        np.testing.assert_allclose(at.dcm_from_axis_angle(axis, angle), A, atol=1e-14)
+
+
+# ------------------------------------------------------------------- Euler angles
+angle = st.floats(-np.pi, np.pi, **finite)
+
+
+@given(angle, st.floats(0, np.pi, **finite), angle)
+def test_euler313_matches_product_of_elementary_rotations(psi, theta, phi):
+    A = at.dcm_axis(3, phi) @ at.dcm_axis(1, theta) @ at.dcm_axis(3, psi)
+    np.testing.assert_allclose(at.dcm_from_euler313([psi, theta, phi]), A, atol=1e-15)
+    assert same_rotation(at.quat_from_euler313([psi, theta, phi]), at.quat_from_dcm(A), 1e-14)
+
+
+@given(angle, st.floats(-np.pi / 2, np.pi / 2, **finite), angle)
+def test_euler321_matches_product_of_elementary_rotations(psi, theta, phi):
+    A = at.dcm_axis(1, phi) @ at.dcm_axis(2, theta) @ at.dcm_axis(3, psi)
+    np.testing.assert_allclose(at.dcm_from_euler321([psi, theta, phi]), A, atol=1e-15)
+    assert same_rotation(at.quat_from_euler321([psi, theta, phi]), at.quat_from_dcm(A), 1e-14)
+
+
+def test_elementary_rotations_match_scipy():
+    for k, name in zip((1, 2, 3), "xyz"):
+        np.testing.assert_allclose(
+            at.dcm_axis(k, 0.3), Rotation.from_euler(name, 0.3).as_matrix().T, atol=1e-15
+        )
+
+
+@settings(max_examples=200)
+@given(quats)
+def test_euler_round_trips_from_any_attitude(q):
+    A = at.dcm_from_quat(q)
+    for to_euler, from_euler in (
+        (at.euler313_from_dcm, at.dcm_from_euler313),
+        (at.euler321_from_dcm, at.dcm_from_euler321),
+    ):
+        np.testing.assert_allclose(from_euler(to_euler(A)), A, atol=2e-14)
+    assert same_rotation(at.quat_from_euler313(at.euler313_from_quat(q)), q, 1e-14)
+    assert same_rotation(at.quat_from_euler321(at.euler321_from_quat(q)), q, 1e-14)
+
+
+@given(angle, st.floats(0, 1e-7, **finite), angle, st.sampled_from([1.0, -1.0]))
+def test_euler321_round_trip_near_gimbal_lock(psi, eps, phi, sign):
+    theta = sign * (np.pi / 2 - eps)
+    A = at.dcm_from_euler321([psi, theta, phi])
+    angles = at.euler321_from_dcm(A)
+    np.testing.assert_allclose(at.dcm_from_euler321(angles), A, atol=1e-14)
+    assert abs(angles[1]) <= np.pi / 2
+
+
+@given(angle, st.floats(0, 1e-7, **finite), angle, st.sampled_from([0.0, np.pi]))
+def test_euler313_round_trip_near_gimbal_lock(psi, eps, phi, lock):
+    theta = abs(lock - eps)
+    A = at.dcm_from_euler313([psi, theta, phi])
+    angles = at.euler313_from_dcm(A)
+    np.testing.assert_allclose(at.dcm_from_euler313(angles), A, atol=1e-14)
+    assert 0 <= angles[1] <= np.pi
+
+
+def test_euler_angles_recovered_in_principal_ranges():
+    rng = np.random.default_rng(2)
+    for _ in range(100):
+        a313 = [rng.uniform(-np.pi, np.pi), rng.uniform(0.01, np.pi - 0.01), rng.uniform(-np.pi, np.pi)]
+        np.testing.assert_allclose(at.euler313_from_dcm(at.dcm_from_euler313(a313)), a313, atol=1e-12)
+        a321 = [rng.uniform(-np.pi, np.pi), rng.uniform(-1.5, 1.5), rng.uniform(-np.pi, np.pi)]
+        np.testing.assert_allclose(at.euler321_from_dcm(at.dcm_from_euler321(a321)), a321, atol=1e-12)
+
+
+def test_euler321_small_angle_quaternion_note():
+    """Seed NOTE: for small angles q ~ (phi/2, theta/2, psi/2, 1)."""
+    errs = []
+    for scale in (1e-3, 1e-4):
+        psi, theta, phi = scale * np.array([1.0, -2.0, 3.0])
+        q = at.quat_from_euler321([psi, theta, phi])
+        errs.append(np.max(np.abs(q - [phi / 2, theta / 2, psi / 2, 1])))
+    assert errs[1] < 2e-7
+    assert errs[0] / errs[1] == pytest.approx(100, rel=1e-3)  # the residual is second order
+
+
+def test_euler_matches_scipy_sequences():
+    """Modern 3-2-1 is scipy's intrinsic 'ZYX'; classical 3-1-3 is intrinsic 'ZXZ'."""
+    rng = np.random.default_rng(5)
+    for _ in range(20):
+        q = Rotation.random(random_state=rng).as_quat()
+        R = Rotation.from_quat(q)
+        np.testing.assert_allclose(at.euler321_from_quat(q), R.as_euler("ZYX"), atol=1e-12)
+        psi, theta, phi = at.euler313_from_quat(q)
+        np.testing.assert_allclose(
+            at.dcm_from_euler313([psi, theta, phi]),
+            Rotation.from_euler("ZXZ", [psi, theta, phi]).as_matrix().T,
+            atol=1e-14,
+        )
+
+
+# --------------------------------------------------------- propagation (Eq. 4.70)
+@given(quats, st.tuples(*[st.floats(-5, 5, **finite)] * 3).map(np.array), st.floats(0, 2, **finite))
+def test_propagate_quat_is_exact_for_constant_rate(q, w, h):
+    """Closed form against the matrix exponential of qdot = -1/2 Wbar q."""
+    expected = expm(-0.5 * at.quat_kinematics_matrix(w) * h) @ q
+    np.testing.assert_allclose(at.propagate_quat(q, w, h), expected, atol=1e-13)
+
+
+def test_quat_rate_is_eq_4_70():
+    rng = np.random.default_rng(4)
+    for _ in range(10):
+        q, w = unit_quat(rng.normal(size=4)), rng.normal(size=3)
+        np.testing.assert_allclose(at.quat_rate(q, w), -0.5 * at.quat_kinematics_matrix(w) @ q)
+        W = at.quat_kinematics_matrix(w)
+        np.testing.assert_allclose(W @ W, -np.dot(w, w) * np.eye(4), atol=1e-14)
+
+
+def test_propagate_quat_smooth_through_zero_rate_in_casadi():
+    q, w, h = ca.SX.sym("q", 4), ca.SX.sym("w", 3), ca.SX.sym("h")
+    out = at.propagate_quat(q, w, h)
+    J = ca.Function("J", [q, w, h], [ca.jacobian(out, w)])
+    q0 = np.array([0.1, -0.2, 0.3, 0.9])
+    J0 = np.array(J(q0, [0, 0, 0], 0.1))
+    # at w = 0: d q(h) / d w = h * d(quat_rate)/dw
+    Jrate = np.array(ca.Function("r", [q, w], [ca.jacobian(at.quat_rate(q, w), w)])(q0, [0, 0, 0]))
+    np.testing.assert_allclose(J0, 0.1 * Jrate, atol=1e-15)
+    assert np.all(np.isfinite(np.array(J(q0, [1e-9, 0, 0], 0.1))))
+
+
+# ------------------------------------------------------------- numpy == casadi
+def test_casadi_and_numpy_agree():
+    rng = np.random.default_rng(7)
+    q = unit_quat(rng.normal(size=4))
+    w = rng.normal(size=3)
+    A = at.dcm_from_quat(q)
+    e313, e321 = at.euler313_from_dcm(A), at.euler321_from_dcm(A)
+    cases = [
+        (at.dcm_from_quat, [q]),
+        (at.quat_from_dcm, [A]),
+        (at.quat_mul, [q, unit_quat(rng.normal(size=4))]),
+        (at.propagate_quat, [q, w, 0.3]),
+        (at.euler313_from_dcm, [A]),
+        (at.euler321_from_dcm, [A]),
+        (at.dcm_from_euler313, [e313]),
+        (at.dcm_from_euler321, [e321]),
+        (at.quat_from_euler313, [e313]),
+        (at.quat_from_euler321, [e321]),
+        (at.rotation_angle, [q]),
+    ]
+    for fun, args in cases:
+        syms = [ca.SX.sym(f"a{i}", *np.shape(a)) if np.ndim(a) else ca.SX.sym(f"a{i}") for i, a in enumerate(args)]
+        F = ca.Function("F", syms, [fun(*syms)])
+        got = np.array(F(*args)).reshape(np.shape(fun(*args)))
+        np.testing.assert_allclose(got, fun(*args), atol=1e-15, err_msg=fun.__name__)
+
+
+def test_batched_numpy_inputs():
+    R = Rotation.random(7, random_state=np.random.default_rng(8))
+    q = R.as_quat().T  # (4, 7)
+    A = at.dcm_from_quat(q)
+    assert A.shape == (3, 3, 7)
+    assert at.euler321_from_dcm(A).shape == (3, 7)
+    for i in range(7):
+        np.testing.assert_allclose(A[:, :, i], at.dcm_from_quat(q[:, i]))
+
+
+# ------------------------------------------------------------------- bad input
+@pytest.mark.parametrize(
+    "call, match",
+    [
+        (lambda: at.dcm_from_quat([1, 0, 0]), "`q` must have shape"),
+        (lambda: at.quat_from_dcm(np.eye(2)), "`A` must have shape"),
+        (lambda: at.quat_normalize([0, 0, 0, 0]), "`q` must be non-zero"),
+        (lambda: at.dcm_from_axis_angle([0, 0, 0], 1.0), "`axis` must be a non-zero"),
+        (lambda: at.dcm_axis(4, 0.1), "`axis` must be 1, 2 or 3"),
+        (lambda: at.propagate_quat([0, 0, 0, 1], [1, 2], 0.1), "`w` must have shape"),
+        (lambda: at.principal_axes(GEMINI, order="sorted"), "`order`"),
+        (lambda: at.principal_axes(-GEMINI), "positive definite"),
+        (lambda: at.quat_mul(ca.SX.sym("q", 3), [0, 0, 0, 1]), "4x1"),
+    ],
+)
+def test_bad_input_raises(call, match):
+    with pytest.raises(ValueError, match=match):
+        call()
