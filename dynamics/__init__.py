@@ -1,7 +1,7 @@
 """appdyn dynamics: models as named-I/O CasADi Functions, simulation, closed-form truths.
 
-The public entry points are imported lazily so that importing one part (say, attitude
-kinematics) does not pay for the others.
+Entry points: `Model`, `rigid_body`, `simulate`, and the modules `attitude` (kinematics)
+and `truth` (closed forms, imported on first use).
 """
 from __future__ import annotations
 
@@ -10,19 +10,12 @@ import importlib
 from . import attitude
 from .model import Model
 from .rigid_body import rigid_body
+from .simulate import SimulationResult, simulate
 
-_LAZY = {
-    "simulate": ("dynamics.simulate", "simulate"),
-    "linearize": ("dynamics.linearize", "linearize"),
-    "truth": ("dynamics.truth", None),
-}
-
-__all__ = ["Model", "attitude", "rigid_body", *_LAZY]
+__all__ = ["Model", "SimulationResult", "attitude", "rigid_body", "simulate", "truth"]
 
 
 def __getattr__(name):
-    if name in _LAZY:
-        module, attr = _LAZY[name]
-        mod = importlib.import_module(module)
-        return mod if attr is None else getattr(mod, attr)
+    if name == "truth":
+        return importlib.import_module("dynamics.truth")
     raise AttributeError(f"module 'dynamics' has no attribute {name!r}")

@@ -1,0 +1,144 @@
+"""The ``appdyn`` command line.
+
+    appdyn simulate torque-free --inertia 1,2,3 --w0 1,0.1,0.8 --t-final 50 [--plot F.png]
+    appdyn demo
+    appdyn bench [NAME ...]
+
+Library code never prints; this module is the one place that does.
+"""
+from __future__ import annotations
+
+import argparse
+import runpy
+import sys
+from pathlib import Path
+
+import numpy as np
+
+__all__ = ["main", "build_parser"]
+
+BENCH_DIR = Path(__file__).resolve().parents[1] / "bench"
+
+
+def _vector(n_allowed):
+    """argparse type: comma-separated floats with one of the allowed lengths."""
+
+    def parse(text):
+        try:
+            vals = [float(v) for v in text.replace(" ", "").split(",") if v != ""]
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"expected comma-separated numbers, got {text!r}")
+        if len(vals) not in n_allowed:
+            raise argparse.ArgumentTypeError(
+                f"expected {' or '.join(map(str, n_allowed))} comma-separated numbers, got {len(vals)}"
+            )
+        if not all(np.isfinite(vals)):
+            raise argparse.ArgumentTypeError(f"numbers must be finite, got {text!r}")
+        return np.array(vals)
+
+    return parse
+
+
+def _inertia(values):
+    return values if values.size == 3 else values.reshape(3, 3)
+
+
+def _positive(text):
+    v = float(text)
+    if not (np.isfinite(v) and v > 0):
+        raise argparse.ArgumentTypeError(f"expected a positive number, got {text!r}")
+    return v
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(
+        prog="appdyn", description="Aerospace vehicle dynamics and optimal control on CasADi."
+    )
+    sub = parser.add_subparsers(dest="command", required=True)
+
+    sim = sub.add_parser("simulate", help="simulate a model and check it against a truth")
+    sim_sub = sim.add_subparsers(dest="case", required=True)
+    tf = sim_sub.add_parser(
+        "torque-free", help="torque-free rigid body vs the Jacobi-elliptic solution"
+    )
+    tf.add_argument("--inertia", type=_vector((3, 9)), required=True,
+                    help="principal moments I1,I2,I3 or 9 matrix entries [kg m^2]")
+    tf.add_argument("--w0", type=_vector((3,)), required=True, help="initial body rates [rad/s]")
+    tf.add_argument("--t-final", type=_positive, default=50.0, help="final time [s] (50)")
+    tf.add_argument("--points", type=int, default=1001, help="output points (1001)")
+    tf.add_argument("--method", default="auto",
+                    choices=["auto", "cvodes", "rk4", "rk8", "lie"], help="integrator (auto)")
+    tf.add_argument("--rtol", type=_positive, default=1e-10, help="relative tolerance (1e-10)")
+    tf.add_argument("--atol", type=_positive, default=1e-12, help="absolute tolerance (1e-12)")
+    tf.add_argument("--plot", metavar="FILE.png", help="save rates, polhode and drift plot")
+    tf.add_argument("--json", metavar="FILE", help="write the summary as JSON")
+
+    sub.add_parser("demo", help="a short tour of the toolkit's main jobs (< 1 min)")
+
+    bench = sub.add_parser("bench", help="run benchmarks from the bench/ folder")
+    bench.add_argument("names", nargs="*", help="benchmark names (default: all), e.g. simulate")
+    return parser
+
+
+def _cmd_torque_free(args) -> int:
+    from problems.torque_free import torque_free
+
+    report = torque_free(_inertia(args.inertia), args.w0, t_final=args.t_final,
+                         n_points=args.points, method=args.method, rtol=args.rtol,
+                         atol=args.atol)
+    print(report)
+    if args.plot:
+        report.plot(args.plot)
+        print(f"plot written to {args.plot}")
+    if args.json:
+        Path(args.json).write_text(report.to_json())
+        print(f"summary written to {args.json}")
+    return 0 if report.success else 1
+
+
+def _cmd_demo(args) -> int:
+    from problems.torque_free import torque_free
+
+    print("== 1. Torque-free asymmetric body, 100 s, checked against the exact solution ==")
+    report = torque_free([1.0, 2.0, 3.0], [1.0, 0.1, 0.8], t_final=100.0, rtol=1e-12, atol=1e-12)
+    print(report)
+    return 0 if report.success else 1
+
+
+def _cmd_bench(args) -> int:
+    if not BENCH_DIR.is_dir():
+        print(f"appdyn: error: no bench/ folder next to the package ({BENCH_DIR}); "
+              "benchmarks run from a source checkout", file=sys.stderr)
+        return 2
+    available = sorted(p.stem for p in BENCH_DIR.glob("*.py") if not p.stem.startswith("_"))
+    names = args.names or available
+    unknown = sorted(set(names) - set(available))
+    if unknown:
+        print(f"appdyn: error: unknown benchmark(s) {unknown}; available: {available}",
+              file=sys.stderr)
+        return 2
+    for name in names:
+        print(f"== bench/{name}.py ==", flush=True)
+        runpy.run_path(str(BENCH_DIR / f"{name}.py"), run_name="__main__")
+    return 0
+
+
+COMMANDS = {
+    ("simulate", "torque-free"): _cmd_torque_free,
+    ("demo", None): _cmd_demo,
+    ("bench", None): _cmd_bench,
+}
+
+
+def main(argv=None) -> int:
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    handler = COMMANDS[(args.command, getattr(args, "case", None))]
+    try:
+        return handler(args)
+    except ValueError as exc:  # bad input reaching the library: report it like argparse does
+        parser.exit(2, f"appdyn: error: {exc}\n")
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,53 @@
+"""The `appdyn` command line and the torque-free job behind it."""
+import json
+
+import numpy as np
+import pytest
+
+from problems.cli import main
+from problems.torque_free import torque_free
+
+
+def test_torque_free_summary_and_json(tmp_path, capsys):
+    out = tmp_path / "tf.json"
+    code = main(["simulate", "torque-free", "--inertia", "1,2,3", "--w0", "1,0.1,0.8",
+                 "--t-final", "20", "--json", str(out)])
+    assert code == 0
+    text = capsys.readouterr().out
+    assert "max |w - w_exact|" in text and "energy drift" in text and "wall time" in text
+    data = json.loads(out.read_text())
+    assert data["success"] is True
+    assert data["max_rate_error"] < 1e-8  # requested rtol 1e-10 over 20 s
+    assert data["energy_drift"] < 1e-9 and data["momentum_drift"] < 1e-9
+
+
+def test_torque_free_plot_written(tmp_path):
+    path = tmp_path / "tf.png"
+    assert main(["simulate", "torque-free", "--inertia", "1,2,3", "--w0", "0.2,1,0.1",
+                 "--t-final", "10", "--points", "201", "--plot", str(path)]) == 0
+    assert path.stat().st_size > 10_000
+
+
+def test_full_inertia_matrix_compared_in_principal_axes():
+    I = np.array([[4560.7, 31.2, -43.4], [31.2, 4545.0, -270.7], [-43.4, -270.7, 1567.4]])
+    rep = torque_free(I, [0.01, 0.02, 0.3], t_final=50.0, rtol=1e-11, atol=1e-13)
+    assert rep.success
+    assert rep.max_rel_rate_error < 1e-8
+    assert rep.momentum_drift < 1e-9
+
+
+@pytest.mark.parametrize(
+    "args, message",
+    [
+        (["--inertia", "1,1,3", "--w0", "1,0,0"], "triangle inequality"),
+        (["--inertia", "1,2", "--w0", "1,0,0"], "expected 3 or 9"),
+        (["--inertia", "1,2,3", "--w0", "1,nan,0"], "finite"),
+        (["--inertia", "1,2,3", "--w0", "1,0,0", "--t-final", "-1"], "positive"),
+        (["--inertia", "1,2,3,0,0,0,1,0,0", "--w0", "1,0,0"], "symmetric"),
+    ],
+)
+def test_bad_input_exits_with_message(args, message, capsys):
+    with pytest.raises(SystemExit) as exc:
+        main(["simulate", "torque-free", *args])
+    assert exc.value.code == 2
+    assert message in capsys.readouterr().err
