@@ -1,0 +1,36 @@
+"""appdyn ocp: direct-collocation optimal control on CasADi and IPOPT.
+
+State a `Problem` (dynamics, bounds, boundary conditions, constraints, cost), pick a
+transcription (`Trapezoid`, `HermiteSimpson`, `Radau`), and `solve` it::
+
+    from ocp import Problem, solve
+    sol = solve(Problem(model, T=1.0, x_initial=..., x_final=..., lagrange=...),
+                transcription="radau", N=20)
+    sol.success, sol.cost, sol.sample(t)
+"""
+from __future__ import annotations
+
+from .mesh import Mesh
+from .problem import Constraint, Problem
+from .scaling import Scaling
+from .solution import Propagation, Solution
+from .solve import Progress, solve
+from .transcription import (TRANSCRIPTIONS, HermiteSimpson, Radau, Transcription, Trapezoid,
+                            get_transcription)
+
+__all__ = [
+    "Problem",
+    "Constraint",
+    "Solution",
+    "Propagation",
+    "Progress",
+    "solve",
+    "Mesh",
+    "Scaling",
+    "Transcription",
+    "Trapezoid",
+    "HermiteSimpson",
+    "Radau",
+    "TRANSCRIPTIONS",
+    "get_transcription",
+]

@@ -1,0 +1,287 @@
+"""Initial guesses on the nodes of a transcription.
+
+A guess is turned into functions of normalized time ``tau in [0, 1]`` (``t = t0 + T tau``)
+for the states and controls, plus values of ``T`` and of the parameters, and then sampled at
+the state and control nodes of the transcription on the mesh (`NodeGuess`).
+
+Sources (argument ``guess`` of `ocp.solve`):
+
+* ``None``: states linear between the given boundary values (a component given at one end
+  only is held constant; one given at neither end sits at the middle of its finite bounds,
+  or at 0 clipped into them); a model's quaternion by SLERP from the initial quaternion to
+  ``q_final`` (the sign of ``q_final`` nearer the initial quaternion, i.e. the shorter
+  rotation) and normalized; controls 0 clipped into their bounds; parameters ``problem.p``;
+  a free ``T`` at the middle of ``[T_min, T_max]`` (``max(1, 2 T_min)`` if ``T_max = inf``).
+* a `Solution` (warm start): its dense solution (`Solution.sample`) stretched to the new
+  horizon in normalized time, its ``T`` and parameters.
+* a mapping with any of the keys ``'t'`` (times [s], shape (m,)), ``'x'``, ``'u'``
+  (arrays (nx, m)/(nu, m) on ``t``, linearly interpolated; constant vectors; or callables
+  ``fun(t) -> (nx,)``/``(nu,)``), ``'T'`` and ``'p'`` (array (np,) or mapping by name);
+  missing entries fall back to the default. Without ``'t'``, arrays are taken as uniformly
+  spaced over ``[t0, t0 + T]``.
+
+Every guess is clipped into the bounds; fixed boundary values are imposed as given.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Callable, Mapping
+
+import numpy as np
+
+__all__ = ["NodeGuess", "initial_guess", "slerp"]
+
+_KEYS = ("t", "x", "u", "T", "p")
+
+
+@dataclass(frozen=True)
+class NodeGuess:
+    """A guess sampled on the nodes of a transcription.
+
+    Attributes
+    ----------
+    X : ndarray, shape (nx, n_x)
+        States at the state nodes.
+    U : ndarray, shape (nu, n_u)
+        Controls at the control nodes.
+    Xu : ndarray, shape (nx, n_u)
+        States at the control nodes (for constraint scaling).
+    p : ndarray, shape (np,)
+        Full parameter vector.
+    T : float [s]
+    """
+
+    X: np.ndarray
+    U: np.ndarray
+    Xu: np.ndarray
+    p: np.ndarray
+    T: float
+
+
+def slerp(qa, qb, s) -> np.ndarray:
+    """Spherical linear interpolation between unit quaternions (no sign flip applied).
+
+    Parameters
+    ----------
+    qa, qb : array_like, shape (4,)
+    s : array_like, shape (m,)
+        Fractions in [0, 1].
+
+    Returns
+    -------
+    ndarray, shape (4, m)
+    """
+    qa, qb = np.asarray(qa, float), np.asarray(qb, float)
+    s = np.asarray(s, float).reshape(-1)
+    c = float(np.clip(np.dot(qa, qb), -1.0, 1.0))
+    angle = math.acos(c)
+    if angle < 1e-8:
+        q = qa[:, None] + s[None, :] * (qb - qa)[:, None]
+    else:
+        sa = math.sin(angle)
+        q = (np.sin((1 - s) * angle)[None, :] * qa[:, None]
+             + np.sin(s * angle)[None, :] * qb[:, None]) / sa
+    return q / np.linalg.norm(q, axis=0)
+
+
+def _clip(v: np.ndarray, bounds: np.ndarray) -> np.ndarray:
+    return np.clip(v, bounds[0][:, None], bounds[1][:, None])
+
+
+def _default_state(problem) -> Callable:
+    model = problem.model
+    a, b = problem.x_initial, problem.x_final
+    lo, hi = problem.x_bounds
+    start, end = a.copy(), b.copy()
+    for i in range(model.nx):
+        if np.isnan(a[i]) and np.isnan(b[i]):
+            if np.isfinite(lo[i]) and np.isfinite(hi[i]):
+                mid = 0.5 * (lo[i] + hi[i])
+            else:
+                mid = float(np.clip(0.0, lo[i], hi[i]))
+            start[i] = end[i] = mid
+        elif np.isnan(a[i]):
+            start[i] = b[i]
+        elif np.isnan(b[i]):
+            end[i] = a[i]
+    qa = qb = None
+    if model.attitude is not None:
+        iq = model.attitude[0]
+        sl = slice(iq, iq + 4)
+        if not np.any(np.isnan(a[sl])):
+            qa = a[sl]
+        if problem.q_final is not None:
+            qb = np.array(problem.q_final)
+        if qa is not None and qb is not None and np.dot(qa, qb) < 0:
+            qb = -qb
+        if qa is None and qb is None:
+            qa = qb = np.array([0.0, 0.0, 0.0, 1.0])
+        elif qa is None:
+            qa = qb
+        elif qb is None:
+            qb = qa
+
+    def x_fun(tau):
+        tau = np.asarray(tau, float)
+        x = start[:, None] + tau[None, :] * (end - start)[:, None]
+        if qa is not None:
+            x[sl] = slerp(qa, qb, tau)
+        return x
+
+    return x_fun
+
+
+def _default_control(problem) -> Callable:
+    lo, hi = problem.u_bounds
+    u0 = np.clip(np.zeros(problem.model.nu), lo, hi)
+    return lambda tau: np.repeat(u0[:, None], np.size(tau), axis=1)
+
+
+def _default_T(problem) -> float:
+    if not problem.free_time:
+        return problem.T
+    lo, hi = problem.T
+    return 0.5 * (lo + hi) if math.isfinite(hi) else max(1.0, 2.0 * lo)
+
+
+def _trajectory(value, n: int, key: str, t_grid, t0: float, T: float) -> Callable:
+    """A guess entry as a function of normalized time."""
+    if callable(value):
+        def fun(tau):
+            cols = []
+            for ti in t0 + T * np.asarray(tau, float):
+                v = np.asarray(value(float(ti)), dtype=float).reshape(-1)
+                if v.size != n:
+                    raise ValueError(f"`guess['{key}']` must return shape ({n},), got {v.shape} at t = {ti}")
+                cols.append(v)
+            return np.stack(cols, axis=1) if cols else np.zeros((n, 0))
+        return fun
+    try:
+        a = np.array(value, dtype=float)
+    except (TypeError, ValueError) as exc:
+        raise ValueError(f"`guess['{key}']` must be an array or a callable: {exc}") from None
+    if a.ndim == 1 and a.size == n:
+        return lambda tau: np.repeat(a[:, None], np.size(tau), axis=1)
+    if a.ndim != 2 or a.shape[0] != n:
+        raise ValueError(f"`guess['{key}']` must have shape ({n}, m), ({n},) or be a callable, got {a.shape}")
+    if not np.all(np.isfinite(a)):
+        raise ValueError(f"`guess['{key}']` must be finite")
+    if t_grid is None:
+        tt = np.linspace(0.0, 1.0, a.shape[1]) if a.shape[1] > 1 else np.zeros(1)
+    else:
+        if t_grid.size != a.shape[1]:
+            raise ValueError(f"`guess['{key}']` has {a.shape[1]} columns but `guess['t']` has {t_grid.size} times")
+        tt = (t_grid - t0) / T
+    if a.shape[1] == 1:
+        return lambda tau: np.repeat(a, np.size(tau), axis=1)
+    return lambda tau: np.stack([np.interp(tau, tt, row) for row in a])
+
+
+def _from_mapping(problem, guess: Mapping):
+    unknown = set(guess) - set(_KEYS)
+    if unknown:
+        raise ValueError(f"`guess` has unknown keys {sorted(unknown)}; allowed {_KEYS}")
+    model = problem.model
+    T = _default_T(problem)
+    if "T" in guess:
+        T = float(guess["T"])
+        if not (math.isfinite(T) and T > 0):
+            raise ValueError(f"`guess['T']` must be finite and > 0, got {guess['T']!r}")
+        if not problem.free_time and T != problem.T:
+            raise ValueError(f"`guess['T']` = {T} differs from the fixed horizon T = {problem.T}")
+    t_grid = None
+    if "t" in guess:
+        t_grid = np.asarray(guess["t"], dtype=float).reshape(-1)
+        if t_grid.size < 2 or np.any(np.diff(t_grid) <= 0) or not np.all(np.isfinite(t_grid)):
+            raise ValueError("`guess['t']` must be a strictly increasing array of at least 2 times")
+    t0 = problem.t0
+    x_fun = _default_state(problem)
+    u_fun = _default_control(problem)
+    if "x" in guess:
+        x_fun = _trajectory(guess["x"], model.nx, "x", t_grid, t0, T)
+    if "u" in guess:
+        u_fun = _trajectory(guess["u"], model.nu, "u", t_grid, t0, T)
+    p = np.array(problem.p)
+    if "p" in guess:
+        gp = guess["p"]
+        if isinstance(gp, Mapping):
+            for key, v in gp.items():
+                if key not in model.params:
+                    raise ValueError(f"`guess['p']` names unknown parameter {key!r}")
+                p[model.params.index(key)] = float(v)
+        else:
+            gp = np.asarray(gp, dtype=float).reshape(-1)
+            if gp.size != model.np:
+                raise ValueError(f"`guess['p']` must have shape ({model.np},), got {gp.shape}")
+            free = problem.free_params
+            p[free] = gp[free]
+    return x_fun, u_fun, p, T
+
+
+def _from_solution(problem, sol):
+    model, other = problem.model, sol.problem.model
+    if (other.nx, other.nu, other.np) != (model.nx, model.nu, model.np):
+        raise ValueError(
+            f"`guess` Solution has (nx, nu, np) = {(other.nx, other.nu, other.np)}, the problem "
+            f"{(model.nx, model.nu, model.np)}"
+        )
+    T = float(sol.T) if problem.free_time else problem.T
+
+    def x_fun(tau):
+        return sol.sample(sol.t0 + np.asarray(tau, float) * sol.T)[0]
+
+    def u_fun(tau):
+        return sol.sample(sol.t0 + np.asarray(tau, float) * sol.T)[1]
+
+    p = np.array(problem.p)
+    free = problem.free_params
+    p[free] = np.asarray(sol.p)[free]
+    return x_fun, u_fun, p, T
+
+
+def initial_guess(problem, transcription, mesh, guess=None) -> NodeGuess:
+    """Sample a guess on the nodes of ``transcription`` on ``mesh``.
+
+    Parameters
+    ----------
+    problem : ocp.Problem
+    transcription : ocp.Transcription
+    mesh : ocp.Mesh
+    guess : None, Solution or mapping
+        See the module docstring.
+
+    Returns
+    -------
+    NodeGuess
+
+    Raises
+    ------
+    ValueError
+        Naming ``guess`` (or its key) for a wrong type, shape or unknown key.
+    """
+    from .solution import Solution
+
+    if guess is None:
+        x_fun, u_fun = _default_state(problem), _default_control(problem)
+        p, T = np.array(problem.p), _default_T(problem)
+    elif isinstance(guess, Solution):
+        x_fun, u_fun, p, T = _from_solution(problem, guess)
+    elif isinstance(guess, Mapping):
+        x_fun, u_fun, p, T = _from_mapping(problem, guess)
+    else:
+        raise ValueError(f"`guess` must be None, a Solution or a mapping, got {type(guess).__name__}")
+
+    lo, hi = problem.T_bounds
+    T = float(np.clip(T, max(lo, 1e-300), hi))
+    p = np.clip(p, problem.p_bounds[0], problem.p_bounds[1])
+    tau_x, tau_u = transcription.state_tau(mesh), transcription.control_tau(mesh)
+    X = _clip(x_fun(tau_x), problem.x_bounds)
+    Xu = _clip(x_fun(tau_u), problem.x_bounds)
+    U = _clip(u_fun(tau_u), problem.u_bounds)
+    for col, values in ((0, problem.x_initial), (-1, problem.x_final)):
+        given = ~np.isnan(values)
+        X[given, col] = values[given]
+    if not (np.all(np.isfinite(X)) and np.all(np.isfinite(U)) and np.all(np.isfinite(Xu))):
+        raise ValueError("`guess` produced non-finite values on the nodes")
+    return NodeGuess(X=X, U=U, Xu=Xu, p=p, T=T)

@@ -1,0 +1,81 @@
+"""The collocation mesh: interval breakpoints in normalized time.
+
+Time on the horizon ``[t0, t0 + T]`` is written ``t = t0 + T tau`` with ``tau`` in ``[0, 1]``;
+the mesh holds the breakpoints ``0 = tau_0 < tau_1 < ... < tau_N = 1``. It is independent of
+``T``, so the same mesh serves a free final time, and mesh refinement only changes it.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+__all__ = ["Mesh"]
+
+
+@dataclass(frozen=True, eq=False)
+class Mesh:
+    """Interval breakpoints ``tau`` in normalized time.
+
+    Parameters
+    ----------
+    breaks : array_like, shape (N + 1,)
+        Strictly increasing, ``breaks[0] == 0`` and ``breaks[-1] == 1``.
+
+    Raises
+    ------
+    ValueError
+        If ``breaks`` has fewer than two points, is not strictly increasing, or does not run
+        from 0 to 1.
+    """
+
+    breaks: np.ndarray
+
+    def __post_init__(self):
+        try:
+            b = np.array(self.breaks, dtype=float).reshape(-1)
+        except (TypeError, ValueError) as exc:
+            raise ValueError(f"`mesh` must be an array of breakpoints: {exc}") from None
+        if b.size < 2 or not np.all(np.isfinite(b)):
+            raise ValueError(f"`mesh` must hold at least 2 finite breakpoints, got {b.tolist()}")
+        if b[0] != 0.0 or b[-1] != 1.0 or np.any(np.diff(b) <= 0):
+            raise ValueError(
+                "`mesh` breakpoints must increase strictly from 0 to 1 (normalized time), got "
+                f"{b.tolist()}"
+            )
+        b.setflags(write=False)
+        object.__setattr__(self, "breaks", b)
+
+    @classmethod
+    def uniform(cls, N: int) -> "Mesh":
+        """``N`` equal intervals."""
+        N = _check_N(N)
+        b = np.linspace(0.0, 1.0, N + 1)
+        return cls(b)
+
+    @property
+    def N(self) -> int:
+        """Number of intervals."""
+        return self.breaks.size - 1
+
+    @property
+    def fractions(self) -> np.ndarray:
+        """Interval lengths in normalized time, shape (N,)."""
+        return np.diff(self.breaks)
+
+    def __eq__(self, other) -> bool:
+        return isinstance(other, Mesh) and np.array_equal(self.breaks, other.breaks)
+
+    def __hash__(self) -> int:
+        return hash(self.breaks.tobytes())
+
+    def __repr__(self) -> str:
+        h = self.fractions
+        kind = "uniform" if np.allclose(h, h[0], rtol=1e-12, atol=0) else "non-uniform"
+        return f"Mesh(N={self.N}, {kind})"
+
+
+def _check_N(N) -> int:
+    if isinstance(N, (bool, np.bool_)) or not isinstance(N, (int, np.integer)) or N < 1:
+        raise ValueError(f"`N` (number of mesh intervals) must be an integer >= 1, got {N!r}")
+    return int(N)

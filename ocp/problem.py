@@ -1,0 +1,500 @@
+"""Optimal-control problem statement (no transcription, no solver).
+
+A `Problem` says *what* is optimized: the dynamics (a `dynamics.Model`), the horizon (fixed
+or free final time), bounds, boundary conditions, path constraints and the cost. How it is
+discretized lives in `ocp.transcription`; how it is solved in `ocp.solve`.
+
+The problem, on ``t in [t0, t0 + T]``::
+
+    minimize     phi(x(tf), p, T) + integral_t0^tf L(x, u, p) dt
+    over         x(t), u(t), the free parameters p, and T when it is free
+    subject to   xdot = f(x, u, p)                                  (model.f)
+                 x_lower <= x(t) <= x_upper, u_lower <= u(t) <= u_upper
+                 p_lower <= p <= p_upper,    T_min <= T <= T_max
+                 x(t0)_i = x_initial_i, x(tf)_i = x_final_i          (components given)
+                 lower <= g(x(t), u(t), p) <= upper                  (path constraints)
+                 lower <= c(x(t0), x(tf), p) <= upper                (boundary constraints)
+                 q(tf) = +/- q_final  (or within an angle q_final_tol)  (attitude target)
+
+Quaternion states
+-----------------
+For a model with an attitude (``model.attitude = (iq, iw)``) the quaternion ``q = x[iq:iq+4]``
+has unit norm. The continuous dynamics preserve ``|q|`` exactly, so the norm is imposed at
+``t0`` only: a fully given initial quaternion must have unit norm (to 1e-6; it is then
+normalized), and a free or partly free one gets the constraint ``|q(t0)|^2 = 1``. Imposing
+``|q|^2 = 1`` at every node as well would over-determine the discrete dynamics (collocation
+does not conserve the norm exactly, and the controls cannot steer it), leaving IPOPT an
+inconsistent or degenerate problem. The discrete drift of ``|q|`` is of the order of the
+transcription's error and is reported as `Solution.quaternion_norm_error`.
+
+The terminal attitude target ``q_final`` is met *up to sign* (``q`` and ``-q`` are the same
+attitude) through the three equations ``vec(q_final^* (x) q(tf)) = 0``: the vector part of the
+error quaternion vanishes exactly when ``q(tf)`` is parallel to ``q_final``. Unlike
+``1 - (q_final . q(tf))^2 = 0`` (whose gradient is parallel to that of the norm, violating
+LICQ at the solution), these rows have full rank and are orthogonal to ``q(tf)``. Fixing all
+four quaternion components in ``x_final`` is refused for the same reason (four equations
+for three degrees of freedom): use ``q_final``.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, replace
+from typing import Callable, Mapping, Sequence, Union
+
+import casadi as ca
+import numpy as np
+
+from dynamics.attitude import quat_conj, quat_mul
+from dynamics.model import Model
+
+__all__ = ["Problem", "Constraint"]
+
+FunctionLike = Union[ca.Function, Callable]
+_QUAT_NORM_TOL = 1e-6
+
+
+@dataclass(frozen=True)
+class Constraint:
+    """A vector constraint ``lower <= fun(...) <= upper`` with an optional row scale.
+
+    Parameters
+    ----------
+    fun : casadi.Function or callable
+        Path constraints: ``g(x, u, p)``; boundary constraints: ``c(x0, xf, p)``. A callable
+        is called once with CasADi SX symbols of those sizes and must return an expression.
+        The output (any shape) is flattened column-major to ``m`` rows.
+    lower, upper : float or array_like, shape (m,)
+        Bounds (``-inf``/``inf`` for none). Defaults: ``g <= 0``.
+    scale : float or array_like, shape (m,), optional
+        Typical magnitude of each row (the NLP uses ``g / scale``); by default chosen from the
+        gradient at the initial guess (see `ocp.scaling`).
+    name : str, optional
+        Label used in messages.
+    """
+
+    fun: FunctionLike
+    lower: object = -math.inf
+    upper: object = 0.0
+    scale: object = None
+    name: str = ""
+
+    @property
+    def size(self) -> int:
+        """Number of rows ``m`` (after `Problem` normalized it)."""
+        return int(np.size(self.lower))
+
+
+def _as_vector(value, n: int, argname: str, *, allow_nan=False) -> np.ndarray:
+    try:
+        a = np.array(value, dtype=float)
+    except (TypeError, ValueError) as exc:
+        raise ValueError(f"`{argname}` must be numeric: {exc}") from None
+    if a.ndim == 0:
+        a = np.full(n, float(a))
+    a = a.reshape(-1) if a.ndim == 1 or a.size == n else a
+    if a.shape != (n,):
+        raise ValueError(f"`{argname}` must have shape ({n},), got {np.shape(value)}")
+    if not allow_nan and np.any(np.isnan(a)):
+        raise ValueError(f"`{argname}` must not contain NaN, got {a.tolist()}")
+    return a
+
+
+def _index(names: tuple[str, ...], key, argname: str) -> int:
+    if key not in names:
+        raise ValueError(f"`{argname}` names unknown component {key!r}; expected one of {names}")
+    return names.index(key)
+
+
+def _values(arg, names: tuple[str, ...], argname: str) -> np.ndarray:
+    """Boundary values: mapping name -> value (others free), or array with NaN = free."""
+    n = len(names)
+    out = np.full(n, np.nan)
+    if arg is None:
+        return out
+    if isinstance(arg, Mapping):
+        for key, value in arg.items():
+            i = _index(names, key, argname)
+            if value is None:
+                continue
+            v = float(value)
+            if not math.isfinite(v):
+                raise ValueError(f"`{argname}`[{key!r}] must be finite or None, got {value!r}")
+            out[i] = v
+        return out
+    if isinstance(arg, (list, tuple)):
+        arg = [np.nan if v is None else v for v in arg]
+    a = _as_vector(arg, n, argname, allow_nan=True)
+    if np.any(np.isinf(a)):
+        raise ValueError(f"`{argname}` must be finite (NaN or None marks a free component), got {a.tolist()}")
+    return a
+
+
+def _bounds(arg, names: tuple[str, ...], argname: str) -> np.ndarray:
+    """Bounds: mapping name -> (lo, hi), or a pair (lower (n,), upper (n,)). Shape (2, n)."""
+    n = len(names)
+    out = np.array([np.full(n, -np.inf), np.full(n, np.inf)])
+    if arg is None:
+        return out
+    if isinstance(arg, Mapping):
+        for key, pair in arg.items():
+            i = _index(names, key, argname)
+            try:
+                lo, hi = pair
+            except (TypeError, ValueError):
+                raise ValueError(f"`{argname}`[{key!r}] must be a pair (lower, upper), got {pair!r}") from None
+            out[0, i] = -np.inf if lo is None else float(lo)
+            out[1, i] = np.inf if hi is None else float(hi)
+    else:
+        try:
+            lo, hi = arg
+        except (TypeError, ValueError):
+            raise ValueError(
+                f"`{argname}` must be a mapping name -> (lower, upper) or a pair (lower, upper) "
+                f"of arrays of shape ({n},)"
+            ) from None
+        lo = -np.inf if lo is None else lo
+        hi = np.inf if hi is None else hi
+        out[0] = _as_vector(lo, n, f"{argname}[0]")
+        out[1] = _as_vector(hi, n, f"{argname}[1]")
+    if np.any(np.isnan(out)):
+        raise ValueError(f"`{argname}` must not contain NaN")
+    bad = np.flatnonzero(out[0] > out[1])
+    if bad.size:
+        raise ValueError(
+            f"`{argname}`: lower bound exceeds upper bound for {[names[i] for i in bad]}: "
+            f"{out[0, bad].tolist()} > {out[1, bad].tolist()}"
+        )
+    out.setflags(write=False)
+    return out
+
+
+def _canonical(fun, inputs: Sequence[tuple[str, int]], out_name: str, argname: str, *,
+               scalar: bool = False) -> ca.Function:
+    """A user Function or callable as a named-I/O Function with one flattened output."""
+    names = [n for n, _ in inputs]
+    sizes = [s for _, s in inputs]
+    signature = f"({', '.join(f'{n} ({s},)' for n, s in inputs)})"
+    if isinstance(fun, ca.Function):
+        if fun.n_in() != len(inputs) or fun.n_out() < 1:
+            raise ValueError(
+                f"`{argname}` must be a casadi.Function of {signature}, got "
+                f"{fun.n_in()} inputs {tuple(fun.name_in())}"
+            )
+        for i, (n, s) in enumerate(inputs):
+            if fun.numel_in(i) != s:
+                raise ValueError(
+                    f"`{argname}`: input {i} ({fun.name_in(i)!r}) must have {s} elements "
+                    f"(the {n} of the problem), got {fun.numel_in(i)}; expected {signature}"
+                )
+        call = lambda *a: fun(*[ca.reshape(ai, fun.size_in(i)) for i, ai in enumerate(a)])  # noqa: E731
+    elif callable(fun):
+        call = fun
+    else:
+        raise ValueError(f"`{argname}` must be a casadi.Function or a callable of {signature}, "
+                         f"got {type(fun).__name__}")
+    last_error = None
+    for sym in (ca.SX, ca.MX):  # SX when the function allows it (cheaper), else MX
+        syms = [sym.sym(n, s) for n, s in zip(names, sizes)]
+        try:
+            out = call(*syms)
+        except Exception as exc:  # noqa: BLE001 - retried with MX, then reported
+            last_error = exc
+            continue
+        if isinstance(out, (list, tuple)):
+            out = out[0]
+        if isinstance(out, (int, float, np.ndarray)):
+            out = sym(ca.DM(np.asarray(out, dtype=float)))
+        out = ca.vec(out)
+        if scalar and out.numel() != 1:
+            raise ValueError(f"`{argname}` must return a scalar, got shape {out.shape}")
+        return ca.Function(argname, syms, [out], names, [out_name])
+    raise ValueError(f"`{argname}` could not be evaluated on symbols of {signature}: {last_error}")
+
+
+@dataclass(frozen=True, eq=False)
+class Problem:
+    """Statement of an optimal-control problem (immutable, validated on creation).
+
+    Parameters
+    ----------
+    model : dynamics.Model
+        Dynamics ``xdot = f(x, u, p)``.
+    T : float or tuple (T_min, T_max) [s]
+        Horizon length ``tf - t0``: fixed (``T > 0``), or free within ``0 <= T_min < T_max``
+        (``T_max`` may be ``inf``). Stored as given: a float, or a tuple of two floats.
+    x_initial, x_final : mapping of str to float, or array_like, shape (nx,), optional
+        Boundary values of the states at ``t0`` and ``tf``. A mapping gives values by state
+        name, unlisted states are free; an array marks free components by NaN or None.
+        Stored as arrays of shape (nx,) with NaN for free components.
+    x_bounds, u_bounds : mapping of str to (lower, upper), or (lower, upper), optional
+        Bounds on states (at every state node) and controls (at every control node); by name
+        or as two arrays of shape (nx,)/(nu,); ``None``/``inf`` for none. Stored as arrays of
+        shape (2, nx) and (2, nu).
+    p : mapping of str to float, or array_like, shape (np,), optional
+        Parameter values: the value of every fixed parameter and the initial guess of the
+        free ones. Defaults to ``model.p_default``. Stored as shape (np,).
+    p_bounds : mapping of str to (lower, upper), or (lower, upper) arrays of shape (np,), optional
+        Parameters listed in the mapping are optimized (static parameters) within their
+        bounds; all others are fixed at ``p``. In the array form, components with
+        ``lower == upper`` are fixed (at ``p``). Stored as shape (2, np), fixed ones with
+        ``lower == upper == p``.
+    lagrange : casadi.Function or callable, optional
+        Running cost ``L(x, u, p)`` (scalar) [cost/s].
+    mayer : casadi.Function or callable, optional
+        Terminal cost ``phi(xf, p, T)`` (scalar). ``mayer=lambda xf, p, T: T`` is minimum time.
+    path : Constraint, casadi.Function, callable, or a sequence of them
+        Path constraints ``g(x, u, p)``; a bare Function/callable means ``g <= 0``.
+        Imposed at the control nodes of the transcription.
+    boundary : Constraint, casadi.Function, callable, or a sequence of them
+        Boundary constraints ``c(x0, xf, p)``; a bare Function/callable means ``c = 0``.
+    q_final : array_like, shape (4,), optional
+        Target attitude (scalar-last unit quaternion) at ``tf``, met up to sign. Needs
+        ``model.attitude``. Normalized on input (its norm must be 1 to 1e-6).
+    q_final_tol : float, optional [rad]
+        Pointing tolerance: ``0`` (default) imposes ``q(tf) = +/- q_final`` exactly (three
+        equations); ``0 < tol < pi`` lets the final attitude lie within a rotation angle
+        ``tol`` of the target (one inequality ``|vec(q_final^* (x) q(tf))|^2 <= sin^2(tol/2)``).
+    t0 : float, optional [s]
+        Initial time (the dynamics are time-invariant; ``t0`` only offsets output times).
+    name : str, optional
+
+    Raises
+    ------
+    TypeError
+        If ``model`` is not a `dynamics.Model`.
+    ValueError
+        Naming the argument: wrong shapes or unknown names, lower > upper, a bad horizon
+        ``T``, boundary values outside the bounds, functions of the wrong signature,
+        ``q_final`` without an attitude or not of unit norm, a non-unit fixed initial
+        quaternion, all four final quaternion components fixed (use ``q_final``).
+
+    Notes
+    -----
+    Quaternion norm handling and the sign-free attitude target are described in the module
+    docstring of `ocp.problem`.
+    """
+
+    model: Model
+    T: object
+    x_initial: object = None
+    x_final: object = None
+    x_bounds: object = None
+    u_bounds: object = None
+    p: object = None
+    p_bounds: object = None
+    lagrange: object = None
+    mayer: object = None
+    path: object = ()
+    boundary: object = ()
+    q_final: object = None
+    q_final_tol: float = 0.0
+    t0: float = 0.0
+    name: str = "ocp"
+
+    def __post_init__(self):
+        model = self.model
+        if not isinstance(model, Model):
+            raise TypeError(f"`model` must be a dynamics.Model, got {type(model).__name__}")
+        put = lambda k, v: object.__setattr__(self, k, v)  # noqa: E731
+        nx, nu, np_ = model.nx, model.nu, model.np
+
+        # horizon
+        T = self.T
+        if isinstance(T, (tuple, list, np.ndarray)):
+            if len(T) != 2:
+                raise ValueError(f"`T` must be a float or a pair (T_min, T_max), got {T!r}")
+            lo, hi = float(T[0]), float(T[1])
+            if not (math.isfinite(lo) and lo >= 0 and hi > lo) or math.isnan(hi):
+                raise ValueError(f"`T` bounds must satisfy 0 <= T_min < T_max, got ({lo}, {hi})")
+            put("T", (lo, hi))
+        else:
+            try:
+                T = float(T)
+            except (TypeError, ValueError):
+                raise ValueError(f"`T` must be a float or a pair (T_min, T_max), got {T!r}") from None
+            if not (math.isfinite(T) and T > 0):
+                raise ValueError(f"`T` (horizon length) must be finite and > 0, got {T}")
+            put("T", T)
+        t0 = float(self.t0)
+        if not math.isfinite(t0):
+            raise ValueError(f"`t0` must be finite, got {self.t0}")
+        put("t0", t0)
+
+        # bounds and boundary values
+        xb = _bounds(self.x_bounds, model.states, "x_bounds")
+        ub = _bounds(self.u_bounds, model.controls, "u_bounds")
+        put("x_bounds", xb)
+        put("u_bounds", ub)
+        for argname in ("x_initial", "x_final"):
+            v = _values(getattr(self, argname), model.states, argname)
+            given = ~np.isnan(v)
+            out = given & ((v < xb[0]) | (v > xb[1]))
+            if np.any(out):
+                i = np.flatnonzero(out)
+                raise ValueError(
+                    f"`{argname}` lies outside `x_bounds` for {[model.states[j] for j in i]}: "
+                    f"{v[i].tolist()} not in [{xb[0, i].tolist()}, {xb[1, i].tolist()}]"
+                )
+            put(argname, v)
+
+        # parameters
+        if self.p is None:
+            p = np.array(model.p_default, dtype=float)
+        elif isinstance(self.p, Mapping):
+            p = np.array(model.p_default, dtype=float)
+            for key, value in self.p.items():
+                p[_index(model.params, key, "p")] = float(value)
+        else:
+            p = _as_vector(self.p, np_, "p")
+        if not np.all(np.isfinite(p)):
+            raise ValueError(f"`p` must be finite, got {p.tolist()}")
+        pb = np.array(_bounds(self.p_bounds, model.params, "p_bounds"))
+        if isinstance(self.p_bounds, Mapping):
+            listed = np.zeros(np_, bool)
+            for key in self.p_bounds:
+                listed[model.params.index(key)] = True
+            fixed = ~listed
+        else:  # a pair of arrays: components with lower == upper are fixed at `p`
+            fixed = pb[0] == pb[1]
+        pb[0, fixed] = p[fixed]
+        pb[1, fixed] = p[fixed]
+        outside = (p < pb[0]) | (p > pb[1])
+        if np.any(outside):
+            i = np.flatnonzero(outside)
+            raise ValueError(f"`p` lies outside `p_bounds` for {[model.params[j] for j in i]}")
+        p.setflags(write=False)
+        pb.setflags(write=False)
+        put("p", p)
+        put("p_bounds", pb)
+
+        # cost and constraints
+        xs, us, ps = ("x", nx), ("u", nu), ("p", np_)
+        if self.lagrange is not None:
+            put("lagrange", _canonical(self.lagrange, [xs, us, ps], "L", "lagrange", scalar=True))
+        if self.mayer is not None:
+            put("mayer", _canonical(self.mayer, [("xf", nx), ps, ("T", 1)], "phi", "mayer",
+                                    scalar=True))
+        put("path", self._constraints(self.path, "path", [xs, us, ps], (-math.inf, 0.0)))
+        put("boundary", self._constraints(self.boundary, "boundary",
+                                          [("x0", nx), ("xf", nx), ps], (0.0, 0.0)))
+
+        # attitude
+        self._check_attitude(put)
+
+        for argname in ("x_initial", "x_final"):
+            getattr(self, argname).setflags(write=False)
+
+    # ------------------------------------------------------------------ helpers
+    @staticmethod
+    def _constraints(arg, argname, inputs, default_bounds) -> tuple[Constraint, ...]:
+        if arg is None:
+            return ()
+        items = list(arg) if isinstance(arg, (list, tuple)) else [arg]
+        out = []
+        for j, item in enumerate(items):
+            label = f"{argname}[{j}]" if isinstance(arg, (list, tuple)) else argname
+            if isinstance(item, Constraint):
+                con = item
+            else:
+                con = Constraint(item, *default_bounds)
+            fun = _canonical(con.fun, inputs, "g" if argname == "path" else "c", label)
+            m = fun.numel_out(0)
+            if m == 0:
+                raise ValueError(f"`{label}` returns no rows")
+            lo = _as_vector(con.lower, m, f"{label}.lower")
+            hi = _as_vector(con.upper, m, f"{label}.upper")
+            if np.any(lo > hi):
+                raise ValueError(f"`{label}`: lower bound exceeds upper bound ({lo.tolist()} > {hi.tolist()})")
+            if np.all(np.isinf(lo)) and np.all(np.isinf(hi)):
+                raise ValueError(f"`{label}` has no finite bound")
+            scale = None
+            if con.scale is not None:
+                scale = _as_vector(con.scale, m, f"{label}.scale")
+                if not np.all(np.isfinite(scale) & (scale > 0)):
+                    raise ValueError(f"`{label}.scale` must be finite and > 0, got {scale.tolist()}")
+                scale.setflags(write=False)
+            lo.setflags(write=False)
+            hi.setflags(write=False)
+            out.append(Constraint(fun, lo, hi, scale, con.name or label))
+        return tuple(out)
+
+    def _check_attitude(self, put):
+        model = self.model
+        if self.q_final is not None:
+            if model.attitude is None:
+                raise ValueError("`q_final` needs a model with an attitude (`model.attitude` is None)")
+            q = _as_vector(self.q_final, 4, "q_final")
+            n = float(np.linalg.norm(q))
+            if not (np.all(np.isfinite(q)) and abs(n - 1.0) <= _QUAT_NORM_TOL):
+                raise ValueError(f"`q_final` must be a unit quaternion (norm within {_QUAT_NORM_TOL} of 1), "
+                                 f"got norm {n}")
+            q = q / n
+            q.setflags(write=False)
+            put("q_final", q)
+        tol = self.q_final_tol
+        if isinstance(tol, bool) or not isinstance(tol, (int, float, np.floating)) or not 0 <= tol < math.pi:
+            raise ValueError(f"`q_final_tol` must be an angle in [0, pi) [rad], got {tol!r}")
+        put("q_final_tol", float(tol))
+        if tol > 0 and self.q_final is None:
+            raise ValueError("`q_final_tol` needs a `q_final`")
+        if model.attitude is None:
+            return
+        iq = model.attitude[0]
+        sl = slice(iq, iq + 4)
+        q0 = np.array(self.x_initial)
+        if not np.any(np.isnan(q0[sl])):
+            n = float(np.linalg.norm(q0[sl]))
+            if abs(n - 1.0) > _QUAT_NORM_TOL:
+                raise ValueError(
+                    f"`x_initial`: the initial quaternion {model.states[sl]} must have unit norm "
+                    f"(within {_QUAT_NORM_TOL}), got norm {n}"
+                )
+            q0[sl] = q0[sl] / n
+            put("x_initial", q0)
+        if not np.any(np.isnan(self.x_final[sl])):
+            raise ValueError(
+                f"`x_final` fixes all four quaternion components {model.states[sl]}: four "
+                "equations for three attitude degrees of freedom make the NLP degenerate "
+                "(the discrete dynamics conserve |q| only approximately). Give the target "
+                "attitude as `q_final=` (met up to sign, three equations) instead."
+            )
+
+    # --------------------------------------------------------------- properties
+    @property
+    def free_time(self) -> bool:
+        """Whether the horizon length ``T`` is optimized."""
+        return isinstance(self.T, tuple)
+
+    @property
+    def T_bounds(self) -> tuple[float, float]:
+        """``(T_min, T_max)``; equal for a fixed horizon."""
+        return self.T if self.free_time else (self.T, self.T)
+
+    @property
+    def free_params(self) -> np.ndarray:
+        """Indices of the optimized parameters, shape (k,)."""
+        return np.flatnonzero(self.p_bounds[0] < self.p_bounds[1])
+
+    @property
+    def quaternion_norm_at_t0(self) -> bool:
+        """Whether the NLP needs ``|q(t0)|^2 = 1`` (attitude model, initial quaternion not given)."""
+        if self.model.attitude is None:
+            return False
+        iq = self.model.attitude[0]
+        return bool(np.any(np.isnan(self.x_initial[iq:iq + 4])))
+
+    def attitude_error(self, qf):
+        """Vector part of ``q_final^* (x) qf`` (zero iff ``qf = +/- q_final``), shape (3,).
+
+        Parameters
+        ----------
+        qf : casadi 4x1 or array_like, shape (4,)
+        """
+        if self.q_final is None:
+            raise ValueError("this problem has no `q_final`")
+        qt = ca.DM(self.q_final) if isinstance(qf, (ca.SX, ca.MX, ca.DM)) else self.q_final
+        return quat_mul(quat_conj(qt), qf)[0:3]
+
+    def replace(self, **changes) -> "Problem":
+        """A copy with some fields changed (validated again), like `dataclasses.replace`."""
+        return replace(self, **changes)

@@ -1,0 +1,209 @@
+"""Automatic scaling of NLP variables and constraints.
+
+The NLP works with scaled variables ``x = d_x * x_s`` (per state), ``u = d_u * u_s``,
+``p = d_p * p_s`` (free parameters), ``T = d_T * T_s``, and scaled constraint rows
+(defects of state ``i`` divided by ``d_x[i]``; path and boundary rows by their scale), and
+minimizes ``J / d_J``.
+
+Rules (every automatic scale is rounded to a power of two, so scaling and unscaling are exact
+in floating point and fixed boundary values reach IPOPT unchanged):
+
+* states, controls, parameters: ``max(|lower|, |upper|)`` when both bounds are finite
+  (a range the user chose); otherwise the largest magnitude of the initial guess on the
+  nodes (boundary values included); otherwise 1;
+* ``T``: the initial guess of ``T``;
+* path and boundary constraint rows: the largest infinity-norm over the nodes of the row's
+  gradient with respect to the *scaled* variables at the initial guess, so that scaled rows
+  have unit gradients there (clamped to [1e-6, 1e6]; 1 when the gradient vanishes);
+* the objective: 1 (IPOPT's own gradient-based scaling still applies on top).
+
+Overrides: ``scale={'name': value}`` in `ocp.solve` for any state, control or parameter
+name, ``'T'`` and ``'objective'`` (used as given, not rounded); ``Constraint(scale=...)``
+for constraint rows.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Mapping
+
+import casadi as ca
+import numpy as np
+
+__all__ = ["Scaling", "auto_scaling"]
+
+_CLAMP = (1e-6, 1e6)
+
+
+@dataclass(frozen=True, eq=False)
+class Scaling:
+    """Scale factors (typical magnitudes) of the NLP.
+
+    Attributes
+    ----------
+    x : ndarray, shape (nx,) [state units]
+    u : ndarray, shape (nu,) [control units]
+    p : ndarray, shape (np,) [parameter units]
+    T : float [s]
+    objective : float [cost units]
+    path : ndarray, shape (ng,)
+        Rows of all path constraints, concatenated in order.
+    boundary : ndarray, shape (nb,)
+        Rows of all boundary constraints, concatenated.
+    """
+
+    x: np.ndarray
+    u: np.ndarray
+    p: np.ndarray
+    T: float
+    objective: float
+    path: np.ndarray
+    boundary: np.ndarray
+
+
+def _pow2(v: np.ndarray) -> np.ndarray:
+    return np.exp2(np.round(np.log2(v)))
+
+
+def _magnitude(bounds: np.ndarray, samples: np.ndarray) -> np.ndarray:
+    lo, hi = bounds
+    out = np.ones(lo.size)
+    both = np.isfinite(lo) & np.isfinite(hi)
+    span = np.maximum(np.abs(lo), np.abs(hi))
+    out[both & (span > 0)] = span[both & (span > 0)]
+    if samples.size:
+        g = np.max(np.abs(samples), axis=1)
+        use = ~(both & (span > 0)) & (g > 1e-12)
+        out[use] = g[use]
+    return _pow2(out)
+
+
+def _row_scale(jac: np.ndarray) -> np.ndarray:
+    """Largest |entry| of each row over nodes: jac has shape (rows, cols, nodes)."""
+    if jac.size == 0:
+        return np.ones(jac.shape[0])
+    g = np.max(np.abs(jac), axis=(1, 2))
+    out = np.ones_like(g)
+    ok = g > 0
+    out[ok] = _pow2(np.clip(g[ok], *_CLAMP))
+    return out
+
+
+def _concat(constraints, attr):
+    parts = [getattr(c, attr) for c in constraints]
+    return np.concatenate(parts) if parts else np.zeros(0)
+
+
+def auto_scaling(problem, guess, overrides: Mapping | None = None) -> Scaling:
+    """Scale factors from the bounds and the initial guess, with overrides.
+
+    Parameters
+    ----------
+    problem : ocp.Problem
+    guess : ocp.guess.NodeGuess
+    overrides : mapping of str to float, optional
+        Scales by state/control/parameter name, ``'T'``, ``'objective'``.
+
+    Returns
+    -------
+    Scaling
+
+    Raises
+    ------
+    ValueError
+        Naming ``scale``: unknown or ambiguous names, non-positive or non-finite values.
+    """
+    model = problem.model
+    dx = _magnitude(problem.x_bounds, np.concatenate([guess.X, guess.Xu], axis=1))
+    du = _magnitude(problem.u_bounds, guess.U)
+    dp = _magnitude(problem.p_bounds, guess.p[:, None])
+    dT = float(_pow2(np.array([guess.T]))[0])
+    dJ = 1.0
+
+    if overrides is not None:
+        if not isinstance(overrides, Mapping):
+            raise ValueError(f"`scale` must be a mapping name -> scale, got {type(overrides).__name__}")
+        targets = {}
+        for vec, names in ((dx, model.states), (du, model.controls), (dp, model.params)):
+            for i, n in enumerate(names):
+                targets.setdefault(n, []).append((vec, i))
+        for key, value in overrides.items():
+            v = float(value)
+            if not (math.isfinite(v) and v > 0):
+                raise ValueError(f"`scale`[{key!r}] must be finite and > 0, got {value!r}")
+            if key == "T":
+                dT = v
+            elif key == "objective":
+                dJ = v
+            elif key in targets:
+                if len(targets[key]) > 1:
+                    raise ValueError(f"`scale` key {key!r} is ambiguous (several model components share it)")
+                vec, i = targets[key][0]
+                vec[i] = v
+            else:
+                raise ValueError(f"`scale` names unknown variable {key!r}; expected a state, control or "
+                                 "parameter name, 'T' or 'objective'")
+
+    free = problem.free_params
+    dp_free = np.zeros(model.np)
+    dp_free[free] = dp[free]
+    path = _path_scales(problem, guess, dx, du, dp_free)
+    boundary = _boundary_scales(problem, guess, dx, dp_free)
+    return Scaling(x=dx, u=du, p=dp, T=dT, objective=dJ, path=path, boundary=boundary)
+
+
+def _path_scales(problem, guess, dx, du, dp_free) -> np.ndarray:
+    cons = problem.path
+    if not cons:
+        return np.zeros(0)
+    auto = _auto_rows(
+        [c.fun for c in cons],
+        [("x", guess.Xu, dx), ("u", guess.U, du), ("p", guess.p[:, None], dp_free)],
+        guess.U.shape[1],
+    )
+    return _merge(cons, auto)
+
+
+def _boundary_scales(problem, guess, dx, dp_free) -> np.ndarray:
+    cons = problem.boundary
+    if not cons:
+        return np.zeros(0)
+    auto = _auto_rows(
+        [c.fun for c in cons],
+        [("x0", guess.X[:, :1], dx), ("xf", guess.X[:, -1:], dx), ("p", guess.p[:, None], dp_free)],
+        1,
+    )
+    return _merge(cons, auto)
+
+
+def _auto_rows(funs, args, n_nodes) -> np.ndarray:
+    """Row scales of the stacked ``funs`` from gradients w.r.t. scaled arguments."""
+    rows = []
+    for fun in funs:
+        syms = [ca.SX.sym(name, fun.size_in(i)) if _sx(fun) else ca.MX.sym(name, fun.size_in(i))
+                for i, (name, _, _) in enumerate(args)]
+        out = fun(*syms)
+        cols = [ca.jacobian(out, s) @ ca.diag(ca.DM(d)) for s, (_, _, d) in zip(syms, args)]
+        jf = ca.Function("row_gradients", syms, [ca.horzcat(*cols)])
+        vals = [np.broadcast_to(v, (v.shape[0], n_nodes)) if v.shape[1] == 1 else v for _, v, _ in args]
+        J = np.asarray(jf.map(n_nodes)(*vals)) if n_nodes > 1 else np.asarray(jf(*vals))
+        m = fun.numel_out(0)
+        rows.append(_row_scale(J.reshape(m, -1, n_nodes, order="F")))
+    return np.concatenate(rows)
+
+
+def _sx(fun) -> bool:
+    try:
+        fun(*[ca.SX.sym("a", fun.sparsity_in(i)) for i in range(fun.n_in())])
+        return True
+    except Exception:  # noqa: BLE001
+        return False
+
+
+def _merge(cons, auto: np.ndarray) -> np.ndarray:
+    out, k = [], 0
+    for c in cons:
+        m = c.size
+        out.append(np.array(c.scale) if c.scale is not None else auto[k:k + m])
+        k += m
+    return np.concatenate(out)

@@ -1,0 +1,270 @@
+"""The result of `ocp.solve`: a `Solution` in the manner of scipy's ``OdeResult``."""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Mapping
+
+import casadi as ca
+import numpy as np
+
+__all__ = ["Solution", "Propagation"]
+
+
+@dataclass(frozen=True)
+class Propagation:
+    """Re-simulation of a solution's control (see `Solution.propagate`).
+
+    Attributes
+    ----------
+    t : ndarray, shape (n,) [s]
+        The solution's node times.
+    x : ndarray, shape (nx, n)
+        States integrated from ``x[:, 0]`` of the solution under its dense control.
+    error : ndarray, shape (nx,)
+        Largest ``|x_propagated - x_collocated|`` of each state over the nodes [state units]
+        (NaN after a failure).
+    success : bool
+    message : str
+    """
+
+    t: np.ndarray
+    x: np.ndarray
+    error: np.ndarray
+    success: bool
+    message: str
+
+
+class _Dense:
+    """Interval data and the transcription's interpolant (dense solution)."""
+
+    def __init__(self, transcription, mesh, model, X, U, p, T, t0):
+        N = mesh.N
+        tr = transcription
+        m_x, m_u = tr.x_sigma.size, tr.u_sigma.size
+        self.transcription, self.mesh, self.model = tr, mesh, model
+        self.nx, self.nu, self.N, self.m_x, self.m_u = model.nx, model.nu, N, m_x, m_u
+        self.xs = X[:, 0:N * m_x:m_x]
+        self.Xo = X[:, 1:].reshape(model.nx, N, m_x)
+        if tr.u_at_start:
+            self.us, Uo = U[:, 0:N * m_u:m_u], U[:, 1:]
+        else:
+            self.us, Uo = np.zeros((model.nu, N)), U
+        self.Uo = Uo.reshape(model.nu, N, m_u)
+        self.p = p
+        self.h = T * mesh.fractions
+        self.t_breaks = t0 + T * mesh.breaks
+        self.t_breaks[-1] = t0 + T
+        self.interp = tr.interpolant(model.f)
+
+    def eval(self, k: np.ndarray, s: np.ndarray):
+        """``(x (nx, M), u (nu, M))`` in intervals ``k`` at ``sigma = s``."""
+        M = k.size
+        if M == 0:
+            return np.zeros((self.nx, 0)), np.zeros((self.nu, 0))
+        args = [self.xs[:, k], self.Xo[:, k, :].reshape(self.nx, M * self.m_x),
+                self.us[:, k], self.Uo[:, k, :].reshape(self.nu, M * self.m_u),
+                self.h[k][None, :], self.p[:, None], s[None, :]]
+        fun = self.interp.map(M, [False] * 5 + [True, False], [False, False]) if M > 1 else self.interp
+        x, u = fun(*args)
+        return np.asarray(x).reshape(self.nx, M), np.asarray(u).reshape(self.nu, M)
+
+    def locate(self, t: np.ndarray):
+        """Interval index (intervals are ``(t_k, t_k+1]``, ``t0`` in the first) and sigma."""
+        k = np.clip(np.searchsorted(self.t_breaks, t, side="left") - 1, 0, self.N - 1)
+        s = np.clip((t - self.t_breaks[k]) / self.h[k], 0.0, 1.0)
+        return k, s
+
+
+@dataclass(frozen=True, eq=False)
+class Solution:
+    """Outcome of `ocp.solve`.
+
+    Attributes
+    ----------
+    success : bool
+        IPOPT converged (``Solve_Succeeded``, or ``Solved_To_Acceptable_Level``, which the
+        message flags). A failure still carries IPOPT's last iterate.
+    status : str
+        IPOPT's return status (``'Solve_Succeeded'``, ``'Infeasible_Problem_Detected'``,
+        ``'Maximum_Iterations_Exceeded'``, ...).
+    message : str
+        What happened, in words.
+    T : float [s]
+        Horizon length (optimized when free).
+    t0 : float [s]
+    cost : float
+        Objective ``phi + integral L`` of the discrete solution (unscaled).
+    t : ndarray, shape (n,) [s]
+        Node times: ``t0`` and every state or control node of the transcription.
+    x : ndarray, shape (nx, n)
+        States at ``t`` (decision variables where they exist; the transcription's
+        interpolant at the Hermite-Simpson-compressed midpoints).
+    u : ndarray, shape (nu, n)
+        Controls at ``t`` (decision variables where they exist; for Radau at ``t0`` the
+        first interval's control polynomial, extrapolated).
+    p : ndarray, shape (np,)
+        Parameters (optimized ones and fixed ones).
+    iterations : int
+        IPOPT iterations.
+    solve_time : float [s]
+        Wall time of the IPOPT call.
+    build_time : float [s]
+        Wall time spent building the NLP and the solver (0 when reused from the cache).
+    costates : ndarray, shape (nx, n), or None
+        Costate estimates ``lambda(t)`` (``H = L + lambda . f``) at ``t`` from the defect
+        multipliers (Radau only; ``None`` for the other transcriptions).
+    transcription : Transcription
+    mesh : Mesh
+    problem : Problem
+    constraint_violation : float
+        Largest violation of the (scaled) NLP constraints at the returned point.
+    multipliers : mapping of str to ndarray
+        Multipliers of the unscaled constraints by block (``'defect'``, ``'path'``,
+        ``'boundary'``, ``'quat_norm'``, ``'q_final'``), for ``J + nu . g`` (CasADi's sign).
+    """
+
+    success: bool
+    status: str
+    message: str
+    T: float
+    t0: float
+    cost: float
+    t: np.ndarray
+    x: np.ndarray
+    u: np.ndarray
+    p: np.ndarray
+    iterations: int
+    solve_time: float
+    build_time: float
+    costates: np.ndarray | None
+    transcription: object
+    mesh: object
+    problem: object
+    constraint_violation: float
+    multipliers: Mapping[str, np.ndarray]
+    _dense: _Dense = field(repr=False)
+    _lazy: dict = field(default_factory=dict, repr=False)
+
+    def __repr__(self) -> str:
+        return (f"Solution(success={self.success}, status={self.status!r}, cost={self.cost:.10g}, "
+                f"T={self.T:.10g}, transcription={self.transcription.name!r}, N={self.mesh.N}, "
+                f"iterations={self.iterations}, solve_time={self.solve_time:.3g} s)")
+
+    # ----------------------------------------------------------------- dense
+    def sample(self, t):
+        """States and controls at arbitrary times, interpolated like the transcription.
+
+        Radau: Lagrange polynomials of the interval (degree ``d`` for ``x``, ``d - 1`` for
+        ``u``); trapezoid: linear ``x`` and ``u``; Hermite-Simpson: cubic Hermite ``x``,
+        quadratic ``u``. At a mesh point the interval on the left is used (controls may jump
+        there in Radau).
+
+        Parameters
+        ----------
+        t : float or array_like, shape (m,) [s]
+            Times in ``[t0, t0 + T]``.
+
+        Returns
+        -------
+        x : ndarray, shape (nx,) or (nx, m)
+        u : ndarray, shape (nu,) or (nu, m)
+
+        Raises
+        ------
+        ValueError
+            If ``t`` is not finite or outside the horizon (no extrapolation).
+        """
+        tq = np.asarray(t, dtype=float)
+        scalar = tq.ndim == 0
+        tq = tq.reshape(-1)
+        if not np.all(np.isfinite(tq)):
+            raise ValueError("`t` must be finite")
+        lo, hi = self.t0, self.t0 + self.T
+        slack = 1e-12 * max(abs(lo), abs(hi), self.T)
+        if tq.size and (tq.min() < lo - slack or tq.max() > hi + slack):
+            raise ValueError(f"`t` must lie in the horizon [{lo}, {hi}], got [{tq.min()}, {tq.max()}]")
+        k, s = self._dense.locate(tq)
+        x, u = self._dense.eval(k, s)
+        return (x[:, 0], u[:, 0]) if scalar else (x, u)
+
+    # ----------------------------------------------------------- diagnostics
+    @property
+    def quaternion_norm_error(self) -> float | None:
+        """``max | |q| - 1 |`` over the nodes (attitude models), else ``None``."""
+        att = self.problem.model.attitude
+        if att is None:
+            return None
+        q = self.x[att[0]:att[0] + 4]
+        return float(np.max(np.abs(np.linalg.norm(q, axis=0) - 1.0)))
+
+    def propagate(self, *, rtol: float = 1e-12, atol: float = 1e-12) -> Propagation:
+        """Re-simulate the dense control from the initial state with CVODES.
+
+        The control is the transcription's own interpolant (as in `sample`): polynomial
+        within each mesh interval, possibly jumping at the mesh points (Radau, bang-bang
+        solutions). Each interval is therefore integrated by a fresh CVODES solve (one
+        CasADi ``mapaccum`` over the intervals, the state handed on), so no integrator steps
+        across a jump. ``rtol``/``atol`` are CVODES' local tolerances: the global integration
+        error is typically 10-100x larger, still far below the collocation errors this is
+        meant to reveal.
+
+        Parameters
+        ----------
+        rtol, atol : float
+            CVODES tolerances, in (0, 1).
+
+        Returns
+        -------
+        Propagation
+            ``success=False`` (with NaN states) if CVODES fails; never raises for that.
+        """
+        for name, v in (("rtol", rtol), ("atol", atol)):
+            if isinstance(v, bool) or not (isinstance(v, (int, float)) and 0 < v < 1):
+                raise ValueError(f"`{name}` must be a float in (0, 1), got {v!r}")
+        d = self._dense
+        model = self.problem.model
+        nx, nu = model.nx, model.nu
+        sigma = self.transcription.node_sigma
+        sym = ca.SX if d.interp.is_a("SXFunction") else ca.MX
+        x, s = sym.sym("x", nx), sym.sym("s")
+        us, U = sym.sym("us", nu), sym.sym("U", nu, d.m_u)
+        h, p = sym.sym("h"), sym.sym("p", model.np)
+        _, u = d.interp(sym.zeros(nx), sym.zeros(nx, d.m_x), us, U, h, p, s)
+        data = ca.vertcat(us, ca.vec(U), h, p)
+        try:
+            integ = ca.integrator("interval", "cvodes",
+                                  {"x": x, "p": data, "t": s, "ode": h * model.f(x, u, p)},
+                                  0.0, [float(v) for v in sigma],
+                                  {"abstol": atol, "reltol": rtol, "max_num_steps": 100000})
+            x0 = ca.MX.sym("x0", nx)
+            dat = ca.MX.sym("data", data.numel())
+            xs = integ(x0=x0, p=dat)["xf"]
+            step = ca.Function("step", [x0, dat], [xs[:, -1], xs])
+            run = step.mapaccum("propagate", d.N)
+            pars = np.concatenate([d.us, _stack_U(d.Uo, np.arange(d.N)), d.h[None, :],
+                                   np.repeat(self.p[:, None], d.N, axis=1)], axis=0)
+            _, xall = run(self.x[:, 0], pars)
+            xp = np.concatenate([self.x[:, :1], np.asarray(xall)], axis=1)
+        except RuntimeError as exc:
+            nan = np.full((nx, self.t.size), np.nan)
+            return Propagation(self.t, nan, np.full(nx, np.nan), False, f"cvodes failed: {exc}")
+        if not np.all(np.isfinite(xp)):
+            return Propagation(self.t, xp, np.full(nx, np.nan), False, "cvodes: non-finite state")
+        err = np.max(np.abs(xp - self.x), axis=1)
+        return Propagation(self.t, xp, err, True, f"cvodes per mesh interval, rtol {rtol:g}, atol {atol:g}")
+
+    @property
+    def propagation_error(self) -> float:
+        """``max |x_propagated - x|`` over states and nodes [mixed state units], from
+        `propagate` with its default tolerances (computed on first access)."""
+        if "propagation" not in self._lazy:
+            self._lazy["propagation"] = self.propagate()
+        err = self._lazy["propagation"].error
+        return float(np.max(err)) if err.size else 0.0
+
+
+def _stack_U(Uo: np.ndarray, k: np.ndarray) -> np.ndarray:
+    """``vec(U_k)`` (column-major, as ``casadi.vec``) of intervals ``k``: shape (nu m_u, len(k))."""
+    nu, _, m_u = Uo.shape
+    blocks = Uo[:, k, :]  # (nu, K, m_u)
+    return blocks.transpose(2, 0, 1).reshape(m_u * nu, k.size)
