@@ -12,6 +12,8 @@ from __future__ import annotations
 
 from .mesh import Mesh
 from .problem import Constraint, Problem
+from .refine import (IntervalErrors, RadauConstantControl, RefinedSolution, RefinementRound,
+                     find_switches, interval_errors, polish_switches, refine, solve_multistart)
 from .scaling import Scaling
 from .solution import Propagation, Solution
 from .solve import Progress, solve
@@ -33,4 +35,13 @@ __all__ = [
     "Radau",
     "TRANSCRIPTIONS",
     "get_transcription",
+    "refine",
+    "solve_multistart",
+    "polish_switches",
+    "RefinedSolution",
+    "RefinementRound",
+    "RadauConstantControl",
+    "IntervalErrors",
+    "interval_errors",
+    "find_switches",
 ]

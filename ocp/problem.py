@@ -38,6 +38,7 @@ for three degrees of freedom): use ``q_final``.
 from __future__ import annotations
 
 import math
+import re
 from dataclasses import dataclass, replace
 from typing import Callable, Mapping, Sequence, Union
 
@@ -207,7 +208,8 @@ def _canonical(fun, inputs: Sequence[tuple[str, int]], out_name: str, argname: s
         out = ca.vec(out)
         if scalar and out.numel() != 1:
             raise ValueError(f"`{argname}` must return a scalar, got shape {out.shape}")
-        return ca.Function(argname, syms, [out], names, [out_name])
+        fname = re.sub(r"_+", "_", re.sub(r"\W", "_", argname)).strip("_")  # 'path[0]' -> 'path_0'
+        return ca.Function(fname, syms, [out], names, [out_name])
     raise ValueError(f"`{argname}` could not be evaluated on symbols of {signature}: {last_error}")
 
 

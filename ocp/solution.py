@@ -222,22 +222,11 @@ class Solution:
             if isinstance(v, bool) or not (isinstance(v, (int, float)) and 0 < v < 1):
                 raise ValueError(f"`{name}` must be a float in (0, 1), got {v!r}")
         d = self._dense
-        model = self.problem.model
-        nx, nu = model.nx, model.nu
-        sigma = self.transcription.node_sigma
-        sym = ca.SX if d.interp.is_a("SXFunction") else ca.MX
-        x, s = sym.sym("x", nx), sym.sym("s")
-        us, U = sym.sym("us", nu), sym.sym("U", nu, d.m_u)
-        h, p = sym.sym("h"), sym.sym("p", model.np)
-        _, u = d.interp(sym.zeros(nx), sym.zeros(nx, d.m_x), us, U, h, p, s)
-        data = ca.vertcat(us, ca.vec(U), h, p)
+        nx = self.problem.model.nx
         try:
-            integ = ca.integrator("interval", "cvodes",
-                                  {"x": x, "p": data, "t": s, "ode": h * model.f(x, u, p)},
-                                  0.0, [float(v) for v in sigma],
-                                  {"abstol": atol, "reltol": rtol, "max_num_steps": 100000})
+            integ = interval_integrator(self, self.transcription.node_sigma, rtol, atol)
             x0 = ca.MX.sym("x0", nx)
-            dat = ca.MX.sym("data", data.numel())
+            dat = ca.MX.sym("data", integ.numel_in("p"))
             xs = integ(x0=x0, p=dat)["xf"]
             step = ca.Function("step", [x0, dat], [xs[:, -1], xs])
             run = step.mapaccum("propagate", d.N)
@@ -261,6 +250,27 @@ class Solution:
             self._lazy["propagation"] = self.propagate()
         err = self._lazy["propagation"].error
         return float(np.max(err)) if err.size else 0.0
+
+
+def interval_integrator(sol: "Solution", grid, rtol: float, atol: float) -> ca.Function:
+    """CVODES over one mesh interval in normalized time ``s in [0, 1]`` under the solution's
+    own control polynomial, with outputs at the normalized times ``grid``.
+
+    Inputs ``x0`` (nx,) and ``p`` = ``[u_start, vec(U_interval), h, p_model]``; output ``xf``
+    (nx, len(grid)). Shared by `Solution.propagate` and mesh refinement (`ocp.refine`).
+    """
+    d = sol._dense
+    model = sol.problem.model
+    nx, nu = model.nx, model.nu
+    sym = ca.SX if d.interp.is_a("SXFunction") else ca.MX
+    x, s = sym.sym("x", nx), sym.sym("s")
+    us, U = sym.sym("us", nu), sym.sym("U", nu, d.m_u)
+    h, p = sym.sym("h"), sym.sym("p", model.np)
+    _, u = d.interp(sym.zeros(nx), sym.zeros(nx, d.m_x), us, U, h, p, s)
+    data = ca.vertcat(us, ca.vec(U), h, p)
+    return ca.integrator("interval", "cvodes", {"x": x, "p": data, "t": s, "ode": h * model.f(x, u, p)},
+                         0.0, [float(v) for v in grid],
+                         {"abstol": atol, "reltol": rtol, "max_num_steps": 100000})
 
 
 def _stack_U(Uo: np.ndarray, k: np.ndarray) -> np.ndarray:

@@ -163,3 +163,17 @@ def test_bad_solve_arguments_raise_naming_argument(kw, name, exc):
 def test_solve_needs_a_problem():
     with pytest.raises(TypeError, match="`problem`"):
         solve("problem")
+
+
+def test_several_path_constraints_are_accepted():
+    """A sequence of constraints gets per-item labels; they must be valid Function names."""
+    import casadi as ca
+
+    from dynamics import rigid_body
+    from ocp import Problem
+
+    x, u, p = ca.SX.sym("x", 7), ca.SX.sym("u", 3), ca.SX.sym("p", 0)
+    g1 = ca.Function("g1", [x, u, p], [ca.sumsqr(u) - 1])
+    prob = Problem(rigid_body([1.0, 1.0, 1.0]), T=1.0, x_initial=[0, 0, 0, 1, 0, 0, 0],
+                   path=(g1, lambda x, u, p: x[4] - 1.0))
+    assert len(prob.path) == 2

@@ -51,3 +51,29 @@ def test_bad_input_exits_with_message(args, message, capsys):
         main(["simulate", "torque-free", *args])
     assert exc.value.code == 2
     assert message in capsys.readouterr().err
+
+
+def test_slew_min_effort_cli(tmp_path, capsys):
+    out = tmp_path / "slew.json"
+    code = main(["slew", "--inertia", "2,3,4", "--axis", "1,0,0", "--angle", "57.29577951308232",
+                 "--min-effort", "2", "--json", str(out), "--quiet"])
+    assert code == 0
+    assert "maneuver time T" in capsys.readouterr().out
+    data = json.loads(out.read_text())
+    assert data["cost"] == pytest.approx(6 * 2.0**2 / 2.0**3, rel=1e-7)  # 6 J^2 theta^2 / T^3
+
+
+@pytest.mark.parametrize(
+    "args, message",
+    [
+        (["--inertia", "1,1,1", "--axis", "0,0,1", "--time-optimal"], "--angle"),
+        (["--inertia", "1,1,1", "--axis", "0,0,1", "--angle", "90"], "one of the arguments"),
+        (["--inertia", "1,1,1", "--axis", "0,0,1", "--angle", "90", "--min-effort", "-2"],
+         "positive"),
+    ],
+)
+def test_slew_bad_input(args, message, capsys):
+    with pytest.raises(SystemExit) as exc:
+        main(["slew", *args])
+    assert exc.value.code == 2
+    assert message in capsys.readouterr().err

@@ -1,0 +1,487 @@
+"""Optimal attitude slews of a rigid body: time-optimal and minimum-effort.
+
+Both build an `ocp.Problem` on `dynamics.rigid_body` (state ``[q1..q4, w1..w3]``, control
+body torque) and return an `ocp.Solution`:
+
+* `time_optimal` minimizes the final time under per-axis torque bounds ``|u_i| <= u_max_i``
+  or a norm bound ``|u| <= u_max``. Time-optimal slews have local optima (the eigenaxis
+  maneuver is one, Bilimoria & Wie 1993), so without a user guess it solves from several
+  seeded guesses (the eigenaxis SLERP and SLERPs tilted by a sinusoidal rotation about
+  seeded random axes), keeps the best, and polishes the bang-bang switch times
+  (`ocp.polish_switches`).
+* `min_effort` minimizes ``1/2 integral |u|^2 dt`` over a fixed time, refined until the
+  re-integrated trajectory matches the collocated one (`ocp.refine`).
+
+The target attitude is ``qf`` or a rotation by ``angle`` about ``axis`` (body frame at the
+start) from ``q0``; it is met up to sign (``q`` and ``-q`` are the same attitude). End rates
+default to rest. An optional keep-out cone keeps a body-fixed boresight more than a given
+angle away from an inertial direction throughout.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import casadi as ca
+import numpy as np
+
+from dynamics import rigid_body
+from dynamics.attitude import (dcm_from_quat, quat_conj, quat_from_axis_angle, quat_mul,
+                               quat_normalize, rotation_angle)
+from dynamics.rigid_body import check_inertia
+from ocp import Problem, Solution, polish_switches, refine, solve, solve_multistart
+from ocp.guess import slerp
+
+__all__ = ["KeepOut", "slew_problem", "time_optimal", "min_effort", "eigenaxis_time",
+           "switch_times", "attitude_guess"]
+
+
+@dataclass(frozen=True)
+class KeepOut:
+    """Keep-out cone: ``angle(A(q)^T boresight, direction) >= half_angle`` at all times.
+
+    Parameters
+    ----------
+    boresight : array_like, shape (3,) — body-fixed unit vector (normalized here)
+    direction : array_like, shape (3,) — inertial unit vector to avoid, e.g. the Sun
+    half_angle : float [rad] — in (0, pi)
+    """
+
+    boresight: tuple
+    direction: tuple
+    half_angle: float
+
+    def __post_init__(self):
+        for name in ("boresight", "direction"):
+            v = np.asarray(getattr(self, name), dtype=float).reshape(-1)
+            if v.shape != (3,) or not np.all(np.isfinite(v)) or np.linalg.norm(v) == 0:
+                raise ValueError(f"KeepOut `{name}` must be a finite non-zero 3-vector, got {v}")
+            object.__setattr__(self, name, tuple(v / np.linalg.norm(v)))
+        a = float(self.half_angle)
+        if not (0 < a < math.pi):
+            raise ValueError(f"KeepOut `half_angle` must be in (0, pi) rad, got {a}")
+        object.__setattr__(self, "half_angle", a)
+
+    def margin(self, q) -> np.ndarray:
+        """``cos(half_angle) - cos(angle)``: >= 0 where the constraint holds. ``q`` (4,) or (4, n)."""
+        A = dcm_from_quat(np.asarray(q, dtype=float))
+        b, s = np.array(self.boresight), np.array(self.direction)
+        # A(q) s: the inertial direction in body axes; its component along the boresight
+        cosang = np.einsum("i,ij...,j->...", b, A, s)
+        return math.cos(self.half_angle) - cosang
+
+    def function(self) -> ca.Function:
+        """Path constraint ``g(x, u, p) = b . A(q) s - cos(half_angle) <= 0``."""
+        x, u, p = ca.SX.sym("x", 7), ca.SX.sym("u", 3), ca.SX.sym("p", 0)
+        g = ca.dot(ca.DM(self.boresight), ca.mtimes(dcm_from_quat(x[:4]), ca.DM(self.direction)))
+        return ca.Function("keep_out", [x, u, p], [g - math.cos(self.half_angle)],
+                           ["x", "u", "p"], ["g"])
+
+
+# ---------------------------------------------------------------------------- inputs
+def _vec3(v, name, default):
+    if v is None:
+        return np.array(default, dtype=float)
+    a = np.asarray(v, dtype=float).reshape(-1)
+    if a.shape != (3,) or not np.all(np.isfinite(a)):
+        raise ValueError(f"`{name}` must be 3 finite numbers, got {v!r}")
+    return a
+
+
+def _unit_quat(q, name):
+    a = np.asarray(q, dtype=float).reshape(-1)
+    if a.shape != (4,) or not np.all(np.isfinite(a)):
+        raise ValueError(f"`{name}` must be 4 finite numbers (scalar-last quaternion), got {q!r}")
+    n = np.linalg.norm(a)
+    if abs(n - 1) > 1e-6:
+        raise ValueError(f"`{name}` must be a unit quaternion (norm 1 to 1e-6), got norm {n:.9g}")
+    return a / n
+
+
+def _targets(q0, qf, angle, axis):
+    q0 = np.array([0.0, 0.0, 0.0, 1.0]) if q0 is None else _unit_quat(q0, "q0")
+    if qf is not None:
+        if angle is not None or axis is not None:
+            raise ValueError("give either `qf` or `angle` and `axis`, not both")
+        return q0, _unit_quat(qf, "qf")
+    if angle is None or axis is None:
+        raise ValueError("the target needs `qf`, or both `angle` [rad] and `axis` (body frame)")
+    angle = float(angle)
+    if not math.isfinite(angle):
+        raise ValueError(f"`angle` must be finite, got {angle}")
+    e = _vec3(axis, "axis", None)
+    if np.linalg.norm(e) == 0:
+        raise ValueError("`axis` must be a non-zero vector")
+    return q0, quat_mul(quat_from_axis_angle(e, angle), q0)
+
+
+def _u_max(u_max):
+    a = np.asarray(u_max, dtype=float).reshape(-1)
+    if a.size == 1:
+        a = np.repeat(a, 3)
+    if a.shape != (3,) or not np.all(np.isfinite(a)) or np.any(a <= 0):
+        raise ValueError(f"`u_max` must be a positive scalar or 3 positive values [N m], got {u_max!r}")
+    return a
+
+
+# --------------------------------------------------------------------------- problem
+def slew_problem(inertia, *, objective, T=None, angle=None, axis=None, q0=None, qf=None,
+                 u_max=1.0, norm_bound=False, w0=None, wf=None, keep_out=None,
+                 T_max=None) -> Problem:
+    """The `ocp.Problem` of a rigid-body slew (shared by `time_optimal` and `min_effort`).
+
+    Parameters
+    ----------
+    inertia : array_like, shape (3, 3) or (3,) [kg m^2]
+    objective : {"time", "effort"}
+        Minimum final time, or minimum ``1/2 integral |u|^2 dt`` [N^2 m^2 s] over fixed ``T``.
+    T : float [s] — horizon for ``"effort"`` (ignored for ``"time"``)
+    angle, axis, q0, qf : see module docstring; ``angle`` [rad], ``axis`` body frame
+    u_max : float or array_like, shape (3,) [N m], or None (unbounded; ``"effort"`` only)
+    norm_bound : bool — bound ``|u| <= u_max`` (scalar ``u_max``) instead of per axis
+    w0, wf : array_like, shape (3,) [rad/s] — end rates (default rest)
+    keep_out : KeepOut, optional
+    T_max : float [s], optional — upper bound of a free final time (default 20x eigenaxis)
+
+    Returns
+    -------
+    ocp.Problem
+    """
+    I = check_inertia(inertia)
+    if objective not in ("time", "effort"):
+        raise ValueError(f"`objective` must be 'time' or 'effort', got {objective!r}")
+    q0, qf = _targets(q0, qf, angle, axis)
+    w0, wf = _vec3(w0, "w0", [0, 0, 0]), _vec3(wf, "wf", [0, 0, 0])
+    if u_max is None:
+        if objective == "time":
+            raise ValueError("a time-optimal slew needs a torque bound `u_max`")
+        u_lim = np.full(3, np.inf)
+    else:
+        u_lim = _u_max(u_max)
+    path = []
+    if norm_bound:
+        if u_max is None or np.ptp(u_lim) != 0:
+            raise ValueError("`norm_bound=True` needs a scalar `u_max`")
+        x, u, p = ca.SX.sym("x", 7), ca.SX.sym("u", 3), ca.SX.sym("p", 0)
+        path.append(ca.Function("torque_norm", [x, u, p], [ca.sumsqr(u) - u_lim[0] ** 2],
+                                ["x", "u", "p"], ["g"]))
+    if keep_out is not None:
+        if not isinstance(keep_out, KeepOut):
+            raise ValueError(f"`keep_out` must be a KeepOut, got {type(keep_out).__name__}")
+        for qq, name in ((q0, "q0"), (qf, "target")):
+            if keep_out.margin(qq) < 0:
+                raise ValueError(f"the {name} attitude already violates the keep-out cone "
+                                 f"(margin {keep_out.margin(qq):.3g})")
+        path.append(keep_out.function())
+    model = rigid_body(I)
+    if objective == "time":
+        T_ref = _rough_time(I, q0, qf, u_lim)
+        horizon = (0.0, float(T_max) if T_max is not None else 20.0 * T_ref)
+        costs = dict(mayer=lambda xf, p, T: T)
+    else:
+        if T is None or not (math.isfinite(float(T)) and float(T) > 0):
+            raise ValueError(f"`T` must be a positive finite horizon [s], got {T!r}")
+        horizon = float(T)
+        x, u, p = ca.SX.sym("x", 7), ca.SX.sym("u", 3), ca.SX.sym("p", 0)
+        costs = dict(lagrange=ca.Function("effort", [x, u, p], [0.5 * ca.sumsqr(u)],
+                                          ["x", "u", "p"], ["L"]))
+    return Problem(
+        model,
+        T=horizon,
+        x_initial=np.r_[q0, w0],
+        x_final=np.r_[[np.nan] * 4, wf],
+        u_bounds=(-u_lim, u_lim),
+        q_final=qf,
+        path=tuple(path),
+        name=f"slew ({objective})",
+        **costs,
+    )
+
+
+def eigenaxis_time(inertia, angle, axis, u_max=1.0) -> float:
+    """Rest-to-rest bang-bang time about a fixed principal axis: ``2 sqrt(angle / alpha)``.
+
+    ``alpha`` is the largest angular acceleration the per-axis bounds allow along the axis,
+    ``min_i u_max_i / |(J e)_i|``. For ``J = E`` and ``|u_i| <= 1`` about a body axis by
+    180 deg this is ``2 sqrt(pi) = 3.5449`` (Bilimoria & Wie's eigenaxis reference).
+
+    Raises
+    ------
+    ValueError
+        If ``axis`` is not a principal axis of ``inertia`` (then the eigenaxis maneuver needs
+        gyroscopic torque and has no such closed form).
+    """
+    I = check_inertia(inertia)
+    e = _vec3(axis, "axis", None)
+    e = e / np.linalg.norm(e)
+    Je = I @ e
+    if np.linalg.norm(Je - (e @ Je) * e) > 1e-9 * np.linalg.norm(Je):
+        raise ValueError(f"`axis` {e} is not a principal axis of `inertia`")
+    u = _u_max(u_max)
+    alpha = np.min(u[np.abs(Je) > 0] / np.abs(Je[np.abs(Je) > 0]))
+    return float(2.0 * math.sqrt(abs(float(angle)) / alpha))
+
+
+def _rough_time(I, q0, qf, u_lim):
+    """Order-of-magnitude slew time: bang-bang about the error axis with the weakest axis."""
+    dq = quat_mul(qf, quat_conj(q0))
+    angle = float(rotation_angle(dq))
+    alpha = np.min(u_lim) / np.max(np.linalg.eigvalsh(I))
+    return max(2.0 * math.sqrt(max(angle, 1e-3) / alpha), 1e-6)
+
+
+# ---------------------------------------------------------------------------- guesses
+def attitude_guess(problem: Problem, *, tilt_axis=None, tilt=0.0, T=None, n=201) -> dict:
+    """A slew guess: SLERP with a smooth-step profile, optionally tilted off the eigenaxis.
+
+    ``q(s) = slerp(q0, qf, 3 s^2 - 2 s^3) (x) rot(tilt_axis, tilt sin(pi s))``: the tilt
+    vanishes at both ends, so boundary values are kept. Rates follow from the quaternion path
+    (``[w, 0] = 2 qdot (x) q^*``), torques from Euler's equations, clipped to the bounds.
+
+    Returns
+    -------
+    dict with keys ``t``, ``x`` (7, n), ``u`` (3, n), ``T`` — accepted by `ocp.solve`
+    """
+    model = problem.model
+    q0 = problem.x_initial[:4]
+    qf = np.array(problem.q_final)
+    if np.dot(qf, q0) < 0:
+        qf = -qf  # the shorter way round
+    if T is None:
+        lo, hi = problem.T_bounds
+        T = problem.T if not problem.free_time else _rough_time(
+            _inertia_of(model), q0, qf, problem.u_bounds[1])
+    s = np.linspace(0.0, 1.0, n)
+    q = slerp(q0, qf, 3 * s**2 - 2 * s**3)
+    if tilt:
+        q = quat_mul(q, quat_from_axis_angle(tilt_axis, tilt * np.sin(np.pi * s)))
+    q = quat_normalize(q)
+    t = s * T
+    qdot = np.gradient(q, t, axis=1, edge_order=2)
+    w = 2.0 * quat_mul(qdot, quat_conj(q))[:3]
+    w[:, 0], w[:, -1] = problem.x_initial[4:], np.nan_to_num(problem.x_final[4:])
+    I = _inertia_of(model)
+    wdot = np.gradient(w, t, axis=1, edge_order=2)
+    u = I @ wdot + np.cross(w.T, (I @ w).T).T
+    u = np.clip(u, problem.u_bounds[0][:, None], problem.u_bounds[1][:, None])
+    return dict(t=t, x=np.vstack([q, w]), u=u, T=float(T))
+
+
+def _inertia_of(model):
+    """Recover the inertia matrix of a rigid-body model from its Jacobian (exact)."""
+    x, u = ca.SX.sym("x", 7), ca.SX.sym("u", 3)
+    J = ca.Function("J", [x, u], [ca.jacobian(model.f(x, u, ca.DM.zeros(0))[4:], u)])
+    return np.linalg.inv(np.array(J(np.r_[0, 0, 0, 1, 0, 0, 0], np.zeros(3))))
+
+
+def _seeded_guesses(problem, starts, seed, *, eigenaxis=True):
+    """The eigenaxis SLERP (optional) and SLERPs tilted about seeded random axes: ``starts``
+    guesses in all."""
+    rng = np.random.default_rng(seed)
+    guesses = [attitude_guess(problem)] if eigenaxis else []
+    while len(guesses) < starts:
+        axis = rng.normal(size=3)
+        guesses.append(attitude_guess(problem, tilt_axis=axis / np.linalg.norm(axis), tilt=1.0))
+    return guesses
+
+
+# ------------------------------------------------------------------------- maneuvers
+def time_optimal(inertia, *, angle=None, axis=None, q0=None, qf=None, u_max=1.0,
+                 norm_bound=False, w0=None, wf=None, keep_out=None, T_max=None, guess=None,
+                 starts=3, seed=0, N=30, transcription="radau", polish=True,
+                 verbose=False, ipopt_options=None) -> Solution:
+    """Minimum-time rigid-body slew under torque bounds.
+
+    Parameters
+    ----------
+    inertia : array_like, shape (3, 3) or (3,) [kg m^2]
+    angle : float [rad], axis : array_like, shape (3,) — rotation from ``q0`` about a body axis
+    q0, qf : array_like, shape (4,) — initial (default identity) and target quaternions
+    u_max : float or array_like, shape (3,) [N m] — per-axis bound (or the norm bound)
+    norm_bound : bool — ``|u| <= u_max`` instead of per-axis bounds
+    w0, wf : array_like, shape (3,) [rad/s] — end rates (default rest to rest)
+    keep_out : KeepOut, optional
+    T_max : float [s], optional — upper bound on the final time
+    guess : None, ocp.Solution or mapping
+        A user guess (then a single start is solved). ``None``: multi-start.
+    starts : int — number of seeded starts without a user guess (eigenaxis + tilted)
+    seed : int — seed of the tilt axes (results are reproducible)
+    N : int — intervals of the first solve
+    transcription : str — of the first solve (any of ``ocp.TRANSCRIPTIONS``)
+    polish : bool — re-solve with free knots so switch times are exact (`ocp.polish_switches`)
+    verbose : bool — IPOPT progress lines
+    ipopt_options : dict, optional
+
+    Returns
+    -------
+    ocp.Solution
+        ``T`` is the optimal time [s]; ``info`` records the starts and the polish.
+    """
+    problem = slew_problem(inertia, objective="time", angle=angle, axis=axis, q0=q0, qf=qf,
+                           u_max=u_max, norm_bound=norm_bound, w0=w0, wf=wf,
+                           keep_out=keep_out, T_max=T_max)
+    opts = dict(transcription=transcription, N=N, verbose=verbose, ipopt_options=ipopt_options)
+    if guess is not None:
+        sol = solve(problem, guess=guess, **opts)
+    else:
+        if int(starts) < 1:
+            raise ValueError(f"`starts` must be at least 1, got {starts}")
+        guesses = _seeded_guesses(problem, int(starts), seed, eigenaxis=keep_out is None)
+        sol = solve_multistart(problem, guesses, **opts)
+    if polish and sol.success and not norm_bound and keep_out is None:
+        # degree 4: at degree 3 the ~4 intervals per arc under-resolve the states and the free
+        # knots exploit the collocation error (T below the best known, measured)
+        polished = polish_switches(problem, sol, degree=4, verbose=verbose,
+                                   ipopt_options=ipopt_options)
+        if polished.success and polished.T <= sol.T + 1e-9:
+            return polished
+    return sol
+
+
+def min_effort(inertia, T, *, angle=None, axis=None, q0=None, qf=None, u_max=None,
+               norm_bound=False, w0=None, wf=None, keep_out=None, guess=None, N=20,
+               tol=1e-7, starts=4, seed=0, verbose=False, ipopt_options=None) -> Solution:
+    """Minimum-effort (``1/2 integral |u|^2 dt``) rigid-body slew over a fixed time ``T``.
+
+    Parameters
+    ----------
+    inertia : array_like, shape (3, 3) or (3,) [kg m^2]
+    T : float [s] — maneuver time
+    angle, axis, q0, qf, w0, wf, keep_out : as in `time_optimal`
+    u_max : float or array_like, shape (3,) [N m], optional — torque bound (default none)
+    norm_bound : bool
+    guess : None, ocp.Solution or mapping — default: eigenaxis SLERP (with a keep-out cone:
+        multi-start from ``starts`` seeded tilted paths, best kept)
+    N : int — intervals of the first mesh
+    tol : float — mesh-refinement target for the re-integration error (`ocp.refine`)
+    verbose : bool
+    ipopt_options : dict, optional
+
+    Returns
+    -------
+    ocp.Solution
+        ``cost`` in [N^2 m^2 s]. For a rest-to-rest rotation by ``theta`` about a principal
+        axis with moment ``J`` and no active bound: ``u = J theta (6/T^2 - 12 t/T^3)``,
+        cost ``6 J^2 theta^2 / T^3``.
+    """
+    problem = slew_problem(inertia, objective="effort", T=T, angle=angle, axis=axis, q0=q0,
+                           qf=qf, u_max=u_max, norm_bound=norm_bound, w0=w0, wf=wf,
+                           keep_out=keep_out)
+    opts = dict(N=N, verbose=verbose, ipopt_options=ipopt_options)
+    if guess is not None:
+        first = solve(problem, guess=guess, **opts)
+    elif keep_out is None:
+        first = solve(problem, guess=attitude_guess(problem), **opts)
+    else:
+        # the eigenaxis path may cross the cone's centre, a symmetric saddle between the two
+        # ways around: start from seeded tilted paths instead and keep the best
+        guesses = _seeded_guesses(problem, int(starts), seed, eigenaxis=False)
+        first = solve_multistart(problem, guesses, **opts)
+    if not first.success:
+        return first
+    return refine(problem, first, tol=tol, verbose=verbose, ipopt_options=ipopt_options)
+
+
+def switch_times(solution: Solution, *, axis=None) -> list:
+    """Times [s] where each torque component changes sign (linear interpolation).
+
+    Parameters
+    ----------
+    solution : ocp.Solution of a slew
+    axis : int, optional — one component (0, 1, 2); default all
+
+    Returns
+    -------
+    list of ndarray — one array of switch times per component (or one array)
+    """
+    t, U = solution.t, solution.u
+    out = []
+    for i in range(U.shape[0]) if axis is None else [int(axis)]:
+        u = U[i]
+        scale = np.max(np.abs(u)) or 1.0
+        sig = np.where(np.abs(u) < 1e-6 * scale, 0.0, np.sign(u))
+        idx = [k for k in range(len(u) - 1) if sig[k] * sig[k + 1] < 0]
+        ts = [t[k] + (t[k + 1] - t[k]) * u[k] / (u[k] - u[k + 1]) for k in idx]
+        out.append(np.unique(np.round(np.array(ts, dtype=float), 12)))
+    return out if axis is None else out[0]
+
+
+# ----------------------------------------------------------------------- reporting
+def summary(solution: Solution, *, eigenaxis=None) -> dict:
+    """JSON-ready summary of a slew solution.
+
+    Keys: success, status, message, T [s], cost, switch_times [s] (per torque axis),
+    iterations, solve_time [s], propagation_error (largest deviation of the re-integrated
+    trajectory from the collocated states), quaternion_norm_error, and ``eigenaxis_T`` [s]
+    when given.
+    """
+    sw = switch_times(solution) if solution.success else [np.array([])] * 3
+    out = dict(
+        success=bool(solution.success),
+        status=str(solution.status),
+        message=str(solution.message),
+        T=float(solution.T),
+        cost=float(solution.cost),
+        switch_times=[s.tolist() for s in sw],
+        iterations=int(solution.iterations),
+        solve_time=float(solution.solve_time),
+        propagation_error=float(solution.propagation_error) if solution.success else float("nan"),
+        quaternion_norm_error=float(solution.quaternion_norm_error),
+    )
+    if eigenaxis is not None:
+        out["eigenaxis_T"] = float(eigenaxis)
+    return out
+
+
+def format_summary(data: dict) -> str:
+    """A readable table of `summary` output."""
+    rows = [
+        ("success", f"{data['success']} ({data['status']})"),
+        ("maneuver time T [s]", f"{data['T']:.6f}"),
+    ]
+    if "eigenaxis_T" in data:
+        rows.append(("eigenaxis maneuver T [s]", f"{data['eigenaxis_T']:.6f}"))
+    rows.append(("cost", f"{data['cost']:.8g}"))
+    for i, s in enumerate(data["switch_times"]):
+        rows.append((f"switch times u{i + 1} [s]", ", ".join(f"{v:.4f}" for v in s) or "-"))
+    rows += [
+        ("IPOPT iterations", f"{data['iterations']}"),
+        ("solve time [s]", f"{data['solve_time']:.3f}"),
+        ("propagation error", f"{data['propagation_error']:.2e}"),
+        ("|q| - 1 (max)", f"{data['quaternion_norm_error']:.2e}"),
+    ]
+    width = max(len(k) for k, _ in rows)
+    return "\n".join(["Optimal slew"] + [f"  {k:<{width}}  {v}" for k, v in rows])
+
+
+def plot_slew(solution: Solution, path: str) -> None:
+    """Save quaternion, rates, torques and the rotation path (body axes on the unit sphere)."""
+    import matplotlib
+
+    matplotlib.use("Agg", force=False)
+    import matplotlib.pyplot as plt
+
+    t = np.linspace(solution.t[0], solution.t[-1], 400)
+    x, u = solution.sample(t)
+    fig = plt.figure(figsize=(12, 8))
+    panels = [(x[:4], "quaternion", [f"q{i + 1}" for i in range(4)]),
+              (x[4:], "body rate [rad/s]", ["w1", "w2", "w3"]),
+              (u, "torque [N m]", ["u1", "u2", "u3"])]
+    for k, (data, label, names) in enumerate(panels):
+        ax = fig.add_subplot(2, 2, k + 1)
+        for row, name in zip(data, names):
+            ax.plot(t, row, label=name)
+        ax.set(xlabel="t [s]", ylabel=label)
+        ax.legend(loc="best", fontsize=8)
+        ax.grid(alpha=0.3)
+    ax = fig.add_subplot(2, 2, 4, projection="3d")
+    A = dcm_from_quat(x[:4] / np.linalg.norm(x[:4], axis=0))  # (3, 3, n): rows = body axes
+    for i, c in enumerate(("tab:red", "tab:green", "tab:blue")):
+        ax.plot(A[i, 0], A[i, 1], A[i, 2], color=c, label=f"body axis {i + 1}")
+        ax.scatter(*A[i, :, -1], color=c, marker="o")
+    ax.set(title="Rotation path (inertial)", xlim=(-1, 1), ylim=(-1, 1), zlim=(-1, 1))
+    ax.legend(fontsize=8)
+    fig.suptitle(f"T = {solution.T:.5f} s, cost = {solution.cost:.6g}")
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
