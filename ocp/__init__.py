@@ -10,6 +10,7 @@ transcription (`Trapezoid`, `HermiteSimpson`, `Radau`), and `solve` it::
 """
 from __future__ import annotations
 
+from .guess import guess_from_simulation
 from .mesh import Mesh
 from .problem import Constraint, Problem
 from .refine import (IntervalErrors, RadauConstantControl, RefinedSolution, RefinementRound,
@@ -44,4 +45,5 @@ __all__ = [
     "IntervalErrors",
     "interval_errors",
     "find_switches",
+    "guess_from_simulation",
 ]

@@ -30,7 +30,7 @@ from typing import Callable, Mapping
 
 import numpy as np
 
-__all__ = ["NodeGuess", "initial_guess", "slerp"]
+__all__ = ["NodeGuess", "initial_guess", "slerp", "guess_from_simulation"]
 
 _KEYS = ("t", "x", "u", "T", "p")
 
@@ -285,3 +285,49 @@ def initial_guess(problem, transcription, mesh, guess=None) -> NodeGuess:
     if not (np.all(np.isfinite(X)) and np.all(np.isfinite(U)) and np.all(np.isfinite(Xu))):
         raise ValueError("`guess` produced non-finite values on the nodes")
     return NodeGuess(X=X, U=U, Xu=Xu, p=p, T=T)
+
+
+def guess_from_simulation(problem, u, *, T=None, n=201, method="auto", rtol=1e-8,
+                          atol=1e-10) -> dict:
+    """A guess made by simulating the model from the problem's initial state.
+
+    Parameters
+    ----------
+    problem : ocp.Problem
+        Its initial state must be fully given (``x_initial`` without free components).
+    u : array_like, shape (nu,) or (nu, n), or callable ``u(t) -> (nu,)``
+        Control to apply (as accepted by `dynamics.simulate`); clipped into the bounds.
+    T : float [s], optional
+        Simulated horizon; default the fixed ``T``, or the middle of a free ``T`` range.
+    n : int
+        Number of output samples.
+    method, rtol, atol : passed to `dynamics.simulate`
+
+    Returns
+    -------
+    dict with keys ``t``, ``x`` (nx, n), ``u`` (nu, n), ``T`` — accepted by `ocp.solve`.
+
+    Raises
+    ------
+    ValueError
+        If the initial state is not fully given or the simulation fails.
+    """
+    from dynamics.simulate import simulate
+
+    x0 = np.asarray(problem.x_initial, dtype=float)
+    if np.any(np.isnan(x0)):
+        free = [problem.model.states[i] for i in np.flatnonzero(np.isnan(x0))]
+        raise ValueError(f"guess_from_simulation needs a fully given `x_initial`; free: {free}")
+    T = _default_T(problem) if T is None else float(T)
+    t = problem.t0 + np.linspace(0.0, T, int(n))
+    lo, hi = problem.u_bounds
+    if callable(u):
+        uc = np.stack([np.clip(np.asarray(u(tk), dtype=float).reshape(-1), lo, hi) for tk in t], 1)
+    else:
+        ua = np.asarray(u, dtype=float)
+        uc = np.clip(ua.reshape(-1, 1) if ua.ndim <= 1 else ua, lo[:, None], hi[:, None])
+        uc = np.broadcast_to(uc, (problem.model.nu, t.size)).copy()
+    res = simulate(problem.model, x0, t, u=uc, p=problem.p, method=method, rtol=rtol, atol=atol)
+    if not res.success or not np.all(np.isfinite(res.x)):
+        raise ValueError(f"the simulation for the guess failed: {res.message}")
+    return dict(t=t, x=res.x, u=uc, T=T)
