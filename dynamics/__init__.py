@@ -1,7 +1,8 @@
 """appdyn dynamics: models as named-I/O CasADi Functions, simulation, closed-form truths.
 
-Entry points: `Model`, `rigid_body`, `simulate`, and the modules `attitude` (kinematics)
-and `truth` (closed forms, imported on first use).
+Entry points: `Model`, `rigid_body`, `simulate`, `linearize` (exact linearization about
+equilibria and steady spins, as a python-control StateSpace), and the modules `attitude`
+(kinematics) and `truth` (closed forms, imported on first use).
 """
 from __future__ import annotations
 
@@ -10,9 +11,11 @@ import importlib
 from . import attitude
 from .model import Model
 from .rigid_body import rigid_body
+from .linearize import Linearization, linearization, linearize
 from .simulate import SimulationResult, simulate
 
-__all__ = ["Model", "SimulationResult", "attitude", "rigid_body", "simulate", "truth"]
+__all__ = ["Linearization", "Model", "SimulationResult", "attitude", "linearization",
+           "linearize", "rigid_body", "simulate", "truth"]
 
 
 def __getattr__(name):

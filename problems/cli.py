@@ -1,6 +1,8 @@
 """The ``appdyn`` command line.
 
     appdyn simulate torque-free --inertia 1,2,3 --w0 1,0.1,0.8 --t-final 50 [--plot F.png]
+    appdyn slew --inertia 1,1,1 --umax 1 --axis 0,0,1 --angle 180 --time-optimal
+    appdyn stability spin|heavy-top|projectile|rotor|gyrostat|sweep ... [--json F] [--plot F.png]
     appdyn demo
     appdyn bench [NAME ...]
 
@@ -15,39 +17,17 @@ from pathlib import Path
 
 import numpy as np
 
+from problems.cli_common import positive as _positive
+from problems.cli_common import vector as _vector
+from problems.cli_common import write_outputs
+
 __all__ = ["main", "build_parser"]
 
 BENCH_DIR = Path(__file__).resolve().parents[1] / "bench"
 
 
-def _vector(n_allowed):
-    """argparse type: comma-separated floats with one of the allowed lengths."""
-
-    def parse(text):
-        try:
-            vals = [float(v) for v in text.replace(" ", "").split(",") if v != ""]
-        except ValueError:
-            raise argparse.ArgumentTypeError(f"expected comma-separated numbers, got {text!r}")
-        if len(vals) not in n_allowed:
-            raise argparse.ArgumentTypeError(
-                f"expected {' or '.join(map(str, n_allowed))} comma-separated numbers, got {len(vals)}"
-            )
-        if not all(np.isfinite(vals)):
-            raise argparse.ArgumentTypeError(f"numbers must be finite, got {text!r}")
-        return np.array(vals)
-
-    return parse
-
-
 def _inertia(values):
     return values if values.size == 3 else values.reshape(3, 3)
-
-
-def _positive(text):
-    v = float(text)
-    if not (np.isfinite(v) and v > 0):
-        raise argparse.ArgumentTypeError(f"expected a positive number, got {text!r}")
-    return v
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -92,6 +72,10 @@ def build_parser() -> argparse.ArgumentParser:
     sl.add_argument("--json", metavar="FILE", help="write the summary as JSON")
     sl.add_argument("--quiet", action="store_true", help="no solver progress lines")
 
+    from problems.stability_cli import add_stability_parser
+
+    add_stability_parser(sub)
+
     sub.add_parser("demo", help="a short tour of the toolkit's main jobs (< 1 min)")
 
     bench = sub.add_parser("bench", help="run benchmarks from the bench/ folder")
@@ -106,12 +90,7 @@ def _cmd_torque_free(args) -> int:
                          n_points=args.points, method=args.method, rtol=args.rtol,
                          atol=args.atol)
     print(report)
-    if args.plot:
-        report.plot(args.plot)
-        print(f"plot written to {args.plot}")
-    if args.json:
-        Path(args.json).write_text(report.to_json())
-        print(f"summary written to {args.json}")
+    write_outputs(report, plot=args.plot, json=args.json)
     return 0 if report.success else 1
 
 
@@ -156,6 +135,12 @@ def _cmd_slew(args) -> int:
     return 0 if sol.success else 1
 
 
+def _cmd_stability(args) -> int:
+    from problems.stability_cli import run
+
+    return run(args)
+
+
 def _cmd_demo(args) -> int:
     from problems.torque_free import torque_free
 
@@ -194,6 +179,8 @@ def _cmd_bench(args) -> int:
 COMMANDS = {
     ("simulate", "torque-free"): _cmd_torque_free,
     ("slew", None): _cmd_slew,
+    **{("stability", case): _cmd_stability
+       for case in ("spin", "heavy-top", "projectile", "rotor", "gyrostat", "sweep")},
     ("demo", None): _cmd_demo,
     ("bench", None): _cmd_bench,
 }

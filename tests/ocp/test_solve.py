@@ -130,7 +130,7 @@ def test_sample_interpolates_like_the_transcription():
     assert np.allclose(u, 0.5 * (sol.u[:, 1:] + sol.u[:, :-1]), atol=1e-14, rtol=0)
     # Hermite-Simpson: quadratic u through start/mid/end, cubic Hermite x with slopes f
     sol = solve(problem, transcription=HermiteSimpson(), N=4, verbose=False)
-    t0, tc, t1 = sol.t[0], sol.t[1], sol.t[2]
+    t0, t1 = sol.t[0], sol.t[2]
     h, s = t1 - t0, 0.3
     x, u = sol.sample(t0 + s * h)
     lag = [(s - 0.5) * (s - 1) / 0.5, s * (s - 1) / -0.25, s * (s - 0.5) / 0.5]

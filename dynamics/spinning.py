@@ -1,0 +1,410 @@
+"""Spinning-vehicle models for stability studies (seed Secs. 4.5-4.6).
+
+* `tilt_torque_body` — a rigid body with a torque that depends only on the tilt of a body
+  axis from an inertially fixed direction (seed Sec. 4.6 Method III): the heavy top
+  (``overturning = m g l``), the spinning projectile (``q S C_N_alpha l``), a rotor in
+  elastic bearings (``-2 k l^2``), with an optional *internal* (rotating) damping.
+* `gyrostat_model` — a rigid body carrying a wheel of constant relative speed (dual spin)
+  and, optionally, an energy damper: a spring-mass point mass sliding along a body line
+  (`PointMassDamper`) or a viscously coupled spherical core (`SphericalDamper`), mounted
+  on the platform or (spherical only) on the rotor. With zero wheel momentum it is a
+  rigid body with a nutation damper (Kelvin-Tait-Chetaev, seed Sec. 4.5 NOTE).
+
+All models have the state ``[q1, q2, q3, q4, w1, w2, w3, ...]`` (scalar-last quaternion,
+inertial -> body, and body rates [rad/s]), ``attitude = (0, 4)``, and external body torques
+``u = [L1, L2, L3]`` [N m]. Their equations are derived in the docstrings; the tests check
+them against conservation laws (energy, inertial angular momentum) and closed forms.
+"""
+from __future__ import annotations
+
+import functools
+import math
+from dataclasses import dataclass
+
+import casadi as ca
+import numpy as np
+
+from .attitude import dcm_from_quat, quat_rate
+from .model import Model
+from .rigid_body import RIGID_BODY_STATES, check_inertia
+
+__all__ = ["PointMassDamper", "SphericalDamper", "tilt_torque_body", "gyrostat_model",
+           "steady_spin_state", "point_mass_offset", "unit_vector"]
+
+_TORQUES = ("L1", "L2", "L3")
+_BASE_UNITS = {**{k: "-" for k in RIGID_BODY_STATES[:4]},
+               **{k: "rad/s" for k in RIGID_BODY_STATES[4:]}, **{k: "N m" for k in _TORQUES}}
+
+
+def unit_vector(v, name: str) -> np.ndarray:
+    """A finite non-zero 3-vector scaled to unit length; ``ValueError`` naming ``name``."""
+    try:
+        a = np.array(v, dtype=float).reshape(-1)
+    except (TypeError, ValueError):
+        raise ValueError(f"`{name}` must be 3 numbers, got {v!r}") from None
+    n = np.linalg.norm(a) if a.size == 3 and np.all(np.isfinite(a)) else 0.0
+    if a.size != 3 or not np.isfinite(n) or n == 0:
+        raise ValueError(f"`{name}` must be a finite non-zero 3-vector, got {a.tolist()}")
+    return a / n
+
+
+def _finite(value, name, *, positive=False, nonnegative=False, allow_inf=False) -> float:
+    try:
+        v = float(value)
+    except (TypeError, ValueError):
+        raise ValueError(f"`{name}` must be a number, got {value!r}") from None
+    if math.isnan(v) or (math.isinf(v) and not (allow_inf and v > 0)):
+        raise ValueError(f"`{name}` must be finite, got {v}")
+    if positive and not v > 0:
+        raise ValueError(f"`{name}` must be positive, got {v}")
+    if nonnegative and v < 0:
+        raise ValueError(f"`{name}` must be non-negative, got {v}")
+    return v
+
+
+# ------------------------------------------------------------------------- dampers
+@dataclass(frozen=True)
+class PointMassDamper:
+    """A point mass on a spring and dashpot, sliding along a straight line fixed in the body.
+
+    Parameters
+    ----------
+    mass : float [kg] — the moving mass ``m > 0``
+    stiffness : float [N/m] — spring ``k > 0`` (force ``-k s``)
+    damping : float [N s/m] — dashpot ``c >= 0`` (force ``-c s'``)
+    position : array_like, shape (3,) [m]
+        Body-frame position of the mass at ``s = 0`` (spring relaxed) relative to the mass
+        center of the rigid body that carries it.
+    direction : array_like, shape (3,)
+        Direction ``d`` of travel in body axes (normalized here); ``rho = position + s d``.
+    body_mass : float [kg], optional
+        Mass ``M`` of the carrying body. The free system's mass center moves with the mass;
+        this enters only through the reduced mass ``mu = m M / (m + M)``. The default ``inf``
+        gives ``mu = m`` (the body's mass center stays at the system's).
+    """
+
+    mass: float
+    stiffness: float
+    damping: float
+    position: tuple = (0.0, 0.0, 0.0)
+    direction: tuple = (1.0, 0.0, 0.0)
+    body_mass: float = math.inf
+
+    def __post_init__(self):
+        object.__setattr__(self, "mass", _finite(self.mass, "damper.mass", positive=True))
+        object.__setattr__(self, "stiffness",
+                           _finite(self.stiffness, "damper.stiffness", positive=True))
+        object.__setattr__(self, "damping",
+                           _finite(self.damping, "damper.damping", nonnegative=True))
+        try:
+            pos = np.array(self.position, dtype=float).reshape(-1)
+        except (TypeError, ValueError):
+            raise ValueError(f"`damper.position` must be 3 numbers, "
+                             f"got {self.position!r}") from None
+        if pos.size != 3 or not np.all(np.isfinite(pos)):
+            raise ValueError(f"`damper.position` must be 3 finite numbers [m], got {pos.tolist()}")
+        object.__setattr__(self, "position", tuple(pos.tolist()))
+        object.__setattr__(self, "direction",
+                           tuple(unit_vector(self.direction, "damper.direction").tolist()))
+        object.__setattr__(self, "body_mass", _finite(self.body_mass, "damper.body_mass",
+                                                      positive=True, allow_inf=True))
+
+    @property
+    def reduced_mass(self) -> float:
+        """``mu = m M / (m + M)`` [kg] (``m`` for an infinite body mass)."""
+        if math.isinf(self.body_mass):
+            return self.mass
+        return self.mass * self.body_mass / (self.mass + self.body_mass)
+
+    def inertia_at(self, s: float = 0.0) -> np.ndarray:
+        """Inertia [kg m^2] the mass adds about the system mass center at displacement ``s``:
+        ``mu (|rho|^2 E - rho rho^T)``."""
+        rho = np.asarray(self.position) + s * np.asarray(self.direction)
+        return self.reduced_mass * (rho @ rho * np.eye(3) - np.outer(rho, rho))
+
+
+@dataclass(frozen=True)
+class SphericalDamper:
+    """A spherical core (e.g. fluid in a spherical cavity) coupled to its housing viscously.
+
+    The core has isotropic inertia ``J_d`` about its center, which lies on the spin axis at the
+    system mass center; it receives the torque ``-c (w_d - w_h)``, ``w_d`` its angular
+    velocity and ``w_h`` that of the housing.
+
+    Parameters
+    ----------
+    inertia : float [kg m^2] — ``J_d > 0``
+    damping : float [N m s] — ``c >= 0``
+    """
+
+    inertia: float
+    damping: float
+
+    def __post_init__(self):
+        object.__setattr__(self, "inertia", _finite(self.inertia, "damper.inertia", positive=True))
+        object.__setattr__(self, "damping",
+                           _finite(self.damping, "damper.damping", nonnegative=True))
+
+
+# -------------------------------------------------------------------- tilt torque
+@functools.lru_cache(maxsize=256)
+def _tilt_torque_body(inertia_key, axis_key, direction_key, overturning, damping) -> Model:
+    inertia = np.array(inertia_key).reshape(3, 3)
+    a = ca.DM(axis_key)
+    d_in = ca.DM(direction_key)
+    x = ca.SX.sym("x", 7)
+    u = ca.SX.sym("u", 3)
+    p = ca.SX.sym("p", 0)
+    q, w = x[0:4], x[4:7]
+    I = ca.DM(inertia)
+    n = ca.mtimes(dcm_from_quat(q), d_in)  # the fixed direction in body axes
+    M = ca.mtimes(n, a.T) - ca.dot(a, n) * ca.DM.eye(3)  # tau' = M w, tau = a x n
+    torque = u - overturning * ca.cross(a, n) - damping * ca.mtimes(M.T, ca.mtimes(M, w))
+    wdot = ca.solve(I, torque - ca.cross(w, ca.mtimes(I, w)))
+    f = ca.Function("tilt_torque_body", [x, u, p], [ca.vertcat(quat_rate(q, w), wdot)],
+                    ["x", "u", "p"], ["xdot"])
+    h = ca.mtimes(I, w)
+    invariants = {
+        "energy": ca.Function("energy", [x, p], [0.5 * ca.dot(w, h) + overturning * ca.dot(a, n)],
+                              ["x", "p"], ["energy"]),
+        "momentum_inertial": ca.Function("momentum_inertial", [x, p],
+                                         [ca.mtimes(dcm_from_quat(q).T, h)], ["x", "p"],
+                                         ["momentum_inertial"]),
+        "quat_norm": ca.Function("quat_norm", [x, p], [ca.norm_2(q)], ["x", "p"], ["quat_norm"]),
+    }
+    return Model(f=f, states=RIGID_BODY_STATES, controls=_TORQUES, units=_BASE_UNITS,
+                 invariants=invariants, name="tilt_torque_body", attitude=(0, 4))
+
+
+def tilt_torque_body(inertia, overturning, *, axis=(1.0, 0.0, 0.0), direction=(1.0, 0.0, 0.0),
+                     internal_damping: float = 0.0) -> Model:
+    """Rigid body about a fixed point with a tilt-dependent torque (seed Sec. 4.6 Method III).
+
+    With ``a`` the body axis, ``n = A(q) d`` the inertially fixed unit direction ``d`` in body
+    axes and ``tau = a x n`` the tilt vector, the torque about the fixed point is
+
+        L = u - kappa a x n - D M^T M w,        M = n a^T - (a . n) E,
+
+    * ``-kappa a x n`` derives from the potential ``V = kappa (a . n)``: for the heavy top
+      (``a`` from the pivot to the mass center at distance ``l``, ``d`` pointing up,
+      gravity ``-m g d``) ``L = l a x (-m g n)``, so ``kappa = m g l``; seed Example 1 gives
+      the same ``L = m g l (theta e2 + psi e3)`` to first order. The spinning projectile has
+      ``kappa = q S C_N_alpha l`` (Example 2); a rotor in bearings of stiffness ``k`` at
+      ``+/- l``, ``V = -2 k l^2 cos(tilt)``, has ``kappa = -2 k l^2`` (Example 3).
+    * ``-D M^T M w`` is internal (rotating) damping: ``M w = tau'`` is the rate of the tilt
+      seen in the body, and the torque derives from the Rayleigh function
+      ``R = D |tau'|^2 / 2``, so the power is ``-D |tau'|^2``. To first order about a spin
+      ``w0 a`` it is ``-D (theta', psi')`` in Method III's deviation angles.
+
+    Euler's law about the fixed point: ``I w' + w x I w = L``; ``q' = -1/2 Wbar(w) q``.
+
+    Parameters
+    ----------
+    inertia : array_like, shape (3, 3) or (3,) [kg m^2]
+        About the fixed point (pivot) or, for a free body whose translation decouples, the
+        mass center.
+    overturning : float [N m]
+        ``kappa``: positive tips the axis away from ``d`` (heavy top, projectile), negative
+        restores it (rotor bearings).
+    axis : array_like, shape (3,), optional — body axis ``a`` (normalized; default e1)
+    direction : array_like, shape (3,), optional — inertial direction ``d`` (default x)
+    internal_damping : float [N m s], optional — ``D >= 0``
+
+    Returns
+    -------
+    Model
+        ``x = [q1..q4, w1..w3]``, ``u = [L1, L2, L3]`` [N m], invariants ``energy``
+        (``1/2 w.Iw + kappa a.n`` [J], conserved for ``D = 0``, ``u = 0``),
+        ``momentum_inertial`` [N m s] and ``quat_norm``. Cached by its arguments.
+
+    Raises
+    ------
+    ValueError
+        Naming the argument: bad ``inertia`` (see `check_inertia`), non-finite
+        ``overturning``, zero ``axis``/``direction``, negative ``internal_damping``.
+    """
+    I = check_inertia(inertia)
+    kappa = _finite(overturning, "overturning")
+    a = unit_vector(axis, "axis")
+    d = unit_vector(direction, "direction")
+    damping = _finite(internal_damping, "internal_damping", nonnegative=True)
+    return _tilt_torque_body(tuple(I.reshape(-1).tolist()), tuple(a.tolist()), tuple(d.tolist()),
+                             kappa, damping)
+
+
+# ------------------------------------------------------------------------ gyrostat
+@functools.lru_cache(maxsize=256)
+def _gyrostat(inertia_key, wheel_axis, wheel_momentum, damper, damper_on, wheel_rate) -> Model:
+    I = ca.DM(np.array(inertia_key).reshape(3, 3))
+    aw = ca.DM(wheel_axis)
+    h = wheel_momentum
+    nd = {None: 0, PointMassDamper: 2, SphericalDamper: 3}[type(damper) if damper else None]
+    x = ca.SX.sym("x", 7 + nd)
+    u = ca.SX.sym("u", 3)
+    p = ca.SX.sym("p", 0)
+    q, w = x[0:4], x[4:7]
+    extra_states, extra_units = (), {}
+    if damper is None:
+        H = ca.mtimes(I, w) + h * aw
+        wdot = ca.solve(I, u - ca.cross(w, H))
+        rest = []
+        energy = 0.5 * ca.dot(w, ca.mtimes(I, w))
+    elif isinstance(damper, PointMassDamper):
+        s, sd = x[7], x[8]
+        mu, k, c = damper.reduced_mass, damper.stiffness, damper.damping
+        b, d = ca.DM(damper.position), ca.DM(damper.direction)
+        rho = b + s * d
+        g = ca.cross(rho, d)
+        E3 = ca.DM.eye(3)
+        J = I + mu * (ca.dot(rho, rho) * E3 - ca.mtimes(rho, rho.T))
+        Jdot = mu * sd * (2 * ca.dot(rho, d) * E3 - ca.mtimes(d, rho.T) - ca.mtimes(rho, d.T))
+        H = ca.mtimes(J, w) + mu * sd * g + h * aw
+        mass = ca.vertcat(ca.horzcat(J, mu * g), ca.horzcat(mu * g.T, mu))
+        rhs = ca.vertcat(u - ca.mtimes(Jdot, w) - ca.cross(w, H),
+                         -k * s - c * sd - mu * ca.dot(d, ca.cross(w, ca.cross(w, rho))))
+        acc = ca.solve(mass, rhs)
+        wdot = acc[0:3]
+        rest = [sd, acc[3]]
+        energy = (0.5 * ca.dot(w, ca.mtimes(J, w)) + mu * sd * ca.dot(g, w) + 0.5 * mu * sd ** 2
+                  + 0.5 * k * s ** 2)
+        extra_states, extra_units = ("s", "s_dot"), {"s": "m", "s_dot": "m/s"}
+    else:
+        wd = x[7:10]
+        Jd, c = damper.inertia, damper.damping
+        wh = w + (wheel_rate * aw if damper_on == "rotor" else 0)
+        H = ca.mtimes(I, w) + h * aw + Jd * wd
+        wdot = ca.solve(I, u - ca.cross(w, ca.mtimes(I, w) + h * aw) + c * (wd - wh))
+        rest = [-(c / Jd) * (wd - wh) - ca.cross(w, wd)]
+        energy = 0.5 * ca.dot(w, ca.mtimes(I, w)) + 0.5 * Jd * ca.dot(wd, wd)
+        extra_states = ("wd1", "wd2", "wd3")
+        extra_units = {k: "rad/s" for k in extra_states}
+    xdot = ca.vertcat(quat_rate(q, w), wdot, *rest)
+    f = ca.Function("gyrostat", [x, u, p], [xdot], ["x", "u", "p"], ["xdot"])
+    invariants = {
+        "energy": ca.Function("energy", [x, p], [energy], ["x", "p"], ["energy"]),
+        "momentum_inertial": ca.Function("momentum_inertial", [x, p],
+                                         [ca.mtimes(dcm_from_quat(q).T, H)], ["x", "p"],
+                                         ["momentum_inertial"]),
+        "quat_norm": ca.Function("quat_norm", [x, p], [ca.norm_2(q)], ["x", "p"], ["quat_norm"]),
+    }
+    return Model(f=f, states=RIGID_BODY_STATES + extra_states, controls=_TORQUES,
+                 units={**_BASE_UNITS, **extra_units}, invariants=invariants, name="gyrostat",
+                 attitude=(0, 4))
+
+
+def _check_damper(damper, damper_on):
+    if damper is not None and not isinstance(damper, (PointMassDamper, SphericalDamper)):
+        raise ValueError("`damper` must be None, a PointMassDamper or a SphericalDamper, got "
+                         f"{type(damper).__name__}")
+    if damper_on not in ("platform", "rotor"):
+        raise ValueError(f"`damper_on` must be 'platform' or 'rotor', got {damper_on!r}")
+    if damper_on == "rotor" and isinstance(damper, PointMassDamper):
+        raise ValueError("`damper_on`='rotor' needs an axisymmetric damper (SphericalDamper): a "
+                         "point mass on the spinning rotor makes the motion time-periodic")
+
+
+def gyrostat_model(inertia, *, wheel_axis=(1.0, 0.0, 0.0), wheel_momentum: float = 0.0,
+                   damper=None, damper_on: str = "platform", wheel_rate: float = 0.0) -> Model:
+    """Gyrostat (rigid body + wheel of constant relative speed) with an optional damper.
+
+    The wheel spins relative to the platform about ``a`` (body axes) at a rate held constant
+    by its motor; its relative angular momentum is ``h a``, and ``inertia`` includes the
+    wheel as if locked. Torque-free apart from ``u`` (about the system mass center):
+    ``H' + w x H = u`` in body axes, with
+
+    * no damper: ``H = I w + h a``.
+    * `PointMassDamper` (on the platform): with ``rho = b + s d``, ``g = rho x d``,
+      ``mu`` the reduced mass and ``J(s) = I + mu (|rho|^2 E - rho rho^T)``, the angular
+      momentum about the system mass center is ``H = J(s) w + mu s' g + h a``; the mass
+      obeys ``mu d.a_rel = -k s - c s'`` with ``a_rel = s'' d + 2 w x s' d + w' x rho +
+      w x (w x rho)``, i.e. ``mu (s'' + g.w' + d.(w x (w x rho))) = -k s - c s'``. Together::
+
+          [[J, mu g], [mu g^T, mu]] [w'; s''] = [u - J' w - w x H;
+                                                 -k s - c s' - mu d.(w x (w x rho))]
+
+      with ``J' = mu s' (2 (rho.d) E - d rho^T - rho d^T)``; the energy
+      ``1/2 w.Jw + mu s' g.w + 1/2 mu s'^2 + 1/2 k s^2`` decays at ``-c s'^2`` (u = 0).
+    * `SphericalDamper`: ``H = I w + h a + J_d w_d``; the core obeys
+      ``J_d (w_d' + w x w_d) = -c (w_d - w_h)`` with the housing rate ``w_h = w`` (platform)
+      or ``w + wheel_rate a`` (rotor), hence ``I w' = u - w x (I w + h a) + c (w_d - w_h)``.
+      The energy ``1/2 w.Iw + 1/2 J_d |w_d|^2`` decays at ``-c |w_d - w|^2`` when the damper
+      is on the platform (u = 0).
+
+    Parameters
+    ----------
+    inertia : array_like, shape (3, 3) or (3,) [kg m^2]
+        Rigid part about its mass center (wheel locked; without the point mass and without
+        the spherical core's own rotational inertia ``J_d``).
+    wheel_axis : array_like, shape (3,), optional — ``a`` (normalized; default e1)
+    wheel_momentum : float [N m s], optional — ``h``, relative to the platform (0: no wheel)
+    damper : PointMassDamper or SphericalDamper, optional
+    damper_on : {'platform', 'rotor'} — where the damper is mounted (rotor: spherical only)
+    wheel_rate : float [rad/s], optional
+        Wheel speed relative to the platform; used only for a damper on the rotor.
+
+    Returns
+    -------
+    Model
+        ``x = [q1..q4, w1..w3]`` plus ``[s, s_dot]`` [m, m/s] (point mass) or
+        ``[wd1, wd2, wd3]`` [rad/s] (core rate, body axes); ``u = [L1, L2, L3]``;
+        invariants ``energy`` [J], ``momentum_inertial`` [N m s], ``quat_norm``. Cached.
+
+    Raises
+    ------
+    ValueError
+        Naming the argument (inertia, axis, momentum, damper type or placement).
+    """
+    I = check_inertia(inertia)
+    a = unit_vector(wheel_axis, "wheel_axis")
+    h = _finite(wheel_momentum, "wheel_momentum")
+    rate = _finite(wheel_rate, "wheel_rate")
+    _check_damper(damper, damper_on)
+    if not isinstance(damper, SphericalDamper) or damper_on != "rotor":
+        rate = 0.0  # only a rotor-mounted damper sees the wheel speed
+    return _gyrostat(tuple(I.reshape(-1).tolist()), tuple(a.tolist()), h, damper, damper_on, rate)
+
+
+def point_mass_offset(damper: PointMassDamper, axis, rate: float) -> float:
+    """Displacement ``s`` [m] of a point-mass damper in a steady spin ``w = rate * axis``.
+
+    From the mass equation with ``s' = s'' = w' = 0``: ``k s + mu d.(w x (w x rho)) = 0``,
+    linear in ``s``: ``s (k - mu W^2 (1 - (d.a)^2)) = mu W^2 (d.b - (d.a)(a.b))``.
+
+    Raises
+    ------
+    ValueError
+        If the centrifugal stiffness cancels the spring (no isolated steady state).
+    """
+    a = unit_vector(axis, "axis")
+    d, b = np.asarray(damper.direction), np.asarray(damper.position)
+    mu, W2 = damper.reduced_mass, float(rate) ** 2
+    stiff = damper.stiffness - mu * W2 * (1 - (d @ a) ** 2)
+    if stiff <= 1e-12 * damper.stiffness:
+        raise ValueError(f"`damper` spring is too soft for this spin: k = {damper.stiffness} N/m "
+                         f"<= mu W^2 (1 - (d.a)^2) = {damper.stiffness - stiff:.6g} N/m, the mass "
+                         "has no stable resting point")
+    return float(mu * W2 * (d @ b - (d @ a) * (a @ b)) / stiff)
+
+
+def steady_spin_state(axis, rate: float, *, damper=None, damper_on: str = "platform",
+                      wheel_rate: float = 0.0) -> np.ndarray:
+    """State of a `gyrostat_model` in the steady spin ``w = rate * axis`` at identity attitude.
+
+    The point mass rests at `point_mass_offset`; a spherical core turns with its housing.
+    Whether this is a relative equilibrium (``axis`` principal for the loaded body) is left
+    to `dynamics.linearize.linearization`, which shows the residual if not.
+
+    Returns
+    -------
+    ndarray, shape (7,), (9,) or (10,)
+    """
+    a = unit_vector(axis, "axis")
+    rate = _finite(rate, "rate")
+    _check_damper(damper, damper_on)
+    x = [0.0, 0.0, 0.0, 1.0, *(rate * a)]
+    if isinstance(damper, PointMassDamper):
+        x += [point_mass_offset(damper, a, rate), 0.0]
+    elif isinstance(damper, SphericalDamper):
+        spin = rate + (wheel_rate if damper_on == "rotor" else 0.0)
+        x += list(spin * a)
+    return np.array(x)

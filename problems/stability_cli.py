@@ -1,0 +1,254 @@
+"""``appdyn stability ...``: the command-line face of `problems.stability`.
+
+    appdyn stability spin --inertia 1,2,3 --axis 1,0,0 --rate 10 [--damper ...] \\
+        [--json F] [--plot F]
+    appdyn stability heavy-top --axial-inertia 0.002 --transverse-inertia 0.005 --mass 0.3 \\
+        --length 0.04 --rate 40
+    appdyn stability projectile --axial-inertia ... --dynamic-pressure ... --area ... \\
+        --cn-alpha ... --cp-offset ... --rate ...
+    appdyn stability rotor --axial-inertia ... --transverse-inertia ... --stiffness ... \\
+        --bearing-distance ... --rate ... [--internal-damping D]
+    appdyn stability gyrostat --inertia 3,4,4 --axis 1,0,0 --rate 2 --wheel-momentum 3 \\
+        [--wheel-inertia J] [--damper ...] [--damper-on platform|rotor]
+    appdyn stability sweep CASE --parameter NAME --values START:STOP:NUM  [CASE options]
+
+``--damper`` takes a kind and ``key=value`` items (vectors comma-separated):
+
+    --damper point mass=0.05 stiffness=20 damping=0.3 position=0,0.5,0 direction=1,0,0 [body_mass=M]
+    --damper sphere inertia=0.05 damping=0.02
+
+`add_stability_parser` adds the ``stability`` command to an argparse sub-parser group (its
+cases land in ``args.case``); `run` executes parsed arguments; `main` is a standalone entry
+(``python -m problems.stability_cli spin ...``). This module prints; the library does not.
+"""
+from __future__ import annotations
+
+import argparse
+import sys
+
+import numpy as np
+
+from problems.cli_common import number as _number
+from problems.cli_common import vector as _floats
+from problems.cli_common import write_outputs
+
+__all__ = ["add_stability_parser", "run", "main", "parse_damper", "CASE_NAMES"]
+
+CASE_NAMES = {"spin": "spin", "heavy-top": "heavy_top", "projectile": "spinning_projectile",
+              "rotor": "rotor", "gyrostat": "gyrostat"}
+
+
+def parse_damper(tokens):
+    """``['point', 'mass=0.05', ...]`` -> `PointMassDamper` / `SphericalDamper`.
+
+    Raises
+    ------
+    ValueError
+        Naming ``--damper`` for an unknown kind, key or malformed item.
+    """
+    if not tokens:
+        raise ValueError("`--damper` needs a kind: 'point' or 'sphere'")
+    kind, items = tokens[0].lower(), tokens[1:]
+    fields = {"point": ("mass", "stiffness", "damping", "position", "direction", "body_mass"),
+              "sphere": ("inertia", "damping")}
+    if kind not in fields:
+        raise ValueError(f"`--damper` kind must be 'point' or 'sphere', got {tokens[0]!r}")
+    kwargs = {}
+    for item in items:
+        key, sep, value = item.partition("=")
+        if not sep or key not in fields[kind]:
+            raise ValueError(f"`--damper {kind}` items are key=value with keys "
+                             f"{', '.join(fields[kind])}; got {item!r}")
+        try:
+            nums = [float(v) for v in value.split(",") if v != ""]
+        except ValueError:
+            raise ValueError(f"`--damper` {key} must be numbers, got {value!r}") from None
+        kwargs[key] = tuple(nums) if key in ("position", "direction") else (
+            nums[0] if len(nums) == 1 else value)
+    from dynamics.spinning import PointMassDamper, SphericalDamper
+
+    try:
+        return PointMassDamper(**kwargs) if kind == "point" else SphericalDamper(**kwargs)
+    except TypeError as exc:
+        needed = fields[kind][:3] if kind == "point" else fields[kind]
+        raise ValueError(f"`--damper {kind}` needs {', '.join(needed)}: {exc}") from None
+
+
+def _inertia(values):
+    return values if values.size == 3 else values.reshape(3, 3)
+
+
+# (dest, flags, type, help); required in a plain case, optional under 'sweep'
+_OPTIONS = {
+    "spin": [
+        ("inertia", "--inertia", _floats((3, 9)), "principal moments or 9 matrix entries [kg m^2]"),
+        ("axis", "--axis", _floats((3,)), "spin axis, body frame (a principal axis)"),
+        ("rate", "--rate", _number, "spin rate [rad/s]"),
+    ],
+    "heavy-top": [
+        ("axial_inertia", "--axial-inertia", _number, "I1 about the symmetry axis [kg m^2]"),
+        ("transverse_inertia", "--transverse-inertia", _number,
+         "I2 about a transverse axis through the pivot [kg m^2]"),
+        ("mass", "--mass", _number, "mass [kg]"),
+        ("length", "--length", _number, "pivot to mass center [m]"),
+        ("rate", "--rate", _number, "spin rate [rad/s]"),
+    ],
+    "projectile": [
+        ("axial_inertia", "--axial-inertia", _number, "I1 [kg m^2]"),
+        ("transverse_inertia", "--transverse-inertia", _number,
+         "I2 about the mass center [kg m^2]"),
+        ("rate", "--rate", _number, "spin rate [rad/s]"),
+        ("dynamic_pressure", "--dynamic-pressure", _number, "q [Pa]"),
+        ("area", "--area", _number, "reference area S [m^2]"),
+        ("cn_alpha", "--cn-alpha", _number, "normal-force slope C_N_alpha [1/rad]"),
+        ("cp_offset", "--cp-offset", _number, "center of pressure ahead of the mass center [m]"),
+    ],
+    "rotor": [
+        ("axial_inertia", "--axial-inertia", _number, "polar moment I1 [kg m^2]"),
+        ("transverse_inertia", "--transverse-inertia", _number, "transverse moment I2 [kg m^2]"),
+        ("stiffness", "--stiffness", _number, "bearing stiffness k [N/m]"),
+        ("bearing_distance", "--bearing-distance", _number, "mass center to bearing l [m]"),
+        ("rate", "--rate", _number, "spin rate [rad/s]"),
+    ],
+    "gyrostat": [
+        ("inertia", "--inertia", _floats((3, 9)), "platform + wheel (locked) [kg m^2]"),
+        ("axis", "--axis", _floats((3,)), "wheel and spin axis, body frame"),
+        ("rate", "--rate", _number, "platform spin rate [rad/s]"),
+        ("wheel_momentum", "--wheel-momentum", _number,
+         "wheel momentum relative to the platform [N m s]"),
+    ],
+}
+_EXTRA = {
+    "spin": [("damper", "--damper", None, "energy damper: point KEY=V ... | sphere KEY=V ...")],
+    "heavy-top": [("gravity", "--gravity", _number, "gravity [m/s^2] (9.80665)")],
+    "projectile": [],
+    "rotor": [("internal_damping", "--internal-damping", _number, "rotating damping D [N m s]")],
+    "gyrostat": [("wheel_inertia", "--wheel-inertia", _number, "wheel axial inertia [kg m^2]"),
+                 ("damper", "--damper", None, "energy damper: point KEY=V ... | sphere KEY=V ..."),
+                 ("damper_on", "--damper-on", None, "platform (default) or rotor")],
+}
+
+
+def _add_case_options(parser, case, *, sweeping):
+    for dest, flag, typ, help_ in _OPTIONS[case]:
+        parser.add_argument(flag, dest=dest, type=typ, required=not sweeping, help=help_)
+    for dest, flag, typ, help_ in _EXTRA[case]:
+        if dest == "damper":
+            parser.add_argument(flag, dest=dest, nargs="+", metavar="ITEM", help=help_)
+        elif dest == "damper_on":
+            parser.add_argument(flag, dest=dest, choices=["platform", "rotor"], help=help_)
+        else:
+            parser.add_argument(flag, dest=dest, type=typ, help=help_)
+    parser.add_argument("--json", metavar="FILE", help="write the report as JSON")
+    parser.add_argument("--plot", metavar="FILE.png",
+                        help="save the pole map (sweep: eigenvalues vs the parameter)")
+
+
+def add_stability_parser(subparsers) -> argparse.ArgumentParser:
+    """Add ``stability`` to ``subparsers`` (from ``parser.add_subparsers(dest="command")``).
+
+    The chosen case lands in ``args.case`` (``spin``, ``heavy-top``, ``projectile``,
+    ``rotor``, ``gyrostat``, ``sweep``); under ``sweep`` the swept case is ``args.sweep_case``.
+    Hand the parsed arguments to `run`.
+    """
+    stab = subparsers.add_parser("stability", help="linear stability reports of spinning bodies")
+    cases = stab.add_subparsers(dest="case", required=True)
+    helps = {"spin": "torque-free spin about a principal axis (optional damper)",
+             "heavy-top": "heavy top, seed Sec. 4.6 Method III (sleeping top, precession)",
+             "projectile": "spin-stabilized projectile (aerodynamic overturning moment)",
+             "rotor": "rotor in elastic bearings: whirl and internal-damping instability",
+             "gyrostat": "dual-spin gyrostat vs wheel momentum (optional damper)"}
+    for case, help_ in helps.items():
+        _add_case_options(cases.add_parser(case, help=help_), case, sweeping=False)
+    sw = cases.add_parser("sweep", help="verdict and least-damped eigenvalue along a parameter")
+    sw_cases = sw.add_subparsers(dest="sweep_case", required=True)
+    for case, help_ in helps.items():
+        p = sw_cases.add_parser(case, help=help_)
+        p.add_argument("--parameter", required=True,
+                       help="argument to sweep, e.g. rate, wheel-momentum, mass")
+        p.add_argument("--values", required=True, metavar="START:STOP:NUM|V1,V2,...",
+                       help="NUM evenly spaced values from START to STOP, or a list "
+                            "(a negative START needs --values=-1:1:5)")
+        p.add_argument("--rtol", type=_number, default=1e-8,
+                       help="relative bracket of the boundary bisection (1e-8)")
+        _add_case_options(p, case, sweeping=True)
+    return stab
+
+
+def _values(text):
+    if ":" in text:
+        parts = text.split(":")
+        if len(parts) != 3:
+            raise ValueError(f"`--values` must be START:STOP:NUM, got {text!r}")
+        try:
+            a, b, n = float(parts[0]), float(parts[1]), int(parts[2])
+        except ValueError:
+            raise ValueError(f"`--values` must be START:STOP:NUM, got {text!r}") from None
+        if n < 1:
+            raise ValueError(f"`--values` NUM must be at least 1, got {n}")
+        return np.linspace(a, b, n)
+    try:
+        return np.array([float(v) for v in text.split(",") if v != ""])
+    except ValueError:
+        raise ValueError(f"`--values` must be numbers, got {text!r}") from None
+
+
+def _case_kwargs(args, case) -> dict:
+    kwargs = {}
+    for dest, *_ in _OPTIONS[case] + _EXTRA[case]:
+        value = getattr(args, dest, None)
+        if value is None:
+            continue
+        if dest == "inertia":
+            value = _inertia(value)
+        elif dest == "damper":
+            value = parse_damper(value)
+        kwargs[dest] = value
+    return kwargs
+
+
+def _outputs(result, args) -> None:
+    write_outputs(result, plot=args.plot, json=args.json)
+
+
+def run(args) -> int:
+    """Execute parsed ``stability`` arguments: print the report, write ``--json``/``--plot``.
+
+    Returns 0 (the verdict is in the report, not the exit status). ``ValueError`` from bad
+    input propagates (``problems.cli.main`` turns it into exit status 2).
+    """
+    from . import stability as st  # imported on use: building the parser stays light
+
+    if args.case == "sweep":
+        case = args.sweep_case
+        kwargs = _case_kwargs(args, case)
+        parameter = args.parameter.replace("-", "_")
+        kwargs.pop(parameter, None)
+        missing = [flag for dest, flag, *_ in _OPTIONS[case]
+                   if dest not in kwargs and dest != parameter]
+        if missing:
+            raise ValueError(f"sweep {case} needs {', '.join(missing)} (all but the swept "
+                             f"--{args.parameter})")
+        result = st.sweep(CASE_NAMES[case], parameter, _values(args.values), rtol=args.rtol,
+                          **kwargs)
+    else:
+        result = st.CASES[CASE_NAMES[args.case]](**_case_kwargs(args, args.case))
+    print(result)
+    _outputs(result, args)
+    return 0
+
+
+def main(argv=None) -> int:
+    """Standalone entry: ``python -m problems.stability_cli spin --inertia ...``."""
+    parser = argparse.ArgumentParser(prog="appdyn")
+    sub = parser.add_subparsers(dest="command", required=True)
+    add_stability_parser(sub)
+    args = parser.parse_args(["stability", *(sys.argv[1:] if argv is None else argv)])
+    try:
+        return run(args)
+    except ValueError as exc:
+        parser.exit(2, f"appdyn: error: {exc}\n")
+
+
+if __name__ == "__main__":
+    sys.exit(main())
