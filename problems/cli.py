@@ -155,6 +155,24 @@ def _cmd_demo(args) -> int:
     eig = slew.eigenaxis_time(np.eye(3), np.pi, [0, 0, 1])
     print(slew.format_summary(slew.summary(sol, eigenaxis=eig)))
     print("  (best known T = 3.2430; the eigenaxis maneuver is a local optimum)")
+
+    from problems import stability
+
+    print("\n== 3. Stability: Explorer I's lesson (Kelvin-Tait-Chetaev, seed Sec. 4.5 NOTE) ==")
+    # a point mass on a spring along the spin axis, mounted off-axis: it moves with nutation
+    for axis, mount, label in (([1, 0, 0], [0, 0.6, 0], "minor"), ([0, 0, 1], [0.6, 0, 0], "major")):
+        rigid = stability.spin([2.0, 3.0, 4.5], axis, 4.0)
+        damper = stability.PointMassDamper(mass=0.5, stiffness=60.0, damping=0.8,
+                                           position=mount, direction=axis)
+        damped = stability.spin([2.0, 3.0, 4.5], axis, 4.0, damper=damper)
+        print(f"  spin about the {label} axis at 4 rad/s: rigid {rigid.verdict}, "
+              f"with a nutation damper {damped.verdict}")
+    print("\n== 4. Sleeping top: stability boundary located by bisection (Eq. 4.128) ==")
+    res = stability.sweep("heavy_top", "rate", np.linspace(0, 60, 7), axial_inertia=0.002,
+                          transverse_inertia=0.005, mass=0.3, length=0.04)
+    b = res.boundaries[0]
+    print(f"  {b.before} -> {b.after} at w0 = {b.value:.9f} rad/s; closed form "
+          f"(2/I1) sqrt(m g l I2) = {2 / 0.002 * np.sqrt(0.3 * 9.80665 * 0.04 * 0.005):.9f}")
     return 0 if report.success and sol.success else 1
 
 
