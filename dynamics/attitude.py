@@ -16,6 +16,26 @@ Every function works on numpy arrays and on CasADi ``SX``/``MX``/``DM`` alike. A
 **components first**: a quaternion is shape ``(4,)`` or, for a batch, ``(4, n)``; a DCM is
 ``(3, 3)`` or ``(3, 3, n)``; Euler angle triples are ``(3,)`` or ``(3, n)``. CasADi inputs are
 column vectors (``4x1``, ``3x1``) and ``3x3`` matrices.
+
+Input checks (`dynamics.validate`): numeric arguments (numpy arrays, lists, numbers and CasADi
+``DM``) are checked on every call; symbolic ``SX``/``MX`` arguments pass through untouched
+(only their shape is checked), so the functions keep working inside CasADi graphs. A wrong
+kind of object (string, dict, ``None``, complex, boolean) raises ``TypeError``; a wrong shape
+or value raises ``ValueError`` naming the argument (for a batch, the first bad column, e.g.
+``q[:, 3]``). What each function accepts:
+
+* every number must be finite (no NaN, no infinity);
+* a quaternion that stands for an *attitude* (``dcm_from_quat``, ``rotation_angle``,
+  ``axis_angle_from_quat``, ``propagate_quat``, ``euler313_from_quat``,
+  ``euler321_from_quat``) must have unit norm to ``validate.QUAT_NORM_TOL`` (1e-6); it is
+  then normalized before use;
+* quaternion *algebra* (``quat_mul``, ``quat_conj``, ``quat_rate``) accepts any finite
+  quaternion, since it also acts on rates ``qdot`` and on states off the unit sphere;
+  ``quat_normalize`` accepts any finite non-zero quaternion;
+* a DCM argument must be a proper rotation: orthogonal to ``validate.DCM_ORTHO_TOL`` (1e-6,
+  ``max |A A^T - E|``) with ``det A = +1``;
+* a rotation axis must be a finite non-zero 3-vector (normalized here); angles, rates and
+  time steps must be finite.
 """
 from __future__ import annotations
 
@@ -23,6 +43,8 @@ import itertools
 
 import casadi as ca
 import numpy as np
+
+from . import validate
 
 __all__ = [
     "skew",
@@ -100,35 +122,53 @@ def _ops(*args):
     return _CasadiOps if any(isinstance(a, _CA_TYPES) for a in args) else _NumpyOps
 
 
-def _vec(x, n, name):
-    """Validate a length-``n`` vector (or components-first batch) argument."""
+def _arg(x, name, shape, check):
+    """Validate one argument: numbers by ``check(x, name)``, CasADi by shape.
+
+    ``SX``/``MX`` symbols pass through untouched (only their shape is checked); a ``DM`` holds
+    numbers, so its values are checked by ``check`` too, and it is returned as a DM (CasADi in,
+    CasADi out). ``shape`` is the numpy shape of one item: ``(n,)`` means an ``n x 1`` CasADi
+    column, ``()`` a ``1 x 1`` scalar.
+    """
     if isinstance(x, _CA_TYPES):
-        if x.shape != (n, 1):
-            raise ValueError(f"`{name}` must be a {n}x1 CasADi column, got shape {x.shape}")
+        want = shape if len(shape) == 2 else ((shape[0], 1) if shape else (1, 1))
+        if x.shape != want:
+            kind = {(1, 1): "scalar (1x1)"}.get(want, f"{want[0]}x{want[1]} CasADi "
+                                                     + ("column" if want[1] == 1 else "matrix"))
+            raise ValueError(f"`{name}` must be a {kind}, got shape {x.shape}")
+        if isinstance(x, ca.DM):
+            check(x, name)
         return x
-    a = np.asarray(x, dtype=float)
-    if a.ndim == 0 or a.shape[0] != n:
-        raise ValueError(f"`{name}` must have shape ({n},) or ({n}, ...), got {a.shape}")
-    return a
+    return check(x, name)
 
 
-def _mat3(A, name="A"):
-    if isinstance(A, _CA_TYPES):
-        if A.shape != (3, 3):
-            raise ValueError(f"`{name}` must be a 3x3 CasADi matrix, got shape {A.shape}")
-        return A
-    a = np.asarray(A, dtype=float)
-    if a.ndim < 2 or a.shape[:2] != (3, 3):
-        raise ValueError(f"`{name}` must have shape (3, 3) or (3, 3, ...), got {a.shape}")
-    return a
+# numeric checks of the argument kinds used below (components first, batches allowed)
+def _finite3(x, name):
+    return validate.finite_array(x, name, (3,), batch=True)
 
 
-def _scalar(x, name):
-    if isinstance(x, _CA_TYPES):
-        if x.numel() != 1:
-            raise ValueError(f"`{name}` must be a scalar, got shape {x.shape}")
-        return x
-    return np.asarray(x, dtype=float)
+def _finite4(x, name):
+    return validate.finite_array(x, name, (4,), batch=True)
+
+
+def _unit_q(x, name):
+    return validate.unit_quaternions(x, name, normalize=True)
+
+
+def _rotation(x, name):
+    return validate.rotation_matrix(x, name, batch=True)
+
+
+def _finite_any(x, name):
+    return validate.finite_array(x, name)
+
+
+def _nonzero3(x, name):
+    return validate.unit_vector(x, name, batch=True)
+
+
+def _nonzero4(x, name):
+    return validate.unit_vector(x, name, size=4, batch=True)
 
 
 # ----------------------------------------------------------------------- quaternions
@@ -142,8 +182,15 @@ def skew(v):
     Returns
     -------
     shape (3, 3) or (3, 3, n)
+
+    Raises
+    ------
+    TypeError
+        If an argument is not real numbers (e.g. a string, a dict or ``None``).
+    ValueError
+        If ``v`` does not have 3 components or is not finite.
     """
-    v = _vec(v, 3, "v")
+    v = _arg(v, "v", (3,), _finite3)
     o = _ops(v)
     z = 0 * v[0]
     return o.matrix([[z, -v[2], v[1]], [v[2], z, -v[0]], [-v[1], v[0], z]])
@@ -154,6 +201,9 @@ def quat_mul(q, p):
 
     ``quat_mul(q, p) = [q4 pv + p4 qv - qv x pv, q4 p4 - qv . pv]``.
 
+    Any finite quaternions are accepted (not only unit ones): the product is also used on
+    quaternion rates, e.g. ``w = 2 vec(quat_mul(qdot, quat_conj(q)))``.
+
     Parameters
     ----------
     q, p : array_like, shape (4,) or (4, n), or CasADi 4x1
@@ -161,8 +211,15 @@ def quat_mul(q, p):
     Returns
     -------
     shape (4,) or (4, n)
+
+    Raises
+    ------
+    TypeError
+        If an argument is not real numbers (e.g. a string, a dict or ``None``).
+    ValueError
+        If ``q`` or ``p`` does not have 4 components or is not finite.
     """
-    q, p = _vec(q, 4, "q"), _vec(p, 4, "p")
+    q, p = _arg(q, "q", (4,), _finite4), _arg(p, "p", (4,), _finite4)
     o = _ops(q, p)
     q1, q2, q3, q4 = q[0], q[1], q[2], q[3]
     p1, p2, p3, p4 = p[0], p[1], p[2], p[3]
@@ -177,19 +234,49 @@ def quat_mul(q, p):
 
 
 def quat_conj(q):
-    """Conjugate (inverse rotation of a unit quaternion): ``[-qv, q4]``."""
-    q = _vec(q, 4, "q")
+    """Conjugate (inverse rotation of a unit quaternion): ``[-qv, q4]``.
+
+    Parameters
+    ----------
+    q : array_like, shape (4,) or (4, n), or CasADi 4x1 — any finite quaternion
+
+    Returns
+    -------
+    shape (4,) or (4, n)
+
+    Raises
+    ------
+    TypeError
+        If an argument is not real numbers (e.g. a string, a dict or ``None``).
+    ValueError
+        If ``q`` does not have 4 components or is not finite.
+    """
+    q = _arg(q, "q", (4,), _finite4)
     return _ops(q).stack([-q[0], -q[1], -q[2], q[3]])
 
 
 def quat_normalize(q):
-    """Scale ``q`` to unit norm. Raises ``ValueError`` for a numeric zero quaternion."""
-    q = _vec(q, 4, "q")
-    o = _ops(q)
-    n = o.sqrt(o.sumsq(q))
-    if o is _NumpyOps and np.any(n == 0):
-        raise ValueError("`q` must be non-zero to normalize")
-    return q / n
+    """Scale ``q`` to unit norm (column by column for a batch).
+
+    Parameters
+    ----------
+    q : array_like, shape (4,) or (4, n), or CasADi 4x1 — any finite non-zero quaternion
+
+    Returns
+    -------
+    shape (4,) or (4, n), unit norm
+
+    Raises
+    ------
+    TypeError
+        If an argument is not real numbers (e.g. a string, a dict or ``None``).
+    ValueError
+        If ``q`` does not have 4 components, is not finite, or is zero (numeric input).
+    """
+    if isinstance(q, _CA_TYPES):
+        q = _arg(q, "q", (4,), _nonzero4)
+        return q / ca.sqrt(ca.sumsqr(q))
+    return validate.unit_vector(q, "q", size=4, batch=True)
 
 
 def quat_kinematics_matrix(w):
@@ -204,8 +291,15 @@ def quat_kinematics_matrix(w):
     Returns
     -------
     shape (4, 4)
+
+    Raises
+    ------
+    TypeError
+        If an argument is not real numbers (e.g. a string, a dict or ``None``).
+    ValueError
+        If ``w`` does not have 3 components or is not finite.
     """
-    w = _vec(w, 3, "w")
+    w = _arg(w, "w", (3,), _finite3)
     o = _ops(w)
     w1, w2, w3 = w[0], w[1], w[2]
     z = 0 * w1
@@ -217,16 +311,26 @@ def quat_kinematics_matrix(w):
 def quat_rate(q, w):
     """Quaternion derivative ``qdot = -1/2 Wbar(w) q`` (Eq. 4.70), written out.
 
+    A linear map of ``q``: any finite ``q`` is accepted (integrators evaluate it off the unit
+    sphere, too).
+
     Parameters
     ----------
-    q : shape (4,) or (4, n) — attitude quaternion
-    w : shape (3,) or (3, n) — body angular velocity [rad/s]
+    q : shape (4,) or (4, n), or CasADi 4x1 — attitude quaternion
+    w : shape (3,) or (3, n), or CasADi 3x1 — body angular velocity [rad/s]
 
     Returns
     -------
     shape (4,) or (4, n) [1/s]
+
+    Raises
+    ------
+    TypeError
+        If an argument is not real numbers (e.g. a string, a dict or ``None``).
+    ValueError
+        If ``q`` or ``w`` has the wrong number of components or is not finite.
     """
-    q, w = _vec(q, 4, "q"), _vec(w, 3, "w")
+    q, w = _arg(q, "q", (4,), _finite4), _arg(w, "w", (3,), _finite3)
     o = _ops(q, w)
     q1, q2, q3, q4 = q[0], q[1], q[2], q[3]
     w1, w2, w3 = w[0], w[1], w[2]
@@ -243,7 +347,10 @@ def quat_rate(q, w):
 def dcm_from_quat(q):
     """Direction cosine matrix of Eq. 4.63 (inertial -> body components).
 
-    For a non-unit ``q`` the result is ``|q|^2`` times a rotation (no normalization).
+    A numeric ``q`` must be a unit quaternion (to ``validate.QUAT_NORM_TOL``); it is
+    normalized before use, so the result is orthogonal to round-off. For a CasADi symbol the
+    formula is applied as it stands: for a non-unit ``q`` its value is ``|q|^2`` times a
+    rotation (no normalization).
 
     Parameters
     ----------
@@ -252,8 +359,16 @@ def dcm_from_quat(q):
     Returns
     -------
     A : shape (3, 3) or (3, 3, n)
+
+    Raises
+    ------
+    TypeError
+        If an argument is not real numbers (e.g. a string, a dict or ``None``).
+    ValueError
+        If ``q`` does not have 4 components, or (numeric) a column is not finite or not of
+        unit norm.
     """
-    q = _vec(q, 4, "q")
+    q = _arg(q, "q", (4,), _unit_q)
     q1, q2, q3, q4 = q[0], q[1], q[2], q[3]
     return _ops(q).matrix(
         [
@@ -284,9 +399,17 @@ def quat_from_dcm(A):
 
     Returns
     -------
-    q : shape (4,) or (4, n), unit norm, ``q4 >= 0``
+    q : shape (4,) or (4, n), unit norm (to the orthogonality of ``A``), ``q4 >= 0``
+
+    Raises
+    ------
+    TypeError
+        If an argument is not real numbers (e.g. a string, a dict or ``None``).
+    ValueError
+        If ``A`` is not 3x3, or (numeric) not finite, not orthogonal to
+        ``validate.DCM_ORTHO_TOL`` or not of determinant +1.
     """
-    A = _mat3(A)
+    A = _arg(A, "A", (3, 3), _rotation)
     o = _ops(A)
     a = [[A[i, j] for j in range(3)] for i in range(3)]
     tr = a[0][0] + a[1][1] + a[2][2]
@@ -312,12 +435,10 @@ def quat_from_dcm(A):
 
 
 def _unit_axis(axis, name="axis"):
-    axis = _vec(axis, 3, name)
-    o = _ops(axis)
-    n = o.sqrt(o.sumsq(axis))
-    if o is _NumpyOps and np.any(n == 0):
-        raise ValueError(f"`{name}` must be a non-zero vector")
-    return axis / n
+    if isinstance(axis, _CA_TYPES):
+        axis = _arg(axis, name, (3,), _nonzero3)
+        return axis / ca.sqrt(ca.sumsqr(axis))
+    return validate.unit_vector(axis, name, batch=True)
 
 
 def dcm_from_axis_angle(axis, angle):
@@ -327,15 +448,22 @@ def dcm_from_axis_angle(axis, angle):
 
     Parameters
     ----------
-    axis : array_like, shape (3,) — rotation axis (normalized here)
-    angle : float [rad]
+    axis : array_like, shape (3,), or CasADi 3x1 — rotation axis (normalized here)
+    angle : float [rad], or CasADi scalar
 
     Returns
     -------
     A : shape (3, 3)
+
+    Raises
+    ------
+    TypeError
+        If an argument is not real numbers (e.g. a string, a dict or ``None``).
+    ValueError
+        If ``axis`` is not 3 finite numbers or is zero, or ``angle`` is not finite.
     """
     e = _unit_axis(axis)
-    d = _scalar(angle, "angle")
+    d = _arg(angle, "angle", (), _finite_any)
     o = _ops(e, d)
     c, s = o.cos(d), o.sin(d)
     ca_, cb, cg = e[0], e[1], e[2]  # direction cosines cos(alpha), cos(beta), cos(gamma)
@@ -353,15 +481,22 @@ def quat_from_axis_angle(axis, angle):
 
     Parameters
     ----------
-    axis : array_like, shape (3,) — rotation axis (normalized here)
-    angle : float or array (n,) [rad]
+    axis : array_like, shape (3,), or CasADi 3x1 — rotation axis (normalized here)
+    angle : float or array (n,) [rad], or CasADi scalar
 
     Returns
     -------
     q : shape (4,) or (4, n)
+
+    Raises
+    ------
+    TypeError
+        If an argument is not real numbers (e.g. a string, a dict or ``None``).
+    ValueError
+        If ``axis`` is not 3 finite numbers or is zero, or ``angle`` is not finite.
     """
     e = _unit_axis(axis)
-    d = _scalar(angle, "angle")
+    d = _arg(angle, "angle", (), _finite_any)
     o = _ops(e, d)
     s, c = o.sin(d / 2), o.cos(d / 2)
     return o.stack([e[0] * s, e[1] * s, e[2] * s, c])
@@ -371,8 +506,24 @@ def rotation_angle(q):
     """Rotation angle ``delta`` in ``[0, pi]`` of a unit quaternion (``q`` and ``-q`` agree).
 
     Computed as ``2 atan2(|qv|, |q4|)``, accurate also near 0 and pi.
+
+    Parameters
+    ----------
+    q : array_like, shape (4,) or (4, n), or CasADi 4x1 — unit quaternion
+
+    Returns
+    -------
+    float or shape (n,) [rad]
+
+    Raises
+    ------
+    TypeError
+        If an argument is not real numbers (e.g. a string, a dict or ``None``).
+    ValueError
+        If ``q`` does not have 4 components, or (numeric) a column is not finite or not of
+        unit norm.
     """
-    q = _vec(q, 4, "q")
+    q = _arg(q, "q", (4,), _unit_q)
     o = _ops(q)
     nv = o.sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2])
     return 2 * o.arctan2(nv, o.fabs(q[3]))
@@ -389,11 +540,16 @@ def axis_angle_from_quat(q):
     -------
     axis : ndarray, shape (3,) — unit vector (``[1, 0, 0]`` for the identity)
     angle : float [rad]
+
+    Raises
+    ------
+    TypeError
+        If ``q`` is symbolic or not numbers.
+    ValueError
+        If ``q`` is not 4 finite numbers of unit norm (to ``validate.QUAT_NORM_TOL``).
     """
-    q = np.asarray(_vec(q, 4, "q"), dtype=float)
-    if q.ndim != 1:
-        raise ValueError(f"`q` must have shape (4,), got {q.shape}")
-    q = q / np.linalg.norm(q)
+    q = validate.finite_array(q, "q", (4,))
+    q = validate.unit_quaternions(q, "q", normalize=True)
     if q[3] < 0:
         q = -q
     nv = np.linalg.norm(q[:3])
@@ -411,17 +567,32 @@ def propagate_quat(q, w, h):
 
     Parameters
     ----------
-    q : shape (4,) or CasADi 4x1 — quaternion at the start of the step
+    q : shape (4,) or CasADi 4x1 — unit quaternion at the start of the step
     w : shape (3,) or CasADi 3x1 — constant body angular velocity [rad/s]
-    h : float — step [s]
+    h : float or CasADi scalar — step [s]
 
     Returns
     -------
     shape (4,) — quaternion after the step
+
+    Raises
+    ------
+    TypeError
+        If an argument is not real numbers (e.g. a string, a dict or ``None``).
+    ValueError
+        If (numeric) ``q`` is not a finite unit quaternion, ``w`` or ``h`` is not finite,
+        or ``|w| h`` is too large to represent.
     """
-    q, w = _vec(q, 4, "q"), _vec(w, 3, "w")
-    h = _scalar(h, "h")
+    q, w = _arg(q, "q", (4,), _unit_q), _arg(w, "w", (3,), _finite3)
+    h = _arg(h, "h", (), _finite_any)
     o = _ops(q, w, h)
+    if o is _NumpyOps:
+        with np.errstate(over="ignore", invalid="ignore"):
+            big = ~np.isfinite(np.sum(w * w, axis=0) * h * h)
+        if np.any(big):
+            raise ValueError(f"`w` and `h` are too large: |w|^2 h^2 is not representable "
+                             f"(max |w_i| = {np.max(np.abs(w)):.3g} rad/s, "
+                             f"max |h| = {np.max(np.abs(h)):.3g} s)")
     wn2 = o.sumsq(w)
     x2 = wn2 * h * h / 4  # (|w| h / 2)^2
     small = x2 < 1e-8
@@ -439,16 +610,22 @@ def dcm_axis(axis: int, angle):
 
     Parameters
     ----------
-    axis : {1, 2, 3}
-    angle : float [rad]
+    axis : {1, 2, 3} — an int (numpy integers too; not a float or bool)
+    angle : float or array (n,) [rad], or CasADi scalar
 
     Returns
     -------
-    shape (3, 3)
+    shape (3, 3) or (3, 3, n)
+
+    Raises
+    ------
+    TypeError
+        If ``axis`` is not an integer.
+    ValueError
+        If ``axis`` is not 1, 2 or 3, or ``angle`` is not finite.
     """
-    if axis not in (1, 2, 3):
-        raise ValueError(f"`axis` must be 1, 2 or 3, got {axis!r}")
-    d = _scalar(angle, "angle")
+    axis = validate.one_of(axis, "axis", (1, 2, 3))
+    d = _arg(angle, "angle", (), _finite_any)
     o = _ops(d)
     c, s = o.cos(d), o.sin(d)
     one, z = 1 + 0 * d, 0 * d
@@ -462,7 +639,7 @@ def dcm_axis(axis: int, angle):
 
 
 def _angles(angles, name="angles"):
-    a = _vec(angles, 3, name)
+    a = _arg(angles, name, (3,), _finite3)
     return a[0], a[1], a[2]
 
 
@@ -476,6 +653,13 @@ def dcm_from_euler313(angles):
     Returns
     -------
     A : shape (3, 3) or (3, 3, n)
+
+    Raises
+    ------
+    TypeError
+        If an argument is not real numbers (e.g. a string, a dict or ``None``).
+    ValueError
+        If ``angles`` does not have 3 components or is not finite.
     """
     psi, th, phi = _angles(angles)
     o = _ops(psi)
@@ -505,8 +689,20 @@ def euler313_from_dcm(A):
     Returns
     -------
     shape (3,) or (3, n) [rad]
+
+    Raises
+    ------
+    TypeError
+        If an argument is not real numbers (e.g. a string, a dict or ``None``).
+    ValueError
+        If ``A`` is not 3x3, or (numeric) not finite, not orthogonal to
+        ``validate.DCM_ORTHO_TOL`` or not of determinant +1.
     """
-    A = _mat3(A)
+    return _euler313(_arg(A, "A", (3, 3), _rotation))
+
+
+def _euler313(A):
+    """`euler313_from_dcm` without the input check."""
     o = _ops(A)
     psi = o.arctan2(A[2, 0], -A[2, 1])
     c, s = o.cos(psi), o.sin(psi)
@@ -521,6 +717,21 @@ def quat_from_euler313(angles):
     ``q = [sin(t/2) cos((psi-phi)/2), sin(t/2) sin((psi-phi)/2),
            cos(t/2) sin((psi+phi)/2), cos(t/2) cos((psi+phi)/2)]``
     (not sign-normalized: ``q4`` may be negative).
+
+    Parameters
+    ----------
+    angles : array_like, shape (3,) or (3, n) [rad], or CasADi 3x1
+
+    Returns
+    -------
+    q : shape (4,) or (4, n)
+
+    Raises
+    ------
+    TypeError
+        If an argument is not real numbers (e.g. a string, a dict or ``None``).
+    ValueError
+        If ``angles`` does not have 3 components or is not finite.
     """
     psi, th, phi = _angles(angles)
     o = _ops(psi)
@@ -530,8 +741,25 @@ def quat_from_euler313(angles):
 
 
 def euler313_from_quat(q):
-    """Classical 3-1-3 angles from a unit quaternion (via the DCM)."""
-    return euler313_from_dcm(dcm_from_quat(q))
+    """Classical 3-1-3 angles from a unit quaternion (via the DCM).
+
+    Parameters
+    ----------
+    q : array_like, shape (4,) or (4, n), or CasADi 4x1 — unit quaternion
+
+    Returns
+    -------
+    shape (3,) or (3, n) [rad]
+
+    Raises
+    ------
+    TypeError
+        If an argument is not real numbers (e.g. a string, a dict or ``None``).
+    ValueError
+        If ``q`` does not have 4 components, or (numeric) a column is not finite or not of
+        unit norm.
+    """
+    return _euler313(dcm_from_quat(q))
 
 
 def dcm_from_euler321(angles):
@@ -544,6 +772,13 @@ def dcm_from_euler321(angles):
     Returns
     -------
     A : shape (3, 3) or (3, 3, n)
+
+    Raises
+    ------
+    TypeError
+        If an argument is not real numbers (e.g. a string, a dict or ``None``).
+    ValueError
+        If ``angles`` does not have 3 components or is not finite.
     """
     psi, th, phi = _angles(angles)
     o = _ops(psi)
@@ -572,8 +807,20 @@ def euler321_from_dcm(A):
     Returns
     -------
     shape (3,) or (3, n) [rad]
+
+    Raises
+    ------
+    TypeError
+        If an argument is not real numbers (e.g. a string, a dict or ``None``).
+    ValueError
+        If ``A`` is not 3x3, or (numeric) not finite, not orthogonal to
+        ``validate.DCM_ORTHO_TOL`` or not of determinant +1.
     """
-    A = _mat3(A)
+    return _euler321(_arg(A, "A", (3, 3), _rotation))
+
+
+def _euler321(A):
+    """`euler321_from_dcm` without the input check."""
     o = _ops(A)
     psi = o.arctan2(A[0, 1], A[0, 0])
     c, s = o.cos(psi), o.sin(psi)
@@ -583,7 +830,23 @@ def euler321_from_dcm(A):
 
 
 def quat_from_euler321(angles):
-    """Quaternion from modern 3-2-1 angles (Sec. 4.3 d D); ``q4`` may be negative."""
+    """Quaternion from modern 3-2-1 angles (Sec. 4.3 d D); ``q4`` may be negative.
+
+    Parameters
+    ----------
+    angles : array_like, shape (3,) or (3, n) [rad], or CasADi 3x1
+
+    Returns
+    -------
+    q : shape (4,) or (4, n)
+
+    Raises
+    ------
+    TypeError
+        If an argument is not real numbers (e.g. a string, a dict or ``None``).
+    ValueError
+        If ``angles`` does not have 3 components or is not finite.
+    """
     psi, th, phi = _angles(angles)
     o = _ops(psi)
     s1, c1 = o.sin(psi / 2), o.cos(psi / 2)
@@ -600,8 +863,25 @@ def quat_from_euler321(angles):
 
 
 def euler321_from_quat(q):
-    """Modern 3-2-1 angles from a unit quaternion (via the DCM)."""
-    return euler321_from_dcm(dcm_from_quat(q))
+    """Modern 3-2-1 angles from a unit quaternion (via the DCM).
+
+    Parameters
+    ----------
+    q : array_like, shape (4,) or (4, n), or CasADi 4x1 — unit quaternion
+
+    Returns
+    -------
+    shape (3,) or (3, n) [rad]
+
+    Raises
+    ------
+    TypeError
+        If an argument is not real numbers (e.g. a string, a dict or ``None``).
+    ValueError
+        If ``q`` does not have 4 components, or (numeric) a column is not finite or not of
+        unit norm.
+    """
+    return _euler321(dcm_from_quat(q))
 
 
 # --------------------------------------------------------------------- principal axes
@@ -629,15 +909,16 @@ def principal_axes(inertia, *, order="nearest"):
 
     Raises
     ------
+    TypeError
+        If ``inertia`` is not numbers or ``order`` is not a string.
     ValueError
         If ``inertia`` is not a finite, symmetric, positive definite 3x3 matrix, or ``order``
         is unknown.
     """
     from .rigid_body import check_inertia  # local import: rigid_body imports this module
 
-    inertia = check_inertia(inertia, triangle=False)
-    if order not in ("nearest", "ascending", "descending"):
-        raise ValueError(f"`order` must be 'nearest', 'ascending' or 'descending', got {order!r}")
+    inertia = check_inertia(validate.finite_array(inertia, "inertia"), triangle=False)
+    order = validate.one_of(order, "order", ("nearest", "ascending", "descending"))
     vals, vecs = np.linalg.eigh(inertia)  # ascending
     perms = list(itertools.permutations(range(3)))
     if order == "ascending":

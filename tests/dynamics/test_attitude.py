@@ -320,7 +320,7 @@ def test_batched_numpy_inputs():
     [
         (lambda: at.dcm_from_quat([1, 0, 0]), "`q` must have shape"),
         (lambda: at.quat_from_dcm(np.eye(2)), "`A` must have shape"),
-        (lambda: at.quat_normalize([0, 0, 0, 0]), "`q` must be non-zero"),
+        (lambda: at.quat_normalize([0, 0, 0, 0]), "`q` must be a non-zero"),
         (lambda: at.dcm_from_axis_angle([0, 0, 0], 1.0), "`axis` must be a non-zero"),
         (lambda: at.dcm_axis(4, 0.1), "`axis` must be 1, 2 or 3"),
         (lambda: at.propagate_quat([0, 0, 0, 1], [1, 2], 0.1), "`w` must have shape"),
@@ -347,3 +347,227 @@ def test_propagate_quat_matches_simulation_of_a_spinning_sphere():
         res = simulate(rigid_body([2.0, 2.0, 2.0]), np.r_[q0, w], t, method=method, **kw)
         assert res.success, res.message
         np.testing.assert_allclose(res.x[:4], expected, atol=1e-9, err_msg=method)
+
+
+# ------------------------------------------------------------- input validation (item 7)
+# A valid call of every public function, by keyword, so each argument can be spoiled in turn.
+_Q = unit_quat([0.1, -0.2, 0.3, 0.9])
+_P = unit_quat([-0.5, 0.4, 0.1, 0.3])
+_W = np.array([0.7, -1.1, 0.4])
+_E = np.array([0.3, 1.1, -2.0])
+_A = Rotation.from_quat(_Q).as_matrix().T  # independent DCM of _Q (scipy's is active: A = R^T)
+VALID_CALLS = {
+    "skew": (at.skew, dict(v=_W)),
+    "quat_mul": (at.quat_mul, dict(q=_Q, p=_P)),
+    "quat_conj": (at.quat_conj, dict(q=_Q)),
+    "quat_normalize": (at.quat_normalize, dict(q=2 * _Q)),
+    "quat_kinematics_matrix": (at.quat_kinematics_matrix, dict(w=_W)),
+    "quat_rate": (at.quat_rate, dict(q=_Q, w=_W)),
+    "dcm_from_quat": (at.dcm_from_quat, dict(q=_Q)),
+    "quat_from_dcm": (at.quat_from_dcm, dict(A=_A)),
+    "dcm_from_axis_angle": (at.dcm_from_axis_angle, dict(axis=_W, angle=0.7)),
+    "quat_from_axis_angle": (at.quat_from_axis_angle, dict(axis=_W, angle=0.7)),
+    "axis_angle_from_quat": (at.axis_angle_from_quat, dict(q=_Q)),
+    "rotation_angle": (at.rotation_angle, dict(q=_Q)),
+    "propagate_quat": (at.propagate_quat, dict(q=_Q, w=_W, h=0.3)),
+    "dcm_axis": (at.dcm_axis, dict(axis=2, angle=0.7)),
+    "dcm_from_euler313": (at.dcm_from_euler313, dict(angles=_E)),
+    "euler313_from_dcm": (at.euler313_from_dcm, dict(A=_A)),
+    "quat_from_euler313": (at.quat_from_euler313, dict(angles=_E)),
+    "euler313_from_quat": (at.euler313_from_quat, dict(q=_Q)),
+    "dcm_from_euler321": (at.dcm_from_euler321, dict(angles=_E)),
+    "euler321_from_dcm": (at.euler321_from_dcm, dict(A=_A)),
+    "quat_from_euler321": (at.quat_from_euler321, dict(angles=_E)),
+    "euler321_from_quat": (at.euler321_from_quat, dict(q=_Q)),
+    "principal_axes": (at.principal_axes, dict(inertia=GEMINI)),
+}
+NUMERIC_ARGS = [(name, arg) for name, (_, kw) in VALID_CALLS.items() for arg in kw
+                if not (name == "dcm_axis" and arg == "axis")]
+ALL_ARGS = [(name, arg) for name, (_, kw) in VALID_CALLS.items() for arg in kw]
+
+
+def _spoil(value, bad):
+    """``value`` with its first entry replaced by ``bad``."""
+    a = np.array(value, dtype=float)
+    a.flat[0] = bad
+    return a
+
+
+def test_every_public_function_is_covered_by_the_validation_tests():
+    assert set(VALID_CALLS) == set(at.__all__)
+
+
+@pytest.mark.filterwarnings("error")
+@pytest.mark.parametrize("name, arg", NUMERIC_ARGS)
+@pytest.mark.parametrize("bad", [np.nan, np.inf, -np.inf])
+def test_non_finite_argument_is_value_error_naming_it(name, arg, bad):
+    fun, kw = VALID_CALLS[name]
+    with pytest.raises(ValueError, match=f"`{arg}` must be finite"):
+        fun(**{**kw, arg: _spoil(kw[arg], bad)})
+
+
+@pytest.mark.filterwarnings("error")
+@pytest.mark.parametrize("name, arg", ALL_ARGS)
+@pytest.mark.parametrize("bad", ["0.5", {"x": 1.0}, None, 1j, [True, False, True]],
+                         ids=["str", "dict", "None", "complex", "bool"])
+def test_wrong_type_argument_is_type_error_naming_it(name, arg, bad):
+    fun, kw = VALID_CALLS[name]
+    with pytest.raises(TypeError, match=f"`{arg}` must be"):
+        fun(**{**kw, arg: bad})
+
+
+@pytest.mark.filterwarnings("error")
+@pytest.mark.parametrize(
+    "call, error, match",
+    [   # seen on the issue "Trustworthy results", item 7: each returned numbers before
+        (lambda: at.quat_from_dcm(2 * np.eye(3)), ValueError, r"`A` must be a rotation matrix"),
+        (lambda: at.quat_from_dcm(np.zeros((3, 3))), ValueError, r"`A` must be a rotation matrix"),
+        (lambda: at.axis_angle_from_quat(np.zeros(4)), ValueError, r"`q` must be a unit .* norm 0"),
+        (lambda: at.rotation_angle(np.zeros(4)), ValueError, r"`q` must be a unit .* norm 0"),
+        (lambda: at.euler313_from_quat(np.zeros(4)), ValueError, r"`q` must be a unit .* norm 0"),
+        (lambda: at.euler321_from_dcm(np.ones((3, 3))), ValueError, r"`A` must be a rotation matrix"),
+        (lambda: at.quat_from_axis_angle([0, 0, 1], np.nan), ValueError, "`angle` must be finite"),
+        (lambda: at.quat_from_axis_angle([np.nan, 0, 1], 1.0), ValueError, "`axis` must be finite"),
+        (lambda: at.quat_normalize([np.nan, 0, 0, 1]), ValueError, "`q` must be finite"),
+        (lambda: at.propagate_quat([0, 0, 0, 1], [np.nan, 0, 0], 0.1), ValueError, "`w` must be finite"),
+        (lambda: at.propagate_quat([0, 0, 0, 1], [1, 0, 0], np.inf), ValueError, "`h` must be finite"),
+        (lambda: at.propagate_quat([np.nan, 0, 0, 1], [1, 0, 0], 0.1), ValueError, "`q` must be finite"),
+        (lambda: at.dcm_from_quat([0, 0, np.nan, 1]), ValueError, "`q` must be finite"),
+        # and around them
+        (lambda: at.quat_from_dcm(-np.eye(3)), ValueError, r"`A` must be a proper rotation .* det -1"),
+        (lambda: at.euler313_from_dcm(np.diag([1.0, 1.0, -1.0])), ValueError, r"`A` .* det -1"),
+        (lambda: at.dcm_from_quat([0, 0, 0, 2]), ValueError, r"`q` must be a unit .* norm 2"),
+        (lambda: at.dcm_from_quat([0, 0, 0, 1 + 2e-6]), ValueError, r"`q` must be a unit quaternion"),
+        (lambda: at.euler321_from_quat([0.5, 0, 0, 0.5]), ValueError, r"`q` must be a unit"),
+        (lambda: at.propagate_quat([0, 0, 0, 3], [1, 0, 0], 0.1), ValueError, r"`q` must be a unit"),
+        (lambda: at.propagate_quat([0, 0, 0, 1], [1e200, 0, 0], 1e200), ValueError, "too large"),
+        (lambda: at.quat_normalize(np.zeros((4, 2))), ValueError, r"`q\[:, 0\]` must be a non-zero"),
+        (lambda: at.quat_from_axis_angle([0, 0, 0], 1.0), ValueError, "`axis` must be a non-zero"),
+        (lambda: at.quat_from_axis_angle([0, 0, 1], np.full(3, np.inf)), ValueError, "`angle` must be finite"),
+        (lambda: at.dcm_axis(True, 0.1), TypeError, "`axis` must be 1, 2 or 3"),
+        (lambda: at.dcm_axis(1.0, 0.1), TypeError, "`axis` must be 1, 2 or 3"),
+        (lambda: at.principal_axes(GEMINI, order=1), TypeError, "`order` must be"),
+        (lambda: at.axis_angle_from_quat(np.tile(_Q[:, None], (1, 2))), ValueError, r"`q` must have shape \(4,\)"),
+        (lambda: at.axis_angle_from_quat(ca.SX.sym("q", 4)), TypeError, "`q` must be numeric"),
+        (lambda: at.dcm_from_quat(ca.DM([0, 0, np.nan, 1])), ValueError, "`q` must be finite"),
+        (lambda: at.quat_from_dcm(ca.DM(2 * np.eye(3))), ValueError, "`A` must be a rotation"),
+        (lambda: at.quat_mul(ca.MX.sym("q", 4, 2), _Q), ValueError, "`q` must be a 4x1"),
+    ],
+)
+def test_bad_values_are_refused_with_the_argument_named(call, error, match):
+    with pytest.raises(error, match=match):
+        call()
+
+
+def test_batches_name_the_first_bad_column():
+    q = np.tile(_Q[:, None], (1, 5))
+    q[:, 3] = 0.0
+    q[:, 4] = np.nan
+    for fun in (at.dcm_from_quat, at.rotation_angle, at.euler313_from_quat, at.euler321_from_quat):
+        with pytest.raises(ValueError, match=r"`q\[:, 3\]` must be a unit quaternion .* norm 0"):
+            fun(q)
+    A = np.stack([_A, _A, -_A], axis=-1)
+    for fun in (at.quat_from_dcm, at.euler313_from_dcm, at.euler321_from_dcm):
+        with pytest.raises(ValueError, match=r"`A\[:, :, 2\]` must be a proper rotation"):
+            fun(A)
+    with pytest.raises(ValueError, match=r"`axis\[:, 1\]` must be a non-zero"):
+        at.quat_from_axis_angle(np.array([[1.0, 0.0], [0.0, 0.0], [0.0, 0.0]]), 0.5)
+
+
+def test_unit_quaternion_tolerance_is_1e_minus_6_and_near_unit_input_is_normalized():
+    for s in (1 - 0.99e-6, 1 + 0.99e-6):
+        A = at.dcm_from_quat(s * _Q)  # normalized first: a rotation to round-off
+        np.testing.assert_allclose(A, _A, atol=1e-15)
+        np.testing.assert_allclose(A @ A.T, np.eye(3), atol=1e-15)
+        assert at.rotation_angle(s * _Q) == pytest.approx(2 * np.arccos(_Q[3]), abs=1e-14)
+    for s in (1 - 1.01e-6, 1 + 1.01e-6):
+        with pytest.raises(ValueError, match="`q` must be a unit quaternion"):
+            at.dcm_from_quat(s * _Q)
+
+
+def test_quaternion_algebra_accepts_any_finite_quaternion():
+    """quat_mul / quat_conj / quat_rate are algebra (also used on rates qdot): no unit norm."""
+    q, p = 2.0 * _Q, np.array([0.3, -0.1, 0.2, -0.4])
+    qv, pv = q[:3], p[:3]
+    expected = np.r_[q[3] * pv + p[3] * qv - np.cross(qv, pv), q[3] * p[3] - qv @ pv]
+    np.testing.assert_allclose(at.quat_mul(q, p), expected, atol=1e-15)
+    np.testing.assert_array_equal(at.quat_mul(np.zeros(4), p), np.zeros(4))
+    np.testing.assert_array_equal(at.quat_conj(q), np.r_[-qv, q[3]])
+    W = np.array([[0, _W[2], -_W[1], _W[0]], [-_W[2], 0, _W[0], _W[1]],
+                  [_W[1], -_W[0], 0, _W[2]], [-_W[0], -_W[1], -_W[2], 0]])  # -Wbar(w), Eq. 4.70
+    np.testing.assert_allclose(at.quat_rate(q, _W), 0.5 * W @ q, atol=1e-15)
+
+
+def test_quat_normalize_accepts_non_unit_and_tiny_or_huge_quaternions():
+    q = np.array([[3.0, 0.0, 0.0], [0.0, 0.0, 1e-300], [0.0, 4e300, 0.0], [4.0, 3e300, 0.0]])
+    expected = np.array([[0.6, 0.0, 0.0], [0.0, 0.0, 1.0], [0.0, 0.8, 0.0], [0.8, 0.6, 0.0]])
+    with np.errstate(all="raise"):
+        np.testing.assert_allclose(at.quat_normalize(q), expected, rtol=1e-15)
+        np.testing.assert_allclose(at.quat_from_axis_angle([0, 1e-200, 0], np.pi),
+                                   [0, 1, 0, np.cos(np.pi / 2)], atol=1e-16)
+
+
+def test_dm_is_checked_by_value_and_stays_casadi():
+    out = at.dcm_from_quat(ca.DM(_Q))
+    assert isinstance(out, ca.DM)
+    np.testing.assert_allclose(np.array(out), _A, atol=1e-15)
+    assert isinstance(at.quat_mul(ca.DM(_Q), _P), ca.DM)
+    assert isinstance(at.quat_from_dcm(ca.DM(_A)), ca.DM)
+
+
+# Arguments of the CasADi-capable functions as (numeric value, CasADi shape).
+_SYMBOLIC = [name for name in VALID_CALLS if name not in ("axis_angle_from_quat", "principal_axes")]
+
+
+@pytest.mark.filterwarnings("error")
+@pytest.mark.parametrize("sym", [ca.SX, ca.MX], ids=["SX", "MX"])
+@pytest.mark.parametrize("name", _SYMBOLIC)
+def test_symbolic_inputs_pass_through_and_agree_with_numpy(name, sym):
+    fun, kw = VALID_CALLS[name]
+    numeric = {k: v for k, v in kw.items() if not (name == "dcm_axis" and k == "axis")}
+    fixed = {k: v for k, v in kw.items() if k not in numeric}
+    syms = {k: sym.sym(k, *np.shape(v)) if np.ndim(v) == 2 else sym.sym(k, max(np.size(v), 1))
+            for k, v in numeric.items()}
+    F = ca.Function("F", list(syms.values()), [fun(**fixed, **syms)])
+    got = np.array(F(*[np.reshape(v, (-1, 1)) if np.ndim(v) < 2 else v for v in numeric.values()]))
+    want = fun(**kw)
+    np.testing.assert_allclose(got.reshape(np.shape(want)), want, atol=1e-14, err_msg=name)
+
+
+def test_symbolic_dcm_of_non_unit_quaternion_keeps_the_formula():
+    """Symbols are never checked: the CasADi expression of Eq. 4.63 is |q|^2 times A(q/|q|)."""
+    q = ca.SX.sym("q", 4)
+    F = ca.Function("F", [q], [at.dcm_from_quat(q)])
+    np.testing.assert_allclose(np.array(F(3 * _Q)), 9 * _A, atol=1e-14)
+    G = ca.Function("G", [q], [at.quat_normalize(q)])
+    np.testing.assert_allclose(np.array(G(3 * _Q)).ravel(), _Q, atol=1e-15)
+
+
+@pytest.mark.filterwarnings("error")
+@settings(max_examples=200)
+@given(st.lists(quats, min_size=1, max_size=6), st.floats(-0.99e-6, 0.99e-6))
+def test_valid_inputs_within_tolerance_round_trip(qs, dn):
+    """Quaternions off unit norm by < 1e-6 and DCMs built from them are accepted; the
+    conversions agree with scipy and round-trip (batched and one at a time)."""
+    q = np.stack(qs, axis=1) * (1 + dn)
+    R = Rotation.from_quat(np.stack(qs))
+    A = at.dcm_from_quat(q)
+    np.testing.assert_allclose(A, np.moveaxis(R.as_matrix(), 0, -1).transpose(1, 0, 2), atol=2e-15)
+    q_back = at.quat_from_dcm(A)
+    assert np.all(q_back[3] >= 0)
+    for k, qk in enumerate(qs):
+        assert same_rotation(q_back[:, k], qk, 2e-14)
+        assert same_rotation(at.quat_from_dcm(at.dcm_from_quat(q[:, k])), qk, 2e-14)
+    np.testing.assert_allclose(at.dcm_from_euler313(at.euler313_from_quat(q)), A, atol=2e-14)
+    np.testing.assert_allclose(at.dcm_from_euler321(at.euler321_from_quat(q)), A, atol=2e-14)
+    np.testing.assert_allclose(at.rotation_angle(q), R.magnitude(), atol=1e-14)
+
+
+@pytest.mark.filterwarnings("error")
+@given(quats, st.tuples(*[st.floats(-1, 1, **finite)] * 9).map(lambda t: np.reshape(t, (3, 3))))
+def test_dcm_perturbed_within_tolerance_is_accepted(q, noise):
+    """A rotation perturbed by 1e-7 (so |A A^T - E| <= ~6e-7 < 1e-6) is still accepted."""
+    A = at.dcm_from_quat(q) + 1e-7 * noise
+    q_back = at.quat_from_dcm(A)
+    assert same_rotation(q_back, q, 1e-6)
+    assert np.all(np.isfinite(at.euler313_from_dcm(A))) and np.all(np.isfinite(at.euler321_from_dcm(A)))

@@ -1,0 +1,435 @@
+"""The one set of input checks shared by every appdyn package.
+
+Each check takes the value and the *name of the argument* it came from, and raises
+``TypeError`` (wrong kind of object: a string, a dict, ``None``, complex or boolean numbers, a
+symbolic CasADi expression) or ``ValueError`` (wrong shape or value) with a message that names
+the argument and says what was expected. They return the value as a float numpy array (the
+input object itself when it already is a float64 array: do not modify it in place).
+
+Arrays are **components first**, as everywhere in appdyn: a quaternion is ``(4,)`` or, for a
+batch, ``(4, n)``; a rotation matrix is ``(3, 3)`` or ``(3, 3, n)``. ``batch=True`` accepts the
+single shape and the single shape followed by batch axes; errors about one member of a batch
+name it by index, e.g. ``q[:, 3]``.
+
+Numbers only: callers that also accept CasADi symbols test `is_symbolic` first and skip the
+check for ``SX``/``MX``. A ``casadi.DM`` holds numbers and is checked like an array (a ``n x 1``
+DM is a vector of length ``n``).
+"""
+from __future__ import annotations
+
+import math
+
+import casadi as ca
+import numpy as np
+
+__all__ = [
+    "QUAT_NORM_TOL",
+    "DCM_ORTHO_TOL",
+    "is_symbolic",
+    "finite_array",
+    "finite_scalar",
+    "unit_vector",
+    "unit_quaternion",
+    "unit_quaternions",
+    "rotation_matrix",
+    "one_of",
+]
+
+#: How far a quaternion argument may deviate from unit norm before it is refused.
+QUAT_NORM_TOL = 1e-6
+
+#: Largest accepted ``max |A A^T - E|`` of a rotation-matrix argument.
+DCM_ORTHO_TOL = 1e-6
+
+
+# ------------------------------------------------------------------------- helpers
+def is_symbolic(x) -> bool:
+    """Whether ``x`` is a symbolic CasADi expression (``SX`` or ``MX``; not ``DM``).
+
+    Parameters
+    ----------
+    x : object
+
+    Returns
+    -------
+    bool
+    """
+    return isinstance(x, (ca.SX, ca.MX))
+
+
+def _real_array(x, name: str) -> np.ndarray:
+    """``x`` as a float64 array; ``TypeError`` unless it holds real numbers."""
+    if type(x) is np.ndarray and x.dtype == np.float64:  # fast path: the common case
+        return x
+    if is_symbolic(x):
+        raise TypeError(f"`{name}` must be numeric here, got a symbolic CasADi {type(x).__name__}")
+    if isinstance(x, ca.DM):
+        a = x.full()
+        return a.ravel() if a.shape[1] == 1 else a
+    try:
+        a = np.asarray(x)
+    except ValueError:  # ragged nested sequences
+        raise ValueError(f"`{name}` must be a regular (non-ragged) array of numbers, "
+                         f"got {_short(x)}") from None
+    kind = a.dtype.kind
+    if kind in "fiu":
+        return a.astype(np.float64, copy=False)
+    if kind == "O" and not any(e is None for e in a.flat):  # astype would make None a NaN
+        try:
+            return a.astype(np.float64)
+        except Exception:  # noqa: BLE001 - any failure to convert means "not numbers"
+            pass
+    what = {"b": "booleans", "c": "complex numbers", "U": "a string", "S": "bytes"}.get(
+        kind, type(x).__name__)
+    raise TypeError(f"`{name}` must be real numbers, got {what}: {_short(x)}")
+
+
+def _short(x, limit: int = 80) -> str:
+    r = repr(x)
+    return r if len(r) <= limit else r[: limit - 3] + "..."
+
+
+def _shape_text(shape: tuple, batch: bool) -> str:
+    one = "(" + ", ".join(str(s) for s in shape) + ("," if len(shape) == 1 else "") + ")"
+    if not batch:
+        return one
+    if not shape:
+        return "a scalar or an array"
+    return f"{one} or ({', '.join(str(s) for s in shape)}, n) (components first)"
+
+
+def _member(name: str, ncomp: int, index) -> str:
+    """``q[:, 3]`` for member 3 of a batch with one component axis; ``name`` when single."""
+    if index is None:
+        return name
+    idx = tuple(int(i) for i in index)
+    return f"{name}[{', '.join([':'] * ncomp + [str(i) for i in idx])}]"
+
+
+def _first(mask: np.ndarray):
+    """Batch index of the first True in ``mask`` (``None`` for a 0-d mask)."""
+    if mask.ndim == 0:
+        return None
+    return np.unravel_index(int(np.argmax(mask)), mask.shape)
+
+
+def _norm(a: np.ndarray) -> float:
+    """Euclidean norm of a finite 1-D array, without under- or overflow."""
+    m = float(np.max(np.abs(a)))
+    return m * float(np.sqrt(np.sum((a / m) ** 2))) if m > 0 else 0.0
+
+
+def _dot3(u, w) -> float:
+    return u[0] * w[0] + u[1] * w[1] + u[2] * w[2]
+
+
+def _cross3(u, w) -> list:
+    return [u[1] * w[2] - u[2] * w[1], u[2] * w[0] - u[0] * w[2], u[0] * w[1] - u[1] * w[0]]
+
+
+def _check_shape(a: np.ndarray, name: str, shape: tuple, batch: bool) -> None:
+    k = len(shape)
+    if a.shape[:k] != shape or (not batch and a.ndim != k):
+        raise ValueError(f"`{name}` must have shape {_shape_text(shape, batch)}, got {a.shape}")
+
+
+def _check_finite(a: np.ndarray, name: str) -> None:
+    if a.size <= 16 and all(map(math.isfinite, a.ravel().tolist())):  # fast path, small input
+        return
+    ok = np.isfinite(a)
+    if not ok.all():
+        idx = tuple(int(i) for i in np.argwhere(~ok)[0])
+        where = f" at index {list(idx)}" if idx else ""
+        raise ValueError(f"`{name}` must be finite, got {a[idx]}{where}")
+
+
+# -------------------------------------------------------------------------- checks
+def finite_array(x, name: str, shape: tuple | None = None, *, batch: bool = False) -> np.ndarray:
+    """Check an array of finite real numbers, optionally of a given shape.
+
+    Parameters
+    ----------
+    x : array_like
+        The value to check (list, tuple, number, numpy array or ``casadi.DM``).
+    name : str
+        Argument name used in the error message.
+    shape : tuple of int, optional
+        Required shape, e.g. ``(3,)`` or ``(3, 3)``; ``None`` accepts any shape.
+    batch : bool, optional
+        Also accept ``shape`` followed by batch axes, e.g. ``(3, n)`` for ``shape=(3,)``.
+
+    Returns
+    -------
+    ndarray, shape ``shape`` or ``shape + (n, ...)``
+        ``x`` as a float array.
+
+    Raises
+    ------
+    TypeError
+        If ``x`` does not hold real numbers (string, dict, ``None``, complex, boolean, symbolic).
+    ValueError
+        If the shape is wrong or an entry is NaN or infinite.
+    """
+    a = _real_array(x, name)
+    if shape is not None:
+        _check_shape(a, name, tuple(shape), batch)
+    _check_finite(a, name)
+    return a
+
+
+def finite_scalar(x, name: str) -> float:
+    """Check one finite real number (an angle, a time step, a rate).
+
+    Parameters
+    ----------
+    x : float or 0-d array_like (a ``1x1`` DM is accepted)
+    name : str
+        Argument name used in the error message.
+
+    Returns
+    -------
+    float
+
+    Raises
+    ------
+    TypeError
+        If ``x`` is not a real number.
+    ValueError
+        If ``x`` is an array of more than one element, NaN or infinite.
+    """
+    a = _real_array(x, name)
+    if a.ndim != 0 and not (isinstance(x, ca.DM) and a.size == 1):
+        raise ValueError(f"`{name}` must be a scalar, got shape {a.shape}")
+    v = float(a.reshape(()))
+    if not np.isfinite(v):
+        raise ValueError(f"`{name}` must be finite, got {v}")
+    return v
+
+
+def unit_vector(v, name: str, *, size: int = 3, batch: bool = False) -> np.ndarray:
+    """Check a finite non-zero vector (an axis, a direction) and return it scaled to unit length.
+
+    The length is computed with scaling, so tiny (``1e-300``) and huge (``1e300``) vectors are
+    normalized without under- or overflow.
+
+    Parameters
+    ----------
+    v : array_like, shape (size,) or, with ``batch``, (size, n)
+    name : str
+        Argument name used in the error message.
+    size : int, optional
+        Number of components (3 for an axis, 4 to normalize a quaternion).
+    batch : bool, optional
+        Accept a components-first batch; each column is normalized.
+
+    Returns
+    -------
+    ndarray, same shape as ``v``
+        ``v / |v|`` (column by column for a batch).
+
+    Raises
+    ------
+    TypeError
+        If ``v`` does not hold real numbers.
+    ValueError
+        If the shape is wrong, an entry is not finite, or a vector is zero.
+    """
+    a = finite_array(v, name, (size,), batch=batch)
+    m = np.max(np.abs(a), axis=0)
+    zero = m == 0
+    if np.any(zero):
+        idx = _first(zero)
+        raise ValueError(f"`{_member(name, 1, idx)}` must be a non-zero vector, got "
+                         f"{(a if idx is None else a[(slice(None), *idx)]).tolist()}")
+    if np.all((m > 1e-150) & (m < 1e150)):  # |v|^2 neither under- nor overflows
+        return a / np.sqrt(np.sum(a * a, axis=0))
+    s = a / m
+    return s / np.sqrt(np.sum(s * s, axis=0))
+
+
+def unit_quaternion(q, name: str, *, tol: float = QUAT_NORM_TOL) -> np.ndarray:
+    """Check a scalar-last unit quaternion and return it normalized.
+
+    Parameters
+    ----------
+    q : array_like, shape (4,)
+        The quaternion ``[q1, q2, q3, q4]`` (any array of 4 numbers, e.g. a ``4x1`` column).
+    name : str
+        Argument name used in the error message.
+    tol : float, optional
+        Largest accepted ``| |q| - 1 |``.
+
+    Returns
+    -------
+    ndarray, shape (4,)
+        ``q / |q|``.
+
+    Raises
+    ------
+    TypeError
+        If ``q`` does not hold real numbers.
+    ValueError
+        If ``q`` is not 4 finite numbers or its norm differs from 1 by more than ``tol``.
+    """
+    a = _real_array(q, name).reshape(-1)
+    if a.shape != (4,) or not np.all(np.isfinite(a)):
+        raise ValueError(
+            f"`{name}` must be 4 finite numbers (scalar-last quaternion), got {_short(q)}")
+    n = _norm(a)
+    if not abs(n - 1.0) <= tol:
+        raise ValueError(
+            f"`{name}` must be a unit quaternion (norm 1 to {tol:g}), got norm {n:.9g}")
+    return a / n
+
+
+def unit_quaternions(q, name: str, *, tol: float = QUAT_NORM_TOL,
+                     normalize: bool = False) -> np.ndarray:
+    """Check one or a batch of scalar-last unit quaternions.
+
+    Parameters
+    ----------
+    q : array_like, shape (4,) or (4, n)
+        Quaternions as columns, components first.
+    name : str
+        Argument name used in the error message.
+    tol : float, optional
+        Largest accepted ``| |q| - 1 |`` of every column.
+    normalize : bool, optional
+        Return ``q / |q|`` (column by column); by default ``q`` is returned as given.
+
+    Returns
+    -------
+    ndarray, shape (4,) or (4, n)
+
+    Raises
+    ------
+    TypeError
+        If ``q`` does not hold real numbers.
+    ValueError
+        If the shape is wrong, or a column is not finite, is zero, or has a norm that differs
+        from 1 by more than ``tol``; the message names the first bad column (``q[:, j]``)
+        and its norm.
+    """
+    a = _real_array(q, name)
+    _check_shape(a, name, (4,), True)
+    if a.ndim == 1:  # fast path for one quaternion (Python floats: no numpy warnings)
+        n = math.sqrt(sum(x * x for x in a.tolist()))
+        if abs(n - 1.0) <= tol:  # False for NaN and inf
+            return a / n if normalize else a
+        bad = np.array(True)
+    else:
+        with np.errstate(over="ignore", invalid="ignore"):
+            n = np.sqrt(np.einsum("i...,i...->...", a, a))
+            bad = ~(np.abs(n - 1.0) <= tol)  # NaN and inf fail too
+    if bad.any():
+        idx = _first(bad)
+        col = a if idx is None else a[(slice(None), *idx)]
+        label = _member(name, 1, idx)
+        if not np.all(np.isfinite(col)):
+            raise ValueError(f"`{label}` must be finite, got {col.tolist()}")
+        raise ValueError(f"`{label}` must be a unit quaternion (norm 1 to {tol:g}), "
+                         f"got norm {_norm(col):.9g}")
+    return a / n if normalize else a
+
+
+def rotation_matrix(A, name: str, *, tol: float = DCM_ORTHO_TOL, batch: bool = False) -> np.ndarray:
+    """Check a proper rotation matrix (direction cosine matrix) or a batch of them.
+
+    Parameters
+    ----------
+    A : array_like, shape (3, 3) or, with ``batch``, (3, 3, n)
+    name : str
+        Argument name used in the error message.
+    tol : float, optional
+        Largest accepted ``max |A A^T - E|`` (element-wise).
+    batch : bool, optional
+        Accept a components-first batch ``(3, 3, n)``.
+
+    Returns
+    -------
+    ndarray, same shape as ``A``
+        ``A`` as given.
+
+    Raises
+    ------
+    TypeError
+        If ``A`` does not hold real numbers.
+    ValueError
+        If the shape is wrong, an entry is not finite, ``A`` is not orthogonal to ``tol``,
+        or ``det A`` is not ``+1`` (a reflection); the message names the first bad matrix
+        (``A[:, :, j]``).
+    """
+    a = _real_array(A, name)
+    _check_shape(a, name, (3, 3), batch)
+    if a.ndim == 2:  # fast path for one matrix, in Python floats (no numpy warnings)
+        r = a.tolist()
+        err = max(abs(_dot3(r[i], r[j]) - (i == j)) for i in range(3) for j in range(i, 3))
+        if err <= tol and _dot3(r[0], _cross3(r[1], r[2])) > 0:  # False for NaN
+            return a
+    # all matrices at once, and the diagnosis of a refused single matrix
+    r0, r1, r2 = a[0], a[1], a[2]  # rows, each (3,) or (3, n, ...)
+    with np.errstate(over="ignore", invalid="ignore"):
+        err = np.abs(np.einsum("k...,k...->...", r0, r0) - 1)
+        for g in (np.einsum("k...,k...->...", r1, r1) - 1,
+                  np.einsum("k...,k...->...", r2, r2) - 1,
+                  np.einsum("k...,k...->...", r0, r1), np.einsum("k...,k...->...", r0, r2),
+                  np.einsum("k...,k...->...", r1, r2)):
+            err = np.maximum(err, np.abs(g))  # NaN propagates
+    bad = ~(err <= tol)
+    if bad.any():
+        idx = _first(bad)
+        m = a if idx is None else a[(slice(None), slice(None), *idx)]
+        label = _member(name, 2, idx)
+        if not np.all(np.isfinite(m)):
+            raise ValueError(f"`{label}` must be finite, got {m.tolist()}")
+        e = float(err if idx is None else err[idx])
+        raise ValueError(f"`{label}` must be a rotation matrix (orthogonal to {tol:g}), "
+                         f"got max |A A^T - E| = {e:.3g}")
+    det = (r0[0] * (r1[1] * r2[2] - r1[2] * r2[1]) + r0[1] * (r1[2] * r2[0] - r1[0] * r2[2])
+           + r0[2] * (r1[0] * r2[1] - r1[1] * r2[0]))
+    neg = ~(det > 0)
+    if np.any(neg):
+        idx = _first(neg)
+        raise ValueError(f"`{_member(name, 2, idx)}` must be a proper rotation (det +1), got "
+                         f"det {float(det if idx is None else det[idx]):.9g} (a reflection)")
+    return a
+
+
+def one_of(value, name: str, choices: tuple):
+    """Check that ``value`` is one of a few allowed options (strings or integers).
+
+    Parameters
+    ----------
+    value : object
+    name : str
+        Argument name used in the error message.
+    choices : tuple
+        The allowed values; their types are the allowed types (a ``bool`` is not an ``int``
+        here, and a numpy integer is).
+
+    Returns
+    -------
+    object
+        ``value`` (a numpy integer as a Python ``int``).
+
+    Raises
+    ------
+    TypeError
+        If ``value`` is not of the type of any choice.
+    ValueError
+        If it is of the right type but not among ``choices``.
+    """
+    names = [repr(c) for c in choices]
+    text = names[0] if len(names) == 1 else ", ".join(names[:-1]) + " or " + names[-1]
+    ints = any(type(c) is int for c in choices)
+    if isinstance(value, (bool, np.bool_)) and not any(type(c) is bool for c in choices):
+        ok = False
+    elif ints and isinstance(value, np.integer):
+        value, ok = int(value), True
+    else:
+        ok = any(type(value) is type(c) for c in choices)
+    if not ok:
+        raise TypeError(f"`{name}` must be {text}, got {type(value).__name__} {_short(value)}")
+    if value not in choices:
+        raise ValueError(f"`{name}` must be {text}, got {_short(value)}")
+    return value
