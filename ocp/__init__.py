@@ -13,11 +13,12 @@ from __future__ import annotations
 from .guess import guess_from_simulation
 from .mesh import Mesh
 from .problem import Constraint, Problem
-from .refine import (IntervalErrors, RadauConstantControl, RefinedSolution, RefinementRound,
+from .ipopt_options import check_ipopt_options, ipopt_option_table
+from .refine import (IntervalErrors, RadauConstantControl, RefinedSolution, RefinementRound, annotate,
                      find_switches, interval_errors, polish_switches, refine, solve_multistart)
 from .scaling import Scaling
 from .solution import Propagation, Solution
-from .solve import Progress, solve
+from .solve import DEFAULT_CONSTRAINT_TOL, Progress, rest_solution, solve
 from .transcription import (TRANSCRIPTIONS, HermiteSimpson, Radau, Transcription, Trapezoid,
                             get_transcription)
 
@@ -28,6 +29,11 @@ __all__ = [
     "Propagation",
     "Progress",
     "solve",
+    "rest_solution",
+    "DEFAULT_CONSTRAINT_TOL",
+    "check_ipopt_options",
+    "ipopt_option_table",
+    "annotate",
     "Mesh",
     "Scaling",
     "Transcription",

@@ -141,7 +141,7 @@ class Discretization:
         elif problem.q_final_tol > 0:
             parts["q_final"] = ca.sumsqr(problem.attitude_error(X[iq:iq + 4, -1]))
         else:
-            parts["q_final"] = problem.attitude_error(X[iq:iq + 4, -1])
+            parts["q_final"] = problem.attitude_error(X[iq:iq + 4, -1]) / sc.q_final
         gsym = self.g.join(parts, symbolic=True)
         self.nlp = {"x": wsym, "f": J / sc.objective, "g": gsym}
 
@@ -206,12 +206,19 @@ class Discretization:
         if parts["boundary"].size:
             parts["boundary"] = parts["boundary"] * dJ / sc.boundary[:, None]
         parts["quat_norm"] = parts["quat_norm"] * dJ
-        parts["q_final"] = parts["q_final"] * dJ
+        parts["q_final"] = parts["q_final"] * dJ / sc.q_final
         return parts
 
-    def violation(self, g) -> float:
-        """Largest violation of the scaled constraint bounds by ``g``."""
+    def violation(self, g, w=None) -> float:
+        """Largest violation of the constraint bounds by ``g`` and, when given, of the
+        variable bounds by ``w``, both in the units of the NLP handed to IPOPT (scaled by
+        `ocp.scaling`, not by IPOPT's internal scaling)."""
         g = np.asarray(g, dtype=float).reshape(-1)
-        if g.size == 0:
-            return 0.0
-        return float(np.max(np.maximum(0.0, np.maximum(self.lbg - g, g - self.ubg))))
+        out = 0.0
+        if g.size:
+            out = float(np.max(np.maximum(0.0, np.maximum(self.lbg - g, g - self.ubg))))
+        if w is not None:
+            w = np.asarray(w, dtype=float).reshape(-1)
+            if w.size:
+                out = max(out, float(np.max(np.maximum(0.0, np.maximum(self.lbx - w, w - self.ubx)))))
+        return out

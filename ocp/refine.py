@@ -50,7 +50,7 @@ from .solve import _make_solution, solve
 from .transcription import Radau, Transcription, _f_cols, _L_cols, _sx_ok, get_transcription
 
 __all__ = ["refine", "solve_multistart", "polish_switches", "RefinedSolution", "RefinementRound",
-           "RadauConstantControl", "IntervalErrors", "interval_errors", "find_switches"]
+           "RadauConstantControl", "IntervalErrors", "interval_errors", "find_switches", "annotate"]
 
 _STRICT = {"tol": 1e-10, "bound_relax_factor": 0.0, "max_iter": 3000}
 _BRACKET = 1.0 / 16.0  # width of the new switch interval relative to the old one (refine)
@@ -79,7 +79,7 @@ class RefinementRound(NamedTuple):
     time: float
 
 
-@dataclass(frozen=True, eq=False)
+@dataclass(frozen=True, eq=False, repr=False)
 class RefinedSolution(Solution):
     """A `Solution` plus ``info`` (returned by `refine`, `solve_multistart`, `polish_switches`).
 
@@ -113,11 +113,35 @@ class RefinedSolution(Solution):
         return self.info.get("starts")
 
 
+def annotate(solution: Solution, info: Mapping | None = None, **changes) -> RefinedSolution:
+    """A copy of ``solution`` as a `RefinedSolution`, ``info`` merged over its own and the
+    fields in ``changes`` (e.g. ``success``, ``status``, ``message``) replaced; the lazily
+    computed re-simulation is shared. For drivers that verify or post-process a result
+    (`problems.slew`).
+
+    Raises
+    ------
+    TypeError
+        If ``solution`` is not a `Solution`.
+    ValueError
+        If ``changes`` names a field a `Solution` does not have.
+    """
+    if not isinstance(solution, Solution):
+        raise TypeError(f"`solution` must be an ocp.Solution, got {type(solution).__name__}")
+    names = {f.name for f in fields(Solution)}
+    bad = sorted(set(changes) - names)
+    if bad:
+        raise ValueError(f"unknown Solution fields {bad}")
+    return _annotate(solution, info or {}, **changes)
+
+
 def _annotate(sol: Solution, info: Mapping, **changes) -> RefinedSolution:
     kw = {f.name: getattr(sol, f.name) for f in fields(Solution)}
-    kw["_lazy"] = dict(sol._lazy)
     kw.pop("info", None)
     kw.update(changes)
+    # the lazily computed re-simulation is shared unless the trajectory itself changed
+    same = not ({"x", "u", "p", "T", "t0", "t", "mesh", "transcription", "problem", "_dense"} & set(changes))
+    kw["_lazy"] = sol._lazy if same else {}
     merged = dict(getattr(sol, "info", {}) or {})
     merged.update(info)
     return RefinedSolution(**kw, info=merged)
@@ -789,7 +813,7 @@ class _FreeMeshDiscretization:
     def multipliers(self, lam_g):
         return self._mult
 
-    def violation(self, g):
+    def violation(self, g, w=None):
         return self._viol
 
 

@@ -15,10 +15,18 @@ in floating point and fixed boundary values reach IPOPT unchanged):
 * path and boundary constraint rows: the largest infinity-norm over the nodes of the row's
   gradient with respect to the *scaled* variables at the initial guess, so that scaled rows
   have unit gradients there (clamped to [1e-6, 1e6]; 1 when the gradient vanishes);
+* the attitude-target rows ``vec(q_final^* (x) q(tf))`` (`ocp.problem`): ``16 e``, clamped
+  to [1e-8, 1] and rounded, with ``e = max(e0, T_g max|w_g| / 2)``: ``e0 =
+  |vec(q_final^* (x) q_guess(t0))|`` (about half the initial angle to the target) and the
+  second term the half-angle the guess's body rates ``w_g`` could turn over its horizon
+  ``T_g``. So 1 for targets more than about 7 deg away; a slew by a tiny angle still has
+  O(1) target rows, and IPOPT's tolerances and the constraint-violation check of
+  `ocp.solve` are relative to the requested rotation instead of admitting a body that
+  never moves;
 * the objective: 1 (IPOPT's own gradient-based scaling still applies on top).
 
 Overrides: ``scale={'name': value}`` in `ocp.solve` for any state, control or parameter
-name, ``'T'`` and ``'objective'`` (used as given, not rounded); ``Constraint(scale=...)``
+name, ``'T'``, ``'objective'`` and ``'q_final'`` (used as given, not rounded); ``Constraint(scale=...)``
 for constraint rows.
 """
 from __future__ import annotations
@@ -50,6 +58,8 @@ class Scaling:
         Rows of all path constraints, concatenated in order.
     boundary : ndarray, shape (nb,)
         Rows of all boundary constraints, concatenated.
+    q_final : float
+        The attitude-target rows (1 without a ``q_final``).
     """
 
     x: np.ndarray
@@ -59,6 +69,7 @@ class Scaling:
     objective: float
     path: np.ndarray
     boundary: np.ndarray
+    q_final: float = 1.0
 
 
 def _pow2(v: np.ndarray) -> np.ndarray:
@@ -102,7 +113,7 @@ def auto_scaling(problem, guess, overrides: Mapping | None = None) -> Scaling:
     problem : ocp.Problem
     guess : ocp.guess.NodeGuess
     overrides : mapping of str to float, optional
-        Scales by state/control/parameter name, ``'T'``, ``'objective'``.
+        Scales by state/control/parameter name, ``'T'``, ``'objective'``, ``'q_final'``.
 
     Returns
     -------
@@ -117,8 +128,9 @@ def auto_scaling(problem, guess, overrides: Mapping | None = None) -> Scaling:
     dx = _magnitude(problem.x_bounds, np.concatenate([guess.X, guess.Xu], axis=1))
     du = _magnitude(problem.u_bounds, guess.U)
     dp = _magnitude(problem.p_bounds, guess.p[:, None])
-    dT = float(_pow2(np.array([guess.T]))[0])
+    dT = float(_pow2(np.array([guess.T]))[0]) if guess.T > 0 else 1.0
     dJ = 1.0
+    dq = _q_final_scale(problem, guess)
 
     if overrides is not None:
         if not isinstance(overrides, Mapping):
@@ -135,6 +147,8 @@ def auto_scaling(problem, guess, overrides: Mapping | None = None) -> Scaling:
                 dT = v
             elif key == "objective":
                 dJ = v
+            elif key == "q_final":
+                dq = v
             elif key in targets:
                 if len(targets[key]) > 1:
                     raise ValueError(f"`scale` key {key!r} is ambiguous (several model components share it)")
@@ -142,14 +156,33 @@ def auto_scaling(problem, guess, overrides: Mapping | None = None) -> Scaling:
                 vec[i] = v
             else:
                 raise ValueError(f"`scale` names unknown variable {key!r}; expected a state, control or "
-                                 "parameter name, 'T' or 'objective'")
+                                 "parameter name, 'T', 'objective' or 'q_final'")
 
     free = problem.free_params
     dp_free = np.zeros(model.np)
     dp_free[free] = dp[free]
     path = _path_scales(problem, guess, dx, du, dp_free)
     boundary = _boundary_scales(problem, guess, dx, dp_free)
-    return Scaling(x=dx, u=du, p=dp, T=dT, objective=dJ, path=path, boundary=boundary)
+    return Scaling(x=dx, u=du, p=dp, T=dT, objective=dJ, path=path, boundary=boundary, q_final=dq)
+
+
+def _q_final_scale(problem, guess) -> float:
+    """Scale of the attitude-target rows from the guess's initial attitude (module docstring)."""
+    if problem.q_final is None or problem.q_final_tol > 0:
+        return 1.0
+    iq = problem.model.attitude[0]
+    q0 = np.asarray(guess.X[iq:iq + 4, 0], dtype=float)
+    n = np.linalg.norm(q0)
+    if not (np.isfinite(n) and n > 0):
+        return 1.0
+    e0 = float(np.linalg.norm(np.asarray(problem.attitude_error(q0 / n), dtype=float)))
+    # rotation the guess's rates could carry out over its horizon (a start on the target
+    # with non-zero rates has to come back to it: that motion sets the scale then)
+    iw = problem.model.attitude[1]
+    w = np.asarray(guess.X[iw:iw + 3], dtype=float)
+    w_max = float(np.max(np.abs(w))) if w.size and np.all(np.isfinite(w)) else 0.0
+    e_ref = max(e0, 0.5 * w_max * float(guess.T))
+    return float(_pow2(np.array([np.clip(16.0 * e_ref, 1e-8, 1.0)]))[0])
 
 
 def _path_scales(problem, guess, dx, du, dp_free) -> np.ndarray:

@@ -7,6 +7,8 @@ from typing import Mapping
 import casadi as ca
 import numpy as np
 
+from dynamics.attitude import quat_conj, quat_mul
+
 __all__ = ["Solution", "Propagation"]
 
 
@@ -71,8 +73,9 @@ class _Dense:
     def locate(self, t: np.ndarray):
         """Interval index (intervals are ``(t_k, t_k+1]``, ``t0`` in the first) and sigma."""
         k = np.clip(np.searchsorted(self.t_breaks, t, side="left") - 1, 0, self.N - 1)
-        s = np.clip((t - self.t_breaks[k]) / self.h[k], 0.0, 1.0)
-        return k, s
+        h = self.h[k]
+        s = np.divide(t - self.t_breaks[k], h, out=np.zeros(np.shape(t)), where=h > 0)
+        return k, np.clip(s, 0.0, 1.0)
 
 
 @dataclass(frozen=True, eq=False)
@@ -82,11 +85,16 @@ class Solution:
     Attributes
     ----------
     success : bool
-        IPOPT converged (``Solve_Succeeded``, or ``Solved_To_Acceptable_Level``, which the
-        message flags). A failure still carries IPOPT's last iterate.
+        Verified: IPOPT returned ``Solve_Succeeded`` (its ``tol`` met; an acceptable-level
+        stop counts only if a warm re-solve then succeeds) *and* ``constraint_violation``
+        is at most the ``constraint_tol`` of `ocp.solve` (default 1e-6). A failure still
+        carries IPOPT's last iterate.
     status : str
-        IPOPT's return status (``'Solve_Succeeded'``, ``'Infeasible_Problem_Detected'``,
-        ``'Maximum_Iterations_Exceeded'``, ...).
+        IPOPT's return status (``'Solve_Succeeded'``, ``'Solved_To_Acceptable_Level'``,
+        ``'Infeasible_Problem_Detected'``, ``'Maximum_Iterations_Exceeded'``, ...) or one of
+        `ocp.solve`'s own: ``'Constraint_Tol_Not_Met'``, ``'Exception'``,
+        ``'Rest_Solution'``; drivers on top add theirs (see `ocp.refine`,
+        `problems.slew`).
     message : str
         What happened, in words.
     T : float [s]
@@ -117,7 +125,11 @@ class Solution:
     mesh : Mesh
     problem : Problem
     constraint_violation : float
-        Largest violation of the (scaled) NLP constraints at the returned point.
+        Largest violation of any NLP constraint row or variable bound at the returned
+        point, in the units of the NLP handed to IPOPT (IPOPT's "unscaled" violation: rows
+        and variables divided by the scales of `ocp.scaling` — defects relative to the
+        state scale, the attitude target relative to its row scale; IPOPT's internal
+        scaling not applied). NaN after an evaluation error.
     multipliers : mapping of str to ndarray
         Multipliers of the unscaled constraints by block (``'defect'``, ``'path'``,
         ``'boundary'``, ``'quat_norm'``, ``'q_final'``), for ``J + nu . g`` (CasADi's sign).
@@ -146,8 +158,10 @@ class Solution:
     _lazy: dict = field(default_factory=dict, repr=False)
 
     def __repr__(self) -> str:
-        return (f"Solution(success={self.success}, status={self.status!r}, cost={self.cost:.10g}, "
-                f"T={self.T:.10g}, transcription={self.transcription.name!r}, N={self.mesh.N}, "
+        return (f"{type(self).__name__}(success={self.success}, status={self.status!r}, "
+                f"cost={self.cost:.10g}, T={self.T:.10g}, "
+                f"constraint_violation={self.constraint_violation:.3g}, "
+                f"transcription={self.transcription.name!r}, N={self.mesh.N}, "
                 f"iterations={self.iterations}, solve_time={self.solve_time:.3g} s)")
 
     # ----------------------------------------------------------------- dense
@@ -243,12 +257,52 @@ class Solution:
         return Propagation(self.t, xp, err, True, f"cvodes per mesh interval, rtol {rtol:g}, atol {atol:g}")
 
     @property
+    def propagation(self) -> Propagation:
+        """`propagate` with its default tolerances, computed once and kept (the one
+        re-simulation behind `propagation_error`, `pointing_error` and `terminal_error`)."""
+        if "propagation" not in self._lazy:
+            self._lazy["propagation"] = self.propagate()
+        return self._lazy["propagation"]
+
+    @property
+    def pointing_error(self) -> float | None:
+        """Attitude error at the end of the *re-simulated* trajectory [rad].
+
+        The rotation angle ``2 atan2(|v|, |s|)`` of ``q_final^* (x) q_sim(tf) / |q_sim(tf)|``
+        (``v``, ``s`` its vector and scalar parts), with ``q_sim`` from `propagation`: the
+        returned control applied to the initial state, integrated independently of the
+        collocation. ``None`` without a ``q_final``; NaN if the re-simulation failed.
+        """
+        if self.problem.q_final is None:
+            return None
+        prop = self.propagation
+        if not prop.success:
+            return float("nan")
+        iq = self.problem.model.attitude[0]
+        q = prop.x[iq:iq + 4, -1]
+        n = np.linalg.norm(q)
+        if not (np.isfinite(n) and n > 0):
+            return float("nan")
+        e = np.asarray(quat_mul(quat_conj(np.asarray(self.problem.q_final, dtype=float)), q / n),
+                       dtype=float)
+        return float(2.0 * np.arctan2(np.linalg.norm(e[:3]), abs(e[3])))
+
+    @property
+    def terminal_error(self) -> np.ndarray:
+        """``|x_sim(tf) - x_final|`` per state, shape (nx,) [state units], from the
+        re-simulated trajectory (`propagation`); NaN for final states the problem leaves free
+        (and everywhere if the re-simulation failed)."""
+        prop = self.propagation
+        xf = np.asarray(self.problem.x_final, dtype=float)
+        if not prop.success:
+            return np.full(xf.size, np.nan)
+        return np.abs(prop.x[:, -1] - xf)
+
+    @property
     def propagation_error(self) -> float:
         """``max |x_propagated - x|`` over states and nodes [mixed state units], from
         `propagate` with its default tolerances (computed on first access)."""
-        if "propagation" not in self._lazy:
-            self._lazy["propagation"] = self.propagate()
-        err = self._lazy["propagation"].error
+        err = self.propagation.error
         return float(np.max(err)) if err.size else 0.0
 
 

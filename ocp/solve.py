@@ -1,4 +1,32 @@
-"""`solve`: transcribe a `Problem`, solve the NLP with IPOPT, return a `Solution`."""
+"""`solve`: transcribe a `Problem`, solve the NLP with IPOPT, return a `Solution`.
+
+Success means verified
+----------------------
+A `Solution` says ``success=True`` only when
+
+1. IPOPT returned ``Solve_Succeeded`` (its ``tol`` met, not merely ``acceptable_tol``), and
+2. the returned point's `Solution.constraint_violation` is at most ``constraint_tol``
+   (default `DEFAULT_CONSTRAINT_TOL` = 1e-6).
+
+``constraint_violation`` is the largest violation of any NLP constraint row *or* variable
+bound, measured in the units of the NLP as handed to IPOPT (what IPOPT calls "unscaled"):
+defect rows of state ``i`` divided by its scale ``d_x[i]``, path and boundary rows by their
+row scales, attitude-target rows by their scale, variables in units of their scales (see
+`ocp.scaling`). It is a relative measure for every row whose scale is its typical magnitude.
+IPOPT's ``constr_viol_tol`` is set to ``constraint_tol`` unless given.
+
+IPOPT's ``Solved_To_Acceptable_Level`` (which admits constraint violations up to
+``acceptable_constr_viol_tol`` = 1e-2) is not a success: the NLP is re-solved once, warm
+started from the acceptable point with the acceptable-level exit disabled
+(``acceptable_iter = 0``, ``mu_init = 1e-9``) and at most 200 more iterations (within
+``max_iter``). If that reaches
+``Solve_Succeeded`` it counts (``iterations`` covers both runs, the message says so);
+otherwise the result has ``success=False``.
+
+Status values besides IPOPT's own return statuses: ``'Constraint_Tol_Not_Met'`` (IPOPT
+succeeded but the violation exceeds ``constraint_tol``), ``'Exception'`` (an evaluation
+error inside CasADi) and ``'Rest_Solution'`` (`rest_solution`).
+"""
 from __future__ import annotations
 
 import sys
@@ -8,17 +36,24 @@ from typing import Callable, Mapping
 import casadi as ca
 import numpy as np
 
-from .guess import initial_guess
+from .guess import NodeGuess, initial_guess
+from .ipopt_options import check_ipopt_options
 from .mesh import Mesh, _check_N
 from .problem import Problem
 from .scaling import auto_scaling
 from .solution import Solution, _Dense
 from .transcription import get_transcription
 
-__all__ = ["solve", "Progress"]
+__all__ = ["solve", "Progress", "rest_solution", "DEFAULT_CONSTRAINT_TOL", "STATUS_CONSTRAINT_TOL",
+           "STATUS_REST"]
 
-_SUCCESS = ("Solve_Succeeded", "Solved_To_Acceptable_Level")
+_SUCCESS = ("Solve_Succeeded",)
+_ACCEPTABLE = "Solved_To_Acceptable_Level"
 _DEFAULT_N = 20
+_RESOLVE_ITER = 200  # iteration budget of the warm re-solve after an acceptable-level stop
+DEFAULT_CONSTRAINT_TOL = 1e-6
+STATUS_CONSTRAINT_TOL = "Constraint_Tol_Not_Met"
+STATUS_REST = "Rest_Solution"
 
 
 class Progress:
@@ -101,23 +136,28 @@ def _mesh(N, mesh) -> Mesh:
     return m
 
 
-def _ipopt_options(ipopt_options) -> dict:
-    opts = {"print_level": 0, "sb": "yes"}
-    if ipopt_options is None:
-        return opts
-    if not isinstance(ipopt_options, Mapping):
-        raise ValueError(f"`ipopt_options` must be a mapping, got {type(ipopt_options).__name__}")
-    for key, value in ipopt_options.items():
-        if not isinstance(key, str):
-            raise ValueError(f"`ipopt_options` keys must be IPOPT option names, got {key!r}")
-        opts[key[len("ipopt."):] if key.startswith("ipopt.") else key] = value
+def _ipopt_options(ipopt_options, constraint_tol: float) -> dict:
+    opts = {"print_level": 0, "sb": "yes", "constr_viol_tol": constraint_tol}
+    opts.update(check_ipopt_options(ipopt_options))
     return opts
+
+
+def _check_constraint_tol(constraint_tol) -> float:
+    if constraint_tol is None:
+        return DEFAULT_CONSTRAINT_TOL
+    if (isinstance(constraint_tol, (bool, np.bool_))
+            or not isinstance(constraint_tol, (int, float, np.integer, np.floating))
+            or not (0 < constraint_tol < np.inf)):
+        raise ValueError(f"`constraint_tol` must be a finite number > 0, got {constraint_tol!r}")
+    return float(constraint_tol)
 
 
 def _message(status: str, iterations: int) -> str:
     text = {
         "Solve_Succeeded": "optimal solution found",
-        "Solved_To_Acceptable_Level": "solved to IPOPT's acceptable level only (tol not met, acceptable_tol met)",
+        "Solved_To_Acceptable_Level": ("stopped at IPOPT's acceptable level (tol not met, acceptable_tol "
+                                       "met; constraints may be violated up to 1e-2): not a verified "
+                                       "solution"),
         "Infeasible_Problem_Detected": "IPOPT converged to a point of local infeasibility: the problem may be infeasible",
         "Maximum_Iterations_Exceeded": "IPOPT reached max_iter",
         "Restoration_Failed": "IPOPT's feasibility restoration failed",
@@ -133,7 +173,8 @@ def _message(status: str, iterations: int) -> str:
 
 def solve(problem: Problem, *, transcription="radau", N: int | None = None, degree: int | None = None,
           mesh=None, guess=None, scale: Mapping | None = None, verbose=True,
-          ipopt_options: Mapping | None = None, expand: bool = True) -> Solution:
+          ipopt_options: Mapping | None = None, expand: bool = True,
+          constraint_tol: float | None = None) -> Solution:
     """Solve ``problem`` by direct collocation and IPOPT.
 
     Parameters
@@ -153,29 +194,34 @@ def solve(problem: Problem, *, transcription="radau", N: int | None = None, degr
         previous Solution (warm start, any transcription or mesh), or a mapping with ``'t'``,
         ``'x'``, ``'u'``, ``'T'``, ``'p'``.
     scale : mapping of str to float, optional
-        Scale overrides by state/control/parameter name, ``'T'``, ``'objective'`` (see
-        `ocp.scaling`).
+        Scale overrides by state/control/parameter name, ``'T'``, ``'objective'``,
+        ``'q_final'`` (see `ocp.scaling`).
     verbose : bool or callable, optional
         ``True`` prints one line per IPOPT iteration (iteration, scaled objective, largest
         scaled constraint violation) to ``sys.stdout`` as it runs; a callable receives a
         `Progress` per iteration instead; ``False`` prints nothing.
     ipopt_options : mapping, optional
         IPOPT options (``{'tol': 1e-10, 'max_iter': 500, 'print_level': 5}``), with or
-        without the ``'ipopt.'`` prefix. Defaults: ``print_level 0``, IPOPT's own otherwise
-        (``tol = 1e-8``; note ``bound_relax_factor = 1e-8``: IPOPT relaxes every bound by
-        1e-8 relative, which moves a bound-limited optimum by that much — pass
-        ``{'bound_relax_factor': 0}`` for bound-exact solutions).
+        without the ``'ipopt.'`` prefix, checked against the installed IPOPT's option list
+        before the solver is built (`ocp.ipopt_options`). Defaults: ``print_level 0``,
+        ``constr_viol_tol = constraint_tol``, IPOPT's own otherwise (``tol = 1e-8``; note
+        ``bound_relax_factor = 1e-8``: IPOPT relaxes every bound by 1e-8 relative, which
+        moves a bound-limited optimum by that much — pass ``{'bound_relax_factor': 0}`` for
+        bound-exact solutions).
     expand : bool, optional
         Expand the whole NLP to SX before solving (default). Evaluation is about 3x faster
         per IPOPT iteration, construction costs about 5 ms per Radau(3) interval of a rigid
         body (measured): ``expand=False`` builds faster and pays off for easy problems on
         fine meshes. Falls back to MX when the functions cannot be expanded.
+    constraint_tol : float, optional
+        Largest `Solution.constraint_violation` (NLP units, see the module docstring) of a
+        successful result; default `DEFAULT_CONSTRAINT_TOL` = 1e-6.
 
     Returns
     -------
     Solution
-        A non-converged IPOPT run returns ``success=False`` with IPOPT's ``status``; it does
-        not raise.
+        ``success=True`` only when verified (module docstring). A non-converged IPOPT run
+        returns ``success=False`` with IPOPT's ``status``; it does not raise.
 
     Raises
     ------
@@ -183,7 +229,8 @@ def solve(problem: Problem, *, transcription="radau", N: int | None = None, degr
         If ``problem`` is not a `Problem`.
     ValueError
         Naming the argument: unknown ``transcription``, bad ``N``/``degree``/``mesh``,
-        ``guess``, ``scale`` or ``ipopt_options``.
+        ``guess``, ``scale``, ``constraint_tol``, or an ``ipopt_options`` key that is not an
+        IPOPT option (with the closest name) or a value of the wrong type or range.
     """
     if not isinstance(problem, Problem):
         raise TypeError(f"`problem` must be an ocp.Problem, got {type(problem).__name__}")
@@ -193,7 +240,8 @@ def solve(problem: Problem, *, transcription="radau", N: int | None = None, degr
         raise ValueError(f"`verbose` must be True, False or a callable, got {verbose!r}")
     if expand not in (True, False):
         raise ValueError(f"`expand` must be True or False, got {expand!r}")
-    opts = _ipopt_options(ipopt_options)
+    ctol = _check_constraint_tol(constraint_tol)
+    opts = _ipopt_options(ipopt_options, ctol)
 
     t_build = time.perf_counter()
     node_guess = initial_guess(problem, tr, m, guess)
@@ -211,19 +259,34 @@ def solve(problem: Problem, *, transcription="radau", N: int | None = None, degr
         if not expand:
             raise
         # e.g. a model holding an integrator or a Callback cannot be expanded to SX
-        solver = ca.nlpsol("ocp", "ipopt", disc.nlp, {**nlp_opts, "expand": False})
+        nlp_opts["expand"] = False
+        solver = ca.nlpsol("ocp", "ipopt", disc.nlp, nlp_opts)
     build_time = time.perf_counter() - t_build
 
     t_solve = time.perf_counter()
-    error = None
-    try:
-        res = solver(x0=w0, lbx=disc.lbx, ubx=disc.ubx, lbg=disc.lbg, ubg=disc.ubg)
-    except RuntimeError as exc:  # an evaluation error inside CasADi: report, do not raise
-        res, error = None, exc
+    bounds = dict(lbx=disc.lbx, ubx=disc.ubx, lbg=disc.lbg, ubg=disc.ubg)
+    res, error, status, iterations = _run(solver, dict(x0=w0, **bounds))
+    note = ""
+    if res is not None and status == _ACCEPTABLE:
+        # not verified: one warm re-solve from the acceptable point, acceptable exit disabled
+        budget = min(max(int(opts.get("max_iter", 3000)) - iterations, 0), _RESOLVE_ITER)
+        if budget > 0:
+            t_re = time.perf_counter()
+            again = {**opts, "acceptable_iter": 0, "max_iter": budget,
+                     "warm_start_init_point": "yes", "mu_init": 1e-9}
+            resolver = ca.nlpsol("ocp_resolve", "ipopt", disc.nlp, {**nlp_opts, "ipopt": again})
+            build_time += time.perf_counter() - t_re
+            res2, error2, status2, it2 = _run(resolver, dict(
+                x0=res["x"], lam_x0=res["lam_x"], lam_g0=res["lam_g"], **bounds))
+            if res2 is not None and status2 in _SUCCESS:
+                note = (f" (after {_ACCEPTABLE} in {iterations} iterations, a warm re-solve "
+                        f"reached {status2} in {it2} more)")
+                res, status = res2, status2
+            else:
+                note = (f"; a warm re-solve without the acceptable-level exit ended with "
+                        f"{status2} after {it2} iterations")
+            iterations += it2
     solve_time = time.perf_counter() - t_solve
-    stats = solver.stats()
-    status = str(stats.get("return_status", "Unknown"))
-    iterations = int(stats.get("iter_count", 0))
     if res is None:
         w, lam_g, g = w0, np.zeros(disc.g.size), np.full(disc.g.size, np.nan)
         status = status if status != "Unknown" else "Exception"
@@ -234,9 +297,26 @@ def solve(problem: Problem, *, transcription="radau", N: int | None = None, degr
         lam_g = np.asarray(res["lam_g"]).reshape(-1)
         g = np.asarray(res["g"]).reshape(-1)
         success = status in _SUCCESS
-        message = _message(status, iterations)
+        message = _message(status, iterations) + note
+        viol = disc.violation(g, w)
+        if success and not viol <= ctol:
+            success = False
+            message = (f"{message}; but the constraint violation {viol:.3g} exceeds "
+                       f"constraint_tol {ctol:g}: not verified")
+            status = STATUS_CONSTRAINT_TOL
     return _make_solution(problem, tr, m, disc, w, lam_g, g, success, status, message,
                           iterations, solve_time, build_time)
+
+
+def _run(solver, args):
+    """``(result or None, error, status, iterations)`` of one IPOPT call (never raises)."""
+    error = None
+    try:
+        res = solver(**args)
+    except RuntimeError as exc:  # an evaluation error inside CasADi: report, do not raise
+        res, error = None, exc
+    stats = solver.stats()
+    return res, error, str(stats.get("return_status", "Unknown")), int(stats.get("iter_count", 0))
 
 
 def _make_solution(problem, tr, mesh, disc, w, lam_g, g, success, status, message,
@@ -272,6 +352,89 @@ def _make_solution(problem, tr, mesh, disc, w, lam_g, g, success, status, messag
         success=bool(success), status=status, message=message, T=T, t0=problem.t0,
         cost=disc.cost(w), t=t, x=x, u=u, p=p, iterations=iterations, solve_time=solve_time,
         build_time=build_time, costates=costates, transcription=tr, mesh=mesh, problem=problem,
-        constraint_violation=disc.violation(g) if np.all(np.isfinite(g)) else float("nan"),
+        constraint_violation=disc.violation(g, w) if np.all(np.isfinite(g)) else float("nan"),
         multipliers=mult, _dense=dense,
     )
+
+
+def rest_solution(problem: Problem, *, T: float | None = None, transcription="radau",
+                  constraint_tol: float | None = None) -> Solution:
+    """The trajectory that holds the initial state under zero control, checked against the
+    problem's own NLP constraints.
+
+    For a rest-to-rest problem whose target is the initial state (a slew by a zero angle),
+    this is the exact optimum: with a free final time ``T = T_min`` (default, usually 0),
+    with a fixed one the zero control over the whole horizon. Nothing is optimized: the
+    point ``x(t) = x_initial``, ``u = 0``, ``T`` is transcribed on one mesh interval and its
+    `Solution.constraint_violation` (defects, path and boundary constraints, the attitude
+    target, bounds; NLP units, see the module docstring) decides ``success``.
+
+    Parameters
+    ----------
+    problem : Problem
+        With every initial state given.
+    T : float, optional [s]
+        The horizon (default: the lower bound of a free ``T``, the fixed ``T`` otherwise).
+    transcription : str or Transcription, optional
+        The transcription of the returned solution (default ``'radau'``).
+    constraint_tol : float, optional
+        As in `solve` (default `DEFAULT_CONSTRAINT_TOL`).
+
+    Returns
+    -------
+    Solution
+        ``status`` `STATUS_REST` (``'Rest_Solution'``) and ``success=True`` when the held
+        state satisfies every constraint to ``constraint_tol``, else ``success=False`` and
+        `STATUS_CONSTRAINT_TOL`. ``iterations = 0``; with ``T = 0`` every node time is
+        ``t0`` and `Solution.sample` accepts ``t0`` only.
+
+    Raises
+    ------
+    TypeError
+        If ``problem`` is not a `Problem`.
+    ValueError
+        If an initial state is free, or ``T`` is not a finite horizon within the bounds of ``T``.
+    """
+    if not isinstance(problem, Problem):
+        raise TypeError(f"`problem` must be an ocp.Problem, got {type(problem).__name__}")
+    if np.any(np.isnan(problem.x_initial)):
+        raise ValueError("`problem` must give every initial state for a rest solution")
+    lo, hi = problem.T_bounds
+    if T is None:
+        T = lo if problem.free_time else problem.T
+    if isinstance(T, (bool, np.bool_)) or not isinstance(T, (int, float, np.integer, np.floating)):
+        raise ValueError(f"`T` must be a number [s], got {T!r}")
+    T = float(T)
+    if not (np.isfinite(T) and lo <= T <= hi):
+        raise ValueError(f"`T` must be a finite horizon in [{lo}, {hi}] s, got {T}")
+    ctol = _check_constraint_tol(constraint_tol)
+    t_build = time.perf_counter()
+    tr = get_transcription(transcription)
+    mesh = Mesh.uniform(1)
+    nx, nu = problem.model.nx, problem.model.nu
+    n_x = 1 + tr.x_sigma.size
+    n_u = tr.u_sigma.size + int(tr.u_at_start)
+    x0 = np.asarray(problem.x_initial, dtype=float)
+    p = np.asarray(problem.p, dtype=float)
+    node = NodeGuess(X=np.repeat(x0[:, None], n_x, axis=1), U=np.zeros((nu, n_u)),
+                     Xu=np.repeat(x0[:, None], n_u, axis=1), p=p, T=T)
+    scaling = auto_scaling(problem, node, {"T": 1.0} if T == 0 else None)
+    disc = tr.build(problem, mesh, scaling)
+    free = problem.free_params
+    sc = scaling
+    w = disc.w.join({"X": node.X / sc.x[:, None], "U": node.U / sc.u[:, None],
+                     "P": (p[free] / sc.p[free])[:, None],
+                     "T": np.full((int(problem.free_time), 1), T / sc.T)})
+    g = np.asarray(ca.Function("g", [disc.nlp["x"]], [disc.nlp["g"]])(w)).reshape(-1)
+    viol = disc.violation(g, w) if np.all(np.isfinite(g)) else float("nan")
+    success = bool(viol <= ctol)
+    if success:
+        status = STATUS_REST
+        message = (f"rest solution: the initial state held under zero control for T = {T:g} s meets "
+                   f"every constraint (violation {viol:.2g} <= constraint_tol {ctol:g})")
+    else:
+        status = STATUS_CONSTRAINT_TOL
+        message = (f"the initial state held under zero control for T = {T:g} s violates the "
+                   f"constraints by {viol:.3g} > constraint_tol {ctol:g}: not a solution")
+    return _make_solution(problem, tr, mesh, disc, w, np.zeros(disc.g.size), g, success, status,
+                          message, 0, 0.0, time.perf_counter() - t_build)

@@ -1,0 +1,260 @@
+"""IPOPT's option list, and the check of user ``ipopt_options`` against it.
+
+IPOPT's own options (``tol``, ``max_iter``, ``linear_solver``, ...) are not among CasADi's
+``nlpsol_options('ipopt')``: CasADi hands them through to IPOPT, which reports an unknown or
+ill-typed option only when the solver is built (a CasADi ``RuntimeError``, with IPOPT's
+documentation dumped on stdout). `check_ipopt_options` checks them *before* the solver is
+built and raises a ``ValueError`` naming the option.
+
+The options this package sets itself (``tol``, ``max_iter``, ``acceptable_iter``, ...) are
+checked against a small kept table; every other name against the installed IPOPT's own
+list: its documentation output (``print_options_documentation yes``,
+``print_advanced_options yes``, ``print_options_mode doxygen``, which names each option's
+type) is captured once in a subprocess (so nothing reaches this process's stdout) and
+parsed (`ipopt_option_table`; the result is kept for the life of the process). If that
+capture fails, names and values are not checked here and the solver's own error is
+reported instead (see `ocp.solve`).
+"""
+from __future__ import annotations
+
+import difflib
+import functools
+import math
+import re
+import subprocess
+import sys
+from dataclasses import dataclass
+from typing import Mapping
+
+import numpy as np
+
+__all__ = ["IpoptOption", "ipopt_option_table", "check_ipopt_options", "parse_documentation"]
+
+# accepted by CasADi's IPOPT interface but not in IPOPT's documentation output
+_UNDOCUMENTED = {"sb": ("String", ("yes", "no"))}
+
+_CAPTURE = r"""
+import casadi as ca
+x = ca.SX.sym("x")
+s = ca.nlpsol("doc", "ipopt", {"x": x, "f": x ** 2},
+              {"print_time": False, "ipopt": {"print_options_documentation": "yes",
+               "print_advanced_options": "yes", "print_options_mode": "doxygen",
+               "max_iter": 0, "sb": "yes"}})
+s(x0=1.0)
+"""
+
+_NAME = re.compile(r"^<strong>(\w+)</strong>")
+_RANGE = re.compile(r"valid range for this (real|integer) option is (.*?) and its default")
+_STRING = re.compile(r"default value for this string option is")
+_VALUE = re.compile(r"^ - (.+?):")
+_OPS = {"&le;": False, "<": True}  # operator -> strict
+
+
+@dataclass(frozen=True)
+class IpoptOption:
+    """One IPOPT option.
+
+    Attributes
+    ----------
+    name : str
+    kind : {'Number', 'Integer', 'String'}
+    lower, upper : float
+        Bounds of a Number/Integer option (``-inf``/``inf`` for none).
+    lower_strict, upper_strict : bool
+        Whether the bound itself is excluded.
+    values : tuple of str
+        Allowed values of a String option; empty when any string is accepted.
+    """
+
+    name: str
+    kind: str
+    lower: float = -math.inf
+    upper: float = math.inf
+    lower_strict: bool = False
+    upper_strict: bool = False
+    values: tuple = ()
+
+    def describe(self) -> str:
+        if self.kind == "String":
+            return "a string" + (f" in {list(self.values)}" if self.values else "")
+        lo = "(" if self.lower_strict else "["
+        hi = ")" if self.upper_strict else "]"
+        what = "an integer" if self.kind == "Integer" else "a number"
+        return f"{what} in {lo}{self.lower:g}, {self.upper:g}{hi}"
+
+
+def _number(text: str) -> float:
+    text = re.sub(r"10<sup>([-+]?\d+)</sup>", r"1e\1", text.strip())
+    return {"+inf": math.inf, "inf": math.inf, "-inf": -math.inf}.get(text, None) or float(text)
+
+
+def _parse_range(name: str, kind: str, text: str) -> IpoptOption:
+    """``'0 &le; max_iter'``, ``'0 < tol < 1'``, ``'unrestricted'`` -> `IpoptOption`."""
+    opt = IpoptOption(name, "Integer" if kind == "integer" else "Number")
+    if text.strip() == "unrestricted":
+        return opt
+    left, _, right = text.partition(name)
+    kw = {}
+    left = left.strip()
+    if left:
+        for op, strict in _OPS.items():
+            if left.endswith(op):
+                kw.update(lower=_number(left[: -len(op)]), lower_strict=strict)
+    right = right.strip()
+    if right:
+        for op, strict in _OPS.items():
+            if right.startswith(op):
+                kw.update(upper=_number(right[len(op):]), upper_strict=strict)
+    return IpoptOption(opt.name, opt.kind, **kw)
+
+
+def parse_documentation(text: str) -> dict:
+    """`IpoptOption` by name from IPOPT's ``print_options_documentation`` output in
+    ``print_options_mode doxygen`` (which names each option's type)."""
+    table, current = {}, None
+    for line in text.splitlines():
+        m = _NAME.match(line)
+        if m:
+            current = m.group(1)
+            continue
+        if current is None:
+            continue
+        r = _RANGE.search(line)
+        if r:
+            try:
+                table[current] = _parse_range(current, r.group(1), r.group(2))
+            except ValueError:  # an unexpected range: keep the type only
+                table[current] = IpoptOption(current, "Integer" if r.group(1) == "integer" else "Number")
+            continue
+        if _STRING.search(line):
+            table[current] = IpoptOption(current, "String")
+            continue
+        if line.startswith("Possible values: ") and table.get(current) is not None:
+            values = tuple(v.strip() for v in line[len("Possible values: "):].split(","))
+            table[current] = IpoptOption(current, "String", values=tuple(v for v in values if v != "*"))
+            continue
+        v = _VALUE.match(line)
+        if v and table.get(current) is not None and table[current].kind == "String":
+            value = v.group(1).strip()
+            if value != "*":
+                table[current] = IpoptOption(current, "String", values=table[current].values + (value,))
+        if line.startswith("</blockquote>"):
+            current = None
+    return table
+
+
+@functools.lru_cache(maxsize=1)
+def ipopt_option_table() -> Mapping[str, IpoptOption] | None:
+    """The installed IPOPT's options, captured once per process (``None`` if unavailable).
+
+    Returns
+    -------
+    mapping of str to IpoptOption, or None
+    """
+    try:
+        out = subprocess.run([sys.executable, "-c", _CAPTURE], capture_output=True, text=True,
+                             timeout=60, check=False)
+    except (OSError, subprocess.SubprocessError):
+        return None
+    table = parse_documentation(out.stdout)
+    if len(table) < 50 or "tol" not in table:  # not the documentation we expect
+        return None
+    for name, (kind, values) in _UNDOCUMENTED.items():
+        table.setdefault(name, IpoptOption(name, kind, values=values))
+    return table
+
+
+def _common() -> dict:
+    """The options this package sets itself, as IPOPT documents them: checked without
+    capturing the documentation (no subprocess on the common path)."""
+    inf = math.inf
+    pos = dict(lower=0.0, upper=inf, lower_strict=True)
+    nonneg = dict(lower=0.0, upper=inf)
+    yes_no = ("yes", "no")
+    opts = [IpoptOption("tol", "Number", **pos), IpoptOption("acceptable_tol", "Number", **pos),
+            IpoptOption("constr_viol_tol", "Number", **pos),
+            IpoptOption("acceptable_constr_viol_tol", "Number", **pos),
+            IpoptOption("dual_inf_tol", "Number", **pos), IpoptOption("compl_inf_tol", "Number", **pos),
+            IpoptOption("mu_init", "Number", **pos), IpoptOption("bound_relax_factor", "Number", **nonneg),
+            IpoptOption("max_wall_time", "Number", **pos), IpoptOption("max_cpu_time", "Number", **pos),
+            IpoptOption("max_iter", "Integer", **nonneg), IpoptOption("acceptable_iter", "Integer", **nonneg),
+            IpoptOption("print_level", "Integer", lower=0.0, upper=12.0),
+            IpoptOption("warm_start_init_point", "String", values=("no", "yes")),
+            IpoptOption("sb", "String", values=yes_no),
+            IpoptOption("mu_strategy", "String", values=("monotone", "adaptive")),
+            IpoptOption("hessian_approximation", "String", values=("exact", "limited-memory"))]
+    return {o.name: o for o in opts}
+
+
+_COMMON = _common()
+
+
+def _check_value(opt: IpoptOption, value):
+    key = opt.name
+    if opt.kind == "String":
+        if not isinstance(value, str):
+            raise ValueError(f"`ipopt_options`[{key!r}] must be {opt.describe()}, got {value!r}")
+        if opt.values and value.lower() not in {v.lower() for v in opt.values}:
+            close = difflib.get_close_matches(value, opt.values, n=1)
+            hint = f" (did you mean {close[0]!r}?)" if close else ""
+            raise ValueError(f"`ipopt_options`[{key!r}] must be one of {list(opt.values)}, "
+                             f"got {value!r}{hint}")
+        return value
+    if opt.kind == "Integer":
+        if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, np.integer)):
+            raise ValueError(f"`ipopt_options`[{key!r}] must be {opt.describe()}, got {value!r}")
+        value = int(value)
+    else:
+        if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, float, np.integer, np.floating)):
+            raise ValueError(f"`ipopt_options`[{key!r}] must be {opt.describe()}, got {value!r}")
+        value = float(value)
+        if math.isnan(value):
+            raise ValueError(f"`ipopt_options`[{key!r}] must be {opt.describe()}, got nan")
+    below = value <= opt.lower if opt.lower_strict else value < opt.lower
+    above = value >= opt.upper if opt.upper_strict else value > opt.upper
+    if below or above:
+        raise ValueError(f"`ipopt_options`[{key!r}] must be {opt.describe()}, got {value!r}")
+    return value
+
+
+def check_ipopt_options(options) -> dict:
+    """Validate user IPOPT options; return them without the ``'ipopt.'`` prefix.
+
+    Parameters
+    ----------
+    options : mapping of str to object, or None
+        IPOPT option names (with or without the ``'ipopt.'`` prefix) and values.
+
+    Returns
+    -------
+    dict
+        The options, keys without the prefix, integers and numbers as Python ``int``/``float``.
+
+    Raises
+    ------
+    ValueError
+        Naming ``ipopt_options`` and the option: not a mapping, a key that is not an IPOPT
+        option (with the closest name, if any), or a value of the wrong type or out of range
+        (Number: int or float; Integer: int; String: str, one of the allowed values).
+    """
+    if options is None:
+        return {}
+    if not isinstance(options, Mapping):
+        raise ValueError(f"`ipopt_options` must be a mapping, got {type(options).__name__}")
+    out = {}
+    for key, value in options.items():
+        if not isinstance(key, str):
+            raise ValueError(f"`ipopt_options` keys must be IPOPT option names, got {key!r}")
+        name = key[len("ipopt."):] if key.startswith("ipopt.") else key
+        if name in _COMMON:
+            out[name] = _check_value(_COMMON[name], value)
+            continue
+        table = ipopt_option_table()
+        if table is not None:
+            if name not in table:
+                close = difflib.get_close_matches(name, list(table), n=1)
+                hint = f"; did you mean {close[0]!r}?" if close else ""
+                raise ValueError(f"`ipopt_options` names unknown IPOPT option {key!r}{hint}")
+            value = _check_value(table[name], value)
+        out[name] = value
+    return out
