@@ -7,7 +7,9 @@ deviation of the body rates from the Jacobi-elliptic solution on the output grid
 
 Writes ``bench/out/simulate.csv`` and ``bench/out/simulate.png`` and prints the wall-time
 ratio of appdyn's best method to DOP853 at matched errors 1e-6 and 1e-10, the error floor,
-and the Python-call overhead of ``model.f`` and of ``simulate``.
+and the Python-call overhead of ``model.f`` and of ``simulate``. Then the hard cases
+(``bench/out/simulate_hard.csv``): a 1e5 s horizon and a 1e5-point output grid, ``auto``
+against DOP853 at matched error.
 
 Run: ``make bench`` or ``appdyn bench simulate`` (``--quick`` for a smoke run).
 """
@@ -93,6 +95,65 @@ def run(quick=False):
             rows.append(dict(solver=f"scipy {meth}", setting={"rtol": tol}, wall_time=dt,
                              error=error(sol.y), n_steps=int(sol.nfev), success=bool(sol.success)))
     return rows, model, x0, t
+
+
+# Hard cases (issue "Trustworthy results"): a long horizon and a dense output grid, where the
+# old auto fell back to cvodes and was off by 2.0 rad/s and 3.6e-6 rad/s.
+HARD_CASES = {
+    "long horizon (1e5 s, 10 001 points)": (1e5, 10_001),
+    "dense grid (1000 s, 100 001 points)": (1000.0, 100_001),
+}
+
+
+def hard_cases(quick=False):
+    """auto against DOP853 at matched error on the hard cases; rows like `run`'s plus case."""
+    rows = []
+    model = rigid_body(INERTIA)
+    x0 = np.r_[0.0, 0.0, 0.0, 1.0, W0]
+    auto_tols = [1e-6] if quick else [1e-6, 1e-8]
+    for case, (t_final, n) in HARD_CASES.items():
+        if quick and t_final > 1e4:
+            continue
+        # DOP853 costs ~1 min per run on the long horizon: two tolerances there
+        dop_tols = [1e-9, 1e-11] if t_final > 1e4 else [1e-7, 1e-9, 1e-11, 1e-13]
+        t = np.linspace(0.0, t_final, n)
+        w_exact = torque_free_omega(INERTIA, W0, t)
+        for tol in auto_tols:
+            dt, res = timed(lambda: simulate(model, x0, t, rtol=tol, atol=tol * 1e-2), 1)
+            rows.append(dict(case=case, solver="appdyn auto", setting={"rtol": tol},
+                             wall_time=dt, error=float(np.max(np.abs(res.x[4:] - w_exact))),
+                             n_steps=int(res.n_steps), success=bool(res.success),
+                             status=int(res.status)))
+        for tol in dop_tols:
+            t0 = time.perf_counter()
+            sol = solve_ivp(numpy_rhs, (0, t_final), x0, method="DOP853", t_eval=t, rtol=tol,
+                            atol=tol * 1e-2)
+            rows.append(dict(case=case, solver="scipy DOP853", setting={"rtol": tol},
+                             wall_time=time.perf_counter() - t0,
+                             error=float(np.max(np.abs(sol.y[4:] - w_exact))),
+                             n_steps=int(sol.nfev), success=bool(sol.success), status=sol.status))
+    return rows
+
+
+def print_hard_cases(rows):
+    print("\nHard cases at matched error: each DOP853 run against the cheapest successful auto "
+          "run that is at least as accurate:")
+    for case in dict.fromkeys(r["case"] for r in rows):
+        sub = [r for r in rows if r["case"] == case]
+        for r in sub:
+            if r["solver"] == "appdyn auto":
+                print(f"  {case}: auto rtol {r['setting']['rtol']:.0e}: {r['wall_time']:7.3f} s, "
+                      f"error {r['error']:.1e}, success {r['success']} (status {r['status']})")
+        for ref in (r for r in sub if r["solver"] == "scipy DOP853"):
+            better = [r for r in sub if r["solver"] == "appdyn auto" and r["success"]
+                      and r["error"] <= ref["error"]]
+            text = "no successful auto run as accurate"
+            if better:
+                best = min(better, key=lambda r: r["wall_time"])
+                text = (f"auto (rtol {best['setting']['rtol']:.0e}) {best['wall_time']:.3f} s, "
+                        f"error {best['error']:.1e} | {ref['wall_time'] / best['wall_time']:.1f}x")
+            print(f"    DOP853 rtol {ref['setting']['rtol']:.0e}: {ref['wall_time']:7.3f} s, "
+                  f"error {ref['error']:.1e} | {text}")
 
 
 def time_at_error(rows, solver, target):
@@ -188,7 +249,13 @@ def main(argv=()):
         plt.close(fig)
     except ImportError:
         pass
-    print(f"\nwrote {OUT / 'simulate.csv'} and {OUT / 'simulate.png'}")
+    hard = hard_cases(quick)
+    print_hard_cases(hard)
+    with open(OUT / "simulate_hard.csv", "w", newline="") as fh:
+        w = csv.DictWriter(fh, fieldnames=list(hard[0]))
+        w.writeheader()
+        w.writerows(hard)
+    print(f"\nwrote {OUT / 'simulate.csv'}, {OUT / 'simulate_hard.csv'} and {OUT / 'simulate.png'}")
     return summary
 
 

@@ -805,7 +805,8 @@ def _resolve_case(case):
     return name, CASES[name]
 
 
-def sweep(case, parameter: str, values, *, rtol: float = 1e-8, **case_kwargs) -> SweepResult:
+def sweep(case, parameter: str, values, *, rtol: float = 1e-8, progress=None,
+          **case_kwargs) -> SweepResult:
     """Run ``case`` for each value of ``parameter`` and locate the verdict boundaries.
 
     Between consecutive values with different verdicts the boundary is bisected until the
@@ -824,6 +825,8 @@ def sweep(case, parameter: str, values, *, rtol: float = 1e-8, **case_kwargs) ->
     parameter : str — the keyword swept, e.g. ``'rate'`` or ``'wheel_momentum'``
     values : array_like, shape (n,) — strictly increasing, finite, ``n >= 1``
     rtol : float — relative bracket width of the bisection
+    progress : callable, optional — ``progress(done, total)`` after each grid value
+        (``total = len(values)``; the bisections that follow are not counted)
     **case_kwargs — the case's other arguments (by keyword)
 
     Returns
@@ -865,7 +868,11 @@ def sweep(case, parameter: str, values, *, rtol: float = 1e-8, **case_kwargs) ->
         except ValueError as exc:
             raise ValueError(f"{name} at {parameter} = {float(v)!r}: {exc}") from None
 
-    reports = [run(v) for v in vals]
+    reports = []
+    for v in vals:
+        reports.append(run(v))
+        if progress is not None:
+            progress(len(reports), len(vals))
     verdicts = tuple(r.verdict for r in reports)
 
     def narrow(lo, hi):

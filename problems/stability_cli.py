@@ -28,11 +28,15 @@ import sys
 
 import numpy as np
 
+from problems.cli_common import Progress, attach_negative_values, progress_enabled
 from problems.cli_common import number as _number
+from problems.cli_common import output_file as _output_file
+from problems.cli_common import positive as _positive
 from problems.cli_common import vector as _floats
 from problems.cli_common import write_outputs
 
-__all__ = ["add_stability_parser", "run", "main", "parse_damper", "CASE_NAMES"]
+__all__ = ["add_stability_parser", "run", "main", "parse_damper", "check_args",
+           "sweep_parameters", "CASE_NAMES"]
 
 CASE_NAMES = {"spin": "spin", "heavy-top": "heavy_top", "projectile": "spinning_projectile",
               "rotor": "rotor", "gyrostat": "gyrostat"}
@@ -139,9 +143,31 @@ def _add_case_options(parser, case, *, sweeping):
             parser.add_argument(flag, dest=dest, choices=["platform", "rotor"], help=help_)
         else:
             parser.add_argument(flag, dest=dest, type=typ, help=help_)
-    parser.add_argument("--json", metavar="FILE", help="write the report as JSON")
-    parser.add_argument("--plot", metavar="FILE.png",
-                        help="save the pole map (sweep: eigenvalues vs the parameter)")
+    parser.add_argument("--json", metavar="FILE", type=_output_file(),
+                        help="write the report as JSON")
+    parser.add_argument("--plot", metavar="FILE.png", type=_output_file((".png",)),
+                        help="save the pole map (sweep: eigenvalues vs the parameter), PNG")
+    parser.set_defaults(_parser=parser)
+
+
+def sweep_parameters(case) -> list:
+    """The options of ``case`` that `sweep` can vary: its scalar numbers (CLI spelling)."""
+    return [flag[2:] for dest, flag, typ, _ in _OPTIONS[case] + _EXTRA[case]
+            if typ is _number]
+
+
+def _parameter(case):
+    """argparse type for ``--parameter`` of ``sweep CASE``: a scalar option of the case."""
+    valid = sweep_parameters(case)
+
+    def parse(text):
+        name = text.strip().lstrip("-").replace("_", "-")
+        if name not in valid:
+            raise argparse.ArgumentTypeError(
+                f"{case} can sweep {', '.join(valid)}; got {text!r}")
+        return name
+
+    return parse
 
 
 def add_stability_parser(subparsers) -> argparse.ArgumentParser:
@@ -164,18 +190,28 @@ def add_stability_parser(subparsers) -> argparse.ArgumentParser:
     sw_cases = sw.add_subparsers(dest="sweep_case", required=True)
     for case, help_ in helps.items():
         p = sw_cases.add_parser(case, help=help_)
-        p.add_argument("--parameter", required=True,
-                       help="argument to sweep, e.g. rate, wheel-momentum, mass")
-        p.add_argument("--values", required=True, metavar="START:STOP:NUM|V1,V2,...",
-                       help="NUM evenly spaced values from START to STOP, or a list "
-                            "(a negative START needs --values=-1:1:5)")
-        p.add_argument("--rtol", type=_number, default=1e-8,
+        p.add_argument("--parameter", required=True, type=_parameter(case),
+                       help="option to sweep: " + ", ".join(sweep_parameters(case)))
+        p.add_argument("--values", required=True,
+                       metavar="START:STOP:NUM|V1,V2,...",
+                       help="NUM evenly spaced values from START to STOP, or a list")
+        p.add_argument("--rtol", type=_positive, default=1e-8,
                        help="relative bracket of the boundary bisection (1e-8)")
+        p.add_argument("--progress", action="store_true",
+                       help="progress lines on stderr (default: only when stderr is a terminal)")
+        p.add_argument("--quiet", action="store_true", help="no progress lines")
         _add_case_options(p, case, sweeping=True)
     return stab
 
 
 def _values(text):
+    """``--values``: ``START:STOP:NUM`` or ``V1,V2,...`` -> finite, strictly increasing array.
+
+    Raises
+    ------
+    ValueError
+        Naming ``--values``.
+    """
     if ":" in text:
         parts = text.split(":")
         if len(parts) != 3:
@@ -186,11 +222,42 @@ def _values(text):
             raise ValueError(f"`--values` must be START:STOP:NUM, got {text!r}") from None
         if n < 1:
             raise ValueError(f"`--values` NUM must be at least 1, got {n}")
-        return np.linspace(a, b, n)
-    try:
-        return np.array([float(v) for v in text.split(",") if v != ""])
-    except ValueError:
-        raise ValueError(f"`--values` must be numbers, got {text!r}") from None
+        vals = np.linspace(a, b, n)
+    else:
+        try:
+            vals = np.array([float(v) for v in text.split(",") if v != ""])
+        except ValueError:
+            raise ValueError(f"`--values` must be numbers, got {text!r}") from None
+        if vals.size == 0:
+            raise ValueError(f"`--values` must be numbers, got {text!r}")
+    if not np.all(np.isfinite(vals)):
+        raise ValueError(f"`--values` must be finite, got {text!r}")
+    if np.any(np.diff(vals) <= 0):
+        raise ValueError(f"`--values` must be strictly increasing, got {text!r}")
+    return vals
+
+
+def check_args(parser, args) -> None:
+    """Checks across options, as argparse errors on ``parser`` (exit status 2)."""
+    if getattr(args, "damper_on", None) is not None and getattr(args, "damper", None) is None:
+        parser.error("argument --damper-on: only with --damper")
+    if args.case == "sweep":
+        try:
+            _values(args.values)
+        except ValueError as exc:
+            parser.error(str(exc))
+        dest = args.parameter.replace("-", "_")
+        if getattr(args, dest, None) is not None:
+            parser.error(f"argument --{args.parameter}: not allowed with --parameter "
+                         f"{args.parameter} (it is swept over --values)")
+        case = args.sweep_case
+        missing = [flag for d, flag, *_ in _OPTIONS[case]
+                   if getattr(args, d, None) is None and d != dest]
+        if missing:
+            parser.error(f"sweep {case} needs {', '.join(missing)} (all but the swept "
+                         f"--{args.parameter})")
+    if args.plot and args.json and args.plot == args.json:
+        parser.error("argument --json: the same file as --plot")
 
 
 def _case_kwargs(args, case) -> dict:
@@ -214,8 +281,9 @@ def _outputs(result, args) -> None:
 def run(args) -> int:
     """Execute parsed ``stability`` arguments: print the report, write ``--json``/``--plot``.
 
-    Returns 0 (the verdict is in the report, not the exit status). ``ValueError`` from bad
-    input propagates (``problems.cli.main`` turns it into exit status 2).
+    Returns 0 (the verdict is in the report, not the exit status). Call `check_args` first
+    (``problems.cli.main`` does). ``ValueError`` from bad input propagates
+    (``problems.cli.main`` turns it into exit status 2).
     """
     from . import stability as st  # imported on use: building the parser stays light
 
@@ -223,14 +291,13 @@ def run(args) -> int:
         case = args.sweep_case
         kwargs = _case_kwargs(args, case)
         parameter = args.parameter.replace("-", "_")
-        kwargs.pop(parameter, None)
-        missing = [flag for dest, flag, *_ in _OPTIONS[case]
-                   if dest not in kwargs and dest != parameter]
-        if missing:
-            raise ValueError(f"sweep {case} needs {', '.join(missing)} (all but the swept "
-                             f"--{args.parameter})")
-        result = st.sweep(CASE_NAMES[case], parameter, _values(args.values), rtol=args.rtol,
-                          **kwargs)
+        progress = Progress(f"sweep {case} over {args.parameter}",
+                            enabled=progress_enabled(args))
+        try:
+            result = st.sweep(CASE_NAMES[case], parameter, _values(args.values), rtol=args.rtol,
+                              progress=progress if progress.enabled else None, **kwargs)
+        finally:
+            progress.close()
     else:
         result = st.CASES[CASE_NAMES[args.case]](**_case_kwargs(args, args.case))
     print(result)
@@ -243,11 +310,13 @@ def main(argv=None) -> int:
     parser = argparse.ArgumentParser(prog="appdyn")
     sub = parser.add_subparsers(dest="command", required=True)
     add_stability_parser(sub)
-    args = parser.parse_args(["stability", *(sys.argv[1:] if argv is None else argv)])
+    argv = ["stability", *(sys.argv[1:] if argv is None else argv)]
+    args = parser.parse_args(attach_negative_values(parser, argv))
+    check_args(args._parser, args)
     try:
         return run(args)
     except ValueError as exc:
-        parser.exit(2, f"appdyn: error: {exc}\n")
+        args._parser.exit(2, f"{args._parser.prog}: error: {' '.join(str(exc).split())}\n")
 
 
 if __name__ == "__main__":

@@ -6,6 +6,7 @@ the error against a closed form and the drift of the conserved quantities.
 from __future__ import annotations
 
 import json
+import math
 from dataclasses import asdict, dataclass, field
 
 import numpy as np
@@ -16,7 +17,15 @@ from dynamics.rigid_body import check_inertia
 from dynamics.simulate import simulate
 from dynamics.truth import torque_free_omega
 
-__all__ = ["TorqueFreeReport", "torque_free"]
+__all__ = ["TorqueFreeReport", "torque_free", "CHECK_FACTOR", "ROUNDOFF_FACTOR"]
+
+#: the truth check allows ``CHECK_FACTOR`` times the requested ``atol + rtol |w_exact|``
+#: (1: ``method='auto'`` promises the tolerance as a global error and says so only when met)
+CHECK_FACTOR = 1.0
+#: round-off floor of the truth check: ``ROUNDOFF_FACTOR eps |w0| (1 + |w0| t_final)`` [rad/s]
+#: (double precision loses about ``eps`` of relative phase per radian turned; measured
+#: errors of ``method='auto'`` at the tightest tolerances stay below half of it)
+ROUNDOFF_FACTOR = 10.0
 
 
 @dataclass(frozen=True)
@@ -29,8 +38,8 @@ class TorqueFreeReport:
     w0 : list of float, shape (3,) [rad/s]
     t_final : float [s]
     method : str — integration method actually used
-    success : bool
-    message : str
+    success : bool — the integrator succeeded *and* the truth check passed (`verified`)
+    message : str — the integrator's message
     max_rate_error : float [rad/s] — max over t and axes of ``|w - w_exact|``
     max_rel_rate_error : float — ``max_rate_error / |w0|``
     energy_drift : float — ``max |T(t) - T(0)| / T(0)``
@@ -38,6 +47,16 @@ class TorqueFreeReport:
     quat_norm_drift : float — ``max | |q| - 1 |``
     wall_time : float [s] — time spent in `simulate`
     n_steps : int
+    integrator_success : bool — what the integrator reported
+    verified : bool — the truth check passed: at every output time and axis
+        ``|w - w_exact| <= allowed_error`` (NaN or inf fails)
+    allowed_error : float [rad/s] — the check's bound, ``max(CHECK_FACTOR (atol + rtol
+        |w_exact|), roundoff)`` at the worst point, or ``tol |w0|`` when ``tol`` was given
+    error_ratio : float — ``max |w - w_exact| / bound`` over times and axes (<= 1 passes)
+    check : str — the rule applied, in words
+    rtol, atol : float — the requested tolerances (fixed-step methods: the accuracy asked of
+        the result; the integrator does not use them)
+    tol : float or None — relative accuracy asked instead (``max_rel_rate_error <= tol``)
     """
 
     inertia: list
@@ -53,6 +72,16 @@ class TorqueFreeReport:
     quat_norm_drift: float
     wall_time: float
     n_steps: int
+    integrator_success: bool = True
+    verified: bool = True
+    allowed_error: float = math.inf
+    error_ratio: float = 0.0
+    check: str = ""
+    rtol: float = math.nan
+    atol: float = math.nan
+    tol: float | None = None
+    worst_time: float = math.nan
+    worst_axis: int = 0
     _series: dict = field(default_factory=dict, repr=False, compare=False)
 
     def to_dict(self) -> dict:
@@ -62,7 +91,21 @@ class TorqueFreeReport:
         return d
 
     def to_json(self) -> str:
-        return json.dumps(self.to_dict(), indent=2)
+        """`to_dict` as strict JSON (non-finite numbers as ``null``)."""
+        d = {k: (None if isinstance(v, float) and not math.isfinite(v) else v)
+             for k, v in self.to_dict().items()}
+        return json.dumps(d, indent=2, allow_nan=False)
+
+    @property
+    def check_text(self) -> str:
+        """``truth check passed: ...`` or ``truth check FAILED: ...`` with the numbers."""
+        if self.verified:
+            return (f"truth check passed: max |w - w_exact| = {self.max_rate_error:.3e} rad/s, "
+                    f"{self.error_ratio:.2g} of the allowed error ({self.check})")
+        return (f"truth check FAILED: max |w - w_exact| = {self.max_rate_error:.3e} rad/s; "
+                f"at t = {self.worst_time:g} s the w{self.worst_axis + 1} error is "
+                f"{self.error_ratio:.3g} times the allowed {self.allowed_error:.3e} rad/s "
+                f"({self.check})")
 
     def __str__(self) -> str:
         rows = [
@@ -70,7 +113,7 @@ class TorqueFreeReport:
             ("w0 [rad/s]", ", ".join(f"{v:g}" for v in self.w0)),
             ("t_final [s]", f"{self.t_final:g}"),
             ("method", self.method),
-            ("success", f"{self.success} ({self.message})"),
+            ("success", f"{self.success} (integrator: {self.message})"),
             ("max |w - w_exact| [rad/s]", f"{self.max_rate_error:.3e}"),
             ("  relative to |w0|", f"{self.max_rel_rate_error:.3e}"),
             ("energy drift (rel)", f"{self.energy_drift:.3e}"),
@@ -82,6 +125,7 @@ class TorqueFreeReport:
         width = max(len(k) for k, _ in rows)
         lines = ["Torque-free rigid body vs Jacobi-elliptic solution"]
         lines += [f"  {k:<{width}}  {v}" for k, v in rows]
+        lines.append(f"  {self.check_text}")
         return "\n".join(lines)
 
     def plot(self, path: str) -> None:
@@ -119,7 +163,7 @@ class TorqueFreeReport:
 
 
 def torque_free(inertia, w0, *, t_final=50.0, n_points=1001, q0=None, method="auto",
-                rtol=1e-10, atol=1e-12) -> TorqueFreeReport:
+                rtol=1e-10, atol=1e-12, steps=None, tol=None, progress=None) -> TorqueFreeReport:
     """Simulate a torque-free rigid body and compare with the exact solution.
 
     Parameters
@@ -130,11 +174,23 @@ def torque_free(inertia, w0, *, t_final=50.0, n_points=1001, q0=None, method="au
     t_final : float [s]
     n_points : int — output grid size
     q0 : array_like, shape (4,), optional — initial attitude (identity)
-    method, rtol, atol : passed to `dynamics.simulate`
+    method, rtol, atol, steps : passed to `dynamics.simulate` (fixed-step methods ignore
+        ``rtol``/``atol`` but the truth check still uses them)
+    tol : float, optional
+        Relative accuracy asked of the result instead of ``rtol``/``atol``.
+    progress : callable, optional
+        ``progress(done, total)`` in integration steps, passed to `dynamics.simulate`.
 
     Returns
     -------
     TorqueFreeReport
+        ``success`` is the integrator's success *and* the truth check (`verified`):
+
+        * default: ``|w_i(t) - w_exact_i(t)| <= max(CHECK_FACTOR (atol + rtol |w_exact_i(t)|),
+          ROUNDOFF_FACTOR eps |w0| (1 + |w0| t_final))`` at every output time and axis —
+          the requested tolerance read as a *global* error (what ``method='auto'`` controls;
+          ``cvodes`` controls the local error only and usually misses it on long runs);
+        * with ``tol``: ``max |w - w_exact| <= tol |w0|`` (``max_rel_rate_error <= tol``).
     """
     I = check_inertia(inertia)
     w0 = np.asarray(w0, dtype=float).reshape(-1)
@@ -147,31 +203,60 @@ def torque_free(inertia, w0, *, t_final=50.0, n_points=1001, q0=None, method="au
     q0 = np.array([0.0, 0.0, 0.0, 1.0]) if q0 is None else np.asarray(q0, dtype=float)
     model = rigid_body(I)
     t = np.linspace(0.0, float(t_final), int(n_points))
-    res = simulate(model, np.concatenate([q0, w0]), t, method=method, rtol=rtol, atol=atol,
-                   invariants=True)
-    moments, A = principal_axes(I)
-    w = res.x[4:7]
-    w_exact = A.T @ torque_free_omega(moments, A @ w0, t)
-    err = np.max(np.abs(w - w_exact))
-    energy = np.asarray(res.invariants["energy"])
-    H = np.asarray(res.invariants["momentum_inertial"])
-    H0 = np.linalg.norm(H[:, 0])
-    momentum_err = np.linalg.norm(H - H[:, :1], axis=0) / H0 if H0 > 0 else np.zeros_like(t)
-    qn = np.asarray(res.invariants["quat_norm"])
+    if tol is not None and not (np.isfinite(tol) and tol > 0):
+        raise ValueError(f"`tol` must be positive and finite, got {tol}")
+    extra = {} if steps is None else dict(steps=int(steps))
+    with np.errstate(over="ignore", invalid="ignore"):  # a diverged run is reported, not warned
+        res = simulate(model, np.concatenate([q0, w0]), t, method=method, rtol=rtol,
+                       atol=atol, invariants=True, progress=progress, **extra)
+        moments, A = principal_axes(I)
+        w = res.x[4:7]
+        w_exact = A.T @ torque_free_omega(moments, A @ w0, t)
+        dev = np.abs(w - w_exact)
+        err = np.max(dev)
+        wn = float(np.linalg.norm(w0))
+        if tol is None:
+            floor = ROUNDOFF_FACTOR * np.finfo(float).eps * wn * (1.0 + wn * float(t_final))
+            bound = np.maximum(CHECK_FACTOR * (atol + rtol * np.abs(w_exact)), floor)
+            check = (f"|w - w_exact| <= {CHECK_FACTOR:g} (atol + rtol |w_exact|) with atol = "
+                     f"{atol:g}, rtol = {rtol:g}, round-off floor {floor:.1e} rad/s")
+        else:
+            bound = np.full_like(dev, tol * max(wn, 1e-300))
+            check = f"max |w - w_exact| <= tol |w0| with tol = {tol:g}"
+        ratio = np.where(np.isfinite(dev), dev / bound, np.inf)
+        worst = np.unravel_index(int(np.argmax(ratio)), ratio.shape)
+        verified = bool(np.all(np.isfinite(dev)) and np.max(ratio) <= 1.0)
+        energy = np.asarray(res.invariants["energy"])
+        energy_drift = (float(np.max(np.abs(energy / energy[0] - 1))) if energy[0] > 0
+                        else 0.0)
+        H = np.asarray(res.invariants["momentum_inertial"])
+        H0 = np.linalg.norm(H[:, 0])
+        momentum_err = np.linalg.norm(H - H[:, :1], axis=0) / H0 if H0 > 0 else np.zeros_like(t)
+        qn = np.asarray(res.invariants["quat_norm"])
     return TorqueFreeReport(
         inertia=I.tolist(),
         w0=w0.tolist(),
         t_final=float(t_final),
         method=res.method,
-        success=bool(res.success),
+        success=bool(res.success) and verified,
         message=str(res.message),
         max_rate_error=float(err),
         max_rel_rate_error=float(err / max(np.linalg.norm(w0), 1e-300)),
-        energy_drift=float(np.max(np.abs(energy / energy[0] - 1))) if energy[0] > 0 else 0.0,
+        energy_drift=energy_drift,
         momentum_drift=float(np.max(momentum_err)),
         quat_norm_drift=float(np.max(np.abs(qn - 1))),
         wall_time=float(res.wall_time),
         n_steps=int(res.n_steps),
+        integrator_success=bool(res.success),
+        verified=verified,
+        allowed_error=float(bound[worst]),
+        error_ratio=float(ratio[worst]),
+        check=check,
+        rtol=float(rtol),
+        atol=float(atol),
+        tol=None if tol is None else float(tol),
+        worst_time=float(t[worst[1]]),
+        worst_axis=int(worst[0]),
         _series=dict(t=t, w=w, w_exact=w_exact, energy=energy, momentum_err=momentum_err,
                      quat_norm=qn),
     )

@@ -259,9 +259,10 @@ def test_auto_meets_the_requested_tolerance(rtol):
 
 def test_auto_reports_a_tolerance_below_round_off():
     """rtol = 1e-13: no double-precision fixed-step run can promise that; the result says so
-    (status 2, error_estimate > 1) and still returns the best solution found."""
+    (status 2, error_estimate > 1, success False: nothing was verified) and still returns
+    the best solution found."""
     res, ratio = axisymmetric_run(1e-13, 1e-15)
-    assert res.success and res.status == 2 and "round-off" in res.message
+    assert not res.success and res.status == 2 and "round-off" in res.message
     assert res.error_estimate > 1.0 and ratio < 1e3
 
 
@@ -336,11 +337,12 @@ def test_other_methods_report_blow_up(method):
     assert isinstance(res, SimulationResult)
 
 
-def test_auto_falls_back_to_cvodes_when_too_many_steps_are_needed():
+def test_auto_says_when_max_steps_is_too_small_and_never_falls_back():
+    """No silent switch to cvodes: the step budget is reported as an unverified result."""
     res = simulate(linear_model(0), X3, np.linspace(0.0, 100.0, 3), rtol=1e-10, max_steps=50,
                    jit=False)
-    assert res.success and res.status == 1 and res.method == "cvodes"
-    assert "fell back" in res.message
+    assert not res.success and res.status == 3 and res.method == "rk8", res.message
+    assert "max_steps = 50" in res.message and "not verified" in res.message
 
 
 @functools.lru_cache(maxsize=None)
