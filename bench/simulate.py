@@ -136,8 +136,8 @@ def hard_cases(quick=False):
 
 
 def print_hard_cases(rows):
-    print("\nHard cases at matched error: each DOP853 run against the cheapest successful auto "
-          "run that is at least as accurate:")
+    print("\nHard cases at matched error: each DOP853 run against the cheapest auto run that is "
+          "at least as accurate (measured against the Jacobi truth):")
     for case in dict.fromkeys(r["case"] for r in rows):
         sub = [r for r in rows if r["case"] == case]
         for r in sub:
@@ -145,12 +145,12 @@ def print_hard_cases(rows):
                 print(f"  {case}: auto rtol {r['setting']['rtol']:.0e}: {r['wall_time']:7.3f} s, "
                       f"error {r['error']:.1e}, success {r['success']} (status {r['status']})")
         for ref in (r for r in sub if r["solver"] == "scipy DOP853"):
-            better = [r for r in sub if r["solver"] == "appdyn auto" and r["success"]
-                      and r["error"] <= ref["error"]]
-            text = "no successful auto run as accurate"
+            better = [r for r in sub if r["solver"] == "appdyn auto" and r["error"] <= ref["error"]]
+            text = "no auto run as accurate"
             if better:
                 best = min(better, key=lambda r: r["wall_time"])
-                text = (f"auto (rtol {best['setting']['rtol']:.0e}) {best['wall_time']:.3f} s, "
+                flag = "" if best["success"] else f", not verified: status {best['status']}"
+                text = (f"auto (rtol {best['setting']['rtol']:.0e}{flag}) {best['wall_time']:.3f} s, "
                         f"error {best['error']:.1e} | {ref['wall_time'] / best['wall_time']:.1f}x")
             print(f"    DOP853 rtol {ref['setting']['rtol']:.0e}: {ref['wall_time']:7.3f} s, "
                   f"error {ref['error']:.1e} | {text}")
