@@ -1,12 +1,18 @@
 """Torque-free rigid body: simulate and check against the Jacobi-elliptic truth.
 
 This is the toolkit's smallest end-to-end job: build the model, integrate it, and measure
-the error against a closed form and the drift of the conserved quantities.
+the error against a closed form (Rheinfurth & Wilson, NASA RP-1262, Sec. 4.5 B) and the
+drift of the conserved quantities.
+
+Status of a `TorqueFreeReport` (``report.status``): `STATUS_VERIFIED` (0) the integrator
+succeeded and the truth check passed; `STATUS_CHECK_FAILED` (1) the integrator succeeded but
+the error exceeds what was asked; `STATUS_INTEGRATOR_FAILED` (-1) the integration failed.
 """
 from __future__ import annotations
 
 import json
 import math
+import warnings
 from dataclasses import asdict, dataclass, field
 
 import numpy as np
@@ -17,7 +23,15 @@ from dynamics.rigid_body import check_inertia
 from dynamics.simulate import simulate
 from dynamics.truth import torque_free_omega
 
-__all__ = ["TorqueFreeReport", "torque_free", "CHECK_FACTOR", "ROUNDOFF_FACTOR"]
+__all__ = ["TorqueFreeReport", "torque_free", "CHECK_FACTOR", "ROUNDOFF_FACTOR",
+           "STATUS_VERIFIED", "STATUS_CHECK_FAILED", "STATUS_INTEGRATOR_FAILED"]
+
+#: status: integrated and verified against the exact solution
+STATUS_VERIFIED = 0
+#: status: integrated, but the error exceeds what was asked (``success`` is False)
+STATUS_CHECK_FAILED = 1
+#: status: the integrator failed (``success`` is False)
+STATUS_INTEGRATOR_FAILED = -1
 
 #: the truth check allows ``CHECK_FACTOR`` times the requested ``atol + rtol |w_exact|``
 #: (1: ``method='auto'`` promises the tolerance as a global error and says so only when met)
@@ -35,28 +49,54 @@ class TorqueFreeReport:
     Attributes
     ----------
     inertia : list of list of float, shape (3, 3) [kg m^2]
+        The inertia matrix.
     w0 : list of float, shape (3,) [rad/s]
+        Initial body rates.
     t_final : float [s]
-    method : str — integration method actually used
-    success : bool — the integrator succeeded *and* the truth check passed (`verified`)
-    message : str — the integrator's message
-    max_rate_error : float [rad/s] — max over t and axes of ``|w - w_exact|``
-    max_rel_rate_error : float — ``max_rate_error / |w0|``
-    energy_drift : float — ``max |T(t) - T(0)| / T(0)``
-    momentum_drift : float — ``max |H(t) - H(0)| / |H(0)|`` with ``H`` in inertial axes
-    quat_norm_drift : float — ``max | |q| - 1 |``
-    wall_time : float [s] — time spent in `simulate`
+        Final time.
+    method : str
+        Integration method actually used.
+    success : bool
+        The integrator succeeded *and* the truth check passed (`verified`).
+    message : str
+        The integrator's message.
+    max_rate_error : float [rad/s]
+        Max over t and axes of ``|w - w_exact|``.
+    max_rel_rate_error : float
+        ``max_rate_error / |w0|``.
+    energy_drift : float
+        ``max |T(t) - T(0)| / T(0)``.
+    momentum_drift : float
+        ``max |H(t) - H(0)| / |H(0)|`` with ``H`` in inertial axes.
+    quat_norm_drift : float
+        ``max | |q| - 1 |``.
+    wall_time : float [s]
+        Time spent in `simulate`.
     n_steps : int
-    integrator_success : bool — what the integrator reported
-    verified : bool — the truth check passed: at every output time and axis
-        ``|w - w_exact| <= allowed_error`` (NaN or inf fails)
-    allowed_error : float [rad/s] — the check's bound, ``max(CHECK_FACTOR (atol + rtol
-        |w_exact|), roundoff)`` at the worst point, or ``tol |w0|`` when ``tol`` was given
-    error_ratio : float — ``max |w - w_exact| / bound`` over times and axes (<= 1 passes)
-    check : str — the rule applied, in words
-    rtol, atol : float — the requested tolerances (fixed-step methods: the accuracy asked of
-        the result; the integrator does not use them)
-    tol : float or None — relative accuracy asked instead (``max_rel_rate_error <= tol``)
+        Integration steps.
+    integrator_success : bool
+        What the integrator reported.
+    verified : bool
+        The truth check passed: at every output time and axis
+        ``|w - w_exact| <= allowed_error`` (NaN or inf fails).
+    allowed_error : float [rad/s]
+        The check's bound, ``max(CHECK_FACTOR (atol + rtol |w_exact|), roundoff)`` at the
+        worst point, or ``tol |w0|`` when ``tol`` was given.
+    error_ratio : float
+        ``max |w - w_exact| / bound`` over times and axes (<= 1 passes).
+    check : str
+        The rule applied, in words.
+    rtol, atol : float
+        The requested tolerances (fixed-step methods: the accuracy asked of the result; the
+        integrator does not use them).
+    tol : float or None
+        Relative accuracy asked instead (``max_rel_rate_error <= tol``).
+    worst_time : float [s]
+        Output time of the largest ``error_ratio``.
+    worst_component : int
+        0-based index of the body rate with the largest ``error_ratio`` (was ``worst_axis``).
+    status : int
+        `STATUS_VERIFIED`, `STATUS_CHECK_FAILED` or `STATUS_INTEGRATOR_FAILED` (property).
     """
 
     inertia: list
@@ -81,13 +121,28 @@ class TorqueFreeReport:
     atol: float = math.nan
     tol: float | None = None
     worst_time: float = math.nan
-    worst_axis: int = 0
+    worst_component: int = 0
     _series: dict = field(default_factory=dict, repr=False, compare=False)
 
+    @property
+    def status(self) -> int:
+        """`STATUS_VERIFIED`, `STATUS_CHECK_FAILED` or `STATUS_INTEGRATOR_FAILED`."""
+        if not self.integrator_success:
+            return STATUS_INTEGRATOR_FAILED
+        return STATUS_VERIFIED if self.verified else STATUS_CHECK_FAILED
+
+    @property
+    def worst_axis(self) -> int:
+        """Deprecated name of `worst_component` (an integer is a component, not an axis)."""
+        warnings.warn("`TorqueFreeReport.worst_axis` is deprecated; use `worst_component`",
+                      DeprecationWarning, stacklevel=2)
+        return self.worst_component
+
     def to_dict(self) -> dict:
-        """JSON-ready summary (no time series)."""
+        """JSON-ready summary (no time series), with ``status``."""
         d = asdict(self)
         d.pop("_series")
+        d["status"] = self.status
         return d
 
     def to_json(self) -> str:
@@ -103,7 +158,7 @@ class TorqueFreeReport:
             return (f"truth check passed: max |w - w_exact| = {self.max_rate_error:.3e} rad/s, "
                     f"{self.error_ratio:.2g} of the allowed error ({self.check})")
         return (f"truth check FAILED: max |w - w_exact| = {self.max_rate_error:.3e} rad/s; "
-                f"at t = {self.worst_time:g} s the w{self.worst_axis + 1} error is "
+                f"at t = {self.worst_time:g} s the w{self.worst_component + 1} error is "
                 f"{self.error_ratio:.3g} times the allowed {self.allowed_error:.3e} rad/s "
                 f"({self.check})")
 
@@ -128,16 +183,27 @@ class TorqueFreeReport:
         lines.append(f"  {self.check_text}")
         return "\n".join(lines)
 
-    def plot(self, path: str) -> None:
-        """Save rates (simulated and exact), the polhode and invariant drift to ``path``."""
-        import matplotlib
+    def plot(self, path=None, *, fig=None):
+        """Rates (simulated and exact), the polhode, invariant drift and error vs truth.
 
-        matplotlib.use("Agg", force=False)
-        import matplotlib.pyplot as plt
+        Parameters
+        ----------
+        path : str or path-like, optional
+            Also save the figure there (format from the suffix).
+        fig : matplotlib.figure.Figure, optional
+            Draw the four panels on this figure; by default on a new one (no pyplot, the
+            backend is left alone).
 
+        Returns
+        -------
+        matplotlib.figure.Figure
+        """
+        if fig is None:
+            from matplotlib.figure import Figure
+
+            fig = Figure(figsize=(12, 8))
         s = self._series
         t, w, w_ex = s["t"], s["w"], s["w_exact"]
-        fig = plt.figure(figsize=(12, 8))
         ax1 = fig.add_subplot(2, 2, 1)
         for i, c in enumerate("tab:blue tab:orange tab:green".split()):
             ax1.plot(t, w[i], color=c, label=f"w{i + 1}")
@@ -158,8 +224,9 @@ class TorqueFreeReport:
         ax4.semilogy(t, np.max(np.abs(w - w_ex), axis=0) + tiny)
         ax4.set(xlabel="t [s]", ylabel="max |w - w_exact| [rad/s]", title="Error vs truth")
         fig.tight_layout()
-        fig.savefig(path, dpi=110)
-        plt.close(fig)
+        if path is not None:
+            fig.savefig(path, dpi=110)
+        return fig
 
 
 def torque_free(inertia, w0, *, t_final=50.0, n_points=1001, q0=None, method="auto",
@@ -170,12 +237,17 @@ def torque_free(inertia, w0, *, t_final=50.0, n_points=1001, q0=None, method="au
     ----------
     inertia : array_like, shape (3,) or (3, 3) [kg m^2]
         Principal moments or a full inertia matrix (the truth is evaluated in principal axes).
-    w0 : array_like, shape (3,) [rad/s] — initial body rates
-    t_final : float [s]
-    n_points : int — output grid size
-    q0 : array_like, shape (4,), optional — initial attitude (identity)
-    method, rtol, atol, steps : passed to `dynamics.simulate` (fixed-step methods ignore
-        ``rtol``/``atol`` but the truth check still uses them)
+    w0 : array_like, shape (3,) [rad/s]
+        Initial body rates.
+    t_final : float [s], optional
+        Final time (50).
+    n_points : int, optional
+        Output grid size (1001).
+    q0 : array_like, shape (4,), optional
+        Initial attitude, scalar-last (identity).
+    method, rtol, atol, steps : optional
+        Passed to `dynamics.simulate` (fixed-step methods ignore ``rtol``/``atol`` but the
+        truth check still uses them).
     tol : float, optional
         Relative accuracy asked of the result instead of ``rtol``/``atol``.
     progress : callable, optional
@@ -256,7 +328,7 @@ def torque_free(inertia, w0, *, t_final=50.0, n_points=1001, q0=None, method="au
         atol=float(atol),
         tol=None if tol is None else float(tol),
         worst_time=float(t[worst[1]]),
-        worst_axis=int(worst[0]),
+        worst_component=int(worst[0]),
         _series=dict(t=t, w=w, w_exact=w_exact, energy=energy, momentum_err=momentum_err,
                      quat_norm=qn),
     )

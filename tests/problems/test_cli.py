@@ -79,3 +79,32 @@ def test_slew_bad_input(args, message, capsys):
         main(["slew", *args])
     assert exc.value.code == 2
     assert message in capsys.readouterr().err
+
+
+def test_torque_free_report_status_plot_and_deprecated_worst_axis():
+    from matplotlib.figure import Figure
+
+    from problems.torque_free import STATUS_CHECK_FAILED, STATUS_VERIFIED
+
+    rep = torque_free([1.0, 2.0, 3.0], [0.2, 1.0, 0.1], t_final=5.0, n_points=51)
+    assert rep.status == STATUS_VERIFIED and rep.to_dict()["status"] == STATUS_VERIFIED
+    assert isinstance(rep.plot(), Figure)
+    with pytest.warns(DeprecationWarning, match="worst_component"):
+        assert rep.worst_axis == rep.worst_component
+    tight = torque_free([1.0, 2.0, 3.0], [0.2, 1.0, 0.1], t_final=5.0, n_points=51,
+                        method="rk4", tol=1e-15)
+    assert tight.status == STATUS_CHECK_FAILED and not tight.success
+
+
+def test_umax_is_a_hidden_alias_of_u_max(capsys):
+    from problems.cli import build_parser
+
+    parser = build_parser()
+    base = ["slew", "--inertia", "1,1,1", "--axis", "0,0,1", "--angle", "90", "--time-optimal"]
+    new = parser.parse_args(base + ["--u-max", "2"])
+    old = parser.parse_args(base + ["--umax", "2"])
+    assert new.u_max.tolist() == old.u_max.tolist() == [2.0]
+    with pytest.raises(SystemExit):
+        parser.parse_args(["slew", "--help"])
+    text = capsys.readouterr().out
+    assert "--u-max" in text and "--umax" not in text

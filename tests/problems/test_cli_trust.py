@@ -17,7 +17,7 @@ from dynamics.truth import torque_free_omega
 from problems import slew
 from problems import stability
 from problems.cli import main, rest_to_rest_bound
-from problems.cli_common import attach_negative_values, strict_json
+from problems.cli.common import attach_negative_values, strict_json
 from problems.torque_free import CHECK_FACTOR, torque_free
 
 TF = ["simulate", "torque-free", "--inertia", "1,2,3"]

@@ -21,7 +21,9 @@ from dynamics.spinning import tilt_torque_body
 from problems import stability as st
 from problems.stability import (PointMassDamper, SphericalDamper, classify, gyrostat,
                                 heavy_top, loop, rotor, spin, spinning_projectile, sweep)
-from problems.stability_cli import add_stability_parser, main as cli_main, run as cli_run
+from problems.cli.stability import add_parser as add_stability_parser
+from problems.cli.stability import main as cli_main
+from problems.cli.stability import run as cli_run
 
 TOL = 1e-9  # eigenvalues vs closed forms, relative to the spectral radius
 G0 = 9.80665
@@ -50,14 +52,14 @@ def method3_roots(I1, I2, kappa, w0, D=0.0):
 
 
 # ------------------------------------------------------------------ torque-free spin
-@pytest.mark.parametrize("axis, verdict", [(0, "marginally stable"), (1, "unstable"),
-                                           (2, "marginally stable")])
+@pytest.mark.parametrize("axis_index, verdict", [(0, "marginally stable"), (1, "unstable"),
+                                                 (2, "marginally stable")])
 @pytest.mark.parametrize("rate", [10.0, -3.0])
-def test_spin_rate_eigenvalues_closed_form(axis, verdict, rate):
+def test_spin_rate_eigenvalues_closed_form(axis_index, verdict, rate):
     I = np.array([2.0, 3.0, 4.5])
-    a = np.eye(3)[axis]
+    a = np.eye(3)[axis_index]
     rep = spin(I, a, rate)
-    Ia, Ib, Ic = I[axis], *np.delete(I, axis)
+    Ia, Ib, Ic = I[axis_index], *np.delete(I, axis_index)
     lam = 1j * rate * np.sqrt(complex((Ia - Ib) * (Ia - Ic) / (Ib * Ic)))  # +/- i rate sqrt(...)
     assert_eigenvalues(rep, [lam, -lam])
     assert rep.verdict == verdict
@@ -548,3 +550,70 @@ def test_cli_bad_input_exits_2(argv, message, capsys):
         cli_main(argv)
     assert exc.value.code == 2
     assert message in capsys.readouterr().err
+
+
+# ------------------------------------------------------- statuses, figures, examples
+def test_report_status_success_message(reports):
+    for rep in reports:
+        assert rep.status in (st.STATUS_VERIFIED, st.STATUS_UNCHECKED, st.STATUS_MISMATCH)
+        assert rep.success is (rep.status != st.STATUS_MISMATCH)
+        d = rep.to_dict()
+        assert (d["success"], d["status"], d["message"]) == (rep.success, rep.status, rep.message)
+    assert reports[1].status == st.STATUS_VERIFIED  # heavy top: Eq. 4.127
+    assert reports[0].status == st.STATUS_UNCHECKED  # point-mass damper: no closed form here
+    assert "no closed form" in reports[0].message
+    expected_wrong = st.loop(launch_vehicle()[0], [[0.8, 0.3]], closed_form=[-1.0, -2.0])
+    assert expected_wrong.status == st.STATUS_MISMATCH and not expected_wrong.success
+    assert "DISAGREE" in expected_wrong.message
+
+
+def test_sweep_status_is_the_worst_along_the_grid():
+    res = sweep("heavy_top", "rate", [10.0, 40.0], axial_inertia=0.002,
+                transverse_inertia=0.005, mass=0.3, length=0.04)
+    assert res.statuses == (st.STATUS_VERIFIED, st.STATUS_VERIFIED)
+    assert res.success and res.status == st.STATUS_VERIFIED
+    d = json.loads(res.to_json())
+    assert d["success"] is True and d["status"] == 0 and d["statuses"] == [0, 0]
+
+
+def test_plots_return_figures_without_pyplot(reports):
+    from matplotlib.figure import Figure
+
+    fig = reports[1].plot()
+    assert isinstance(fig, Figure) and len(fig.axes) == 1
+    other = Figure()
+    ax = other.add_subplot(1, 1, 1)
+    assert reports[1].plot(ax=ax) is other
+    res = sweep("rotor", "rate", [30.0, 90.0], axial_inertia=0.01, transverse_inertia=0.05,
+                stiffness=1e4, bearing_distance=0.1, internal_damping=0.01)
+    assert len(res.plot().axes) == 2
+    import pathlib
+
+    import problems.torque_free
+
+    for path in [*pathlib.Path(st.__file__).parent.glob("*.py"),
+                 pathlib.Path(problems.torque_free.__file__)]:
+        text = path.read_text()
+        assert "matplotlib.use(" not in text and "import matplotlib.pyplot" not in text, path
+
+
+def test_one_case_table_serves_library_and_cli():
+    from problems.cli.stability import _OPTIONS
+
+    for cli_name in _OPTIONS:
+        name, fun = st.resolve_case(cli_name)
+        assert st.CASES[name] is fun
+
+
+@pytest.mark.parametrize("module", ["__init__", "verdict", "report", "closed_forms", "spin",
+                                    "tilt", "loop", "cases", "sweep"])
+def test_docstring_examples_run(module):
+    """The Examples sections of problems.stability, printed values included."""
+    import doctest
+    import importlib
+
+    mod = importlib.import_module("problems.stability" + ("" if module == "__init__"
+                                                         else f".{module}"))
+    result = doctest.testmod(mod, optionflags=doctest.NORMALIZE_WHITESPACE)
+    assert result.failed == 0
+    assert result.attempted > 0

@@ -17,9 +17,12 @@
     --damper point mass=0.05 stiffness=20 damping=0.3 position=0,0.5,0 direction=1,0,0 [body_mass=M]
     --damper sphere inertia=0.05 damping=0.02
 
-`add_stability_parser` adds the ``stability`` command to an argparse sub-parser group (its
-cases land in ``args.case``); `run` executes parsed arguments; `main` is a standalone entry
-(``python -m problems.stability_cli spin ...``). This module prints; the library does not.
+`add_parser` adds the ``stability`` command to an argparse sub-parser group (its cases land
+in ``args.case``); `check` checks across options; `run` executes parsed arguments; `main` is
+a standalone entry taking the arguments after ``stability`` (from a shell:
+``python -m problems.cli stability spin ...``). Case names are mapped to
+the library's functions by `problems.stability.resolve_case` (its one alias table). This
+module prints; the library does not.
 """
 from __future__ import annotations
 
@@ -28,18 +31,15 @@ import sys
 
 import numpy as np
 
-from problems.cli_common import Progress, attach_negative_values, progress_enabled
-from problems.cli_common import number as _number
-from problems.cli_common import output_file as _output_file
-from problems.cli_common import positive as _positive
-from problems.cli_common import vector as _floats
-from problems.cli_common import write_outputs
+from problems.cli.common import Progress, attach_negative_values, inertia_matrix
+from problems.cli.common import number as _number
+from problems.cli.common import output_file as _output_file
+from problems.cli.common import positive as _positive
+from problems.cli.common import progress_enabled, same_file
+from problems.cli.common import vector as _floats
+from problems.cli.common import write_outputs
 
-__all__ = ["add_stability_parser", "run", "main", "parse_damper", "check_args",
-           "sweep_parameters", "CASE_NAMES"]
-
-CASE_NAMES = {"spin": "spin", "heavy-top": "heavy_top", "projectile": "spinning_projectile",
-              "rotor": "rotor", "gyrostat": "gyrostat"}
+__all__ = ["add_parser", "check", "run", "main", "parse_damper", "sweep_parameters"]
 
 
 def parse_damper(tokens):
@@ -76,10 +76,6 @@ def parse_damper(tokens):
     except TypeError as exc:
         needed = fields[kind][:3] if kind == "point" else fields[kind]
         raise ValueError(f"`--damper {kind}` needs {', '.join(needed)}: {exc}") from None
-
-
-def _inertia(values):
-    return values if values.size == 3 else values.reshape(3, 3)
 
 
 # (dest, flags, type, help); required in a plain case, optional under 'sweep'
@@ -170,7 +166,7 @@ def _parameter(case):
     return parse
 
 
-def add_stability_parser(subparsers) -> argparse.ArgumentParser:
+def add_parser(subparsers) -> argparse.ArgumentParser:
     """Add ``stability`` to ``subparsers`` (from ``parser.add_subparsers(dest="command")``).
 
     The chosen case lands in ``args.case`` (``spin``, ``heavy-top``, ``projectile``,
@@ -180,7 +176,7 @@ def add_stability_parser(subparsers) -> argparse.ArgumentParser:
     stab = subparsers.add_parser("stability", help="linear stability reports of spinning bodies")
     cases = stab.add_subparsers(dest="case", required=True)
     helps = {"spin": "torque-free spin about a principal axis (optional damper)",
-             "heavy-top": "heavy top, seed Sec. 4.6 Method III (sleeping top, precession)",
+             "heavy-top": "heavy top, NASA RP-1262 Sec. 4.6 Method III (sleeping top, precession)",
              "projectile": "spin-stabilized projectile (aerodynamic overturning moment)",
              "rotor": "rotor in elastic bearings: whirl and internal-damping instability",
              "gyrostat": "dual-spin gyrostat vs wheel momentum (optional damper)"}
@@ -237,7 +233,7 @@ def _values(text):
     return vals
 
 
-def check_args(parser, args) -> None:
+def check(parser, args) -> None:
     """Checks across options, as argparse errors on ``parser`` (exit status 2)."""
     if getattr(args, "damper_on", None) is not None and getattr(args, "damper", None) is None:
         parser.error("argument --damper-on: only with --damper")
@@ -256,7 +252,7 @@ def check_args(parser, args) -> None:
         if missing:
             parser.error(f"sweep {case} needs {', '.join(missing)} (all but the swept "
                          f"--{args.parameter})")
-    if args.plot and args.json and args.plot == args.json:
+    if same_file(args.plot, args.json):
         parser.error("argument --json: the same file as --plot")
 
 
@@ -267,25 +263,21 @@ def _case_kwargs(args, case) -> dict:
         if value is None:
             continue
         if dest == "inertia":
-            value = _inertia(value)
+            value = inertia_matrix(value)
         elif dest == "damper":
             value = parse_damper(value)
         kwargs[dest] = value
     return kwargs
 
 
-def _outputs(result, args) -> None:
-    write_outputs(result, plot=args.plot, json=args.json)
-
-
 def run(args) -> int:
     """Execute parsed ``stability`` arguments: print the report, write ``--json``/``--plot``.
 
-    Returns 0 (the verdict is in the report, not the exit status). Call `check_args` first
+    Returns 0 (the verdict is in the report, not the exit status). Call `check` first
     (``problems.cli.main`` does). ``ValueError`` from bad input propagates
     (``problems.cli.main`` turns it into exit status 2).
     """
-    from . import stability as st  # imported on use: building the parser stays light
+    from problems import stability as st  # imported on use: building the parser stays light
 
     if args.case == "sweep":
         case = args.sweep_case
@@ -294,30 +286,29 @@ def run(args) -> int:
         progress = Progress(f"sweep {case} over {args.parameter}",
                             enabled=progress_enabled(args))
         try:
-            result = st.sweep(CASE_NAMES[case], parameter, _values(args.values), rtol=args.rtol,
+            result = st.sweep(case, parameter, _values(args.values), rtol=args.rtol,
                               progress=progress if progress.enabled else None, **kwargs)
         finally:
             progress.close()
     else:
-        result = st.CASES[CASE_NAMES[args.case]](**_case_kwargs(args, args.case))
+        _, case_function = st.resolve_case(args.case)
+        result = case_function(**_case_kwargs(args, args.case))
     print(result)
-    _outputs(result, args)
+    write_outputs(result, plot=args.plot, json=args.json)
     return 0
 
 
 def main(argv=None) -> int:
-    """Standalone entry: ``python -m problems.stability_cli spin --inertia ...``."""
+    """Standalone entry: ``main(["spin", "--inertia", ...])`` (the arguments after
+    ``stability``); returns the exit status."""
     parser = argparse.ArgumentParser(prog="appdyn")
     sub = parser.add_subparsers(dest="command", required=True)
-    add_stability_parser(sub)
+    add_parser(sub)
     argv = ["stability", *(sys.argv[1:] if argv is None else argv)]
     args = parser.parse_args(attach_negative_values(parser, argv))
-    check_args(args._parser, args)
+    check(args._parser, args)
     try:
         return run(args)
     except ValueError as exc:
         args._parser.exit(2, f"{args._parser.prog}: error: {' '.join(str(exc).split())}\n")
 
-
-if __name__ == "__main__":
-    sys.exit(main())

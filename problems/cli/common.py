@@ -1,5 +1,6 @@
 """Pieces shared by the `appdyn` commands: argparse value types, argv clean-up, output-path
-checks, strict JSON, progress lines and output writing.
+checks, strict JSON, progress lines and output writing (figures are saved here: the library
+only builds them).
 
 Exit-code convention of every command: 0 done (and verified where the command checks its
 answer), 1 numerical failure or failed verification, 2 bad input (argparse-style one-line
@@ -21,7 +22,7 @@ import numpy as np
 
 __all__ = ["vector", "number", "positive", "integer", "output_file", "attach_negative_values",
            "strict_jsonable", "strict_json", "Progress", "progress_enabled", "write_outputs",
-           "PLOT_SUFFIXES"]
+           "save_figure", "write_json", "inertia_matrix", "same_file", "PLOT_SUFFIXES"]
 
 #: file name suffixes a ``--plot`` may have (matplotlib infers the format from them)
 PLOT_SUFFIXES = (".png", ".pdf", ".svg")
@@ -234,12 +235,32 @@ def progress_enabled(args) -> bool:
 
 
 # --------------------------------------------------------------------------- outputs
+def inertia_matrix(values: np.ndarray) -> np.ndarray:
+    """``--inertia`` values: 3 principal moments as they are, 9 entries as a 3x3 matrix."""
+    return values if values.size == 3 else values.reshape(3, 3)
+
+
+def same_file(a, b) -> bool:
+    """Whether two output options name the same file (both given)."""
+    return bool(a and b and Path(a).resolve() == Path(b).resolve())
+
+
+def save_figure(fig, path) -> None:
+    """Save a `matplotlib.figure.Figure` (format from the suffix, `PLOT_SUFFIXES`)."""
+    fig.savefig(path, dpi=110)
+
+
+def write_json(data, path) -> None:
+    """Write ``data`` to ``path`` as strict JSON."""
+    Path(path).write_text(strict_json(data) + "\n")
+
+
 def write_outputs(result, *, plot=None, json=None) -> None:
-    """Save ``result.plot(plot)`` and strict JSON of ``result.to_dict()`` where asked, saying
-    so on stdout."""
+    """Save the figure of ``result.plot()`` and strict JSON of ``result.to_dict()`` where
+    asked, saying so on stdout."""
     if plot:
-        result.plot(plot)
+        save_figure(result.plot(), plot)
         print(f"plot written to {plot}")
     if json:
-        Path(json).write_text(strict_json(result.to_dict()) + "\n")
+        write_json(result.to_dict(), json)
         print(f"report written to {json}")

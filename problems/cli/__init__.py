@@ -1,0 +1,97 @@
+"""The ``appdyn`` command line.
+
+    appdyn simulate torque-free --inertia 1,2,3 --w0 -1,0.1,0.8 --t-final 50 [--plot F.png]
+    appdyn slew --inertia 1,1,1 --u-max 1 --axis 0,0,1 --angle 180 --time-optimal
+    appdyn stability spin|heavy-top|projectile|rotor|gyrostat|sweep ... [--json F] [--plot F.png]
+    appdyn demo
+    appdyn bench [NAME ...]
+
+One module per command (`simulate`, `slew`, `stability`, `demo`, `bench`), each with
+``add_parser(subparsers)``, ``check(parser, args)`` (checks across options, before any
+computation) and ``run(args) -> exit status``; `common` holds what they share.
+
+Exit status: 0 done (and verified where the command checks its answer: ``simulate`` against
+the closed form, ``slew`` against the solver's success and the rest-to-rest time bound);
+1 numerical failure or failed check (a one-line reason on stderr); 2 bad input (argparse-style
+usage and a one-line ``error: argument --OPTION: ...``, before any computation where the input
+can be checked up front: values, conflicting options, output paths). Option values may start
+with a minus sign (``--w0 -1,0,0``, ``--values -1:1:5``). JSON output is strict (non-finite
+numbers as ``null``). ``APPDYN_TRACEBACK=1`` shows the traceback of an unexpected error.
+
+Library code never prints or saves files; this package is the one place that does.
+"""
+from __future__ import annotations
+
+import argparse
+import os
+import re
+import sys
+
+from problems.cli import bench, demo, simulate, slew, stability
+from problems.cli.common import attach_negative_values
+from problems.cli.slew import rest_to_rest_bound
+
+__all__ = ["main", "build_parser", "COMMANDS", "rest_to_rest_bound"]
+
+#: command name -> its module (``add_parser``, ``check``, ``run``), in the order of ``--help``
+COMMANDS = {"simulate": simulate, "slew": slew, "stability": stability, "demo": demo,
+            "bench": bench}
+
+
+def build_parser() -> argparse.ArgumentParser:
+    """The ``appdyn`` parser with every command of `COMMANDS`."""
+    parser = argparse.ArgumentParser(
+        prog="appdyn", description="Aerospace vehicle dynamics and optimal control on CasADi.",
+        epilog="exit status: 0 done (and verified), 1 numerical failure or failed check, "
+               "2 bad input")
+    sub = parser.add_subparsers(dest="command", required=True)
+    for module in COMMANDS.values():
+        module.add_parser(sub)
+    return parser
+
+
+def _one_line(exc) -> str:
+    text = " ".join(str(exc).split())
+    return (text[:400] + " ...") if len(text) > 400 else text or type(exc).__name__
+
+
+def _name_option(parser, message) -> str:
+    """Library messages name the argument (```rtol` must be ...``): name the option too."""
+    m = re.match(r"`(\w+)`", message)
+    if m:
+        flag = "--" + m.group(1).replace("_", "-")
+        if any(flag in a.option_strings for a in parser._actions):
+            return f"argument {flag}: {message}"
+    return message
+
+
+def main(argv=None) -> int:
+    """Run the command line; returns the exit status (argparse errors raise SystemExit(2)).
+
+    Exit status: 0 done (and verified where the command checks its answer); 1 numerical
+    failure, failed verification or failure while computing/writing; 2 bad input (a one-line
+    message naming the option, before the computation where it can be checked up front).
+    """
+    parser = build_parser()
+    argv = sys.argv[1:] if argv is None else list(argv)
+    args = parser.parse_args(attach_negative_values(parser, argv))
+    sub = getattr(args, "_parser", parser)
+    command = COMMANDS[args.command]
+    command.check(sub, args)
+    try:
+        return command.run(args)
+    except ValueError as exc:  # bad input reaching the library (argparse checked the types)
+        sub.exit(2, f"{sub.prog}: error: {_name_option(sub, _one_line(exc))}\n")
+    except KeyboardInterrupt:
+        sub.exit(130, f"{sub.prog}: interrupted\n")
+    except BrokenPipeError:  # `appdyn ... | head`: the reader left; stop quietly
+        try:
+            os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        except (OSError, ValueError, AttributeError):
+            pass
+        return 1
+    except Exception as exc:  # numerical failure or an unexpected error: no traceback
+        if os.environ.get("APPDYN_TRACEBACK"):
+            raise
+        sub.exit(1, f"{sub.prog}: error: {type(exc).__name__}: {_one_line(exc)} "
+                    "(APPDYN_TRACEBACK=1 shows the traceback)\n")

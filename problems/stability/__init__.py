@@ -1,0 +1,56 @@
+"""Linear stability reports about spin states and operating points (Rheinfurth & Wilson,
+NASA RP-1262, Secs. 4.5-4.6).
+
+Every case returns a `StabilityReport`: the analysed ``control.StateSpace`` (``.ss``), its
+eigenvalues, a verdict, a mode table with natural frequencies, damping ratios, labels and
+closed-form values where they are known, derived quantities (precession and whirl rates,
+stability boundaries), gain/phase margins for feedback loops, and ``success`` / ``status``
+/ ``message`` of the check against the closed forms.
+
+Cases
+-----
+`spin`                 torque-free spin about a principal axis, optionally with an energy damper
+`heavy_top`            Method III, Example 1 (Eqs. 4.122-4.132)
+`spinning_projectile`  Example 2: aerodynamic overturning moment in place of ``m g l``
+`rotor`                Example 3: whirl (4.134-4.135) and internal-damping instability
+`gyrostat`             body + wheel of constant relative speed, optional damper
+`loop`                 any plant with a feedback law: margins via ``control.stability_margins``
+`analyze`              any ``StateSpace`` (e.g. from `dynamics.linearize.linearize`)
+
+`sweep` runs a case along one parameter and locates each verdict boundary by bisection.
+
+Modules: `verdict` (the rule: an eigenvalue with ``|Re| <= ZERO_RTOL * rho`` counts as on
+the imaginary axis; "marginally stable" needs those to be semisimple), `report` (the report,
+its statuses, `analyze`), `closed_forms`, `spin` and `tilt` (the cases), `loop`, `cases`
+(the table of names), `sweep`, `common` (shared conversions and checks).
+
+Spin cases report the *reduced* motion: the spin phase about the axis (cyclic) and the
+conserved spin-axis momentum (a first integral, whose steady spins form a one-parameter
+family with eigenvalue 0) are factored out by `Linearization.quotient` and
+`Linearization.restrict`; the notes say which states went.
+
+Examples
+--------
+>>> from problems import stability
+>>> stability.spin([2.0, 3.0, 4.5], axis=[0, 0, 1], rate=5.0).verdict
+'marginally stable'
+"""
+from dynamics.spinning import PointMassDamper, SphericalDamper
+
+from .cases import CASE_ALIASES, CASES, resolve_case
+from .common import STANDARD_GRAVITY
+from .loop import loop
+from .report import (CLOSED_FORM_RTOL, STATUS_MISMATCH, STATUS_UNCHECKED, STATUS_VERIFIED,
+                     Margins, Mode, Quantity, StabilityReport, analyze)
+from .spin import gyrostat, spin
+from .sweep import Boundary, SweepResult, sweep
+from .tilt import heavy_top, rotor, spinning_projectile
+from .verdict import VERDICTS, ZERO_RTOL, classify
+
+__all__ = [
+    "ZERO_RTOL", "VERDICTS", "Mode", "Margins", "Quantity", "StabilityReport", "Boundary",
+    "SweepResult", "PointMassDamper", "SphericalDamper", "classify", "analyze", "spin",
+    "heavy_top", "spinning_projectile", "rotor", "gyrostat", "loop", "sweep", "CASES",
+    "CASE_ALIASES", "resolve_case", "STANDARD_GRAVITY", "STATUS_VERIFIED", "STATUS_UNCHECKED",
+    "STATUS_MISMATCH", "CLOSED_FORM_RTOL",
+]

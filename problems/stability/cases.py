@@ -1,0 +1,53 @@
+"""The table of named stability cases: the one place that maps a case name (or its
+command-line spelling) to its function."""
+from __future__ import annotations
+
+from typing import Callable
+
+from .report import StabilityReport
+from .spin import gyrostat, spin
+from .tilt import heavy_top, rotor, spinning_projectile
+
+__all__ = ["CASES", "CASE_ALIASES", "resolve_case"]
+
+#: case name -> function; every case takes its parameters by keyword
+CASES: dict[str, Callable[..., StabilityReport]] = {
+    "spin": spin, "heavy_top": heavy_top, "spinning_projectile": spinning_projectile,
+    "rotor": rotor, "gyrostat": gyrostat,
+}
+#: other accepted spellings (the command line's among them) -> case name
+CASE_ALIASES = {"heavy-top": "heavy_top", "projectile": "spinning_projectile",
+                "spinning-projectile": "spinning_projectile"}
+
+
+def resolve_case(case):
+    """``(name, function)`` of a case given by name, alias or function.
+
+    Parameters
+    ----------
+    case : str or callable
+        A key of `CASES` or `CASE_ALIASES`, or one of the case functions.
+
+    Returns
+    -------
+    (str, callable)
+
+    Raises
+    ------
+    ValueError
+        "```case`` must be one of ...".
+
+    Examples
+    --------
+    >>> resolve_case("projectile")[0]
+    'spinning_projectile'
+    """
+    if callable(case):
+        for name, fun in CASES.items():
+            if fun is case:
+                return name, fun
+        raise ValueError(f"`case` must be one of {sorted(CASES)} (or the function), got {case!r}")
+    name = CASE_ALIASES.get(case, case)
+    if name not in CASES:
+        raise ValueError(f"`case` must be one of {sorted(CASES)}, got {case!r}")
+    return name, CASES[name]

@@ -1,0 +1,102 @@
+"""`loop`: closed-loop stability and classical margins of any plant under a feedback law."""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from .report import Margins, StabilityReport, build_report
+
+__all__ = ["loop"]
+
+
+def loop(plant, controller, *, title: str = "Feedback loop", closed_form=None) -> StabilityReport:
+    """Closed-loop stability and margins of ``plant`` under ``u = -controller(y)``.
+
+    Parameters
+    ----------
+    plant : control.StateSpace or control.TransferFunction
+        ``ny`` outputs, ``nu`` inputs.
+    controller : array_like, shape (nu, ny), or control.StateSpace / TransferFunction
+        A static gain or a dynamic compensator from ``y`` to ``u`` (negative feedback).
+    title : str, optional
+        Title of the report.
+    closed_form : array_like of complex, optional
+        Expected closed-loop eigenvalues, matched and checked.
+
+    Returns
+    -------
+    StabilityReport
+        ``ss`` is the closed loop (input added at the plant input, outputs ``y``); ``margins``
+        of the loop transfer ``L = controller * plant`` broken at the plant input, when it
+        is single-input (``None`` otherwise, with a note).
+
+    Raises
+    ------
+    ValueError
+        Naming ``plant`` or ``controller`` when they are not LTI systems or do not fit.
+
+    Examples
+    --------
+    Attitude loop of a launch vehicle, ``I psi'' = F l delta`` with
+    ``delta = -(k_psi psi + k_psidot psi')`` (RP-1262, Ch. 5, Eqs. 5.53-5.54):
+
+    >>> import control, numpy as np
+    >>> from problems import stability
+    >>> plant = control.ss([[0, 1], [0, 0]], [[0], [200.0]], np.eye(2), np.zeros((2, 1)))
+    >>> rep = stability.loop(plant, [[0.8, 0.3]])
+    >>> rep.verdict
+    'asymptotically stable'
+    >>> round(rep.margins.phase_margin, 2)
+    87.46
+    """
+    import control
+
+    if isinstance(plant, control.TransferFunction):
+        plant = control.ss(plant)
+    if not isinstance(plant, control.StateSpace):
+        raise ValueError(f"`plant` must be a control.StateSpace or TransferFunction, got "
+                         f"{type(plant).__name__}")
+    if isinstance(controller, control.TransferFunction):
+        controller = control.ss(controller)
+    if not isinstance(controller, control.StateSpace):
+        try:
+            K = np.atleast_2d(np.asarray(controller, dtype=float))
+        except (TypeError, ValueError):
+            raise ValueError("`controller` must be a gain matrix or an LTI system, got "
+                             f"{type(controller).__name__}") from None
+        if K.shape != (plant.ninputs, plant.noutputs) or not np.all(np.isfinite(K)):
+            raise ValueError(f"`controller` gain must be finite with shape (nu, ny) = "
+                             f"({plant.ninputs}, {plant.noutputs}), got {K.shape}")
+        controller = control.ss(np.zeros((0, 0)), np.zeros((0, plant.noutputs)),
+                                np.zeros((plant.ninputs, 0)), K, name="controller")
+    if controller.ninputs != plant.noutputs or controller.noutputs != plant.ninputs:
+        raise ValueError(f"`controller` must map the {plant.noutputs} plant outputs to the "
+                         f"{plant.ninputs} plant inputs, got {controller.ninputs} -> "
+                         f"{controller.noutputs}")
+    closed = control.feedback(plant, controller, sign=-1)
+    k_states = [f"k_{s}" for s in controller.state_labels]
+    closed = control.ss(closed.A, closed.B, closed.C, closed.D,
+                        states=list(plant.state_labels) + k_states,
+                        inputs=list(plant.input_labels), outputs=list(plant.output_labels),
+                        name="closed_loop")
+    margins, notes = None, []
+    if plant.ninputs == 1:
+        L = control.series(plant, controller)
+        gm, pm, sm, wpc, wgc, wms = control.stability_margins(L)
+        gm = float(gm)
+        margins = Margins(gain_margin=gm,
+                          gain_margin_db=20 * math.log10(gm) if gm > 0 and math.isfinite(gm)
+                          else (math.inf if gm == math.inf else math.nan),
+                          phase_margin=float(pm), stability_margin=float(sm),
+                          phase_crossover=float(wpc), gain_crossover=float(wgc),
+                          stability_margin_frequency=float(wms))
+    else:
+        notes.append(f"margins need a single loop; the plant has {plant.ninputs} inputs")
+    groups = {"plant": list(plant.state_labels),
+              "controller": k_states}
+    return build_report("loop", title, {"plant": plant.name, "controller": controller.name},
+                        closed, groups=groups, margins=margins, notes=notes,
+                        closed_form=closed_form)
+
+

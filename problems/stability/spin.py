@@ -1,0 +1,304 @@
+"""Free-spin cases: `spin` (rigid or with an energy damper) and `gyrostat` (dual spin).
+
+Both are linearized in body rates (``frame='rates'``; the attitude does not enter
+torque-free dynamics) and restricted to a first integral (``|H|^2``, else the energy), which
+removes the eigenvalue 0 of the neighbouring steady spins; the notes say which state went.
+"""
+from __future__ import annotations
+
+import math
+
+import casadi as ca
+import numpy as np
+
+from dynamics.linearize import Linearization, linearization
+from dynamics.rigid_body import check_inertia, rigid_body
+from dynamics.spinning import (PointMassDamper, SphericalDamper, gyrostat_model,
+                               steady_spin_state, unit_vector)
+
+from .closed_forms import (axis_kind, gyrostat_lambda2, principal_moments, rigid_spin_lambda2,
+                           spherical_damper_roots)
+from .common import check_number, plain
+from .report import Quantity, StabilityReport, build_report
+
+__all__ = ["spin", "gyrostat", "reduce_free_spin"]
+
+
+def _case_linearization(model, x, frame, damper):
+    """Linearize a steady spin; a damper that spoils the relative equilibrium is named."""
+    try:
+        return linearization(model, x, frame=frame)
+    except ValueError as exc:
+        if damper is None:
+            raise
+        raise ValueError(f"`damper`: no steady spin about `axis` with this damper: {exc}") from None
+
+
+def _invariant_gradient(model, x, lin: Linearization, key: str) -> np.ndarray:
+    """Gradient of ``|invariant|^2`` at ``x``, in the (non-attitude) states of ``lin``."""
+    xs = ca.SX.sym("x", model.nx)
+    value = model.invariants[key](xs, ca.DM(model.resolve_p()))
+    grad = ca.Function("grad", [xs], [ca.gradient(ca.sumsqr(value), xs)])
+    g = np.asarray(grad(x), dtype=float).reshape(-1)
+    return np.array([g[model.states.index(s)] if s in model.states else 0.0 for s in lin.states])
+
+
+def reduce_free_spin(model, x, lin: Linearization) -> tuple[Linearization, list]:
+    """Remove the neutral spin-rate direction of a torque-free spin (rates frame).
+
+    ``|H|^2`` is a first integral; where ``H = 0`` its gradient vanishes and the energy (a
+    first integral, or decaying to second order at the steady spin) takes over."""
+    notes = []
+    for name, key in (("|H|^2", "momentum_inertial"), ("energy", "energy")):
+        c = _invariant_gradient(model, x, lin, key)
+        if np.max(np.abs(c)) == 0:
+            continue
+        try:
+            red = lin.restrict(c, reason=f"{name} is a first integral; the steady spins form a "
+                               "one-parameter family, whose eigenvalue 0 goes")
+        except ValueError:
+            continue
+        return red, notes
+    notes.append("no first integral with a non-zero gradient: the neutral eigenvalue 0 of the "
+                 "spin-rate family stays in the model")
+    return lin, notes
+
+
+def _damper_dict(damper):
+    return None if damper is None else plain(damper)
+
+
+def spin(inertia, axis, rate, *, damper=None) -> StabilityReport:
+    """Torque-free spin ``w = rate * axis`` about a principal axis, optionally with a damper.
+
+    The body-rate perturbations (Rheinfurth & Wilson, NASA RP-1262, Sec. 4.5 C,
+    Eqs. 4.94-4.95) have the eigenvalues
+    ``+/- i rate sqrt((Ia - Ib)(Ia - Ic) / (Ib Ic))`` (a real pair about the intermediate
+    axis). With an energy damper (`PointMassDamper` or `SphericalDamper` on the body, a
+    multibody `dynamics.spinning.gyrostat_model`) the spin is asymptotically stable about the
+    major axis and unstable about the minor one (Kelvin-Tait-Chetaev; RP-1262, Sec. 4.5,
+    NOTE).
+
+    The model is linearized in body rates (``frame='rates'``; the attitude does not enter
+    torque-free dynamics) and restricted to constant ``|H|``, which removes the eigenvalue 0
+    of the neighbouring steady spins (one spin-axis state is eliminated).
+
+    Parameters
+    ----------
+    inertia : array_like, shape (3, 3) or (3,) [kg m^2]
+        Of the rigid body about its mass center (without the damper mass / core inertia).
+    axis : array_like, shape (3,)
+        Spin axis in body axes; must be a principal axis of ``inertia``.
+    rate : float [rad/s]
+        Spin rate, finite and non-zero.
+    damper : PointMassDamper or SphericalDamper, optional
+        An energy damper on the body.
+
+    Returns
+    -------
+    StabilityReport
+        Closed forms for the rigid body and for a symmetric body with a spherical damper
+        (`~problems.stability.closed_forms.spherical_damper_roots`); mode labels
+        'nutation' / 'damper'.
+
+    Raises
+    ------
+    ValueError
+        Naming ``inertia``, ``axis``, ``rate`` or ``damper`` (e.g. a damper position that
+        makes the axis non-principal for the loaded body: the residual is shown).
+
+    References
+    ----------
+    Rheinfurth & Wilson, NASA RP-1262, Sec. 4.5 C, Eqs. 4.94-4.95 (rigid body);
+    Sec. 4.5, NOTE (energy dissipation).
+
+    Examples
+    --------
+    >>> from problems import stability
+    >>> rep = stability.spin([2.0, 3.0, 4.5], axis=[1, 0, 0], rate=10.0)
+    >>> rep.verdict
+    'marginally stable'
+    >>> print(rep.eigenvalues.round(4))
+    [0.-4.3033j 0.+4.3033j]
+    >>> stability.spin([2.0, 3.0, 4.5], [0, 1, 0], 10.0).verdict  # intermediate axis
+    'unstable'
+    >>> damper = stability.PointMassDamper(mass=0.5, stiffness=60.0, damping=0.8,
+    ...                                    position=[0, 0.6, 0], direction=[1, 0, 0])
+    >>> stability.spin([2.0, 3.0, 4.5], [1, 0, 0], 4.0, damper=damper).verdict  # minor axis
+    'unstable'
+    """
+    I = check_inertia(inertia)
+    a = unit_vector(axis, "axis")
+    rate = check_number(rate, "rate", nonzero=True)
+    Ia, Ib, Ic = principal_moments(I, a)
+    if damper is not None and not isinstance(damper, (PointMassDamper, SphericalDamper)):
+        raise ValueError("`damper` must be None, a PointMassDamper or a SphericalDamper, got "
+                         f"{type(damper).__name__}")
+    params = {"inertia": I, "axis": a, "rate": rate, "damper": _damper_dict(damper)}
+    notes, quantities, cf = [], [], None
+    if damper is None:
+        model = rigid_body(I)
+        x = np.concatenate([[0.0, 0.0, 0.0, 1.0], rate * a])
+        title = "Torque-free spin about a principal axis (RP-1262, Sec. 4.5)"
+    else:
+        model = gyrostat_model(I, wheel_axis=a, damper=damper)
+        x = steady_spin_state(a, rate, damper=damper)
+        title = (f"Spin about a principal axis with a {type(damper).__name__} "
+                 "(RP-1262, Sec. 4.5 NOTE)")
+    lin = _case_linearization(model, x, "rates", damper)
+    red, more = reduce_free_spin(model, x, lin)
+    notes += list(red.notes) + more
+    kind = axis_kind(Ia, Ib, Ic)
+    lam2 = rigid_spin_lambda2(Ia, Ib, Ic, rate)
+    if damper is None:
+        root = np.sqrt(complex(lam2))
+        cf = np.array([root, -root])
+        quantities.append(Quantity("lambda^2 = -rate^2 (Ia - Ib)(Ia - Ic) / (Ib Ic)", None, lam2,
+                                   "1/s^2", "Eqs. 4.94-4.95"))
+        if lam2 < 0:
+            quantities.append(Quantity("nutation frequency (body rates)",
+                                       _pair_frequency(red.eigenvalues()), float(abs(root.imag)),
+                                       "rad/s", "Sec. 4.5 C: sqrt(lambda1 lambda2)"))
+    else:
+        comp = I + (damper.inertia_at(float(x[7])) if isinstance(damper, PointMassDamper)
+                    else damper.inertia * np.eye(3))
+        Ja, Jb, Jc = principal_moments(comp, a)
+        kind = axis_kind(Ja, Jb, Jc)
+        quantities += [Quantity("loaded axial moment Ja", None, Ja, "kg m^2"),
+                       Quantity("loaded transverse moment Jb", None, Jb, "kg m^2"),
+                       Quantity("loaded transverse moment Jc", None, Jc, "kg m^2"),
+                       Quantity("locked-damper lambda^2 = -rate^2 (Ja-Jb)(Ja-Jc)/(Jb Jc)", None,
+                                rigid_spin_lambda2(Ja, Jb, Jc, rate), "1/s^2",
+                                "Eqs. 4.94-4.95, damper locked")]
+        if isinstance(damper, SphericalDamper) and abs(Ib - Ic) <= 1e-12 * Ib:
+            cf = spherical_damper_roots(Ib, damper.inertia, damper.damping, Ia * rate, rate,
+                                        rate, Ia)
+        expected = {"major": "asymptotically stable", "minor": "unstable",
+                    "intermediate": "unstable"}.get(kind)
+        if expected:
+            notes.append(f"Kelvin-Tait-Chetaev: energy dissipation makes a {kind}-axis spin "
+                         f"{expected} (if the damper is excited by the nutation)")
+    notes.insert(0, f"spin about the {kind} axis{' of the loaded body' if damper else ''}; "
+                    f"rigid moments Ia = {Ia:.10g}, Ib = {Ib:.10g}, Ic = {Ic:.10g} kg m^2")
+    rates = [s for s in red.states if s.startswith("w") and not s.startswith("wd")]
+    others = [s for s in red.states if s not in rates]
+    return build_report("spin", title, params, red.ss, lin=lin, closed_form=cf,
+                        groups={"nutation": rates, "damper": others},
+                        quantities=quantities, notes=notes)
+
+
+def _pair_frequency(ev) -> float | None:
+    im = [abs(z.imag) for z in ev if abs(z.imag) > 0]
+    return float(max(im)) if im else None
+
+
+def gyrostat(inertia, axis, rate, wheel_momentum, *, wheel_inertia=None, damper=None,
+             damper_on: str = "platform") -> StabilityReport:
+    """Dual-spin gyrostat: platform spinning at ``rate`` about ``axis``, a wheel along
+    ``axis`` with relative momentum ``h`` held constant, optionally an energy damper.
+
+    Without damper the transverse rates obey ``Ib wb' = (Ic W - Ia W - h) wc`` and
+    ``Ic wc' = (Ia W + h - Ib W) wb``: eigenvalues ``+/- sqrt(-(Ia W + h - Ib W)(Ia W + h
+    - Ic W) / (Ib Ic))``, unstable iff ``Ia + h/W`` lies between ``Ib`` and ``Ic``
+    (boundaries ``h = (Ib - Ia) W``, ``(Ic - Ia) W``). With a `SphericalDamper` and
+    ``Ib = Ic = It`` the eigenvalues are closed-form too
+    (`~problems.stability.closed_forms.spherical_damper_roots`); the boundary, where the
+    housing turns at the nutation rate, is ``h = (It - Ia) W`` on the platform and
+    ``(Ia - It) W + (J_r - It) W_r = 0`` (``W_r = h / J_r``) on the rotor.
+
+    Parameters
+    ----------
+    inertia : array_like, shape (3, 3) or (3,) [kg m^2]
+        Platform plus wheel (locked) about the mass center; without damper mass / core.
+    axis : array_like, shape (3,)
+        Wheel and spin axis, body frame; a principal axis of ``inertia``.
+    rate : float [rad/s]
+        Platform spin ``W`` (0: despun platform).
+    wheel_momentum : float [N m s]
+        ``h = J_r W_r``, relative to the platform.
+    wheel_inertia : float [kg m^2], optional
+        ``J_r``, needed for a damper on the rotor.
+    damper : PointMassDamper or SphericalDamper, optional
+        An energy damper on the platform or in the rotor.
+    damper_on : {'platform', 'rotor'}, optional
+        Where the damper sits (default ``'platform'``).
+
+    Returns
+    -------
+    StabilityReport
+
+    Raises
+    ------
+    ValueError
+        Naming the argument.
+
+    Examples
+    --------
+    >>> from problems import stability
+    >>> rep = stability.gyrostat([3.0, 4.0, 5.0], [1, 0, 0], rate=2.0, wheel_momentum=3.0)
+    >>> rep.verdict  # Ia + h/W = 4.5 lies between the transverse moments 4 and 5
+    'unstable'
+    >>> stability.gyrostat([3.0, 4.0, 5.0], [1, 0, 0], 2.0, wheel_momentum=6.0).verdict
+    'marginally stable'
+    """
+    I = check_inertia(inertia)
+    a = unit_vector(axis, "axis")
+    W = check_number(rate, "rate")
+    h = check_number(wheel_momentum, "wheel_momentum")
+    Ia, Ib, Ic = principal_moments(I, a)
+    if damper_on not in ("platform", "rotor"):
+        raise ValueError(f"`damper_on` must be 'platform' or 'rotor', got {damper_on!r}")
+    Wr = 0.0
+    if wheel_inertia is not None:
+        Jr = check_number(wheel_inertia, "wheel_inertia", positive=True)
+        if Jr > Ia:
+            raise ValueError(f"`wheel_inertia` {Jr} exceeds the axial moment Ia = {Ia} of "
+                             "`inertia`, which includes the wheel")
+        Wr = h / Jr
+    elif damper is not None and damper_on == "rotor":
+        raise ValueError("`wheel_inertia` is needed for a damper on the rotor (its housing "
+                         "turns at rate + wheel_momentum / wheel_inertia)")
+    if W == 0 and h == 0:
+        raise ValueError("`rate` and `wheel_momentum` are both zero: nothing spins")
+    model = gyrostat_model(I, wheel_axis=a, wheel_momentum=h, damper=damper,
+                           damper_on=damper_on, wheel_rate=Wr)
+    x = steady_spin_state(a, W, damper=damper, damper_on=damper_on, wheel_rate=Wr)
+    lin = _case_linearization(model, x, "rates", damper)
+    red, notes = reduce_free_spin(model, x, lin)
+    notes = list(red.notes) + notes
+    params = {"inertia": I, "axis": a, "rate": W, "wheel_momentum": h,
+              "wheel_inertia": wheel_inertia, "damper": _damper_dict(damper),
+              "damper_on": damper_on}
+    Ha = Ia * W + h
+    quantities = [Quantity("axial momentum Ia W + h", None, Ha, "N m s"),
+                  Quantity("effective axial moment Ia + h/W", None,
+                           Ia + h / W if W else math.inf, "kg m^2")]
+    cf = None
+    if damper is None:
+        lam2 = gyrostat_lambda2(Ia, Ib, Ic, W, h)
+        root = np.sqrt(complex(lam2))
+        cf = np.array([root, -root])
+        lo, hi = sorted([(Ib - Ia) * W, (Ic - Ia) * W])
+        quantities += [Quantity("boundary h = (Ib - Ia) W", None, (Ib - Ia) * W, "N m s"),
+                       Quantity("boundary h = (Ic - Ia) W", None, (Ic - Ia) * W, "N m s")]
+        notes.append(f"undamped: unstable for {lo:.10g} < h < {hi:.10g} N m s")
+    elif isinstance(damper, SphericalDamper) and abs(Ib - Ic) <= 1e-12 * Ib:
+        It, Jd = Ib, damper.inertia
+        wd = W + (Wr if damper_on == "rotor" else 0.0)
+        cf = spherical_damper_roots(It, Jd, damper.damping, Ha, W, wd, Ia)
+        if damper_on == "platform":
+            quantities.append(Quantity("boundary h = (It - Ia) W", None, (It - Ia) * W, "N m s",
+                                       "housing at the nutation rate"))
+        elif wheel_inertia is not None and It != Jr:
+            quantities.append(Quantity("boundary h = Jr (Ia - It) W / (It - Jr)", None,
+                                       Jr * (Ia - It) * W / (It - Jr), "N m s",
+                                       "housing at the nutation rate"))
+    rates = [s for s in red.states if s in ("w1", "w2", "w3")]
+    title = "Gyrostat (dual spin)" + (f" with a {type(damper).__name__} on the {damper_on}"
+                                      if damper else "")
+    others = [s for s in red.states if s not in rates]
+    return build_report("gyrostat", title, params, red.ss, lin=lin, closed_form=cf,
+                        groups={"nutation": rates, "damper": others},
+                        quantities=quantities, notes=notes)
+
+
