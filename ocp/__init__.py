@@ -7,6 +7,11 @@ transcription (`Trapezoid`, `HermiteSimpson`, `Radau`), and `solve` it::
     sol = solve(Problem(model, T=1.0, x_initial=..., x_final=..., lagrange=...),
                 transcription="radau", N=20)
     sol.success, sol.cost, sol.sample(t)
+
+The library prints nothing unless asked (``verbose=True``): progress goes to an optional
+``progress`` callable and to the logger ``"appdyn.ocp"`` (`ocp.progress`). Mesh refinement,
+multistart and moving-knot polishing are in `ocp.refine`; attitude targets, quaternion norm
+handling and SLERP guesses in `ocp.attitude`.
 """
 from __future__ import annotations
 
@@ -14,13 +19,14 @@ from .guess import guess_from_simulation
 from .mesh import Mesh
 from .problem import Constraint, Problem
 from .ipopt_options import check_ipopt_options, ipopt_option_table
-from .refine import (IntervalErrors, RadauConstantControl, RefinedSolution, RefinementRound, annotate,
+from .refine import (IntervalErrors, RefinedSolution, RefinementRound, annotate, control_switches,
                      find_switches, interval_errors, polish_switches, refine, solve_multistart)
 from .scaling import Scaling
+from .progress import LOGGER
 from .solution import Propagation, Solution
 from .solve import DEFAULT_CONSTRAINT_TOL, Progress, rest_solution, solve
-from .transcription import (TRANSCRIPTIONS, HermiteSimpson, Radau, Transcription, Trapezoid,
-                            get_transcription)
+from .transcription import (TRANSCRIPTIONS, HermiteSimpson, Radau, RadauConstantControl,
+                            Transcription, Trapezoid, get_transcription)
 
 __all__ = [
     "Problem",
@@ -28,6 +34,7 @@ __all__ = [
     "Solution",
     "Propagation",
     "Progress",
+    "LOGGER",
     "solve",
     "rest_solution",
     "DEFAULT_CONSTRAINT_TOL",
@@ -51,5 +58,6 @@ __all__ = [
     "IntervalErrors",
     "interval_errors",
     "find_switches",
+    "control_switches",
     "guess_from_simulation",
 ]

@@ -30,6 +30,8 @@ from typing import Callable, Mapping
 
 import numpy as np
 
+from .attitude import quaternion_path, slerp  # slerp: re-exported (compatibility)
+
 __all__ = ["NodeGuess", "initial_guess", "slerp", "guess_from_simulation"]
 
 _KEYS = ("t", "x", "u", "T", "p")
@@ -59,32 +61,6 @@ class NodeGuess:
     T: float
 
 
-def slerp(qa, qb, s) -> np.ndarray:
-    """Spherical linear interpolation between unit quaternions (no sign flip applied).
-
-    Parameters
-    ----------
-    qa, qb : array_like, shape (4,)
-    s : array_like, shape (m,)
-        Fractions in [0, 1].
-
-    Returns
-    -------
-    ndarray, shape (4, m)
-    """
-    qa, qb = np.asarray(qa, float), np.asarray(qb, float)
-    s = np.asarray(s, float).reshape(-1)
-    c = float(np.clip(np.dot(qa, qb), -1.0, 1.0))
-    angle = math.acos(c)
-    if angle < 1e-8:
-        q = qa[:, None] + s[None, :] * (qb - qa)[:, None]
-    else:
-        sa = math.sin(angle)
-        q = (np.sin((1 - s) * angle)[None, :] * qa[:, None]
-             + np.sin(s * angle)[None, :] * qb[:, None]) / sa
-    return q / np.linalg.norm(q, axis=0)
-
-
 def _clip(v: np.ndarray, bounds: np.ndarray) -> np.ndarray:
     return np.clip(v, bounds[0][:, None], bounds[1][:, None])
 
@@ -105,28 +81,13 @@ def _default_state(problem) -> Callable:
             start[i] = b[i]
         elif np.isnan(b[i]):
             end[i] = a[i]
-    qa = qb = None
-    if model.attitude is not None:
-        iq = model.attitude[0]
-        sl = slice(iq, iq + 4)
-        if not np.any(np.isnan(a[sl])):
-            qa = a[sl]
-        if problem.q_final is not None:
-            qb = np.array(problem.q_final)
-        if qa is not None and qb is not None and np.dot(qa, qb) < 0:
-            qb = -qb
-        if qa is None and qb is None:
-            qa = qb = np.array([0.0, 0.0, 0.0, 1.0])
-        elif qa is None:
-            qa = qb
-        elif qb is None:
-            qb = qa
+    quat = quaternion_path(problem)  # ocp.attitude: SLERP for attitude models
 
     def x_fun(tau):
         tau = np.asarray(tau, float)
         x = start[:, None] + tau[None, :] * (end - start)[:, None]
-        if qa is not None:
-            x[sl] = slerp(qa, qb, tau)
+        if quat is not None:
+            x[quat[0]] = quat[1](tau)
         return x
 
     return x_fun

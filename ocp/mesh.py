@@ -10,7 +10,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["Mesh"]
+__all__ = ["Mesh", "check_N"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -49,7 +49,7 @@ class Mesh:
     @classmethod
     def uniform(cls, N: int) -> "Mesh":
         """``N`` equal intervals."""
-        N = _check_N(N)
+        N = check_N(N)
         b = np.linspace(0.0, 1.0, N + 1)
         return cls(b)
 
@@ -75,7 +75,8 @@ class Mesh:
         return f"Mesh(N={self.N}, {kind})"
 
 
-def _check_N(N) -> int:
+def check_N(N) -> int:
+    """``N`` (number of mesh intervals) as an int >= 1, else ValueError naming `N`."""
     if isinstance(N, (bool, np.bool_)) or not isinstance(N, (int, np.integer)) or N < 1:
         raise ValueError(f"`N` (number of mesh intervals) must be an integer >= 1, got {N!r}")
     return int(N)

@@ -19,6 +19,7 @@ from __future__ import annotations
 import casadi as ca
 import numpy as np
 
+from .attitude import nlp_rows, target_bounds, target_rows
 from .layout import Layout
 
 __all__ = ["Discretization"]
@@ -39,12 +40,6 @@ def _path_function(problem) -> ca.Function | None:
     syms = [ca.MX.sym("x", m.nx), ca.MX.sym("u", m.nu), ca.MX.sym("p", m.np)]
     out = ca.vertcat(*[c.fun(*syms) for c in cons])
     return ca.Function("path", syms, [out], ["x", "u", "p"], ["g"])
-
-
-def _q_final_rows(problem) -> int:
-    if problem.q_final is None:
-        return 0
-    return 1 if problem.q_final_tol > 0 else 3
 
 
 class Discretization:
@@ -86,7 +81,7 @@ class Discretization:
                          "T": (int(problem.free_time), 1)})
         self.g = Layout({"defect": (nx, N * m_d), "path": (n_path, self.n_u),
                          "boundary": (n_bound, 1), "quat_norm": (int(problem.quaternion_norm_at_t0), 1),
-                         "q_final": (_q_final_rows(problem), 1)})
+                         "q_final": (target_rows(problem), 1)})
 
         # ------------------------------------------------ symbols (scaled -> physical)
         wsym = ca.MX.sym("w", self.w.size)
@@ -133,15 +128,7 @@ class Discretization:
             parts["boundary"] = _diag_scale(c, sc.boundary)
         else:
             parts["boundary"] = ca.MX(0, 1)
-        iq = model.attitude[0] if model.attitude is not None else 0
-        parts["quat_norm"] = (ca.sumsqr(X[iq:iq + 4, 0]) - 1 if problem.quaternion_norm_at_t0
-                              else ca.MX(0, 1))
-        if problem.q_final is None:
-            parts["q_final"] = ca.MX(0, 1)
-        elif problem.q_final_tol > 0:
-            parts["q_final"] = ca.sumsqr(problem.attitude_error(X[iq:iq + 4, -1]))
-        else:
-            parts["q_final"] = problem.attitude_error(X[iq:iq + 4, -1]) / sc.q_final
+        parts["quat_norm"], parts["q_final"] = nlp_rows(problem, X, sc.q_final)  # ocp.attitude
         gsym = self.g.join(parts, symbolic=True)
         self.nlp = {"x": wsym, "f": J / sc.objective, "g": gsym}
 
@@ -166,9 +153,9 @@ class Discretization:
         b_lo = np.concatenate([c.lower for c in problem.boundary]) if problem.boundary else zeros(0)
         b_hi = np.concatenate([c.upper for c in problem.boundary]) if problem.boundary else zeros(0)
         common = {"defect": 0.0, "quat_norm": 0.0}
-        q_hi = np.sin(problem.q_final_tol / 2) ** 2 if problem.q_final_tol > 0 else 0.0
+        q_lo, q_hi = target_bounds(problem)
         self.lbg = self.g.join({**common, "path": (path_lo / sc.path)[:, None],
-                                "boundary": (b_lo / sc.boundary)[:, None], "q_final": 0.0})
+                                "boundary": (b_lo / sc.boundary)[:, None], "q_final": q_lo})
         self.ubg = self.g.join({**common, "path": (path_hi / sc.path)[:, None],
                                 "boundary": (b_hi / sc.boundary)[:, None], "q_final": q_hi})
 

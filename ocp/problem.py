@@ -18,6 +18,10 @@ The problem, on ``t in [t0, t0 + T]``::
 
 Quaternion states
 -----------------
+The statement itself is generic: everything attitude-specific (the checks below, the NLP
+rows, the SLERP guess) lives in `ocp.attitude`; ``q_final`` and ``q_final_tol`` are the
+fields through which a problem asks for it.
+
 For a model with an attitude (``model.attitude = (iq, iw)``) the quaternion ``q = x[iq:iq+4]``
 has unit norm. The continuous dynamics preserve ``|q|`` exactly, so the norm is imposed at
 ``t0`` only: a fully given initial quaternion must have unit norm (to 1e-6; it is then
@@ -45,13 +49,13 @@ from typing import Callable, Mapping, Sequence, Union
 import casadi as ca
 import numpy as np
 
-from dynamics.attitude import quat_conj, quat_mul
 from dynamics.model import Model
+
+from .attitude import attitude_error, check_attitude, needs_norm_at_t0
 
 __all__ = ["Problem", "Constraint"]
 
 FunctionLike = Union[ca.Function, Callable]
-_QUAT_NORM_TOL = 1e-6
 
 
 @dataclass(frozen=True)
@@ -380,8 +384,11 @@ class Problem:
         put("boundary", self._constraints(self.boundary, "boundary",
                                           [("x0", nx), ("xf", nx), ps], (0.0, 0.0)))
 
-        # attitude
-        self._check_attitude(put)
+        # attitude (ocp.attitude)
+        x0, qf, qtol = check_attitude(model, self.x_initial, self.x_final, self.q_final, self.q_final_tol)
+        put("x_initial", x0)
+        put("q_final", qf)
+        put("q_final_tol", qtol)
 
         for argname in ("x_initial", "x_final"):
             getattr(self, argname).setflags(write=False)
@@ -420,47 +427,6 @@ class Problem:
             out.append(Constraint(fun, lo, hi, scale, con.name or label))
         return tuple(out)
 
-    def _check_attitude(self, put):
-        model = self.model
-        if self.q_final is not None:
-            if model.attitude is None:
-                raise ValueError("`q_final` needs a model with an attitude (`model.attitude` is None)")
-            q = _as_vector(self.q_final, 4, "q_final")
-            n = float(np.linalg.norm(q))
-            if not (np.all(np.isfinite(q)) and abs(n - 1.0) <= _QUAT_NORM_TOL):
-                raise ValueError(f"`q_final` must be a unit quaternion (norm within {_QUAT_NORM_TOL} of 1), "
-                                 f"got norm {n}")
-            q = q / n
-            q.setflags(write=False)
-            put("q_final", q)
-        tol = self.q_final_tol
-        if isinstance(tol, bool) or not isinstance(tol, (int, float, np.floating)) or not 0 <= tol < math.pi:
-            raise ValueError(f"`q_final_tol` must be an angle in [0, pi) [rad], got {tol!r}")
-        put("q_final_tol", float(tol))
-        if tol > 0 and self.q_final is None:
-            raise ValueError("`q_final_tol` needs a `q_final`")
-        if model.attitude is None:
-            return
-        iq = model.attitude[0]
-        sl = slice(iq, iq + 4)
-        q0 = np.array(self.x_initial)
-        if not np.any(np.isnan(q0[sl])):
-            n = float(np.linalg.norm(q0[sl]))
-            if abs(n - 1.0) > _QUAT_NORM_TOL:
-                raise ValueError(
-                    f"`x_initial`: the initial quaternion {model.states[sl]} must have unit norm "
-                    f"(within {_QUAT_NORM_TOL}), got norm {n}"
-                )
-            q0[sl] = q0[sl] / n
-            put("x_initial", q0)
-        if not np.any(np.isnan(self.x_final[sl])):
-            raise ValueError(
-                f"`x_final` fixes all four quaternion components {model.states[sl]}: four "
-                "equations for three attitude degrees of freedom make the NLP degenerate "
-                "(the discrete dynamics conserve |q| only approximately). Give the target "
-                "attitude as `q_final=` (met up to sign, three equations) instead."
-            )
-
     # --------------------------------------------------------------- properties
     @property
     def free_time(self) -> bool:
@@ -479,11 +445,9 @@ class Problem:
 
     @property
     def quaternion_norm_at_t0(self) -> bool:
-        """Whether the NLP needs ``|q(t0)|^2 = 1`` (attitude model, initial quaternion not given)."""
-        if self.model.attitude is None:
-            return False
-        iq = self.model.attitude[0]
-        return bool(np.any(np.isnan(self.x_initial[iq:iq + 4])))
+        """Whether the NLP needs ``|q(t0)|^2 = 1`` (attitude model, initial quaternion not
+        given; `ocp.attitude.needs_norm_at_t0`)."""
+        return needs_norm_at_t0(self.model, self.x_initial)
 
     def attitude_error(self, qf):
         """Vector part of ``q_final^* (x) qf`` (zero iff ``qf = +/- q_final``), shape (3,).
@@ -494,8 +458,7 @@ class Problem:
         """
         if self.q_final is None:
             raise ValueError("this problem has no `q_final`")
-        qt = ca.DM(self.q_final) if isinstance(qf, (ca.SX, ca.MX, ca.DM)) else self.q_final
-        return quat_mul(quat_conj(qt), qf)[0:3]
+        return attitude_error(self.q_final, qf)
 
     def replace(self, **changes) -> "Problem":
         """A copy with some fields changed (validated again), like `dataclasses.replace`."""

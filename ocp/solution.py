@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from functools import cached_property
 from typing import Mapping
 
 import casadi as ca
@@ -9,7 +10,7 @@ import numpy as np
 
 from dynamics.attitude import quat_conj, quat_mul
 
-__all__ = ["Solution", "Propagation"]
+__all__ = ["Solution", "Propagation", "DenseOutput", "interval_integrator", "stack_interval_controls"]
 
 
 @dataclass(frozen=True)
@@ -36,8 +37,25 @@ class Propagation:
     message: str
 
 
-class _Dense:
-    """Interval data and the transcription's interpolant (dense solution)."""
+class DenseOutput:
+    """Interval data of a solution and the transcription's interpolant (its dense output).
+
+    Attributes
+    ----------
+    xs : ndarray, shape (nx, N)
+        State at each interval start.
+    Xo : ndarray, shape (nx, N, m_x)
+        States at the interval's own state nodes.
+    us : ndarray, shape (nu, N)
+        Control at each interval start (zeros when the transcription has none there).
+    Uo : ndarray, shape (nu, N, m_u)
+        Controls at the interval's own control nodes.
+    p : ndarray, shape (np,)
+    h : ndarray, shape (N,) [s]
+        Interval lengths.
+    t_breaks : ndarray, shape (N + 1,) [s]
+        Mesh points in time.
+    """
 
     def __init__(self, transcription, mesh, model, X, U, p, T, t0):
         N = mesh.N
@@ -78,9 +96,15 @@ class _Dense:
         return k, np.clip(s, 0.0, 1.0)
 
 
-@dataclass(frozen=True, eq=False)
+@dataclass(eq=False)
 class Solution:
     """Outcome of `ocp.solve`.
+
+    Build one from arrays with `Solution.from_arrays` (drivers that solve a restated
+    problem, e.g. `ocp.polish_switches`). The re-simulation `propagation` (and what derives
+    from it: `propagation_error`, `pointing_error`, `terminal_error`) is computed on first
+    use and cached on the instance (``functools.cached_property``); treat the fields as
+    read-only (the arrays are).
 
     Attributes
     ----------
@@ -133,6 +157,8 @@ class Solution:
     multipliers : mapping of str to ndarray
         Multipliers of the unscaled constraints by block (``'defect'``, ``'path'``,
         ``'boundary'``, ``'quat_norm'``, ``'q_final'``), for ``J + nu . g`` (CasADi's sign).
+    dense : DenseOutput
+        Interval data and interpolant behind `sample`.
     """
 
     success: bool
@@ -154,8 +180,7 @@ class Solution:
     problem: object
     constraint_violation: float
     multipliers: Mapping[str, np.ndarray]
-    _dense: _Dense = field(repr=False)
-    _lazy: dict = field(default_factory=dict, repr=False)
+    dense: DenseOutput = field(repr=False)
 
     def __repr__(self) -> str:
         return (f"{type(self).__name__}(success={self.success}, status={self.status!r}, "
@@ -163,6 +188,73 @@ class Solution:
                 f"constraint_violation={self.constraint_violation:.3g}, "
                 f"transcription={self.transcription.name!r}, N={self.mesh.N}, "
                 f"iterations={self.iterations}, solve_time={self.solve_time:.3g} s)")
+
+    # ----------------------------------------------------------- construction
+    @classmethod
+    def from_arrays(cls, problem, transcription, mesh, X, U, p, T, *, cost: float,
+                    success: bool = True, status: str = "Solve_Succeeded", message: str = "",
+                    iterations: int = 0, solve_time: float = 0.0, build_time: float = 0.0,
+                    constraint_violation: float = float("nan"),
+                    multipliers: Mapping[str, np.ndarray] | None = None, **extra) -> "Solution":
+        """A solution of ``problem`` from the values at the transcription's nodes.
+
+        Parameters
+        ----------
+        problem : Problem
+        transcription : Transcription
+        mesh : Mesh
+        X : array_like, shape (nx, 1 + N m_x)
+            States at the state nodes (``t0``, then each interval's own state nodes).
+        U : array_like, shape (nu, n_u)
+            Controls at the control nodes (a start value first when the transcription has
+            one, then each interval's own control nodes).
+        p : array_like, shape (np,)
+        T : float [s]
+        cost, success, status, message, iterations, solve_time, build_time, constraint_violation
+            As the attributes of the same name.
+        multipliers : mapping of str to ndarray, optional
+            By block, as `ocp.nlp.Discretization.multipliers`; costates follow from its
+            ``'defect'`` entry (Radau). Default: none (empty mapping, no costates).
+        **extra
+            Further fields of a subclass (``info`` of `ocp.RefinedSolution`).
+
+        Returns
+        -------
+        Solution (or the subclass it is called on)
+        """
+        X, U = np.asarray(X, dtype=float), np.asarray(U, dtype=float)
+        p, T, tr = np.array(p, dtype=float).reshape(-1), float(T), transcription
+        dense = DenseOutput(tr, mesh, problem.model, X, U, p, T, problem.t0)
+        N = mesh.N
+        sig = tr.node_sigma
+        n_owned = sig.size
+        k = np.concatenate([[0], np.repeat(np.arange(N), n_owned)])
+        s = np.concatenate([[0.0], np.tile(sig, N)])
+        x, u = dense.eval(k, s)
+        # decision variables exactly where they exist
+        x[:, 0] = X[:, 0]
+        xpos = np.flatnonzero(np.isin(sig, tr.x_sigma))
+        xcols = 1 + np.arange(N)[:, None] * n_owned + xpos[None, :]
+        x[:, xcols.reshape(-1)] = X[:, 1:]
+        upos = np.flatnonzero(np.isin(sig, tr.u_sigma))
+        ucols = 1 + np.arange(N)[:, None] * n_owned + upos[None, :]
+        u[:, ucols.reshape(-1)] = U[:, int(tr.u_at_start):]
+        if tr.u_at_start:
+            u[:, 0] = U[:, 0]
+        t = problem.t0 + T * tr.node_tau(mesh)
+        t[-1] = problem.t0 + T
+        mult = dict(multipliers) if multipliers is not None else {}
+        costates = tr.costates(mult["defect"], mesh) if "defect" in mult else None
+        for a in (t, x, u, p):
+            a.setflags(write=False)
+        if costates is not None:
+            costates.setflags(write=False)
+        return cls(success=bool(success), status=str(status), message=str(message), T=T,
+                   t0=problem.t0, cost=float(cost), t=t, x=x, u=u, p=p, iterations=int(iterations),
+                   solve_time=float(solve_time), build_time=float(build_time), costates=costates,
+                   transcription=tr, mesh=mesh, problem=problem,
+                   constraint_violation=float(constraint_violation), multipliers=mult,
+                   dense=dense, **extra)
 
     # ----------------------------------------------------------------- dense
     def sample(self, t):
@@ -197,8 +289,8 @@ class Solution:
         slack = 1e-12 * max(abs(lo), abs(hi), self.T)
         if tq.size and (tq.min() < lo - slack or tq.max() > hi + slack):
             raise ValueError(f"`t` must lie in the horizon [{lo}, {hi}], got [{tq.min()}, {tq.max()}]")
-        k, s = self._dense.locate(tq)
-        x, u = self._dense.eval(k, s)
+        k, s = self.dense.locate(tq)
+        x, u = self.dense.eval(k, s)
         return (x[:, 0], u[:, 0]) if scalar else (x, u)
 
     # ----------------------------------------------------------- diagnostics
@@ -235,7 +327,7 @@ class Solution:
         for name, v in (("rtol", rtol), ("atol", atol)):
             if isinstance(v, bool) or not (isinstance(v, (int, float)) and 0 < v < 1):
                 raise ValueError(f"`{name}` must be a float in (0, 1), got {v!r}")
-        d = self._dense
+        d = self.dense
         nx = self.problem.model.nx
         try:
             integ = interval_integrator(self, self.transcription.node_sigma, rtol, atol)
@@ -244,7 +336,7 @@ class Solution:
             xs = integ(x0=x0, p=dat)["xf"]
             step = ca.Function("step", [x0, dat], [xs[:, -1], xs])
             run = step.mapaccum("propagate", d.N)
-            pars = np.concatenate([d.us, _stack_U(d.Uo, np.arange(d.N)), d.h[None, :],
+            pars = np.concatenate([d.us, stack_interval_controls(d.Uo, np.arange(d.N)), d.h[None, :],
                                    np.repeat(self.p[:, None], d.N, axis=1)], axis=0)
             _, xall = run(self.x[:, 0], pars)
             xp = np.concatenate([self.x[:, :1], np.asarray(xall)], axis=1)
@@ -256,13 +348,12 @@ class Solution:
         err = np.max(np.abs(xp - self.x), axis=1)
         return Propagation(self.t, xp, err, True, f"cvodes per mesh interval, rtol {rtol:g}, atol {atol:g}")
 
-    @property
+    @cached_property
     def propagation(self) -> Propagation:
-        """`propagate` with its default tolerances, computed once and kept (the one
-        re-simulation behind `propagation_error`, `pointing_error` and `terminal_error`)."""
-        if "propagation" not in self._lazy:
-            self._lazy["propagation"] = self.propagate()
-        return self._lazy["propagation"]
+        """`propagate` with its default tolerances, computed on first use and cached (the
+        one re-simulation behind `propagation_error`, `pointing_error` and
+        `terminal_error`)."""
+        return self.propagate()
 
     @property
     def pointing_error(self) -> float | None:
@@ -313,7 +404,7 @@ def interval_integrator(sol: "Solution", grid, rtol: float, atol: float) -> ca.F
     Inputs ``x0`` (nx,) and ``p`` = ``[u_start, vec(U_interval), h, p_model]``; output ``xf``
     (nx, len(grid)). Shared by `Solution.propagate` and mesh refinement (`ocp.refine`).
     """
-    d = sol._dense
+    d = sol.dense
     model = sol.problem.model
     nx, nu = model.nx, model.nu
     sym = ca.SX if d.interp.is_a("SXFunction") else ca.MX
@@ -327,7 +418,7 @@ def interval_integrator(sol: "Solution", grid, rtol: float, atol: float) -> ca.F
                          {"abstol": atol, "reltol": rtol, "max_num_steps": 100000})
 
 
-def _stack_U(Uo: np.ndarray, k: np.ndarray) -> np.ndarray:
+def stack_interval_controls(Uo: np.ndarray, k: np.ndarray) -> np.ndarray:
     """``vec(U_k)`` (column-major, as ``casadi.vec``) of intervals ``k``: shape (nu m_u, len(k))."""
     nu, _, m_u = Uo.shape
     blocks = Uo[:, k, :]  # (nu, K, m_u)

@@ -29,19 +29,19 @@ error inside CasADi) and ``'Rest_Solution'`` (`rest_solution`).
 """
 from __future__ import annotations
 
-import sys
 import time
-from typing import Callable, Mapping
+from typing import Mapping
 
 import casadi as ca
 import numpy as np
 
 from .guess import NodeGuess, initial_guess
 from .ipopt_options import check_ipopt_options
-from .mesh import Mesh, _check_N
+from .mesh import Mesh, check_N
 from .problem import Problem
+from .progress import LOGGER, IterationCallback, Progress, iteration_sink
 from .scaling import auto_scaling
-from .solution import Solution, _Dense
+from .solution import Solution
 from .transcription import get_transcription
 
 __all__ = ["solve", "Progress", "rest_solution", "DEFAULT_CONSTRAINT_TOL", "STATUS_CONSTRAINT_TOL",
@@ -56,82 +56,11 @@ STATUS_CONSTRAINT_TOL = "Constraint_Tol_Not_Met"
 STATUS_REST = "Rest_Solution"
 
 
-class Progress:
-    """One IPOPT iteration as reported to a progress callable.
-
-    Attributes
-    ----------
-    iteration : int
-    objective : float
-        Scaled NLP objective ``J / d_J``.
-    infeasibility : float
-        Largest violation of the scaled NLP constraints.
-    """
-
-    __slots__ = ("iteration", "objective", "infeasibility")
-
-    def __init__(self, iteration: int, objective: float, infeasibility: float):
-        self.iteration, self.objective, self.infeasibility = iteration, objective, infeasibility
-
-    def __str__(self) -> str:
-        return f"{self.iteration:5d}  {self.objective: .10e}  {self.infeasibility:.3e}"
-
-
-class _IterationCallback(ca.Callback):
-    """Hands every IPOPT iterate to ``sink(Progress)``; never stops the solver."""
-
-    def __init__(self, nx: int, ng: int, violation: Callable, sink: Callable):
-        ca.Callback.__init__(self)
-        self._nx, self._ng, self._violation, self._sink = nx, ng, violation, sink
-        self._count = 0
-        self.construct("ocp_progress", {})
-
-    def get_n_in(self):
-        return ca.nlpsol_n_out()
-
-    def get_n_out(self):
-        return 1
-
-    def get_name_in(self, i):
-        return ca.nlpsol_out(i)
-
-    def get_name_out(self, i):
-        return "ret"
-
-    def get_sparsity_in(self, i):
-        name = ca.nlpsol_out(i)
-        if name == "f":
-            return ca.Sparsity.dense(1)
-        if name in ("x", "lam_x"):
-            return ca.Sparsity.dense(self._nx)
-        if name in ("g", "lam_g"):
-            return ca.Sparsity.dense(self._ng)
-        return ca.Sparsity(0, 0)
-
-    def eval(self, arg):
-        g = np.asarray(arg[2]).reshape(-1)
-        self._sink(Progress(self._count, float(arg[1]), self._violation(g)))
-        self._count += 1
-        return [0]
-
-
-def _printer(stream):
-    state = {"header": False}
-
-    def sink(progress: Progress):
-        if not state["header"]:
-            print(" iter   objective (scaled)  inf_pr", file=stream, flush=True)
-            state["header"] = True
-        print(str(progress), file=stream, flush=True)
-
-    return sink
-
-
 def _mesh(N, mesh) -> Mesh:
     if mesh is None:
         return Mesh.uniform(_DEFAULT_N if N is None else N)
     m = mesh if isinstance(mesh, Mesh) else Mesh(mesh)
-    if N is not None and _check_N(N) != m.N:
+    if N is not None and check_N(N) != m.N:
         raise ValueError(f"`N` = {N} conflicts with `mesh`, which has {m.N} intervals")
     return m
 
@@ -172,8 +101,8 @@ def _message(status: str, iterations: int) -> str:
 
 
 def solve(problem: Problem, *, transcription="radau", N: int | None = None, degree: int | None = None,
-          mesh=None, guess=None, scale: Mapping | None = None, verbose=True,
-          ipopt_options: Mapping | None = None, expand: bool = True,
+          mesh=None, guess=None, scale: Mapping | None = None, verbose=False,
+          progress=None, ipopt_options: Mapping | None = None, expand: bool = True,
           constraint_tol: float | None = None) -> Solution:
     """Solve ``problem`` by direct collocation and IPOPT.
 
@@ -197,9 +126,13 @@ def solve(problem: Problem, *, transcription="radau", N: int | None = None, degr
         Scale overrides by state/control/parameter name, ``'T'``, ``'objective'``,
         ``'q_final'`` (see `ocp.scaling`).
     verbose : bool or callable, optional
-        ``True`` prints one line per IPOPT iteration (iteration, scaled objective, largest
-        scaled constraint violation) to ``sys.stdout`` as it runs; a callable receives a
-        `Progress` per iteration instead; ``False`` prints nothing.
+        ``False`` (default) prints nothing. ``True`` prints one line per IPOPT iteration
+        (iteration, scaled objective, largest scaled constraint violation) to
+        ``sys.stdout`` as it runs; a callable is taken as ``progress``.
+    progress : callable, optional
+        Receives a `Progress` per IPOPT iteration. Independently, every solve logs one INFO
+        record (and, when enabled, one DEBUG record per iteration) to the logger
+        ``"appdyn.ocp"`` (`ocp.progress`).
     ipopt_options : mapping, optional
         IPOPT options (``{'tol': 1e-10, 'max_iter': 500, 'print_level': 5}``), with or
         without the ``'ipopt.'`` prefix, checked against the installed IPOPT's option list
@@ -236,8 +169,7 @@ def solve(problem: Problem, *, transcription="radau", N: int | None = None, degr
         raise TypeError(f"`problem` must be an ocp.Problem, got {type(problem).__name__}")
     tr = get_transcription(transcription, degree)
     m = _mesh(N, mesh)
-    if not (verbose is True or verbose is False or callable(verbose)):
-        raise ValueError(f"`verbose` must be True, False or a callable, got {verbose!r}")
+    sink = iteration_sink(verbose, progress)
     if expand not in (True, False):
         raise ValueError(f"`expand` must be True or False, got {expand!r}")
     ctol = _check_constraint_tol(constraint_tol)
@@ -249,10 +181,8 @@ def solve(problem: Problem, *, transcription="radau", N: int | None = None, degr
     disc = tr.build(problem, m, scaling)
     w0 = disc.pack(node_guess)
     nlp_opts = {"ipopt": opts, "print_time": False, "error_on_fail": False, "expand": expand}
-    if verbose is not False:
-        sink = verbose if callable(verbose) else _printer(sys.stdout)
-        callback = _IterationCallback(disc.w.size, disc.g.size, disc.violation, sink)
-        nlp_opts["iteration_callback"] = callback
+    if sink is not None:
+        nlp_opts["iteration_callback"] = IterationCallback(disc.w.size, disc.g.size, disc.violation, sink)
     try:
         solver = ca.nlpsol("ocp", "ipopt", disc.nlp, nlp_opts)
     except RuntimeError:
@@ -304,6 +234,7 @@ def solve(problem: Problem, *, transcription="radau", N: int | None = None, degr
             message = (f"{message}; but the constraint violation {viol:.3g} exceeds "
                        f"constraint_tol {ctol:g}: not verified")
             status = STATUS_CONSTRAINT_TOL
+    LOGGER.info("solve %s (%s, N=%d): %s; %.3g s", problem.name, tr.name, m.N, message, solve_time)
     return _make_solution(problem, tr, m, disc, w, lam_g, g, success, status, message,
                           iterations, solve_time, build_time)
 
@@ -321,40 +252,14 @@ def _run(solver, args):
 
 def _make_solution(problem, tr, mesh, disc, w, lam_g, g, success, status, message,
                    iterations, solve_time, build_time) -> Solution:
+    """The `Solution` at the scaled NLP point ``w`` (multipliers ``lam_g``, constraints ``g``)."""
     phys = disc.unpack(w)
-    X, U, p, T = phys["X"], phys["U"], phys["p"], phys["T"]
-    dense = _Dense(tr, mesh, problem.model, X, U, p, T, problem.t0)
-    N = mesh.N
-    sig = tr.node_sigma
-    n_owned = sig.size
-    k = np.concatenate([[0], np.repeat(np.arange(N), n_owned)])
-    s = np.concatenate([[0.0], np.tile(sig, N)])
-    x, u = dense.eval(k, s)
-    # decision variables exactly where they exist
-    x[:, 0] = X[:, 0]
-    xpos = np.flatnonzero(np.isin(sig, tr.x_sigma))
-    xcols = 1 + np.arange(N)[:, None] * n_owned + xpos[None, :]
-    x[:, xcols.reshape(-1)] = X[:, 1:]
-    upos = np.flatnonzero(np.isin(sig, tr.u_sigma))
-    ucols = 1 + np.arange(N)[:, None] * n_owned + upos[None, :]
-    u[:, ucols.reshape(-1)] = U[:, int(tr.u_at_start):]
-    if tr.u_at_start:
-        u[:, 0] = U[:, 0]
-    t = problem.t0 + T * tr.node_tau(mesh)
-    t[-1] = problem.t0 + T
-    mult = disc.multipliers(lam_g)
-    costates = tr.costates(mult["defect"], mesh)
-    for a in (t, x, u, p):
-        a.setflags(write=False)
-    if costates is not None:
-        costates.setflags(write=False)
-    return Solution(
-        success=bool(success), status=status, message=message, T=T, t0=problem.t0,
-        cost=disc.cost(w), t=t, x=x, u=u, p=p, iterations=iterations, solve_time=solve_time,
-        build_time=build_time, costates=costates, transcription=tr, mesh=mesh, problem=problem,
-        constraint_violation=disc.violation(g, w) if np.all(np.isfinite(g)) else float("nan"),
-        multipliers=mult, _dense=dense,
-    )
+    viol = disc.violation(g, w) if np.all(np.isfinite(g)) else float("nan")
+    return Solution.from_arrays(
+        problem, tr, mesh, phys["X"], phys["U"], phys["p"], phys["T"], cost=disc.cost(w),
+        success=success, status=status, message=message, iterations=iterations,
+        solve_time=solve_time, build_time=build_time, constraint_violation=viol,
+        multipliers=disc.multipliers(lam_g))
 
 
 def rest_solution(problem: Problem, *, T: float | None = None, transcription="radau",

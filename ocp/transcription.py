@@ -45,7 +45,8 @@ import numpy as np
 
 from .mesh import Mesh
 
-__all__ = ["Transcription", "Trapezoid", "HermiteSimpson", "Radau", "TRANSCRIPTIONS",
+__all__ = ["Transcription", "Trapezoid", "HermiteSimpson", "Radau", "RadauConstantControl",
+           "TRANSCRIPTIONS", "f_columns", "lagrange_columns", "sx_compatible",
            "get_transcription"]
 
 
@@ -83,7 +84,7 @@ def _quadrature_weights(nodes: np.ndarray) -> np.ndarray:
     return np.array([np.dot(gw, b) for b in _lagrange_basis(nodes, s)])
 
 
-def _sx_ok(fun: ca.Function) -> bool:
+def sx_compatible(fun: ca.Function) -> bool:
     """Whether ``fun`` can be called on SX symbols (then kernels are built expanded, in SX)."""
     try:
         fun(*[ca.SX.sym(f"a{i}", fun.sparsity_in(i)) for i in range(fun.n_in())])
@@ -155,7 +156,7 @@ class Transcription(abc.ABC):
         L : casadi.Function or None
             Running cost ``(x, u, p) -> L``; ``None`` gives ``quad = 0``.
         """
-        sym = ca.SX if _sx_ok(f) and (L is None or _sx_ok(L)) else ca.MX
+        sym = ca.SX if sx_compatible(f) and (L is None or sx_compatible(L)) else ca.MX
         nx, nu, np_ = f.numel_in(0), f.numel_in(1), f.numel_in(2)
         ins = self._symbols(sym, nx, nu, np_)
         defect, xu, quad = self._kernel(f, L, *ins)
@@ -166,7 +167,7 @@ class Transcription(abc.ABC):
 
     def interpolant(self, f: ca.Function) -> ca.Function:
         """The interval Function ``(xs, X, us, U, h, p, s) -> (x, u)`` (dense solution)."""
-        sym = ca.SX if _sx_ok(f) else ca.MX
+        sym = ca.SX if sx_compatible(f) else ca.MX
         nx, nu, np_ = f.numel_in(0), f.numel_in(1), f.numel_in(2)
         ins = self._symbols(sym, nx, nu, np_)
         s = sym.sym("s")
@@ -221,13 +222,14 @@ class Transcription(abc.ABC):
         return Discretization(problem, self, mesh, scaling)
 
 
-def _f_cols(f, X, U, p):
+def f_columns(f, X, U, p):
     """``f`` at each column of ``X``/``U`` (shape (nx, m))."""
     m = X.shape[1]
     return f.map(m)(X, U, p) if m > 1 else f(X, U, p)
 
 
-def _L_cols(L, X, U, p):
+def lagrange_columns(L, X, U, p):
+    """``L`` at each column of ``X``/``U`` (shape (1, m)); zeros without ``L``."""
     m = X.shape[1]
     if L is None:
         return ca.DM.zeros(1, m)
@@ -392,9 +394,9 @@ class Radau(Transcription):
 
     def _kernel(self, f, L, xs, X, us, U, h, p):
         Xall = ca.horzcat(xs, X)
-        F = _f_cols(f, X, U, p)
+        F = f_columns(f, X, U, p)
         defect = ca.mtimes(Xall, ca.DM(self.D.T)) - h * F
-        quad = 0 if L is None else h * ca.mtimes(_L_cols(L, X, U, p), ca.DM(self.weights))
+        quad = 0 if L is None else h * ca.mtimes(lagrange_columns(L, X, U, p), ca.DM(self.weights))
         return defect, X, quad
 
     def _interpolate(self, f, xs, X, us, U, h, p, s):
@@ -418,7 +420,38 @@ class Radau(Transcription):
         return np.concatenate([lam0[:, None], lam.reshape(nx, N * d)], axis=1)
 
 
-TRANSCRIPTIONS = ("trapezoid", "hermite-simpson", "hermite-simpson-compressed", "radau")
+@dataclass(frozen=True)
+class RadauConstantControl(Radau):
+    """Radau collocation of degree ``d`` with one constant control per mesh interval.
+
+    The state is collocated exactly as in `Radau`; the control is a single value per
+    interval (``u_sigma = [1]``), held at every collocation point, so a bang-bang control
+    can only switch at mesh points. Path constraints are imposed at the interval ends.
+    Use it with ``solve(..., transcription="radau-constant-control", degree=3)`` (or an
+    instance); `ocp.polish_switches` uses it on a free mesh.
+    """
+
+    name = "radau-constant-control"
+
+    @property
+    def u_sigma(self):
+        return np.array([1.0])
+
+    def _kernel(self, f, L, xs, X, us, U, h, p):
+        Uc = ca.repmat(U[:, 0], 1, self.degree)
+        Xall = ca.horzcat(xs, X)
+        defect = ca.mtimes(Xall, ca.DM(self.D.T)) - h * f_columns(f, X, Uc, p)
+        quad = 0 if L is None else h * ca.mtimes(lagrange_columns(L, X, Uc, p), ca.DM(self.weights))
+        return defect, X[:, -1], quad
+
+    def _interpolate(self, f, xs, X, us, U, h, p, s):
+        x, _ = super()._interpolate(f, xs, X, us, ca.repmat(U[:, 0], 1, self.degree), h, p, s)
+        return x, U[:, 0]
+
+
+TRANSCRIPTIONS = ("trapezoid", "hermite-simpson", "hermite-simpson-compressed", "radau",
+                  "radau-constant-control")
+_WITH_DEGREE = {"radau": Radau, "radau-constant-control": RadauConstantControl}
 
 
 def get_transcription(transcription="radau", degree: int | None = None) -> Transcription:
@@ -429,7 +462,8 @@ def get_transcription(transcription="radau", degree: int | None = None) -> Trans
     transcription : str or Transcription
         One of ``TRANSCRIPTIONS`` or an instance.
     degree : int, optional
-        Radau degree (default 3); only valid with ``'radau'``.
+        Radau degree (default 3); only valid with ``'radau'`` and
+        ``'radau-constant-control'``.
 
     Raises
     ------
@@ -440,13 +474,13 @@ def get_transcription(transcription="radau", degree: int | None = None) -> Trans
         if degree is not None and getattr(transcription, "degree", None) != degree:
             raise ValueError(f"`degree` {degree} conflicts with the transcription {transcription!r}")
         return transcription
-    if transcription == "radau":
-        return Radau(3 if degree is None else degree)
+    if transcription in _WITH_DEGREE:
+        return _WITH_DEGREE[transcription](3 if degree is None else degree)
     if transcription not in TRANSCRIPTIONS:
         raise ValueError(f"`transcription` must be one of {TRANSCRIPTIONS} or a Transcription, "
                          f"got {transcription!r}")
     if degree is not None:
-        raise ValueError(f"`degree` applies to 'radau' only, not to {transcription!r}")
+        raise ValueError(f"`degree` applies to the Radau transcriptions only, not to {transcription!r}")
     if transcription == "trapezoid":
         return Trapezoid()
     return HermiteSimpson(separated=transcription == "hermite-simpson")

@@ -41,6 +41,7 @@ target rows by the initial attitude error (`ocp.scaling`).
 from __future__ import annotations
 
 import math
+import warnings
 from dataclasses import dataclass
 
 import casadi as ca
@@ -50,12 +51,14 @@ from dynamics import rigid_body
 from dynamics.attitude import (dcm_from_quat, quat_conj, quat_from_axis_angle, quat_mul,
                                quat_normalize, rotation_angle)
 from dynamics.rigid_body import check_inertia
-from ocp import (Problem, Solution, annotate, polish_switches, refine, rest_solution, solve,
-                 solve_multistart)
-from ocp.guess import slerp
+from dynamics.validate import finite_array, finite_scalar, unit_quaternion, unit_vector
+from ocp import (Problem, Solution, annotate, control_switches, polish_switches, refine,
+                 rest_solution, solve, solve_multistart)
+from ocp.attitude import slerp
+from ocp.checks import integer, positive
 
 __all__ = ["KeepOut", "slew_problem", "time_optimal", "min_effort", "eigenaxis_time",
-           "switch_times", "attitude_guess", "verify", "summary", "format_summary",
+           "switch_times", "attitude_guess", "verify", "summary", "format_summary", "plot_slew",
            "POINTING_TOL", "RATE_TOL", "STATUS_POINTING", "STATUS_REFINE"]
 
 POINTING_TOL = 1e-6  # [rad] default largest re-simulated final attitude error of a success
@@ -83,11 +86,8 @@ class KeepOut:
 
     def __post_init__(self):
         for name in ("boresight", "direction"):
-            v = np.asarray(getattr(self, name), dtype=float).reshape(-1)
-            if v.shape != (3,) or not np.all(np.isfinite(v)) or np.linalg.norm(v) == 0:
-                raise ValueError(f"KeepOut `{name}` must be a finite non-zero 3-vector, got {v}")
-            object.__setattr__(self, name, tuple(v / np.linalg.norm(v)))
-        a = float(self.half_angle)
+            object.__setattr__(self, name, tuple(unit_vector(getattr(self, name), name)))
+        a = finite_scalar(self.half_angle, "half_angle")
         if not (0 < a < math.pi):
             raise ValueError(f"KeepOut `half_angle` must be in (0, pi) rad, got {a}")
         object.__setattr__(self, "half_angle", a)
@@ -114,44 +114,28 @@ class KeepOut:
 
 # ---------------------------------------------------------------------------- inputs
 def _vec3(v, name, default):
-    if v is None:
-        return np.array(default, dtype=float)
-    a = np.asarray(v, dtype=float).reshape(-1)
-    if a.shape != (3,) or not np.all(np.isfinite(a)):
-        raise ValueError(f"`{name}` must be 3 finite numbers, got {v!r}")
-    return a
-
-
-def _unit_quat(q, name):
-    a = np.asarray(q, dtype=float).reshape(-1)
-    if a.shape != (4,) or not np.all(np.isfinite(a)):
-        raise ValueError(f"`{name}` must be 4 finite numbers (scalar-last quaternion), got {q!r}")
-    n = np.linalg.norm(a)
-    if abs(n - 1) > 1e-6:
-        raise ValueError(f"`{name}` must be a unit quaternion (norm 1 to 1e-6), got norm {n:.9g}")
-    return a / n
+    """``default`` when ``v`` is None, else ``v`` as 3 finite numbers (`dynamics.validate`)."""
+    return np.array(default, dtype=float) if v is None else finite_array(v, name, (3,))
 
 
 def _targets(q0, qf, angle, axis):
-    q0 = np.array([0.0, 0.0, 0.0, 1.0]) if q0 is None else _unit_quat(q0, "q0")
+    q0 = np.array([0.0, 0.0, 0.0, 1.0]) if q0 is None else unit_quaternion(q0, "q0")
     if qf is not None:
         if angle is not None or axis is not None:
             raise ValueError("give either `qf` or `angle` and `axis`, not both")
-        return q0, _unit_quat(qf, "qf")
+        return q0, unit_quaternion(qf, "qf")
     if angle is None or axis is None:
         raise ValueError("the target needs `qf`, or both `angle` [rad] and `axis` (body frame)")
     angle = _angle(angle)
-    e = _vec3(axis, "axis", None)
-    if np.linalg.norm(e) == 0:
-        raise ValueError("`axis` must be a non-zero vector")
+    e = unit_vector(axis, "axis")
     return q0, quat_mul(quat_from_axis_angle(e, angle), q0)
 
 
 def _u_max(u_max):
-    a = np.asarray(u_max, dtype=float).reshape(-1)
+    a = finite_array(u_max, "u_max").reshape(-1)
     if a.size == 1:
         a = np.repeat(a, 3)
-    if a.shape != (3,) or not np.all(np.isfinite(a)) or np.any(a <= 0):
+    if a.shape != (3,) or np.any(a <= 0):
         raise ValueError(f"`u_max` must be a positive scalar or 3 positive values [N m], got {u_max!r}")
     return a
 
@@ -182,6 +166,9 @@ def slew_problem(inertia, *, objective, T=None, angle=None, axis=None, q0=None, 
     I = check_inertia(inertia)
     if objective not in ("time", "effort"):
         raise ValueError(f"`objective` must be 'time' or 'effort', got {objective!r}")
+    if objective == "time" and T is not None:
+        warnings.warn("`T` is ignored for a time-optimal slew (the horizon is optimized; "
+                      "bound it with `T_max`)", stacklevel=2)
     q0, qf = _targets(q0, qf, angle, axis)
     w0, wf = _vec3(w0, "w0", [0, 0, 0]), _vec3(wf, "wf", [0, 0, 0])
     if u_max is None:
@@ -199,7 +186,7 @@ def slew_problem(inertia, *, objective, T=None, angle=None, axis=None, q0=None, 
                                 ["x", "u", "p"], ["g"]))
     if keep_out is not None:
         if not isinstance(keep_out, KeepOut):
-            raise ValueError(f"`keep_out` must be a KeepOut, got {type(keep_out).__name__}")
+            raise TypeError(f"`keep_out` must be a KeepOut, got {type(keep_out).__name__}")
         for qq, name in ((q0, "q0"), (qf, "target")):
             if keep_out.margin(qq) < 0:
                 raise ValueError(f"the {name} attitude already violates the keep-out cone "
@@ -260,10 +247,7 @@ def eigenaxis_time(inertia, angle, axis, u_max=1.0) -> float:
     """
     I = check_inertia(inertia)
     angle = _angle(angle)
-    e = _vec3(axis, "axis", None)
-    if not np.linalg.norm(e) > 0:
-        raise ValueError(f"`axis` must be a non-zero 3-vector, got {axis!r}")
-    e = e / np.linalg.norm(e)
+    e = unit_vector(axis, "axis")
     Je = I @ e
     if np.linalg.norm(Je - (e @ Je) * e) > 1e-9 * np.linalg.norm(Je):
         raise ValueError(f"`axis` {e} is not a principal axis of `inertia`")
@@ -275,15 +259,8 @@ def eigenaxis_time(inertia, angle, axis, u_max=1.0) -> float:
 
 
 def _angle(angle) -> float:
-    if isinstance(angle, (bool, np.bool_)):
-        raise TypeError(f"`angle` must be a real number [rad], got {angle!r}")
-    try:
-        a = float(angle)
-    except (TypeError, ValueError):
-        raise TypeError(f"`angle` must be a real number [rad], got {angle!r}") from None
-    if not math.isfinite(a):
-        raise ValueError(f"`angle` must be finite [rad], got {a}")
-    return a
+    """``angle`` [rad] as a finite float (`dynamics.validate.finite_scalar`)."""
+    return finite_scalar(angle, "angle")
 
 
 def _rough_time(I, q0, qf, u_lim, floor=1e-3):
@@ -363,13 +340,8 @@ def _seeded_guesses(problem, starts, seed, *, eigenaxis=True):
 
 # ------------------------------------------------------------------------- maneuvers
 def _check_tol(name, value, default):
-    if value is None:
-        return default
-    if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, float, np.integer, np.floating)):
-        raise TypeError(f"`{name}` must be a number, got {type(value).__name__}")
-    if not (0 < value < math.inf):
-        raise ValueError(f"`{name}` must be a finite number > 0, got {value!r}")
-    return float(value)
+    """``default`` when ``value`` is None, else a finite float > 0 (`ocp.checks.positive`)."""
+    return default if value is None else positive(value, name)
 
 
 def verify(solution: Solution, *, pointing_tol: float = POINTING_TOL, rate_tol: float = RATE_TOL):
@@ -483,8 +455,8 @@ def time_optimal(inertia, *, angle=None, axis=None, q0=None, qf=None, u_max=1.0,
     problem = slew_problem(inertia, objective="time", angle=angle, axis=axis, q0=q0, qf=qf,
                            u_max=u_max, norm_bound=norm_bound, w0=w0, wf=wf,
                            keep_out=keep_out, T_max=T_max)
-    if guess is None and int(starts) < 1:
-        raise ValueError(f"`starts` must be at least 1, got {starts}")
+    if guess is None:
+        starts = integer(starts, "starts", 1)
     rest = _rest(problem, 0.0, ptol, rtol)
     if rest is not None:
         return rest
@@ -611,7 +583,9 @@ def min_effort(inertia, T, *, angle=None, axis=None, q0=None, qf=None, u_max=Non
 
 
 def switch_times(solution: Solution, *, axis=None) -> list:
-    """Times [s] where each torque component changes sign (linear interpolation).
+    """Switch times [s] of each torque component: the engine's one switch detector
+    (`ocp.control_switches`: bound-to-bound jumps at the middle of the range, and both ends
+    of interior arcs), so they agree with `ocp.find_switches` and `ocp.interval_errors`.
 
     Parameters
     ----------
@@ -622,16 +596,14 @@ def switch_times(solution: Solution, *, axis=None) -> list:
     -------
     list of ndarray — one array of switch times per component (or one array)
     """
-    t, U = solution.t, solution.u
-    out = []
-    for i in range(U.shape[0]) if axis is None else [int(axis)]:
-        u = U[i]
-        scale = np.max(np.abs(u)) or 1.0
-        sig = np.where(np.abs(u) < 1e-6 * scale, 0.0, np.sign(u))
-        idx = [k for k in range(len(u) - 1) if sig[k] * sig[k + 1] < 0]
-        ts = [t[k] + (t[k + 1] - t[k]) * u[k] / (u[k] - u[k + 1]) for k in idx]
-        out.append(np.unique(np.round(np.array(ts, dtype=float), 12)))
-    return out if axis is None else out[0]
+    per = control_switches(solution)
+    if axis is None:
+        return per
+    if isinstance(axis, (bool, np.bool_)) or not isinstance(axis, (int, np.integer)):
+        raise TypeError(f"`axis` must be a component index 0, 1 or 2, got {axis!r}")
+    if not 0 <= axis < len(per):
+        raise ValueError(f"`axis` must be a component index in [0, {len(per)}), got {axis!r}")
+    return per[int(axis)]
 
 
 # ----------------------------------------------------------------------- reporting
@@ -696,16 +668,34 @@ def format_summary(data: dict) -> str:
     return "\n".join(["Optimal slew"] + [f"  {k:<{width}}  {v}" for k, v in rows])
 
 
-def plot_slew(solution: Solution, path: str) -> None:
-    """Save quaternion, rates, torques and the rotation path (body axes on the unit sphere)."""
-    import matplotlib
+def plot_slew(solution: Solution, path=None, *, fig=None, dpi: int = 110):
+    """Quaternion, rates, torques and the rotation path (body axes on the unit sphere).
 
-    matplotlib.use("Agg", force=False)
-    import matplotlib.pyplot as plt
+    Builds a `matplotlib.figure.Figure` (no pyplot, no backend change) and returns it; the
+    caller shows or saves it. With ``path`` it is also saved there (``Figure.savefig``).
 
+    Parameters
+    ----------
+    solution : ocp.Solution of a slew
+    path : str or path-like, optional
+        Where to save the figure.
+    fig : matplotlib.figure.Figure, optional
+        Draw into this (empty) figure instead of a new 12 x 8 in one.
+    dpi : int
+        Resolution when saving.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    from matplotlib.figure import Figure
+
+    if fig is None:
+        fig = Figure(figsize=(12, 8))
+    elif not isinstance(fig, Figure):
+        raise TypeError(f"`fig` must be a matplotlib Figure, got {type(fig).__name__}")
     t = np.linspace(solution.t[0], solution.t[-1], 400)
     x, u = solution.sample(t)
-    fig = plt.figure(figsize=(12, 8))
     panels = [(x[:4], "quaternion", [f"q{i + 1}" for i in range(4)]),
               (x[4:], "body rate [rad/s]", ["w1", "w2", "w3"]),
               (u, "torque [N m]", ["u1", "u2", "u3"])]
@@ -725,5 +715,6 @@ def plot_slew(solution: Solution, path: str) -> None:
     ax.legend(fontsize=8)
     fig.suptitle(f"T = {solution.T:.5f} s, cost = {solution.cost:.6g}")
     fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
+    if path is not None:
+        fig.savefig(path, dpi=dpi)
+    return fig

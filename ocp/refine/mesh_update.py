@@ -1,0 +1,232 @@
+"""`refine`: ``hp``-style mesh refinement driven by `interval_errors`, and the mesh update
+it applies each round (split inaccurate intervals, bracket switches, merge very accurate
+neighbours)."""
+from __future__ import annotations
+
+import math
+import sys
+import time
+
+import numpy as np
+
+from ..checks import integer, positive
+from ..mesh import Mesh
+from ..problem import Problem
+from ..progress import LOGGER
+from ..solution import Solution
+from ..solve import solve
+from ..transcription import Radau, Transcription, get_transcription
+from .errors import IntervalErrors, interval_errors
+from .result import RefinedSolution, RefinementRound, annotate
+
+__all__ = ["refine"]
+
+_BRACKET = 1.0 / 16.0  # width of the new switch interval relative to the old one
+
+
+def _local_order(tr: Transcription) -> int:
+    if isinstance(tr, Radau):
+        return tr.degree + 1
+    return {"trapezoid": 3}.get(tr.name, 4)
+
+
+def _new_mesh(mesh: Mesh, est: IntervalErrors, T: float, t0: float, tol: float, q: int,
+              max_intervals: int) -> Mesh | None:
+    """Split inaccurate intervals, bracket switches, merge very accurate neighbours."""
+    b, h = mesh.breaks, mesh.fractions
+    N = mesh.N
+    err = np.minimum(np.where(np.isfinite(est.error), est.error, np.inf), 1e12 * tol)
+    cuts: list[np.ndarray] = [np.zeros(0)] * N  # interior knots per interval, in sigma
+    priority = np.zeros(N)
+    for k in range(N):
+        if err[k] <= tol:
+            continue
+        priority[k] = err[k] / tol
+        if est.switching[k] and est.switch[k] >= est.defect[k]:
+            s = (est.switch_time[k] - t0) / T - b[k]
+            s = s / h[k]
+            # a bracket 1/16 of the interval wide around the impulse-matched switch time
+            knots = np.array([s - _BRACKET / 2, s + _BRACKET / 2])
+            cuts[k] = knots[(knots > 0.02) & (knots < 0.98)]
+            if cuts[k].size == 0:
+                cuts[k] = np.array([0.5])
+            priority[k] = np.inf
+        else:
+            n = int(np.clip(math.ceil((err[k] / (0.25 * tol)) ** (1.0 / q)), 2, 8))
+            cuts[k] = np.arange(1, n) / n
+    # budget: most important splits first
+    n_new = N + sum(c.size for c in cuts)
+    if n_new > max_intervals:
+        order = np.argsort(-priority, kind="stable")
+        budget = max_intervals - N
+        for k in order:
+            if cuts[k].size == 0:
+                continue
+            if cuts[k].size <= budget:
+                budget -= cuts[k].size
+            elif budget >= 1:
+                cuts[k] = np.arange(1, budget + 1) / (budget + 1)
+                budget = 0
+            else:
+                cuts[k] = np.zeros(0)
+    # merge pairs of very accurate, unsplit, non-switching neighbours
+    drop = np.zeros(N + 1, bool)
+    merge_ok = (err * 2.0 ** (q + 1) <= 1e-3 * tol) & ~est.switching
+    k = 0
+    while k < N - 1:
+        if (merge_ok[k] and merge_ok[k + 1] and cuts[k].size == 0 and cuts[k + 1].size == 0):
+            drop[k + 1] = True
+            k += 2
+        else:
+            k += 1
+    pieces = [b[:-1][~drop[:-1]]]
+    for k in range(N):
+        if cuts[k].size:
+            pieces.append(b[k] + cuts[k] * h[k])
+    new = np.unique(np.concatenate(pieces + [[1.0]]))
+    new[0], new[-1] = 0.0, 1.0
+    new = new[np.concatenate([[True], np.diff(new) > 1e-14])]
+    new[-1] = 1.0
+    if new.size == b.size and np.array_equal(new, b):
+        return None
+    if not any(c.size for c in cuts):
+        return None  # nothing to split (budget exhausted): merging alone does not help
+    return Mesh(new)
+
+
+def _transcription(transcription, degree) -> Transcription:
+    if isinstance(transcription, Transcription):
+        return transcription
+    if transcription == "radau":
+        return get_transcription("radau", degree)
+    return get_transcription(transcription)
+
+
+def _report(rnd: int, r: RefinementRound, verbose, progress) -> None:
+    line = (f"refine round {rnd}: N = {r.n_intervals}, max error {r.max_error:.3e}, "
+            f"cost {r.cost:.12g}, {r.iterations} iterations")
+    LOGGER.info(line)
+    if verbose is True:
+        print(line, file=sys.stdout, flush=True)
+    if progress is not None:
+        progress(r)
+
+
+def refine(problem: Problem, solution: Solution | None = None, *, tol: float = 1e-6,
+           max_rounds: int = 6, max_intervals: int = 400, transcription="radau", N: int = 20,
+           degree: int = 3, verbose=False, progress=None, **solve_kwargs) -> RefinedSolution:
+    """Solve ``problem`` and refine the mesh until the estimated error is below ``tol``.
+
+    Each round estimates the error of every interval (`interval_errors`: re-integration of
+    the dynamics from each interval's collocated initial state under the solution's control,
+    relative to the state scale ``max(1, max_t |x_i|)``; plus, where a control switches between
+    its bounds inside an interval, the state increment the smeared control misses). Then:
+
+    * an interval with a switch is cut just around the estimated switch time (a bracket
+      1/16 of the interval wide), so intervals concentrate geometrically there (the error of
+      ``T`` from a switch smeared over an interval ``h`` is ``O(h^2)``: 1/256 per round);
+    * any other interval with error ``e > tol`` is cut into ``n = ceil((4 e/tol)^(1/q))``
+      equal pieces (2 to 8), ``q`` the local order (``d + 1`` for Radau of degree ``d``);
+    * two neighbours with ``e 2^(q+1) <= 1e-3 tol`` and no switch are merged;
+
+    and the problem is solved again on the new mesh, warm-started from the last solution.
+    It stops when the largest estimated error is ``<= tol``, after ``max_rounds`` rounds, when
+    the mesh would exceed ``max_intervals`` intervals, or when an NLP fails.
+
+    Parameters
+    ----------
+    problem : Problem
+    solution : Solution, optional
+        Start from this solution (its mesh; reused as round 0 if it solves ``problem`` with
+        the same transcription, else re-solved on its mesh with it as the guess).
+    tol : float
+        Target relative interval error.
+    max_rounds : int
+        Largest number of re-solves after the initial solve.
+    max_intervals : int
+        Largest number of mesh intervals.
+    transcription, degree : see `ocp.solve` (``degree`` applies to ``'radau'`` only).
+    N : int
+        Number of uniform intervals of the initial mesh (without ``solution`` or ``mesh``).
+    verbose : bool or callable
+        Passed to `ocp.solve`; ``True`` also prints one line per round to ``sys.stdout``.
+    progress : callable, optional
+        Receives each `RefinementRound` as it completes (IPOPT iterations are not passed
+        on; give ``verbose`` a callable for those). Each round is also logged (INFO) to the
+        logger ``"appdyn.ocp"``.
+    **solve_kwargs
+        Passed to `ocp.solve` (``ipopt_options``, ``scale``, ``expand``; ``guess`` and
+        ``mesh`` for the initial solve only).
+
+    Returns
+    -------
+    RefinedSolution
+        The last solution, with ``info['refinement']`` (also ``.refinement``): one
+        `RefinementRound` ``(n_intervals, max_error, cost, iterations, time)`` per NLP
+        solved, and ``info['converged']``, ``info['errors']``, ``info['meshes']``,
+        ``info['stop']``. ``success`` is that of the last NLP (its message says so); not
+        reaching ``tol`` within the limits keeps ``success=True`` with
+        ``info['converged'] = False`` and a note in the message.
+    """
+    if not isinstance(problem, Problem):
+        raise TypeError(f"`problem` must be an ocp.Problem, got {type(problem).__name__}")
+    if solution is not None and not isinstance(solution, Solution):
+        raise TypeError(f"`solution` must be an ocp.Solution or None, got {type(solution).__name__}")
+    positive(tol, "tol")
+    max_rounds = integer(max_rounds, "max_rounds", 0)
+    max_intervals = integer(max_intervals, "max_intervals", 1)
+    if progress is not None and not callable(progress):
+        raise TypeError(f"`progress` must be a callable or None, got {type(progress).__name__}")
+    tr = _transcription(transcription, degree)
+    q = _local_order(tr)
+    kw = dict(solve_kwargs)
+    guess0 = kw.pop("guess", None)
+    mesh0 = kw.pop("mesh", None)
+
+    t_round = time.perf_counter()
+    if solution is not None and solution.problem is problem and solution.transcription == tr:
+        sol = solution
+    elif solution is not None:
+        sol = solve(problem, transcription=tr, mesh=solution.mesh,
+                    guess=solution if guess0 is None else guess0, verbose=verbose, **kw)
+    else:
+        sol = solve(problem, transcription=tr, N=None if mesh0 is not None else N, mesh=mesh0,
+                    guess=guess0, verbose=verbose, **kw)
+    history, meshes = [], []
+    stop, est = "", None
+    for rnd in range(max_rounds + 1):
+        meshes.append(sol.mesh)
+        if not sol.success:
+            history.append(RefinementRound(sol.mesh.N, float("nan"), sol.cost, sol.iterations,
+                                           time.perf_counter() - t_round))
+            stop = f"the NLP of round {rnd} failed"
+            break
+        itol = float(np.clip(1e-4 * tol, 1e-13, 1e-10))  # CVODES fails below ~1e-14
+        est = interval_errors(sol, rtol=itol, atol=itol)
+        history.append(RefinementRound(sol.mesh.N, est.max_error, sol.cost, sol.iterations,
+                                       time.perf_counter() - t_round))
+        _report(rnd, history[-1], verbose, progress)
+        if est.max_error <= tol:
+            stop = "tolerance reached"
+            break
+        if rnd == max_rounds:
+            stop = f"max_rounds = {max_rounds} reached"
+            break
+        mesh = _new_mesh(sol.mesh, est, sol.T, sol.t0, tol, q, max_intervals)
+        if mesh is None:
+            stop = f"max_intervals = {max_intervals} reached"
+            break
+        t_round = time.perf_counter()
+        sol = solve(problem, transcription=tr, mesh=mesh, guess=sol, verbose=verbose, **kw)
+    converged = est is not None and sol.success and est.max_error <= tol
+    if not sol.success:
+        message = f"refine: {stop}: {sol.message}"
+    elif converged:
+        message = (f"refine: estimated error {est.max_error:.2e} <= tol {tol:g} on {sol.mesh.N} "
+                   f"intervals after {len(history) - 1} rounds; {sol.message}")
+    else:
+        message = (f"refine: {stop}; estimated error {est.max_error:.2e} > tol {tol:g} on "
+                   f"{sol.mesh.N} intervals; {sol.message}")
+    info = {"refinement": history, "converged": bool(converged), "errors": est, "meshes": meshes,
+            "tol": tol, "stop": stop}
+    return annotate(sol, info, message=message)

@@ -1,0 +1,258 @@
+"""`polish_switches`: moving knots for bang-bang / time-optimal problems.
+
+A re-solve with a piecewise-constant control (`ocp.RadauConstantControl`) on a *free* mesh
+whose interval lengths are decision variables, so switch times land exactly on knots: the
+switching structure no longer costs accuracy (on a fixed mesh a switch inside an interval of
+length ``h`` leaves an ``O(h^2)`` error in ``T``).
+
+The free mesh is built without touching the engine: the problem is restated in a pseudo
+time ``sigma in [0, 1]`` on a fixed mesh, with the physical time ``t`` an extra state and
+the time dilation ``v = dt/dsigma`` an extra control, piecewise constant per interval::
+
+    dx/dsigma = v f(x, u, p),    dt/dsigma = v,     v_lower <= v <= v_upper
+
+Within an interval ``t`` is affine in ``sigma``, so Radau collocation of the restated
+problem is exactly Radau collocation of the original one on the mesh of the physical
+interval lengths ``h_k = v_k dsigma_k``; the result is returned as a `Solution` of the
+original problem on that mesh (`Solution.from_arrays`).
+"""
+from __future__ import annotations
+
+import math
+import time
+from typing import Mapping
+
+import casadi as ca
+import numpy as np
+
+from dynamics.model import Model
+
+from ..checks import integer
+from ..mesh import Mesh
+from ..problem import Constraint, Problem
+from ..solution import Solution
+from ..solve import solve
+from ..transcription import RadauConstantControl, sx_compatible
+from .result import RefinedSolution, annotate
+from .switches import find_switches
+
+__all__ = ["polish_switches"]
+
+_STRICT = {"tol": 1e-10, "bound_relax_factor": 0.0, "max_iter": 3000}
+_CLOCK, _STRETCH = "t_clock", "t_stretch"
+
+
+def _fresh_name(name: str, taken) -> str:
+    while name in taken:
+        name += "_"
+    return name
+
+
+def _merged(constraints, wrap, extra=()) -> Constraint | None:
+    """Constraints of ``problem`` restated through ``wrap`` (plus ``extra`` ones, each
+    ``(fun, lower, upper)`` of one row), stacked into a single `Constraint`. Row scales
+    are kept when every constraint has one. (One Constraint, not a list: it keeps the
+    Function names valid.)"""
+    funs = [wrap(c.fun) for c in constraints] + [e[0] for e in extra]
+    if not funs:
+        return None
+    lower = np.concatenate([np.asarray(c.lower, float) for c in constraints] + [[e[1]] for e in extra])
+    upper = np.concatenate([np.asarray(c.upper, float) for c in constraints] + [[e[2]] for e in extra])
+    scale = None
+    if not extra and all(c.scale is not None for c in constraints):
+        scale = np.concatenate([np.asarray(c.scale, float) for c in constraints])
+    name = "+".join(c.name for c in constraints) or "horizon"
+    return Constraint(lambda *a: ca.vertcat(*[f(*a) for f in funs]), lower, upper, scale, name)
+
+
+def _free_mesh_problem(problem: Problem, T_ref: float, stretch) -> Problem:
+    """The problem in pseudo time ``sigma`` with the clock ``t`` as an extra state and the
+    dilation ``v = dt/dsigma`` as an extra control, ``stretch[0] T_ref <= v <=
+    stretch[1] T_ref`` (see the module docstring)."""
+    model = problem.model
+    nx, nu, np_ = model.nx, model.nu, model.np
+    sym = ca.SX if sx_compatible(model.f) else ca.MX
+    xa, ua, p = sym.sym("x", nx + 1), sym.sym("u", nu + 1), sym.sym("p", np_)
+    v = ua[nu]
+    rhs = ca.vertcat(v * model.f(xa[:nx], ua[:nu], p), v)
+    fa = ca.Function(f"{model.f.name()}_free_mesh", [xa, ua, p], [rhs], ["x", "u", "p"], ["xdot"])
+    aug = Model(fa, model.states + (_fresh_name(_CLOCK, model.states),),
+                model.controls + (_fresh_name(_STRETCH, model.controls),), model.params,
+                p_default=model.p_default, name=f"{model.name}_free_mesh", attitude=model.attitude)
+    T_lo, T_hi = problem.T_bounds
+    x_initial = np.concatenate([problem.x_initial, [0.0]])
+    x_final = np.concatenate([problem.x_final, [np.nan if problem.free_time else problem.T]])
+    x_bounds = (np.concatenate([problem.x_bounds[0], [0.0]]),
+                np.concatenate([problem.x_bounds[1], [T_hi]]))
+    u_bounds = (np.concatenate([problem.u_bounds[0], [stretch[0] * T_ref]]),
+                np.concatenate([problem.u_bounds[1], [stretch[1] * T_ref]]))
+    lagrange = mayer = None
+    if problem.lagrange is not None:
+        L = problem.lagrange
+        lagrange = lambda x, u, p_: u[nu] * L(x[:nx], u[:nu], p_)  # noqa: E731
+    if problem.mayer is not None:
+        phi = problem.mayer
+        mayer = lambda xf, p_, T: phi(xf[:nx], p_, xf[nx])  # noqa: E731
+    path = _merged(problem.path, lambda c: (lambda x, u, p_: c(x[:nx], u[:nu], p_)))
+    extra = [(lambda x0, xf, p_: xf[nx], T_lo, T_hi)] if problem.free_time else []
+    boundary = _merged(problem.boundary, lambda c: (lambda x0, xf, p_: c(x0[:nx], xf[:nx], p_)), extra)
+    fixed = problem.p_bounds[0] == problem.p_bounds[1]
+    p_bounds = {name: (problem.p_bounds[0][i], problem.p_bounds[1][i])
+                for i, name in enumerate(model.params) if not fixed[i]}
+    return Problem(aug, T=1.0, x_initial=x_initial, x_final=x_final, x_bounds=x_bounds,
+                   u_bounds=u_bounds, p=problem.p, p_bounds=p_bounds, lagrange=lagrange, mayer=mayer,
+                   path=() if path is None else path, boundary=() if boundary is None else boundary,
+                   q_final=problem.q_final, q_final_tol=problem.q_final_tol, t0=0.0,
+                   name=f"{problem.name}_free_mesh")
+
+
+def _aligned_mesh(solution: Solution, N: int | None) -> tuple[Mesh, np.ndarray]:
+    """A mesh with knots at the detected switches (also returned [s]), the arcs between them
+    cut evenly."""
+    T, t0 = solution.T, solution.t0
+    sw = (find_switches(solution) - t0) / T
+    sw = sw[(sw > 1e-6) & (sw < 1 - 1e-6)]
+    edges = np.concatenate([[0.0], sw, [1.0]])
+    lengths = np.diff(edges)
+    n_arcs = lengths.size
+    if N is None:
+        N = 4 * n_arcs if n_arcs > 1 else solution.mesh.N
+    N = max(N, n_arcs)
+    # largest-remainder allocation, at least one interval per arc
+    share = lengths / lengths.sum() * N
+    n = np.maximum(1, np.floor(share).astype(int))
+    while n.sum() < N:
+        n[np.argmax(share - n)] += 1
+    while n.sum() > N and np.any(n > 1):
+        cand = np.where(n > 1, share - n, np.inf)
+        n[np.argmin(cand)] -= 1
+    breaks = np.concatenate([np.linspace(edges[a], edges[a + 1], n[a] + 1)[:-1] for a in range(n_arcs)]
+                            + [[1.0]])
+    return Mesh(breaks), sw * T + t0
+
+
+def polish_switches(problem: Problem, solution: Solution, *, N: int | None = None, degree: int = 3,
+                    verbose=False, stretch=(0.05, 5.0), **solve_kwargs) -> RefinedSolution:
+    """Re-solve a bang-bang / time-optimal problem with moving knots.
+
+    The control is constant within each mesh interval (`RadauConstantControl` of ``degree``)
+    and the interval lengths are decision variables: ``h_k = v_k dsigma_k`` on a mesh
+    ``dsigma`` of pseudo time, ``stretch[0] T0 <= v_k <= stretch[1] T0`` (``T0`` the horizon
+    of ``solution``), so an interval may shrink to ``stretch[0]`` or grow to ``stretch[1]``
+    times its initial length (``sum h_k = T`` holds by construction). Switch times then sit
+    exactly on knots and the switching structure costs no accuracy: a fixed mesh leaves an
+    ``O(h^2)`` error in ``T``; here what remains is the state's collocation error within the
+    arcs (zero when the state is polynomial, e.g. the double integrator; ``O(h^(2d-1))``
+    otherwise) and the NLP tolerance. The initial mesh puts knots at the switches detected in
+    ``solution`` (`find_switches`) and cuts the arcs between them evenly; the guess is
+    ``solution`` with its interval-mean control.
+
+    Parameters
+    ----------
+    problem : Problem
+    solution : Solution
+        A solution of ``problem`` (any transcription and mesh) to start from.
+    N : int, optional
+        Number of intervals; default 4 per control arc (``solution.mesh.N`` without switches).
+    degree : int
+        Radau degree of the state.
+    verbose : bool or callable
+        Passed to `ocp.solve`.
+    stretch : (float, float)
+        Bounds of the interval lengths relative to their initial lengths.
+    **solve_kwargs
+        Passed to `ocp.solve` (``ipopt_options`` is merged over the defaults
+        ``{'tol': 1e-10, 'bound_relax_factor': 0, 'max_iter': 3000}``; ``scale`` may name the
+        extra state ``'t_clock'`` and control ``'t_stretch'``).
+
+    Returns
+    -------
+    RefinedSolution
+        A solution of ``problem`` with transcription `RadauConstantControl` on the optimized
+        mesh. ``info``: ``'switch_times'`` (where the control jumps, on knots),
+        ``'initial_switch_times'``, ``'initial_T'``, ``'N'``,
+        ``'stretch_active'`` (indices of intervals at a ``stretch`` bound),
+        ``'free_mesh_solution'`` (the solution of the restated problem), ``'wall_time'``.
+        ``success=False`` (never an exception) if IPOPT failed.
+
+    Notes
+    -----
+    Path constraints are imposed at the interval ends only. ``T`` of the result is not
+    necessarily below that of ``solution``: both carry their own discretization errors.
+    """
+    if not isinstance(problem, Problem):
+        raise TypeError(f"`problem` must be an ocp.Problem, got {type(problem).__name__}")
+    if not isinstance(solution, Solution):
+        raise TypeError(f"`solution` must be an ocp.Solution, got {type(solution).__name__}")
+    if solution.problem.model.nx != problem.model.nx or solution.problem.model.nu != problem.model.nu:
+        raise ValueError("`solution` must solve a problem with the states and controls of `problem`")
+    if N is not None:
+        N = integer(N, "N", 1)
+    try:
+        lo_s, hi_s = (float(v) for v in stretch)
+    except (TypeError, ValueError):
+        raise ValueError(f"`stretch` must be a pair (lower, upper), got {stretch!r}") from None
+    if not (0 < lo_s < 1 < hi_s < math.inf):
+        raise ValueError(f"`stretch` must satisfy 0 < lower < 1 < upper < inf, got {stretch!r}")
+    tr = RadauConstantControl(degree)
+    kw = dict(solve_kwargs)
+    for bad in ("transcription", "mesh", "guess", "N", "degree"):
+        if bad in kw:
+            raise ValueError(f"polish_switches chooses `{bad}` itself; got {bad}={kw[bad]!r}")
+    user_ipopt = kw.pop("ipopt_options", None) or {}
+    if not isinstance(user_ipopt, Mapping):
+        raise ValueError(f"`ipopt_options` must be a mapping, got {type(user_ipopt).__name__}")
+    ipopt = {**_STRICT, **{k[len("ipopt."):] if k.startswith("ipopt.") else k: v
+                           for k, v in user_ipopt.items()}}
+
+    t_start = time.perf_counter()
+    mesh, sw0 = _aligned_mesh(solution, N)
+    T0 = float(solution.T)
+    nx, nu, np_ = problem.model.nx, problem.model.nu, problem.model.np
+    b = mesh.breaks
+    aug = _free_mesh_problem(problem, T0, (lo_s, hi_s))
+    # guess in pseudo time sigma (= t / T0 initially): states and clock at the nodes, the
+    # interval-mean control of `solution`, v = T0
+    sig = np.unique(np.concatenate([tr.state_tau(mesh), b]))
+    xg = np.vstack([solution.sample(solution.t0 + T0 * sig)[0], T0 * sig])
+    m = 16
+    tm = (b[:-1, None] + (np.arange(m)[None, :] + 0.5) / m * np.diff(b)[:, None]).reshape(-1)
+    um = solution.sample(solution.t0 + T0 * tm)[1].reshape(nu, mesh.N, m).mean(axis=2)
+    um = np.clip(um, problem.u_bounds[0][:, None], problem.u_bounds[1][:, None])
+    um = np.vstack([um, np.full((1, mesh.N), T0)])
+
+    def u_guess(t):
+        return um[:, int(np.clip(np.searchsorted(b, t, side="left") - 1, 0, mesh.N - 1))]
+
+    guess = {"t": sig, "x": xg, "u": u_guess, "p": np.asarray(solution.p, dtype=float)}
+    sa = solve(aug, transcription=tr, mesh=mesh, guess=guess, verbose=verbose,
+               ipopt_options=ipopt, **kw)
+
+    # ---- back to the original problem on the mesh of physical interval lengths
+    d = degree
+    clock = sa.x[nx, ::d]  # at the sigma breaks (state columns 0, d, 2d, ...)
+    T = float(clock[-1])
+    frac = np.diff(clock)
+    if not (np.isfinite(T) and T > 0 and np.all(np.isfinite(frac))):
+        frac, T = mesh.fractions * T0, T0
+    frac = np.maximum(frac, 1e-14 * T) / T
+    breaks = np.concatenate([[0.0], np.cumsum(frac)])
+    breaks = breaks / breaks[-1]
+    breaks[-1] = 1.0
+    phys_mesh = Mesh(breaks)
+    mult = dict(sa.multipliers)
+    mult["defect"] = mult["defect"][:nx]
+    if problem.free_time:
+        mult["boundary"] = mult["boundary"][:-1]
+    out = Solution.from_arrays(
+        problem, tr, phys_mesh, sa.x[:nx], sa.dense.Uo[:nu, :, 0], np.asarray(sa.p)[:np_], T,
+        cost=sa.cost, success=sa.success, status=sa.status, message=sa.message,
+        iterations=sa.iterations, solve_time=sa.solve_time, build_time=sa.build_time,
+        constraint_violation=sa.constraint_violation, multipliers=mult)
+    v = sa.dense.Uo[nu, :, 0]
+    active = np.flatnonzero((v <= lo_s * T0 * (1 + 1e-6)) | (v >= hi_s * T0 * (1 - 1e-6)))
+    info = {"switch_times": find_switches(out), "initial_switch_times": sw0, "initial_T": T0,
+            "N": mesh.N, "stretch_active": active, "free_mesh_solution": sa,
+            "wall_time": time.perf_counter() - t_start}
+    prefix = "polish_switches (constant control and free length per interval): "
+    return annotate(out, info, message=prefix + sa.message)

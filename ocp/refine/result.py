@@ -1,0 +1,98 @@
+"""Result types of the drivers on top of `ocp.solve` (`refine`, `solve_multistart`,
+`polish_switches`) and `annotate`, which turns any `Solution` into one."""
+from __future__ import annotations
+
+from dataclasses import dataclass, field, fields
+from typing import Mapping, NamedTuple
+
+from ..solution import Solution
+
+__all__ = ["RefinementRound", "RefinedSolution", "annotate"]
+
+_TRAJECTORY = frozenset({"x", "u", "p", "T", "t0", "t", "mesh", "transcription", "problem", "dense"})
+
+
+class RefinementRound(NamedTuple):
+    """One round of `refine`: the NLP solved on a mesh and the error estimated on it.
+
+    Attributes
+    ----------
+    n_intervals : int
+    max_error : float
+        Largest estimated relative interval error (NaN when the NLP failed).
+    cost : float
+    iterations : int
+        IPOPT iterations of the round.
+    time : float [s]
+        Wall time of the round: NLP build + solve + error estimate.
+    """
+
+    n_intervals: int
+    max_error: float
+    cost: float
+    iterations: int
+    time: float
+
+
+@dataclass(eq=False, repr=False)
+class RefinedSolution(Solution):
+    """A `Solution` plus ``info`` (returned by `refine`, `solve_multistart`, `polish_switches`).
+
+    It is a `Solution` in every respect (``isinstance`` holds, it warm-starts `solve`).
+
+    Attributes
+    ----------
+    info : mapping of str to object
+        What the driver did. `refine`: ``'refinement'`` (list of `RefinementRound`, one per
+        NLP solved, first the initial one), ``'converged'`` (max error <= tol), ``'errors'``
+        (the final `IntervalErrors`), ``'meshes'`` (the mesh of each round),
+        ``'tol'``, ``'stop'`` (why it stopped). `solve_multistart`: ``'starts'`` (list of
+        dicts with ``index, success, status, cost, T, constraint_violation, iterations,
+        time``) and ``'best'`` (index of the start returned). `polish_switches`:
+        ``'switch_times'`` (knots where the control jumps), ``'initial_switch_times'``,
+        ``'initial_T'``, ``'N'``, ``'stretch_active'`` (intervals whose length sits at a
+        bound of ``stretch``), ``'free_mesh_solution'`` (the solution of the restated
+        problem) and ``'wall_time'``.
+    """
+
+    info: Mapping = field(default_factory=dict)
+
+    @property
+    def refinement(self) -> list | None:
+        """`refine` history: list of `RefinementRound` (``None`` from the other drivers)."""
+        return self.info.get("refinement")
+
+    @property
+    def starts(self) -> list | None:
+        """`solve_multistart` record of all starts (``None`` from the other drivers)."""
+        return self.info.get("starts")
+
+
+def annotate(solution: Solution, info: Mapping | None = None, **changes) -> RefinedSolution:
+    """A copy of ``solution`` as a `RefinedSolution`, ``info`` merged over its own and the
+    fields in ``changes`` (e.g. ``success``, ``status``, ``message``) replaced; the cached
+    re-simulation (`Solution.propagation`) is shared when the trajectory is unchanged. For drivers that verify or post-process a result
+    (`problems.slew`).
+
+    Raises
+    ------
+    TypeError
+        If ``solution`` is not a `Solution`.
+    ValueError
+        If ``changes`` names a field a `Solution` does not have.
+    """
+    if not isinstance(solution, Solution):
+        raise TypeError(f"`solution` must be an ocp.Solution, got {type(solution).__name__}")
+    names = {f.name for f in fields(Solution)}
+    bad = sorted(set(changes) - names)
+    if bad:
+        raise ValueError(f"unknown Solution fields {bad}")
+    kw = {f.name: getattr(solution, f.name) for f in fields(Solution)}
+    kw.update(changes)
+    merged = dict(getattr(solution, "info", {}) or {})
+    merged.update(info or {})
+    out = RefinedSolution(**kw, info=merged)
+    # the cached re-simulation (`Solution.propagation`) is shared unless the trajectory changed
+    if "propagation" in vars(solution) and not (_TRAJECTORY & set(changes)):
+        vars(out)["propagation"] = solution.propagation
+    return out

@@ -1,0 +1,42 @@
+"""The engine's one switch detector: `find_switches`, `control_switches` and the switch
+intervals of `interval_errors` agree (bang-bang double integrator, T* = 2 sqrt(d), one switch
+at T*/2)."""
+import numpy as np
+import pytest
+
+from ocp import control_switches, find_switches, interval_errors, solve
+
+from .reference import STRICT, bang_bang
+
+
+@pytest.mark.parametrize("N", [7, 8])  # odd: switch inside an interval; even: on a knot
+def test_detectors_agree_on_a_bang_bang_solution(N):
+    problem, truth = bang_bang()
+    sol = solve(problem, N=N, ipopt_options=STRICT)
+    assert sol.success, sol.message
+    per = control_switches(sol)
+    merged = find_switches(sol)
+    assert len(per) == 1
+    np.testing.assert_array_equal(per[0], merged)
+    assert merged.size == 1 and abs(merged[0] - truth["T"] / 2) < 0.02
+    est = interval_errors(sol)
+    tb = sol.t0 + sol.T * sol.mesh.breaks
+    # every interval flagged as switching holds a detected switch
+    for k in np.flatnonzero(est.switching):
+        assert tb[k] <= merged[0] <= tb[k + 1]
+        assert tb[k] <= est.switch_time[k] <= tb[k + 1]
+    if N % 2:  # a smeared switch inside interval 3 is flagged there and only there
+        assert list(np.flatnonzero(est.switching)) == [3]
+    else:  # a jump on a knot: nothing smeared, nothing flagged
+        assert not np.any(est.switching)
+
+
+def test_detector_checks_its_arguments():
+    problem, _ = bang_bang()
+    sol = solve(problem, N=4)
+    with pytest.raises(TypeError, match="`solution`"):
+        control_switches("sol")
+    with pytest.raises(ValueError, match="`samples`"):
+        find_switches(sol, samples=1)
+    with pytest.raises(TypeError, match="`samples`"):
+        find_switches(sol, samples=2.5)
