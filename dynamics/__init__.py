@@ -1,21 +1,31 @@
 """appdyn dynamics: models as named-I/O CasADi Functions, simulation, closed-form truths.
 
-Entry points: `Model`, `rigid_body`, `simulate`, `linearize` (exact linearization about
-equilibria and steady spins, as a python-control StateSpace), and the modules `attitude`
+Entry points: `Model`, `rigid_body`, `simulate` (with `SimulationResult` and `METHODS`;
+internals in the subpackage `dynamics.integrate`), `linearize` (exact linearization about
+equilibria and steady spins, as a python-control StateSpace), `clear_caches` (empties the one
+cache of built and compiled Functions, `dynamics.cache`), and the modules `attitude`
 (kinematics) and `truth` (closed forms, imported on first use).
 """
 from __future__ import annotations
 
 import importlib
 
-from . import attitude
+from . import attitude, cache
+from .integrate import METHODS, SimulationResult, simulate
+from .linearize import Linearization, linearization, linearize
 from .model import Model
 from .rigid_body import rigid_body
-from .linearize import Linearization, linearization, linearize
-from .simulate import SimulationResult, simulate
 
-__all__ = ["Linearization", "Model", "SimulationResult", "attitude", "linearization",
-           "linearize", "rigid_body", "simulate", "truth"]
+__all__ = ["METHODS", "Linearization", "Model", "SimulationResult", "attitude", "clear_caches",
+           "linearization", "linearize", "rigid_body", "simulate", "truth"]
+
+def clear_caches() -> None:
+    """Empty every cache of built and compiled CasADi Functions, jit files included.
+
+    Models, integration loops, Jacobians and compiled C code are all kept in
+    `dynamics.cache`; after this call they are rebuilt (and recompiled) on next use.
+    """
+    cache.clear()
 
 
 def __getattr__(name):

@@ -1,6 +1,6 @@
 """Attitude kinematics: quaternions, direction cosines, Euler angles, principal axes.
 
-Conventions (seed: Rheinfurth & Wilson, NASA RP-1262, Sec. 4.3):
+Conventions (Rheinfurth & Wilson, NASA RP-1262, Sec. 4.3):
 
 * Quaternion **scalar-last** ``q = [q1, q2, q3, q4]`` with ``q4 = cos(delta/2)`` (Eqs. 4.55-4.58).
 * The direction cosine matrix ``A(q)`` (Eq. 4.63) maps inertial components to body components,
@@ -238,7 +238,8 @@ def quat_conj(q):
 
     Parameters
     ----------
-    q : array_like, shape (4,) or (4, n), or CasADi 4x1 — any finite quaternion
+    q : array_like, shape (4,) or (4, n), or CasADi 4x1
+        Any finite quaternion
 
     Returns
     -------
@@ -260,7 +261,8 @@ def quat_normalize(q):
 
     Parameters
     ----------
-    q : array_like, shape (4,) or (4, n), or CasADi 4x1 — any finite non-zero quaternion
+    q : array_like, shape (4,) or (4, n), or CasADi 4x1
+        Any finite non-zero quaternion
 
     Returns
     -------
@@ -286,7 +288,8 @@ def quat_kinematics_matrix(w):
 
     Parameters
     ----------
-    w : array_like, shape (3,), or CasADi 3x1 — body angular velocity [rad/s]
+    w : array_like, shape (3,), or CasADi 3x1
+        Body angular velocity [rad/s]
 
     Returns
     -------
@@ -316,8 +319,10 @@ def quat_rate(q, w):
 
     Parameters
     ----------
-    q : shape (4,) or (4, n), or CasADi 4x1 — attitude quaternion
-    w : shape (3,) or (3, n), or CasADi 3x1 — body angular velocity [rad/s]
+    q : shape (4,) or (4, n), or CasADi 4x1
+        Attitude quaternion
+    w : shape (3,) or (3, n), or CasADi 3x1
+        Body angular velocity [rad/s]
 
     Returns
     -------
@@ -380,9 +385,9 @@ def dcm_from_quat(q):
 
 
 def quat_from_dcm(A):
-    """Quaternion from a rotation matrix by the seed's largest-diagonal algorithm.
+    """Quaternion from a rotation matrix by the largest-diagonal algorithm [1]_.
 
-    Sec. 4.3 E, steps 1-5 (re-derived from Eqs. 4.79-4.80; the OCR of step 1 is garbled):
+    Steps 1-5 of [1]_ (re-derived from Eqs. 4.79-4.80; the OCR of step 1 is garbled):
     with ``T = tr A`` and ``p = 2 q`` the symmetric matrix ``P = p p^T`` is
 
     ``P = [[1+2A11-T, A12+A21, A13+A31, A23-A32],
@@ -395,7 +400,8 @@ def quat_from_dcm(A):
 
     Parameters
     ----------
-    A : array_like, shape (3, 3) or (3, 3, n), or CasADi 3x3 — a rotation matrix
+    A : array_like, shape (3, 3) or (3, 3, n), or CasADi 3x3
+        A rotation matrix
 
     Returns
     -------
@@ -408,6 +414,10 @@ def quat_from_dcm(A):
     ValueError
         If ``A`` is not 3x3, or (numeric) not finite, not orthogonal to
         ``validate.DCM_ORTHO_TOL`` or not of determinant +1.
+
+    References
+    ----------
+    .. [1] Rheinfurth & Wilson, NASA RP-1262, Sec. 4.3 E, steps 1-5 and Eqs. 4.79-4.80.
     """
     A = _arg(A, "A", (3, 3), _rotation)
     o = _ops(A)
@@ -448,7 +458,8 @@ def dcm_from_axis_angle(axis, angle):
 
     Parameters
     ----------
-    axis : array_like, shape (3,), or CasADi 3x1 — rotation axis (normalized here)
+    axis : array_like, shape (3,), or CasADi 3x1
+        Rotation axis (normalized here)
     angle : float [rad], or CasADi scalar
 
     Returns
@@ -481,7 +492,8 @@ def quat_from_axis_angle(axis, angle):
 
     Parameters
     ----------
-    axis : array_like, shape (3,), or CasADi 3x1 — rotation axis (normalized here)
+    axis : array_like, shape (3,), or CasADi 3x1
+        Rotation axis (normalized here)
     angle : float or array (n,) [rad], or CasADi scalar
 
     Returns
@@ -509,7 +521,8 @@ def rotation_angle(q):
 
     Parameters
     ----------
-    q : array_like, shape (4,) or (4, n), or CasADi 4x1 — unit quaternion
+    q : array_like, shape (4,) or (4, n), or CasADi 4x1
+        Unit quaternion
 
     Returns
     -------
@@ -534,11 +547,13 @@ def axis_angle_from_quat(q):
 
     Parameters
     ----------
-    q : array_like, shape (4,) — numpy only
+    q : array_like, shape (4,)
+        Numpy only
 
     Returns
     -------
-    axis : ndarray, shape (3,) — unit vector (``[1, 0, 0]`` for the identity)
+    axis : ndarray, shape (3,)
+        Unit vector (``[1, 0, 0]`` for the identity)
     angle : float [rad]
 
     Raises
@@ -559,7 +574,7 @@ def axis_angle_from_quat(q):
 
 
 def propagate_quat(q, w, h):
-    """Closed-form quaternion update for a constant body rate (seed, "Integration of Quaternions").
+    """Closed-form quaternion update for a constant body rate [1]_.
 
     ``q(h) = (E cos(|w| h/2) - Wbar(w)/|w| sin(|w| h/2)) q`` — exact for constant ``w``, norm
     preserving to round-off. Written with ``sin(x)/x`` so that ``w -> 0`` is smooth (also
@@ -567,13 +582,17 @@ def propagate_quat(q, w, h):
 
     Parameters
     ----------
-    q : shape (4,) or CasADi 4x1 — unit quaternion at the start of the step
-    w : shape (3,) or CasADi 3x1 — constant body angular velocity [rad/s]
-    h : float or CasADi scalar — step [s]
+    q : shape (4,) or CasADi 4x1
+        Unit quaternion at the start of the step
+    w : shape (3,) or CasADi 3x1
+        Constant body angular velocity [rad/s]
+    h : float or CasADi scalar
+        Step [s]
 
     Returns
     -------
-    shape (4,) — quaternion after the step
+    shape (4,)
+        Quaternion after the step
 
     Raises
     ------
@@ -582,6 +601,10 @@ def propagate_quat(q, w, h):
     ValueError
         If (numeric) ``q`` is not a finite unit quaternion, ``w`` or ``h`` is not finite,
         or ``|w| h`` is too large to represent.
+
+    References
+    ----------
+    .. [1] Rheinfurth & Wilson, NASA RP-1262, Sec. 4.3, "Integration of Quaternions" (Eq. 4.70 for constant ``w``).
     """
     q, w = _arg(q, "q", (4,), _unit_q), _arg(w, "w", (3,), _finite3)
     h = _arg(h, "h", (), _finite_any)
@@ -610,7 +633,8 @@ def dcm_axis(axis: int, angle):
 
     Parameters
     ----------
-    axis : {1, 2, 3} — an int (numpy integers too; not a float or bool)
+    axis : {1, 2, 3}
+        An int (numpy integers too; not a float or bool)
     angle : float or array (n,) [rad], or CasADi scalar
 
     Returns
@@ -745,7 +769,8 @@ def euler313_from_quat(q):
 
     Parameters
     ----------
-    q : array_like, shape (4,) or (4, n), or CasADi 4x1 — unit quaternion
+    q : array_like, shape (4,) or (4, n), or CasADi 4x1
+        Unit quaternion
 
     Returns
     -------
@@ -867,7 +892,8 @@ def euler321_from_quat(q):
 
     Parameters
     ----------
-    q : array_like, shape (4,) or (4, n), or CasADi 4x1 — unit quaternion
+    q : array_like, shape (4,) or (4, n), or CasADi 4x1
+        Unit quaternion
 
     Returns
     -------
@@ -886,26 +912,28 @@ def euler321_from_quat(q):
 
 # --------------------------------------------------------------------- principal axes
 def principal_axes(inertia, *, order="nearest"):
-    """Principal moments and the principal-axes rotation (seed Sec. 4.4 D, Gemini example).
+    """Principal moments and the principal-axes rotation [1]_.
 
     The eigenvectors of ``inertia`` form the modal matrix ``Phi`` (columns); the rotation is
     ``A = Phi^T`` so that ``A @ inertia @ A.T = diag(moments)`` and ``x_principal = A @ x_ref``.
     Eigenvector signs are chosen so that ``det A = +1`` and the rotation angle
-    (``tr A = 1 + 2 cos delta``) is the smallest, as in the seed.
+    (``tr A = 1 + 2 cos delta``) is the smallest, as in [1]_.
 
     Parameters
     ----------
-    inertia : array_like, shape (3, 3) [kg m^2] — symmetric positive definite
+    inertia : array_like, shape (3, 3) [kg m^2]
+        Symmetric positive definite
     order : {"nearest", "ascending", "descending"}
         ``"nearest"`` (default) also chooses which principal axis is called 1, 2, 3: among
         all 24 proper assignments the smallest rotation wins, so each principal axis keeps the
-        label of the reference axis it lies closest to (the seed's Gemini ordering).
+        label of the reference axis it lies closest to (the Gemini ordering of [1]_).
         ``"ascending"``/``"descending"`` fix the order of the moments and choose signs only.
 
     Returns
     -------
     moments : ndarray, shape (3,) [kg m^2]
-    A : ndarray, shape (3, 3) — rotation from reference to principal axes (rows = axes)
+    A : ndarray, shape (3, 3)
+        Rotation from reference to principal axes (rows = axes)
 
     Raises
     ------
@@ -914,10 +942,13 @@ def principal_axes(inertia, *, order="nearest"):
     ValueError
         If ``inertia`` is not a finite, symmetric, positive definite 3x3 matrix, or ``order``
         is unknown.
-    """
-    from .rigid_body import check_inertia  # local import: rigid_body imports this module
 
-    inertia = check_inertia(validate.finite_array(inertia, "inertia"), triangle=False)
+    References
+    ----------
+    .. [1] Rheinfurth & Wilson, NASA RP-1262, Sec. 4.4 D (the Gemini example).
+    """
+
+    inertia = validate.check_inertia(validate.finite_array(inertia, "inertia"), triangle=False)
     order = validate.one_of(order, "order", ("nearest", "ascending", "descending"))
     vals, vecs = np.linalg.eigh(inertia)  # ascending
     perms = list(itertools.permutations(range(3)))

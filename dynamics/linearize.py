@@ -17,13 +17,14 @@ constraint leaves no fourth, spurious zero mode. Two frames are offered:
 * ``frame="spinning"`` (default): the reference frame turns at the constant body rate
   ``w_ref = x[iw:iw+3]`` of the operating point, ``q_ref(t)`` solving
   ``q_ref' = -1/2 Wbar(w_ref) q_ref`` from ``q_ref(0) = x[iq:iq+4]``; this is the nominal
-  frame of seed Sec. 4.6 Method III. A steady spin ``w = w_ref`` with the other states at
-  rest is then an equilibrium of the error dynamics (a *relative* equilibrium of the model),
-  and ``dth' = dw - w_ref x dth`` to first order. With ``w_ref = 0`` this is the ordinary
-  fixed-reference linearization.
+  frame of Rheinfurth & Wilson, NASA RP-1262, Sec. 4.6 Method III. A steady spin
+  ``w = w_ref`` with the other states at rest is then an equilibrium of the error dynamics
+  (a *relative* equilibrium of the model), and ``dth' = dw - w_ref x dth`` to first order.
+  With ``w_ref = 0`` this is the ordinary fixed-reference linearization.
 * ``frame="rates"``: the attitude is dropped; the states are the body rates and the other
   states. Allowed only when their equations do not depend on the attitude (torque-free
-  bodies, internal dampers): the Euler-equation perturbations of seed Sec. 4.5 C.
+  bodies, internal dampers): the Euler-equation perturbations of
+  Rheinfurth & Wilson, Sec. 4.5 C.
 
 The error dynamics in the spinning frame are time-invariant only if the model is symmetric
 about the spin: the residual and the Jacobians are therefore also evaluated at two other spin
@@ -31,16 +32,16 @@ phases of the reference (spin angles ``2`` and ``4`` rad) and must agree.
 """
 from __future__ import annotations
 
-import threading
-from collections import OrderedDict
 from dataclasses import dataclass, field, replace
 from typing import Literal, Mapping
 
 import casadi as ca
 import numpy as np
 
+from . import cache
 from .attitude import propagate_quat, quat_conj, quat_mul, quat_rate
-from .model import Model
+from . import validate
+from .model import Model, check_model
 
 __all__ = ["Linearization", "linearization", "linearize", "error_dynamics", "ANGLE_STATES",
            "EQ_RTOL"]
@@ -62,15 +63,19 @@ class Linearization:
     ----------
     A : ndarray, shape (n, n)
     B : ndarray, shape (n, m)
-    C : ndarray, shape (n, n) — identity: the outputs are the states
-    D : ndarray, shape (n, m) — zero
+    C : ndarray, shape (n, n)
+        Identity: the outputs are the states
+    D : ndarray, shape (n, m)
+        Zero
     states, inputs : tuple of str
         Names of the (reduced) state and input components; attitude models use
         `ANGLE_STATES` for the error angles.
-    x0 : ndarray, shape (nx,) — the model state it was taken at (quaternion normalized)
+    x0 : ndarray, shape (nx,)
+        The model state it was taken at (quaternion normalized)
     u0 : ndarray, shape (nu,)
     p : ndarray, shape (np,)
-    frame : {'spinning', 'rates', 'none'} — ``'none'`` for models without attitude
+    frame : {'spinning', 'rates', 'none'}
+        ``'none'`` for models without attitude
     reference_rate : ndarray, shape (3,) or None
         Body rate [rad/s] of the reference frame (``frame='spinning'``).
     residual : ndarray, shape (n,)
@@ -222,8 +227,8 @@ class Linearization:
             out = np.zeros(self.n)
             out[self.index(v)] = 1.0
             return out
-        v = np.asarray(v, dtype=float).reshape(-1)
-        if v.size != self.n or not np.all(np.isfinite(v)) or not np.any(v):
+        v = validate.finite_array(v, name).reshape(-1)
+        if v.size != self.n or not np.any(v):
             raise ValueError(f"`{name}` must be a finite non-zero vector of {self.n} values "
                              f"or a state name, got {v}")
         return v
@@ -258,13 +263,8 @@ class Linearization:
 
 
 # ------------------------------------------------------------------------ building
-def _check_model(model) -> Model:
-    if not isinstance(model, Model):
-        raise TypeError(f"`model` must be a dynamics.Model, got {type(model).__name__}")
-    return model
-
-
 def _check_point(model: Model, x, u, p):
+    # own messages (they name the state names); the quaternion tolerance is validate's
     try:
         x = np.array(x, dtype=float).reshape(-1)
     except (TypeError, ValueError):
@@ -281,7 +281,7 @@ def _check_point(model: Model, x, u, p):
     if model.attitude is not None:
         iq = model.attitude[0]
         nq = np.linalg.norm(x[iq:iq + 4])
-        if abs(nq - 1.0) > 1e-6:
+        if abs(nq - 1.0) > validate.QUAT_NORM_TOL:
             raise ValueError(f"`x` must hold a unit quaternion in {model.states[iq:iq + 4]}, "
                              f"got norm {nq:.9g}")
         x[iq:iq + 4] /= nq
@@ -327,7 +327,7 @@ def error_dynamics(model: Model, q_ref, w_ref) -> ca.Function:
         ``dq = [dth/2, sqrt(1 - |dth|^2/4)]``), ``xrdot`` its exact time derivative at
         ``t = 0``: ``dth' = 2 vec(q' (x) q_ref* + q (x) q_ref'*)``.
     """
-    model = _check_model(model)
+    model = check_model(model)
     if model.attitude is None:
         raise ValueError(f"`model` {model.name!r} has no attitude (model.attitude is None)")
     xr = ca.SX.sym("xr", model.nx - 1)
@@ -338,22 +338,17 @@ def error_dynamics(model: Model, q_ref, w_ref) -> ca.Function:
     return ca.Function(f"{model.name}_error", [xr, u, p], [xrdot], ["xr", "u", "p"], ["xrdot"])
 
 
-_JACOBIANS: OrderedDict = OrderedDict()  # hash(model.f), attitude -> (Function, model.f)
-_JACOBIANS_LOCK = threading.Lock()
-_JACOBIANS_SIZE = 128
-
-
 def _jacobian_function(model: Model) -> ca.Function:
     """``(xr, u, p, q_ref, w_ref) -> (f, A, B)``, built once per model right-hand side.
 
     Without attitude ``xr`` is the state and ``q_ref``, ``w_ref`` are ignored. The cache
     entry keeps ``model.f`` alive, so its address cannot be reused while the entry exists.
     """
-    key = (hash(model.f), model.attitude)
-    with _JACOBIANS_LOCK:
-        if key in _JACOBIANS:
-            _JACOBIANS.move_to_end(key)
-            return _JACOBIANS[key][0]
+    key = ("linearization", cache.function_key(model.f), model.attitude)
+    return cache.get(key, lambda: _build_jacobian_function(model), keepalive=model.f)
+
+
+def _build_jacobian_function(model: Model) -> ca.Function:
     n = model.nx if model.attitude is None else model.nx - 1
     xr, u, p = ca.SX.sym("xr", n), ca.SX.sym("u", model.nu), ca.SX.sym("p", model.np)
     q_ref, w_ref = ca.SX.sym("q_ref", 4), ca.SX.sym("w_ref", 3)
@@ -364,10 +359,6 @@ def _jacobian_function(model: Model) -> ca.Function:
     fun = ca.Function("linearization", [xr, u, p, q_ref, w_ref],
                       [f, ca.jacobian(f, xr), ca.jacobian(f, u)],
                       ["xr", "u", "p", "q_ref", "w_ref"], ["f", "A", "B"])
-    with _JACOBIANS_LOCK:
-        _JACOBIANS[key] = (fun, model.f)
-        while len(_JACOBIANS) > _JACOBIANS_SIZE:
-            _JACOBIANS.popitem(last=False)
     return fun
 
 
@@ -427,7 +418,7 @@ def linearization(model: Model, x, u=None, p=None, *, frame: Frame = "spinning",
         ``x`` is not an equilibrium (the message lists the residual by state) or when a
         spinning reference makes the linearization depend on the spin phase.
     """
-    model = _check_model(model)
+    model = check_model(model)
     if frame not in FRAMES:
         raise ValueError(f"`frame` must be one of {FRAMES}, got {frame!r}")
     x, u, p = _check_point(model, x, u, p)

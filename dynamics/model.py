@@ -13,7 +13,7 @@ from typing import Mapping
 import casadi as ca
 import numpy as np
 
-__all__ = ["Model"]
+__all__ = ["Model", "check_model"]
 
 
 def _freeze(mapping: Mapping | None) -> Mapping:
@@ -190,3 +190,10 @@ class Model:
         if res.shape[0] == 1:
             res = res[0]
         return res[..., 0] if single else res
+
+
+def check_model(model, name: str = "model") -> Model:
+    """``model`` if it is a `Model`; a ``TypeError`` naming ``name`` otherwise."""
+    if not isinstance(model, Model):
+        raise TypeError(f"`{name}` must be a dynamics.Model, got {type(model).__name__}")
+    return model

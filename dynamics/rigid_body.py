@@ -1,4 +1,5 @@
-"""Rigid body with quaternion attitude (seed Sec. 4.2 Euler's law, Sec. 4.3 kinematics).
+"""Rigid body with quaternion attitude (Rheinfurth & Wilson, NASA RP-1262, Sec. 4.2 Euler's law,
+Sec. 4.3 kinematics).
 
 State ``x = [q1, q2, q3, q4, w1, w2, w3]``: scalar-last unit quaternion (inertial -> body) and
 body angular velocity [rad/s]. Control ``u = [L1, L2, L3]``: body-frame torque [N m] about the
@@ -7,68 +8,20 @@ mass center. Dynamics ``I wdot = u - w x (I w)`` with a full symmetric inertia m
 """
 from __future__ import annotations
 
-import functools
-
 import casadi as ca
 import numpy as np
 
+from . import cache
 from .attitude import dcm_from_quat, quat_rate
 from .model import Model
+from .validate import check_inertia  # re-exported: its old home
 
 __all__ = ["check_inertia", "rigid_body", "RIGID_BODY_STATES"]
 
 RIGID_BODY_STATES = ("q1", "q2", "q3", "q4", "w1", "w2", "w3")
 
 
-def check_inertia(inertia, *, name="inertia", triangle=True):
-    """Validate an inertia matrix and return it as a float array.
-
-    Parameters
-    ----------
-    inertia : array_like, shape (3, 3) or (3,) [kg m^2]
-        Full symmetric matrix, or the three principal moments (a diagonal matrix).
-    name : str
-        Argument name used in error messages.
-    triangle : bool
-        Also require the triangle inequality of the principal moments (seed Sec. 4.4 A),
-        ``I_i + I_j >= I_k``, which every physical body satisfies.
-
-    Returns
-    -------
-    ndarray, shape (3, 3)
-
-    Raises
-    ------
-    ValueError
-        Naming the argument and the violated requirement: shape, finiteness, symmetry,
-        positive definiteness (eigenvalues shown), triangle inequality (moments shown).
-    """
-    try:
-        a = np.array(inertia, dtype=float)
-    except (TypeError, ValueError) as exc:
-        raise ValueError(f"`{name}` must be a 3x3 matrix of numbers: {exc}") from None
-    if a.shape == (3,):
-        a = np.diag(a)
-    if a.shape != (3, 3):
-        raise ValueError(f"`{name}` must have shape (3, 3) or (3,), got {a.shape}")
-    if not np.all(np.isfinite(a)):
-        raise ValueError(f"`{name}` must be finite, got {a.tolist()}")
-    scale = np.max(np.abs(a))
-    if np.max(np.abs(a - a.T)) > 1e-12 * max(scale, 1e-300):
-        raise ValueError(f"`{name}` must be symmetric, got {a.tolist()}")
-    a = 0.5 * (a + a.T)
-    eig = np.linalg.eigvalsh(a)
-    if eig[0] <= 0:
-        raise ValueError(f"`{name}` must be symmetric positive definite, got eigenvalues {tuple(eig)}")
-    if triangle and eig[0] + eig[1] < eig[2] * (1 - 1e-12):
-        raise ValueError(
-            f"`{name}` violates the triangle inequality I1 + I2 >= I3 of rigid-body principal "
-            f"moments (seed Sec. 4.4 A): principal moments {tuple(eig)}"
-        )
-    return a
-
-
-@functools.lru_cache(maxsize=64)
+@cache.memoize
 def _rigid_body(inertia_key: tuple) -> Model:
     inertia = np.array(inertia_key).reshape(3, 3)
     inv = np.linalg.inv(inertia)
@@ -111,7 +64,7 @@ def rigid_body(inertia) -> Model:
     ----------
     inertia : array_like, shape (3, 3) or (3,) [kg m^2]
         Inertia matrix about the mass center in body axes (full symmetric; products of
-        inertia with the seed's sign, ``Ixy = -sum m x y``), or principal moments.
+        inertia with the sign of [1]_, Eq. 4.16, ``Ixy = -sum m x y``), or principal moments.
 
     Returns
     -------
@@ -126,6 +79,11 @@ def rigid_body(inertia) -> Model:
     ValueError
         If ``inertia`` has the wrong shape, is not finite, not symmetric, not positive definite,
         or violates the triangle inequality (see `check_inertia`).
+
+    References
+    ----------
+    .. [1] Rheinfurth & Wilson, NASA RP-1262, Sec. 4.2 (Euler's law), Eq. 4.16 (products
+       of inertia), Eq. 4.70 (kinematics).
     """
     a = check_inertia(inertia)
     return _rigid_body(tuple(a.reshape(-1).tolist()))

@@ -1,14 +1,15 @@
-"""Spinning-vehicle models for stability studies (seed Secs. 4.5-4.6).
+"""Spinning-vehicle models for stability studies (Rheinfurth & Wilson, NASA RP-1262,
+Secs. 4.5-4.6).
 
 * `tilt_torque_body` — a rigid body with a torque that depends only on the tilt of a body
-  axis from an inertially fixed direction (seed Sec. 4.6 Method III): the heavy top
+  axis from an inertially fixed direction (Sec. 4.6 Method III): the heavy top
   (``overturning = m g l``), the spinning projectile (``q S C_N_alpha l``), a rotor in
   elastic bearings (``-2 k l^2``), with an optional *internal* (rotating) damping.
 * `gyrostat_model` — a rigid body carrying a wheel of constant relative speed (dual spin)
   and, optionally, an energy damper: a spring-mass point mass sliding along a body line
   (`PointMassDamper`) or a viscously coupled spherical core (`SphericalDamper`), mounted
   on the platform or (spherical only) on the rotor. With zero wheel momentum it is a
-  rigid body with a nutation damper (Kelvin-Tait-Chetaev, seed Sec. 4.5 NOTE).
+  rigid body with a nutation damper (Kelvin-Tait-Chetaev, Sec. 4.5 NOTE).
 
 All models have the state ``[q1, q2, q3, q4, w1, w2, w3, ...]`` (scalar-last quaternion,
 inertial -> body, and body rates [rad/s]), ``attitude = (0, 4)``, and external body torques
@@ -17,16 +18,17 @@ them against conservation laws (energy, inertial angular momentum) and closed fo
 """
 from __future__ import annotations
 
-import functools
 import math
 from dataclasses import dataclass
 
 import casadi as ca
 import numpy as np
 
+from . import cache, validate
 from .attitude import dcm_from_quat, quat_rate
 from .model import Model
-from .rigid_body import RIGID_BODY_STATES, check_inertia
+from .rigid_body import RIGID_BODY_STATES
+from .validate import check_inertia
 
 __all__ = ["PointMassDamper", "SphericalDamper", "tilt_torque_body", "gyrostat_model",
            "steady_spin_state", "point_mass_offset", "unit_vector"]
@@ -37,24 +39,21 @@ _BASE_UNITS = {**{k: "-" for k in RIGID_BODY_STATES[:4]},
 
 
 def unit_vector(v, name: str) -> np.ndarray:
-    """A finite non-zero 3-vector scaled to unit length; ``ValueError`` naming ``name``."""
+    """`validate.unit_vector` of a 3-vector, with the one message the stability reports show:
+    "`name` must be a finite non-zero 3-vector" for a wrong shape, a non-finite or a zero
+    vector (a `validate.ArgumentTypeError` when ``v`` holds no numbers)."""
     try:
-        a = np.array(v, dtype=float).reshape(-1)
-    except (TypeError, ValueError):
-        raise ValueError(f"`{name}` must be 3 numbers, got {v!r}") from None
-    n = np.linalg.norm(a) if a.size == 3 and np.all(np.isfinite(a)) else 0.0
-    if a.size != 3 or not np.isfinite(n) or n == 0:
-        raise ValueError(f"`{name}` must be a finite non-zero 3-vector, got {a.tolist()}")
-    return a / n
+        return validate.unit_vector(v, name)
+    except ValueError as exc:
+        raise type(exc)(f"`{name}` must be a finite non-zero 3-vector, got {v!r}") from None
 
 
 def _finite(value, name, *, positive=False, nonnegative=False, allow_inf=False) -> float:
-    try:
-        v = float(value)
-    except (TypeError, ValueError):
-        raise ValueError(f"`{name}` must be a number, got {value!r}") from None
-    if math.isnan(v) or (math.isinf(v) and not (allow_inf and v > 0)):
-        raise ValueError(f"`{name}` must be finite, got {v}")
+    """A real number (`validate.finite_scalar`), optionally positive or non-negative;
+    ``allow_inf`` also accepts ``+inf`` (an infinitely heavy body)."""
+    if allow_inf and isinstance(value, (int, float, np.floating)) and value == math.inf:
+        return math.inf
+    v = validate.finite_scalar(value, name)
     if positive and not v > 0:
         raise ValueError(f"`{name}` must be positive, got {v}")
     if nonnegative and v < 0:
@@ -69,9 +68,12 @@ class PointMassDamper:
 
     Parameters
     ----------
-    mass : float [kg] — the moving mass ``m > 0``
-    stiffness : float [N/m] — spring ``k > 0`` (force ``-k s``)
-    damping : float [N s/m] — dashpot ``c >= 0`` (force ``-c s'``)
+    mass : float [kg]
+        The moving mass ``m > 0``
+    stiffness : float [N/m]
+        Spring ``k > 0`` (force ``-k s``)
+    damping : float [N s/m]
+        Dashpot ``c >= 0`` (force ``-c s'``)
     position : array_like, shape (3,) [m]
         Body-frame position of the mass at ``s = 0`` (spring relaxed) relative to the mass
         center of the rigid body that carries it.
@@ -133,8 +135,10 @@ class SphericalDamper:
 
     Parameters
     ----------
-    inertia : float [kg m^2] — ``J_d > 0``
-    damping : float [N m s] — ``c >= 0``
+    inertia : float [kg m^2]
+        ``J_d > 0``
+    damping : float [N m s]
+        ``c >= 0``
     """
 
     inertia: float
@@ -147,7 +151,7 @@ class SphericalDamper:
 
 
 # -------------------------------------------------------------------- tilt torque
-@functools.lru_cache(maxsize=256)
+@cache.memoize
 def _tilt_torque_body(inertia_key, axis_key, direction_key, overturning, damping) -> Model:
     inertia = np.array(inertia_key).reshape(3, 3)
     a = ca.DM(axis_key)
@@ -178,7 +182,7 @@ def _tilt_torque_body(inertia_key, axis_key, direction_key, overturning, damping
 
 def tilt_torque_body(inertia, overturning, *, axis=(1.0, 0.0, 0.0), direction=(1.0, 0.0, 0.0),
                      internal_damping: float = 0.0) -> Model:
-    """Rigid body about a fixed point with a tilt-dependent torque (seed Sec. 4.6 Method III).
+    """Rigid body about a fixed point with a tilt-dependent torque ([1]_, Method III).
 
     With ``a`` the body axis, ``n = A(q) d`` the inertially fixed unit direction ``d`` in body
     axes and ``tau = a x n`` the tilt vector, the torque about the fixed point is
@@ -187,7 +191,7 @@ def tilt_torque_body(inertia, overturning, *, axis=(1.0, 0.0, 0.0), direction=(1
 
     * ``-kappa a x n`` derives from the potential ``V = kappa (a . n)``: for the heavy top
       (``a`` from the pivot to the mass center at distance ``l``, ``d`` pointing up,
-      gravity ``-m g d``) ``L = l a x (-m g n)``, so ``kappa = m g l``; seed Example 1 gives
+      gravity ``-m g d``) ``L = l a x (-m g n)``, so ``kappa = m g l``; Example 1 of [1]_ gives
       the same ``L = m g l (theta e2 + psi e3)`` to first order. The spinning projectile has
       ``kappa = q S C_N_alpha l`` (Example 2); a rotor in bearings of stiffness ``k`` at
       ``+/- l``, ``V = -2 k l^2 cos(tilt)``, has ``kappa = -2 k l^2`` (Example 3).
@@ -206,9 +210,12 @@ def tilt_torque_body(inertia, overturning, *, axis=(1.0, 0.0, 0.0), direction=(1
     overturning : float [N m]
         ``kappa``: positive tips the axis away from ``d`` (heavy top, projectile), negative
         restores it (rotor bearings).
-    axis : array_like, shape (3,), optional — body axis ``a`` (normalized; default e1)
-    direction : array_like, shape (3,), optional — inertial direction ``d`` (default x)
-    internal_damping : float [N m s], optional — ``D >= 0``
+    axis : array_like, shape (3,), optional
+        Body axis ``a`` (normalized; default e1)
+    direction : array_like, shape (3,), optional
+        Inertial direction ``d`` (default x)
+    internal_damping : float [N m s], optional
+        ``D >= 0``
 
     Returns
     -------
@@ -222,6 +229,10 @@ def tilt_torque_body(inertia, overturning, *, axis=(1.0, 0.0, 0.0), direction=(1
     ValueError
         Naming the argument: bad ``inertia`` (see `check_inertia`), non-finite
         ``overturning``, zero ``axis``/``direction``, negative ``internal_damping``.
+
+    References
+    ----------
+    .. [1] Rheinfurth & Wilson, NASA RP-1262, Sec. 4.6, Method III and its Example 1.
     """
     I = check_inertia(inertia)
     kappa = _finite(overturning, "overturning")
@@ -233,7 +244,7 @@ def tilt_torque_body(inertia, overturning, *, axis=(1.0, 0.0, 0.0), direction=(1
 
 
 # ------------------------------------------------------------------------ gyrostat
-@functools.lru_cache(maxsize=256)
+@cache.memoize
 def _gyrostat(inertia_key, wheel_axis, wheel_momentum, damper, damper_on, wheel_rate) -> Model:
     I = ca.DM(np.array(inertia_key).reshape(3, 3))
     aw = ca.DM(wheel_axis)
@@ -335,10 +346,13 @@ def gyrostat_model(inertia, *, wheel_axis=(1.0, 0.0, 0.0), wheel_momentum: float
     inertia : array_like, shape (3, 3) or (3,) [kg m^2]
         Rigid part about its mass center (wheel locked; without the point mass and without
         the spherical core's own rotational inertia ``J_d``).
-    wheel_axis : array_like, shape (3,), optional — ``a`` (normalized; default e1)
-    wheel_momentum : float [N m s], optional — ``h``, relative to the platform (0: no wheel)
+    wheel_axis : array_like, shape (3,), optional
+        ``a`` (normalized; default e1)
+    wheel_momentum : float [N m s], optional
+        ``h``, relative to the platform (0: no wheel)
     damper : PointMassDamper or SphericalDamper, optional
-    damper_on : {'platform', 'rotor'} — where the damper is mounted (rotor: spherical only)
+    damper_on : {'platform', 'rotor'}
+        Where the damper is mounted (rotor: spherical only)
     wheel_rate : float [rad/s], optional
         Wheel speed relative to the platform; used only for a damper on the rotor.
 

@@ -1,10 +1,11 @@
 """Closed-form truth models of torque-free rigid-body rotation (numpy/scipy only).
 
 These functions are *independent references* for the tests and benchmarks of the simulation
-code: they use no integrator and none of appdyn's model code, only closed forms (seed 002,
+code: they use no integrator and none of appdyn's model code, only closed forms (Rheinfurth & Wilson, NASA RP-1262,
 Sec. 4.5; Landau & Lifshitz, Mechanics, Sec. 37). Even the quaternion product and the
 direction cosine matrix they need are written out here rather than imported from
-``dynamics.attitude``, so that a bug there cannot hide itself.
+``dynamics.attitude``, so that a bug there cannot hide itself. (Only the input checks are
+shared: `dynamics.validate`.)
 
 Conventions (the project's):
 
@@ -28,6 +29,8 @@ from typing import NamedTuple
 import numpy as np
 from scipy.special import elliprf, ellipkm1
 
+from . import validate
+
 __all__ = [
     "TorqueFreeParameters",
     "torque_free_parameters",
@@ -44,100 +47,43 @@ __all__ = [
     "symmetric_precession",
 ]
 
-# Relative tolerance of the triangle inequality (same as dynamics.rigid_body.check_inertia)
+# Relative tolerance of the triangle inequality (same as dynamics.validate.check_inertia)
 # and of "equal moments" in `axisymmetric`.
 _TRIANGLE_RTOL = 1e-12
 _EQUAL_RTOL = 1e-12
-# A quaternion argument may deviate this much from unit norm before it is refused.
-_UNIT_QUAT_TOL = 1e-6
 # Rate components below this fraction of the largest are flushed to zero (see below).
 _FLUSH = 1e-140
 
 
 # ------------------------------------------------------------------ input validation
 def _moments(inertia_diag, name="inertia_diag"):
-    try:
-        a = np.array(inertia_diag, dtype=float)
-    except (TypeError, ValueError) as exc:
-        raise ValueError(f"`{name}` must be three principal moments (numbers): {exc}") from None
-    if a.shape != (3,):
-        raise ValueError(f"`{name}` must have shape (3,) (principal moments), got {a.shape}")
-    if not np.all(np.isfinite(a)):
-        raise ValueError(f"`{name}` must be finite, got {a.tolist()}")
+    """Three positive principal moments that satisfy the triangle inequality."""
+    a = validate.finite_array(inertia_diag, name, (3,))
     if np.any(a <= 0):
         raise ValueError(f"`{name}` must be positive principal moments, got {a.tolist()}")
     s = np.sort(a)
     if s[0] + s[1] < s[2] * (1 - _TRIANGLE_RTOL):
         raise ValueError(
             f"`{name}` violates the triangle inequality I_i + I_j >= I_k of principal "
-            f"moments (seed Sec. 4.4 A), got {a.tolist()}"
+            f"moments (Rheinfurth & Wilson, NASA RP-1262, Sec. 4.4 A), got {a.tolist()}"
         )
     return a
 
 
-def _vector(x, n, name):
-    try:
-        a = np.array(x, dtype=float)
-    except (TypeError, ValueError) as exc:
-        raise ValueError(f"`{name}` must be a vector of {n} numbers: {exc}") from None
-    if a.shape != (n,):
-        raise ValueError(f"`{name}` must have shape ({n},), got {a.shape}")
-    if not np.all(np.isfinite(a)):
-        raise ValueError(f"`{name}` must be finite, got {a.tolist()}")
-    return a
-
-
 def _rates(w, name="w"):
-    try:
-        a = np.array(w, dtype=float)
-    except (TypeError, ValueError) as exc:
-        raise ValueError(f"`{name}` must be body rates (numbers): {exc}") from None
-    if a.ndim not in (1, 2) or a.shape[0] != 3:
+    """Body rates, shape (3,) or (3, n)."""
+    a = validate.finite_array(w, name, (3,), batch=True)
+    if a.ndim > 2:
         raise ValueError(f"`{name}` must have shape (3,) or (3, n), got {a.shape}")
-    if not np.all(np.isfinite(a)):
-        raise ValueError(f"`{name}` must be finite")
     return a
 
 
 def _times(t, name="t"):
-    try:
-        a = np.array(t, dtype=float)
-    except (TypeError, ValueError) as exc:
-        raise ValueError(f"`{name}` must be a time or 1-D array of times [s]: {exc}") from None
+    """A time or a 1-D array of times, as a 1-D array."""
+    a = validate.finite_array(t, name)
     if a.ndim > 1:
         raise ValueError(f"`{name}` must be a scalar or 1-D array of times, got shape {a.shape}")
-    a = np.atleast_1d(a)
-    if not np.all(np.isfinite(a)):
-        raise ValueError(f"`{name}` must be finite")
-    return a
-
-
-def _scalar(x, name):
-    try:
-        a = np.array(x, dtype=float)
-    except (TypeError, ValueError) as exc:
-        raise ValueError(f"`{name}` must be a real number: {exc}") from None
-    if a.shape != ():
-        raise ValueError(f"`{name}` must be a scalar, got shape {a.shape}")
-    if not np.isfinite(a):
-        raise ValueError(f"`{name}` must be finite, got {float(a)}")
-    return float(a)
-
-
-def _unit_quat(q, name="q0"):
-    a = _vector(q, 4, name)
-    norm = np.linalg.norm(a)
-    if abs(norm - 1.0) > _UNIT_QUAT_TOL:
-        raise ValueError(f"`{name}` must be a unit quaternion, got norm {norm!r}")
-    return a / norm
-
-
-def _axis_index(axis, name="axis"):
-    if isinstance(axis, (bool, np.bool_)) or not isinstance(axis, (int, np.integer)):
-        raise ValueError(f"`{name}` must be an axis index 0, 1 or 2, got {axis!r}")
-    if not 0 <= int(axis) <= 2:
-        raise ValueError(f"`{name}` must be an axis index 0, 1 or 2, got {axis!r}")
-    return int(axis)
+    return np.atleast_1d(a)
 
 
 # --------------------------------------------------- private quaternion / DCM kernels
@@ -397,7 +343,7 @@ def torque_free_parameters(inertia_diag, w0):
     first branch, prolate ones (``I2 == I3``) the second.
     """
     inertia = _moments(inertia_diag)
-    w0 = _vector(w0, 3, "w0")
+    w0 = validate.finite_array(w0, "w0", (3,))
     if not np.any(w0):
         return TorqueFreeParameters(
             "steady", None, 0.0, 0.0, 1.0, 0.0, w0.copy(), ("dn", "dn", "dn"), float("nan"),
@@ -507,7 +453,7 @@ def _symmetry_axis(inertia, axis):
                 f"got {inertia.tolist()}"
             )
         return candidates[0]
-    a = _axis_index(axis)
+    a = validate.one_of(axis, "axis", (0, 1, 2))
     if not equal((a + 1) % 3, (a + 2) % 3):
         raise ValueError(
             f"`inertia_diag` must have equal transverse moments for symmetry `axis` {a}, "
@@ -564,8 +510,8 @@ def axisymmetric(inertia_diag, w0, q0, t, *, axis=None):
     """
     inertia = _moments(inertia_diag)
     a = _symmetry_axis(inertia, axis)
-    w0 = _vector(w0, 3, "w0")
-    q0 = _unit_quat(q0, "q0")
+    w0 = validate.finite_array(w0, "w0", (3,))
+    q0 = validate.unit_quaternion(q0, "q0")
     t = _times(t)
     i_ax = inertia[a]
     i_tr = 0.5 * (inertia[(a + 1) % 3] + inertia[(a + 2) % 3])
@@ -614,8 +560,8 @@ def constant_rate_quat(q0, w, t):
     ``A' = -[w x] A`` with constant ``w`` gives ``A(t) = exp(-[w x] t) A0
     = Rot(e, |w| t)^T A0 = A(q_rot) A(q0)``.
     """
-    q0 = _unit_quat(q0, "q0")
-    w = _vector(w, 3, "w")
+    q0 = validate.unit_quaternion(q0, "q0")
+    w = validate.finite_array(w, "w", (3,))
     t = _times(t)
     rate = float(np.linalg.norm(w))
     if rate == 0.0:
@@ -642,7 +588,7 @@ class ConeAngles(NamedTuple):
 
 
 def cone_angles(inertia_diag, w0):
-    """Nutation limits of a torque-free body (Poinsot construction, seed Sec. 4.5 A).
+    """Nutation limits of a torque-free body (Poinsot construction) [1]_.
 
     Parameters
     ----------
@@ -667,9 +613,13 @@ def cone_angles(inertia_diag, w0):
     ValueError
         Naming ``inertia_diag`` (bad moments, or a sphere, where ``H`` keeps its body
         direction and no axis is singled out) or ``w0`` (bad, or zero).
+
+    References
+    ----------
+    .. [1] Rheinfurth & Wilson, NASA RP-1262, Sec. 4.5 A.
     """
     inertia = _moments(inertia_diag)
-    w0 = _vector(w0, 3, "w0")
+    w0 = validate.finite_array(w0, "w0", (3,))
     if not np.any(w0):
         raise ValueError("`w0` must be non-zero for cone angles (H = 0 has no direction)")
     if inertia.max() == inertia.min():
@@ -693,7 +643,7 @@ def cone_angles(inertia_diag, w0):
 
 
 def small_asymmetry_rates(inertia_diag, spin_rate, *, axis=0):
-    """Coefficients of the linearized motion about a steady spin (seed Sec. 4.5 C).
+    """Coefficients of the linearized motion about a steady spin [1]_.
 
     With spin axis ``a`` and the other axes ``b, c`` in cyclic order (``a, b, c`` =
     ``0, 1, 2``; ``1, 2, 0``; ``2, 0, 1``), Euler's equations linearized about
@@ -706,7 +656,7 @@ def small_asymmetry_rates(inertia_diag, spin_rate, *, axis=0):
     spin_rate : float [rad/s]
         Nominal spin ``w0`` about ``axis``.
     axis : int, optional
-        Spin axis index, default 0 (the seed's axis 1).
+        Spin axis index, default 0 (axis 1 of [1]_).
 
     Returns
     -------
@@ -717,10 +667,14 @@ def small_asymmetry_rates(inertia_diag, spin_rate, *, axis=0):
     ------
     ValueError
         Naming ``inertia_diag``, ``spin_rate`` or ``axis``.
+
+    References
+    ----------
+    .. [1] Rheinfurth & Wilson, NASA RP-1262, Sec. 4.5 C.
     """
     inertia = _moments(inertia_diag)
-    w0 = _scalar(spin_rate, "spin_rate")
-    a = _axis_index(axis)
+    w0 = validate.finite_scalar(spin_rate, "spin_rate")
+    a = validate.one_of(axis, "axis", (0, 1, 2))
     b, c = (a + 1) % 3, (a + 2) % 3
     return (inertia[a] - inertia[c]) / inertia[b] * w0, (inertia[a] - inertia[b]) / inertia[c] * w0
 
@@ -729,7 +683,7 @@ def small_asymmetry_frequency(inertia_diag, spin_rate, *, axis=0):
     """Nutation frequency ``sqrt(lambda1 lambda2)`` of a spin about a major or minor axis.
 
     It is the limit of the exact elliptic rate ``lam`` as the nutation goes to zero
-    (seed Sec. 4.5 C). See :func:`small_asymmetry_rates` for the parameters.
+    [1]_. See :func:`small_asymmetry_rates` for the parameters.
 
     Returns
     -------
@@ -742,6 +696,10 @@ def small_asymmetry_frequency(inertia_diag, spin_rate, *, axis=0):
         Naming ``axis`` if it is the intermediate axis (``lambda1 lambda2 < 0``: the
         linearized motion grows like ``exp(sqrt(-lambda1 lambda2) t)``), or the arguments
         as in :func:`small_asymmetry_rates`.
+
+    References
+    ----------
+    .. [1] Rheinfurth & Wilson, NASA RP-1262, Sec. 4.5 C.
     """
     lam1, lam2 = small_asymmetry_rates(inertia_diag, spin_rate, axis=axis)
     prod = lam1 * lam2
@@ -760,7 +718,7 @@ class SymmetricPrecession(NamedTuple):
     ----------
     omega_p : float [rad/s]
         Inertial precession rate ``|H| / I_t`` of the symmetry axis about ``H``; for small
-        nutation ``~ I_a / I_t * n = n + lam`` (seed Sec. 4.5 C note).
+        nutation ``~ I_a / I_t * n = n + lam`` (Rheinfurth & Wilson, NASA RP-1262, Sec. 4.5 C, note).
     lam : float [rad/s]
         Body-frame rate ``(I_a - I_t) / I_t * n`` at which the transverse rate turns about the
         symmetry axis (positive: counter-clockwise about ``+e``).
@@ -799,7 +757,7 @@ def symmetric_precession(inertia_diag, w0, *, axis=None):
     """
     inertia = _moments(inertia_diag)
     a = _symmetry_axis(inertia, axis)
-    w0 = _vector(w0, 3, "w0")
+    w0 = validate.finite_array(w0, "w0", (3,))
     i_ax = inertia[a]
     i_tr = 0.5 * (inertia[(a + 1) % 3] + inertia[(a + 2) % 3])
     n = w0[a]

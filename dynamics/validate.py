@@ -23,6 +23,7 @@ import casadi as ca
 import numpy as np
 
 __all__ = [
+    "ArgumentTypeError",
     "QUAT_NORM_TOL",
     "DCM_ORTHO_TOL",
     "is_symbolic",
@@ -33,6 +34,8 @@ __all__ = [
     "unit_quaternions",
     "rotation_matrix",
     "one_of",
+    "integer",
+    "check_inertia",
 ]
 
 #: How far a quaternion argument may deviate from unit norm before it is refused.
@@ -40,6 +43,17 @@ QUAT_NORM_TOL = 1e-6
 
 #: Largest accepted ``max |A A^T - E|`` of a rotation-matrix argument.
 DCM_ORTHO_TOL = 1e-6
+
+
+
+class ArgumentTypeError(TypeError, ValueError):
+    """A wrong kind of argument (a string, ``None``, a symbol where numbers are needed).
+
+    A ``TypeError``, as the convention asks; also a ``ValueError``, so that code written when
+    appdyn raised ``ValueError`` for every bad input (``except ValueError`` in a CLI, tests)
+    still catches it -- the way numpy's ``AxisError`` is both a ``ValueError`` and an
+    ``IndexError``.
+    """
 
 
 # ------------------------------------------------------------------------- helpers
@@ -62,7 +76,8 @@ def _real_array(x, name: str) -> np.ndarray:
     if type(x) is np.ndarray and x.dtype == np.float64:  # fast path: the common case
         return x
     if is_symbolic(x):
-        raise TypeError(f"`{name}` must be numeric here, got a symbolic CasADi {type(x).__name__}")
+        raise ArgumentTypeError(
+            f"`{name}` must be numeric here, got a symbolic CasADi {type(x).__name__}")
     if isinstance(x, ca.DM):
         a = x.full()
         return a.ravel() if a.shape[1] == 1 else a
@@ -81,7 +96,7 @@ def _real_array(x, name: str) -> np.ndarray:
             pass
     what = {"b": "booleans", "c": "complex numbers", "U": "a string", "S": "bytes"}.get(
         kind, type(x).__name__)
-    raise TypeError(f"`{name}` must be real numbers, got {what}: {_short(x)}")
+    raise ArgumentTypeError(f"`{name}` must be real numbers, got {what}: {_short(x)}")
 
 
 def _short(x, limit: int = 80) -> str:
@@ -429,7 +444,93 @@ def one_of(value, name: str, choices: tuple):
     else:
         ok = any(type(value) is type(c) for c in choices)
     if not ok:
-        raise TypeError(f"`{name}` must be {text}, got {type(value).__name__} {_short(value)}")
+        raise ArgumentTypeError(
+            f"`{name}` must be {text}, got {type(value).__name__} {_short(value)}")
     if value not in choices:
         raise ValueError(f"`{name}` must be {text}, got {_short(value)}")
     return value
+
+
+def integer(value, name: str, *, minimum: int | None = None) -> int:
+    """Check an integer count (steps, a run budget, an index), optionally ``>= minimum``.
+
+    Parameters
+    ----------
+    value : int
+        A Python or numpy integer (``bool`` is refused).
+    name : str
+        Argument name used in the error message.
+    minimum : int, optional
+        Least accepted value.
+
+    Returns
+    -------
+    int
+
+    Raises
+    ------
+    TypeError
+        If ``value`` is not a number (a string, ``None``, a ``bool``, an array).
+    ValueError
+        If it is a number but not an integer (``2.5``, ``3.0``), or below ``minimum``.
+    """
+    bound = "" if minimum is None else f" >= {minimum}"
+    number = isinstance(value, (int, np.integer, float, np.floating))
+    if isinstance(value, (bool, np.bool_)) or not number:
+        raise ArgumentTypeError(
+            f"`{name}` must be an integer{bound}, got {type(value).__name__} {_short(value)}")
+    if not isinstance(value, (int, np.integer)) or (minimum is not None and value < minimum):
+        raise ValueError(f"`{name}` must be an integer{bound}, got {value!r}")
+    return int(value)
+
+
+def check_inertia(inertia, *, name="inertia", triangle=True):
+    """Validate an inertia matrix and return it as a float array.
+
+    Parameters
+    ----------
+    inertia : array_like, shape (3, 3) or (3,) [kg m^2]
+        Full symmetric matrix, or the three principal moments (a diagonal matrix).
+    name : str
+        Argument name used in error messages.
+    triangle : bool
+        Also require the triangle inequality of the principal moments, ``I_i + I_j >= I_k``
+        (Rheinfurth & Wilson, NASA RP-1262, Sec. 4.4 A), which every physical body satisfies.
+
+    Returns
+    -------
+    ndarray, shape (3, 3)
+
+    Raises
+    ------
+    ArgumentTypeError
+        (a ``TypeError`` and ``ValueError``) If ``inertia`` does not hold numbers.
+    ValueError
+        Naming the argument and the violated requirement: shape, finiteness, symmetry,
+        positive definiteness (eigenvalues shown), triangle inequality (moments shown).
+    """
+    try:
+        a = np.array(inertia, dtype=float)
+    except (TypeError, ValueError) as exc:
+        raise ArgumentTypeError(f"`{name}` must be a 3x3 matrix of numbers: {exc}") from None
+    if a.shape == (3,):
+        a = np.diag(a)
+    if a.shape != (3, 3):
+        raise ValueError(f"`{name}` must have shape (3, 3) or (3,), got {a.shape}")
+    if not np.all(np.isfinite(a)):
+        raise ValueError(f"`{name}` must be finite, got {a.tolist()}")
+    scale = np.max(np.abs(a))
+    if np.max(np.abs(a - a.T)) > 1e-12 * max(scale, 1e-300):
+        raise ValueError(f"`{name}` must be symmetric, got {a.tolist()}")
+    a = 0.5 * (a + a.T)
+    eig = np.linalg.eigvalsh(a)
+    if eig[0] <= 0:
+        raise ValueError(
+            f"`{name}` must be symmetric positive definite, got eigenvalues {tuple(eig)}")
+    if triangle and eig[0] + eig[1] < eig[2] * (1 - 1e-12):
+        raise ValueError(
+            f"`{name}` violates the triangle inequality I1 + I2 >= I3 of rigid-body principal "
+            f"moments (Rheinfurth & Wilson, NASA RP-1262, Sec. 4.4 A): principal moments "
+            f"{tuple(eig)}"
+        )
+    return a

@@ -273,7 +273,7 @@ def guess_from_simulation(problem, u, *, T=None, n=201, method="auto", rtol=1e-8
     ValueError
         If the initial state is not fully given or the simulation fails.
     """
-    from dynamics.simulate import simulate
+    from dynamics import simulate
 
     x0 = np.asarray(problem.x_initial, dtype=float)
     if np.any(np.isnan(x0)):

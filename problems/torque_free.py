@@ -20,7 +20,7 @@ import numpy as np
 from dynamics import rigid_body
 from dynamics.attitude import principal_axes
 from dynamics.rigid_body import check_inertia
-from dynamics.simulate import simulate
+from dynamics import simulate
 from dynamics.truth import torque_free_omega
 
 __all__ = ["TorqueFreeReport", "torque_free", "CHECK_FACTOR", "ROUNDOFF_FACTOR",

@@ -3,7 +3,6 @@
 Jacobi-elliptic torque-free solution, the constant-rate closed form, conservation laws)."""
 import functools
 import io
-import sys
 from contextlib import redirect_stdout
 
 import casadi as ca
@@ -12,11 +11,9 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from dynamics import Model, rigid_body
-from dynamics.simulate import simulate
+from dynamics import Model, cache, rigid_body, simulate
 from dynamics.truth import axisymmetric, constant_rate_quat, torque_free_omega
 
-SIM = sys.modules["dynamics.simulate"]
 X0 = np.array([0.0, 0.0, 0.0, 1.0, 1.0, 0.1, 0.8])
 
 
@@ -156,8 +153,8 @@ def test_one_compiled_chunk_serves_every_grid_and_step_count():
     model = rigid_body([1.0, 2.0, 3.0])
 
     def chunks():
-        return {k for k in SIM._CACHE._items
-                if k[0] == "chunk" and k[1] == SIM._fkey(model.f) and k[3] == "rk4"}
+        return {k for k in cache._CACHE._items
+                if k[0] == "chunk" and k[1] == cache.function_key(model.f) and k[3] == "rk4"}
 
     simulate(model, X0, np.linspace(0.0, 1.0, 11), method="rk4", steps=1)
     before = chunks()

@@ -234,3 +234,35 @@ def test_one_of():
             v.one_of(bad, "axis", (1, 2, 3))
     with pytest.raises(TypeError, match="`order` must be 'nearest' or 'ascending'"):
         v.one_of(0, "order", ("nearest", "ascending"))
+
+
+# ---------------------------------------------------------------------------- integer
+def test_integer():
+    assert v.integer(3, "steps") == 3 and type(v.integer(np.int64(3), "steps")) is int
+    assert v.integer(0, "index", minimum=0) == 0
+    with pytest.raises(ValueError, match="`steps` must be an integer >= 1, got 0"):
+        v.integer(0, "steps", minimum=1)
+    for bad in (2.5, 3.0, np.float64(2.0)):
+        with pytest.raises(ValueError, match="`steps` must be an integer"):
+            v.integer(bad, "steps")
+    for bad in ("3", None, True, [3]):
+        with pytest.raises(TypeError, match="`steps` must be an integer"):
+            v.integer(bad, "steps")
+
+
+# ---------------------------------------------------------------------- check_inertia
+def test_check_inertia_lives_here_and_in_rigid_body():
+    from dynamics.rigid_body import check_inertia
+
+    assert check_inertia is v.check_inertia
+    np.testing.assert_array_equal(v.check_inertia([1.0, 2.0, 2.5]), np.diag([1.0, 2.0, 2.5]))
+    with pytest.raises(ValueError, match="`J` violates the triangle inequality"):
+        v.check_inertia([1.0, 1.0, 3.0], name="J")
+    v.check_inertia([1.0, 1.0, 3.0], triangle=False)
+
+
+def test_wrong_kind_is_a_type_error_that_old_value_error_handlers_still_catch():
+    for call in (lambda: v.finite_scalar("x", "rate"), lambda: v.check_inertia("abc")):
+        with pytest.raises(TypeError) as info:
+            call()
+        assert isinstance(info.value, ValueError) and isinstance(info.value, v.ArgumentTypeError)

@@ -1,0 +1,221 @@
+"""The one cache of built and compiled CasADi Functions, and the jit policy.
+
+Building a CasADi Function (a model's right-hand side, a Runge-Kutta step, a chunked
+integration loop, a Jacobian) costs milliseconds; compiling one to C costs about 0.2-0.5 s.
+Every package keeps what it builds here, keyed by the arguments that define it, so that
+`dynamics.clear_caches` (and `clear`) can empty all of it in one place.
+
+API
+---
+``get(key, build, keepalive=None)``
+    The entry for ``key`` (any hashable; by convention a tuple whose first item names the
+    kind of entry, e.g. ``("chunk", function_key(f), ...)``), built by ``build()`` on a miss.
+    ``keepalive`` is held with the entry: pass the Function whose `function_key` is in
+    ``key`` so that its address cannot be reused by another Function while the entry lives.
+``contains(key)``
+    Whether ``key`` has an entry (does not count as a use).
+``clear()``
+    Drop every entry and delete the compiled (jit) files.
+``info()``
+    A `CacheInfo`: entries, maximum size, hits, misses, entries per kind, jit directory
+    and compiler.
+``function_key(f)``
+    The identity of a ``casadi.Function`` to put in a key.
+``memoize``
+    Decorator for factories of hashable arguments (e.g. ``rigid_body``'s model builder).
+``jit_options()``
+    casadi options that compile a Function to C, or ``None`` when no C compiler is found.
+
+Entries are evicted least-recently-used beyond `MAXSIZE`; every operation holds one
+re-entrant lock, so a ``build`` may itself call `get` (a loop built from a cached step).
+
+Jit policy
+----------
+Deterministic: whether a loop is compiled depends only on the arguments of the call (and on
+whether a C compiler -- ``gcc`` or ``cc`` on the ``PATH`` -- exists), never on how often a
+model was used before. `should_compile`:
+
+* ``jit=True``: compile; ``jit=False``: never.
+* ``jit=None`` (the default): compile when the run's work is at least `JIT_MIN_WORK`
+  right-hand-side evaluations. `dynamics.simulate` passes ``work=inf`` for the fixed-step
+  methods (``rk4``, ``rk8``, ``lie``: the caller asked for that loop, so it is compiled once
+  per model and method and reused for every grid and step count) and each run's own
+  ``steps x stages`` for the estimation runs of ``auto`` (a short run is cheaper
+  interpreted than compiled). A short ``auto`` run still uses a model's compiled rk8 chunk
+  when one exists already: the policy decides what is compiled, not what is reused.
+
+A Function that cannot be code-generated falls back to the interpreted one.
+"""
+from __future__ import annotations
+
+import functools
+import shutil
+import tempfile
+import threading
+import weakref
+from collections import Counter, OrderedDict
+from typing import Callable, Hashable, NamedTuple
+
+import casadi as ca
+
+__all__ = ["MAXSIZE", "JIT_MIN_WORK", "CacheInfo", "FunctionCache", "get", "contains", "clear",
+           "info", "function_key", "memoize", "jit_options", "should_compile"]
+
+#: Most entries kept (least recently used are dropped first).
+MAXSIZE = 512
+
+#: Right-hand-side evaluations from which a run is compiled under ``jit=None`` (interpreted,
+#: this many cost about the compile time of a small model).
+JIT_MIN_WORK = 500_000
+
+
+class CacheInfo(NamedTuple):
+    """What `info` reports."""
+
+    entries: int
+    maxsize: int
+    hits: int
+    misses: int
+    kinds: dict  # first item of the key (when a string) -> number of entries
+    jit_directory: str | None
+    compiler: str | None
+
+
+class FunctionCache:
+    """Built CasADi Functions keyed by their defining arguments (LRU, thread-safe).
+
+    One instance serves the process (the module-level functions); see the module docstring.
+    """
+
+    def __init__(self, maxsize: int = MAXSIZE):
+        self._maxsize = maxsize
+        self._items: OrderedDict = OrderedDict()
+        self._lock = threading.RLock()
+        self._hits = self._misses = 0
+        self._jit_dir: str | None = None
+        self._compiler: str | None = None
+        self._jit_opts: dict | None = None
+        self._jit_checked = False
+        self._finalizer = None
+
+    def get(self, key: Hashable, build: Callable[[], object], keepalive=None):
+        """Return the entry for ``key``, building it with ``build()`` on a miss."""
+        with self._lock:
+            if key in self._items:
+                self._hits += 1
+                self._items.move_to_end(key)
+                return self._items[key][0]
+            self._misses += 1
+            value = build()
+            self._items[key] = (value, keepalive)
+            while len(self._items) > self._maxsize:
+                self._items.popitem(last=False)
+            return value
+
+    def contains(self, key: Hashable) -> bool:
+        """Whether ``key`` has an entry."""
+        with self._lock:
+            return key in self._items
+
+    def clear(self) -> None:
+        """Drop every entry and delete the jit directory with its compiled files."""
+        with self._lock:
+            self._items.clear()
+            self._hits = self._misses = 0
+            if self._finalizer is not None:
+                self._finalizer()  # removes the directory now, and never again at exit
+            self._finalizer = None
+            self._jit_dir, self._jit_opts, self._jit_checked = None, None, False
+
+    def info(self) -> CacheInfo:
+        """Counts and jit location, for diagnostics."""
+        with self._lock:
+            kinds = Counter(k[0] for k in self._items
+                            if isinstance(k, tuple) and k and isinstance(k[0], str))
+            return CacheInfo(len(self._items), self._maxsize, self._hits, self._misses,
+                             dict(kinds), self._jit_dir, self._compiler)
+
+    def jit_options(self) -> dict | None:
+        """casadi jit options (a fresh dict), or None when no C compiler is on the PATH.
+
+        The compiled files go to a scratch directory made on first use and removed by
+        `clear` or at interpreter exit.
+        """
+        with self._lock:
+            if not self._jit_checked:
+                self._jit_checked = True
+                self._compiler = shutil.which("gcc") or shutil.which("cc")
+                if self._compiler is not None:
+                    self._jit_dir = tempfile.mkdtemp(prefix="appdyn-jit-")
+                    self._finalizer = weakref.finalize(self, _remove_jit_files, self._items,
+                                                       self._jit_dir)
+                    self._jit_opts = {
+                        "jit": True,
+                        "compiler": "shell",
+                        "jit_name": "appdyn_jit",
+                        "jit_options": {
+                            "flags": ["-O3", "-w"],
+                            "compiler": self._compiler,
+                            "linker": self._compiler,
+                            "directory": self._jit_dir + "/",
+                            "verbose": False,
+                        },
+                    }
+            if self._jit_opts is None:
+                return None
+            return {**self._jit_opts, "jit_options": dict(self._jit_opts["jit_options"])}
+
+
+def _remove_jit_files(items: dict, directory: str):
+    """Drop the Functions first (casadi deletes its own files), then the directory."""
+    items.clear()
+    shutil.rmtree(directory, ignore_errors=True)
+
+
+_CACHE = FunctionCache()
+
+get = _CACHE.get
+contains = _CACHE.contains
+clear = _CACHE.clear
+info = _CACHE.info
+jit_options = _CACHE.jit_options
+
+
+def function_key(f: ca.Function) -> int:
+    """Identity of a casadi Function (the address of its internal object), for cache keys.
+
+    Pass ``f`` as ``keepalive`` to `get` with any key that contains it.
+    """
+    return hash(f)
+
+
+def memoize(fun: Callable) -> Callable:
+    """Decorator: cache ``fun(*args)`` (hashable positional arguments) in the one cache."""
+    name = f"{fun.__module__}.{fun.__qualname__}"
+
+    @functools.wraps(fun)
+    def cached(*args):
+        return get((name,) + args, lambda: fun(*args))
+
+    return cached
+
+
+def should_compile(jit: bool | None, work: float) -> bool:
+    """The jit policy (module docstring): ``jit`` if given, else ``work >= JIT_MIN_WORK``.
+
+    Parameters
+    ----------
+    jit : bool or None
+        The caller's choice; ``None`` decides by ``work``.
+    work : float
+        Right-hand-side evaluations of the run (``inf`` to compile whenever possible).
+
+    Returns
+    -------
+    bool
+        Whether to ask for a compiled Function (`jit_options` may still say there is no
+        compiler).
+    """
+    if jit is not None:
+        return bool(jit)
+    return work >= JIT_MIN_WORK

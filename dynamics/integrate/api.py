@@ -1,0 +1,173 @@
+"""`simulate`: the public driver (checks the inputs, runs a method, builds the result)."""
+from __future__ import annotations
+
+import math
+import time
+from types import MappingProxyType
+from typing import Callable, Literal, Mapping
+
+import numpy as np
+
+from .. import cache, validate
+from ..model import Model, check_model
+from .auto import solve_auto
+from .cvodes import run_cvodes
+from .inputs import (Problem, check_cvodes_options, check_invariants, check_t, check_tolerances,
+                     check_u, check_x0)
+from .kernels import check_lie_model
+from .loops import Progress, run_fixed
+from .result import FAILED, OK, OK_STIFF, Dense, SimulationResult
+
+__all__ = ["simulate", "METHODS", "Method"]
+
+Method = Literal["auto", "cvodes", "rk4", "rk8", "lie"]
+METHODS = ("auto", "cvodes", "rk4", "rk8", "lie")
+_FIXED_STEP = ("rk4", "rk8", "lie")
+
+
+def simulate(model: Model, x0, t, *, u=None, p=None, method: Method = "auto",
+             rtol: float = 1e-8, atol=1e-10, invariants=False, steps: int | None = None,
+             jit: bool | None = None, max_steps: int = 100_000_000,
+             cvodes_options: Mapping | None = None,
+             progress: Callable[[int, int], None] | None = None) -> SimulationResult:
+    """Integrate ``xdot = f(x, u, p)`` of ``model`` from ``x0`` over the grid ``t``.
+
+    Parameters
+    ----------
+    model : Model
+        The dynamics (``model.f``: ``(x, u, p) -> xdot``).
+    x0 : array_like, shape (nx,)
+        State at ``t[0]``, in the model's units.
+    t : array_like, shape (n,) [s]
+        Output times, strictly increasing, ``n >= 2``. Fixed-step methods step exactly onto
+        every output time.
+    u : None, array_like (nu,) or (nu, n), or callable, optional
+        Control [model units]: ``None`` is zero; a constant; samples on ``t``, linear in time
+        between samples; or ``u(t) -> (nu,)`` for a float ``t`` [s], called at every stage
+        time (fixed step) or right-hand-side evaluation (cvodes).
+    p : array_like, shape (np,), optional
+        Parameters; the model's defaults when omitted.
+    method : {'auto', 'cvodes', 'rk4', 'rk8', 'lie'}
+        * ``'rk4'``, ``'rk8'`` (DOP853's 8th-order weights), ``'lie'`` (CF4 on the quaternion,
+          RK4 on the other states; needs ``model.attitude``): fixed step, ``steps`` steps per
+          output interval, run by one compiled chunk Function of 512 steps called in a
+          loop (the code and its compile time do not depend on the grid or step count).
+        * ``'cvodes'``: SUNDIALS CVODES (BDF by default) through ``casadi.integrator`` with
+          ``rtol``/``atol`` as its local tolerances (the smallest ``atol`` when a vector).
+        * ``'auto'``: ``rk8`` with the step count chosen from global error estimates so
+          that ``|error| <= atol + rtol |x|`` at every output time (Richardson estimates
+          from runs with different step counts, checked for 8th-order behaviour; see
+          `dynamics.integrate.auto`). A stiff problem (a decaying mode of the Jacobian at
+          ``x0`` faster than ``1e6`` explicit steps over the horizon can follow) goes to
+          cvodes, whose global error is then estimated from runs at tightened local
+          tolerances (``status`` 1). A tolerance that cannot be verified is ``success=False`` with
+          ``status`` 2 (round-off floor) or 3 (``max_steps``); never a silent fallback.
+    rtol : float, optional
+        Relative tolerance, ``100 eps <= rtol < 1`` (used by ``auto`` and ``cvodes``).
+    atol : float or array_like (nx,), optional
+        Absolute tolerance [state units], ``>= 0``.
+    invariants : bool or sequence of str, optional
+        Evaluate all (``True``) or the named ``model.invariants`` along the solution.
+    steps : int, optional
+        Fixed-step methods only: steps per output interval (default 1: the grid is the step).
+    jit : bool, optional
+        Compile the loops to C (``True``) or never (``False``). By default (``None``) the
+        rule depends only on the arguments (see `dynamics.cache`): the fixed-step methods
+        compile their loop whenever a C compiler (``gcc`` or ``cc``) is found, and each run
+        of ``auto`` is compiled when its work (steps x 12 stages) reaches
+        `dynamics.cache.JIT_MIN_WORK` (500 000 right-hand-side evaluations) and interpreted
+        below. Compiled loops are cached per model, method and control mode;
+        `dynamics.clear_caches` drops them.
+    max_steps : int, optional
+        ``auto``: most rk8 steps in one run (default 1e8); a tolerance that needs more is
+        reported as ``status`` 3, not attempted.
+    cvodes_options : mapping, optional
+        Extra options for ``casadi.integrator('cvodes')`` over casadi's defaults (BDF,
+        ``max_num_steps`` 10 000 per output interval), e.g.
+        ``{'linear_multistep_method': 'adams'}`` (about 2x fewer steps than BDF on a
+        non-stiff tumbling body).
+    progress : callable, optional
+        ``progress(done, total)`` is called after every chunk of 512 fixed steps with the
+        steps done and planned so far (``total`` grows when ``auto`` starts another run);
+        for a progress line on long runs. Not called by ``cvodes``.
+
+    Returns
+    -------
+    SimulationResult
+        ``t``, ``x (nx, n)``, ``success``, ``status``, ``message``, ``method``, ``wall_time``,
+        ``n_steps``, ``n_rhs``, ``substeps``, ``error_estimate``, ``compiled``,
+        ``invariants`` and ``sample(t)``.
+
+    Raises
+    ------
+    TypeError
+        If ``model`` is not a `Model`.
+    ValueError
+        Naming the argument: non-finite or wrongly shaped ``x0``, ``t`` not strictly
+        increasing or shorter than 2, ``u`` or ``p`` of the wrong shape (also a callable
+        ``u`` returning the wrong shape), an unknown ``method``, bad ``rtol``/``atol``,
+        ``steps`` with a method that does not take it, ``'lie'`` on a model without an
+        attitude, unknown ``invariants``, an attitude quaternion in ``x0`` whose norm is
+        not 1 to 1e-6, an unknown or ill-typed ``cvodes_options`` entry.
+        ``TypeError`` for ``cvodes_options`` that is not a mapping.
+
+    Notes
+    -----
+    A numerical failure (cvodes gives up, a fixed-step state becomes non-finite) returns
+    ``success=False`` with the reason; it never raises. An exception raised by a callable
+    ``u`` propagates.
+    """
+    start = time.perf_counter()
+    model = check_model(model)
+    if method not in METHODS:
+        raise ValueError(f"`method` must be one of {METHODS}, got {method!r}")
+    t = check_t(t)
+    x0 = check_x0(x0, model)
+    p = model.resolve_p(p)
+    rtol, atol = check_tolerances(rtol, atol, model.nx)
+    control = check_u(u, model.nu, t)
+    names = check_invariants(invariants, model)
+    max_steps = validate.integer(max_steps, "max_steps", minimum=1)
+    if jit not in (None, True, False):
+        raise ValueError(f"`jit` must be None, True or False, got {jit!r}")
+    if method in _FIXED_STEP:
+        steps = 1 if steps is None else validate.integer(steps, "steps", minimum=1)
+    elif steps is not None:
+        raise ValueError(f"`steps` applies to the fixed-step methods {_FIXED_STEP}, not {method!r}")
+    cvodes_options = check_cvodes_options(cvodes_options)
+    if method == "lie":
+        check_lie_model(model, x0, p)
+
+    if progress is not None and not callable(progress):
+        raise TypeError(f"`progress` must be None or a callable (done, total), "
+                        f"got {type(progress).__name__}")
+    counter = Progress(progress)
+    problem = Problem(model, x0, t, control, p)
+    used, status, estimate = method, OK, math.nan
+    if method in _FIXED_STEP:
+        run = run_fixed(problem, method, steps, cache.should_compile(jit, math.inf), counter)
+    elif method == "cvodes":
+        run = run_cvodes(problem, rtol, atol, cvodes_options)
+    else:
+        run, used, status, estimate = solve_auto(problem, rtol, atol, max_steps, jit,
+                                                 cvodes_options, counter)
+    x = run.x
+    x.setflags(write=False)
+    values = _invariants(model, x, p, names)
+    success = run.ok and status in (OK, OK_STIFF)
+    return SimulationResult(
+        t=t, x=x, success=success, status=status if run.ok else FAILED, message=run.message,
+        method=used, wall_time=time.perf_counter() - start, n_steps=run.n_steps, n_rhs=run.n_rhs,
+        substeps=run.substeps, error_estimate=estimate, compiled=run.compiled,
+        invariants=MappingProxyType(values),
+        _dense=Dense(model, p, lambda: control.grid(t)),
+    )
+
+
+def _invariants(model: Model, x: np.ndarray, p: np.ndarray, names) -> dict:
+    out = {}
+    for name in names:
+        value = np.asarray(model.invariant(name, x, p))
+        value.setflags(write=False)
+        out[name] = value
+    return out

@@ -1,0 +1,129 @@
+"""SUNDIALS CVODES through ``casadi.integrator``: one run on the grid, with a callable
+control through a ``casadi.Callback``; a failure returns the solution up to where it stopped."""
+from __future__ import annotations
+
+import casadi as ca
+import numpy as np
+
+from .. import cache
+from .inputs import Problem
+from .result import Run
+
+__all__ = ["run_cvodes"]
+
+
+class _ControlCallback(ca.Callback):
+    """``u(t)`` of a Python callable as a casadi Function of time, for cvodes."""
+
+    def __init__(self, fun, nu: int):
+        ca.Callback.__init__(self)
+        self._fun, self._nu = fun, nu
+        self.error: BaseException | None = None
+        self.construct("u_of_t", {})
+
+    def get_n_in(self):
+        return 1
+
+    def get_n_out(self):
+        return 1
+
+    def get_sparsity_in(self, i):
+        return ca.Sparsity.dense(1, 1)
+
+    def get_sparsity_out(self, i):
+        return ca.Sparsity.dense(self._nu, 1)
+
+    def eval(self, arg):
+        # After a user exception every call returns NaN: casadi reports a non-finite rhs to
+        # cvodes as a recoverable error, and errors at every time make it give up at once
+        # (failing only after the bad time, it would creep towards that time until
+        # max_num_steps). `run_cvodes` then re-raises the exception.
+        if self.error is None:
+            try:
+                return [ca.DM(self._fun(float(arg[0])))]
+            except Exception as exc:
+                self.error = exc
+        return [ca.DM.nan(self._nu, 1)]
+
+
+_CVODES_DEFAULTS = {"show_eval_warnings": False, "disable_internal_warnings": True}
+
+
+def _cvodes_integrator(model, mode, t, opts, callback=None):
+    nx, nu, np_ = model.nx, model.nu, model.np
+    if mode == "linear":
+        x, tau, p = ca.SX.sym("x", nx), ca.SX.sym("t"), ca.SX.sym("p", np_)
+        ua, ud, tk = ca.SX.sym("ua", nu), ca.SX.sym("ud", nu), ca.SX.sym("tk")
+        ode = model.f.call([x, ua + (tau - tk) * ud, p])[0]
+        uaug = ca.vertcat(ua, ud, tk)
+    else:
+        x, tau, p = ca.MX.sym("x", nx), ca.MX.sym("t"), ca.MX.sym("p", np_)
+        ode = model.f.call([x, callback(tau), p])[0]
+        uaug = None
+    dae = {"x": x, "t": tau, "p": p, "ode": ode}
+    if uaug is not None:
+        dae["u"] = uaug
+    return ca.integrator("simulate_cvodes", "cvodes", dae, float(t[0]), t[1:].tolist(), opts)
+
+
+def _cvodes_options(rtol, atol, extra) -> dict:
+    opts = dict(_CVODES_DEFAULTS)
+    opts.update({"reltol": rtol, "abstol": float(np.min(atol))})
+    opts.update(dict(extra or {}))
+    return opts
+
+
+def run_cvodes(problem: Problem, rtol, atol, extra) -> Run:
+    model, t, ctrl = problem.model, problem.t, problem.control
+    opts = _cvodes_options(rtol, atol, extra)
+    callback = None
+    if ctrl.mode == "linear":
+        key = ("cvodes", cache.function_key(model.f), t.tobytes(),
+               repr(sorted(opts.items(), key=str)))
+        integ = cache.get(key, lambda: _cvodes_integrator(model, "linear", t, opts),
+                          keepalive=model.f)
+    else:
+        callback = _ControlCallback(ctrl.fun, model.nu)
+        integ = _cvodes_integrator(model, "stages", t, opts, callback)
+    try:
+        out = _cvodes_call(integ, problem.x0, problem.p, ctrl.cvodes_input(t))
+    except RuntimeError as exc:
+        if callback is not None and callback.error is not None:
+            raise callback.error
+        stats = integ.stats()
+        reached = float(stats.get("tcur", t[0]))
+        x = _cvodes_prefix(problem, opts, reached, callback)
+        text = str(exc)
+        cut = text.find("CVode returned")
+        reason = text[cut:] if cut >= 0 else text.strip().splitlines()[-1]
+        return Run(x, int(stats.get("nsteps", 0)), int(stats.get("nfevals", 0)), 0, False, False,
+                   f"cvodes failed near t = {reached:.6g}: {reason}")
+    stats = integ.stats()
+    x = np.concatenate([problem.x0[:, None], out.T], axis=1)
+    return Run(x, int(stats["nsteps"]), int(stats["nfevals"]), 0, False, True,
+               f"cvodes: {int(stats['nsteps'])} steps (rtol {rtol:g}, atol {np.min(atol):g})")
+
+
+def _cvodes_call(integ, x0, p, uaug) -> np.ndarray:
+    """Run the integrator; (nint, nx) out. A plain call: buffers do not record SUNDIALS stats."""
+    res = integ(x0=x0, p=p, u=np.ascontiguousarray(uaug.T))
+    return np.asarray(res["xf"], dtype=float).reshape(x0.size, uaug.shape[0]).T
+
+
+def _cvodes_prefix(problem: Problem, opts, reached: float, callback) -> np.ndarray:
+    """After a failure: the solution on the grid points before ``reached`` (NaN after)."""
+    t = problem.t
+    x = np.full((problem.model.nx, t.size), np.nan)
+    x[:, 0] = problem.x0
+    k = int(np.searchsorted(t, reached, side="right"))  # t[:k] <= reached
+    if k < 2:
+        return x
+    control = problem.control.head(k - 1)
+    try:
+        integ = _cvodes_integrator(problem.model, control.mode, t[:k], opts, callback)
+        out = _cvodes_call(integ, problem.x0, problem.p, control.cvodes_input(t[:k]))
+    except RuntimeError:
+        return x
+    x[:, 1:k] = out.T
+    return x
+

@@ -1,0 +1,230 @@
+"""Normalisation of `simulate`'s inputs (``t``, ``x0``, ``u``, tolerances, options) into a
+`Problem`; every check raises naming the argument (``TypeError`` wrong type, ``ValueError``
+wrong value)."""
+from __future__ import annotations
+
+import contextlib
+import difflib
+import io
+import re
+from dataclasses import dataclass
+from typing import Callable, Mapping
+
+import casadi as ca
+import numpy as np
+
+from .. import cache
+from ..model import Model
+from ..validate import finite_array, finite_scalar, unit_quaternion
+
+__all__ = ["Control", "Problem", "check_t", "check_x0", "check_tolerances",
+           "check_u", "check_invariants", "check_cvodes_options"]
+
+_EPS = np.finfo(float).eps
+
+
+def check_t(t) -> np.ndarray:
+    """The output grid: 1-D, at least 2 finite times, strictly increasing (read-only copy)."""
+    t = np.array(finite_array(t, "t"), dtype=float)
+    if t.ndim != 1 or t.size < 2:
+        raise ValueError(f"`t` must be a 1-D grid of at least 2 times, got shape {t.shape}")
+    dt = t[1:] - t[:-1]
+    if not (dt > 0).all():
+        k = int(np.argmin(dt))
+        raise ValueError(
+            f"`t` must be strictly increasing, got t[{k}] = {t[k]} >= t[{k + 1}] = {t[k + 1]}"
+        )
+    t.setflags(write=False)
+    return t
+
+
+def check_x0(x0, model: Model) -> np.ndarray:
+    """The initial state, shape (nx,) (a copy); its attitude quaternion of unit norm."""
+    nx = model.nx
+    x = finite_array(x0, "x0")
+    if x.shape not in ((nx,), (nx, 1)):
+        raise ValueError(f"`x0` must have shape ({nx},), got {x.shape}")
+    x = np.array(x, dtype=float).reshape(nx)
+    if model.attitude is not None:
+        iq = model.attitude[0]
+        unit_quaternion(x[iq:iq + 4], f"x0[{iq}:{iq + 4}] (the attitude quaternion)")
+    return x
+
+
+def check_cvodes_options(options) -> dict:
+    """``cvodes_options`` as a dict, each key and value checked by building a one-state
+    cvodes integrator with them (cached): a ``ValueError`` names the bad option."""
+    if options is None:
+        return {}
+    if not isinstance(options, Mapping):
+        raise TypeError(f"`cvodes_options` must be a mapping, got {type(options).__name__}")
+    options = dict(options)
+    bad = [k for k in options if not isinstance(k, str)]
+    if bad:
+        raise TypeError(f"`cvodes_options` keys must be strings, got {bad[0]!r}")
+    key = ("cvodes-options", repr(sorted(options.items(), key=str)))
+    if not cache.contains(key):
+        cache.get(key, lambda: _try_cvodes_options(options))
+    return options
+
+
+def _try_cvodes_options(options: dict) -> bool:
+    x = ca.SX.sym("x")
+    try:
+        ca.integrator("check", "cvodes", {"x": x, "ode": -x}, 0.0, [1.0], options)
+    except RuntimeError as exc:
+        text = [line.strip() for line in str(exc).strip().splitlines() if line.strip()]
+        unknown = [k for k in options if k not in _cvodes_option_names()]
+        if unknown:
+            close = difflib.get_close_matches(unknown[0], _cvodes_option_names(), n=3)
+            hint = f"; did you mean {', '.join(map(repr, close))}?" if close else ""
+            raise ValueError(f"`cvodes_options` has an unknown option {unknown[0]!r}{hint} "
+                             "(see casadi's integrator documentation for 'cvodes')") from None
+        raise ValueError(f"`cvodes_options` has a bad value: {text[-1] if text else exc}") from None
+    return True
+
+
+@cache.memoize
+def _cvodes_option_names() -> frozenset:
+    """Names of the options casadi's cvodes integrator takes (parsed from print_options)."""
+    x = ca.SX.sym("x")
+    buf = io.StringIO()
+    with contextlib.redirect_stdout(buf):
+        ca.integrator("names", "cvodes", {"x": x, "ode": -x}, 0.0, [1.0], {}).print_options()
+    return frozenset(re.findall(r'^> "([^"]+)"', buf.getvalue(), flags=re.M))
+
+
+def check_tolerances(rtol, atol, nx: int) -> tuple[float, np.ndarray]:
+    """``rtol`` in ``[100 eps, 1)``; ``atol`` a scalar or (nx,), finite and >= 0 -> (nx,)."""
+    rtol_f = finite_scalar(rtol, "rtol")
+    if not 100 * _EPS <= rtol_f < 1:
+        raise ValueError(f"`rtol` must be in [{100 * _EPS:.3g}, 1), got {rtol!r}")
+    a = finite_array(atol, "atol")
+    if a.shape not in ((), (nx,)):
+        raise ValueError(f"`atol` must be a scalar or have shape ({nx},), got {a.shape}")
+    if not (a >= 0).all():
+        raise ValueError(f"`atol` must be non-negative, got {atol!r}")
+    a = np.full(nx, float(a)) if a.ndim == 0 else np.array(a, dtype=float)
+    return rtol_f, a
+
+
+@dataclass(frozen=True)
+class Control:
+    """The control input, normalized.
+
+    ``mode == "linear"``: ``ua[k], ub[k]`` (shape (nint, nu)) are the values at the start and
+    end of interval ``k``. ``mode == "stages"``: ``fun(t) -> (nu,)`` is called at stage times.
+    """
+
+    mode: str
+    ua: np.ndarray | None = None
+    ub: np.ndarray | None = None
+    fun: Callable | None = None
+
+    def at(self, t: float, k: int, tk: float, H: float) -> np.ndarray:
+        if self.mode == "stages":
+            return self.fun(t)
+        return self.ua[k] + (t - tk) / H * (self.ub[k] - self.ua[k])
+
+    def grid(self, t: np.ndarray) -> np.ndarray:
+        """Control on the output grid, shape (nu, n)."""
+        if self.mode == "stages":
+            return np.stack([self.fun(ti) for ti in t], axis=1)
+        return np.concatenate([self.ua, self.ub[-1:]], axis=0).T
+
+    def head(self, nint: int) -> "Control":
+        """The control of the first ``nint`` intervals."""
+        if self.mode == "stages":
+            return self
+        return Control("linear", self.ua[:nint], self.ub[:nint])
+
+    def cvodes_input(self, t: np.ndarray) -> np.ndarray:
+        """Piecewise-constant integrator input ``[u_k, slope_k, t_k]``, shape (nint, 2 nu + 1)."""
+        if self.mode == "stages":
+            return np.zeros((t.size - 1, 0))
+        slope = (self.ub - self.ua) / np.diff(t)[:, None]
+        return np.concatenate([self.ua, slope, t[:-1, None]], axis=1)
+
+
+def check_u(u, nu: int, t: np.ndarray) -> Control:
+    n = t.size
+    if u is None:
+        z = np.zeros((n - 1, nu))
+        return Control("linear", z, z)
+    if callable(u):
+        fun = _checked_callable(u, nu)
+        fun(float(t[0]))  # raises ValueError naming `u` on a wrong shape
+        if nu == 0:
+            z = np.zeros((n - 1, 0))
+            return Control("linear", z, z)
+        return Control("stages", fun=fun)
+    try:
+        a = np.array(u, dtype=float)
+    except (TypeError, ValueError) as exc:
+        raise ValueError(f"`u` must be None, a callable or an array of numbers: {exc}") from None
+    if a.ndim == 0 and nu == 1:
+        a = a.reshape(1)
+    if a.shape == (nu,):
+        if not np.all(np.isfinite(a)):
+            raise ValueError(f"`u` must be finite, got {a.tolist()}")
+        c = np.broadcast_to(a, (n - 1, nu))
+        return Control("linear", c, c)
+    if a.shape == (nu, n):
+        if not np.all(np.isfinite(a)):
+            raise ValueError("`u` must be finite")
+        return Control("linear", np.ascontiguousarray(a[:, :-1].T),
+                       np.ascontiguousarray(a[:, 1:].T))
+    raise ValueError(
+        f"`u` must be None, a constant of shape ({nu},), samples of shape ({nu}, {n}) on `t`, "
+        f"or a callable of t returning shape ({nu},); got shape {a.shape}"
+    )
+
+
+def _checked_callable(fun, nu: int):
+    def checked(t: float) -> np.ndarray:
+        value = np.asarray(fun(t), dtype=float)
+        if value.size != nu or value.ndim > 1 or (value.ndim == 0 and nu != 1):
+            raise ValueError(
+                f"`u` must return shape ({nu},) when called with a time, "
+                f"got {value.shape} at t = {t}"
+            )
+        value = value.reshape(nu)
+        if not np.all(np.isfinite(value)):
+            raise ValueError(f"`u` returned a non-finite value {value.tolist()} at t = {t}")
+        return value
+
+    return checked
+
+
+def check_invariants(invariants, model: Model) -> tuple[str, ...]:
+    if invariants is True:
+        return tuple(model.invariants)
+    if invariants is False or invariants is None:
+        return ()
+    if isinstance(invariants, str):
+        invariants = (invariants,)
+    try:
+        names = tuple(invariants)
+    except TypeError:
+        raise ValueError(
+            f"`invariants` must be a bool or names of invariants, got {invariants!r}") from None
+    unknown = [k for k in names if k not in model.invariants]
+    if unknown:
+        raise ValueError(
+            f"`invariants` names unknown invariants {unknown}; "
+            f"this model has {sorted(model.invariants)}"
+        )
+    return names
+
+
+@dataclass(frozen=True)
+class Problem:
+    model: Model
+    x0: np.ndarray
+    t: np.ndarray
+    control: Control
+    p: np.ndarray
+
+    @property
+    def nint(self) -> int:
+        return self.t.size - 1

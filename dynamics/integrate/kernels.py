@@ -1,0 +1,169 @@
+"""One step of a method as a CasADi Function ``(x, h, u-data, p) -> x_next`` (SX where the
+model allows): explicit Runge-Kutta from a `Tableau`, and the Lie-group method CF4."""
+from __future__ import annotations
+
+import casadi as ca
+import numpy as np
+
+from .. import cache
+from ..attitude import propagate_quat, quat_rate
+from ..model import Model
+from .tableaux import TABLEAUX, unique_nodes
+
+__all__ = ["kernel", "check_lie_model"]
+
+
+def _sym(f: ca.Function):
+    """SX when ``f`` can be evaluated on SX (small, fast kernels), else MX."""
+    try:
+        f.call([ca.SX.sym("x", f.sparsity_in(i)) for i in range(f.n_in())])
+        return ca.SX
+    except RuntimeError:
+        return ca.MX
+
+
+def _kernel_inputs(sym, nx, nu, np_, mode, n_nodes):
+    x, h, p = sym.sym("x", nx), sym.sym("h"), sym.sym("p", np_)
+    if mode == "linear":
+        ua, ud = sym.sym("ua", nu), sym.sym("ud", nu)
+        return [x, h, ua, ud, p], (lambda c: ua + (c * h) * ud)
+    us = sym.sym("us", nu * n_nodes)
+    return [x, h, us, p], None
+
+
+def _stage_control(mode, ins, nu, nodes_unique, linear_u):
+    if mode == "linear":
+        return linear_u
+    us = ins[2]
+
+    def u_at(c):
+        j = nodes_unique.index(c)
+        return us[j * nu:(j + 1) * nu]
+
+    return u_at
+
+
+def _rk_kernel(f: ca.Function, method: str, mode: str) -> ca.Function:
+    """One explicit Runge-Kutta step ``(x, h, u-data, p) -> x_next`` as a Function."""
+    tab = TABLEAUX[method]
+    nx, nu, np_ = f.numel_in(0), f.numel_in(1), f.numel_in(2)
+    nodes = unique_nodes(method)
+    sym = _sym(f)
+    ins, linear_u = _kernel_inputs(sym, nx, nu, np_, mode, len(nodes))
+    u_at = _stage_control(mode, ins, nu, nodes, linear_u)
+    x, h, p = ins[0], ins[1], ins[-1]
+    k = []
+    for i in range(tab.stages):
+        xi = x
+        for j, aij in enumerate(tab.a[i]):
+            if aij != 0.0:
+                xi = xi + (aij * h) * k[j]
+        k.append(f.call([xi, u_at(tab.c[i]), p])[0])
+    incr = 0
+    for bi, ki in zip(tab.b, k):
+        if bi != 0.0:
+            incr = incr + bi * ki
+    return ca.Function(f"{method}_step", ins, [x + h * incr])
+
+
+def _lie_kernel(f: ca.Function, attitude: tuple[int, int], mode: str) -> ca.Function:
+    """One step of the commutator-free Lie group method CF4 (Celledoni, Marthinsen & Owren 2003).
+
+    The state is ``(q, y)``: the unit quaternion ``q = x[iq:iq+4]`` on S^3 and every other
+    state ``y`` in a vector space. A right-hand side evaluation ``F_i`` at a stage state gives
+    the body rate ``w_i`` (a Lie algebra element acting on ``q`` by ``qdot = -1/2 Wbar(w) q``)
+    and ``ydot_i``. The flow of a frozen combination ``sum a_i F_i`` over ``h`` is exact:
+    ``q <- propagate_quat(q, sum a_i w_i, h)`` and ``y <- y + h sum a_i ydot_i``.
+
+        X2 = exp(h/2 F1) x,  X3 = exp(h/2 F2) x,  X4 = exp(h (F3 - F1/2)) X2,
+        x+ = exp(h (-F1/12 + F2/6 + F3/6 + F4/4)) applied after exp(h (F1/4 + F2/6 + F3/6 - F4/12)).
+
+    The final flows are applied in this order (measured: 4th order; the other order is 2nd
+    order for the quaternion). For ``y`` this is the classical RK4; ``q`` only ever moves
+    by exact rotations, so ``|q|`` is kept to round-off for any step size and horizon.
+    """
+    iq, iw = attitude
+    nx, nu, np_ = f.numel_in(0), f.numel_in(1), f.numel_in(2)
+    nodes = unique_nodes("lie")
+    sym = _sym(f)
+    ins, linear_u = _kernel_inputs(sym, nx, nu, np_, mode, len(nodes))
+    u_at = _stage_control(mode, ins, nu, nodes, linear_u)
+    x, h, p = ins[0], ins[1], ins[-1]
+    qsl = slice(iq, iq + 4)
+
+    def rhs(xs, c):
+        return xs[iw:iw + 3], f.call([xs, u_at(c), p])[0]
+
+    def flow(base, coefs, evals):
+        w = sum(a * e[0] for a, e in zip(coefs, evals) if a != 0)
+        d = sum(a * e[1] for a, e in zip(coefs, evals) if a != 0)
+        out = base + h * d
+        out[qsl] = propagate_quat(base[qsl], w, h)
+        return out
+
+    f1 = rhs(x, 0.0)
+    x2 = flow(x, [0.5], [f1])
+    f2 = rhs(x2, 0.5)
+    x3 = flow(x, [0.5], [f2])
+    f3 = rhs(x3, 0.5)
+    x4 = flow(x2, [-0.5, 0.0, 1.0], [f1, f2, f3])
+    f4 = rhs(x4, 1.0)
+    evals = [f1, f2, f3, f4]
+    mid = flow(x, [1 / 4, 1 / 6, 1 / 6, -1 / 12], evals)
+    return ca.Function("lie_step", ins, [flow(mid, [-1 / 12, 1 / 6, 1 / 6, 1 / 4], evals)])
+
+
+def check_lie_model(model: Model, x0: np.ndarray, p: np.ndarray):
+    """Raise ValueError unless ``model`` has an attitude whose kinematics are Eq. 4.70.
+
+    Checked numerically at ``x0`` and at two random states near it, once per model (a
+    passed check is cached).
+    """
+    if model.attitude is None:
+        raise ValueError(
+            f"`method` 'lie' needs a model with an attitude (model.attitude), "
+            f"and {model.name!r} has none"
+        )
+    iq, iw = model.attitude
+    if not (iq + 4 <= iw or iw + 3 <= iq):
+        raise ValueError(f"`model` attitude blocks overlap: quaternion at {iq}, rates at {iw}")
+    key = ("lie-check", cache.function_key(model.f), model.attitude)
+    if not cache.contains(key):
+        cache.get(key, lambda: _lie_kinematics_check(model, x0, p), keepalive=model.f)
+
+
+def _lie_kinematics_check(model: Model, x0: np.ndarray, p: np.ndarray) -> bool:
+    iq, iw = model.attitude
+    rng = np.random.default_rng(7)
+    for trial in range(3):
+        x = x0.copy()
+        if trial:
+            q = rng.standard_normal(4)
+            x[iq:iq + 4] = q / np.linalg.norm(q)
+            x[iw:iw + 3] = x0[iw:iw + 3] + rng.standard_normal(3)
+        u = rng.standard_normal(model.nu) if trial else np.zeros(model.nu)
+        qdot = model.rhs(x, u, p)[iq:iq + 4]
+        expected = quat_rate(x[iq:iq + 4], x[iw:iw + 3])
+        if not np.all(np.isfinite(qdot)):
+            continue
+        scale = np.linalg.norm(x[iq:iq + 4]) * (np.linalg.norm(x[iw:iw + 3]) + 1.0)
+        if np.max(np.abs(qdot - expected)) > 1e-10 * scale:
+            raise ValueError(
+                f"`model` {model.name!r}: the derivative of x[{iq}:{iq + 4}] is not the "
+                f"quaternion kinematics -1/2 Wbar(w) q of the rates x[{iw}:{iw + 3}] "
+                "(Eq. 4.70), so the 'lie' method does not apply"
+            )
+    return True
+
+
+def kernel(model: Model, method: str, mode: str) -> ca.Function:
+    key = ("kernel", cache.function_key(model.f), model.attitude if method == "lie" else None,
+           method, mode)
+
+    def build():
+        if method == "lie":
+            return _lie_kernel(model.f, model.attitude, mode)
+        return _rk_kernel(model.f, method, mode)
+
+    return cache.get(key, build, keepalive=model.f)
+

@@ -1,0 +1,216 @@
+"""Fixed-step runs: the chunk Function (a ``mapaccum`` of step kernels, wrapped in MX and
+optionally jit-compiled) and the Python loop over chunks that runs it."""
+from __future__ import annotations
+
+from typing import Callable
+
+import casadi as ca
+import numpy as np
+
+from .. import cache
+from ..model import Model
+from .evaluate import call_buffered
+from .inputs import Problem
+from .kernels import kernel
+from .result import Run
+from .tableaux import TABLEAUX, unique_nodes
+
+__all__ = ["CHUNK", "Progress", "chunk_function", "chunk_key", "run_fixed"]
+
+_BASE = 4  # unroll base of mapaccum: casadi's construction cost grows ~5x from base 4 to 10
+
+# Every fixed-step run calls ONE compiled Function per (model, method, control mode): a
+# `mapaccum` of `CHUNK` steps, each with its own step size and control data. A run of any
+# length is a Python loop over chunks (a few microseconds each), so neither the code nor the
+# compile time grows with the grid length or the step count, and 1e7 steps are as easy as 1e3.
+# The steps of a short last chunk past its length are skipped (a conditional in the loop).
+CHUNK = 512
+
+
+def chunk_function(model: Model, method: str, mode: str, jit: bool):
+    """The chunk Function of ``model`` and ``method`` (cached); returns (Function, compiled).
+
+    Inputs ``mode == 'linear'``: ``x0 (nx)``, ``n`` the number of steps to take (the rest
+    are skipped), ``h (1 x B)`` step sizes, ``ua (nu x B)`` control at the start of each
+    step, ``ud (nu x B)`` its slope [1/s], ``p (np)``. ``mode == 'stages'``: ``x0``, ``n``,
+    ``h``, ``us (nu*s x B)`` control at the distinct stage nodes of each step, ``p``.
+    Output ``X (nx x B)``: the state after each step.
+    """
+    base_key = chunk_key(model, method, mode)
+    opts = cache.jit_options() if jit else None
+    if opts is None:
+        return cache.get(base_key + (False,),
+                         lambda: (_build_chunk(model, method, mode, {}), False),
+                         keepalive=model.f)
+
+    def build_compiled():
+        try:
+            return _build_chunk(model, method, mode, opts), True
+        except RuntimeError:  # e.g. a right-hand side that cannot be code-generated
+            return _build_chunk(model, method, mode, {}), False
+
+    return cache.get(base_key + (True,), build_compiled, keepalive=model.f)
+
+
+def chunk_key(model: Model, method: str, mode: str) -> tuple:
+    return ("chunk", cache.function_key(model.f), model.attitude if method == "lie" else None,
+            method, mode)
+
+
+_BLOCK = 16  # steps per block of a chunk: a chunk is `CHUNK // _BLOCK` blocks
+
+
+def _build_chunk(model, method, mode, opts) -> ca.Function:
+    """``mapaccum`` of `CHUNK` steps that takes only the first ``n``: the chunk is a
+    ``mapaccum`` of blocks of `_BLOCK` steps, each block and each step inside a block a
+    ``Function.conditional`` that skips (copies the state) past step ``n``. A short run
+    then costs its own steps plus about 25 us, not the 512 steps of a full chunk."""
+    step = kernel(model, method, mode)
+    args = [ca.MX.sym(step.name_in(i), step.sparsity_in(i)) for i in range(step.n_in())]
+    gated = _gated(step, args, "step")
+    inner = gated.mapaccum("steps", _BLOCK, {"base": _BASE})
+    blk = [ca.MX.sym(inner.name_in(i), inner.sparsity_in(i)) for i in range(inner.n_in())]
+    states = inner.call(blk)[0]
+    run = ca.Function("block", blk, [states[:, -1], states])
+    skip = ca.Function("skip_block", blk, [blk[0], ca.repmat(blk[0], 1, _BLOCK)])
+    block_on = ca.MX.sym("block_on")
+    gated_block = ca.Function("gated_block", [blk[0], block_on] + blk[1:],
+                              ca.Function.conditional("maybe_block", [skip], run)
+                              .call([block_on] + blk))
+    loop = gated_block.mapaccum("blocks", CHUNK // _BLOCK, 1, {"base": _BASE})
+    x0, n = ca.MX.sym("x0", model.nx), ca.MX.sym("n")
+    ins = [x0, n, ca.MX.sym("h", 1, CHUNK)]
+    if mode == "linear":
+        ins += [ca.MX.sym("ua", model.nu, CHUNK), ca.MX.sym("ud", model.nu, CHUNK)]
+    else:
+        ins += [ca.MX.sym("us", model.nu * len(unique_nodes(method)), CHUNK)]
+    ins.append(ca.MX.sym("p", model.np))
+    step_on = ca.DM(np.arange(CHUNK, dtype=float)).T < n
+    block_on = ca.DM(np.arange(0, CHUNK, _BLOCK, dtype=float)).T < n
+    out = loop.call([x0, block_on, step_on] + ins[2:-1] + [ca.repmat(ins[-1], 1, CHUNK)])
+    return ca.Function(f"simulate_{method}", ins, [out[1]], opts)
+
+
+def _gated(step: ca.Function, args: list, name: str) -> ca.Function:
+    """``(x, on, *rest) -> step(x, *rest)`` when ``on`` else ``x``."""
+    skip = ca.Function(f"skip_{name}", args, [args[0]])
+    on = ca.MX.sym("on")
+    return ca.Function(f"gated_{name}", [args[0], on] + args[1:],
+                       ca.Function.conditional(f"maybe_{name}", [skip], step).call([on] + args))
+
+
+def _stage_samples(problem: Problem, method: str, m: int) -> np.ndarray:
+    """Callable control at the distinct stage nodes of every step: shape (nint, m, s, nu)."""
+    nodes = np.array(unique_nodes(method))
+    t = problem.t
+    h = np.diff(t) / m
+    offsets = np.arange(m)[None, :, None] + nodes[None, None, :]
+    times = t[:-1, None, None] + offsets * h[:, None, None]
+    fun, nu = problem.control.fun, problem.model.nu
+    values = np.empty(times.shape + (nu,))
+    flat_t, flat_v = times.reshape(-1), values.reshape(-1, nu)
+    for i, ti in enumerate(flat_t):
+        flat_v[i] = fun(float(ti))
+    return values
+
+
+class _Steps:
+    """Per-step data of a fixed-step run, served a chunk at a time (padded to ``CHUNK``).
+
+    Step ``s`` is substep ``j = s mod m`` of output interval ``k = s // m``: size
+    ``h = H_k / m``; linear control ``ua = u_k + j h ud_k`` with slope ``ud_k``; or, for a
+    callable control, its samples at the step's stage times.
+    """
+
+    def __init__(self, problem: Problem, method: str, m: int):
+        self.m, self.total = m, m * problem.nint
+        self.hm = np.diff(problem.t) / m
+        ctrl = problem.control
+        self.mode = ctrl.mode
+        if self.mode == "linear":
+            self.ua = ctrl.ua
+            self.ud = (ctrl.ub - ctrl.ua) / np.diff(problem.t)[:, None]
+            self.constant = not np.any(self.ud) and bool(np.all(ctrl.ua == ctrl.ua[:1]))
+        else:
+            s = _stage_samples(problem, method, m)  # (nint, m, nodes, nu)
+            self.us = s.reshape(self.total, -1)
+        nu = problem.model.nu
+        self._pad_h = np.zeros(CHUNK)
+        if self.mode == "linear" and self.constant:
+            self._ua_c = np.broadcast_to(ctrl.ua[:1], (CHUNK, nu)).copy()
+            self._ud_c = np.zeros((CHUNK, nu))
+
+    def chunk(self, s0: int) -> list:
+        """Arrays for steps ``s0 .. s0 + CHUNK - 1`` in casadi's column-major layout."""
+        n = min(CHUNK, self.total - s0)
+        s = np.arange(s0, s0 + n)
+        k = s // self.m
+        h = self._pad_h.copy()
+        h[:n] = self.hm[k]
+        if self.mode != "linear":
+            us = np.zeros((CHUNK, self.us.shape[1]))
+            us[:n] = self.us[s0:s0 + n]
+            return [h, us]
+        if self.constant:
+            return [h, self._ua_c, self._ud_c]
+        ua, ud = np.zeros((CHUNK, self.ua.shape[1])), np.zeros((CHUNK, self.ua.shape[1]))
+        ud[:n] = self.ud[k]
+        ua[:n] = self.ua[k] + ((s - k * self.m) * h[:n])[:, None] * ud[:n]
+        return [h, ua, ud]
+
+
+class Progress:
+    """Counts steps for a ``progress(done, total)`` callback across all runs of one call:
+    ``total`` grows by each run's step count when the run starts."""
+
+    def __init__(self, fun: Callable | None):
+        self.fun, self.done, self.total = fun, 0, 0
+
+    def start(self, n: int):
+        self.total += n
+
+    def advance(self, n: int):
+        self.done += n
+        if self.fun is not None:
+            self.fun(self.done, self.total)
+
+    def abandon(self, n: int):
+        self.total -= n
+
+
+def run_fixed(problem: Problem, method: str, m: int, jit: bool,
+              progress: Progress | None = None) -> Run:
+    """``m`` steps of ``method`` per output interval, chunk by chunk; stops at a non-finite
+    state (the columns not reached are NaN)."""
+    model, nint, t = problem.model, problem.nint, problem.t
+    fun, compiled = chunk_function(model, method, problem.control.mode, jit)
+    steps = _Steps(problem, method, m)
+    progress = Progress(None) if progress is None else progress
+    progress.start(steps.total)
+    x = np.full((model.nx, nint + 1), np.nan)
+    x[:, 0] = problem.x0
+    xk = problem.x0
+    stages = 4 if method == "lie" else TABLEAUX[method].stages
+    done = 0
+    for s0 in range(0, steps.total, CHUNK):
+        n = min(CHUNK, steps.total - s0)
+        X = call_buffered(fun, [xk, np.array([float(n)]), *steps.chunk(s0), problem.p],
+                          (CHUNK, model.nx))
+        k_lo, k_hi = (s0 + m) // m - 1, (s0 + n) // m  # intervals ending in this chunk
+        last = (np.arange(k_lo, k_hi) + 1) * m - 1 - s0
+        x[:, k_lo + 1:k_hi + 1] = X[last].T
+        xk = X[n - 1]
+        done = s0 + n
+        progress.advance(n)
+        if not np.all(np.isfinite(xk)):
+            break
+    progress.abandon(steps.total - done)
+    n_steps = done
+    if done < steps.total or not np.all(np.isfinite(x)):
+        k = int(np.argmax(~np.isfinite(x).all(axis=0)))
+        x[:, k:] = np.nan
+        return Run(x, n_steps, stages * n_steps, m, compiled, False,
+                   f"{method}: the state became non-finite before t = {t[k]:.6g}")
+    return Run(x, n_steps, stages * n_steps, m, compiled, True,
+               f"{method}: {m} step(s) per output interval, {n_steps} steps")
+

@@ -1,0 +1,194 @@
+"""`SimulationResult` (the public outcome of `simulate`), its dense output, and `Run`
+(the outcome of one integration run inside a call)."""
+from __future__ import annotations
+
+import math
+import threading
+from dataclasses import dataclass, field
+from types import MappingProxyType
+from typing import Callable, Mapping
+
+import numpy as np
+
+from ..model import Model
+from .evaluate import map_eval
+
+__all__ = ["SimulationResult", "Dense", "Run", "OK", "OK_STIFF", "ROUNDOFF", "UNVERIFIED",
+           "FAILED"]
+
+# status codes of SimulationResult (documented in its docstring)
+OK, OK_STIFF, ROUNDOFF, UNVERIFIED, FAILED = 0, 1, 2, 3, -1
+
+
+class Dense:
+    """What `SimulationResult.sample` needs: the model, ``p`` and ``u`` on the grid; caches xdot."""
+
+    def __init__(self, model: Model, p: np.ndarray, u_grid: Callable[[], np.ndarray]):
+        self._model, self._p, self._u_grid = model, p, u_grid
+        self._xdot = None
+        self._drift = None
+        self._lock = threading.Lock()
+
+    def drift(self, x: np.ndarray) -> Mapping[str, float]:
+        with self._lock:
+            if self._drift is None:
+                self._drift = MappingProxyType(_drift(self._model, x, self._p))
+            return self._drift
+
+    def xdot(self, x: np.ndarray) -> np.ndarray:
+        with self._lock:
+            if self._xdot is None:
+                xdot = map_eval(self._model.f, [x, self._u_grid(), self._p])
+                xdot.setflags(write=False)
+                self._xdot = xdot
+            return self._xdot
+
+
+@dataclass(frozen=True, eq=False)
+class SimulationResult:
+    """Outcome of `simulate`, in the manner of scipy's ``OdeResult``.
+
+    Attributes
+    ----------
+    t : ndarray, shape (n,) [s]
+        The output grid.
+    x : ndarray, shape (nx, n)
+        States at ``t`` (``x[:, 0]`` is ``x0``). After a failure the columns the integrator
+        did not reach are NaN.
+    success : bool
+        True only when the answer was verified against what was asked: ``auto`` met the
+        tolerance by its global error estimate (status 0 or 1); a fixed-step method or
+        ``cvodes`` reached ``t[-1]`` with finite states (they take no global tolerance; see
+        ``invariant_drift`` for a check of a fixed-step run).
+    status : int
+        ``0`` success (``auto``: the estimated global error of the rk8 run is within
+        tolerance); ``1`` success of ``auto`` on a stiff problem through cvodes, its global
+        error estimated from runs at tightened local tolerances; ``2`` not verified: the
+        tolerance lies below the round-off floor of fixed-step runs on this grid (more steps
+        no longer reduce the differences between runs); ``3`` not verified: ``max_steps``
+        or the run budget was reached first; ``-1`` failure (integrator error, or a
+        non-finite state). With 2 and 3 ``x`` is the finest run made and
+        ``error_estimate`` says how far off it is thought to be.
+    message : str
+        What happened, in words.
+    method : str
+        The method that produced ``x`` (``auto`` reports ``rk8`` or ``cvodes``).
+    wall_time : float [s]
+        Time spent in `simulate`, validation and any compilation included.
+    n_steps, n_rhs : int
+        Steps taken and right-hand-side evaluations made, summed over every run the call made
+        (``auto`` makes several).
+    substeps : int
+        Fixed-step methods: steps per output interval of the returned solution; 0 for cvodes.
+    error_estimate : float
+        ``auto`` with a fixed-step result: estimated max over states and output times of
+        ``|error| / (atol + rtol |x|)`` (1.0 is exactly the tolerance); NaN otherwise.
+    compiled : bool
+        Whether the loop that produced ``x`` ran as jit-compiled C.
+    invariants : mapping of str to ndarray
+        Each requested invariant along ``x``: shape ``(n,)`` for a scalar, ``(m, n)`` for a
+        vector invariant. Empty unless asked for.
+    """
+
+    t: np.ndarray
+    x: np.ndarray
+    success: bool
+    status: int
+    message: str
+    method: str
+    wall_time: float
+    n_steps: int
+    n_rhs: int
+    substeps: int = 0
+    error_estimate: float = float("nan")
+    compiled: bool = False
+    invariants: Mapping[str, np.ndarray] = field(default_factory=dict)
+    _dense: Dense | None = field(default=None, repr=False)
+
+    @property
+    def xdot(self) -> np.ndarray:
+        """State derivative at ``t``, shape (nx, n); evaluated on first use."""
+        if self._dense is None:
+            raise ValueError("this result carries no model to evaluate xdot")
+        return self._dense.xdot(self.x)
+
+    @property
+    def invariant_drift(self) -> Mapping[str, float]:
+        """Largest change of each of the model's invariants along ``x`` (evaluated on first use).
+
+        ``max_t |I(t) - I(t[0])| / |I(t[0])|`` (Euclidean norm for a vector invariant;
+        absolute where ``I(t[0]) = 0``), NaN when ``x`` has non-finite columns. For a quantity
+        conserved by the model under the given ``u`` (energy and inertial angular momentum of
+        a torque-free body, a unit quaternion's norm) this is a measured error of the
+        solution; a fixed-step run that went unstable shows it as a drift of order 1 or more.
+        """
+        if self._dense is None:
+            return MappingProxyType({})
+        return self._dense.drift(self.x)
+
+    def sample(self, t) -> np.ndarray:
+        """Dense output: cubic Hermite interpolation of ``x`` and ``xdot`` on the grid.
+
+        Exact at the grid points; between them the error is ``O(dt^4)`` in the grid spacing
+        ``dt`` (not the integrator's accuracy: refine ``t`` for accurate dense output).
+
+        Parameters
+        ----------
+        t : float or array_like, shape (m,) [s]
+            Times within ``[self.t[0], self.t[-1]]``.
+
+        Returns
+        -------
+        ndarray, shape (nx,) for a scalar ``t``, else (nx, m)
+
+        Raises
+        ------
+        ValueError
+            If ``t`` is not finite or lies outside the grid (no extrapolation).
+        """
+        tq = np.asarray(t, dtype=float)
+        scalar = tq.ndim == 0
+        tq = tq.reshape(-1)
+        if not np.all(np.isfinite(tq)):
+            raise ValueError("`t` must be finite")
+        if tq.size and (tq.min() < self.t[0] or tq.max() > self.t[-1]):
+            raise ValueError(
+                f"`t` must lie within the simulated interval [{self.t[0]}, {self.t[-1]}], "
+                f"got [{tq.min()}, {tq.max()}]"
+            )
+        out = _hermite(self.t, self.x, self.xdot, tq)
+        return out[:, 0] if scalar else out
+
+
+def _hermite(t, x, xdot, tq):
+    i = np.clip(np.searchsorted(t, tq, side="right") - 1, 0, t.size - 2)
+    dt = t[i + 1] - t[i]
+    s = (tq - t[i]) / dt
+    s2, s3 = s * s, s * s * s
+    h00, h10, h01, h11 = 2 * s3 - 3 * s2 + 1, s3 - 2 * s2 + s, 3 * s2 - 2 * s3, s3 - s2
+    return (h00 * x[:, i] + h10 * dt * xdot[:, i] + h01 * x[:, i + 1]
+            + h11 * dt * xdot[:, i + 1])
+
+
+@dataclass(frozen=True)
+class Run:
+    x: np.ndarray  # (nx, n)
+    n_steps: int
+    n_rhs: int
+    substeps: int
+    compiled: bool
+    ok: bool
+    message: str
+
+
+def _drift(model: Model, x: np.ndarray, p: np.ndarray) -> dict:
+    """``max_t |I(t) - I(t[0])|`` relative to ``|I(t[0])|`` for each invariant of ``model``."""
+    out = {}
+    if not np.all(np.isfinite(x)):
+        return {name: math.nan for name in model.invariants}
+    for name, fun in model.invariants.items():
+        v = map_eval(fun, [x, p])
+        diff = np.linalg.norm(v - v[:, :1], axis=0)
+        ref = float(np.linalg.norm(v[:, 0]))
+        out[name] = float(np.max(diff)) / ref if ref > 0 else float(np.max(diff))
+    return out

@@ -1,0 +1,86 @@
+"""The one cache (`dynamics.cache`) and its deterministic jit policy."""
+import os
+import shutil
+import threading
+
+import numpy as np
+import pytest
+
+import dynamics
+from dynamics import cache, rigid_body, simulate
+
+HAVE_CC = shutil.which("gcc") is not None or shutil.which("cc") is not None
+X0 = np.array([0.0, 0.0, 0.0, 1.0, 1.0, 0.1, 0.8])
+
+
+def test_get_builds_once_and_info_counts():
+    calls = []
+
+    def build():
+        calls.append(1)
+        return object()
+
+    key = ("test-entry", 1)
+    first = cache.get(key, build)
+    assert cache.get(key, build) is first and calls == [1]
+    assert cache.contains(key)
+    info = cache.info()
+    assert info.kinds.get("test-entry") == 1 and info.hits >= 1 and info.entries <= info.maxsize
+
+
+def test_get_is_thread_safe_one_build_per_key():
+    calls = []
+
+    def build():
+        calls.append(1)
+        return len(calls)
+
+    key = ("test-threads", 2)
+    out = []
+    threads = [threading.Thread(target=lambda: out.append(cache.get(key, build)))
+               for _ in range(8)]
+    for th in threads:
+        th.start()
+    for th in threads:
+        th.join()
+    assert calls == [1] and set(out) == {1}
+
+
+def test_memoized_model_factory_is_cached_and_cleared():
+    a = rigid_body([1.0, 2.0, 3.0])
+    assert rigid_body([1.0, 2.0, 3.0]) is a
+    dynamics.clear_caches()
+    assert rigid_body([1.0, 2.0, 3.0]) is not a
+    assert cache.info().entries >= 1
+
+
+def test_should_compile_depends_only_on_arguments():
+    assert cache.should_compile(True, 0) and not cache.should_compile(False, 1e12)
+    assert not cache.should_compile(None, cache.JIT_MIN_WORK - 1)
+    assert cache.should_compile(None, cache.JIT_MIN_WORK)
+    assert cache.should_compile(None, float("inf"))
+
+
+def test_identical_auto_calls_make_identical_jit_choices():
+    """Four identical calls: the same `compiled` flag every time (the old policy compiled on
+    the third use of a model) and the same answer."""
+    model = rigid_body([1.0, 2.0, 2.5])
+    t = np.linspace(0.0, 10.0, 101)
+    runs = [simulate(model, X0, t) for _ in range(4)]
+    assert len({r.compiled for r in runs}) == 1
+    assert all(np.array_equal(r.x, runs[0].x) for r in runs)
+
+
+@pytest.mark.skipif(not HAVE_CC, reason="no C compiler for the jit")
+def test_clear_caches_removes_compiled_files_and_rebuilds():
+    model = rigid_body([1.0, 2.0, 2.75])
+    t = np.linspace(0.0, 1.0, 11)
+    first = simulate(model, X0, t, method="rk4", jit=True)
+    directory = cache.info().jit_directory
+    assert first.compiled and directory is not None and os.path.isdir(directory)
+    dynamics.clear_caches()
+    info = cache.info()
+    assert not os.path.exists(directory)
+    assert info.entries == 0 and info.jit_directory is None
+    again = simulate(model, X0, t, method="rk4", jit=True)
+    assert again.compiled and np.allclose(again.x, first.x, rtol=0, atol=1e-14)
