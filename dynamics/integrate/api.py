@@ -71,12 +71,11 @@ def simulate(model: Model, x0, t, *, u=None, p=None, method: Method = "auto",
     steps : int, optional
         Fixed-step methods only: steps per output interval (default 1: the grid is the step).
     jit : bool, optional
-        Compile the loops to C (``True``) or never (``False``). By default (``None``) the
-        rule depends only on the arguments (see `dynamics.cache`): the fixed-step methods
-        compile their loop whenever a C compiler (``gcc`` or ``cc``) is found, and each run
-        of ``auto`` is compiled when its work (steps x 12 stages) reaches
-        `dynamics.cache.JIT_MIN_WORK` (500 000 right-hand-side evaluations) and interpreted
-        below. Compiled loops are cached per model, method and control mode;
+        Compile the loops to C (``True``) or never (``False``). By default (``None``) every
+        method compiles its one chunk loop per model and control mode on first use whenever
+        a C compiler (``gcc`` or ``cc``) is found (about 0.4 s once; then a 100 s run at
+        rtol 1e-10 takes 3-4 ms instead of 23 ms interpreted), never depending on how often
+        the model was used (see `dynamics.cache`). Compiled loops are cached;
         `dynamics.clear_caches` drops them.
     max_steps : int, optional
         ``auto``: most rk8 steps in one run (default 1e8); a tolerance that needs more is
@@ -116,6 +115,18 @@ def simulate(model: Model, x0, t, *, u=None, p=None, method: Method = "auto",
     A numerical failure (cvodes gives up, a fixed-step state becomes non-finite) returns
     ``success=False`` with the reason; it never raises. An exception raised by a callable
     ``u`` propagates.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from dynamics import rigid_body, simulate
+    >>> from dynamics.truth import torque_free_omega
+    >>> inertia, w0, t = [1.0, 2.0, 3.0], [0.1, 0.2, 0.3], np.linspace(0.0, 10.0, 11)
+    >>> res = simulate(rigid_body(inertia), [0, 0, 0, 1, *w0], t, method="rk8", steps=10, jit=False)
+    >>> res.success, res.x.shape
+    (True, (7, 11))
+    >>> bool(np.max(np.abs(res.x[4:] - torque_free_omega(inertia, w0, t))) < 1e-10)
+    True
     """
     start = time.perf_counter()
     model = check_model(model)

@@ -13,7 +13,7 @@ from .. import cache
 from .cvodes import run_cvodes
 from .evaluate import map_eval
 from .inputs import Problem
-from .loops import Progress, chunk_key, run_fixed
+from .loops import Progress, run_fixed
 from .result import FAILED, OK, OK_STIFF, ROUNDOFF, UNVERIFIED, Run
 from .tableaux import DOP853
 
@@ -354,14 +354,9 @@ def _first_bad(x: np.ndarray) -> int:
 
 
 def _auto_jit(problem: Problem, m: int, jit_pref) -> bool:
-    """jit for a run of ``m`` rk8 steps per interval: `cache.should_compile` on its work;
-    under ``jit=None`` a short run also uses the model's compiled rk8 chunk when one was
-    built already (that costs nothing: the policy decides what is compiled, not what is
-    reused)."""
-    if cache.should_compile(jit_pref, m * problem.nint * DOP853.stages):
-        return True
-    return jit_pref is None and cache.contains(chunk_key(problem.model, "rk8",
-                                                         problem.control.mode) + (True,))
+    """jit for ``auto``'s runs: `cache.should_compile` with unbounded work, as for the
+    fixed-step methods (one compiled chunk per model, reused by every run and call)."""
+    return cache.should_compile(jit_pref, math.inf)
 
 
 def _auto_cvodes(problem: Problem, rtol, atol, extra):
