@@ -24,6 +24,16 @@ def clear_caches() -> None:
 
     Models, integration loops, Jacobians and compiled C code are all kept in
     `dynamics.cache`; after this call they are rebuilt (and recompiled) on next use.
+
+    Examples
+    --------
+    >>> from dynamics import clear_caches, rigid_body
+    >>> model = rigid_body([1.0, 2.0, 3.0])
+    >>> rigid_body([1.0, 2.0, 3.0]) is model  # built once, cached by inertia
+    True
+    >>> clear_caches()
+    >>> rigid_body([1.0, 2.0, 3.0]) is model  # rebuilt
+    False
     """
     cache.clear()
 

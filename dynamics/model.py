@@ -52,6 +52,20 @@ class Model:
         If ``f`` or an invariant is not a ``casadi.Function``.
     ValueError
         If the I/O names or sizes of ``f`` or of an invariant do not match the name tuples.
+
+    Examples
+    --------
+    >>> import casadi as ca
+    >>> from dynamics import Model
+    >>> x, u, p = ca.SX.sym("x", 2), ca.SX.sym("u", 1), ca.SX.sym("p", 1)
+    >>> f = ca.Function("oscillator", [x, u, p], [ca.vertcat(x[1], -p[0] * x[0] + u[0])],
+    ...                 ["x", "u", "p"], ["xdot"])
+    >>> model = Model(f, ("y", "ydot"), ("force",), ("k",), p_default=[4.0],
+    ...               units={"y": "m", "ydot": "m/s", "force": "N/kg", "k": "1/s^2"})
+    >>> model.nx, model.nu, model.np
+    (2, 1, 1)
+    >>> model.f(x=[1.0, 0.0], u=0.0, p=model.p_default)["xdot"]
+    DM([0, -4])
     """
 
     f: ca.Function

@@ -84,6 +84,16 @@ def rigid_body(inertia) -> Model:
     ----------
     .. [1] Rheinfurth & Wilson, NASA RP-1262, Sec. 4.2 (Euler's law), Eq. 4.16 (products
        of inertia), Eq. 4.70 (kinematics).
+
+    Examples
+    --------
+    >>> from dynamics import rigid_body
+    >>> model = rigid_body([1.0, 2.0, 3.0])
+    >>> model.states, model.controls
+    (('q1', 'q2', 'q3', 'q4', 'w1', 'w2', 'w3'), ('L1', 'L2', 'L3'))
+    >>> xdot = model.f(x=[0, 0, 0, 1, 1.0, 1.0, 1.0], u=[0, 0, 0], p=[])["xdot"]
+    >>> xdot[4:].T  # Euler's equations: I wdot = (I w) x w
+    DM([[-1, 1, -0.333333]])
     """
     a = check_inertia(inertia)
     return _rigid_body(tuple(a.reshape(-1).tolist()))

@@ -67,6 +67,13 @@ def is_symbolic(x) -> bool:
     Returns
     -------
     bool
+
+    Examples
+    --------
+    >>> import casadi as ca
+    >>> from dynamics.validate import is_symbolic
+    >>> is_symbolic(ca.SX.sym("x")), is_symbolic(ca.DM(1.0)), is_symbolic([1.0])
+    (True, False, False)
     """
     return isinstance(x, (ca.SX, ca.MX))
 
@@ -184,6 +191,16 @@ def finite_array(x, name: str, shape: tuple | None = None, *, batch: bool = Fals
         If ``x`` does not hold real numbers (string, dict, ``None``, complex, boolean, symbolic).
     ValueError
         If the shape is wrong or an entry is NaN or infinite.
+
+    Examples
+    --------
+    >>> from dynamics.validate import finite_array
+    >>> finite_array([1, 2, 3], "w0", (3,))
+    array([1., 2., 3.])
+    >>> finite_array([1.0, float("nan"), 3.0], "w0", (3,))
+    Traceback (most recent call last):
+        ...
+    ValueError: `w0` must be finite, got nan at index [1]
     """
     a = _real_array(x, name)
     if shape is not None:
@@ -211,6 +228,16 @@ def finite_scalar(x, name: str) -> float:
         If ``x`` is not a real number.
     ValueError
         If ``x`` is an array of more than one element, NaN or infinite.
+
+    Examples
+    --------
+    >>> from dynamics.validate import finite_scalar
+    >>> finite_scalar(2, "rate")
+    2.0
+    >>> finite_scalar("fast", "rate")
+    Traceback (most recent call last):
+        ...
+    dynamics.validate.ArgumentTypeError: `rate` must be real numbers, got a string: 'fast'
     """
     a = _real_array(x, name)
     if a.ndim != 0 and not (isinstance(x, ca.DM) and a.size == 1):
@@ -248,6 +275,12 @@ def unit_vector(v, name: str, *, size: int = 3, batch: bool = False) -> np.ndarr
         If ``v`` does not hold real numbers.
     ValueError
         If the shape is wrong, an entry is not finite, or a vector is zero.
+
+    Examples
+    --------
+    >>> from dynamics.validate import unit_vector
+    >>> unit_vector([0, 3, 4], "axis")
+    array([0. , 0.6, 0.8])
     """
     a = finite_array(v, name, (size,), batch=batch)
     m = np.max(np.abs(a), axis=0)
@@ -285,6 +318,16 @@ def unit_quaternion(q, name: str, *, tol: float = QUAT_NORM_TOL) -> np.ndarray:
         If ``q`` does not hold real numbers.
     ValueError
         If ``q`` is not 4 finite numbers or its norm differs from 1 by more than ``tol``.
+
+    Examples
+    --------
+    >>> from dynamics.validate import unit_quaternion
+    >>> unit_quaternion([0.0, 0.6, 0.0, 0.8], "q0")
+    array([0. , 0.6, 0. , 0.8])
+    >>> unit_quaternion([0.0, 0.0, 0.0, 2.0], "q0")
+    Traceback (most recent call last):
+        ...
+    ValueError: `q0` must be a unit quaternion (norm 1 to 1e-06), got norm 2
     """
     a = _real_array(q, name).reshape(-1)
     if a.shape != (4,) or not np.all(np.isfinite(a)):
@@ -324,6 +367,15 @@ def unit_quaternions(q, name: str, *, tol: float = QUAT_NORM_TOL,
         If the shape is wrong, or a column is not finite, is zero, or has a norm that differs
         from 1 by more than ``tol``; the message names the first bad column (``q[:, j]``)
         and its norm.
+
+    Examples
+    --------
+    >>> from dynamics.validate import unit_quaternions
+    >>> unit_quaternions([[0.0, 0.0], [0.0, 0.6], [0.0, 0.0], [1.0, 0.8]], "q")  # (4, n)
+    array([[0. , 0. ],
+           [0. , 0.6],
+           [0. , 0. ],
+           [1. , 0.8]])
     """
     a = _real_array(q, name)
     _check_shape(a, name, (4,), True)
@@ -373,6 +425,15 @@ def rotation_matrix(A, name: str, *, tol: float = DCM_ORTHO_TOL, batch: bool = F
         If the shape is wrong, an entry is not finite, ``A`` is not orthogonal to ``tol``,
         or ``det A`` is not ``+1`` (a reflection); the message names the first bad matrix
         (``A[:, :, j]``).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from dynamics.validate import rotation_matrix
+    >>> rotation_matrix(2 * np.eye(3), "A")
+    Traceback (most recent call last):
+        ...
+    ValueError: `A` must be a rotation matrix (orthogonal to 1e-06), got max |A A^T - E| = 3
     """
     a = _real_array(A, name)
     _check_shape(a, name, (3, 3), batch)
@@ -433,6 +494,16 @@ def one_of(value, name: str, choices: tuple):
         If ``value`` is not of the type of any choice.
     ValueError
         If it is of the right type but not among ``choices``.
+
+    Examples
+    --------
+    >>> from dynamics.validate import one_of
+    >>> one_of("rk4", "method", ("rk4", "rk8"))
+    'rk4'
+    >>> one_of("rk5", "method", ("rk4", "rk8"))
+    Traceback (most recent call last):
+        ...
+    ValueError: `method` must be 'rk4' or 'rk8', got 'rk5'
     """
     names = [repr(c) for c in choices]
     text = names[0] if len(names) == 1 else ", ".join(names[:-1]) + " or " + names[-1]
@@ -473,6 +544,17 @@ def integer(value, name: str, *, minimum: int | None = None) -> int:
         If ``value`` is not a number (a string, ``None``, a ``bool``, an array).
     ValueError
         If it is a number but not an integer (``2.5``, ``3.0``), or below ``minimum``.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from dynamics.validate import integer
+    >>> integer(np.int64(3), "steps", minimum=1)
+    3
+    >>> integer(0, "steps", minimum=1)
+    Traceback (most recent call last):
+        ...
+    ValueError: `steps` must be an integer >= 1, got 0
     """
     bound = "" if minimum is None else f" >= {minimum}"
     number = isinstance(value, (int, np.integer, float, np.floating))
@@ -508,6 +590,18 @@ def check_inertia(inertia, *, name="inertia", triangle=True):
     ValueError
         Naming the argument and the violated requirement: shape, finiteness, symmetry,
         positive definiteness (eigenvalues shown), triangle inequality (moments shown).
+
+    Examples
+    --------
+    >>> from dynamics.validate import check_inertia
+    >>> check_inertia([1.0, 2.0, 3.0])  # principal moments become a diagonal matrix
+    array([[1., 0., 0.],
+           [0., 2., 0.],
+           [0., 0., 3.]])
+    >>> check_inertia([1.0, 1.0, 3.0])
+    Traceback (most recent call last):
+        ...
+    ValueError: `inertia` violates the triangle inequality I1 + I2 >= I3 ...
     """
     try:
         a = np.array(inertia, dtype=float)

@@ -115,7 +115,7 @@ def test_every_ordering_and_branch_matches_integration(perm, branch):
     d_eff = momentum_ref(inertia, w0[:, None])[0] ** 2 / (2 * energy_ref(inertia, w0[:, None])[0])
     assert (d_eff > BASE[1]) == (branch == "major")  # the case really is this branch
     assert prm.branch == branch
-    assert prm.axis == perm.index(2 if branch == "major" else 0)
+    assert prm.axis_index == perm.index(2 if branch == "major" else 0)
     assert prm.D == pytest.approx(d_eff, rel=1e-14)
     assert 0.0 < prm.m < 1.0
     assert prm.lam * 40.0 > 2 * np.pi  # the run covers more than a period of u
@@ -303,7 +303,7 @@ SMALL_ASYM = {"rod": np.array([1.0, 5.0, 5.2]), "disk": np.array([2.0, 1.05, 1.0
 @pytest.mark.parametrize("body", ["rod", "disk"])
 def test_small_asymmetry_frequency_is_the_exact_limit(body):
     inertia, w_spin = SMALL_ASYM[body], 1.3
-    lam1, lam2 = truth.small_asymmetry_rates(inertia, w_spin, axis=0)
+    lam1, lam2 = truth.small_asymmetry_rates(inertia, w_spin, axis_index=0)
     assert lam1 == pytest.approx((inertia[0] - inertia[2]) / inertia[1] * w_spin, rel=1e-15)
     assert lam2 == pytest.approx((inertia[0] - inertia[1]) / inertia[2] * w_spin, rel=1e-15)
     assert (lam1 < 0) == (body == "rod")
@@ -363,21 +363,22 @@ def test_period_matches_integrated_zero_crossings(body):
 
 def test_small_asymmetry_frequency_other_axes():
     inertia = np.array([5.0, 1.0, 5.2])  # spin about axis 1, the smallest moment
-    lam1, lam2 = truth.small_asymmetry_rates(inertia, 2.0, axis=1)
+    lam1, lam2 = truth.small_asymmetry_rates(inertia, 2.0, axis_index=1)
     assert lam1 == pytest.approx((1.0 - 5.0) / 5.2 * 2.0) and lam2 == pytest.approx((1.0 - 5.2) / 5.0 * 2.0)
     # exact identity when the intermediate-axis rate (here axis 0) is zero
     lam = truth.torque_free_parameters(inertia, [0.0, 2.0, 1e-3]).lam
-    assert lam == pytest.approx(truth.small_asymmetry_frequency(inertia, 2.0, axis=1), rel=1e-13)
+    assert lam == pytest.approx(truth.small_asymmetry_frequency(inertia, 2.0, axis_index=1),
+                                rel=1e-13)
 
 
 # ------------------------------------------------------------------ cone angles
-def _angle_extremes(inertia, w0, axis, period):
+def _angle_extremes(inertia, w0, axis_index, period):
     """Min and max angle between H (body) and the principal axis on the integrated motion."""
     sol = solve_ivp(euler_rhs(inertia), (0.0, period), w0, dense_output=True, **INTEGRATOR)
 
     def angle(tt):
         h = np.asarray(inertia) * sol.sol(tt)
-        return np.arctan2(np.hypot(*np.delete(h, axis)), abs(h[axis]))
+        return np.arctan2(np.hypot(*np.delete(h, axis_index)), abs(h[axis_index]))
 
     grid = np.linspace(0.0, period, 2001)
     values = np.array([angle(tt) for tt in grid])
@@ -396,8 +397,8 @@ def test_cone_angles_match_integrated_extremes(branch):
     inertia, w0 = BASE[perm], SORTED_W0[branch][perm]
     cones = truth.cone_angles(inertia, w0)
     prm = truth.torque_free_parameters(inertia, w0)
-    assert cones.axis == prm.axis
-    lo, hi = _angle_extremes(inertia, w0, cones.axis, prm.period)
+    assert cones.axis_index == prm.axis_index
+    lo, hi = _angle_extremes(inertia, w0, cones.axis_index, prm.period)
     assert 0 < cones.theta_min < cones.theta_max < np.pi / 2
     assert cones.theta_min == pytest.approx(lo, abs=1e-9)
     assert cones.theta_max == pytest.approx(hi, abs=1e-9)
@@ -415,14 +416,14 @@ def test_cone_angle_ratio_small_asymmetry_limit():
 
 def test_cone_angles_axisymmetric_are_equal():
     cones = truth.cone_angles([2.0, 3.5, 2.0], [0.3, 1.1, -0.8])
-    assert cones.axis == 1
+    assert cones.axis_index == 1
     assert cones.theta_min == pytest.approx(cones.theta_max, rel=1e-14)
     assert np.tan(cones.theta_min) == pytest.approx(2.0 * np.hypot(0.3, 0.8) / (3.5 * 1.1), rel=1e-14)
 
 
 # ------------------------------------------------------------------ attitude
 @pytest.mark.parametrize(
-    "inertia, w0, axis",
+    "inertia, w0, axis_index",
     [
         ([1.8, 1.0, 1.0], [1.0, 0.3, -0.5], 0),  # oblate (axial moment largest), lam > 0
         ([1.0, 3.0, 3.0], [1.0, 0.3, -0.5], 0),  # prolate, lam < 0
@@ -432,11 +433,11 @@ def test_cone_angles_axisymmetric_are_equal():
         ([2.0, 2.0, 3.5], [0.2, -0.4, 0.0], 2),  # no axial rate: steady transverse rotation
     ],
 )
-def test_axisymmetric_attitude_matches_integration(inertia, w0, axis):
+def test_axisymmetric_attitude_matches_integration(inertia, w0, axis_index):
     w0 = np.array(w0)
     t = np.linspace(0.0, 40.0, 401)
     w, q = truth.axisymmetric(inertia, w0, Q0, t)
-    w_ax, q_ax = truth.axisymmetric(inertia, w0, Q0, t, axis=axis)
+    w_ax, q_ax = truth.axisymmetric(inertia, w0, Q0, t, axis_index=axis_index)
     np.testing.assert_array_equal(w, w_ax)
     np.testing.assert_array_equal(q, q_ax)
     assert w.shape == (3, t.size) and q.shape == (4, t.size)
@@ -455,7 +456,7 @@ def test_axisymmetric_attitude_matches_integration(inertia, w0, axis):
 def test_symmetric_precession_rates_from_integrated_attitude():
     inertia, w0 = np.array([1.0, 3.0, 3.0]), np.array([1.2, 0.3, -0.5])
     prec = truth.symmetric_precession(inertia, w0)
-    assert prec.axis == 0
+    assert prec.axis_index == 0
     n = w0[0]
     assert prec.lam == pytest.approx((1.0 - 3.0) / 3.0 * n, rel=1e-15)
     t = np.linspace(0.0, 30.0, 3001)
@@ -558,10 +559,78 @@ BAD = [
     (truth.small_asymmetry_rates, (BASE, [1.0, 2.0]), {}, "spin_rate"),
     (truth.small_asymmetry_rates, (BASE, 1.0), {"axis": -1}, "axis"),
     (truth.symmetric_precession, (BASE, W), {}, "inertia_diag"),
+    (truth.axisymmetric, ([1.0, 1.0, 1.5], W, Q0, 1.0), {"axis_index": 0}, "inertia_diag"),
+    (truth.axisymmetric, ([1.0, 1.0, 1.5], W, Q0, 1.0), {"axis_index": 3}, "axis_index"),
+    (truth.small_asymmetry_frequency, (BASE, 1.0), {"axis_index": 1}, "axis_index"),
+    (truth.small_asymmetry_rates, (BASE, 1.0), {"axis_index": -1}, "axis_index"),
+    (truth.symmetric_precession, ([1.0, 1.0, 1.5], W), {"axis_index": 1}, "inertia_diag"),
 ]
 
 
+@pytest.mark.filterwarnings("ignore:the keyword `axis` is deprecated:DeprecationWarning")
 @pytest.mark.parametrize("func, args, kwargs, name", BAD, ids=lambda x: getattr(x, "__name__", None))
 def test_bad_input_raises_value_error_naming_the_argument(func, args, kwargs, name):
     with pytest.raises(ValueError, match=f"`{name}`"):
         func(*args, **kwargs)
+
+
+# ------------------------------------------- starts on the separatrix (regression tests)
+@pytest.mark.parametrize("w0", [
+    [0.0, 5.0, 2.7e-83],      # intermediate-axis spin, subnormal-scale transverse rate
+    [1e-60, 5.0, 0.0],
+    [0.3, -1.1, 0.7],
+    [0.0, 5.0, 1e-150],       # below the flush threshold: steady, still w0 at t = 0
+    [0.0, 0.0, 0.0],
+])
+def test_initial_value_is_returned_exactly(w0):
+    w = truth.torque_free_omega([1.0, 2.0, 3.0], w0, [0.0, 1.0, 0.0])
+    np.testing.assert_array_equal(w[:, 0], w0)
+    np.testing.assert_array_equal(w[:, 2], w0)
+
+
+@pytest.mark.parametrize("w_small", [2.7e-83, -1e-120, 1e-20])
+def test_tiny_transverse_rate_about_the_intermediate_axis_matches_dop853(w_small):
+    """Each component to 1e-10 of itself (not of |w|), though it starts 1e-83 of |w|."""
+    i1, i2, i3 = 1.0, 2.0, 3.0
+    w0 = [0.0, 5.0, w_small]
+
+    def euler(_t, w):  # Euler's torque-free equations, written out
+        return [(i2 - i3) / i1 * w[1] * w[2], (i3 - i1) / i2 * w[2] * w[0],
+                (i1 - i2) / i3 * w[0] * w[1]]
+
+    t = np.linspace(0.0, 5.0, 6)
+    tiny = abs(w_small) * 1e-13
+    ref = solve_ivp(euler, (0.0, 5.0), w0, t_eval=t, method="DOP853", rtol=1e-13,
+                    atol=[tiny, 1e-13, tiny])
+    assert ref.success
+    w = truth.torque_free_omega([i1, i2, i3], w0, t)
+    np.testing.assert_array_equal(w[:, 0], w0)
+    np.testing.assert_allclose(w[:, 1:], ref.y[:, 1:], rtol=1e-10, atol=0.0)
+    assert 1e-78 * abs(w_small) / 2.7e-83 < abs(w[2, -1]) < 1e-75 * abs(w_small) / 2.7e-83
+
+
+# ------------------------------------------------- vocabulary: `axis` -> `axis_index`
+@pytest.mark.parametrize("func, args, index", [
+    (truth.small_asymmetry_rates, (BASE, 2.0), 2),
+    (truth.small_asymmetry_frequency, (BASE, 2.0), 2),
+    (truth.axisymmetric, ([1.0, 1.0, 1.5], [0.1, 0.2, 0.3], Q0, [0.0, 1.0]), 2),
+    (truth.symmetric_precession, ([1.0, 1.0, 1.5], [0.1, 0.2, 0.3]), 2),
+])
+def test_deprecated_axis_keyword_warns_and_gives_the_same_result(func, args, index):
+    with pytest.warns(DeprecationWarning, match="axis_index") as record:
+        old = func(*args, axis=index)
+    assert record[0].filename == __file__  # points at the caller
+    new = func(*args, axis_index=index)
+    np.testing.assert_equal(old, new)
+    with pytest.raises(TypeError, match="`axis_index` only"):
+        func(*args, axis_index=index, axis=index)
+
+
+@pytest.mark.filterwarnings("error")
+def test_deprecated_axis_field_warns():
+    results = [truth.torque_free_parameters(BASE, [0.1, 0.2, 0.3]),
+               truth.cone_angles(BASE, [0.1, 0.2, 0.3]),
+               truth.symmetric_precession([1.0, 1.0, 1.5], [0.1, 0.2, 0.3])]
+    for res in results:
+        with pytest.warns(DeprecationWarning, match="axis_index"):
+            assert res.axis == res.axis_index
