@@ -8,6 +8,9 @@
    the propagation error of the refined solution (target < 1e-6).
 3. Scaling: build and IPOPT time of a minimum-effort slew versus N = 50 ... 800 (Radau,
    degree 3) and the log-log slopes.
+4. Reuse: build time of a second `ocp.solve` of the same minimum-effort slew (N = 200) from
+   another guess of the same magnitudes (the NLP and IPOPT solver come from
+   `dynamics.cache`), and after `dynamics.clear_caches`.
 
 Run: ``make bench`` or ``appdyn bench slew``; ``--quick`` for a smoke run.
 """
@@ -41,6 +44,23 @@ def scaling(Ns):
     for N in Ns:
         sol = solve(problem, N=N, verbose=False)
         rows.append((N, sol.build_time, sol.solve_time, sol.iterations, sol.success))
+    return rows
+
+
+def reuse(N=200):
+    from dynamics import clear_caches
+
+    J = np.array([2.0, 3.0, 4.0])
+    problem = slew.slew_problem(J, objective="effort", T=4.0, angle=1.0, axis=[1, 0.5, 0.2])
+    guesses = {"first": slew.attitude_guess(problem),
+               "another guess": slew.attitude_guess(problem, tilt_axis=[0, 0, 1], tilt=0.02)}
+    rows = []
+    for label, guess in guesses.items():
+        sol = solve(problem, N=N, guess=guess)
+        rows.append((label, sol.build_time, sol.solve_time, sol.cost))
+    clear_caches()
+    sol = solve(problem, N=N, guess=guesses["another guess"])
+    rows.append(("after clear_caches", sol.build_time, sol.solve_time, sol.cost))
     return rows
 
 
@@ -80,6 +100,11 @@ def main(argv=()):
         y = np.array([r[2] / r[3] if col is None else r[col] for r in rows])
         slope = np.polyfit(n, np.log(y), 1)[0]
         print(f"  log-log slope of {label} time vs N ({Ns[0]}..{Ns[-1]}): {slope:.2f}")
+
+    print("\nReuse: the same min-effort slew (N = 200) solved again from another guess:")
+    print(f"  {'solve':<20} {'build [s]':>10} {'IPOPT [s]':>10} {'cost':>14}")
+    for label, b, t, cost in reuse():
+        print(f"  {label:<20} {b:>10.3f} {t:>10.3f} {cost:>14.10f}")
 
 
 if __name__ == "__main__":

@@ -11,7 +11,9 @@ transcription (`Trapezoid`, `HermiteSimpson`, `Radau`), and `solve` it::
 The library prints nothing unless asked (``verbose=True``): progress goes to an optional
 ``progress`` callable and to the logger ``"appdyn.ocp"`` (`ocp.progress`). Mesh refinement,
 multistart and moving-knot polishing are in `ocp.refine`; attitude targets, quaternion norm
-handling and SLERP guesses in `ocp.attitude`.
+handling and SLERP guesses in `ocp.attitude`. What the engine builds repeatedly (interval
+kernels, integrators, the NLP and its solver) is kept in `dynamics.cache` (`ocp.cached`);
+`ocp.examples` holds the small problems of the docstring Examples.
 """
 from __future__ import annotations
 
@@ -24,7 +26,8 @@ from .refine import (IntervalErrors, RefinedSolution, RefinementRound, annotate,
 from .scaling import Scaling
 from .progress import LOGGER
 from .solution import Propagation, Solution
-from .solve import DEFAULT_CONSTRAINT_TOL, Progress, rest_solution, solve
+from .solve import (DEFAULT_CONSTRAINT_TOL, STATUS_CONSTRAINT_TOL, STATUS_EXCEPTION, STATUS_REST,
+                    Progress, rest_solution, solve)
 from .transcription import (TRANSCRIPTIONS, HermiteSimpson, Radau, RadauConstantControl,
                             Transcription, Trapezoid, get_transcription)
 
@@ -38,6 +41,9 @@ __all__ = [
     "solve",
     "rest_solution",
     "DEFAULT_CONSTRAINT_TOL",
+    "STATUS_CONSTRAINT_TOL",
+    "STATUS_EXCEPTION",
+    "STATUS_REST",
     "check_ipopt_options",
     "ipopt_option_table",
     "annotate",

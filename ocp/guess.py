@@ -272,6 +272,18 @@ def guess_from_simulation(problem, u, *, T=None, n=201, method="auto", rtol=1e-8
     ------
     ValueError
         If the initial state is not fully given or the simulation fails.
+
+    Examples
+    --------
+    >>> import ocp
+    >>> from ocp.examples import min_time
+    >>> fastest = min_time()  # x'' = u, |u| <= 1, from rest at 0 to rest at 1
+    >>> guess = ocp.guess_from_simulation(fastest, lambda t: 1.0 if t < 1 else -1.0, T=2.0, n=21)
+    >>> guess["x"].shape, guess["u"].shape, guess["T"]
+    ((2, 21), (1, 21), 2.0)
+    >>> sol = ocp.solve(fastest, N=10, guess=guess)
+    >>> sol.success, round(sol.T, 6)
+    (True, 2.0)
     """
     from dynamics import simulate
 

@@ -278,6 +278,24 @@ class Problem:
     -----
     Quaternion norm handling and the sign-free attitude target are described in the module
     docstring of `ocp.problem`.
+
+    Examples
+    --------
+    Minimum energy (Bryson & Ho: J = 6) and minimum time (T = 2) of the double integrator,
+    rest to rest over a unit distance:
+
+    >>> import casadi as ca
+    >>> from dynamics.model import Model
+    >>> import ocp
+    >>> x, u, p = ca.SX.sym("x", 2), ca.SX.sym("u"), ca.SX.sym("p", 0)
+    >>> f = ca.Function("f", [x, u, p], [ca.vertcat(x[1], u)], ["x", "u", "p"], ["xdot"])
+    >>> model = Model(f, ("x", "v"), ("u",))  # the double integrator x'' = u
+    >>> energy = ocp.Problem(model, T=1.0, x_initial=[0, 0], x_final=[1, 0],
+    ...                       lagrange=lambda x, u, p: 0.5 * u**2)
+    >>> fastest = ocp.Problem(model, T=(0.1, 10.0), x_initial=[0, 0], x_final=[1, 0],
+    ...                        u_bounds={"u": (-1, 1)}, mayer=lambda xf, p, T: T)
+    >>> energy.free_time, fastest.free_time, fastest.T_bounds
+    (False, True, (0.1, 10.0))
     """
 
     model: Model

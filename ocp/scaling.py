@@ -38,6 +38,8 @@ from typing import Mapping
 import casadi as ca
 import numpy as np
 
+from .transcription import sx_compatible
+
 __all__ = ["Scaling", "auto_scaling"]
 
 _CLAMP = (1e-6, 1e6)
@@ -213,7 +215,7 @@ def _auto_rows(funs, args, n_nodes) -> np.ndarray:
     """Row scales of the stacked ``funs`` from gradients w.r.t. scaled arguments."""
     rows = []
     for fun in funs:
-        syms = [ca.SX.sym(name, fun.size_in(i)) if _sx(fun) else ca.MX.sym(name, fun.size_in(i))
+        syms = [ca.SX.sym(name, fun.size_in(i)) if sx_compatible(fun) else ca.MX.sym(name, fun.size_in(i))
                 for i, (name, _, _) in enumerate(args)]
         out = fun(*syms)
         cols = [ca.jacobian(out, s) @ ca.diag(ca.DM(d)) for s, (_, _, d) in zip(syms, args)]
@@ -223,14 +225,6 @@ def _auto_rows(funs, args, n_nodes) -> np.ndarray:
         m = fun.numel_out(0)
         rows.append(_row_scale(J.reshape(m, -1, n_nodes, order="F")))
     return np.concatenate(rows)
-
-
-def _sx(fun) -> bool:
-    try:
-        fun(*[ca.SX.sym("a", fun.sparsity_in(i)) for i in range(fun.n_in())])
-        return True
-    except Exception:  # noqa: BLE001
-        return False
 
 
 def _merge(cons, auto: np.ndarray) -> np.ndarray:

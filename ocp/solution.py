@@ -10,6 +10,8 @@ import numpy as np
 
 from dynamics.attitude import quat_conj, quat_mul
 
+from .cached import cached, function_key
+
 __all__ = ["Solution", "Propagation", "DenseOutput", "interval_integrator", "stack_interval_controls"]
 
 
@@ -141,7 +143,9 @@ class Solution:
     solve_time : float [s]
         Wall time of the IPOPT call.
     build_time : float [s]
-        Wall time spent building the NLP and the solver (0 when reused from the cache).
+        Wall time spent on the guess, the scaling, the NLP and the solver (the NLP and the
+        solver are reused from `dynamics.cache` when a problem is solved again on the same
+        mesh with the same scaling and options: `ocp.solve`).
     costates : ndarray, shape (nx, n), or None
         Costate estimates ``lambda(t)`` (``H = L + lambda . f``) at ``t`` from the defect
         multipliers (Radau only; ``None`` for the other transcriptions).
@@ -279,6 +283,18 @@ class Solution:
         ------
         ValueError
             If ``t`` is not finite or outside the horizon (no extrapolation).
+
+        Examples
+        --------
+        >>> import ocp
+        >>> from ocp.examples import min_energy
+        >>> energy = min_energy()  # x'' = u from rest at 0 to rest at 1 in T = 1 s
+        >>> sol = ocp.solve(energy, N=10)
+        >>> t = [0.0, 0.5, 1.0]
+        >>> x, u = sol.sample(t)  # x = 3 t^2 - 2 t^3, v = 6 t - 6 t^2, u = 6 - 12 t
+        >>> x.round(6) + 0.0, u.round(6) + 0.0
+        (array([[0. , 0.5, 1. ],
+               [0. , 1.5, 0. ]]), array([[ 6.,  0., -6.]]))
         """
         tq = np.asarray(t, dtype=float)
         scalar = tq.ndim == 0
@@ -330,12 +346,7 @@ class Solution:
         d = self.dense
         nx = self.problem.model.nx
         try:
-            integ = interval_integrator(self, self.transcription.node_sigma, rtol, atol)
-            x0 = ca.MX.sym("x0", nx)
-            dat = ca.MX.sym("data", integ.numel_in("p"))
-            xs = integ(x0=x0, p=dat)["xf"]
-            step = ca.Function("step", [x0, dat], [xs[:, -1], xs])
-            run = step.mapaccum("propagate", d.N)
+            run = _propagator(self, rtol, atol)
             pars = np.concatenate([d.us, stack_interval_controls(d.Uo, np.arange(d.N)), d.h[None, :],
                                    np.repeat(self.p[:, None], d.N, axis=1)], axis=0)
             _, xall = run(self.x[:, 0], pars)
@@ -402,8 +413,16 @@ def interval_integrator(sol: "Solution", grid, rtol: float, atol: float) -> ca.F
     own control polynomial, with outputs at the normalized times ``grid``.
 
     Inputs ``x0`` (nx,) and ``p`` = ``[u_start, vec(U_interval), h, p_model]``; output ``xf``
-    (nx, len(grid)). Shared by `Solution.propagate` and mesh refinement (`ocp.refine`).
+    (nx, len(grid)). Shared by `Solution.propagate` and mesh refinement (`ocp.refine`);
+    built once per transcription, model right-hand side, grid and tolerances (`ocp.cached`).
     """
+    tr, f = sol.transcription, sol.problem.model.f
+    grid = tuple(float(v) for v in grid)
+    return cached("interval_integrator", (tr, function_key(f), grid, float(rtol), float(atol)),
+                  lambda: _build_interval_integrator(sol, grid, rtol, atol), keepalive=f)
+
+
+def _build_interval_integrator(sol, grid, rtol, atol):
     d = sol.dense
     model = sol.problem.model
     nx, nu = model.nx, model.nu
@@ -416,6 +435,22 @@ def interval_integrator(sol: "Solution", grid, rtol: float, atol: float) -> ca.F
     return ca.integrator("interval", "cvodes", {"x": x, "p": data, "t": s, "ode": h * model.f(x, u, p)},
                          0.0, [float(v) for v in grid],
                          {"abstol": atol, "reltol": rtol, "max_num_steps": 100000})
+
+
+def _propagator(sol: "Solution", rtol: float, atol: float) -> ca.Function:
+    """``(x0 (nx,), data (.., N)) -> (xf, x at the owned nodes of every interval)``: the
+    interval integrators chained by ``mapaccum`` over the ``N`` intervals (cached)."""
+    tr, f, N = sol.transcription, sol.problem.model.f, sol.dense.N
+
+    def build():
+        integ = interval_integrator(sol, tr.node_sigma, rtol, atol)
+        x0 = ca.MX.sym("x0", f.numel_in(0))
+        dat = ca.MX.sym("data", integ.numel_in("p"))
+        xs = integ(x0=x0, p=dat)["xf"]
+        return ca.Function("step", [x0, dat], [xs[:, -1], xs]).mapaccum("propagate", N)
+
+    return cached("propagator", (tr, function_key(f), N, float(rtol), float(atol)), build,
+                  keepalive=f)
 
 
 def stack_interval_controls(Uo: np.ndarray, k: np.ndarray) -> np.ndarray:

@@ -43,6 +43,7 @@ from functools import cached_property
 import casadi as ca
 import numpy as np
 
+from .cached import cached, function_key
 from .mesh import Mesh
 
 __all__ = ["Transcription", "Trapezoid", "HermiteSimpson", "Radau", "RadauConstantControl",
@@ -155,7 +156,17 @@ class Transcription(abc.ABC):
             ``(x, u, p) -> xdot``.
         L : casadi.Function or None
             Running cost ``(x, u, p) -> L``; ``None`` gives ``quad = 0``.
+
+        Returns
+        -------
+        casadi.Function
+            Built once per transcription, ``f`` and ``L`` (`ocp.cached`).
         """
+        Lkey = None if L is None else function_key(L)
+        return cached("kernel", (self, function_key(f), Lkey), lambda: self._build_kernel(f, L),
+                      keepalive=(f, L))
+
+    def _build_kernel(self, f, L):
         sym = ca.SX if sx_compatible(f) and (L is None or sx_compatible(L)) else ca.MX
         nx, nu, np_ = f.numel_in(0), f.numel_in(1), f.numel_in(2)
         ins = self._symbols(sym, nx, nu, np_)
@@ -166,7 +177,12 @@ class Transcription(abc.ABC):
                            ["xs", "X", "us", "U", "h", "p"], ["defect", "xu", "quad"])
 
     def interpolant(self, f: ca.Function) -> ca.Function:
-        """The interval Function ``(xs, X, us, U, h, p, s) -> (x, u)`` (dense solution)."""
+        """The interval Function ``(xs, X, us, U, h, p, s) -> (x, u)`` (dense solution),
+        built once per transcription and ``f`` (`ocp.cached`)."""
+        return cached("interpolant", (self, function_key(f)), lambda: self._build_interpolant(f),
+                      keepalive=f)
+
+    def _build_interpolant(self, f):
         sym = ca.SX if sx_compatible(f) else ca.MX
         nx, nu, np_ = f.numel_in(0), f.numel_in(1), f.numel_in(2)
         ins = self._symbols(sym, nx, nu, np_)

@@ -8,6 +8,7 @@ from dataclasses import dataclass
 import casadi as ca
 import numpy as np
 
+from ..cached import cached, function_key
 from ..checks import integer
 from ..solution import Solution, interval_integrator, stack_interval_controls
 from ..transcription import Transcription
@@ -61,11 +62,16 @@ def _check_sigma(tr: Transcription) -> np.ndarray:
 
 def _interval_integrator(sol: Solution, rtol: float, atol: float) -> ca.Function:
     """``(x0 (nx, N), data) -> x at the check points of every interval`` by CVODES."""
-    integ = interval_integrator(sol, _check_sigma(sol.transcription), rtol, atol)
-    nx = sol.problem.model.nx
-    x0, dat = ca.MX.sym("x0", nx), ca.MX.sym("data", integ.numel_in("p"))
-    step = ca.Function("interval_step", [x0, dat], [ca.vec(integ(x0=x0, p=dat)["xf"])])
-    return step.map(sol.dense.N)
+    tr, f, N = sol.transcription, sol.problem.model.f, sol.dense.N
+
+    def build():
+        integ = interval_integrator(sol, _check_sigma(tr), rtol, atol)
+        x0, dat = ca.MX.sym("x0", f.numel_in(0)), ca.MX.sym("data", integ.numel_in("p"))
+        step = ca.Function("interval_step", [x0, dat], [ca.vec(integ(x0=x0, p=dat)["xf"])])
+        return step.map(N)
+
+    return cached("interval_check", (tr, function_key(f), N, float(rtol), float(atol)), build,
+                  keepalive=f)
 
 
 def _simpson(n: int) -> np.ndarray:

@@ -167,6 +167,16 @@ def refine(problem: Problem, solution: Solution | None = None, *, tol: float = 1
         ``info['stop']``. ``success`` is that of the last NLP (its message says so); not
         reaching ``tol`` within the limits keeps ``success=True`` with
         ``info['converged'] = False`` and a note in the message.
+
+    Examples
+    --------
+    >>> import ocp
+    >>> from ocp.examples import min_energy
+    >>> energy = min_energy()  # x'' = u from rest at 0 to rest at 1 in T = 1 s
+    >>> first = ocp.solve(energy, N=10, transcription="trapezoid")
+    >>> sol = ocp.refine(energy, first, tol=1e-8)
+    >>> sol.success, sol.info["converged"], round(sol.cost, 6)
+    (True, True, 6.0)
     """
     if not isinstance(problem, Problem):
         raise TypeError(f"`problem` must be an ocp.Problem, got {type(problem).__name__}")

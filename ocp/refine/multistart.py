@@ -38,6 +38,15 @@ def solve_multistart(problem: Problem, guesses: Sequence, **solve_kwargs) -> Ref
     ------
     ValueError
         If ``guesses`` is empty or not a sequence, or a guess is malformed (as `ocp.solve`).
+
+    Examples
+    --------
+    >>> import ocp
+    >>> from ocp.examples import min_time
+    >>> fastest = min_time()  # x'' = u, |u| <= 1, from rest at 0 to rest at 1
+    >>> sol = ocp.solve_multistart(fastest, [None, {"T": 5.0}], N=10)
+    >>> sol.success, round(sol.T, 6), len(sol.info["starts"])
+    (True, 2.0, 2)
     """
     if isinstance(guesses, (str, bytes, Mapping, Solution)) or not isinstance(guesses, Sequence):
         raise ValueError(f"`guesses` must be a sequence of guesses (None, Solution or mapping), "

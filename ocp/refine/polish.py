@@ -27,6 +27,7 @@ import numpy as np
 
 from dynamics.model import Model
 
+from ..cached import cached, function_key
 from ..checks import integer
 from ..mesh import Mesh
 from ..problem import Constraint, Problem
@@ -65,17 +66,24 @@ def _merged(constraints, wrap, extra=()) -> Constraint | None:
     return Constraint(lambda *a: ca.vertcat(*[f(*a) for f in funs]), lower, upper, scale, name)
 
 
+def _free_mesh_rhs(f: ca.Function) -> ca.Function:
+    """``(x, t), (u, v) -> (v f(x, u, p), v)``: the right-hand side in pseudo time."""
+    nx, nu, np_ = f.numel_in(0), f.numel_in(1), f.numel_in(2)
+    sym = ca.SX if sx_compatible(f) else ca.MX
+    xa, ua, p = sym.sym("x", nx + 1), sym.sym("u", nu + 1), sym.sym("p", np_)
+    v = ua[nu]
+    rhs = ca.vertcat(v * f(xa[:nx], ua[:nu], p), v)
+    return ca.Function(f"{f.name()}_free_mesh", [xa, ua, p], [rhs], ["x", "u", "p"], ["xdot"])
+
+
 def _free_mesh_problem(problem: Problem, T_ref: float, stretch) -> Problem:
     """The problem in pseudo time ``sigma`` with the clock ``t`` as an extra state and the
     dilation ``v = dt/dsigma`` as an extra control, ``stretch[0] T_ref <= v <=
     stretch[1] T_ref`` (see the module docstring)."""
     model = problem.model
-    nx, nu, np_ = model.nx, model.nu, model.np
-    sym = ca.SX if sx_compatible(model.f) else ca.MX
-    xa, ua, p = sym.sym("x", nx + 1), sym.sym("u", nu + 1), sym.sym("p", np_)
-    v = ua[nu]
-    rhs = ca.vertcat(v * model.f(xa[:nx], ua[:nu], p), v)
-    fa = ca.Function(f"{model.f.name()}_free_mesh", [xa, ua, p], [rhs], ["x", "u", "p"], ["xdot"])
+    nx, nu = model.nx, model.nu
+    fa = cached("free_mesh_rhs", (function_key(model.f),), lambda: _free_mesh_rhs(model.f),
+                keepalive=model.f)
     aug = Model(fa, model.states + (_fresh_name(_CLOCK, model.states),),
                 model.controls + (_fresh_name(_STRETCH, model.controls),), model.params,
                 p_default=model.p_default, name=f"{model.name}_free_mesh", attitude=model.attitude)
@@ -179,6 +187,17 @@ def polish_switches(problem: Problem, solution: Solution, *, N: int | None = Non
     -----
     Path constraints are imposed at the interval ends only. ``T`` of the result is not
     necessarily below that of ``solution``: both carry their own discretization errors.
+
+    Examples
+    --------
+    The bang-bang double integrator: the switch moves onto its exact time T/2 = 1 s.
+
+    >>> import ocp
+    >>> from ocp.examples import min_time
+    >>> fastest = min_time()  # x'' = u, |u| <= 1, from rest at 0 to rest at 1
+    >>> sol = ocp.polish_switches(fastest, ocp.solve(fastest, N=10))
+    >>> sol.success, round(sol.T, 8), ocp.find_switches(sol).round(8)
+    (True, 2.0, array([1.]))
     """
     if not isinstance(problem, Problem):
         raise TypeError(f"`problem` must be an ocp.Problem, got {type(problem).__name__}")

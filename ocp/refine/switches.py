@@ -79,6 +79,15 @@ def control_switches(solution: Solution, *, samples: int = 9) -> list[np.ndarray
         If ``solution`` is not a `Solution` or ``samples`` not an integer.
     ValueError
         If ``samples < 2``.
+
+    Examples
+    --------
+    >>> import ocp
+    >>> from ocp.examples import min_time
+    >>> fastest = min_time()  # x'' = u, |u| <= 1, from rest at 0 to rest at 1
+    >>> sol = ocp.solve(fastest, N=10)
+    >>> [s.round(6) for s in ocp.control_switches(sol)]  # u = +1, then -1 from t = T/2
+    [array([1.])]
     """
     if not isinstance(solution, Solution):
         raise TypeError(f"`solution` must be an ocp.Solution, got {type(solution).__name__}")
@@ -113,6 +122,12 @@ def find_switches(solution: Solution, *, samples: int = 9) -> np.ndarray:
     Returns
     -------
     ndarray, shape (m,) [s]
+
+    Examples
+    --------
+    >>> from ocp import examples, find_switches, solve
+    >>> find_switches(solve(examples.min_time(), N=10)).round(6)  # x'' = u, |u| <= 1
+    array([1.])
     """
     per = control_switches(solution, samples=samples)
     out = np.sort(np.concatenate(per)) if per else np.zeros(0)

@@ -38,3 +38,18 @@ def test_starts_must_be_a_positive_integer():
         slew.time_optimal(np.eye(3), angle=1.0, axis=[0, 0, 1], starts=0)
     with pytest.raises(TypeError, match="`starts`"):
         slew.time_optimal(np.eye(3), angle=1.0, axis=[0, 0, 1], starts=2.5)
+
+
+def test_ignored_arguments_warn():
+    guess = {"T": 1.0}
+    with pytest.warns(UserWarning, match="`starts` and `seed` are ignored with a user `guess`"):
+        slew.time_optimal(np.eye(3), angle=0.1, axis=[0, 0, 1], guess=guess, starts=2, seed=1,
+                          N=8, polish=False)
+    with pytest.warns(UserWarning, match="`polish` is ignored with `norm_bound`"):
+        slew.time_optimal(np.eye(3), angle=0.1, axis=[0, 0, 1], norm_bound=True, polish=True,
+                          starts=1, N=8)
+    with pytest.warns(UserWarning, match="`starts` is ignored without a `keep_out`"):
+        slew.min_effort(np.eye(3), 2.0, angle=0.1, axis=[1, 0, 0], N=8, starts=2)
+    with pytest.warns(UserWarning, match="`T_max` is ignored"):
+        slew.slew_problem(np.eye(3), objective="effort", T=1.0, angle=0.1, axis=[1, 0, 0],
+                          T_max=5.0)

@@ -34,3 +34,17 @@ def test_plot_slew_returns_a_figure_and_saves_on_request(bilimoria_wie, tmp_path
     assert isinstance(fig2, Figure) and out.stat().st_size > 0
     with pytest.raises(TypeError, match="`fig`"):
         slew.plot_slew(bilimoria_wie, fig="figure")
+
+
+def test_switch_times_component_and_the_deprecated_axis(bilimoria_wie):
+    sol = bilimoria_wie
+    per = slew.switch_times(sol)
+    np.testing.assert_array_equal(slew.switch_times(sol, component=1), per[1])
+    with pytest.warns(DeprecationWarning, match="component"):
+        np.testing.assert_array_equal(slew.switch_times(sol, axis=1), per[1])
+    with pytest.raises(ValueError, match="`component`"):
+        slew.switch_times(sol, component=3)
+    with pytest.raises(TypeError, match="`component`"):
+        slew.switch_times(sol, component=[0, 0, 1])
+    with pytest.raises(TypeError, match="not both"):
+        slew.switch_times(sol, component=1, axis=1)

@@ -13,6 +13,7 @@ from hypothesis import strategies as st
 from scipy.integrate import solve_ivp
 
 from problems import slew
+from problems.slew import maneuvers
 
 E = np.eye(3)
 
@@ -134,7 +135,7 @@ def test_refinement_tol_is_required(monkeypatch):
         slew.min_effort(E, 2.0, angle=1.0, axis=[1, 0, 0], tol=1e-16)
     # a refinement stopped above tol (here: no refinement round allowed) is not a success
     import ocp
-    monkeypatch.setattr(slew, "refine", lambda *a, **k: ocp.refine(*a, **{**k, "max_rounds": 0}))
+    monkeypatch.setattr(maneuvers, "refine", lambda *a, **k: ocp.refine(*a, **{**k, "max_rounds": 0}))
     sol = slew.min_effort([2.0, 3.0, 4.0], 2.0, angle=1.0, axis=[1, 1, 0], N=4, tol=1e-12)
     assert sol.success is False and sol.status == slew.STATUS_REFINE
     assert "tol 1e-12 was not met" in sol.message

@@ -1,0 +1,57 @@
+"""Optimal attitude slews of a rigid body: time-optimal and minimum-effort.
+
+Both build an `ocp.Problem` on `dynamics.rigid_body` (state ``[q1..q4, w1..w3]``, control
+body torque) and return an `ocp.Solution`:
+
+* `time_optimal` minimizes the final time under per-axis torque bounds ``|u_i| <= u_max_i``
+  or a norm bound ``|u| <= u_max``. Time-optimal slews have local optima (the eigenaxis
+  maneuver is one, Bilimoria & Wie 1993), so without a user guess it solves from several
+  seeded guesses (the eigenaxis SLERP and SLERPs tilted by a sinusoidal rotation about
+  seeded random axes), keeps the best, and polishes the bang-bang switch times
+  (`ocp.polish_switches`).
+* `min_effort` minimizes ``1/2 integral |u|^2 dt`` over a fixed time, refined until the
+  re-integrated trajectory matches the collocated one (`ocp.refine`).
+
+The target attitude is ``qf`` or a rotation by ``angle`` about ``axis`` (body frame at the
+start) from ``q0``; it is met up to sign (``q`` and ``-q`` are the same attitude). End rates
+default to rest. An optional keep-out cone keeps a body-fixed boresight more than a given
+angle away from an inertial direction throughout.
+
+Verified results
+----------------
+Every slew result says ``success=True`` only when
+
+1. the NLP is verified (`ocp.solve`: IPOPT's ``Solve_Succeeded`` and a constraint violation
+   below ``constraint_tol``; for `min_effort` also the refinement ``tol`` met), and
+2. re-simulating the returned control from ``q0``, ``w0`` (`ocp.Solution.propagation`,
+   CVODES at rtol = atol = 1e-12) ends within ``pointing_tol`` [rad] of the target attitude
+   (`ocp.Solution.pointing_error`, the rotation angle between the re-simulated final
+   quaternion and ``qf``) and within ``rate_tol`` [rad/s] of the final rates ``wf``
+   (largest component of `ocp.Solution.terminal_error`). Defaults: ``pointing_tol`` =
+   `POINTING_TOL` = 1e-6 rad (0.2 arcsec), ``rate_tol`` = `RATE_TOL` = 1e-6 rad/s.
+
+Otherwise ``success=False`` with ``status`` `STATUS_POINTING` (``'Pointing_Tol_Not_Met'``),
+`STATUS_REFINE` (``'Refinement_Tol_Not_Met'``) or the engine's own status. A rest-to-rest
+slew by a zero angle (``q0 = +/- qf``) is answered exactly without an NLP:
+`ocp.rest_solution` with ``T = 0`` (time-optimal) or zero torque over ``T`` (minimum
+effort), ``status = 'Rest_Solution'``. Tiny angles are solved in well-conditioned units: the
+horizon and the objective are scaled by the bang-bang time ``2 sqrt(angle / alpha)``, the
+target rows by the initial attitude error (`ocp.scaling`).
+
+Modules
+-------
+`targets` (input checks, the target attitude, `KeepOut`, defaults and statuses),
+`problem` (`slew_problem`, `eigenaxis_time`, guesses), `maneuvers` (`time_optimal`,
+`min_effort`, `verify`), `report` (`switch_times`, `summary`, `format_summary`, `plot_slew`).
+"""
+from __future__ import annotations
+
+from .maneuvers import min_effort, time_optimal, verify
+from .problem import attitude_guess, eigenaxis_time, slew_problem
+from .report import format_summary, plot_slew, summary, switch_times
+from .targets import (MIN_REFINE_TOL, POINTING_TOL, RATE_TOL, STATUS_POINTING, STATUS_REFINE,
+                      KeepOut)
+
+__all__ = ["KeepOut", "slew_problem", "time_optimal", "min_effort", "eigenaxis_time",
+           "switch_times", "attitude_guess", "verify", "summary", "format_summary", "plot_slew",
+           "POINTING_TOL", "RATE_TOL", "MIN_REFINE_TOL", "STATUS_POINTING", "STATUS_REFINE"]

@@ -1,0 +1,313 @@
+"""The maneuvers: `time_optimal`, `min_effort`, and `verify` (the re-simulation grade)."""
+from __future__ import annotations
+
+import math
+import warnings
+
+import numpy as np
+
+from ocp import (Solution, annotate, polish_switches, refine, rest_solution, solve,
+                 solve_multistart)
+from ocp.checks import integer
+
+from .problem import (attitude_guess, inertia_of, is_rest_to_rest, rough_time, seeded_guesses,
+                      slew_angle, slew_problem)
+from .targets import (ARCSEC, MIN_REFINE_TOL, POINTING_TOL, RATE_TOL, STATUS_POINTING,
+                      STATUS_REFINE, check_tol)
+
+__all__ = ["time_optimal", "min_effort", "verify", "DEFAULT_STARTS_TIME", "DEFAULT_STARTS_EFFORT"]
+
+DEFAULT_STARTS_TIME = 3  # seeded starts of time_optimal without a user guess
+DEFAULT_STARTS_EFFORT = 4  # seeded starts of min_effort with a keep-out cone
+
+
+def verify(solution: Solution, *, pointing_tol: float = POINTING_TOL, rate_tol: float = RATE_TOL):
+    """Re-simulate a slew solution and grade it (see the module docstring).
+
+    Parameters
+    ----------
+    solution : ocp.Solution
+        A solution of a `slew_problem`.
+    pointing_tol : float [rad]
+        Largest accepted `ocp.Solution.pointing_error` (default 1e-6).
+    rate_tol : float [rad/s]
+        Largest accepted final rate error, ``max_i |w_sim,i(tf) - wf_i|`` (default 1e-6).
+
+    Returns
+    -------
+    ocp.RefinedSolution
+        ``solution`` with ``info['pointing_error']`` [rad], ``info['final_rate_error']``
+        [rad/s], ``info['pointing_tol']``, ``info['rate_tol']``; ``success`` stays ``True``
+        only if it was and both errors are within their tolerances (else ``status``
+        `STATUS_POINTING` and a message with the numbers).
+
+    Raises
+    ------
+    TypeError
+        If ``solution`` is not an `ocp.Solution` or a tolerance is not a number.
+    ValueError
+        If a tolerance is not a finite number > 0.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from problems import slew
+    >>> sol = slew.min_effort(np.eye(3), 2.0, angle=0.1, axis=[1, 0, 0], N=10)
+    >>> strict = slew.verify(sol, pointing_tol=1e-15)  # re-simulated, graded again
+    >>> strict.success, strict.status
+    (False, 'Pointing_Tol_Not_Met')
+    """
+    if not isinstance(solution, Solution):
+        raise TypeError(f"`solution` must be an ocp.Solution, got {type(solution).__name__}")
+    ptol = check_tol("pointing_tol", pointing_tol, POINTING_TOL)
+    rtol = check_tol("rate_tol", rate_tol, RATE_TOL)
+    perr = solution.pointing_error
+    perr = float("nan") if perr is None else perr
+    term = solution.terminal_error[4:7]
+    rerr = float(np.max(term)) if np.all(np.isfinite(term)) else float("nan")
+    info = {"pointing_error": perr, "final_rate_error": rerr, "pointing_tol": ptol, "rate_tol": rtol}
+    if not solution.success:
+        return annotate(solution, info)
+    if perr <= ptol and rerr <= rtol:
+        return annotate(solution, info, message=(
+            f"{solution.message}; verified by re-simulation: pointing error "
+            f"{perr * ARCSEC:.3g} arcsec, final rate error {rerr:.2g} rad/s"))
+    return annotate(solution, info, success=False, status=STATUS_POINTING, message=(
+        f"{solution.message}; NOT verified: the re-simulated control ends {perr:.3g} rad "
+        f"({perr * ARCSEC:.3g} arcsec) from the target (pointing_tol {ptol:g}) with a final "
+        f"rate error {rerr:.3g} rad/s (rate_tol {rtol:g})"))
+
+
+def _warn_ignored(*, why: str, **given) -> None:
+    """A `UserWarning` naming the arguments of ``given`` that are not None: ignored ``why``."""
+    names = [f"`{k}`" for k, v in given.items() if v is not None]
+    if names:
+        warnings.warn(f"{' and '.join(names)} {'is' if len(names) == 1 else 'are'} ignored {why}",
+                      stacklevel=3)
+
+
+def _rest(problem, T, pointing_tol, rate_tol):
+    """Zero-angle rest-to-rest slews: the exact answer, no NLP (or None)."""
+    if not (is_rest_to_rest(problem) and slew_angle(problem) <= 8 * np.finfo(float).eps):
+        return None
+    return verify(rest_solution(problem, T=T), pointing_tol=pointing_tol, rate_tol=rate_tol)
+
+
+def _tiny_scale(problem, T_est):
+    """Scale overrides for small rest-to-rest angles: horizon and objective in units of the
+    bang-bang time (IPOPT then sees O(1) numbers however small the angle)."""
+    if slew_angle(problem) >= 1e-2 or not is_rest_to_rest(problem):
+        return None
+    d = float(2.0 ** round(math.log2(T_est)))
+    return {"T": d, "objective": d}
+
+
+def time_optimal(inertia, *, angle=None, axis=None, q0=None, qf=None, u_max=1.0,
+                 norm_bound=False, w0=None, wf=None, keep_out=None, T_max=None, guess=None,
+                 starts=None, seed=None, N=30, transcription="radau", polish=None,
+                 verbose=False, ipopt_options=None, pointing_tol=POINTING_TOL,
+                 rate_tol=RATE_TOL) -> Solution:
+    """Minimum-time rigid-body slew under torque bounds.
+
+    Parameters
+    ----------
+    inertia : array_like, shape (3, 3) or (3,) [kg m^2]
+    angle : float [rad], axis : array_like, shape (3,) — rotation from ``q0`` about a body axis
+    q0, qf : array_like, shape (4,) — initial (default identity) and target quaternions
+    u_max : float or array_like, shape (3,) [N m] — per-axis bound (or the norm bound)
+    norm_bound : bool — ``|u| <= u_max`` instead of per-axis bounds
+    w0, wf : array_like, shape (3,) [rad/s] — end rates (default rest to rest)
+    keep_out : KeepOut, optional
+    T_max : float [s], optional — upper bound on the final time
+    guess : None, ocp.Solution or mapping
+        A user guess (then a single start is solved). ``None``: multi-start.
+    starts : int, optional — number of seeded starts without a user guess (eigenaxis +
+        tilted; default 3). Ignored, with a warning, when ``guess`` is given.
+    seed : int, optional — seed of the tilt axes (default 0; results are reproducible).
+        Ignored, with a warning, when ``guess`` is given.
+    N : int — intervals of the first solve
+    transcription : str — of the first solve (any of ``ocp.TRANSCRIPTIONS``)
+    polish : bool, optional
+        Default True where it applies: not with ``norm_bound`` or ``keep_out`` (their
+        optimal torques are not bang-bang per axis), where ``polish=True`` is ignored with a
+        warning. Re-solve with free knots so switch times are exact (`ocp.polish_switches`, Radau
+        degree 5, IPOPT ``tol`` 1e-9 unless ``ipopt_options`` says otherwise). The polished
+        result is returned only if it is verified and not slower than the first; otherwise
+        the first solution (``info['polish']`` says why). Should neither be verified (the
+        first's fixed mesh can smear the switches beyond ``pointing_tol``), the first is
+        mesh-refined (`ocp.refine`, tol 1e-6, at most 4 rounds) and verified again.
+    verbose : bool — IPOPT progress lines
+    ipopt_options : dict, optional
+    pointing_tol : float [rad] — largest re-simulated final attitude error of a success
+    rate_tol : float [rad/s] — largest re-simulated final rate error of a success
+
+    Returns
+    -------
+    ocp.RefinedSolution
+        ``T`` is the optimal time [s]; ``success`` as in the module docstring; ``info``
+        records the starts, the polish, ``pointing_error`` [rad] and ``final_rate_error``
+        [rad/s]. A zero-angle rest-to-rest slew returns ``T = 0`` at once.
+
+    Examples
+    --------
+    A 0.1 rad rest-to-rest slew of a unit-inertia body about its third axis, ``|u_i| <= 1``:
+    bang-bang, ``T = 2 sqrt(0.1)`` (small N and one start to keep it quick):
+
+    >>> import numpy as np
+    >>> from problems import slew
+    >>> sol = slew.time_optimal(np.eye(3), angle=0.1, axis=[0, 0, 1], N=10, starts=1)
+    >>> sol.success, round(sol.T, 6), round(slew.eigenaxis_time(np.eye(3), 0.1, [0, 0, 1]), 6)
+    (True, 0.632456, 0.632456)
+    """
+    ptol = check_tol("pointing_tol", pointing_tol, POINTING_TOL)
+    rtol = check_tol("rate_tol", rate_tol, RATE_TOL)
+    problem = slew_problem(inertia, objective="time", angle=angle, axis=axis, q0=q0, qf=qf,
+                           u_max=u_max, norm_bound=norm_bound, w0=w0, wf=wf,
+                           keep_out=keep_out, T_max=T_max)
+    if guess is None:
+        starts = integer(DEFAULT_STARTS_TIME if starts is None else starts, "starts", 1)
+    else:
+        _warn_ignored(starts=starts, seed=seed, why="with a user `guess` (a single start is solved)")
+    seed = 0 if seed is None else seed
+    if polish and (norm_bound or keep_out is not None):
+        _warn_ignored(polish=polish, why="with `norm_bound` or `keep_out` (not bang-bang per axis)")
+    polish = True if polish is None else bool(polish)
+    rest = _rest(problem, 0.0, ptol, rtol)
+    if rest is not None:
+        return rest
+    T_est = rough_time(inertia_of(problem.model), problem.x_initial[:4], problem.q_final,
+                        problem.u_bounds[1], floor=1e-14 if is_rest_to_rest(problem) else 1e-3)
+    opts = dict(transcription=transcription, N=N, verbose=verbose, ipopt_options=ipopt_options,
+                scale=_tiny_scale(problem, T_est))
+    if guess is not None:
+        sol = solve(problem, guess=guess, **opts)
+    else:
+        guesses = seeded_guesses(problem, int(starts), seed, eigenaxis=keep_out is None)
+        sol = solve_multistart(problem, guesses, **opts)
+    first = sol
+    sol = verify(sol, pointing_tol=ptol, rate_tol=rtol)
+    if not (polish and first.success and not norm_bound and keep_out is None):
+        return _refined_fallback(problem, first, sol, ptol, rtol, ipopt_options, opts["scale"])
+    # degree 5: at degree 3 the ~4 intervals per arc under-resolve the states and the free
+    # knots exploit the collocation error (T below the best known); at degree 4 the
+    # re-simulated pointing error of Bilimoria-Wie is 4e-7 rad, at degree 5 3e-10 (measured)
+    polish_opts = {"tol": 1e-9, **(ipopt_options or {})}
+    pscale = None if opts["scale"] is None else {"objective": opts["scale"]["objective"],
+                                                 "t_clock": opts["scale"]["T"]}
+    polished = polish_switches(problem, sol, degree=5, verbose=verbose, ipopt_options=polish_opts,
+                               scale=pscale)
+    polished = verify(polished, pointing_tol=ptol, rate_tol=rtol)
+    if polished.success and (polished.T <= sol.T + 1e-9 or not sol.success):
+        first = {k: sol.info[k] for k in ("starts", "best") if k in sol.info}
+        return annotate(polished, first) if first else polished
+    why = (f"polish not used: {polished.message}" if not polished.success else
+           f"polish not used: its T = {polished.T:.10g} s is not below {sol.T:.10g} s")
+    return _refined_fallback(problem, first, annotate(sol, {"polish": why}), ptol, rtol,
+                             ipopt_options, opts["scale"])
+
+
+def _refined_fallback(problem, first, verified, ptol, rtol, ipopt_options, scale):
+    """When the first NLP solution converged but its re-simulation misses the target (the
+    fixed mesh smears the switches): refine the mesh (`ocp.refine`, 4 rounds, tol 1e-6)
+    and verify again. Returns ``verified`` unchanged if it already is a success or the NLP
+    itself failed."""
+    if verified.success or not first.success:
+        return verified
+    ref = refine(problem, first, tol=1e-6, max_rounds=4, ipopt_options=ipopt_options, scale=scale)
+    ref = verify(ref, pointing_tol=ptol, rate_tol=rtol)
+    if ref.success:
+        keep = {k: first.info[k] for k in ("starts", "best", "polish") if k in first.info}
+        keep.update({k: verified.info[k] for k in ("polish",) if k in verified.info})
+        return annotate(ref, keep)
+    return verified
+
+
+def min_effort(inertia, T, *, angle=None, axis=None, q0=None, qf=None, u_max=None,
+               norm_bound=False, w0=None, wf=None, keep_out=None, guess=None, N=20,
+               tol=1e-7, starts=None, seed=None, verbose=False, ipopt_options=None,
+               pointing_tol=POINTING_TOL, rate_tol=RATE_TOL) -> Solution:
+    """Minimum-effort (``1/2 integral |u|^2 dt``) rigid-body slew over a fixed time ``T``.
+
+    Parameters
+    ----------
+    inertia : array_like, shape (3, 3) or (3,) [kg m^2]
+    T : float [s] — maneuver time
+    angle, axis, q0, qf, w0, wf, keep_out : as in `time_optimal`
+    u_max : float or array_like, shape (3,) [N m], optional — torque bound (default none)
+    norm_bound : bool
+    guess : None, ocp.Solution or mapping — default: eigenaxis SLERP (with a keep-out cone:
+        multi-start from ``starts`` seeded tilted paths, best kept)
+    N : int — intervals of the first mesh
+    starts : int, optional — seeded tilted starts with a ``keep_out`` cone and no ``guess``
+        (default 4); ignored otherwise, with a warning
+    seed : int, optional — seed of their tilt axes (default 0); ignored, with a warning,
+        where ``starts`` is
+    tol : float
+        Mesh-refinement target for the relative re-integration error (`ocp.refine`), at
+        least `MIN_REFINE_TOL` = 1e-12 (the CVODES reference of the error estimate is good
+        to about 1e-13). ``success`` requires it to be met.
+    verbose, ipopt_options, pointing_tol, rate_tol : as in `time_optimal`
+
+    Returns
+    -------
+    ocp.RefinedSolution
+        ``cost`` in [N^2 m^2 s]; ``success`` as in the module docstring (``status``
+        `STATUS_REFINE` when the refinement stopped above ``tol``). For a rest-to-rest
+        rotation by ``theta`` about a principal axis with moment ``J`` and no active bound:
+        ``u = J theta (6/T^2 - 12 t/T^3)``, cost ``6 J^2 theta^2 / T^3``.
+
+    Raises
+    ------
+    TypeError, ValueError
+        Bad input, naming the argument (``tol`` below 1e-12 among them).
+
+    Examples
+    --------
+    A 0.1 rad rest-to-rest slew about a principal axis in T = 2 s: the cubic profile, cost
+    ``6 J^2 theta^2 / T^3 = 0.0075``:
+
+    >>> import numpy as np
+    >>> from problems import slew
+    >>> sol = slew.min_effort(np.eye(3), 2.0, angle=0.1, axis=[1, 0, 0], N=10)
+    >>> sol.success, round(sol.cost, 8)
+    (True, 0.0075)
+    """
+    ptol = check_tol("pointing_tol", pointing_tol, POINTING_TOL)
+    rtol = check_tol("rate_tol", rate_tol, RATE_TOL)
+    tol = check_tol("tol", tol, 1e-7)
+    if tol < MIN_REFINE_TOL:
+        raise ValueError(f"`tol` must be at least {MIN_REFINE_TOL:g} (what the re-integration "
+                         f"reference can resolve in double precision), got {tol:g}")
+    if guess is not None or keep_out is None:
+        _warn_ignored(starts=starts, seed=seed,
+                      why="without a `keep_out` cone or with a user `guess` (a single start)")
+    problem = slew_problem(inertia, objective="effort", T=T, angle=angle, axis=axis, q0=q0,
+                           qf=qf, u_max=u_max, norm_bound=norm_bound, w0=w0, wf=wf,
+                           keep_out=keep_out)
+    rest = _rest(problem, problem.T, ptol, rtol)
+    if rest is not None:
+        return rest
+    scale = None
+    if is_rest_to_rest(problem) and slew_angle(problem) < 1e-2:
+        # the cost of the single-axis cubic profile, 6 (J theta)^2 / T^3, as its scale
+        J = float(np.max(np.linalg.eigvalsh(inertia_of(problem.model))))
+        d = 6.0 * (J * slew_angle(problem)) ** 2 / problem.T ** 3
+        scale = {"objective": float(2.0 ** round(math.log2(d)))}
+    opts = dict(N=N, verbose=verbose, ipopt_options=ipopt_options, scale=scale)
+    if guess is not None:
+        first = solve(problem, guess=guess, **opts)
+    elif keep_out is None:
+        first = solve(problem, guess=attitude_guess(problem), **opts)
+    else:
+        # the eigenaxis path may cross the cone's centre, a symmetric saddle between the two
+        # ways around: start from seeded tilted paths instead and keep the best
+        starts = integer(DEFAULT_STARTS_EFFORT if starts is None else starts, "starts", 1)
+        guesses = seeded_guesses(problem, starts, 0 if seed is None else seed, eigenaxis=False)
+        first = solve_multistart(problem, guesses, **opts)
+    if not first.success:
+        return verify(first, pointing_tol=ptol, rate_tol=rtol)
+    sol = refine(problem, first, tol=tol, verbose=verbose, ipopt_options=ipopt_options, scale=scale)
+    if sol.success and not sol.info.get("converged", False):
+        sol = annotate(sol, {}, success=False, status=STATUS_REFINE,
+                       message=f"{sol.message}; the requested refinement tol {tol:g} was not met")
+    return verify(sol, pointing_tol=ptol, rate_tol=rtol)

@@ -1,0 +1,211 @@
+"""Reports of a slew solution: switch times, a JSON-ready summary, a table, a figure."""
+from __future__ import annotations
+
+import warnings
+
+import numpy as np
+
+from dynamics.attitude import dcm_from_quat
+from ocp import Solution, control_switches
+
+from .targets import ARCSEC
+
+__all__ = ["switch_times", "summary", "format_summary", "plot_slew"]
+
+
+def switch_times(solution: Solution, *, component=None, axis=None) -> list:
+    """Switch times [s] of each torque component: the engine's one switch detector
+    (`ocp.control_switches`: bound-to-bound jumps at the middle of the range, and both ends
+    of interior arcs), so they agree with `ocp.find_switches` and `ocp.interval_errors`.
+
+    Parameters
+    ----------
+    solution : ocp.Solution of a slew
+    component : int, optional
+        One torque component (0, 1, 2); default all.
+    axis : int, optional
+        Deprecated name of ``component`` (``axis`` is a 3-vector everywhere else); warns
+        with a `DeprecationWarning`.
+
+    Returns
+    -------
+    list of ndarray, or ndarray
+        One array of switch times per component, or the array of ``component``.
+
+    Raises
+    ------
+    TypeError
+        If ``component`` is not an integer, or both ``component`` and ``axis`` are given.
+    ValueError
+        If ``component`` is out of range.
+
+    Examples
+    --------
+    A 0.1 rad rest-to-rest slew about the third body axis switches once, at half time:
+
+    >>> import numpy as np
+    >>> from problems import slew
+    >>> sol = slew.time_optimal(np.eye(3), angle=0.1, axis=[0, 0, 1], N=10, starts=1)
+    >>> t_s = slew.switch_times(sol, component=2)
+    >>> t_s.round(4), round(sol.T / 2, 4)
+    (array([0.3162]), 0.3162)
+    """
+    if axis is not None:
+        if component is not None:
+            raise TypeError("give `component`, not both `component` and its old name `axis`")
+        warnings.warn("`switch_times(axis=...)` is deprecated: use `component=` (an integer "
+                      "torque component; `axis` is a 3-vector elsewhere)", DeprecationWarning,
+                      stacklevel=2)
+        component, name = axis, "axis"
+    else:
+        name = "component"
+    per = control_switches(solution)
+    if component is None:
+        return per
+    if isinstance(component, (bool, np.bool_)) or not isinstance(component, (int, np.integer)):
+        raise TypeError(f"`{name}` must be a component index 0, 1 or 2, got {component!r}")
+    if not 0 <= component < len(per):
+        raise ValueError(f"`{name}` must be a component index in [0, {len(per)}), "
+                         f"got {component!r}")
+    return per[int(component)]
+
+
+# ----------------------------------------------------------------------- reporting
+def summary(solution: Solution, *, eigenaxis=None) -> dict:
+    """JSON-ready summary of a slew solution.
+
+    Keys: success, status, message, T [s], cost, switch_times [s] (per torque axis),
+    iterations, solve_time [s], constraint_violation (NLP units, see `ocp.solve`),
+    pointing_error_arcsec (final attitude error of the re-simulated control [arcsec]),
+    final_rate_error [rad/s] (same re-simulation), propagation_error (largest deviation of
+    the re-integrated trajectory from the collocated states), quaternion_norm_error, and
+    ``eigenaxis_T`` [s] when given. Re-simulation numbers are NaN when it failed.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from problems import slew
+    >>> sol = slew.time_optimal(np.eye(3), angle=0.1, axis=[0, 0, 1], N=10, starts=1)
+    >>> data = slew.summary(sol, eigenaxis=slew.eigenaxis_time(np.eye(3), 0.1, [0, 0, 1]))
+    >>> data["success"], data["status"], round(data["T"], 6), round(data["eigenaxis_T"], 6)
+    (True, 'Solve_Succeeded', 0.632456, 0.632456)
+    >>> [np.round(s, 4).tolist() for s in data["switch_times"]]
+    [[], [], [0.3162]]
+    """
+    sw = switch_times(solution) if solution.success else [np.array([])] * 3
+    info = getattr(solution, "info", {}) or {}
+    perr = info.get("pointing_error", solution.pointing_error)
+    rerr = info.get("final_rate_error")
+    if rerr is None:
+        term = solution.terminal_error[4:7]
+        rerr = float(np.max(term)) if np.all(np.isfinite(term)) else float("nan")
+    out = dict(
+        success=bool(solution.success),
+        status=str(solution.status),
+        message=str(solution.message),
+        T=float(solution.T),
+        cost=float(solution.cost),
+        switch_times=[s.tolist() for s in sw],
+        iterations=int(solution.iterations),
+        solve_time=float(solution.solve_time),
+        constraint_violation=float(solution.constraint_violation),
+        pointing_error_arcsec=float("nan") if perr is None else float(perr) * ARCSEC,
+        final_rate_error=float(rerr),
+        propagation_error=float(solution.propagation_error),
+        quaternion_norm_error=float(solution.quaternion_norm_error),
+    )
+    if eigenaxis is not None:
+        out["eigenaxis_T"] = float(eigenaxis)
+    return out
+
+
+def format_summary(data: dict) -> str:
+    """A readable table of `summary` output.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from problems import slew
+    >>> sol = slew.time_optimal(np.eye(3), angle=0.1, axis=[0, 0, 1], N=10, starts=1)
+    >>> print(slew.format_summary(slew.summary(sol)))  # doctest: +ELLIPSIS
+    Optimal slew
+      success                   True (Solve_Succeeded)
+      maneuver time T [s]       0.632456
+      cost                      0.6324555...
+      switch times u1 [s]       -
+      switch times u2 [s]       -
+      switch times u3 [s]       0.3162
+      IPOPT iterations          ...
+    """
+    rows = [
+        ("success", f"{data['success']} ({data['status']})"),
+        ("maneuver time T [s]", f"{data['T']:.6f}"),
+    ]
+    if "eigenaxis_T" in data:
+        rows.append(("eigenaxis maneuver T [s]", f"{data['eigenaxis_T']:.6f}"))
+    rows.append(("cost", f"{data['cost']:.8g}"))
+    for i, s in enumerate(data["switch_times"]):
+        rows.append((f"switch times u{i + 1} [s]", ", ".join(f"{v:.4f}" for v in s) or "-"))
+    rows += [
+        ("IPOPT iterations", f"{data['iterations']}"),
+        ("solve time [s]", f"{data['solve_time']:.3f}"),
+        ("constraint violation", f"{data['constraint_violation']:.2e}"),
+        ("pointing error [arcsec]", f"{data['pointing_error_arcsec']:.3g}"),
+        ("final rate error [rad/s]", f"{data['final_rate_error']:.2e}"),
+        ("propagation error", f"{data['propagation_error']:.2e}"),
+        ("|q| - 1 (max)", f"{data['quaternion_norm_error']:.2e}"),
+    ]
+    width = max(len(k) for k, _ in rows)
+    return "\n".join(["Optimal slew"] + [f"  {k:<{width}}  {v}" for k, v in rows])
+
+
+def plot_slew(solution: Solution, path=None, *, fig=None, dpi: int = 110):
+    """Quaternion, rates, torques and the rotation path (body axes on the unit sphere).
+
+    Builds a `matplotlib.figure.Figure` (no pyplot, no backend change) and returns it; the
+    caller shows or saves it. With ``path`` it is also saved there (``Figure.savefig``).
+
+    Parameters
+    ----------
+    solution : ocp.Solution of a slew
+    path : str or path-like, optional
+        Where to save the figure.
+    fig : matplotlib.figure.Figure, optional
+        Draw into this (empty) figure instead of a new 12 x 8 in one.
+    dpi : int
+        Resolution when saving.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    from matplotlib.figure import Figure
+
+    if fig is None:
+        fig = Figure(figsize=(12, 8))
+    elif not isinstance(fig, Figure):
+        raise TypeError(f"`fig` must be a matplotlib Figure, got {type(fig).__name__}")
+    t = np.linspace(solution.t[0], solution.t[-1], 400)
+    x, u = solution.sample(t)
+    panels = [(x[:4], "quaternion", [f"q{i + 1}" for i in range(4)]),
+              (x[4:], "body rate [rad/s]", ["w1", "w2", "w3"]),
+              (u, "torque [N m]", ["u1", "u2", "u3"])]
+    for k, (data, label, names) in enumerate(panels):
+        ax = fig.add_subplot(2, 2, k + 1)
+        for row, name in zip(data, names):
+            ax.plot(t, row, label=name)
+        ax.set(xlabel="t [s]", ylabel=label)
+        ax.legend(loc="best", fontsize=8)
+        ax.grid(alpha=0.3)
+    ax = fig.add_subplot(2, 2, 4, projection="3d")
+    A = dcm_from_quat(x[:4] / np.linalg.norm(x[:4], axis=0))  # (3, 3, n): rows = body axes
+    for i, c in enumerate(("tab:red", "tab:green", "tab:blue")):
+        ax.plot(A[i, 0], A[i, 1], A[i, 2], color=c, label=f"body axis {i + 1}")
+        ax.scatter(*A[i, :, -1], color=c, marker="o")
+    ax.set(title="Rotation path (inertial)", xlim=(-1, 1), ylim=(-1, 1), zlim=(-1, 1))
+    ax.legend(fontsize=8)
+    fig.suptitle(f"T = {solution.T:.5f} s, cost = {solution.cost:.6g}")
+    fig.tight_layout()
+    if path is not None:
+        fig.savefig(path, dpi=dpi)
+    return fig
