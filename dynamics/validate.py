@@ -35,6 +35,7 @@ __all__ = [
     "rotation_matrix",
     "one_of",
     "integer",
+    "positive",
     "check_inertia",
 ]
 
@@ -541,9 +542,10 @@ def integer(value, name: str, *, minimum: int | None = None) -> int:
     Raises
     ------
     TypeError
-        If ``value`` is not a number (a string, ``None``, a ``bool``, an array).
+        If ``value`` is not an integer (a string, ``None``, a ``bool``, an array, ``2.5`` or
+        ``3.0``); raised as `ArgumentTypeError`, which is also a ``ValueError``.
     ValueError
-        If it is a number but not an integer (``2.5``, ``3.0``), or below ``minimum``.
+        If it is below ``minimum``.
 
     Examples
     --------
@@ -561,9 +563,47 @@ def integer(value, name: str, *, minimum: int | None = None) -> int:
     if isinstance(value, (bool, np.bool_)) or not number:
         raise ArgumentTypeError(
             f"`{name}` must be an integer{bound}, got {type(value).__name__} {_short(value)}")
-    if not isinstance(value, (int, np.integer)) or (minimum is not None and value < minimum):
+    if not isinstance(value, (int, np.integer)):
+        raise ArgumentTypeError(f"`{name}` must be an integer{bound}, got {value!r}")
+    if minimum is not None and value < minimum:
         raise ValueError(f"`{name}` must be an integer{bound}, got {value!r}")
     return int(value)
+
+
+def positive(value, name: str) -> float:
+    """Check a finite number ``> 0`` and return it as a float.
+
+    Parameters
+    ----------
+    value : float
+    name : str
+        Argument name used in the error message.
+
+    Returns
+    -------
+    float
+
+    Raises
+    ------
+    TypeError
+        If ``value`` is not a real number.
+    ValueError
+        If it is not finite or not ``> 0``.
+
+    Examples
+    --------
+    >>> from dynamics.validate import positive
+    >>> positive(2, "u_max")
+    2.0
+    >>> positive(0.0, "u_max")
+    Traceback (most recent call last):
+        ...
+    ValueError: `u_max` must be a finite number > 0, got 0.0
+    """
+    v = finite_scalar(value, name)
+    if not v > 0:
+        raise ValueError(f"`{name}` must be a finite number > 0, got {value!r}")
+    return v
 
 
 def check_inertia(inertia, *, name="inertia", triangle=True):

@@ -9,7 +9,7 @@ import casadi as ca
 import numpy as np
 
 from ..cached import cached, function_key
-from ..checks import integer
+from dynamics.validate import integer
 from ..solution import Solution, interval_integrator, stack_interval_controls
 from ..transcription import Transcription
 from .switches import control_switches
@@ -119,7 +119,7 @@ def interval_errors(solution: Solution, *, rtol: float = 1e-11, atol: float = 1e
     """
     if not isinstance(solution, Solution):
         raise TypeError(f"`solution` must be an ocp.Solution, got {type(solution).__name__}")
-    samples = integer(samples, "samples", 3)
+    samples = integer(samples, "samples", minimum=3)
     if samples % 2 == 0:
         raise ValueError(f"`samples` must be an odd integer >= 3, got {samples!r}")
     sol, d = solution, solution.dense

@@ -9,7 +9,7 @@ import time
 
 import numpy as np
 
-from ..checks import integer, positive
+from dynamics.validate import integer, positive
 from ..mesh import Mesh
 from ..problem import Problem
 from ..progress import LOGGER
@@ -183,8 +183,8 @@ def refine(problem: Problem, solution: Solution | None = None, *, tol: float = 1
     if solution is not None and not isinstance(solution, Solution):
         raise TypeError(f"`solution` must be an ocp.Solution or None, got {type(solution).__name__}")
     positive(tol, "tol")
-    max_rounds = integer(max_rounds, "max_rounds", 0)
-    max_intervals = integer(max_intervals, "max_intervals", 1)
+    max_rounds = integer(max_rounds, "max_rounds", minimum=0)
+    max_intervals = integer(max_intervals, "max_intervals", minimum=1)
     if progress is not None and not callable(progress):
         raise TypeError(f"`progress` must be a callable or None, got {type(progress).__name__}")
     tr = _transcription(transcription, degree)

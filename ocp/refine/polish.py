@@ -28,7 +28,7 @@ import numpy as np
 from dynamics.model import Model
 
 from ..cached import cached, function_key
-from ..checks import integer
+from dynamics.validate import integer
 from ..mesh import Mesh
 from ..problem import Constraint, Problem
 from ..solution import Solution
@@ -206,7 +206,7 @@ def polish_switches(problem: Problem, solution: Solution, *, N: int | None = Non
     if solution.problem.model.nx != problem.model.nx or solution.problem.model.nu != problem.model.nu:
         raise ValueError("`solution` must solve a problem with the states and controls of `problem`")
     if N is not None:
-        N = integer(N, "N", 1)
+        N = integer(N, "N", minimum=1)
     try:
         lo_s, hi_s = (float(v) for v in stretch)
     except (TypeError, ValueError):

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..checks import integer
+from dynamics.validate import integer
 from ..solution import Solution
 
 __all__ = ["control_switches", "find_switches"]
@@ -91,7 +91,7 @@ def control_switches(solution: Solution, *, samples: int = 9) -> list[np.ndarray
     """
     if not isinstance(solution, Solution):
         raise TypeError(f"`solution` must be an ocp.Solution, got {type(solution).__name__}")
-    samples = integer(samples, "samples", 2)
+    samples = integer(samples, "samples", minimum=2)
     d = solution.dense
     N = d.N
     s = np.linspace(0.0, 1.0, samples)

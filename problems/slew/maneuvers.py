@@ -8,7 +8,7 @@ import numpy as np
 
 from ocp import (Solution, annotate, polish_switches, refine, rest_solution, solve,
                  solve_multistart)
-from ocp.checks import integer
+from dynamics.validate import integer
 
 from .problem import (attitude_guess, inertia_of, is_rest_to_rest, rough_time, seeded_guesses,
                       slew_angle, slew_problem)
@@ -165,7 +165,7 @@ def time_optimal(inertia, *, angle=None, axis=None, q0=None, qf=None, u_max=1.0,
                            u_max=u_max, norm_bound=norm_bound, w0=w0, wf=wf,
                            keep_out=keep_out, T_max=T_max)
     if guess is None:
-        starts = integer(DEFAULT_STARTS_TIME if starts is None else starts, "starts", 1)
+        starts = integer(DEFAULT_STARTS_TIME if starts is None else starts, "starts", minimum=1)
     else:
         _warn_ignored(starts=starts, seed=seed, why="with a user `guess` (a single start is solved)")
     seed = 0 if seed is None else seed
@@ -301,7 +301,7 @@ def min_effort(inertia, T, *, angle=None, axis=None, q0=None, qf=None, u_max=Non
     else:
         # the eigenaxis path may cross the cone's centre, a symmetric saddle between the two
         # ways around: start from seeded tilted paths instead and keep the best
-        starts = integer(DEFAULT_STARTS_EFFORT if starts is None else starts, "starts", 1)
+        starts = integer(DEFAULT_STARTS_EFFORT if starts is None else starts, "starts", minimum=1)
         guesses = seeded_guesses(problem, starts, 0 if seed is None else seed, eigenaxis=False)
         first = solve_multistart(problem, guesses, **opts)
     if not first.success:

@@ -14,7 +14,7 @@ import numpy as np
 
 from dynamics.attitude import dcm_from_quat, quat_from_axis_angle, quat_mul, quat_normalize
 from dynamics.validate import finite_array, finite_scalar, unit_quaternion, unit_vector
-from ocp.checks import positive
+from dynamics.validate import positive
 
 __all__ = ["KeepOut", "POINTING_TOL", "RATE_TOL", "MIN_REFINE_TOL", "STATUS_POINTING",
            "STATUS_REFINE", "ARCSEC", "vector3", "targets", "check_u_max", "check_angle",
@@ -117,5 +117,5 @@ def check_angle(angle) -> float:
     return finite_scalar(angle, "angle")
 
 def check_tol(name, value, default):
-    """``default`` when ``value`` is None, else a finite float > 0 (`ocp.checks.positive`)."""
+    """``default`` when ``value`` is None, else a finite float > 0 (`dynamics.validate.positive`)."""
     return default if value is None else positive(value, name)
