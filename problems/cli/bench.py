@@ -16,6 +16,8 @@ def add_parser(subparsers):
     bench = subparsers.add_parser("bench", help="run benchmarks from the bench/ folder")
     bench.set_defaults(_parser=bench)
     bench.add_argument("names", nargs="*", help="benchmark names (default: all), e.g. simulate")
+    bench.add_argument("--quick", action="store_true",
+                       help="a smoke run: fewer tolerances and repeats (passed to each script)")
     return bench
 
 
@@ -36,7 +38,12 @@ def run(args) -> int:
         print(f"appdyn: error: unknown benchmark(s) {unknown}; available: {available}",
               file=sys.stderr)
         return 2
-    for name in names:
-        print(f"== bench/{name}.py ==", flush=True)
-        runpy.run_path(str(BENCH_DIR / f"{name}.py"), run_name="__main__")
+    argv = sys.argv
+    try:
+        for name in names:
+            print(f"== bench/{name}.py ==", flush=True)
+            sys.argv = [str(BENCH_DIR / f"{name}.py")] + (["--quick"] if args.quick else [])
+            runpy.run_path(sys.argv[0], run_name="__main__")
+    finally:
+        sys.argv = argv
     return 0

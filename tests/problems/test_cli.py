@@ -108,3 +108,20 @@ def test_umax_is_a_hidden_alias_of_u_max(capsys):
         parser.parse_args(["slew", "--help"])
     text = capsys.readouterr().out
     assert "--u-max" in text and "--umax" not in text
+
+
+def test_bench_passes_quick_to_the_script(tmp_path, monkeypatch, capsys):
+    """`appdyn bench NAME --quick` runs bench/NAME.py as __main__ with --quick in sys.argv."""
+    import sys
+
+    from problems.cli import bench
+
+    out = tmp_path / "argv.txt"
+    (tmp_path / "probe.py").write_text(
+        "import sys\nopen(%r, 'w').write(' '.join(sys.argv[1:]))\n" % str(out))
+    monkeypatch.setattr(bench, "BENCH_DIR", tmp_path)
+    argv = list(sys.argv)
+    assert main(["bench", "probe", "--quick"]) == 0
+    assert out.read_text() == "--quick" and sys.argv == argv
+    assert main(["bench", "probe"]) == 0 and out.read_text() == ""
+    assert main(["bench", "missing"]) == 2
