@@ -32,6 +32,8 @@ phases of the reference (spin angles ``2`` and ``4`` rad) and must agree.
 """
 from __future__ import annotations
 
+import warnings
+
 from dataclasses import dataclass, field, replace
 from typing import Literal, Mapping
 
@@ -76,8 +78,9 @@ class Linearization:
     p : ndarray, shape (np,)
     frame : {'spinning', 'rates', 'none'}
         ``'none'`` for models without attitude
-    reference_rate : ndarray, shape (3,) or None
-        Body rate [rad/s] of the reference frame (``frame='spinning'``).
+    w_ref : ndarray, shape (3,) or None
+        Body rates [rad/s] of the reference frame (``frame='spinning'``); ``reference_rate``
+        is its deprecated name.
     residual : ndarray, shape (n,)
         The derivative of the (reduced) state at the operating point; zero at an equilibrium.
         Its units are those of ``states`` per second.
@@ -101,13 +104,20 @@ class Linearization:
     u0: np.ndarray
     p: np.ndarray
     frame: str
-    reference_rate: np.ndarray | None
+    w_ref: np.ndarray | None
     residual: np.ndarray
     tolerance: float
     is_equilibrium: bool
     units: Mapping[str, str] = field(default_factory=dict)
     model_name: str = "model"
     notes: tuple = ()
+
+    @property
+    def reference_rate(self) -> np.ndarray | None:
+        """Deprecated name of `w_ref` (a rate vector is ``w_*``; ``rate`` is a scalar)."""
+        warnings.warn("`reference_rate` is deprecated; use `w_ref`", DeprecationWarning,
+                      stacklevel=2)
+        return self.w_ref
 
     @property
     def outputs(self) -> tuple:
@@ -492,7 +502,7 @@ def linearization(model: Model, x, u=None, p=None, *, frame: Frame = "spinning",
     return Linearization(
         A=A[sub], B=B[keep], C=np.eye(n), D=np.zeros((n, model.nu)), states=states,
         inputs=model.controls, x0=x, u0=u, p=p, frame=used_frame,
-        reference_rate=w_ref if used_frame == "spinning" else None, residual=residual,
+        w_ref=w_ref if used_frame == "spinning" else None, residual=residual,
         tolerance=float(tol), is_equilibrium=not problems,
         units={s: units.get(s, "") for s in states}, model_name=model.name,
         notes=tuple(problems))

@@ -6,6 +6,7 @@ from __future__ import annotations
 import math
 import sys
 import time
+import warnings
 
 import numpy as np
 
@@ -113,8 +114,9 @@ def _report(rnd: int, r: RefinementRound, verbose, progress) -> None:
 
 
 def refine(problem: Problem, solution: Solution | None = None, *, tol: float = 1e-6,
-           max_rounds: int = 6, max_intervals: int = 400, transcription="radau", N: int = 20,
-           degree: int = 3, verbose=False, progress=None, **solve_kwargs) -> RefinedSolution:
+           max_rounds: int = 6, max_intervals: int = 400, transcription="radau",
+           N: int | None = None, degree: int | None = None, verbose=False, progress=None,
+           **solve_kwargs) -> RefinedSolution:
     """Solve ``problem`` and refine the mesh until the estimated error is below ``tol``.
 
     Each round estimates the error of every interval (`interval_errors`: re-integration of
@@ -145,9 +147,11 @@ def refine(problem: Problem, solution: Solution | None = None, *, tol: float = 1
         Largest number of re-solves after the initial solve.
     max_intervals : int
         Largest number of mesh intervals.
-    transcription, degree : see `ocp.solve` (``degree`` applies to ``'radau'`` only).
-    N : int
-        Number of uniform intervals of the initial mesh (without ``solution`` or ``mesh``).
+    transcription, degree : see `ocp.solve` (``degree``, default 3, applies to ``'radau'``
+        given by name only; given otherwise it is ignored with a warning).
+    N : int, optional
+        Number of uniform intervals of the initial mesh (default 20); ignored with a warning
+        when ``solution`` or ``mesh`` gives the mesh.
     verbose : bool or callable
         Passed to `ocp.solve`; ``True`` also prints one line per round to ``sys.stdout``.
     progress : callable, optional
@@ -187,11 +191,19 @@ def refine(problem: Problem, solution: Solution | None = None, *, tol: float = 1
     max_intervals = integer(max_intervals, "max_intervals", minimum=1)
     if progress is not None and not callable(progress):
         raise TypeError(f"`progress` must be a callable or None, got {type(progress).__name__}")
-    tr = _transcription(transcription, degree)
-    q = _local_order(tr)
     kw = dict(solve_kwargs)
     guess0 = kw.pop("guess", None)
     mesh0 = kw.pop("mesh", None)
+    if degree is not None and transcription != "radau":
+        warnings.warn(f"`degree` is ignored: it applies to transcription 'radau' given by "
+                      f"name, not {transcription!r}", UserWarning, stacklevel=2)
+    if N is not None and (solution is not None or mesh0 is not None):
+        warnings.warn("`N` is ignored: the mesh comes from "
+                      f"{'`solution`' if solution is not None else '`mesh`'}", UserWarning,
+                      stacklevel=2)
+    N = 20 if N is None else N
+    tr = _transcription(transcription, 3 if degree is None else degree)
+    q = _local_order(tr)
 
     t_round = time.perf_counter()
     if solution is not None and solution.problem is problem and solution.transcription == tr:

@@ -239,3 +239,17 @@ def test_quotient_and_restrict_remove_exactly_the_neutral_zero():
         lin.restrict("w2")
     with pytest.raises(ValueError, match="`state` must be one of"):
         lin.quotient("q1")
+
+
+def test_reference_rate_is_the_deprecated_name_of_w_ref():
+    """Vocabulary: a rate vector is ``w_*``; the old field name still reads, with a warning."""
+    import warnings as _warnings
+
+    from dynamics import linearization, rigid_body
+
+    lin = linearization(rigid_body([2.0, 3.0, 4.5]), [0, 0, 0, 1, 10.0, 0, 0])
+    np.testing.assert_allclose(lin.w_ref, [10.0, 0.0, 0.0])
+    with _warnings.catch_warnings(record=True) as seen:
+        _warnings.simplefilter("always")
+        np.testing.assert_array_equal(lin.reference_rate, lin.w_ref)
+    assert any(issubclass(w.category, DeprecationWarning) for w in seen)

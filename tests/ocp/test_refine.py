@@ -258,3 +258,13 @@ def test_multistart_rejects_bad_guesses():
         solve_multistart(problem, [])
     with pytest.raises(ValueError, match="`guesses`"):
         solve_multistart(problem, {"T": 1.0})
+
+
+def test_ignored_mesh_arguments_warn():
+    """`N` with a solution and `degree` with a non-Radau transcription are ignored: say so."""
+    problem, _ = min_energy()
+    first = solve(problem, N=6, verbose=False)
+    with pytest.warns(UserWarning, match="`N` is ignored"):
+        refine(problem, first, N=50, tol=1e-3, max_rounds=0)
+    with pytest.warns(UserWarning, match="`degree` is ignored"):
+        refine(problem, N=4, tol=1e-3, max_rounds=0, transcription="trapezoid", degree=5)
