@@ -4,6 +4,8 @@ Rheinfurth & Wilson, NASA RP-1262, Sec. 4.5 A (Poinsot construction) and 4.5 C (
 """
 from __future__ import annotations
 
+import warnings
+
 from typing import NamedTuple
 
 import numpy as np
@@ -99,23 +101,39 @@ def cone_angles(inertia_diag, w0):
     return ConeAngles(float(th_min), float(th_max), axis_index)
 
 
-def small_asymmetry_rates(inertia_diag, spin_rate, *, axis_index=None, axis=None):
+def _rate_arg(rate, spin_rate):
+    """Resolve ``rate`` and its deprecated keyword ``spin_rate``: ``(value, name used)``."""
+    if spin_rate is None:
+        if rate is None:
+            raise TypeError("missing the spin `rate` [rad/s]")
+        return rate, "rate"
+    if rate is not None:
+        raise TypeError("pass `rate` only; `spin_rate` is its deprecated name")
+    warnings.warn("the keyword `spin_rate` is deprecated (a scalar spin rate is `rate`); use "
+                  "`rate=`", DeprecationWarning, stacklevel=3)
+    return spin_rate, "spin_rate"
+
+
+def small_asymmetry_rates(inertia_diag, rate=None, *, axis_index=None, axis=None,
+                          spin_rate=None):
     """Coefficients of the linearized motion about a steady spin [1]_.
 
     With spin axis ``a`` and the other axes ``b, c`` in cyclic order (``a, b, c`` =
     ``0, 1, 2``; ``1, 2, 0``; ``2, 0, 1``), Euler's equations linearized about
-    ``w = spin_rate e_a`` read ``w_b' + lambda1 w_c = 0``, ``w_c' - lambda2 w_b = 0``.
+    ``w = rate e_a`` read ``w_b' + lambda1 w_c = 0``, ``w_c' - lambda2 w_b = 0``.
 
     Parameters
     ----------
     inertia_diag : array_like, shape (3,) [kg m^2]
         Principal moments (caller's order).
-    spin_rate : float [rad/s]
+    rate : float [rad/s]
         Nominal spin ``w0`` about the axis ``axis_index``.
     axis_index : {0, 1, 2}, optional
         Spin axis index; ``None`` (default) means 0 (axis 1 of [1]_).
     axis : int, optional
         Deprecated name of ``axis_index`` (warns).
+    spin_rate : float, optional
+        Deprecated name of ``rate`` (warns).
 
     Returns
     -------
@@ -125,7 +143,7 @@ def small_asymmetry_rates(inertia_diag, spin_rate, *, axis_index=None, axis=None
     Raises
     ------
     ValueError
-        Naming ``inertia_diag``, ``spin_rate`` or ``axis_index``.
+        Naming ``inertia_diag``, ``rate`` or ``axis_index``.
 
     References
     ----------
@@ -139,13 +157,15 @@ def small_asymmetry_rates(inertia_diag, spin_rate, *, axis_index=None, axis=None
     (2.0, 2.0)
     """
     inertia = check_moments(inertia_diag)
-    w0 = validate.finite_scalar(spin_rate, "spin_rate")
+    rate, rate_name = _rate_arg(rate, spin_rate)
+    w0 = validate.finite_scalar(rate, rate_name)
     a = validate.one_of(*axis_index_arg(axis_index, axis, 0), (0, 1, 2))
     b, c = (a + 1) % 3, (a + 2) % 3
     return (inertia[a] - inertia[c]) / inertia[b] * w0, (inertia[a] - inertia[b]) / inertia[c] * w0
 
 
-def small_asymmetry_frequency(inertia_diag, spin_rate, *, axis_index=None, axis=None):
+def small_asymmetry_frequency(inertia_diag, rate=None, *, axis_index=None, axis=None,
+                              spin_rate=None):
     """Nutation frequency ``sqrt(lambda1 lambda2)`` of a spin about a major or minor axis.
 
     It is the limit of the exact elliptic rate ``lam`` as the nutation goes to zero
@@ -174,7 +194,11 @@ def small_asymmetry_frequency(inertia_diag, spin_rate, *, axis_index=None, axis=
     2.0
     """
     a, name = axis_index_arg(axis_index, axis, 0)
-    lam1, lam2 = small_asymmetry_rates(inertia_diag, spin_rate, axis_index=a)
+    rate, rate_name = _rate_arg(rate, spin_rate)
+    try:
+        lam1, lam2 = small_asymmetry_rates(inertia_diag, rate, axis_index=a)
+    except ValueError as exc:
+        raise type(exc)(str(exc).replace("`rate`", f"`{rate_name}`")) from None
     prod = lam1 * lam2
     if prod < 0:
         raise ValueError(

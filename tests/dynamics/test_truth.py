@@ -556,7 +556,7 @@ BAD = [
     (truth.cone_angles, (BASE, [0.0, 0.0, 0.0]), {}, "w0"),
     (truth.cone_angles, ([2.0, 2.0, 2.0], W), {}, "inertia_diag"),
     (truth.small_asymmetry_frequency, (BASE, 1.0), {"axis": 1}, "axis"),  # intermediate
-    (truth.small_asymmetry_rates, (BASE, [1.0, 2.0]), {}, "spin_rate"),
+    (truth.small_asymmetry_rates, (BASE, [1.0, 2.0]), {}, "rate"),
     (truth.small_asymmetry_rates, (BASE, 1.0), {"axis": -1}, "axis"),
     (truth.symmetric_precession, (BASE, W), {}, "inertia_diag"),
     (truth.axisymmetric, ([1.0, 1.0, 1.5], W, Q0, 1.0), {"axis_index": 0}, "inertia_diag"),
@@ -634,3 +634,15 @@ def test_deprecated_axis_field_warns():
     for res in results:
         with pytest.warns(DeprecationWarning, match="axis_index"):
             assert res.axis == res.axis_index
+
+
+def test_spin_rate_is_the_deprecated_name_of_rate():
+    """Vocabulary: a scalar spin rate is `rate`; `spin_rate=` still works and warns."""
+    new = truth.small_asymmetry_rates([1.0, 2.0, 3.0], rate=2.0, axis_index=2)
+    with pytest.warns(DeprecationWarning, match="spin_rate"):
+        old = truth.small_asymmetry_rates([1.0, 2.0, 3.0], spin_rate=2.0, axis_index=2)
+    assert old == new == (2.0, 2.0)
+    with pytest.warns(DeprecationWarning), pytest.raises(ValueError, match="`spin_rate`"):
+        truth.small_asymmetry_frequency([1.0, 2.0, 3.0], spin_rate=float("nan"))
+    with pytest.raises(TypeError, match="rate"):
+        truth.small_asymmetry_rates([1.0, 2.0, 3.0], 1.0, spin_rate=1.0)
