@@ -112,21 +112,33 @@ def time_optimal(inertia, *, angle=None, axis=None, q0=None, qf=None, u_max=1.0,
     Parameters
     ----------
     inertia : array_like, shape (3, 3) or (3,) [kg m^2]
-    angle : float [rad], axis : array_like, shape (3,) — rotation from ``q0`` about a body axis
-    q0, qf : array_like, shape (4,) — initial (default identity) and target quaternions
-    u_max : float or array_like, shape (3,) [N m] — per-axis bound (or the norm bound)
-    norm_bound : bool — ``|u| <= u_max`` instead of per-axis bounds
-    w0, wf : array_like, shape (3,) [rad/s] — end rates (default rest to rest)
+    angle : float [rad]
+        Rotation from ``q0`` about the body axis ``axis``.
+    axis : array_like, shape (3,)
+        The rotation axis in the body frame.
+    q0, qf : array_like, shape (4,)
+        Initial (default identity) and target quaternions
+    u_max : float or array_like, shape (3,) [N m]
+        Per-axis bound (or the norm bound)
+    norm_bound : bool
+        ``|u| <= u_max`` instead of per-axis bounds
+    w0, wf : array_like, shape (3,) [rad/s]
+        End rates (default rest to rest)
     keep_out : KeepOut, optional
-    T_max : float [s], optional — upper bound on the final time
+    T_max : float [s], optional
+        Upper bound on the final time
     guess : None, ocp.Solution or mapping
         A user guess (then a single start is solved). ``None``: multi-start.
-    starts : int, optional — number of seeded starts without a user guess (eigenaxis +
+    starts : int, optional
+        Number of seeded starts without a user guess (eigenaxis +
         tilted; default 3). Ignored, with a warning, when ``guess`` is given.
-    seed : int, optional — seed of the tilt axes (default 0; results are reproducible).
+    seed : int, optional
+        Seed of the tilt axes (default 0; results are reproducible).
         Ignored, with a warning, when ``guess`` is given.
-    N : int — intervals of the first solve
-    transcription : str — of the first solve (any of ``ocp.TRANSCRIPTIONS``)
+    N : int
+        Intervals of the first solve
+    transcription : str
+        Of the first solve (any of ``ocp.TRANSCRIPTIONS``)
     polish : bool, optional
         Default True where it applies: not with ``norm_bound`` or ``keep_out`` (their
         optimal torques are not bang-bang per axis), where ``polish=True`` is ignored with a
@@ -136,10 +148,13 @@ def time_optimal(inertia, *, angle=None, axis=None, q0=None, qf=None, u_max=1.0,
         the first solution (``info['polish']`` says why). Should neither be verified (the
         first's fixed mesh can smear the switches beyond ``pointing_tol``), the first is
         mesh-refined (`ocp.refine`, tol 1e-6, at most 4 rounds) and verified again.
-    verbose : bool — IPOPT progress lines
+    verbose : bool
+        IPOPT progress lines
     ipopt_options : dict, optional
-    pointing_tol : float [rad] — largest re-simulated final attitude error of a success
-    rate_tol : float [rad/s] — largest re-simulated final rate error of a success
+    pointing_tol : float [rad]
+        Largest re-simulated final attitude error of a success
+    rate_tol : float [rad/s]
+        Largest re-simulated final rate error of a success
 
     Returns
     -------
@@ -231,16 +246,22 @@ def min_effort(inertia, T, *, angle=None, axis=None, q0=None, qf=None, u_max=Non
     Parameters
     ----------
     inertia : array_like, shape (3, 3) or (3,) [kg m^2]
-    T : float [s] — maneuver time
+    T : float [s]
+        Maneuver time
     angle, axis, q0, qf, w0, wf, keep_out : as in `time_optimal`
-    u_max : float or array_like, shape (3,) [N m], optional — torque bound (default none)
+    u_max : float or array_like, shape (3,) [N m], optional
+        Torque bound (default none)
     norm_bound : bool
-    guess : None, ocp.Solution or mapping — default: eigenaxis SLERP (with a keep-out cone:
+    guess : None, ocp.Solution or mapping
+        Default: eigenaxis SLERP (with a keep-out cone:
         multi-start from ``starts`` seeded tilted paths, best kept)
-    N : int — intervals of the first mesh
-    starts : int, optional — seeded tilted starts with a ``keep_out`` cone and no ``guess``
+    N : int
+        Intervals of the first mesh
+    starts : int, optional
+        Seeded tilted starts with a ``keep_out`` cone and no ``guess``
         (default 4); ignored otherwise, with a warning
-    seed : int, optional — seed of their tilt axes (default 0); ignored, with a warning,
+    seed : int, optional
+        Seed of their tilt axes (default 0); ignored, with a warning,
         where ``starts`` is
     tol : float
         Mesh-refinement target for the relative re-integration error (`ocp.refine`), at

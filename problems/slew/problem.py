@@ -31,13 +31,17 @@ def slew_problem(inertia, *, objective, T=None, angle=None, axis=None, q0=None, 
     inertia : array_like, shape (3, 3) or (3,) [kg m^2]
     objective : {"time", "effort"}
         Minimum final time, or minimum ``1/2 integral |u|^2 dt`` [N^2 m^2 s] over fixed ``T``.
-    T : float [s] — horizon for ``"effort"`` (ignored for ``"time"``)
+    T : float [s]
+        Horizon for ``"effort"`` (ignored for ``"time"``)
     angle, axis, q0, qf : see module docstring; ``angle`` [rad], ``axis`` body frame
     u_max : float or array_like, shape (3,) [N m], or None (unbounded; ``"effort"`` only)
-    norm_bound : bool — bound ``|u| <= u_max`` (scalar ``u_max``) instead of per axis
-    w0, wf : array_like, shape (3,) [rad/s] — end rates (default rest)
+    norm_bound : bool
+        Bound ``|u| <= u_max`` (scalar ``u_max``) instead of per axis
+    w0, wf : array_like, shape (3,) [rad/s]
+        End rates (default rest)
     keep_out : KeepOut, optional
-    T_max : float [s], optional — upper bound of a free final time (default 20x eigenaxis);
+    T_max : float [s], optional
+        Upper bound of a free final time (default 20x eigenaxis);
         ignored for ``"effort"``, with a warning
 
     Returns
@@ -123,7 +127,8 @@ def eigenaxis_time(inertia, angle, axis, u_max=1.0) -> float:
         Rotation angle; the maneuver takes the short way: ``angle`` is reduced to the
         equivalent rotation in [0, pi] (modulo 2 pi, and ``2 pi - a`` about the same axis
         for ``a > pi``; the sign of ``angle`` does not matter).
-    axis : array_like, shape (3,) — non-zero, body frame (normalized here)
+    axis : array_like, shape (3,)
+        Non-zero, body frame (normalized here)
     u_max : float or array_like, shape (3,) [N m]
 
     Returns

@@ -34,9 +34,12 @@ class KeepOut:
 
     Parameters
     ----------
-    boresight : array_like, shape (3,) — body-fixed unit vector (normalized here)
-    direction : array_like, shape (3,) — inertial unit vector to avoid, e.g. the Sun
-    half_angle : float [rad] — in (0, pi)
+    boresight : array_like, shape (3,)
+        Body-fixed unit vector (normalized here)
+    direction : array_like, shape (3,)
+        Inertial unit vector to avoid, e.g. the Sun
+    half_angle : float [rad]
+        In (0, pi)
 
     Examples
     --------
