@@ -31,7 +31,8 @@ inside the loop.
 Costs measured on a 2-core machine (rigid body, 7 states): per step about 55 ns (rk4),
 140 ns (lie), 180-250 ns (rk8) compiled, 2-3 us interpreted, plus a few us of Python per
 chunk of 512 steps. The default ``max_steps`` of ``auto`` (1e8 rk8 steps) is thus
-about 20 s of compiled work.
+about 20 s of compiled work. Compiling a model's chunk takes about 0.4 s, once; after it a
+100 s torque-free run at rtol 1e-10 takes 3-4 ms (23 ms interpreted).
 
 Controls
 --------

@@ -73,10 +73,9 @@ def simulate(model: Model, x0, t, *, u=None, p=None, method: Method = "auto",
     jit : bool, optional
         Compile the loops to C (``True``) or never (``False``). By default (``None``) every
         method compiles its one chunk loop per model and control mode on first use whenever
-        a C compiler (``gcc`` or ``cc``) is found (about 0.4 s once; then a 100 s run at
-        rtol 1e-10 takes 3-4 ms instead of 23 ms interpreted), never depending on how often
-        the model was used (see `dynamics.cache`). Compiled loops are cached;
-        `dynamics.clear_caches` drops them.
+        a C compiler (``gcc`` or ``cc``) is found, never depending on how often the model was
+        used (see `dynamics.cache`; costs in `dynamics.integrate`). Compiled loops are
+        cached; `dynamics.clear_caches` drops them.
     max_steps : int, optional
         ``auto``: most rk8 steps in one run (default 1e8); a tolerance that needs more is
         reported as ``status`` 3, not attempted.
