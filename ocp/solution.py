@@ -9,6 +9,8 @@ import casadi as ca
 import numpy as np
 
 from dynamics.attitude import quat_conj, quat_mul
+from dynamics.figures import finish_figure, new_figure
+from dynamics.serialize import text_table, to_json
 
 from .cached import cached, function_key
 
@@ -192,6 +194,69 @@ class Solution:
                 f"constraint_violation={self.constraint_violation:.3g}, "
                 f"transcription={self.transcription.name!r}, N={self.mesh.N}, "
                 f"iterations={self.iterations}, solve_time={self.solve_time:.3g} s)")
+
+    def __str__(self) -> str:
+        rows = [("success", f"{self.success} ({self.status})"),
+                ("cost", f"{self.cost:.10g}"),
+                ("T [s]", f"{self.T:.10g}"),
+                ("mesh", f"{self.transcription.name}, N = {self.mesh.N}"),
+                ("constraint violation", f"{self.constraint_violation:.3g}"),
+                ("IPOPT iterations", f"{self.iterations}"),
+                ("build / solve time [s]", f"{self.build_time:.3g} / {self.solve_time:.3g}"),
+                ("message", self.message)]
+        return text_table("Optimal control solution", rows)
+
+    def to_dict(self) -> dict:
+        """Summary and trajectories as plain Python (``x``, ``u`` by name at the nodes ``t``);
+        JSON-ready through `to_json`. The re-simulation is not run for it."""
+        model = self.problem.model
+        return {
+            "success": bool(self.success), "status": self.status, "message": self.message,
+            "cost": self.cost, "T": self.T, "t0": self.t0,
+            "constraint_violation": self.constraint_violation,
+            "transcription": self.transcription.name, "N": int(self.mesh.N),
+            "iterations": int(self.iterations), "solve_time": self.solve_time,
+            "build_time": self.build_time, "t": self.t,
+            "x": dict(zip(model.states, self.x)), "u": dict(zip(model.controls, self.u)),
+            "p": dict(zip(model.params, self.p)),
+        }
+
+    def to_json(self) -> str:
+        """`to_dict` as strict JSON (non-finite numbers as ``null``)."""
+        return to_json(self.to_dict())
+
+    def plot(self, path=None, *, fig=None, n=400):
+        """States (top) and controls (bottom) against time, from the dense output.
+
+        Parameters
+        ----------
+        path : str, optional
+            Also save the figure there (PNG unless the suffix is .pdf or .svg).
+        fig : matplotlib.figure.Figure, optional
+            Draw on this figure; by default a new one (no pyplot, the backend untouched).
+        n : int, optional
+            Samples of the dense output.
+
+        Returns
+        -------
+        matplotlib.figure.Figure
+        """
+        model = self.problem.model
+        fig = new_figure((8.0, 6.5)) if fig is None else fig
+        top, bottom = fig.subplots(2, 1, sharex=True)
+        ts = np.linspace(self.t0, self.t0 + self.T, n) if self.T > 0 else np.array([self.t0])
+        xs, us = self.sample(ts)
+        for name, row in zip(model.states, np.atleast_2d(xs)):
+            top.plot(ts, row, label=name)
+        for name, row in zip(model.controls, np.atleast_2d(us)):
+            bottom.plot(ts, row, label=name)
+        top.set(ylabel="states", title=f"{self.transcription.name}, N = {self.mesh.N}: "
+                f"cost {self.cost:.6g}, success {self.success}")
+        bottom.set(xlabel="t [s]", ylabel="controls")
+        for ax in (top, bottom):
+            ax.grid(True, alpha=0.3)
+            ax.legend(fontsize=8)
+        return finish_figure(fig, path)
 
     # ----------------------------------------------------------- construction
     @classmethod

@@ -10,7 +10,9 @@ from typing import Callable, Mapping
 
 import numpy as np
 
+from ..figures import axes_or_new_figure, finish_figure
 from ..model import Model
+from ..serialize import text_table, to_json
 from .evaluate import map_eval
 
 __all__ = ["SimulationResult", "Dense", "Run", "OK", "OK_STIFF", "ROUNDOFF", "UNVERIFIED",
@@ -28,6 +30,10 @@ class Dense:
         self._xdot = None
         self._drift = None
         self._lock = threading.Lock()
+
+    @property
+    def model(self) -> Model:
+        return self._model
 
     def drift(self, x: np.ndarray) -> Mapping[str, float]:
         with self._lock:
@@ -111,6 +117,70 @@ class SimulationResult:
         if self._dense is None:
             raise ValueError("this result carries no model to evaluate xdot")
         return self._dense.xdot(self.x)
+
+    @property
+    def states(self) -> tuple:
+        """Names of the state components (``x0, x1, ...`` without a model)."""
+        if self._dense is None:
+            return tuple(f"x{i}" for i in range(self.x.shape[0]))
+        return tuple(self._dense.model.states)
+
+    def to_dict(self) -> dict:
+        """Summary and trajectory as plain Python: counters, ``t``, ``x`` by state name,
+        ``invariants`` (JSON-ready through `to_json`)."""
+        return {
+            "success": bool(self.success), "status": int(self.status), "message": self.message,
+            "method": self.method, "wall_time": self.wall_time, "n_steps": int(self.n_steps),
+            "n_rhs": int(self.n_rhs), "substeps": int(self.substeps),
+            "error_estimate": self.error_estimate, "compiled": bool(self.compiled),
+            "t": self.t, "x": dict(zip(self.states, self.x)),
+            "invariants": dict(self.invariants),
+        }
+
+    def to_json(self) -> str:
+        """`to_dict` as strict JSON (non-finite numbers as ``null``)."""
+        return to_json(self.to_dict())
+
+    def __str__(self) -> str:
+        rows = [("success", f"{self.success} (status {self.status})"),
+                ("method", f"{self.method}" + (f", {self.substeps} step(s) per interval"
+                                               if self.substeps else "")),
+                ("grid", f"{self.t.size} points, t = {self.t[0]:g} .. {self.t[-1]:g} s"),
+                ("steps / rhs", f"{self.n_steps} / {self.n_rhs}"),
+                ("error estimate", f"{self.error_estimate:.3g} of tolerance"),
+                ("wall time", f"{1e3 * self.wall_time:.3f} ms"),
+                ("message", self.message)]
+        return text_table("Simulation", rows)
+
+    def plot(self, path=None, *, ax=None, states=None):
+        """The states against time on one axes.
+
+        Parameters
+        ----------
+        path : str, optional
+            Also save the figure there (PNG unless the suffix is .pdf or .svg).
+        ax : matplotlib.axes.Axes, optional
+            Draw on these axes; by default on a new `matplotlib.figure.Figure` (no pyplot,
+            the backend untouched).
+        states : sequence of str, optional
+            The states to draw (default all).
+
+        Returns
+        -------
+        matplotlib.figure.Figure
+        """
+        names = self.states if states is None else tuple(states)
+        unknown = [s for s in names if s not in self.states]
+        if unknown:
+            raise ValueError(f"`states` names unknown states {unknown}; "
+                             f"the states are {self.states}")
+        fig, ax = axes_or_new_figure(ax, (8.0, 5.0))
+        for name in names:
+            ax.plot(self.t, self.x[self.states.index(name)], label=name)
+        ax.set(xlabel="t [s]", title=f"{self.method}: success {self.success}")
+        ax.grid(True, alpha=0.3)
+        ax.legend(fontsize=8)
+        return finish_figure(fig, path)
 
     @property
     def invariant_drift(self) -> Mapping[str, float]:

@@ -10,7 +10,6 @@ the input can be checked up front).
 from __future__ import annotations
 
 import argparse
-import json as _json
 import math
 import os
 import re
@@ -19,6 +18,8 @@ import time
 from pathlib import Path
 
 import numpy as np
+
+from dynamics.serialize import jsonable, to_json
 
 __all__ = ["vector", "number", "positive", "integer", "output_file", "attach_negative_values",
            "strict_jsonable", "strict_json", "Progress", "progress_enabled", "write_outputs",
@@ -165,29 +166,9 @@ def attach_negative_values(parser, argv) -> list:
 
 
 # ------------------------------------------------------------------------------ JSON
-def strict_jsonable(v):
-    """JSON-ready copy: arrays -> lists, numpy scalars -> Python, complex -> [re, im],
-    non-finite floats -> None."""
-    if isinstance(v, dict):
-        return {str(k): strict_jsonable(x) for k, x in v.items()}
-    if isinstance(v, (list, tuple)):
-        return [strict_jsonable(x) for x in v]
-    if isinstance(v, np.ndarray):
-        return strict_jsonable(v.tolist())
-    if isinstance(v, (bool, np.bool_)):
-        return bool(v)
-    if isinstance(v, (int, np.integer)):
-        return int(v)
-    if isinstance(v, (float, np.floating)):
-        return float(v) if math.isfinite(v) else None
-    if isinstance(v, (complex, np.complexfloating)):
-        return [strict_jsonable(float(v.real)), strict_jsonable(float(v.imag))]
-    return v
-
-
-def strict_json(data) -> str:
-    """Strict JSON text (RFC 8259: no NaN/Infinity; non-finite numbers become ``null``)."""
-    return _json.dumps(strict_jsonable(data), indent=2, allow_nan=False)
+# one converter for every result (dynamics.serialize); the CLI's names for it
+strict_jsonable = jsonable
+strict_json = to_json
 
 
 # -------------------------------------------------------------------------- progress

@@ -3,9 +3,11 @@ plain-Python / text conversions and the figure helpers used by reports and sweep
 from __future__ import annotations
 
 import math
-from dataclasses import asdict
 
 import numpy as np
+
+from dynamics.figures import axes_or_new_figure, finish_figure
+from dynamics.serialize import jsonable, plain
 
 __all__ = ["STANDARD_GRAVITY", "check_number", "plain", "jsonable", "format_complex",
            "format_number", "param_text", "axes_or_new_figure", "finish_figure"]
@@ -50,33 +52,6 @@ def check_number(value, name, *, positive=False, nonzero=False, nonnegative=Fals
     return v
 
 
-def plain(v, *, strict=False):
-    """Plain-Python copy: arrays -> lists, complex -> [re, im], dataclasses -> dicts; with
-    ``strict`` also non-finite floats -> None (JSON-ready)."""
-    if isinstance(v, dict):
-        return {str(k): plain(x, strict=strict) for k, x in v.items()}
-    if isinstance(v, (list, tuple)):
-        return [plain(x, strict=strict) for x in v]
-    if isinstance(v, np.ndarray):
-        return plain(v.tolist(), strict=strict)
-    if isinstance(v, (complex, np.complexfloating)):
-        return [plain(float(v.real), strict=strict), plain(float(v.imag), strict=strict)]
-    if isinstance(v, (bool, np.bool_)):
-        return bool(v)
-    if isinstance(v, (int, np.integer)):
-        return int(v)
-    if isinstance(v, (float, np.floating)):
-        return None if strict and not math.isfinite(v) else float(v)
-    if hasattr(v, "__dataclass_fields__"):
-        return {"type": type(v).__name__, **plain(asdict(v), strict=strict)}
-    return v
-
-
-def jsonable(v):
-    """JSON-ready copy: complex -> [re, im], arrays -> lists, non-finite floats -> None."""
-    return plain(v, strict=True)
-
-
 def format_complex(z, width=13) -> str:
     """``+1.234560e+00 + 5.000000e-01j`` (``-`` for None); ``width - 7`` decimals."""
     if z is None:
@@ -107,23 +82,3 @@ def param_text(v) -> str:
     return str(v)
 
 
-def axes_or_new_figure(ax, figsize):
-    """``(ax.figure, ax)``, or a new `matplotlib.figure.Figure` with one axes (no pyplot)."""
-    if ax is not None:
-        return ax.figure, ax
-    from matplotlib.figure import Figure
-
-    fig = Figure(figsize=figsize)
-    return fig, fig.add_subplot(1, 1, 1)
-
-
-def finish_figure(fig, path=None):
-    """Lay ``fig`` out, save it to ``path`` if given (PNG unless the suffix says otherwise),
-    and return it."""
-    fig.tight_layout()
-    if path is not None:
-        from pathlib import Path
-
-        suffix = Path(path).suffix.lower().lstrip(".")
-        fig.savefig(path, dpi=110, format=suffix if suffix in ("png", "pdf", "svg") else "png")
-    return fig

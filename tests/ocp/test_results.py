@@ -1,0 +1,20 @@
+"""ocp.Solution shares the result habits: __str__, to_dict, to_json (strict), plot."""
+import json
+
+import numpy as np
+
+import ocp
+from ocp.examples import min_energy
+
+
+def test_solution_serializes_and_plots(tmp_path):
+    sol = ocp.solve(min_energy(), N=10)
+    data = json.loads(sol.to_json(), parse_constant=lambda c: (_ for _ in ()).throw(ValueError(c)))
+    assert data["success"] is True and data["status"] == "Solve_Succeeded"
+    assert abs(data["cost"] - 6.0) < 1e-8  # Bryson & Ho: J = 6
+    assert list(data["x"]) == list(sol.problem.model.states)
+    np.testing.assert_array_equal(data["u"][sol.problem.model.controls[0]], sol.u[0])
+    assert "Optimal control solution" in str(sol) and "Solve_Succeeded" in str(sol)
+    fig = sol.plot(tmp_path / "sol.png")
+    assert type(fig).__name__ == "Figure" and len(fig.axes) == 2
+    assert (tmp_path / "sol.png").stat().st_size > 5_000
