@@ -6,6 +6,8 @@ for the conventions and input checks shared by all attitude functions.
 """
 from __future__ import annotations
 
+import warnings
+
 from .. import validate
 from .backend import checked, finite3, finite_any, ops_for, rotation_matrix
 from .dcm import dcm_from_quat
@@ -17,14 +19,17 @@ __all__ = [
 ]
 
 
-def dcm_axis(axis: int, angle):
+def dcm_axis(component=None, angle=None, *, axis=None):
     """Elementary frame rotation ``A1``, ``A2`` or ``A3`` (Eq. 4.45 about a coordinate axis).
 
     Parameters
     ----------
-    axis : {1, 2, 3}
-        An int (numpy integers too; not a float or bool)
+    component : {1, 2, 3}
+        The coordinate axis, 1-based as in ``A1, A2, A3`` and the Euler sequences' digits
+        (``3-1-3``): an int (numpy integers too; not a float or bool).
     angle : float or array (n,) [rad], or CasADi scalar
+    axis : {1, 2, 3}, optional
+        Deprecated name of ``component`` (warns; ``axis`` is a 3-vector elsewhere).
 
     Returns
     -------
@@ -33,9 +38,9 @@ def dcm_axis(axis: int, angle):
     Raises
     ------
     TypeError
-        If ``axis`` is not an integer.
+        If ``component`` is not an integer.
     ValueError
-        If ``axis`` is not 1, 2 or 3, or ``angle`` is not finite.
+        If ``component`` is not 1, 2 or 3, or ``angle`` is not finite.
 
     Examples
     --------
@@ -46,7 +51,15 @@ def dcm_axis(axis: int, angle):
            [-1.,  0.,  0.],
            [ 0.,  0.,  1.]])
     """
-    axis = validate.one_of(axis, "axis", (1, 2, 3))
+    name = "component"
+    if axis is not None:
+        if component is not None:
+            raise TypeError("pass `component` only; `axis` is its deprecated name")
+        warnings.warn("the keyword `axis` of dcm_axis is deprecated (`axis` is a 3-vector; "
+                      "a coordinate index is `component`); use `component=`",
+                      DeprecationWarning, stacklevel=2)
+        component, name = axis, "axis"
+    axis = validate.one_of(component, name, (1, 2, 3))
     d = checked(angle, "angle", (), finite_any)
     o = ops_for(d)
     c, s = o.cos(d), o.sin(d)

@@ -322,7 +322,7 @@ def test_batched_numpy_inputs():
         (lambda: at.quat_from_dcm(np.eye(2)), "`A` must have shape"),
         (lambda: at.quat_normalize([0, 0, 0, 0]), "`q` must be a non-zero"),
         (lambda: at.dcm_from_axis_angle([0, 0, 0], 1.0), "`axis` must be a non-zero"),
-        (lambda: at.dcm_axis(4, 0.1), "`axis` must be 1, 2 or 3"),
+        (lambda: at.dcm_axis(4, 0.1), "`component` must be 1, 2 or 3"),
         (lambda: at.propagate_quat([0, 0, 0, 1], [1, 2], 0.1), "`w` must have shape"),
         (lambda: at.principal_axes(GEMINI, order="sorted"), "`order`"),
         (lambda: at.principal_axes(-GEMINI), "positive definite"),
@@ -370,7 +370,7 @@ VALID_CALLS = {
     "axis_angle_from_quat": (at.axis_angle_from_quat, dict(q=_Q)),
     "rotation_angle": (at.rotation_angle, dict(q=_Q)),
     "propagate_quat": (at.propagate_quat, dict(q=_Q, w=_W, h=0.3)),
-    "dcm_axis": (at.dcm_axis, dict(axis=2, angle=0.7)),
+    "dcm_axis": (at.dcm_axis, dict(component=2, angle=0.7)),
     "dcm_from_euler313": (at.dcm_from_euler313, dict(angles=_E)),
     "euler313_from_dcm": (at.euler313_from_dcm, dict(A=_A)),
     "quat_from_euler313": (at.quat_from_euler313, dict(angles=_E)),
@@ -382,7 +382,7 @@ VALID_CALLS = {
     "principal_axes": (at.principal_axes, dict(inertia=GEMINI)),
 }
 NUMERIC_ARGS = [(name, arg) for name, (_, kw) in VALID_CALLS.items() for arg in kw
-                if not (name == "dcm_axis" and arg == "axis")]
+                if not (name == "dcm_axis" and arg == "component")]
 ALL_ARGS = [(name, arg) for name, (_, kw) in VALID_CALLS.items() for arg in kw]
 
 
@@ -444,8 +444,8 @@ def test_wrong_type_argument_is_type_error_naming_it(name, arg, bad):
         (lambda: at.quat_normalize(np.zeros((4, 2))), ValueError, r"`q\[:, 0\]` must be a non-zero"),
         (lambda: at.quat_from_axis_angle([0, 0, 0], 1.0), ValueError, "`axis` must be a non-zero"),
         (lambda: at.quat_from_axis_angle([0, 0, 1], np.full(3, np.inf)), ValueError, "`angle` must be finite"),
-        (lambda: at.dcm_axis(True, 0.1), TypeError, "`axis` must be 1, 2 or 3"),
-        (lambda: at.dcm_axis(1.0, 0.1), TypeError, "`axis` must be 1, 2 or 3"),
+        (lambda: at.dcm_axis(True, 0.1), TypeError, "`component` must be 1, 2 or 3"),
+        (lambda: at.dcm_axis(1.0, 0.1), TypeError, "`component` must be 1, 2 or 3"),
         (lambda: at.principal_axes(GEMINI, order=1), TypeError, "`order` must be"),
         (lambda: at.axis_angle_from_quat(np.tile(_Q[:, None], (1, 2))), ValueError, r"`q` must have shape \(4,\)"),
         (lambda: at.axis_angle_from_quat(ca.SX.sym("q", 4)), TypeError, "`q` must be numeric"),
@@ -524,7 +524,7 @@ _SYMBOLIC = [name for name in VALID_CALLS if name not in ("axis_angle_from_quat"
 @pytest.mark.parametrize("name", _SYMBOLIC)
 def test_symbolic_inputs_pass_through_and_agree_with_numpy(name, sym):
     fun, kw = VALID_CALLS[name]
-    numeric = {k: v for k, v in kw.items() if not (name == "dcm_axis" and k == "axis")}
+    numeric = {k: v for k, v in kw.items() if not (name == "dcm_axis" and k == "component")}
     fixed = {k: v for k, v in kw.items() if k not in numeric}
     syms = {k: sym.sym(k, *np.shape(v)) if np.ndim(v) == 2 else sym.sym(k, max(np.size(v), 1))
             for k, v in numeric.items()}
@@ -571,3 +571,12 @@ def test_dcm_perturbed_within_tolerance_is_accepted(q, noise):
     q_back = at.quat_from_dcm(A)
     assert same_rotation(q_back, q, 1e-6)
     assert np.all(np.isfinite(at.euler313_from_dcm(A))) and np.all(np.isfinite(at.euler321_from_dcm(A)))
+
+
+def test_dcm_axis_keyword_axis_is_deprecated():
+    """Vocabulary: `axis` is a 3-vector; the coordinate index of A1..A3 is `component`."""
+    with pytest.warns(DeprecationWarning, match="component"):
+        old = at.dcm_axis(axis=2, angle=0.7)
+    np.testing.assert_array_equal(old, at.dcm_axis(component=2, angle=0.7))
+    with pytest.warns(DeprecationWarning), pytest.raises(ValueError, match="`axis` must be 1, 2 or 3"):
+        at.dcm_axis(axis=4, angle=0.1)
