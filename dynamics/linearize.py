@@ -274,7 +274,7 @@ class Linearization:
 
 # ------------------------------------------------------------------------ building
 def _check_point(model: Model, x, u, p):
-    # own messages (they name the state names); the quaternion tolerance is validate's
+    # messages name the state names; the quaternion check is validate's (as simulate's)
     try:
         x = np.array(x, dtype=float).reshape(-1)
     except (TypeError, ValueError):
@@ -290,11 +290,8 @@ def _check_point(model: Model, x, u, p):
     p = model.resolve_p(p)
     if model.attitude is not None:
         iq = model.attitude[0]
-        nq = np.linalg.norm(x[iq:iq + 4])
-        if abs(nq - 1.0) > validate.QUAT_NORM_TOL:
-            raise ValueError(f"`x` must hold a unit quaternion in {model.states[iq:iq + 4]}, "
-                             f"got norm {nq:.9g}")
-        x[iq:iq + 4] /= nq
+        x[iq:iq + 4] = validate.unit_quaternion(
+            x[iq:iq + 4], f"x[{iq}:{iq + 4}] (the attitude quaternion {model.states[iq:iq + 4]})")
     return x, u, p
 
 
