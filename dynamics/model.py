@@ -20,6 +20,19 @@ def _freeze(mapping: Mapping | None) -> Mapping:
     return MappingProxyType(dict(mapping or {}))
 
 
+def _function_from_text(text: str) -> ca.Function:
+    return ca.Function.deserialize(text)
+
+
+def _rebuild_model(f: str, states, controls, params, p_default, units: dict,
+                   invariants: dict, name: str, attitude) -> "Model":
+    """Inverse of `Model.__reduce__`: deserialize the Functions, re-check, re-freeze."""
+    return Model(_function_from_text(f), states, controls, params, p_default=p_default,
+                 units=units,
+                 invariants={k: _function_from_text(v) for k, v in invariants.items()},
+                 name=name, attitude=attitude)
+
+
 @dataclass(frozen=True)
 class Model:
     """A dynamic system ``xdot = f(x, u, p)`` as a named-I/O CasADi Function.
@@ -123,6 +136,19 @@ class Model:
                     f"invariant {key!r} must map inputs ('x', 'p') to one output, got "
                     f"{tuple(fun.name_in())} -> {tuple(fun.name_out())}"
                 )
+
+    # --------------------------------------------------------------- pickling
+    def __reduce__(self):
+        """Pickle through CasADi's own serialization of ``f`` and the invariants.
+
+        The mappings travel as plain dicts and are frozen again on load; the loaded model is
+        a new object (with its own cache entries: the cache keys on the Function's identity).
+        """
+        return (_rebuild_model, (
+            self.f.serialize(), self.states, self.controls, self.params,
+            np.array(self.p_default), dict(self.units),
+            {k: fun.serialize() for k, fun in self.invariants.items()},
+            self.name, self.attitude))
 
     # ------------------------------------------------------------------ sizes
     @property

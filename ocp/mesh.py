@@ -63,6 +63,9 @@ class Mesh:
         """Interval lengths in normalized time, shape (N,)."""
         return np.diff(self.breaks)
 
+    def __reduce__(self):
+        return (type(self), (np.array(self.breaks),))
+
     def __eq__(self, other) -> bool:
         return isinstance(other, Mesh) and np.array_equal(self.breaks, other.breaks)
 

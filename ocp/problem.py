@@ -104,6 +104,11 @@ def _as_vector(value, n: int, argname: str, *, allow_nan=False) -> np.ndarray:
     return a
 
 
+def _read_only(value) -> None:
+    if isinstance(value, np.ndarray):
+        value.setflags(write=False)
+
+
 def _index(names: tuple[str, ...], key, argname: str) -> int:
     if key not in names:
         raise ValueError(f"`{argname}` names unknown component {key!r}; expected one of {names}")
@@ -444,6 +449,19 @@ class Problem:
             hi.setflags(write=False)
             out.append(Constraint(fun, lo, hi, scale, con.name or label))
         return tuple(out)
+
+    # ----------------------------------------------------------------- pickling
+    def __setstate__(self, state: dict) -> None:
+        """Restore a pickled problem as it was normalized (no re-validation), its arrays
+        read-only again (pickle does not keep numpy's write flag)."""
+        for value in state.values():
+            _read_only(value)
+            for con in value if isinstance(value, tuple) else ():
+                if isinstance(con, Constraint):
+                    for part in (con.lower, con.upper, con.scale):
+                        _read_only(part)
+        for key, value in state.items():
+            object.__setattr__(self, key, value)
 
     # --------------------------------------------------------------- properties
     @property

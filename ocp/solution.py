@@ -78,7 +78,24 @@ class DenseOutput:
         self.h = T * mesh.fractions
         self.t_breaks = t0 + T * mesh.breaks
         self.t_breaks[-1] = t0 + T
-        self.interp = tr.interpolant(model.f)
+        self._interp = tr.interpolant(model.f)
+
+    @property
+    def interp(self) -> ca.Function:
+        """The transcription's interpolant Function (`Transcription.interpolant`; rebuilt on
+        first use after unpickling, from the cache when present)."""
+        fun = self._interp
+        if fun is None:
+            fun = self._interp = self.transcription.interpolant(self.model.f)
+        return fun
+
+    def __getstate__(self) -> dict:
+        state = dict(self.__dict__)
+        state["_interp"] = None  # a cached CasADi Function: rebuilt on load
+        return state
+
+    def __setstate__(self, state: dict) -> None:
+        self.__dict__.update(state)
 
     def eval(self, k: np.ndarray, s: np.ndarray):
         """``(x (nx, M), u (nu, M))`` in intervals ``k`` at ``sigma = s``."""
@@ -187,6 +204,18 @@ class Solution:
     constraint_violation: float
     multipliers: Mapping[str, np.ndarray]
     dense: DenseOutput = field(repr=False)
+
+    def __getstate__(self) -> dict:
+        state = dict(self.__dict__)
+        state["multipliers"] = dict(self.multipliers)
+        return state
+
+    def __setstate__(self, state: dict) -> None:
+        for key in ("t", "x", "u", "p", "costates"):
+            value = state.get(key)
+            if isinstance(value, np.ndarray):
+                value.setflags(write=False)
+        self.__dict__.update(state)
 
     def __repr__(self) -> str:
         return (f"{type(self).__name__}(success={self.success}, status={self.status!r}, "

@@ -23,10 +23,18 @@ OK, OK_STIFF, ROUNDOFF, UNVERIFIED, FAILED = 0, 1, 2, 3, -1
 
 
 class Dense:
-    """What `SimulationResult.sample` needs: the model, ``p`` and ``u`` on the grid; caches xdot."""
+    """What `SimulationResult.sample` needs: the model, ``p`` and ``u`` on the grid; caches xdot.
 
-    def __init__(self, model: Model, p: np.ndarray, u_grid: Callable[[], np.ndarray]):
-        self._model, self._p, self._u_grid = model, p, u_grid
+    ``u_grid`` is the control on the output grid, shape (nu, n), or a callable returning it
+    (evaluated on first use). Pickling stores the evaluated array, never the callable, and
+    leaves the lock out (a new one is made on load).
+    """
+
+    def __init__(self, model: Model, p: np.ndarray,
+                 u_grid: Callable[[], np.ndarray] | np.ndarray):
+        self._model, self._p = model, p
+        self._u_grid = u_grid if callable(u_grid) else None
+        self._u = None if callable(u_grid) else np.asarray(u_grid, dtype=float)
         self._xdot = None
         self._drift = None
         self._lock = threading.Lock()
@@ -34,6 +42,13 @@ class Dense:
     @property
     def model(self) -> Model:
         return self._model
+
+    def _controls(self) -> np.ndarray:
+        # the caller holds self._lock
+        if self._u is None:
+            self._u = np.asarray(self._u_grid(), dtype=float)
+            self._u_grid = None
+        return self._u
 
     def drift(self, x: np.ndarray) -> Mapping[str, float]:
         with self._lock:
@@ -44,10 +59,26 @@ class Dense:
     def xdot(self, x: np.ndarray) -> np.ndarray:
         with self._lock:
             if self._xdot is None:
-                xdot = map_eval(self._model.f, [x, self._u_grid(), self._p])
+                xdot = map_eval(self._model.f, [x, self._controls(), self._p])
                 xdot.setflags(write=False)
                 self._xdot = xdot
             return self._xdot
+
+    def __getstate__(self) -> dict:
+        with self._lock:
+            return {"model": self._model, "p": self._p, "u": self._controls(),
+                    "xdot": self._xdot,
+                    "drift": None if self._drift is None else dict(self._drift)}
+
+    def __setstate__(self, state: dict) -> None:
+        self._model, self._p = state["model"], state["p"]
+        self._u_grid, self._u = None, state["u"]
+        self._xdot = state["xdot"]
+        if self._xdot is not None:
+            self._xdot.setflags(write=False)
+        drift = state["drift"]
+        self._drift = None if drift is None else MappingProxyType(drift)
+        self._lock = threading.Lock()
 
 
 @dataclass(frozen=True, eq=False)
@@ -110,6 +141,21 @@ class SimulationResult:
     compiled: bool = False
     invariants: Mapping[str, np.ndarray] = field(default_factory=dict)
     _dense: Dense | None = field(default=None, repr=False)
+
+    def __getstate__(self) -> dict:
+        state = dict(self.__dict__)
+        state["invariants"] = dict(self.invariants)
+        return state
+
+    def __setstate__(self, state: dict) -> None:
+        state = dict(state)
+        state["invariants"] = MappingProxyType(dict(state["invariants"]))
+        for key in ("t", "x"):
+            value = np.array(state[key])
+            value.setflags(write=False)
+            state[key] = value
+        for key, value in state.items():
+            object.__setattr__(self, key, value)
 
     @property
     def xdot(self) -> np.ndarray:

@@ -203,6 +203,19 @@ class StabilityReport:
     notes: tuple = ()
     linearization: Linearization | None = field(default=None, repr=False, compare=False)
 
+    def __getstate__(self) -> dict:
+        """Pickled state: the fields, ``ss`` as its matrices and names (python-control's
+        `StateSpace` holds a local lambda and does not pickle); rebuilt on load."""
+        state = dict(self.__dict__)
+        state["ss"] = _ss_data(self.ss)
+        return state
+
+    def __setstate__(self, state: dict) -> None:
+        state = dict(state)
+        state["ss"] = _ss_from_data(state["ss"])
+        for key, value in state.items():
+            object.__setattr__(self, key, value)
+
     @property
     def status(self) -> int:
         """`STATUS_VERIFIED`, `STATUS_UNCHECKED` or `STATUS_MISMATCH` (closed-form check)."""
@@ -343,6 +356,27 @@ class StabilityReport:
         ax.grid(True, alpha=0.3)
         ax.legend(loc="lower left", fontsize=8)
         return finish_figure(fig, path)
+
+
+def _ss_data(ss) -> dict:
+    """A python-control ``StateSpace`` as plain data (see `_ss_from_data`)."""
+    if not hasattr(ss, "A"):  # not a StateSpace: pickled as it is
+        return {"object": ss}
+    return {"A": np.array(ss.A), "B": np.array(ss.B), "C": np.array(ss.C),
+            "D": np.array(ss.D), "dt": ss.dt, "states": list(ss.state_labels),
+            "inputs": list(ss.input_labels), "outputs": list(ss.output_labels),
+            "name": ss.name}
+
+
+def _ss_from_data(data: dict):
+    """The ``StateSpace`` of `_ss_data` again."""
+    if "object" in data:
+        return data["object"]
+    import control
+
+    return control.ss(data["A"], data["B"], data["C"], data["D"], data["dt"],
+                      states=data["states"], inputs=data["inputs"],
+                      outputs=data["outputs"], name=data["name"])
 
 
 def _fmt_mode(z: complex, pair: bool) -> str:
