@@ -7,6 +7,8 @@ from dataclasses import asdict, dataclass
 
 import numpy as np
 
+from dynamics.interrupts import check_interrupt, interruptible
+
 from .cases import resolve_case
 from .common import finish_figure, format_complex, jsonable, param_text, plain
 from .report import STATUS_MISMATCH, STATUS_UNCHECKED, status_message
@@ -177,6 +179,7 @@ class SweepResult:
         return finish_figure(fig, path)
 
 
+@interruptible
 def sweep(case, parameter: str, values, *, rtol: float = 1e-8, progress=None,
           **case_kwargs) -> SweepResult:
     """Run ``case`` for each value of ``parameter`` and locate the verdict boundaries.
@@ -254,6 +257,7 @@ def sweep(case, parameter: str, values, *, rtol: float = 1e-8, progress=None,
     count = [0]
 
     def run(v):
+        check_interrupt()
         count[0] += 1
         try:
             return fun(**{parameter: float(v)}, **case_kwargs)
