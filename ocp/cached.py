@@ -8,6 +8,14 @@ model. Keys are ``("ocp.<kind>", ...)`` tuples holding `dynamics.cache.function_
 model Functions (which are kept alive with the entry); `dynamics.clear_caches` empties
 them with everything else.
 
+Threads (see `dynamics.cache`): entries holding CVODES integrators -- kinds in
+`PER_THREAD`: ``interval_integrator``, and ``interval_check`` and ``propagator``, which call
+one -- are kept once per thread (the thread id is part of the key), since a plain call of
+an integrator runs in state shared by all its callers. A finished thread's entries age out
+of the LRU cache (or serve a later thread that gets the same id). An IPOPT solver is lent to one
+caller at a time with `checkout`. Every other entry (kernels, interpolants, right-hand
+sides) is a pure Function, shared by all threads.
+
 Examples
 --------
 >>> import casadi as ca
@@ -24,11 +32,16 @@ False
 """
 from __future__ import annotations
 
+import contextlib
+import threading
 from typing import Callable, Hashable
 
 from dynamics import cache
 
-__all__ = ["cached", "function_key"]
+__all__ = ["cached", "checkout", "function_key", "PER_THREAD"]
+
+#: Kinds whose entries run a CVODES integrator: one entry per thread.
+PER_THREAD = frozenset({"interval_integrator", "interval_check", "propagator"})
 
 function_key = cache.function_key
 
@@ -55,8 +68,28 @@ def cached(kind: str, parts: tuple, build: Callable[[], object], *, keepalive=No
         user-defined transcription with mutable fields).
     """
     key: Hashable = ("ocp." + kind,) + tuple(parts)
+    if kind in PER_THREAD:
+        key += (("thread", threading.get_ident()),)
     try:
         hash(key)
     except TypeError:
-        return build()
+        with cache.construction_lock():
+            return build()
     return cache.get(key, build, keepalive=keepalive)
+
+
+@contextlib.contextmanager
+def checkout(kind: str, parts: tuple, build: Callable[[], object], *, keepalive=None):
+    """Like `cached`, for an entry that must not run in two threads at once (an IPOPT
+    solver): a context manager lending an instance to this caller alone, from a pool kept in
+    `dynamics.cache` (`dynamics.cache.checkout`); a fresh ``build()`` for unhashable parts."""
+    key: Hashable = ("ocp." + kind,) + tuple(parts)
+    try:
+        hash(key)
+    except TypeError:
+        with cache.construction_lock():
+            value = build()
+        yield value
+        return
+    with cache.checkout(key, build, keepalive=keepalive) as value:
+        yield value

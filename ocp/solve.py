@@ -40,6 +40,11 @@ reuses them: about 1 s of build time saved for a rigid-body slew at N = 200.
 ``expand=True`` (the default) makes each IPOPT iteration about 3x faster and construction
 about 5 ms per Radau(3) interval of a rigid body slower (measured on a 2-core machine).
 `dynamics.clear_caches` drops them.
+
+Threads: `solve` may run in several threads at once, on the same problem. A cached IPOPT
+solver (with its NLP) is lent to one solve at a time (`ocp.cached.checkout`): a second
+concurrent solve of the same structure builds its own instance once, and both are reused
+afterwards. Every ``casadi.nlpsol`` construction holds `dynamics.cache.construction_lock`.
 """
 from __future__ import annotations
 
@@ -50,7 +55,9 @@ from typing import Mapping
 import casadi as ca
 import numpy as np
 
-from .cached import cached
+from dynamics.cache import construction_lock
+
+from .cached import checkout
 from .guess import NodeGuess, initial_guess
 from .ipopt_options import check_ipopt_options
 from .mesh import Mesh, check_N
@@ -209,12 +216,18 @@ def solve(problem: Problem, *, transcription="radau", N: int | None = None, degr
     scaling = auto_scaling(problem, node_guess, scale)
     nlp_opts = {"ipopt": opts, "print_time": False, "error_on_fail": False, "expand": expand}
     if sink is None:
-        # the NLP and its solver depend on the guess only through the (power-of-two) scaling
-        disc, solver, nlp_opts = cached("nlpsol", _nlp_key(problem, tr, m, scaling, nlp_opts),
-                                        lambda: _build_nlp(problem, tr, m, scaling, nlp_opts, None),
-                                        keepalive=problem)
-    else:
-        disc, solver, nlp_opts = _build_nlp(problem, tr, m, scaling, nlp_opts, sink)
+        # the NLP and its solver depend on the guess only through the (power-of-two) scaling;
+        # the solver is lent to this call alone (a pool: threads never share a running IPOPT)
+        with checkout("nlpsol", _nlp_key(problem, tr, m, scaling, nlp_opts),
+                      lambda: _build_nlp(problem, tr, m, scaling, nlp_opts, None),
+                      keepalive=problem) as built:
+            return _solve_built(problem, tr, m, node_guess, opts, ctol, *built, t_build)
+    return _solve_built(problem, tr, m, node_guess, opts, ctol,
+                        *_build_nlp(problem, tr, m, scaling, nlp_opts, sink), t_build)
+
+
+def _solve_built(problem, tr, m, node_guess, opts, ctol, disc, solver, nlp_opts, t_build):
+    """IPOPT on the transcribed NLP ``disc`` with ``solver`` (used by this call alone)."""
     w0 = disc.pack(node_guess)
     build_time = time.perf_counter() - t_build
 
@@ -229,7 +242,9 @@ def solve(problem: Problem, *, transcription="radau", N: int | None = None, degr
             t_re = time.perf_counter()
             again = {**opts, "acceptable_iter": 0, "max_iter": budget,
                      "warm_start_init_point": "yes", "mu_init": 1e-9}
-            resolver = ca.nlpsol("ocp_resolve", "ipopt", disc.nlp, {**nlp_opts, "ipopt": again})
+            with construction_lock():
+                resolver = ca.nlpsol("ocp_resolve", "ipopt", disc.nlp,
+                                     {**nlp_opts, "ipopt": again})
             build_time += time.perf_counter() - t_re
             res2, error2, status2, it2 = _run(resolver, dict(
                 x0=res["x"], lam_x0=res["lam_x"], lam_g0=res["lam_g"], **bounds))
@@ -276,7 +291,13 @@ def _nlp_key(problem, transcription, mesh, scaling, nlp_opts) -> tuple:
 
 def _build_nlp(problem, tr, mesh, scaling, nlp_opts, sink):
     """``(Discretization, IPOPT solver, the nlpsol options used)``; without SX expansion when
-    the functions cannot be expanded (e.g. a model holding an integrator or a Callback)."""
+    the functions cannot be expanded (e.g. a model holding an integrator or a Callback).
+    Holds `dynamics.cache.construction_lock` (casadi construction is not thread-safe)."""
+    with construction_lock():
+        return _build_nlp_locked(problem, tr, mesh, scaling, nlp_opts, sink)
+
+
+def _build_nlp_locked(problem, tr, mesh, scaling, nlp_opts, sink):
     disc = tr.build(problem, mesh, scaling)
     nlp_opts = dict(nlp_opts)
     if sink is not None:
@@ -389,13 +410,15 @@ def rest_solution(problem: Problem, *, T: float | None = None, transcription="ra
     node = NodeGuess(X=np.repeat(x0[:, None], n_x, axis=1), U=np.zeros((nu, n_u)),
                      Xu=np.repeat(x0[:, None], n_u, axis=1), p=p, T=T)
     scaling = auto_scaling(problem, node, {"T": 1.0} if T == 0 else None)
-    disc = tr.build(problem, mesh, scaling)
+    with construction_lock():
+        disc = tr.build(problem, mesh, scaling)
+        g_of_w = ca.Function("g", [disc.nlp["x"]], [disc.nlp["g"]])
     free = problem.free_params
     sc = scaling
     w = disc.w.join({"X": node.X / sc.x[:, None], "U": node.U / sc.u[:, None],
                      "P": (p[free] / sc.p[free])[:, None],
                      "T": np.full((int(problem.free_time), 1), T / sc.T)})
-    g = np.asarray(ca.Function("g", [disc.nlp["x"]], [disc.nlp["g"]])(w)).reshape(-1)
+    g = np.asarray(g_of_w(w)).reshape(-1)
     viol = disc.violation(g, w) if np.all(np.isfinite(g)) else float("nan")
     success = bool(viol <= ctol)
     if success:

@@ -1,5 +1,11 @@
 """SUNDIALS CVODES through ``casadi.integrator``: one run on the grid, with a callable
-control through a ``casadi.Callback``; a failure returns the solution up to where it stopped."""
+control through a ``casadi.Callback``; a failure returns the solution up to where it stopped.
+
+Threads: a cvodes integrator keeps its whole solver state in the memory used by a plain call,
+so one instance must never run in two threads at once. The integrators of linear controls
+are pooled in `dynamics.cache` (`cache.checkout`: one instance per concurrent caller, reused);
+those of callable controls are built per call; every construction holds
+`cache.construction_lock`."""
 from __future__ import annotations
 
 import casadi as ca
@@ -50,6 +56,11 @@ _CVODES_DEFAULTS = {"show_eval_warnings": False, "disable_internal_warnings": Tr
 
 
 def _cvodes_integrator(model, mode, t, opts, callback=None):
+    with cache.construction_lock():
+        return _build_cvodes_integrator(model, mode, t, opts, callback)
+
+
+def _build_cvodes_integrator(model, mode, t, opts, callback):
     nx, nu, np_ = model.nx, model.nu, model.np
     if mode == "linear":
         x, tau, p = ca.SX.sym("x", nx), ca.SX.sym("t"), ca.SX.sym("p", np_)
@@ -76,17 +87,23 @@ def _cvodes_options(rtol, atol, extra) -> dict:
 def run_cvodes(problem: Problem, rtol, atol, extra) -> Run:
     model, t, ctrl = problem.model, problem.t, problem.control
     opts = _cvodes_options(rtol, atol, extra)
-    callback = None
     if ctrl.mode == "linear":
         key = ("cvodes", cache.function_key(model.f), t.tobytes(),
                repr(sorted(opts.items(), key=str)))
-        integ = cache.get(key, lambda: _cvodes_integrator(model, "linear", t, opts),
-                          keepalive=model.f)
-    else:
+        with cache.checkout(key, lambda: _cvodes_integrator(model, "linear", t, opts),
+                            keepalive=model.f) as integ:
+            return _run(problem, integ, opts, rtol, atol, None)
+    with cache.construction_lock():
         callback = _ControlCallback(ctrl.fun, model.nu)
-        integ = _cvodes_integrator(model, "stages", t, opts, callback)
+    integ = _cvodes_integrator(model, "stages", t, opts, callback)
+    return _run(problem, integ, opts, rtol, atol, callback)
+
+
+def _run(problem: Problem, integ, opts, rtol, atol, callback) -> Run:
+    """One call of ``integ`` (used by this thread alone) and its statistics."""
+    t = problem.t
     try:
-        out = _cvodes_call(integ, problem.x0, problem.p, ctrl.cvodes_input(t))
+        out = _cvodes_call(integ, problem.x0, problem.p, problem.control.cvodes_input(t))
     except RuntimeError as exc:
         if callback is not None and callback.error is not None:
             raise callback.error
