@@ -8,6 +8,7 @@ import casadi as ca
 import numpy as np
 
 from .. import cache
+from ..interrupts import check_interrupt
 from ..model import Model
 from .evaluate import call_buffered
 from .inputs import Problem
@@ -193,6 +194,7 @@ def run_fixed(problem: Problem, method: str, m: int, jit: bool,
     stages = 4 if method == "lie" else TABLEAUX[method].stages
     done = 0
     for s0 in range(0, steps.total, CHUNK):
+        check_interrupt()  # Ctrl-C stops between chunks (simulate defers it to here)
         n = min(CHUNK, steps.total - s0)
         X = call_buffered(fun, [xk, np.array([float(n)]), *steps.chunk(s0), problem.p],
                           (CHUNK, model.nx))
