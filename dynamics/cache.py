@@ -89,7 +89,9 @@ from __future__ import annotations
 
 import contextlib
 import functools
+import os
 import shutil
+import subprocess
 import tempfile
 import threading
 import weakref
@@ -99,7 +101,8 @@ from typing import Callable, Hashable, NamedTuple
 import casadi as ca
 
 __all__ = ["MAXSIZE", "JIT_MIN_WORK", "CacheInfo", "FunctionCache", "get", "contains", "clear",
-           "info", "function_key", "memoize", "checkout", "construction_lock", "POOL_SIZE", "jit_options", "should_compile"]
+           "info", "function_key", "memoize", "checkout", "construction_lock", "POOL_SIZE", "jit_options",
+           "should_compile", "compile_function"]
 
 #: Most entries kept (least recently used are dropped first).
 MAXSIZE = 512
@@ -236,6 +239,33 @@ class _Pool:
 
     def __init__(self):
         self.idle: list = []
+
+
+def compile_function(fun: ca.Function) -> ca.Function | None:
+    """``fun`` compiled to C and loaded with ``casadi.external``; None without a C compiler.
+
+    The code is generated into a scratch directory, compiled with ``-O3`` by the C compiler
+    found on the ``PATH`` (`jit_options` tells which), loaded, and the files are deleted at
+    once (a loaded shared library stays mapped): unlike casadi's own jit, which leaves two
+    file descriptors open per compile (casadi issue #4295) and its files on disk, nothing is
+    left behind. Raises ``RuntimeError`` when the code cannot be generated or compiled.
+    """
+    opts = _CACHE.jit_options()
+    if opts is None:
+        return None
+    compiler = opts["jit_options"]["compiler"]
+    with tempfile.TemporaryDirectory(prefix="appdyn-cc-") as work:
+        name = fun.name()
+        source = os.path.join(work, f"{name}.c")
+        library = os.path.join(work, f"{name}.so")
+        gen = ca.CodeGenerator(f"{name}.c", {"with_header": False})
+        gen.add(fun)
+        gen.generate(work + os.sep)
+        done = subprocess.run([compiler, "-O3", "-w", "-fPIC", "-shared", source, "-o", library,
+                               "-lm"], capture_output=True, text=True)
+        if done.returncode != 0:
+            raise RuntimeError(f"C compilation of {name} failed: {done.stderr.strip()[-500:]}")
+        return ca.external(name, library)
 
 
 def _remove_jit_files(items: dict, directory: str):

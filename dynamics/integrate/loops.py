@@ -38,17 +38,17 @@ def chunk_function(model: Model, method: str, mode: str, jit: bool):
     Output ``X (nx x B)``: the state after each step.
     """
     base_key = chunk_key(model, method, mode)
-    opts = cache.jit_options() if jit else None
-    if opts is None:
+    if not jit or cache.jit_options() is None:
         return cache.get(base_key + (False,),
                          lambda: (_build_chunk(model, method, mode, {}), False),
                          keepalive=model.f)
 
     def build_compiled():
+        loop = _build_chunk(model, method, mode, {})
         try:
-            return _build_chunk(model, method, mode, opts), True
+            return cache.compile_function(loop), True
         except RuntimeError:  # e.g. a right-hand side that cannot be code-generated
-            return _build_chunk(model, method, mode, {}), False
+            return loop, False
 
     return cache.get(base_key + (True,), build_compiled, keepalive=model.f)
 
