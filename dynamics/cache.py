@@ -15,10 +15,10 @@ API
 ``contains(key)``
     Whether ``key`` has an entry (does not count as a use).
 ``clear()``
-    Drop every entry and delete the compiled (jit) files.
+    Drop every entry (compiled libraries are unloaded with their Functions).
 ``info()``
-    A `CacheInfo`: entries, maximum size, hits, misses, entries per kind, jit directory
-    and compiler.
+    A `CacheInfo`: entries, maximum size, hits, misses, entries per kind and the C
+    compiler.
 ``function_key(f)``
     The identity of a ``casadi.Function`` to put in a key.
 ``checkout(key, build, keepalive=None)``
@@ -28,8 +28,10 @@ API
     The lock to hold around casadi construction outside `get` (see Threads below).
 ``memoize``
     Decorator for factories of hashable arguments (e.g. ``rigid_body``'s model builder).
-``jit_options()``
-    casadi options that compile a Function to C, or ``None`` when no C compiler is found.
+``compiler()``
+    Path of the C compiler (``gcc`` or ``cc`` on the ``PATH``), or ``None``.
+``compile_function(f)``
+    ``f`` compiled to C and loaded with ``casadi.external``; no files stay behind.
 
 Entries are evicted least-recently-used beyond `MAXSIZE`; every operation holds one
 re-entrant lock, so a ``build`` may itself call `get` (a loop built from a cached step).
@@ -94,14 +96,13 @@ import shutil
 import subprocess
 import tempfile
 import threading
-import weakref
 from collections import Counter, OrderedDict
 from typing import Callable, Hashable, NamedTuple
 
 import casadi as ca
 
 __all__ = ["MAXSIZE", "JIT_MIN_WORK", "CacheInfo", "FunctionCache", "get", "contains", "clear",
-           "info", "function_key", "memoize", "checkout", "construction_lock", "POOL_SIZE", "jit_options",
+           "info", "function_key", "memoize", "checkout", "construction_lock", "POOL_SIZE", "compiler",
            "should_compile", "compile_function"]
 
 #: Most entries kept (least recently used are dropped first).
@@ -123,7 +124,6 @@ class CacheInfo(NamedTuple):
     hits: int
     misses: int
     kinds: dict  # first item of the key (when a string) -> number of entries
-    jit_directory: str | None
     compiler: str | None
 
 
@@ -138,11 +138,8 @@ class FunctionCache:
         self._items: OrderedDict = OrderedDict()
         self._lock = threading.RLock()
         self._hits = self._misses = 0
-        self._jit_dir: str | None = None
         self._compiler: str | None = None
-        self._jit_opts: dict | None = None
-        self._jit_checked = False
-        self._finalizer = None
+        self._compiler_checked = False
 
     def get(self, key: Hashable, build: Callable[[], object], keepalive=None):
         """Return the entry for ``key``, building it with ``build()`` on a miss."""
@@ -184,52 +181,27 @@ class FunctionCache:
             return key in self._items
 
     def clear(self) -> None:
-        """Drop every entry and delete the jit directory with its compiled files."""
+        """Drop every entry (compiled libraries are unloaded with their Functions)."""
         with self._lock:
             self._items.clear()
             self._hits = self._misses = 0
-            if self._finalizer is not None:
-                self._finalizer()  # removes the directory now, and never again at exit
-            self._finalizer = None
-            self._jit_dir, self._jit_opts, self._jit_checked = None, None, False
 
     def info(self) -> CacheInfo:
-        """Counts and jit location, for diagnostics."""
+        """Counts and the C compiler, for diagnostics."""
         with self._lock:
             kinds = Counter(k[0] for k in self._items
                             if isinstance(k, tuple) and k and isinstance(k[0], str))
             return CacheInfo(len(self._items), self._maxsize, self._hits, self._misses,
-                             dict(kinds), self._jit_dir, self._compiler)
+                             dict(kinds), self.compiler())
 
-    def jit_options(self) -> dict | None:
-        """casadi jit options (a fresh dict), or None when no C compiler is on the PATH.
-
-        The compiled files go to a scratch directory made on first use and removed by
-        `clear` or at interpreter exit.
-        """
+    def compiler(self) -> str | None:
+        """Path of the C compiler (``gcc`` or ``cc`` on the ``PATH``), or None (looked up
+        once)."""
         with self._lock:
-            if not self._jit_checked:
-                self._jit_checked = True
+            if not self._compiler_checked:
+                self._compiler_checked = True
                 self._compiler = shutil.which("gcc") or shutil.which("cc")
-                if self._compiler is not None:
-                    self._jit_dir = tempfile.mkdtemp(prefix="appdyn-jit-")
-                    self._finalizer = weakref.finalize(self, _remove_jit_files, self._items,
-                                                       self._jit_dir)
-                    self._jit_opts = {
-                        "jit": True,
-                        "compiler": "shell",
-                        "jit_name": "appdyn_jit",
-                        "jit_options": {
-                            "flags": ["-O3", "-w"],
-                            "compiler": self._compiler,
-                            "linker": self._compiler,
-                            "directory": self._jit_dir + "/",
-                            "verbose": False,
-                        },
-                    }
-            if self._jit_opts is None:
-                return None
-            return {**self._jit_opts, "jit_options": dict(self._jit_opts["jit_options"])}
+            return self._compiler
 
 
 class _Pool:
@@ -245,15 +217,14 @@ def compile_function(fun: ca.Function) -> ca.Function | None:
     """``fun`` compiled to C and loaded with ``casadi.external``; None without a C compiler.
 
     The code is generated into a scratch directory, compiled with ``-O3`` by the C compiler
-    found on the ``PATH`` (`jit_options` tells which), loaded, and the files are deleted at
+    found on the ``PATH`` (`compiler` tells which), loaded, and the files are deleted at
     once (a loaded shared library stays mapped): unlike casadi's own jit, which leaves two
     file descriptors open per compile (casadi issue #4295) and its files on disk, nothing is
     left behind. Raises ``RuntimeError`` when the code cannot be generated or compiled.
     """
-    opts = _CACHE.jit_options()
-    if opts is None:
+    compiler = _CACHE.compiler()
+    if compiler is None:
         return None
-    compiler = opts["jit_options"]["compiler"]
     with tempfile.TemporaryDirectory(prefix="appdyn-cc-") as work:
         name = fun.name()
         source = os.path.join(work, f"{name}.c")
@@ -268,19 +239,13 @@ def compile_function(fun: ca.Function) -> ca.Function | None:
         return ca.external(name, library)
 
 
-def _remove_jit_files(items: dict, directory: str):
-    """Drop the Functions first (casadi deletes its own files), then the directory."""
-    items.clear()
-    shutil.rmtree(directory, ignore_errors=True)
-
-
 _CACHE = FunctionCache()
 
 get = _CACHE.get
 contains = _CACHE.contains
 clear = _CACHE.clear
 info = _CACHE.info
-jit_options = _CACHE.jit_options
+compiler = _CACHE.compiler
 checkout = _CACHE.checkout
 construction_lock = _CACHE.construction_lock
 
@@ -317,7 +282,7 @@ def should_compile(jit: bool | None, work: float) -> bool:
     Returns
     -------
     bool
-        Whether to ask for a compiled Function (`jit_options` may still say there is no
+        Whether to ask for a compiled Function (`compiler` may still say there is no
         compiler).
     """
     if jit is not None:

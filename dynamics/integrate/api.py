@@ -9,7 +9,6 @@ from typing import Callable, Literal, Mapping
 import numpy as np
 
 from .. import cache, validate
-from ..interrupts import interruptible
 from ..model import Model, check_model
 from .auto import solve_auto
 from .cvodes import run_cvodes
@@ -26,7 +25,6 @@ METHODS = ("auto", "cvodes", "rk4", "rk8", "lie")
 _FIXED_STEP = ("rk4", "rk8", "lie")
 
 
-@interruptible
 def simulate(model: Model, x0, t, *, u=None, p=None, method: Method = "auto",
              rtol: float = 1e-8, atol=1e-10, invariants=False, steps: int | None = None,
              jit: bool | None = None, max_steps: int = 100_000_000,
