@@ -8,11 +8,12 @@ from contextlib import redirect_stdout
 import casadi as ca
 import numpy as np
 import pytest
-from hypothesis import HealthCheck, given, settings
+from hypothesis import HealthCheck, assume, given, settings
 from hypothesis import strategies as st
 
 from dynamics import Model, cache, rigid_body, simulate
-from dynamics.truth import axisymmetric, constant_rate_quat, torque_free_omega
+from dynamics.truth import (axisymmetric, constant_rate_quat, torque_free_omega,
+                            torque_free_parameters)
 
 X0 = np.array([0.0, 0.0, 0.0, 1.0, 1.0, 0.1, 0.8])
 
@@ -210,7 +211,8 @@ def body(inertia):
     return rigid_body(list(inertia))
 
 
-@settings(max_examples=25, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@settings(max_examples=25, deadline=None, derandomize=True,
+          suppress_health_check=[HealthCheck.too_slow])
 @given(
     inertia=st.sampled_from([(1.0, 2.0, 3.0), (1.0, 1.5, 2.0), (2.0, 3.0, 4.5), (1.0, 1.0, 1.5),
                              (5.0, 4.0, 2.0), (3.0, 1.0, 3.5)]),
@@ -227,6 +229,12 @@ def test_auto_success_implies_the_tolerance_is_met(inertia, w0, t_final, n, log_
     w0 = np.array(w0)
     if np.linalg.norm(w0) < 1e-3:
         w0 = w0 + 0.1
+    # The Jacobi-elliptic truth loses digits as the elliptic parameter m nears 1 (close to
+    # the separatrix): at 1 - m = 1.2e-4 it was 6.5e-11 away from DOP853 at rtol 2.3e-14,
+    # where auto was within 0.2 of a 1.8e-10 tolerance. Judge auto only where the truth is
+    # clearly better than the tolerance.
+    params = torque_free_parameters(list(inertia), w0)
+    assume(1 - float(params.m) > 1e-3)
     t = np.linspace(0.0, t_final, n)
     res = simulate(body(inertia), np.r_[0, 0, 0, 1.0, w0], t, rtol=rtol, atol=atol)
     assert res.success or res.status in (2, 3), res.message
