@@ -17,7 +17,7 @@ import functools
 import signal
 import threading
 
-__all__ = ["deferred_interrupts", "check_interrupt", "interruptible"]
+__all__ = ["deferred_interrupts", "check_interrupt", "interrupt_pending", "interruptible"]
 
 _lock = threading.Lock()
 _state = {"depth": 0, "pending": False, "previous": None}
@@ -69,6 +69,16 @@ def deferred_interrupts():
                 pending, _state["pending"] = _state["pending"], False
         if pending:
             raise KeyboardInterrupt
+
+
+def interrupt_pending() -> bool:
+    """Whether a SIGINT deferred by `deferred_interrupts` waits for `check_interrupt`.
+
+    True only in the main thread (where signals arrive); for C code that can stop early on
+    request (an IPOPT iteration callback: `ocp.progress.IterationCallback`), which the
+    caller then follows by `check_interrupt`.
+    """
+    return bool(_state["pending"]) and threading.current_thread() is threading.main_thread()
 
 
 def check_interrupt() -> None:

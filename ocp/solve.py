@@ -56,6 +56,7 @@ import casadi as ca
 import numpy as np
 
 from dynamics.cache import construction_lock
+from dynamics.interrupts import check_interrupt, interruptible
 
 from .cached import checkout
 from .guess import NodeGuess, initial_guess
@@ -124,6 +125,7 @@ def _message(status: str, iterations: int) -> str:
     return f"IPOPT {status} after {iterations} iterations: {text}"
 
 
+@interruptible
 def solve(problem: Problem, *, transcription="radau", N: int | None = None, degree: int | None = None,
           mesh=None, guess=None, scale: Mapping | None = None, verbose=False,
           progress=None, ipopt_options: Mapping | None = None, expand: bool = True,
@@ -228,6 +230,7 @@ def solve(problem: Problem, *, transcription="radau", N: int | None = None, degr
 
 def _solve_built(problem, tr, m, node_guess, opts, ctol, disc, solver, nlp_opts, t_build):
     """IPOPT on the transcribed NLP ``disc`` with ``solver`` (used by this call alone)."""
+    check_interrupt()  # a Ctrl-C during the build (C++ construction cannot be interrupted)
     w0 = disc.pack(node_guess)
     build_time = time.perf_counter() - t_build
 
@@ -300,8 +303,9 @@ def _build_nlp(problem, tr, mesh, scaling, nlp_opts, sink):
 def _build_nlp_locked(problem, tr, mesh, scaling, nlp_opts, sink):
     disc = tr.build(problem, mesh, scaling)
     nlp_opts = dict(nlp_opts)
-    if sink is not None:
-        nlp_opts["iteration_callback"] = IterationCallback(disc.w.size, disc.g.size, disc.violation, sink)
+    # always attached: stops IPOPT at the next iteration after a (deferred) Ctrl-C; the
+    # options dict returned with the solver keeps the Python callback alive
+    nlp_opts["iteration_callback"] = IterationCallback(disc.w.size, disc.g.size, disc.violation, sink)
     try:
         solver = ca.nlpsol("ocp", "ipopt", disc.nlp, nlp_opts)
     except RuntimeError:
@@ -313,12 +317,15 @@ def _build_nlp_locked(problem, tr, mesh, scaling, nlp_opts, sink):
 
 
 def _run(solver, args):
-    """``(result or None, error, status, iterations)`` of one IPOPT call (never raises)."""
+    """``(result or None, error, status, iterations)`` of one IPOPT call; raises only
+    ``KeyboardInterrupt`` (a Ctrl-C deferred during the call stops IPOPT at its next
+    iteration through the `IterationCallback`, and is raised here)."""
     error = None
     try:
         res = solver(**args)
     except RuntimeError as exc:  # an evaluation error inside CasADi: report, do not raise
         res, error = None, exc
+    check_interrupt()
     stats = solver.stats()
     return res, error, str(stats.get("return_status", "Unknown")), int(stats.get("iter_count", 0))
 

@@ -11,6 +11,7 @@ import warnings
 import numpy as np
 
 from dynamics.validate import integer, positive
+from dynamics.interrupts import interruptible
 from ..mesh import Mesh
 from ..problem import Problem
 from ..progress import LOGGER
@@ -113,6 +114,7 @@ def _report(rnd: int, r: RefinementRound, verbose, progress) -> None:
         progress(r)
 
 
+@interruptible
 def refine(problem: Problem, solution: Solution | None = None, *, tol: float = 1e-6,
            max_rounds: int = 6, max_intervals: int = 400, transcription="radau",
            N: int | None = None, degree: int | None = None, verbose=False, progress=None,

@@ -6,6 +6,7 @@ from typing import Mapping, Sequence
 
 import numpy as np
 
+from dynamics.interrupts import interruptible
 from ..problem import Problem
 from ..progress import LOGGER
 from ..solution import Solution
@@ -15,6 +16,7 @@ from .result import RefinedSolution, annotate
 __all__ = ["solve_multistart"]
 
 
+@interruptible
 def solve_multistart(problem: Problem, guesses: Sequence, **solve_kwargs) -> RefinedSolution:
     """Solve ``problem`` from each guess and keep the best converged solution.
 

@@ -26,6 +26,7 @@ import casadi as ca
 import numpy as np
 
 from dynamics.model import Model
+from dynamics.interrupts import interruptible
 
 from ..cached import cached, function_key
 from dynamics.validate import integer
@@ -139,6 +140,7 @@ def _aligned_mesh(solution: Solution, N: int | None) -> tuple[Mesh, np.ndarray]:
     return Mesh(breaks), sw * T + t0
 
 
+@interruptible
 def polish_switches(problem: Problem, solution: Solution, *, N: int | None = None, degree: int = 3,
                     verbose=False, stretch=(0.05, 5.0), **solve_kwargs) -> RefinedSolution:
     """Re-solve a bang-bang / time-optimal problem with moving knots.

@@ -9,6 +9,7 @@ import numpy as np
 from ocp import (Solution, annotate, polish_switches, refine, rest_solution, solve,
                  solve_multistart)
 from dynamics.validate import integer
+from dynamics.interrupts import interruptible
 
 from .problem import (attitude_guess, inertia_of, is_rest_to_rest, rough_time, seeded_guesses,
                       slew_angle, slew_problem)
@@ -102,6 +103,7 @@ def _tiny_scale(problem, T_est):
     return {"T": d, "objective": d}
 
 
+@interruptible
 def time_optimal(inertia, *, angle=None, axis=None, q0=None, qf=None, u_max=1.0,
                  norm_bound=False, w0=None, wf=None, keep_out=None, T_max=None, guess=None,
                  starts=None, seed=None, N=30, transcription="radau", polish=None,
@@ -237,6 +239,7 @@ def _refined_fallback(problem, first, verified, ptol, rtol, ipopt_options, scale
     return verified
 
 
+@interruptible
 def min_effort(inertia, T, *, angle=None, axis=None, q0=None, qf=None, u_max=None,
                norm_bound=False, w0=None, wf=None, keep_out=None, guess=None, N=20,
                tol=1e-7, starts=None, seed=None, verbose=False, ipopt_options=None,

@@ -68,6 +68,9 @@ class SweepResult:
         The fixed arguments as plain Python values.
     statuses : tuple of int, length n
         The report status at each grid value (`STATUS_VERIFIED`, ...).
+    complete : bool
+        False for the partial result of an interrupted sweep (`sweep`, Ctrl-C): the grid
+        values evaluated before the interrupt, and the boundaries located by then.
     success : bool
         False when some report disagreed with its closed forms (property).
     status : int
@@ -87,6 +90,7 @@ class SweepResult:
     evaluations: int
     case_kwargs: dict
     statuses: tuple = ()
+    complete: bool = True
 
     @property
     def status(self) -> int:
@@ -106,6 +110,9 @@ class SweepResult:
         if self.status == STATUS_MISMATCH:
             bad = [float(v) for v, s in zip(self.values, self.statuses) if s == STATUS_MISMATCH]
             text += f" at {self.parameter} = {bad}"
+        if not self.complete:
+            text += (f"; interrupted after {len(self.values)} grid values "
+                     f"(boundaries located by then only)")
         return text
 
     def to_dict(self) -> dict:
@@ -117,7 +124,7 @@ class SweepResult:
                           "least_damped": self.least_damped, "eigenvalues": self.eigenvalues,
                           "boundaries": [asdict(b) for b in self.boundaries],
                           "rtol": self.rtol, "evaluations": self.evaluations,
-                          "case_kwargs": self.case_kwargs})
+                          "case_kwargs": self.case_kwargs, "complete": self.complete})
 
     def to_json(self) -> str:
         """`to_dict` as strict JSON text."""
@@ -125,7 +132,7 @@ class SweepResult:
 
     def __str__(self) -> str:
         lines = [f"Sweep of {self.case} over {self.parameter} ({len(self.values)} values, "
-                 f"{self.evaluations} evaluations)"]
+                 f"{self.evaluations} evaluations{'' if self.complete else ', interrupted'})"]
         if self.case_kwargs:
             lines.append("  fixed: " + param_text(self.case_kwargs))
         lines.append(f"  {self.parameter:>16}  {'verdict':<22} "
@@ -219,6 +226,15 @@ def sweep(case, parameter: str, values, *, rtol: float = 1e-8, progress=None,
     ValueError
         Naming ``case``, ``parameter``, ``values`` or ``rtol``; a ValueError of the case at
         one value is re-raised with that value.
+    KeyboardInterrupt
+        On Ctrl-C (within one case evaluation, `dynamics.interrupts`). When some grid values
+        were finished, the exception's ``partial`` attribute is their `SweepResult`
+        (``complete=False``, with the boundaries located before the interrupt)::
+
+            try:
+                res = stability.sweep(...)
+            except KeyboardInterrupt as exc:
+                res = getattr(exc, "partial", None)
 
     Examples
     --------
@@ -264,13 +280,6 @@ def sweep(case, parameter: str, values, *, rtol: float = 1e-8, progress=None,
         except ValueError as exc:
             raise ValueError(f"{name} at {parameter} = {float(v)!r}: {exc}") from None
 
-    reports = []
-    for v in vals:
-        reports.append(run(v))
-        if progress is not None:
-            progress(len(reports), len(vals))
-    verdicts = tuple(r.verdict for r in reports)
-
     def narrow(lo, hi):
         return abs(hi - lo) > rtol * max(abs(lo), abs(hi)) and lo < 0.5 * (lo + hi) < hi
 
@@ -296,15 +305,37 @@ def sweep(case, parameter: str, values, *, rtol: float = 1e-8, progress=None,
                 lo = mid
             else:
                 hi, vhi = mid, vm
-        found = [Boundary(0.5 * (lo + hi), lo, hi, va, vhi)]
+        here = [Boundary(0.5 * (lo + hi), lo, hi, va, vhi)]
         if vhi != vb:
-            found += locate(hi, vhi, b, vb)
-        return found
+            here += locate(hi, vhi, b, vb)
+        return here
 
-    found = []
-    for i in range(len(vals) - 1):
-        if verdicts[i] != verdicts[i + 1]:
-            found += locate(vals[i], verdicts[i], vals[i + 1], verdicts[i + 1])
+    reports, found = [], []
+
+    def result(boundaries, complete=True):
+        return _result(name, parameter, vals[:len(reports)], reports, boundaries, rtol, count[0],
+                       case_kwargs, complete)
+
+    try:
+        for v in vals:
+            reports.append(run(v))
+            if progress is not None:
+                progress(len(reports), len(vals))
+        verdicts = tuple(r.verdict for r in reports)
+        for i in range(len(vals) - 1):
+            if verdicts[i] != verdicts[i + 1]:
+                found += locate(vals[i], verdicts[i], vals[i + 1], verdicts[i + 1])
+        return result(_merged(found, rtol, crossing))
+    except KeyboardInterrupt as exc:
+        if reports:  # what was finished rides on the interrupt
+            exc.partial = result(tuple(found), complete=False)
+        raise
+
+
+
+def _merged(found, rtol, crossing) -> tuple:
+    """Boundaries in sweep order, a verdict's zero band around a crossing (or brackets
+    closer than ``rtol``) merged into one boundary."""
     boundaries = []
     for bnd in found:
         prev = boundaries[-1] if boundaries else None
@@ -321,12 +352,19 @@ def sweep(case, parameter: str, values, *, rtol: float = 1e-8, progress=None,
                                           prev.before, bnd.after)
                 continue
         boundaries.append(bnd)
+    return tuple(boundaries)
+
+
+def _result(name, parameter, vals, reports, boundaries, rtol, evaluations, case_kwargs,
+            complete) -> SweepResult:
+    """The `SweepResult` of ``reports`` at the grid values ``vals``."""
     m = max(len(r.eigenvalues) for r in reports)
     ev = np.full((len(vals), m), np.nan + 1j * np.nan, dtype=complex)
     for i, r in enumerate(reports):
         ev[i, :len(r.eigenvalues)] = r.eigenvalues
-    return SweepResult(case=name, parameter=parameter, values=vals, verdicts=verdicts,
+    return SweepResult(case=name, parameter=parameter, values=np.array(vals),
+                       verdicts=tuple(r.verdict for r in reports),
                        least_damped=np.array([r.least_damped() for r in reports], dtype=complex),
                        eigenvalues=ev, boundaries=tuple(boundaries), rtol=float(rtol),
-                       evaluations=count[0], case_kwargs=plain(case_kwargs),
-                       statuses=tuple(r.status for r in reports))
+                       evaluations=evaluations, case_kwargs=plain(case_kwargs),
+                       statuses=tuple(r.status for r in reports), complete=complete)

@@ -1,5 +1,9 @@
 """Thread safety: 8 threads of mixed calls on shared models give the serial results.
 
+The calls: simulate with cvodes (rigid body and a stiff model), auto (explicit and stiff),
+rk8 and lie; linearize; a gyrostat stability report (linearization, eigenvalues, closed
+forms); and a minimum-effort slew (IPOPT, mesh refinement with cvodes) in two threads.
+
 A data race inside CasADi kills the process (SIGSEGV, ``double free``, a failed assertion),
 so the threaded workload runs in a subprocess; the test checks its return code and that
 every threaded result equals the serial reference computed first in that subprocess.
@@ -25,7 +29,7 @@ import json, random, sys, threading
 import casadi as ca
 import numpy as np
 from dynamics import Model, linearize, rigid_body, simulate
-from problems import slew
+from problems import slew, stability
 
 x, tt = ca.SX.sym("x"), ca.SX.sym("tt")
 u, p = ca.SX.sym("u", 0), ca.SX.sym("p", 0)
@@ -57,6 +61,9 @@ tasks = {
     "rk8_rb": sim(rb, x0_rb, t, "rk8", steps=20),
     "lie_rb": sim(rb, x0_rb, t, "lie", steps=20),
     "linearize_rb": lambda: np.asarray(linearize(rb, x_spin).A),
+    "stability_gyrostat": lambda: np.concatenate([
+        (r := stability.gyrostat([2.0, 3.0, 4.5], [1, 0, 0], 0.7, 1.5)).eigenvalues.view(float),
+        [r.status, r.closed_form_error or 0.0]]),
 }
 ref = {k: f() for k, f in tasks.items()}
 ref["slew"] = slew_run()
@@ -97,7 +104,7 @@ def _run_workload(repeat: int = 1, timeout: float = 120.0) -> dict:
                                   f" (negative: killed by that signal)\n{proc.stderr[-3000:]}")
     report = json.loads(proc.stdout.strip().splitlines()[-1])
     assert report["errors"] == [], report["errors"]
-    assert report["calls"] == 8 * 7 * repeat + 2
+    assert report["calls"] == 8 * 8 * repeat + 2
     return report
 
 
@@ -153,3 +160,29 @@ def test_cache_checkout_lends_distinct_instances_and_reuses_them():
         th.join()
     assert len({id(o) for o in seen}) == 4  # never the same instance twice at once
     assert len(built) == 4
+
+
+def test_a_cache_hit_does_not_wait_for_another_threads_build():
+    import threading
+
+    from dynamics import cache
+
+    key_hit, key_slow = ("test.hit", id(cache)), ("test.slow", id(cache))
+    cache.get(key_hit, lambda: "ready")
+    started, took = threading.Event(), []
+
+    def slow_build():
+        started.set()
+        time.sleep(1.0)  # an IPOPT build of a large NLP
+        return "slow"
+
+    builder = threading.Thread(target=lambda: cache.get(key_slow, slow_build))
+    builder.start()
+    assert started.wait(10)
+    t0 = time.perf_counter()
+    assert cache.get(key_hit, lambda: "rebuilt") == "ready"
+    took.append(time.perf_counter() - t0)
+    still_building = builder.is_alive()
+    builder.join()
+    assert still_building and took[0] < 0.1
+    assert cache.get(key_slow, lambda: "again") == "slow"  # built once, kept
