@@ -27,6 +27,7 @@ import numpy as np
 from . import cache, validate
 from .attitude import dcm_from_quat, quat_rate
 from .model import Model
+from .momentum.wheels import rotor_dynamics
 from .rigid_body import RIGID_BODY_STATES
 from .validate import check_inertia
 
@@ -255,9 +256,8 @@ def _gyrostat(inertia_key, wheel_axis, wheel_momentum, damper, damper_on, wheel_
     p = ca.SX.sym("p", 0)
     q, w = x[0:4], x[4:7]
     extra_states, extra_units = (), {}
-    if damper is None:
-        H = ca.mtimes(I, w) + h * aw
-        wdot = ca.solve(I, u - ca.cross(w, H))
+    if damper is None:  # a wheel spacecraft whose wheel is held at constant relative speed
+        H, wdot, _ = rotor_dynamics(I, aw, w, [h], u)
         rest = []
         energy = 0.5 * ca.dot(w, ca.mtimes(I, w))
     elif isinstance(damper, PointMassDamper):
@@ -323,7 +323,8 @@ def gyrostat_model(inertia, *, wheel_axis=(1.0, 0.0, 0.0), wheel_momentum: float
     wheel as if locked. Torque-free apart from ``u`` (about the system mass center):
     ``H' + w x H = u`` in body axes, with
 
-    * no damper: ``H = I w + h a``.
+    * no damper: ``H = I w + h a``, ``I w' = u - w x H`` -- a wheel spacecraft whose wheel
+      is held at constant speed (`dynamics.momentum.wheels.rotor_dynamics`, shared).
     * `PointMassDamper` (on the platform): with ``rho = b + s d``, ``g = rho x d``,
       ``mu`` the reduced mass and ``J(s) = I + mu (|rho|^2 E - rho rho^T)``, the angular
       momentum about the system mass center is ``H = J(s) w + mu s' g + h a``; the mass

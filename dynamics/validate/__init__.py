@@ -17,15 +17,15 @@ DM is a vector of length ``n``).
 
 Modules: `base` (the error class, symbol detection, shared array helpers), `numbers`
 (finite arrays and scalars, integers, positive values, choices), `rotations` (unit vectors,
-unit quaternions, rotation matrices and their tolerances), `inertia` (`check_inertia`).
+device axes, unit quaternions, rotation matrices and their tolerances), `inertia` (`check_inertia`).
 """
 from __future__ import annotations
 
 from .base import ArgumentTypeError, is_symbolic
 from .inertia import check_inertia
-from .numbers import finite_array, finite_scalar, integer, one_of, positive
-from .rotations import (DCM_ORTHO_TOL, QUAT_NORM_TOL, rotation_matrix, unit_quaternion,
-                        unit_quaternions, unit_vector)
+from .numbers import finite_array, finite_scalar, integer, one_of, positive, positive_each
+from .rotations import (AXIS_NORM_TOL, DCM_ORTHO_TOL, QUAT_NORM_TOL, rotation_matrix, unit_axes,
+                        unit_quaternion, unit_quaternions, unit_vector)
 
 ArgumentTypeError.__module__ = __name__  # shown where users import it from
 
@@ -33,10 +33,13 @@ __all__ = [
     "ArgumentTypeError",
     "QUAT_NORM_TOL",
     "DCM_ORTHO_TOL",
+    "AXIS_NORM_TOL",
     "is_symbolic",
     "finite_array",
     "finite_scalar",
     "unit_vector",
+    "unit_axes",
+    "positive_each",
     "unit_quaternion",
     "unit_quaternions",
     "rotation_matrix",

@@ -6,7 +6,7 @@ import numpy as np
 
 from .base import ArgumentTypeError, check_finite, check_shape, real_array, short_repr
 
-__all__ = ["finite_array", "finite_scalar", "one_of", "integer", "positive"]
+__all__ = ["finite_array", "finite_scalar", "one_of", "integer", "positive", "positive_each"]
 
 
 def finite_array(x, name: str, shape: tuple | None = None, *, batch: bool = False) -> np.ndarray:
@@ -222,4 +222,48 @@ def positive(value, name: str) -> float:
     v = finite_scalar(value, name)
     if not v > 0:
         raise ValueError(f"`{name}` must be a finite number > 0, got {value!r}")
+    return v
+
+
+def positive_each(value, name: str, n: int) -> np.ndarray:
+    """A finite number ``> 0`` per device (a scalar is used for all ``n``).
+
+    Parameters
+    ----------
+    value : float or array_like, shape (n,)
+        E.g. wheel axial moments [kg m^2] or rotor momenta [N m s].
+    name : str
+        Argument name used in error messages.
+    n : int
+        Number of devices.
+
+    Returns
+    -------
+    ndarray, shape (n,)
+
+    Raises
+    ------
+    TypeError
+        If ``value`` does not hold real numbers.
+    ValueError
+        Naming ``name`` (and the entry): wrong length, not finite or not ``> 0``.
+
+    Examples
+    --------
+    >>> from dynamics.validate import positive_each
+    >>> positive_each(0.5, "wheel_inertia", 3)
+    array([0.5, 0.5, 0.5])
+    >>> positive_each([1.0, -1.0], "wheel_inertia", 2)
+    Traceback (most recent call last):
+        ...
+    ValueError: `wheel_inertia[1]` must be a finite number > 0, got -1.0
+    """
+    v = finite_array(value, name)
+    if v.ndim == 0:
+        return np.full(n, positive(float(v), name))
+    if v.shape != (n,):
+        raise ValueError(f"`{name}` must be a scalar or have shape ({n},) (one per unit), "
+                         f"got {v.shape}")
+    for i, vi in enumerate(v.tolist()):
+        positive(vi, f"{name}[{i}]")
     return v

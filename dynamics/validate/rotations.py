@@ -8,14 +8,18 @@ import numpy as np
 from .base import check_shape, cross3, dot3, first_index, member, norm, real_array, short_repr
 from .numbers import finite_array
 
-__all__ = ["QUAT_NORM_TOL", "DCM_ORTHO_TOL", "unit_vector", "unit_quaternion",
-           "unit_quaternions", "rotation_matrix"]
+__all__ = ["QUAT_NORM_TOL", "DCM_ORTHO_TOL", "AXIS_NORM_TOL", "unit_vector", "unit_axes",
+           "unit_quaternion", "unit_quaternions", "rotation_matrix"]
 
 #: How far a quaternion argument may deviate from unit norm before it is refused.
 QUAT_NORM_TOL = 1e-6
 
 #: Largest accepted ``max |A A^T - E|`` of a rotation-matrix argument.
 DCM_ORTHO_TOL = 1e-6
+
+#: Largest accepted ``| |axis| - 1 |`` of a device axis (wheel spin axes, CMG gimbal and
+#: spin axes): they define the device, so they are refused, not normalized, when off.
+AXIS_NORM_TOL = 1e-9
 
 
 
@@ -241,3 +245,58 @@ def rotation_matrix(A, name: str, *, tol: float = DCM_ORTHO_TOL, batch: bool = F
         raise ValueError(f"`{member(name, 2, idx)}` must be a proper rotation (det +1), got "
                          f"det {float(det if idx is None else det[idx]):.9g} (a reflection)")
     return a
+
+
+def unit_axes(axes, name: str, *, n: int | None = None, tol: float = AXIS_NORM_TOL) -> np.ndarray:
+    """Check unit axes given as the columns of a ``(3, n)`` array (or one ``(3,)`` axis).
+
+    Parameters
+    ----------
+    axes : array_like, shape (3, n) or (3,)
+        Unit vectors as columns, components first.
+    name : str
+        Argument name used in error messages.
+    n : int, optional
+        Required number of columns.
+    tol : float, optional
+        Largest accepted ``| |axis| - 1 |`` (default `AXIS_NORM_TOL`).
+
+    Returns
+    -------
+    ndarray, shape (3, n)
+        The axes scaled to exactly unit length.
+
+    Raises
+    ------
+    TypeError
+        If ``axes`` does not hold real numbers.
+    ValueError
+        Naming ``name`` (and the column): wrong shape, not finite, no columns, a zero column
+        or one not of unit length to ``tol``.
+
+    Examples
+    --------
+    >>> from dynamics.validate import unit_axes
+    >>> unit_axes([[1.0, 0.0], [0.0, 0.6], [0.0, 0.8]], "axes")
+    array([[1. , 0. ],
+           [0. , 0.6],
+           [0. , 0.8]])
+    >>> unit_axes([[2.0], [0.0], [0.0]], "axes")
+    Traceback (most recent call last):
+        ...
+    ValueError: `axes[:, 0]` must be a unit vector (norm 1 to 1e-09), got norm 2
+    """
+    a = finite_array(axes, name)
+    if a.shape == (3,):
+        a = a.reshape(3, 1)
+    if a.ndim != 2 or a.shape[0] != 3 or a.shape[1] == 0:
+        raise ValueError(f"`{name}` must have shape (3, n) with n >= 1 (components first, one "
+                         f"unit axis per column), got {a.shape}")
+    if n is not None and a.shape[1] != n:
+        raise ValueError(f"`{name}` must have shape (3, {n}), got {a.shape}")
+    norms = np.linalg.norm(a, axis=0)
+    for j, nj in enumerate(norms):
+        if not abs(nj - 1.0) <= tol:
+            what = "a non-zero unit vector" if nj == 0 else f"a unit vector (norm 1 to {tol:g})"
+            raise ValueError(f"`{member(name, 1, (j,))}` must be {what}, got norm {nj:.12g}")
+    return a / norms
