@@ -42,16 +42,18 @@ Modules
 -------
 `targets` (input checks, the target attitude, `KeepOut`, defaults and statuses),
 `problem` (`slew_problem`, `eigenaxis_time`, guesses), `maneuvers` (`time_optimal`,
-`min_effort`, `verify`), `report` (`switch_times`, `summary`, `format_summary`, `plot_slew`).
+`min_effort`, `verify`), `devices` (`wheel_slew`, `cmg_slew`: the same slews by reaction
+wheels or CMGs, momentum exchanged inside the spacecraft), `report` (`switch_times`, `summary`, `format_summary`, `plot_slew`).
 """
 from __future__ import annotations
 
+from .devices import cmg_slew, wheel_slew
 from .maneuvers import min_effort, time_optimal, verify
 from .problem import attitude_guess, eigenaxis_time, slew_problem
 from .report import format_summary, plot_slew, summary, switch_times
 from .targets import (MIN_REFINE_TOL, POINTING_TOL, RATE_TOL, STATUS_POINTING, STATUS_REFINE,
                       KeepOut)
 
-__all__ = ["KeepOut", "slew_problem", "time_optimal", "min_effort", "eigenaxis_time",
+__all__ = ["KeepOut", "slew_problem", "time_optimal", "min_effort", "wheel_slew", "cmg_slew", "eigenaxis_time",
            "switch_times", "attitude_guess", "verify", "summary", "format_summary", "plot_slew",
            "POINTING_TOL", "RATE_TOL", "MIN_REFINE_TOL", "STATUS_POINTING", "STATUS_REFINE"]

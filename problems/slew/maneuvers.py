@@ -32,7 +32,9 @@ def verify(solution: Solution, *, pointing_tol: float = POINTING_TOL, rate_tol: 
     pointing_tol : float [rad]
         Largest accepted `ocp.Solution.pointing_error` (default 1e-6).
     rate_tol : float [rad/s]
-        Largest accepted final rate error, ``max_i |w_sim,i(tf) - wf_i|`` (default 1e-6).
+        Largest accepted final rate error, ``max_i |w_sim,i(tf) - wf_i|`` (default 1e-6),
+        over every final state given after the quaternion (device slews: also the wheel
+        speeds [rad/s] or gimbal angles [rad] where their final values are fixed).
 
     Returns
     -------
@@ -64,8 +66,12 @@ def verify(solution: Solution, *, pointing_tol: float = POINTING_TOL, rate_tol: 
     rtol = check_tol("rate_tol", rate_tol, RATE_TOL)
     perr = solution.pointing_error
     perr = float("nan") if perr is None else perr
-    term = solution.terminal_error[4:7]
-    rerr = float(np.max(term)) if np.all(np.isfinite(term)) else float("nan")
+    # every fixed final state after the quaternion: body rates, and wheel speeds or gimbal
+    # angles of the device slews where their final values are given
+    fixed = np.isfinite(np.asarray(solution.problem.x_final, dtype=float))
+    fixed[:4] = False
+    term = solution.terminal_error[fixed]
+    rerr = float(np.max(term, initial=0.0)) if np.all(np.isfinite(term)) else float("nan")
     info = {"pointing_error": perr, "final_rate_error": rerr, "pointing_tol": ptol, "rate_tol": rtol}
     if not solution.success:
         return annotate(solution, info)
@@ -196,14 +202,28 @@ def time_optimal(inertia, *, angle=None, axis=None, q0=None, qf=None, u_max=1.0,
                         problem.u_bounds[1], floor=1e-14 if is_rest_to_rest(problem) else 1e-3)
     opts = dict(transcription=transcription, N=N, verbose=verbose, ipopt_options=ipopt_options,
                 scale=_tiny_scale(problem, T_est))
+    guesses = None if guess is not None else seeded_guesses(problem, int(starts), seed,
+                                                             eigenaxis=keep_out is None)
+    return solve_time_optimal(problem, guess, guesses, opts,
+                              polish=polish and not norm_bound and keep_out is None,
+                              pointing_tol=ptol, rate_tol=rtol, ipopt_options=ipopt_options,
+                              verbose=verbose)
+
+
+def solve_time_optimal(problem, guess, guesses, opts, *, polish, pointing_tol, rate_tol,
+                       ipopt_options, verbose):
+    """The time-optimal pipeline shared by the rigid-body and the device slews: solve from
+    ``guess`` (or the best of ``guesses``), verify by re-simulation, polish the switch
+    times when ``polish`` (kept only if verified and not slower), else refine the mesh
+    (`_refined_fallback`). ``opts`` are `ocp.solve` keywords."""
+    ptol, rtol = pointing_tol, rate_tol
     if guess is not None:
         sol = solve(problem, guess=guess, **opts)
     else:
-        guesses = seeded_guesses(problem, int(starts), seed, eigenaxis=keep_out is None)
         sol = solve_multistart(problem, guesses, **opts)
     first = sol
     sol = verify(sol, pointing_tol=ptol, rate_tol=rtol)
-    if not (polish and first.success and not norm_bound and keep_out is None):
+    if not (polish and first.success):
         return _refined_fallback(problem, first, sol, ptol, rtol, ipopt_options, opts["scale"])
     # degree 5: at degree 3 the ~4 intervals per arc under-resolve the states and the free
     # knots exploit the collocation error (T below the best known); at degree 4 the
@@ -328,10 +348,19 @@ def min_effort(inertia, T, *, angle=None, axis=None, q0=None, qf=None, u_max=Non
         starts = integer(DEFAULT_STARTS_EFFORT if starts is None else starts, "starts", minimum=1)
         guesses = seeded_guesses(problem, starts, 0 if seed is None else seed, eigenaxis=False)
         first = solve_multistart(problem, guesses, **opts)
+    return refine_and_verify(problem, first, tol=tol, scale=scale, pointing_tol=ptol,
+                             rate_tol=rtol, ipopt_options=ipopt_options, verbose=verbose)
+
+
+def refine_and_verify(problem, first, *, tol, scale, pointing_tol, rate_tol, ipopt_options,
+                      verbose):
+    """The minimum-effort pipeline after the first solve (shared with the device slews):
+    refine the mesh to ``tol`` (`ocp.refine`; not meeting it is `STATUS_REFINE`) and verify
+    by re-simulation."""
     if not first.success:
-        return verify(first, pointing_tol=ptol, rate_tol=rtol)
+        return verify(first, pointing_tol=pointing_tol, rate_tol=rate_tol)
     sol = refine(problem, first, tol=tol, verbose=verbose, ipopt_options=ipopt_options, scale=scale)
     if sol.success and not sol.info.get("converged", False):
         sol = annotate(sol, {}, success=False, status=STATUS_REFINE,
                        message=f"{sol.message}; the requested refinement tol {tol:g} was not met")
-    return verify(sol, pointing_tol=ptol, rate_tol=rtol)
+    return verify(sol, pointing_tol=pointing_tol, rate_tol=rate_tol)

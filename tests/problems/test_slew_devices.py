@@ -1,0 +1,75 @@
+"""Slews by reaction wheels and CMGs (problems.slew.devices), against independent truths:
+the rigid-body optimum where the physics coincide, conservation of the total inertial
+momentum, and the singularity-measure path bound."""
+import numpy as np
+import pytest
+
+from dynamics.momentum import pyramid, singularity_measure
+from problems import slew
+
+BETA = np.deg2rad(54.74)
+
+
+def test_wheel_time_optimal_reproduces_bilimoria_wie():
+    """A unit-inertia hub with three orthogonal wheels at zero total momentum obeys
+    I w' = -tau exactly (no gyroscopic term): the rigid-body optimum, T = 3.2430833 s
+    (Bilimoria & Wie's best known 180 deg slew, |u_i| <= 1)."""
+    sol = slew.wheel_slew(np.eye(3), np.eye(3), 0.01, angle=np.pi, axis=[0, 0, 1])
+    assert sol.success, sol.message
+    assert abs(sol.T - 3.2430833) < 5e-7
+    assert sol.info["momentum_drift"] < 1e-9
+
+
+def test_wheel_min_effort_equals_rigid_body_min_effort_with_speed_limit_inactive():
+    """Same hub: the wheel torques are the (negated) body torques, so the minimum effort is
+    the rigid body's; a generous wheel-speed limit changes nothing."""
+    rigid = slew.min_effort(np.eye(3), 3.0, angle=1.0, axis=[1, 1, 0])
+    wheels = slew.wheel_slew(np.eye(3), np.eye(3), 0.05, objective="effort", T=3.0, angle=1.0,
+                             axis=[1, 1, 0], speed_max=1e3)
+    assert rigid.success and wheels.success, wheels.message
+    assert abs(wheels.cost - rigid.cost) < 1e-6 * rigid.cost
+    assert wheels.info["momentum_drift"] < 1e-8
+
+
+def test_wheel_speed_limit_binds_and_final_speeds_are_met():
+    free = slew.wheel_slew(np.diag([1.0, 2.0, 3.0]), np.eye(3), 0.05, objective="effort", T=4.0,
+                           angle=1.0, axis=[0, 0, 1], torque_max=None)
+    limit = 0.8 * float(np.max(np.abs(free.x[7:])))
+    held = slew.wheel_slew(np.diag([1.0, 2.0, 3.0]), np.eye(3), 0.05, objective="effort", T=4.0,
+                           angle=1.0, axis=[0, 0, 1], torque_max=None, speed_max=limit,
+                           Wf=[0.0, 0.0, 0.0])
+    assert free.success and held.success, held.message
+    assert np.max(np.abs(held.x[7:])) <= limit * (1 + 1e-8)
+    assert held.cost > free.cost  # the bound is active
+    assert held.info["momentum_drift"] < 1e-8
+
+
+def test_cmg_min_effort_keeps_the_singularity_measure_above_its_bound():
+    geo = pyramid(BETA)
+    free = slew.cmg_slew(10 * np.eye(3), geo, objective="effort", T=2.0, angle=0.1,
+                         axis=[1, 0, 0], N=15)
+    bound = 0.5 * (free.info["min_measure"] + float(singularity_measure(geo, np.zeros(4))))
+    kept = slew.cmg_slew(10 * np.eye(3), geo, objective="effort", T=2.0, angle=0.1,
+                         axis=[1, 0, 0], N=15, min_measure=bound)
+    assert free.success and kept.success, kept.message
+    assert free.info["min_measure"] < bound  # unconstrained, the path dips below
+    assert kept.info["min_measure"] >= bound * (1 - 1e-6)
+    assert kept.cost >= free.cost
+    assert kept.info["momentum_drift"] < 1e-5
+
+
+def test_bad_inputs_name_the_argument():
+    with pytest.raises(ValueError, match="`W0`"):
+        slew.wheel_slew(np.eye(3), np.eye(3), 0.01, angle=1.0, axis=[1, 0, 0], speed_max=1.0,
+                        W0=[2.0, 0.0, 0.0])
+    with pytest.raises(ValueError, match="torque_max"):
+        slew.wheel_slew(np.eye(3), np.eye(3), 0.01, angle=1.0, axis=[1, 0, 0], torque_max=None)
+    with pytest.raises(ValueError, match="`axes"):
+        slew.wheel_slew(np.eye(3), 2 * np.eye(3), 0.01, angle=1.0, axis=[1, 0, 0])
+    with pytest.raises(TypeError, match="`geometry`"):
+        slew.cmg_slew(np.eye(3), np.eye(3), angle=1.0, axis=[1, 0, 0])
+    with pytest.raises(ValueError, match="`objective`"):
+        slew.cmg_slew(np.eye(3), pyramid(BETA), objective="fast", angle=1.0, axis=[1, 0, 0])
+    with pytest.raises(ValueError, match="`delta0`"):
+        slew.cmg_slew(np.eye(3), pyramid(np.pi / 2), objective="effort", T=1.0, angle=1.0,
+                      axis=[1, 0, 0], min_measure=0.1)
