@@ -8,7 +8,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-__all__ = ["new_figure", "axes_or_new_figure", "finish_figure"]
+__all__ = ["new_figure", "cleared_figure", "axes_or_new_figure", "finish_figure"]
 
 
 def new_figure(figsize=(8.0, 5.0)):
@@ -23,6 +23,13 @@ def new_figure(figsize=(8.0, 5.0)):
     from matplotlib.figure import Figure
 
     return Figure(figsize=figsize)
+
+
+def cleared_figure(fig, figsize):
+    """``fig`` cleared for a multi-panel plot, or a new Figure of ``figsize`` [in]."""
+    fig = new_figure(figsize) if fig is None else fig
+    fig.clear()
+    return fig
 
 
 def axes_or_new_figure(ax, figsize):

@@ -12,7 +12,10 @@ Modules (every name in ``__all__`` is importable from ``dynamics.momentum``):
   symmetric gyroscope);
 * `wheels` -- `wheel_spacecraft` and `rotor_dynamics`, the one body-plus-rotor derivation
   (shared with `dynamics.spinning.gyrostat_model`, a wheel held at constant speed);
-* `cmg` -- `cmg_spacecraft` (exact and torque-model fidelity).
+* `cmg` -- `cmg_spacecraft` (exact and torque-model fidelity);
+* `envelope` -- singular surfaces and the momentum envelope (`momentum_envelope`,
+  `MomentumEnvelope`, `singular_surface`, `classify_singularities`);
+* `steering_sim` -- steering-law simulations (`steering_model`, `steer`, `SteeringResult`).
 """
 from __future__ import annotations
 
@@ -21,8 +24,11 @@ from .cluster import (ClusterGeometry, classify_singularity, cluster_jacobian, c
 from .gyroscopic import (cmg_torque, coriolis_torque, gyroscope_reaction_torque,
                          propeller_torque, wheel_torque)
 from .cmg import cmg_spacecraft
+from .envelope import (MomentumEnvelope, classify_singularities, fibonacci_directions,
+                       momentum_envelope, singular_surface)
 from .steering import (gsr_inverse_steering, null_motion, pseudo_inverse_steering,
                        sr_inverse_steering)
+from .steering_sim import SteeringResult, steer, steering_model
 from .wheels import rotor_dynamics, wheel_spacecraft
 
 __all__ = [
@@ -41,6 +47,14 @@ __all__ = [
     "sr_inverse_steering",
     "gsr_inverse_steering",
     "null_motion",
+    "fibonacci_directions",
+    "singular_surface",
+    "classify_singularities",
+    "momentum_envelope",
+    "MomentumEnvelope",
+    "steering_model",
+    "steer",
+    "SteeringResult",
     "wheel_torque",
     "cmg_torque",
     "coriolis_torque",

@@ -3,10 +3,12 @@
     appdyn simulate torque-free --inertia 1,2,3 --w0 -1,0.1,0.8 --t-final 50 [--plot F.png]
     appdyn slew --inertia 1,1,1 --u-max 1 --axis 0,0,1 --angle 180 --time-optimal
     appdyn stability spin|heavy-top|projectile|rotor|gyrostat|sweep ... [--json F] [--plot F.png]
+    appdyn cmg envelope --beta 54.74 [--h 1] [--directions N] [--plot F.png] [--json F]
+    appdyn cmg steer --beta 54.74 --torque 0,0,0.5 --law sr|pinv|gsr --t-final 10 [--delta0 ...]
     appdyn demo
     appdyn bench [NAME ...]
 
-One module per command (`simulate`, `slew`, `stability`, `demo`, `bench`), each with
+One module per command (`simulate`, `slew`, `stability`, `cmg`, `demo`, `bench`), each with
 ``add_parser(subparsers)``, ``check(parser, args)`` (checks across options, before any
 computation) and ``run(args) -> exit status``; `common` holds what they share.
 
@@ -27,15 +29,15 @@ import os
 import re
 import sys
 
-from problems.cli import bench, demo, simulate, slew, stability
+from problems.cli import bench, cmg, demo, simulate, slew, stability
 from problems.cli.common import attach_negative_values
 from problems.cli.slew import rest_to_rest_bound
 
 __all__ = ["main", "build_parser", "COMMANDS", "rest_to_rest_bound"]
 
 #: command name -> its module (``add_parser``, ``check``, ``run``), in the order of ``--help``
-COMMANDS = {"simulate": simulate, "slew": slew, "stability": stability, "demo": demo,
-            "bench": bench}
+COMMANDS = {"simulate": simulate, "slew": slew, "stability": stability, "cmg": cmg,
+            "demo": demo, "bench": bench}
 
 
 def build_parser() -> argparse.ArgumentParser:
