@@ -1,7 +1,9 @@
 """appdyn dynamics: models as named-I/O CasADi Functions, simulation, closed-form truths.
 
 Entry points: `Model`, `rigid_body`, `wheel_spacecraft` and `cmg_spacecraft` (momentum-exchange
-devices; cluster analysis and steering laws in `dynamics.momentum`), `closed_loop` (a
+devices; cluster analysis and steering laws in `dynamics.momentum`), `launch_vehicle` (the
+thrust-vectored vehicle in the yaw plane with opt-in aero, mass flow, slosh, bending, actuator
+and autopilot; parts in `dynamics.launch_vehicle`), `closed_loop` (a
 state-feedback law closed around any model), `simulate` (with `SimulationResult` and `METHODS`;
 internals in the subpackage `dynamics.integrate`), `linearize` (exact linearization about
 equilibria and steady spins, as a python-control StateSpace), `clear_caches` (empties the one
@@ -15,14 +17,15 @@ import importlib
 from . import attitude, cache, momentum
 from .feedback import closed_loop
 from .integrate import METHODS, SimulationResult, simulate
+from .launch_vehicle import launch_vehicle
 from .linearize import Linearization, linearization, linearize
 from .model import Model
 from .momentum import cmg_spacecraft, wheel_spacecraft
 from .rigid_body import rigid_body
 
 __all__ = ["METHODS", "Linearization", "Model", "SimulationResult", "attitude", "clear_caches",
-           "closed_loop", "cmg_spacecraft", "linearization", "linearize", "momentum",
-           "rigid_body", "simulate", "truth", "wheel_spacecraft"]
+           "closed_loop", "cmg_spacecraft", "launch_vehicle", "linearization", "linearize",
+           "momentum", "rigid_body", "simulate", "truth", "wheel_spacecraft"]
 
 def clear_caches() -> None:
     """Empty every cache of built and compiled CasADi Functions, jit files included.
