@@ -10,12 +10,20 @@
         --bearing-distance ... --rate ... [--internal-damping D]
     appdyn stability gyrostat --inertia 3,4,4 --axis 1,0,0 --rate 2 --wheel-momentum 3 \\
         [--wheel-inertia J] [--damper ...] [--damper-on platform|rotor]
+    appdyn stability launch-vehicle --thrust 2e6 --inertia 4e7 --arm 20 --mass 1e5 \\
+        --k-psi 2 --k-psidot 2 [--aero Q,S,CNA,LCP --velocity V] [--slosh KEY=V,...] \\
+        [--bending KEY=V,...] [--actuator TAU]
     appdyn stability sweep CASE --parameter NAME --values START:STOP:NUM  [CASE options]
 
 ``--damper`` takes a kind and ``key=value`` items (vectors comma-separated):
 
     --damper point mass=0.05 stiffness=20 damping=0.3 position=0,0.5,0 direction=1,0,0 [body_mass=M]
     --damper sphere inertia=0.05 damping=0.02
+
+``launch-vehicle`` parts: ``--aero`` dynamic pressure [Pa], reference area [m^2], normal-force
+slope [1/rad], centre of pressure ahead of the mass centre [m]; ``--slosh`` and ``--bending``
+take the fields of `dynamics.launch_vehicle.Slosh` / `~dynamics.launch_vehicle.Bending` as
+``key=value`` items joined by commas; ``--actuator`` the time constant [s].
 
 `add_parser` adds the ``stability`` command to an argparse sub-parser group (its cases land
 in ``args.case``); `check` checks across options; `run` executes parsed arguments; `main` is
@@ -27,6 +35,7 @@ module prints; the library does not.
 from __future__ import annotations
 
 import argparse
+import re
 import sys
 
 import numpy as np
@@ -35,11 +44,13 @@ from problems.cli.common import Progress, attach_negative_values, inertia_matrix
 from problems.cli.common import number as _number
 from problems.cli.common import output_file as _output_file
 from problems.cli.common import positive as _positive
-from problems.cli.common import progress_enabled, same_file
+from problems.cli.common import progress_enabled, same_file, save_figure
 from problems.cli.common import vector as _floats
 from problems.cli.common import write_outputs
 
-__all__ = ["add_parser", "check", "run", "main", "parse_damper", "sweep_parameters"]
+__all__ = ["add_parser", "check", "run", "main", "parse_damper", "sweep_parameters",
+           "add_launch_vehicle_options", "launch_vehicle_kwargs", "check_flight",
+           "call_naming_parts"]
 
 
 def parse_damper(tokens):
@@ -76,6 +87,54 @@ def parse_damper(tokens):
     except TypeError as exc:
         needed = fields[kind][:3] if kind == "point" else fields[kind]
         raise ValueError(f"`--damper {kind}` needs {', '.join(needed)}: {exc}") from None
+
+
+def _argument_type(build):
+    """argparse type calling ``build(text)``; its ValueError/TypeError is the message."""
+    def parse(text):
+        try:
+            return build(text)
+        except (TypeError, ValueError) as exc:
+            raise argparse.ArgumentTypeError(" ".join(str(exc).split())) from None
+    return parse
+
+
+def _items(fields):
+    """``key=value,...`` -> dict of floats, keys among ``fields``."""
+    def parse(text):
+        items = [item.partition("=") for item in text.replace(" ", "").split(",")]
+        bad = [k + sep + v for k, sep, v in items if not sep or k not in fields]
+        if bad:
+            raise ValueError(f"expected key=value items joined by commas, keys "
+                             f"{', '.join(fields)}; got {bad[0]!r}")
+        return {k: _number(v) for k, _, v in items}
+    return parse
+
+
+def _launch_vehicle_parts():
+    from dynamics.launch_vehicle import Actuator, Aero, Bending, Slosh
+
+    slosh = _items(("mass", "hinge", "length", "frequency", "damping_ratio"))
+    bending = _items(("frequency", "generalized_mass", "damping_ratio", "slope_sensor",
+                      "deflection_gimbal", "slope_gimbal"))
+    return [
+        ("velocity", "--velocity", _number, "flight speed along X [m/s], with --aero"),
+        ("aero", "--aero", _argument_type(lambda text: Aero(*_floats((4,))(text))),
+         "dynamic pressure [Pa], reference area [m^2], normal-force slope [1/rad], centre "
+         "of pressure ahead of the mass centre [m]"),
+        ("slosh", "--slosh", _argument_type(lambda text: Slosh(**slosh(text))),
+         "slosh mode: mass=KG,hinge=M and length=M (pendulum) or frequency=RAD_S "
+         "(spring-mass), optional damping_ratio=Z"),
+        ("bending", "--bending", _argument_type(lambda text: Bending(**bending(text))),
+         "bending mode: frequency=RAD_S,generalized_mass=KG, optional damping_ratio, "
+         "slope_sensor [rad/m], deflection_gimbal [-], slope_gimbal [rad/m]"),
+        ("actuator", "--actuator", _argument_type(lambda text: Actuator(_positive(text))),
+         "gimbal actuator time constant [s]"),
+    ]
+
+
+_METAVARS = {"aero": "Q,S,CNA,LCP", "slosh": "KEY=V,...", "bending": "KEY=V,...",
+             "actuator": "TAU"}
 
 
 # (dest, flags, type, help); required in a plain case, optional under 'sweep'
@@ -117,6 +176,14 @@ _OPTIONS = {
         ("wheel_momentum", "--wheel-momentum", _number,
          "wheel momentum relative to the platform [N m s]"),
     ],
+    "launch-vehicle": [
+        ("thrust", "--thrust", _number, "thrust F [N]"),
+        ("inertia", "--inertia", _number, "pitch/yaw moment of inertia I [kg m^2]"),
+        ("arm", "--arm", _number, "mass centre to the gimbal l [m]"),
+        ("mass", "--mass", _number, "mass m [kg]"),
+        ("k_psi", "--k-psi", _number, "attitude gain [rad/rad]"),
+        ("k_psidot", "--k-psidot", _number, "rate gain [rad/(rad/s)]"),
+    ],
 }
 _EXTRA = {
     "spin": [("damper", "--damper", None, "energy damper: point KEY=V ... | sphere KEY=V ...")],
@@ -126,24 +193,55 @@ _EXTRA = {
     "gyrostat": [("wheel_inertia", "--wheel-inertia", _number, "wheel axial inertia [kg m^2]"),
                  ("damper", "--damper", None, "energy damper: point KEY=V ... | sphere KEY=V ..."),
                  ("damper_on", "--damper-on", None, "platform (default) or rotor")],
+    "launch-vehicle": _launch_vehicle_parts(),
 }
 
 
-def _add_case_options(parser, case, *, sweeping):
+def _add_inputs(parser, case, *, required):
     for dest, flag, typ, help_ in _OPTIONS[case]:
-        parser.add_argument(flag, dest=dest, type=typ, required=not sweeping, help=help_)
+        parser.add_argument(flag, dest=dest, type=typ, required=required, help=help_)
     for dest, flag, typ, help_ in _EXTRA[case]:
         if dest == "damper":
             parser.add_argument(flag, dest=dest, nargs="+", metavar="ITEM", help=help_)
         elif dest == "damper_on":
             parser.add_argument(flag, dest=dest, choices=["platform", "rotor"], help=help_)
         else:
-            parser.add_argument(flag, dest=dest, type=typ, help=help_)
+            parser.add_argument(flag, dest=dest, type=typ, metavar=_METAVARS.get(dest),
+                                help=help_)
+
+
+def _add_case_options(parser, case, *, sweeping):
+    _add_inputs(parser, case, required=not sweeping)
     parser.add_argument("--json", metavar="FILE", type=_output_file(),
                         help="write the report as JSON")
     parser.add_argument("--plot", metavar="FILE.png", type=_output_file((".png",)),
-                        help="save the pole map (sweep: eigenvalues vs the parameter), PNG")
+                        help="save the Bode plot of the loop with its margins and the pole "
+                             "map, PNG" if case == "launch-vehicle" and not sweeping else
+                        "save the pole map (sweep: eigenvalues vs the parameter), PNG")
     parser.set_defaults(_parser=parser)
+
+
+def add_launch_vehicle_options(parser) -> None:
+    """The vehicle, autopilot and part options of ``launch-vehicle`` (also used by
+    ``appdyn simulate launch-vehicle``); `launch_vehicle_kwargs` reads them back."""
+    _add_inputs(parser, "launch-vehicle", required=True)
+
+
+def launch_vehicle_kwargs(args) -> dict:
+    """Keyword arguments of `problems.stability.launch_vehicle` from parsed options."""
+    return _case_kwargs(args, "launch-vehicle")
+
+
+def call_naming_parts(fun, **kwargs):
+    """``fun(**kwargs)``; a ValueError about a part's field (```slosh.mass`` ...``) is
+    re-raised naming the part's option (``argument --slosh: ...``)."""
+    try:
+        return fun(**kwargs)
+    except ValueError as exc:
+        part = re.match(r"`(aero|slosh|bending|actuator)\.", str(exc))
+        if part is None:
+            raise
+        raise ValueError(f"argument --{part.group(1)}: {exc}") from None
 
 
 def sweep_parameters(case) -> list:
@@ -170,7 +268,8 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
     """Add ``stability`` to ``subparsers`` (from ``parser.add_subparsers(dest="command")``).
 
     The chosen case lands in ``args.case`` (``spin``, ``heavy-top``, ``projectile``,
-    ``rotor``, ``gyrostat``, ``sweep``); under ``sweep`` the swept case is ``args.sweep_case``.
+    ``rotor``, ``gyrostat``, ``launch-vehicle``, ``sweep``); under ``sweep`` the swept case
+    is ``args.sweep_case``.
     Hand the parsed arguments to `run`.
     """
     stab = subparsers.add_parser("stability", help="linear stability reports of spinning bodies")
@@ -179,7 +278,9 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
              "heavy-top": "heavy top, NASA RP-1262 Sec. 4.6 Method III (sleeping top, precession)",
              "projectile": "spin-stabilized projectile (aerodynamic overturning moment)",
              "rotor": "rotor in elastic bearings: whirl and internal-damping instability",
-             "gyrostat": "dual-spin gyrostat vs wheel momentum (optional damper)"}
+             "gyrostat": "dual-spin gyrostat vs wheel momentum (optional damper)",
+             "launch-vehicle": "launch-vehicle attitude autopilot (RP-1262 Sec. 5.4): margins "
+                               "at the engine deflection, named modes"}
     for case, help_ in helps.items():
         _add_case_options(cases.add_parser(case, help=help_), case, sweeping=False)
     sw = cases.add_parser("sweep", help="verdict and least-damped eigenvalue along a parameter")
@@ -252,8 +353,19 @@ def check(parser, args) -> None:
         if missing:
             parser.error(f"sweep {case} needs {', '.join(missing)} (all but the swept "
                          f"--{args.parameter})")
+    if "launch-vehicle" in (args.case, getattr(args, "sweep_case", None)):
+        check_flight(parser, args)
     if same_file(args.plot, args.json):
         parser.error("argument --json: the same file as --plot")
+
+
+def check_flight(parser, args) -> None:
+    """``--velocity`` goes with ``--aero`` (unless swept), as argparse errors."""
+    swept = getattr(args, "parameter", None) == "velocity"
+    if args.aero is not None and args.velocity is None and not swept:
+        parser.error("argument --velocity: needed with --aero (alpha = psi - y_dot / V)")
+    if args.aero is None and (args.velocity is not None or swept):
+        parser.error("argument --velocity: only with --aero")
 
 
 def _case_kwargs(args, case) -> dict:
@@ -262,7 +374,7 @@ def _case_kwargs(args, case) -> dict:
         value = getattr(args, dest, None)
         if value is None:
             continue
-        if dest == "inertia":
+        if dest == "inertia" and isinstance(value, np.ndarray):
             value = inertia_matrix(value)
         elif dest == "damper":
             value = parse_damper(value)
@@ -273,7 +385,8 @@ def _case_kwargs(args, case) -> dict:
 def run(args) -> int:
     """Execute parsed ``stability`` arguments: print the report, write ``--json``/``--plot``.
 
-    Returns 0 (the verdict is in the report, not the exit status). Call `check` first
+    Returns 0, or 1 when the eigenvalues disagree with the case's closed forms (the verdict
+    is in the report, not the exit status). Call `check` first
     (``problems.cli.main`` does). ``ValueError`` from bad input propagates
     (``problems.cli.main`` turns it into exit status 2).
     """
@@ -292,10 +405,16 @@ def run(args) -> int:
             progress.close()
     else:
         _, case_function = st.resolve_case(args.case)
-        result = case_function(**_case_kwargs(args, args.case))
+        result = call_naming_parts(case_function, **_case_kwargs(args, args.case))
     print(result)
-    write_outputs(result, plot=args.plot, json=args.json)
-    return 0
+    if args.case == "launch-vehicle" and args.plot:
+        save_figure(st.bode_plot(result, pole_map=True), args.plot)
+        print(f"plot written to {args.plot}")
+    write_outputs(result, plot=None if args.case == "launch-vehicle" else args.plot,
+                  json=args.json)
+    if not result.success:
+        print(f"appdyn stability {args.case}: {result.message}", file=sys.stderr)
+    return 0 if result.success else 1
 
 
 def main(argv=None) -> int:

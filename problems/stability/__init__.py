@@ -14,6 +14,9 @@ Cases
 `spinning_projectile`  Example 2: aerodynamic overturning moment in place of ``m g l``
 `rotor`                Example 3: whirl (4.134-4.135) and internal-damping instability
 `gyrostat`             body + wheel of constant relative speed, optional damper
+`launch_vehicle`       thrust-vectored vehicle under the attitude/rate autopilot (Sec. 5.4):
+                       margins at the engine deflection, named modes; `bode_plot`,
+                       `nichols_plot`, `launch_vehicle_response` (time response)
 `loop`                 any plant with a feedback law: margins via ``control.stability_margins``
 `analyze`              any ``StateSpace`` (e.g. from `dynamics.linearize.linearize`)
 
@@ -21,13 +24,15 @@ Cases
 
 Modules: `verdict` (the rule: an eigenvalue with ``|Re| <= ZERO_RTOL * rho`` counts as on
 the imaginary axis; "marginally stable" needs those to be semisimple), `report` (the report,
-its statuses, `analyze`), `closed_forms`, `spin` and `tilt` (the cases), `loop`, `cases`
-(the table of names), `sweep`, `common` (shared conversions and checks).
+its statuses, `analyze`), `closed_forms`, `spin`, `tilt` and `launch_vehicle` (the cases),
+`launch_vehicle_plots` (Bode, Nichols), `launch_vehicle_response` (time response), `loop`,
+`cases` (the table of names), `sweep`, `common` (shared conversions and checks).
 
 Spin cases report the *reduced* motion: the spin phase about the axis (cyclic) and the
 conserved spin-axis momentum (a first integral, whose steady spins form a one-parameter
 family with eigenvalue 0) are factored out by `Linearization.quotient` and
-`Linearization.restrict`; the notes say which states went.
+`Linearization.restrict`; the notes say which states went. The launch vehicle's translation
+(rigid-body drift, for guidance to correct) is factored out the same way.
 
 Examples
 --------
@@ -39,6 +44,9 @@ from dynamics.spinning import PointMassDamper, SphericalDamper
 
 from .cases import CASE_ALIASES, CASES, resolve_case
 from .common import STANDARD_GRAVITY
+from .launch_vehicle import launch_vehicle
+from .launch_vehicle_plots import bode_plot, loop_transfer, nichols_plot
+from .launch_vehicle_response import AutopilotResponse, launch_vehicle_response
 from .loop import loop
 from .report import (CLOSED_FORM_RTOL, STATUS_MISMATCH, STATUS_UNCHECKED, STATUS_VERIFIED,
                      Margins, Mode, Quantity, StabilityReport, analyze)
@@ -50,7 +58,9 @@ from .verdict import VERDICTS, ZERO_RTOL, classify
 __all__ = [
     "ZERO_RTOL", "VERDICTS", "Mode", "Margins", "Quantity", "StabilityReport", "Boundary",
     "SweepResult", "PointMassDamper", "SphericalDamper", "classify", "analyze", "spin",
-    "heavy_top", "spinning_projectile", "rotor", "gyrostat", "loop", "sweep", "CASES",
+    "heavy_top", "spinning_projectile", "rotor", "gyrostat", "launch_vehicle", "loop_transfer",
+    "bode_plot", "nichols_plot", "launch_vehicle_response", "AutopilotResponse", "loop",
+    "sweep", "CASES",
     "CASE_ALIASES", "resolve_case", "STANDARD_GRAVITY", "STATUS_VERIFIED", "STATUS_UNCHECKED",
     "STATUS_MISMATCH", "CLOSED_FORM_RTOL",
 ]

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from typing import Callable
 
+from .launch_vehicle import launch_vehicle
 from .report import StabilityReport
 from .spin import gyrostat, spin
 from .tilt import heavy_top, rotor, spinning_projectile
@@ -13,11 +14,11 @@ __all__ = ["CASES", "CASE_ALIASES", "resolve_case"]
 #: case name -> function; every case takes its parameters by keyword
 CASES: dict[str, Callable[..., StabilityReport]] = {
     "spin": spin, "heavy_top": heavy_top, "spinning_projectile": spinning_projectile,
-    "rotor": rotor, "gyrostat": gyrostat,
+    "rotor": rotor, "gyrostat": gyrostat, "launch_vehicle": launch_vehicle,
 }
 #: other accepted spellings (the command line's among them) -> case name
 CASE_ALIASES = {"heavy-top": "heavy_top", "projectile": "spinning_projectile",
-                "spinning-projectile": "spinning_projectile"}
+                "spinning-projectile": "spinning_projectile", "launch-vehicle": "launch_vehicle"}
 
 
 def resolve_case(case):
