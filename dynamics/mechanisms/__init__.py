@@ -1,0 +1,30 @@
+"""Worked mechanisms of the seeds, each a `Model` builder with its closed forms.
+
+* `pendulums` -- the double pendulum (Rheinfurth & Wilson, NASA RP-1262, Sec. 5.4 a) with
+  its normal-mode frequencies, the pendulum on a string of prescribed length (Eq. 5.51),
+  and the exact simple pendulum (`pendulum_swing`, `pendulum_period`);
+* `spherical` -- the spherical pendulum of Ch. 6 Example 1 in 3-1-3 and 3-2-1 angles, the
+  conical rate and the mass matrices;
+* `shaken` -- the physical pendulum on a sinusoidally shaken hinge (seed 000, Euler's law
+  about an arbitrary point), with the Kapitza frequency and the first resonance tongue;
+* `common` -- the shared symbols, model assembly and parameter checks.
+
+Time-dependent mechanisms carry the clock state ``t`` of `dynamics.clock`. Every model
+keeps its physical constants as parameters (``model.params``), defaulting to the builder's
+arguments, so one built right-hand side serves all values. Systems held together by
+Lagrange multipliers (`dynamics.constrained`) are not here.
+"""
+from __future__ import annotations
+
+from .common import GRAVITY
+from .pendulums import (double_pendulum, double_pendulum_modes, pendulum_period, pendulum_swing,
+                        variable_length_pendulum)
+from .shaken import (SHAKEN_DEFAULTS, equivalent_length, kapitza_frequency, natural_frequency,
+                     resonance_tongue, shaken_pendulum)
+from .spherical import SEQUENCES, conical_rate, spherical_mass_matrix, spherical_pendulum
+
+__all__ = ["GRAVITY", "SEQUENCES", "SHAKEN_DEFAULTS", "conical_rate", "double_pendulum",
+           "double_pendulum_modes", "equivalent_length", "kapitza_frequency",
+           "natural_frequency", "pendulum_period", "pendulum_swing", "resonance_tongue",
+           "shaken_pendulum", "spherical_mass_matrix", "spherical_pendulum",
+           "variable_length_pendulum"]
