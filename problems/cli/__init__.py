@@ -1,8 +1,11 @@
 """The ``appdyn`` command line.
 
     appdyn simulate torque-free --inertia 1,2,3 --w0 -1,0.1,0.8 --t-final 50 [--plot F.png]
+    appdyn simulate launch-vehicle --thrust F --inertia I --arm L --mass M --k-psi K --k-psidot KD
+                                   [--aero ...] --psi0 DEG [--gust V ...] [--plot F.png]
     appdyn slew --inertia 1,1,1 --u-max 1 --axis 0,0,1 --angle 180 --time-optimal
-    appdyn stability spin|heavy-top|projectile|rotor|gyrostat|sweep ... [--json F] [--plot F.png]
+    appdyn stability spin|heavy-top|projectile|rotor|gyrostat|launch-vehicle|sweep ...
+                     [--json F] [--plot F.png]
     appdyn cmg envelope --beta 54.74 [--h 1] [--directions N] [--plot F.png] [--json F]
     appdyn cmg steer --beta 54.74 --torque 0,0,0.5 --law sr|pinv|gsr --t-final 10 [--delta0 ...]
     appdyn demo
