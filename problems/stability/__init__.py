@@ -18,6 +18,10 @@ Cases
                        margins at the engine deflection, named modes; `bode_plot`,
                        `nichols_plot`, `launch_vehicle_response` (time response)
 `loop`                 any plant with a feedback law: margins via ``control.stability_margins``
+`shaken_pendulum`      hanging / inverted pendulum on a shaken hinge: Floquet multipliers
+                       (a `PeriodicStabilityReport`), checked against Mathieu's chart
+`conical_pendulum`     steady cone of the spherical pendulum (3-1-3 or 3-2-1 form), reduced by
+                       its symmetry about the vertical (Routh)
 `analyze`              any ``StateSpace`` (e.g. from `dynamics.linearize.linearize`)
 
 `sweep` runs a case along one parameter and locates each verdict boundary by bisection.
@@ -26,6 +30,7 @@ Modules: `verdict` (the rule: an eigenvalue with ``|Re| <= ZERO_RTOL * rho`` cou
 the imaginary axis; "marginally stable" needs those to be semisimple), `report` (the report,
 its statuses, `analyze`), `closed_forms`, `spin`, `tilt` and `launch_vehicle` (the cases),
 `launch_vehicle_plots` (Bode, Nichols), `launch_vehicle_response` (time response), `loop`,
+`periodic` (time-periodic operating points), `constrained` (relative equilibria),
 `cases` (the table of names), `sweep`, `common` (shared conversions and checks).
 
 Spin cases report the *reduced* motion: the spin phase about the axis (cyclic) and the
@@ -44,10 +49,12 @@ from dynamics.spinning import PointMassDamper, SphericalDamper
 
 from .cases import CASE_ALIASES, CASES, resolve_case
 from .common import STANDARD_GRAVITY
+from .constrained import conical_pendulum
 from .launch_vehicle import launch_vehicle
 from .launch_vehicle_plots import bode_plot, loop_transfer, nichols_plot
 from .launch_vehicle_response import AutopilotResponse, launch_vehicle_response
 from .loop import loop
+from .periodic import FloquetMode, PeriodicStabilityReport, shaken_pendulum
 from .report import (CLOSED_FORM_RTOL, STATUS_MISMATCH, STATUS_UNCHECKED, STATUS_VERIFIED,
                      Margins, Mode, Quantity, StabilityReport, analyze)
 from .spin import gyrostat, spin
@@ -62,5 +69,6 @@ __all__ = [
     "bode_plot", "nichols_plot", "launch_vehicle_response", "AutopilotResponse", "loop",
     "sweep", "CASES",
     "CASE_ALIASES", "resolve_case", "STANDARD_GRAVITY", "STATUS_VERIFIED", "STATUS_UNCHECKED",
-    "STATUS_MISMATCH", "CLOSED_FORM_RTOL",
+    "STATUS_MISMATCH", "CLOSED_FORM_RTOL", "shaken_pendulum", "conical_pendulum",
+    "PeriodicStabilityReport", "FloquetMode",
 ]

@@ -4,21 +4,26 @@ from __future__ import annotations
 
 from typing import Callable
 
+from .constrained import conical_pendulum
 from .launch_vehicle import launch_vehicle
+from .periodic import PeriodicStabilityReport, shaken_pendulum
 from .report import StabilityReport
 from .spin import gyrostat, spin
 from .tilt import heavy_top, rotor, spinning_projectile
 
 __all__ = ["CASES", "CASE_ALIASES", "resolve_case"]
 
-#: case name -> function; every case takes its parameters by keyword
-CASES: dict[str, Callable[..., StabilityReport]] = {
+#: case name -> function; every case takes its parameters by keyword and returns a
+#: `StabilityReport` (`shaken_pendulum`: a `PeriodicStabilityReport`, the same format)
+CASES: dict[str, Callable[..., StabilityReport | PeriodicStabilityReport]] = {
     "spin": spin, "heavy_top": heavy_top, "spinning_projectile": spinning_projectile,
     "rotor": rotor, "gyrostat": gyrostat, "launch_vehicle": launch_vehicle,
+    "shaken_pendulum": shaken_pendulum, "conical_pendulum": conical_pendulum,
 }
 #: other accepted spellings (the command line's among them) -> case name
 CASE_ALIASES = {"heavy-top": "heavy_top", "projectile": "spinning_projectile",
-                "spinning-projectile": "spinning_projectile", "launch-vehicle": "launch_vehicle"}
+                "spinning-projectile": "spinning_projectile", "launch-vehicle": "launch_vehicle",
+                "shaken-pendulum": "shaken_pendulum", "conical-pendulum": "conical_pendulum"}
 
 
 def resolve_case(case):
