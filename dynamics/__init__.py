@@ -3,19 +3,25 @@
 Entry points: `Model`, `rigid_body`, `wheel_spacecraft` and `cmg_spacecraft` (momentum-exchange
 devices; cluster analysis and steering laws in `dynamics.momentum`), `launch_vehicle` (the
 thrust-vectored vehicle in the yaw plane with opt-in aero, mass flow, slosh, bending, actuator
-and autopilot; parts in `dynamics.launch_vehicle`), `closed_loop` (a
+and autopilot; parts in `dynamics.launch_vehicle`), `hinged_bodies` (two rigid
+bodies joined by a ball or revolute hinge, held by Lagrange multipliers), `closed_loop` (a
 state-feedback law closed around any model), `simulate` (with `SimulationResult` and `METHODS`;
 internals in the subpackage `dynamics.integrate`), `linearize` (exact linearization about
 equilibria and steady spins, as a python-control StateSpace), `clear_caches` (empties the one
 cache of built and compiled Functions, `dynamics.cache`), and the modules `attitude`
-(kinematics) and `truth` (closed forms, imported on first use).
+(kinematics), `constrained` (the multiplier machinery: accelerations, multipliers, reaction
+forces, Baumgarte stabilization and projection), `mechanisms` (the seed's worked systems with
+their closed forms), `clock` (time-dependent models carry a clock state ``"t"``), `floquet`
+(monodromy matrix and multipliers of periodic motion) and `truth` (closed forms, imported on
+first use).
 """
 from __future__ import annotations
 
 import importlib
 
-from . import attitude, cache, momentum
+from . import attitude, cache, clock, constrained, floquet, mechanisms, momentum
 from .feedback import closed_loop
+from .hinged import hinged_bodies
 from .integrate import METHODS, SimulationResult, simulate
 from .launch_vehicle import launch_vehicle
 from .linearize import Linearization, linearization, linearize
@@ -24,8 +30,9 @@ from .momentum import cmg_spacecraft, wheel_spacecraft
 from .rigid_body import rigid_body
 
 __all__ = ["METHODS", "Linearization", "Model", "SimulationResult", "attitude", "clear_caches",
-           "closed_loop", "cmg_spacecraft", "launch_vehicle", "linearization", "linearize",
-           "momentum", "rigid_body", "simulate", "truth", "wheel_spacecraft"]
+           "clock", "closed_loop", "cmg_spacecraft", "constrained", "floquet", "hinged_bodies",
+           "launch_vehicle", "linearization", "linearize", "mechanisms", "momentum", "rigid_body", "simulate", "truth",
+           "wheel_spacecraft"]
 
 def clear_caches() -> None:
     """Empty every cache of built and compiled CasADi Functions, jit files included.
