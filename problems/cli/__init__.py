@@ -3,8 +3,12 @@
     appdyn simulate torque-free --inertia 1,2,3 --w0 -1,0.1,0.8 --t-final 50 [--plot F.png]
     appdyn simulate launch-vehicle --thrust F --inertia I --arm L --mass M --k-psi K --k-psidot KD
                                    [--aero ...] --psi0 DEG [--gust V ...] [--plot F.png]
+    appdyn simulate hinged --m1 M --inertia1 a,b,c --m2 M --inertia2 a,b,c --r1 x,y,z --r2 x,y,z
+                           [--kind ball|revolute --axis x,y,z] --w1 ... --w2 ... [--v1 ...]
+                           --t-final T [--steps N] [--no-stabilization] [--plot F.png] [--json F]
     appdyn slew --inertia 1,1,1 --u-max 1 --axis 0,0,1 --angle 180 --time-optimal
-    appdyn stability spin|heavy-top|projectile|rotor|gyrostat|launch-vehicle|sweep ...
+    appdyn stability spin|heavy-top|projectile|rotor|gyrostat|launch-vehicle|shaken-pendulum|
+                     conical-pendulum|sweep ...
                      [--json F] [--plot F.png]
     appdyn cmg envelope --beta 54.74 [--h 1] [--directions N] [--plot F.png] [--json F]
     appdyn cmg steer --beta 54.74 --torque 0,0,0.5 --law sr|pinv|gsr --t-final 10 [--delta0 ...]

@@ -13,6 +13,10 @@
     appdyn stability launch-vehicle --thrust 2e6 --inertia 4e7 --arm 20 --mass 1e5 \\
         --k-psi 2 --k-psidot 2 [--aero Q,S,CNA,LCP --velocity V] [--slosh KEY=V,...] \\
         [--bending KEY=V,...] [--actuator TAU]
+    appdyn stability shaken-pendulum --mass 1 --inertia 0.0208 --length 0.25 --amp-y 0.02 \\
+        --freq 200 [--position hanging|inverted] [--damping C] [--amp-x A] [--gravity G]
+    appdyn stability conical-pendulum --mass 1 --length 1 --cone-angle 60 [--inertia I] \\
+        [--sequence 3-2-1|3-1-3] [--gravity G]
     appdyn stability sweep CASE --parameter NAME --values START:STOP:NUM  [CASE options]
 
 ``--damper`` takes a kind and ``key=value`` items (vectors comma-separated):
@@ -24,6 +28,9 @@
 slope [1/rad], centre of pressure ahead of the mass centre [m]; ``--slosh`` and ``--bending``
 take the fields of `dynamics.launch_vehicle.Slosh` / `~dynamics.launch_vehicle.Bending` as
 ``key=value`` items joined by commas; ``--actuator`` the time constant [s].
+
+``conical-pendulum --cone-angle`` is in degrees (also when swept: ``--values`` in degrees);
+the report shows the library's radians.
 
 `add_parser` adds the ``stability`` command to an argparse sub-parser group (its cases land
 in ``args.case``); `check` checks across options; `run` executes parsed arguments; `main` is
@@ -184,6 +191,18 @@ _OPTIONS = {
         ("k_psi", "--k-psi", _number, "attitude gain [rad/rad]"),
         ("k_psidot", "--k-psidot", _number, "rate gain [rad/(rad/s)]"),
     ],
+    "shaken-pendulum": [
+        ("mass", "--mass", _number, "mass m [kg]"),
+        ("inertia", "--inertia", _number, "central moment about the hinge axis [kg m^2]"),
+        ("length", "--length", _number, "hinge to mass centre l [m]"),
+        ("amp_y", "--amp-y", _number, "vertical shaking amplitude [m]"),
+        ("freq", "--freq", _number, "shaking frequency [rad/s]"),
+    ],
+    "conical-pendulum": [
+        ("mass", "--mass", _number, "mass m [kg]"),
+        ("length", "--length", _number, "pivot to bob l [m]"),
+        ("cone_angle", "--cone-angle", _number, "cone half-angle, 0 < DEG < 90 [deg]"),
+    ],
 }
 _EXTRA = {
     "spin": [("damper", "--damper", None, "energy damper: point KEY=V ... | sphere KEY=V ...")],
@@ -194,7 +213,23 @@ _EXTRA = {
                  ("damper", "--damper", None, "energy damper: point KEY=V ... | sphere KEY=V ..."),
                  ("damper_on", "--damper-on", None, "platform (default) or rotor")],
     "launch-vehicle": _launch_vehicle_parts(),
+    "shaken-pendulum": [
+        ("position", "--position", None, "hanging (default) or inverted"),
+        ("damping", "--damping", _number, "viscous hinge damping [N m s] (0)"),
+        ("amp_x", "--amp-x", _number, "horizontal shaking amplitude [m] (0; no closed form)"),
+        ("gravity", "--gravity", _number, "gravity [m/s^2] (9.80665)")],
+    "conical-pendulum": [
+        ("inertia", "--inertia", _number, "central moment of the body [kg m^2] (0: point "
+                                          "mass; > 0 needs --sequence 3-1-3)"),
+        ("sequence", "--sequence", None, "Euler sequence of the formulation: 3-2-1 (default) "
+                                         "or 3-1-3"),
+        ("gravity", "--gravity", _number, "gravity [m/s^2] (9.80665)")],
 }
+#: options taking one of a few words (dest -> choices)
+_CHOICES = {"damper_on": ["platform", "rotor"], "position": ["hanging", "inverted"],
+            "sequence": ["3-2-1", "3-1-3"]}
+#: options given in degrees on the command line, radians in the library
+_DEGREES = ("cone_angle",)
 
 
 def _add_inputs(parser, case, *, required):
@@ -203,8 +238,8 @@ def _add_inputs(parser, case, *, required):
     for dest, flag, typ, help_ in _EXTRA[case]:
         if dest == "damper":
             parser.add_argument(flag, dest=dest, nargs="+", metavar="ITEM", help=help_)
-        elif dest == "damper_on":
-            parser.add_argument(flag, dest=dest, choices=["platform", "rotor"], help=help_)
+        elif dest in _CHOICES:
+            parser.add_argument(flag, dest=dest, choices=_CHOICES[dest], help=help_)
         else:
             parser.add_argument(flag, dest=dest, type=typ, metavar=_METAVARS.get(dest),
                                 help=help_)
@@ -268,11 +303,12 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
     """Add ``stability`` to ``subparsers`` (from ``parser.add_subparsers(dest="command")``).
 
     The chosen case lands in ``args.case`` (``spin``, ``heavy-top``, ``projectile``,
-    ``rotor``, ``gyrostat``, ``launch-vehicle``, ``sweep``); under ``sweep`` the swept case
+    ``rotor``, ``gyrostat``, ``launch-vehicle``, ``shaken-pendulum``, ``conical-pendulum``,
+    ``sweep``); under ``sweep`` the swept case
     is ``args.sweep_case``.
     Hand the parsed arguments to `run`.
     """
-    stab = subparsers.add_parser("stability", help="linear stability reports of spinning bodies")
+    stab = subparsers.add_parser("stability", help="linear stability reports of spinning bodies and mechanisms")
     cases = stab.add_subparsers(dest="case", required=True)
     helps = {"spin": "torque-free spin about a principal axis (optional damper)",
              "heavy-top": "heavy top, NASA RP-1262 Sec. 4.6 Method III (sleeping top, precession)",
@@ -280,7 +316,11 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
              "rotor": "rotor in elastic bearings: whirl and internal-damping instability",
              "gyrostat": "dual-spin gyrostat vs wheel momentum (optional damper)",
              "launch-vehicle": "launch-vehicle attitude autopilot (RP-1262 Sec. 5.4): margins "
-                               "at the engine deflection, named modes"}
+                               "at the engine deflection, named modes",
+             "shaken-pendulum": "pendulum on a shaken hinge: Floquet multipliers vs Mathieu "
+                                "(Kapitza's inverted pendulum, resonance tongues)",
+             "conical-pendulum": "conical pendulum (RP-1262 Ch. 6 Ex. 1): nutation about the "
+                                 "steady cone vs the closed form"}
     for case, help_ in helps.items():
         _add_case_options(cases.add_parser(case, help=help_), case, sweeping=False)
     sw = cases.add_parser("sweep", help="verdict and least-damped eigenvalue along a parameter")
@@ -378,6 +418,8 @@ def _case_kwargs(args, case) -> dict:
             value = inertia_matrix(value)
         elif dest == "damper":
             value = parse_damper(value)
+        elif dest in _DEGREES:
+            value = np.radians(value)
         kwargs[dest] = value
     return kwargs
 
@@ -399,7 +441,10 @@ def run(args) -> int:
         progress = Progress(f"sweep {case} over {args.parameter}",
                             enabled=progress_enabled(args))
         try:
-            result = st.sweep(case, parameter, _values(args.values), rtol=args.rtol,
+            values = _values(args.values)
+            if parameter in _DEGREES:
+                values = np.radians(values)
+            result = st.sweep(case, parameter, values, rtol=args.rtol,
                               progress=progress if progress.enabled else None, **kwargs)
         finally:
             progress.close()
