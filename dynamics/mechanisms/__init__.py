@@ -7,24 +7,39 @@
   conical rate and the mass matrices;
 * `shaken` -- the physical pendulum on a sinusoidally shaken hinge (seed 000, Euler's law
   about an arbitrary point), with the Kapitza frequency and the first resonance tongue;
+* `multipliers` -- systems held by Lagrange multipliers (`dynamics.constrained`): the rod
+  pendulum in Cartesian coordinates and its rod tension, the shaken pendulum a second time
+  (its multipliers the hinge force), the bead on a driven wire (Eq. 5.79);
+* `bodies` -- constrained rigid bodies: the rolling coin (nonholonomic) with its steady
+  circular rolling, and the dumbbell elastically hinged to a free disk with its planar
+  swing frequency;
+* `lagrange` -- Lagrange's equations by automatic differentiation and the assembly of a
+  constrained model (shared by `multipliers` and `bodies`);
 * `common` -- the shared symbols, model assembly and parameter checks.
 
 Time-dependent mechanisms carry the clock state ``t`` of `dynamics.clock`. Every model
 keeps its physical constants as parameters (``model.params``), defaulting to the builder's
-arguments, so one built right-hand side serves all values. Systems held together by
-Lagrange multipliers (`dynamics.constrained`) are not here.
+arguments, so one built right-hand side serves all values.
 """
 from __future__ import annotations
 
 from .common import GRAVITY
+from .bodies import (coin_state, coin_steady_rates, dumbbell_disk, dumbbell_disk_frequency,
+                     dumbbell_disk_state, rolling_coin)
+from .lagrange import lagrange_terms
+from .multipliers import (bead_motion, bead_torque, rod_pendulum, rod_reaction,
+                          shaken_multiplier_state, shaken_pendulum_multipliers, sliding_bead)
 from .pendulums import (double_pendulum, double_pendulum_modes, pendulum_period, pendulum_swing,
                         variable_length_pendulum)
 from .shaken import (SHAKEN_DEFAULTS, equivalent_length, kapitza_frequency, natural_frequency,
                      resonance_tongue, shaken_pendulum)
 from .spherical import SEQUENCES, conical_rate, spherical_mass_matrix, spherical_pendulum
 
-__all__ = ["GRAVITY", "SEQUENCES", "SHAKEN_DEFAULTS", "conical_rate", "double_pendulum",
-           "double_pendulum_modes", "equivalent_length", "kapitza_frequency",
+__all__ = ["GRAVITY", "SEQUENCES", "SHAKEN_DEFAULTS", "bead_motion", "bead_torque",
+           "coin_state", "coin_steady_rates", "conical_rate", "double_pendulum",
+           "double_pendulum_modes", "dumbbell_disk", "dumbbell_disk_frequency",
+           "dumbbell_disk_state", "equivalent_length", "kapitza_frequency", "lagrange_terms",
            "natural_frequency", "pendulum_period", "pendulum_swing", "resonance_tongue",
-           "shaken_pendulum", "spherical_mass_matrix", "spherical_pendulum",
-           "variable_length_pendulum"]
+           "rod_pendulum", "rod_reaction", "rolling_coin", "shaken_multiplier_state",
+           "shaken_pendulum", "shaken_pendulum_multipliers", "sliding_bead",
+           "spherical_mass_matrix", "spherical_pendulum", "variable_length_pendulum"]
