@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from typing import Callable
 
-from .constrained import conical_pendulum
+from .constrained import conical_pendulum, hinged_spin
 from .launch_vehicle import launch_vehicle
 from .periodic import PeriodicStabilityReport, shaken_pendulum
 from .report import StabilityReport
@@ -19,11 +19,13 @@ CASES: dict[str, Callable[..., StabilityReport | PeriodicStabilityReport]] = {
     "spin": spin, "heavy_top": heavy_top, "spinning_projectile": spinning_projectile,
     "rotor": rotor, "gyrostat": gyrostat, "launch_vehicle": launch_vehicle,
     "shaken_pendulum": shaken_pendulum, "conical_pendulum": conical_pendulum,
+    "hinged_spin": hinged_spin,
 }
 #: other accepted spellings (the command line's among them) -> case name
 CASE_ALIASES = {"heavy-top": "heavy_top", "projectile": "spinning_projectile",
                 "spinning-projectile": "spinning_projectile", "launch-vehicle": "launch_vehicle",
-                "shaken-pendulum": "shaken_pendulum", "conical-pendulum": "conical_pendulum"}
+                "shaken-pendulum": "shaken_pendulum", "conical-pendulum": "conical_pendulum",
+                "hinged-spin": "hinged_spin"}
 
 
 def resolve_case(case):
