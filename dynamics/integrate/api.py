@@ -9,6 +9,7 @@ from typing import Callable, Literal, Mapping
 import numpy as np
 
 from .. import cache, validate
+from ..clock import check_clock_start, clock_index
 from ..model import Model, check_model
 from .auto import solve_auto
 from .cvodes import run_cvodes
@@ -133,6 +134,8 @@ def simulate(model: Model, x0, t, *, u=None, p=None, method: Method = "auto",
         raise ValueError(f"`method` must be one of {METHODS}, got {method!r}")
     t = check_t(t)
     x0 = check_x0(x0, model)
+    if clock_index(model) is not None:  # a time-dependent model: its clock starts at t[0]
+        check_clock_start(model, x0, t[0])
     p = model.resolve_p(p)
     rtol, atol = check_tolerances(rtol, atol, model.nx)
     control = check_u(u, model.nu, t)
