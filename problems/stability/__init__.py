@@ -51,7 +51,8 @@ from dynamics.spinning import PointMassDamper, SphericalDamper
 
 from .cases import CASE_ALIASES, CASES, resolve_case
 from .common import STANDARD_GRAVITY
-from .constrained import conical_pendulum, hinged_spin
+from .constrained import conical_pendulum
+from .hinged import hinged_spin
 from .launch_vehicle import launch_vehicle
 from .launch_vehicle_plots import bode_plot, loop_transfer, nichols_plot
 from .launch_vehicle_response import AutopilotResponse, launch_vehicle_response

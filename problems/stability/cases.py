@@ -4,7 +4,8 @@ from __future__ import annotations
 
 from typing import Callable
 
-from .constrained import conical_pendulum, hinged_spin
+from .constrained import conical_pendulum
+from .hinged import hinged_spin
 from .launch_vehicle import launch_vehicle
 from .periodic import PeriodicStabilityReport, shaken_pendulum
 from .report import StabilityReport
