@@ -13,7 +13,7 @@ from typing import Mapping
 import casadi as ca
 import numpy as np
 
-__all__ = ["Model", "check_model"]
+__all__ = ["Model", "check_model", "model_from_expressions"]
 
 
 def _freeze(mapping: Mapping | None) -> Mapping:
@@ -137,6 +137,28 @@ class Model:
                     f"{tuple(fun.name_in())} -> {tuple(fun.name_out())}"
                 )
 
+    # ----------------------------------------------------------- construction
+    @classmethod
+    def from_expressions(cls, states, xdot, controls=None, params=None, *, p_default=None,
+                         units=None, invariants=None, name: str = "model",
+                         attitude=None) -> "Model":
+        """A model from CasADi SX expressions of named scalar symbols (`model_from_expressions`).
+
+        Examples
+        --------
+        >>> import casadi as ca
+        >>> from dynamics import Model
+        >>> x, v, u = ca.SX.sym("x"), ca.SX.sym("v"), ca.SX.sym("u")
+        >>> model = Model.from_expressions({"x": x, "v": v}, {"x": v, "v": u}, {"u": u})
+        >>> model.states, model.controls, model.params
+        (('x', 'v'), ('u',), ())
+        >>> model.rhs([0.0, 2.0], [3.0])
+        array([2., 3.])
+        """
+        return model_from_expressions(states, xdot, controls, params, p_default=p_default,
+                                      units=units, invariants=invariants, name=name,
+                                      attitude=attitude)
+
     # --------------------------------------------------------------- pickling
     def __reduce__(self):
         """Pickle through CasADi's own serialization of ``f`` and the invariants.
@@ -230,6 +252,209 @@ class Model:
         if res.shape[0] == 1:
             res = res[0]
         return res[..., 0] if single else res
+
+
+# ------------------------------------------------------- models from expressions
+def _named_symbols(arg, argname: str) -> tuple[tuple[str, ...], list]:
+    """``(names, symbols)`` of a mapping name -> scalar SX symbol or a sequence of pairs."""
+    if arg is None:
+        return (), []
+    if isinstance(arg, Mapping):
+        pairs = list(arg.items())
+    elif isinstance(arg, (list, tuple)):
+        pairs = list(arg)
+        if not all(isinstance(pair, (list, tuple)) and len(pair) == 2 for pair in pairs):
+            raise TypeError(f"`{argname}` must be a mapping name -> casadi.SX symbol or a "
+                            f"sequence of (name, symbol) pairs, got {arg!r}")
+    else:
+        raise TypeError(f"`{argname}` must be a mapping name -> casadi.SX symbol or a sequence "
+                        f"of (name, symbol) pairs, got {type(arg).__name__}")
+    names, syms = [], []
+    for key, sym in pairs:
+        if not isinstance(key, str) or not key:
+            raise TypeError(f"`{argname}`: names must be non-empty str, got {key!r}")
+        if key in names:
+            raise ValueError(f"`{argname}`: name {key!r} is given twice")
+        if not isinstance(sym, ca.SX):
+            raise TypeError(f"`{argname}`[{key!r}] must be a casadi.SX symbol, got "
+                            f"{type(sym).__name__}")
+        if sym.numel() != 1 or not sym.is_symbolic():
+            raise ValueError(f"`{argname}`[{key!r}] must be a scalar symbol (casadi.SX.sym), "
+                             f"got {sym}")
+        names.append(key)
+        syms.append(sym)
+    return tuple(names), syms
+
+
+def _scalar_expression(expr, label: str) -> ca.SX:
+    if isinstance(expr, ca.MX):
+        raise TypeError(f"{label} must be a casadi.SX expression or a number, got casadi.MX")
+    try:
+        out = ca.SX(expr)
+    except (NotImplementedError, TypeError, RuntimeError):
+        raise TypeError(f"{label} must be a casadi.SX expression or a number, got "
+                        f"{type(expr).__name__}") from None
+    if out.numel() != 1:
+        raise ValueError(f"{label} must be a scalar expression, got shape {out.shape}")
+    return out
+
+
+def _check_declared(expr: ca.SX, declared: ca.SX, label: str, allowed: str) -> None:
+    """ValueError naming the symbols of ``expr`` that are not among ``declared``."""
+    free = [s.name() for s in ca.symvar(expr)
+            if declared.numel() == 0 or not ca.depends_on(s, declared)]
+    if free:
+        raise ValueError(f"{label} depends on undeclared symbol(s) {free}; declare them in "
+                         f"{allowed}")
+
+
+def model_from_expressions(states, xdot, controls=None, params=None, *, p_default=None,
+                           units=None, invariants=None, name: str = "model",
+                           attitude=None) -> Model:
+    """Build a `Model` from CasADi SX expressions of named scalar symbols.
+
+    The named-I/O Function ``f(x, u, p) -> xdot`` is built here (no empty parameter
+    symbol needed when there are no parameters or controls).
+
+    Parameters
+    ----------
+    states : mapping of str to casadi.SX, or sequence of (str, casadi.SX)
+        The state names and their scalar symbols (``casadi.SX.sym``), in state order.
+    xdot : mapping of str to expression, or sequence of expressions
+        Each state's derivative (an SX expression or a number): by state name, or in state
+        order. Expressions may use only the declared state, control and parameter symbols.
+    controls, params : mapping of str to casadi.SX, or sequence of (str, casadi.SX), optional
+        The control and parameter names and symbols, in order (none by default).
+    p_default : mapping of str to float, or array_like, shape (np,), optional
+        Default parameter values, by name (every parameter) or in order. Needed when there
+        are parameters.
+    units : mapping of str to str, optional
+        As `Model`.
+    invariants : mapping of str to expression or casadi.Function, optional
+        Monitored quantities: SX expressions of the states and parameters (scalar or
+        vector), or ready Functions of ``(x, p)`` (as `Model`).
+    name : str, optional
+        Model name (also the name of the Function).
+    attitude : tuple of (int or str), optional
+        As `Model`; the two entries may also be state names (``("q1", "w1")``).
+
+    Returns
+    -------
+    Model
+
+    Raises
+    ------
+    TypeError
+        If a symbol is not a ``casadi.SX`` or an expression is not SX or a number.
+    ValueError
+        Naming the argument: a state without an ``xdot`` (or an ``xdot`` without a state),
+        a name given twice, a non-scalar symbol or derivative, an expression depending on an
+        undeclared symbol, missing or extra ``p_default`` values.
+
+    Examples
+    --------
+    A pendulum ``theta'' = -(g / l) sin(theta) + u``:
+
+    >>> import casadi as ca
+    >>> from dynamics.model import model_from_expressions
+    >>> th, om, u, g, l = (ca.SX.sym(n) for n in ("theta", "omega", "u", "g", "l"))
+    >>> model = model_from_expressions(
+    ...     [("theta", th), ("omega", om)], [om, -g / l * ca.sin(th) + u],
+    ...     {"u": u}, {"g": g, "l": l}, p_default={"g": 9.81, "l": 1.0},
+    ...     invariants={"energy": 0.5 * l**2 * om**2 + g * l * (1 - ca.cos(th))},
+    ...     name="pendulum")
+    >>> model.params, model.p_default
+    (('g', 'l'), array([9.81, 1.  ]))
+    >>> model.rhs([0.0, 1.0], [0.5])
+    array([1. , 0.5])
+    >>> float(model.invariant("energy", [0.0, 2.0]))
+    2.0
+    """
+    state_names, xs = _named_symbols(states, "states")
+    control_names, us = _named_symbols(controls, "controls")
+    param_names, ps = _named_symbols(params, "params")
+    if not state_names:
+        raise ValueError("`states` must name at least one state")
+    seen: dict[str, str] = {}
+    for argname, names in (("states", state_names), ("controls", control_names),
+                           ("params", param_names)):
+        for key in names:
+            if key in seen:
+                raise ValueError(f"name {key!r} is used in both `{seen[key]}` and `{argname}`")
+            seen[key] = argname
+    everything = xs + us + ps
+    all_names = state_names + control_names + param_names
+    for i in range(1, len(everything)):
+        if ca.depends_on(everything[i], ca.vertcat(*everything[:i])):
+            raise ValueError(f"{all_names[i]!r} reuses the symbol of an earlier name; "
+                             "`states`, `controls` and `params` need distinct symbols")
+
+    # derivatives, in state order
+    if isinstance(xdot, Mapping):
+        missing = [k for k in state_names if k not in xdot]
+        if missing:
+            raise ValueError(f"`xdot` gives no derivative for state(s) {missing}")
+        extra = [k for k in xdot if k not in state_names]
+        if extra:
+            raise ValueError(f"`xdot` names unknown state(s) {extra}; the states are {state_names}")
+        exprs = [xdot[k] for k in state_names]
+    elif isinstance(xdot, (list, tuple)):
+        if len(xdot) != len(state_names):
+            raise ValueError(f"`xdot` must have {len(state_names)} expressions (one per state "
+                             f"{state_names}), got {len(xdot)}")
+        exprs = list(xdot)
+    else:
+        raise TypeError(f"`xdot` must be a mapping state name -> expression or a sequence of "
+                        f"expressions, got {type(xdot).__name__}")
+    declared = ca.vertcat(*everything)
+    rhs = []
+    for key, expr in zip(state_names, exprs):
+        e = _scalar_expression(expr, f"`xdot`[{key!r}]")
+        _check_declared(e, declared, f"`xdot`[{key!r}]", "`states`, `controls` or `params`")
+        rhs.append(e)
+
+    x = ca.vertcat(*xs)
+    u = ca.vertcat(*us) if us else ca.SX.sym("u", 0)
+    p = ca.vertcat(*ps) if ps else ca.SX.sym("p", 0)
+    f = ca.Function(str(name) or "model", [x, u, p], [ca.vertcat(*rhs)], ["x", "u", "p"], ["xdot"])
+
+    # parameter defaults
+    if isinstance(p_default, Mapping):
+        unknown = [k for k in p_default if k not in param_names]
+        if unknown:
+            raise ValueError(f"`p_default` names unknown parameter(s) {unknown}; the "
+                             f"parameters are {param_names}")
+        missing = [k for k in param_names if k not in p_default]
+        if missing:
+            raise ValueError(f"`p_default` gives no value for parameter(s) {missing}")
+        p_default = [float(p_default[k]) for k in param_names]
+    elif p_default is None:
+        if param_names:
+            raise ValueError(f"`p_default` must give a value for each parameter {param_names}")
+        p_default = np.zeros(0)
+
+    # invariants: expressions of (x, p), or Functions as `Model` takes them
+    state_params = ca.vertcat(*(xs + ps))
+    funs = {}
+    for key, expr in dict(invariants or {}).items():
+        if isinstance(expr, ca.Function):
+            funs[key] = expr
+            continue
+        if isinstance(expr, ca.MX):
+            raise TypeError(f"`invariants`[{key!r}] must be a casadi.SX expression or a "
+                            "casadi.Function, got casadi.MX")
+        e = ca.SX(expr) if not isinstance(expr, ca.SX) else expr
+        _check_declared(e, state_params, f"`invariants`[{key!r}]", "`states` or `params`")
+        funs[key] = ca.Function(str(key), [x, p], [ca.vec(e)], ["x", "p"], [str(key)])
+
+    if attitude is not None:
+        try:
+            attitude = tuple(state_names.index(a) if isinstance(a, str) else a for a in attitude)
+        except ValueError:
+            raise ValueError(f"`attitude` names unknown state(s) in {attitude!r}; the states "
+                             f"are {state_names}") from None
+    return Model(f, state_names, control_names, param_names, p_default=p_default,
+                 units=units or {}, invariants=funs, name=str(name), attitude=attitude)
 
 
 def check_model(model, name: str = "model") -> Model:

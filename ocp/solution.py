@@ -235,6 +235,45 @@ class Solution:
                 ("message", self.message)]
         return text_table("Optimal control solution", rows)
 
+    def __getitem__(self, name: str) -> np.ndarray:
+        """The trajectory of a state or control by name, at the node times ``t``.
+
+        A state name gives its row of ``x``; a control name its row of ``u``. Both are
+        sampled at ``t`` (the node times): ``u`` holds the controls there (decision
+        variables at the transcription's control nodes, its interpolant at the other
+        nodes; see the ``u`` attribute). Use `sample` for other times.
+
+        Parameters
+        ----------
+        name : str
+            One of ``problem.model.states`` or ``problem.model.controls``.
+
+        Returns
+        -------
+        ndarray, shape (n,)
+
+        Raises
+        ------
+        KeyError
+            If ``name`` is neither a state nor a control (the message lists them).
+
+        Examples
+        --------
+        >>> import ocp
+        >>> from ocp.examples import min_energy
+        >>> sol = ocp.solve(min_energy(), N=10)  # x'' = u, rest to rest: u = 6 - 12 t
+        >>> sol["v"].shape == sol.t.shape, round(float(sol["u"][0]), 6), round(float(sol["x"][-1]), 6)
+        (True, 6.0, 1.0)
+        """
+        model = self.problem.model
+        if isinstance(name, str):
+            if name in model.states:
+                return self.x[model.states.index(name)]
+            if name in model.controls:
+                return self.u[model.controls.index(name)]
+        raise KeyError(f"no state or control named {name!r}; the states are {model.states}, "
+                       f"the controls {model.controls}")
+
     def to_dict(self) -> dict:
         """Summary and trajectories as plain Python (``x``, ``u`` by name at the nodes ``t``);
         JSON-ready through `to_json`. The re-simulation is not run for it."""

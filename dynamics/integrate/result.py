@@ -171,6 +171,28 @@ class SimulationResult:
             return tuple(f"x{i}" for i in range(self.x.shape[0]))
         return tuple(self._dense.model.states)
 
+    def __getitem__(self, name: str) -> np.ndarray:
+        """The trajectory of state ``name`` at ``t``: the row of ``x``, shape (n,).
+
+        Raises
+        ------
+        KeyError
+            If ``name`` is not a state name (the message lists them).
+
+        Examples
+        --------
+        >>> import numpy as np
+        >>> from dynamics import rigid_body, simulate
+        >>> res = simulate(rigid_body([1.0, 2.0, 3.0]), [0, 0, 0, 1, 1.0, 0.0, 0.0],
+        ...                np.linspace(0.0, 1.0, 3))
+        >>> res["w1"]  # a pure spin about a principal axis stays put
+        array([1., 1., 1.])
+        """
+        names = self.states
+        if not isinstance(name, str) or name not in names:
+            raise KeyError(f"no state named {name!r}; the states are {names}")
+        return self.x[names.index(name)]
+
     def to_dict(self) -> dict:
         """Summary and trajectory as plain Python: counters, ``t``, ``x`` by state name,
         ``invariants`` (JSON-ready through `to_json`)."""
