@@ -57,7 +57,8 @@ class Discretization:
     w, g : Layout
         Structure of the decision and constraint vectors.
     nlp : dict
-        ``{'x': w, 'f': J / d_J, 'g': g}`` (MX) for ``casadi.nlpsol``.
+        ``{'x': w, 'f': sign J / d_J, 'g': g}`` (MX) for ``casadi.nlpsol``, ``sign`` =
+        `Problem.objective_sign` (``-1`` when maximizing).
     lbx, ubx, lbg, ubg : ndarray
         Bounds of the scaled variables and constraints.
     """
@@ -130,7 +131,7 @@ class Discretization:
             parts["boundary"] = ca.MX(0, 1)
         parts["quat_norm"], parts["q_final"] = nlp_rows(problem, X, sc.q_final)  # ocp.attitude
         gsym = self.g.join(parts, symbolic=True)
-        self.nlp = {"x": wsym, "f": J / sc.objective, "g": gsym}
+        self.nlp = {"x": wsym, "f": problem.objective_sign * J / sc.objective, "g": gsym}
 
         # ------------------------------------------------ bounds
         xl = np.repeat(problem.x_bounds[0][:, None], self.n_x, axis=1)
@@ -176,14 +177,16 @@ class Discretization:
                 "p": np.asarray(out["p"]).reshape(-1), "T": float(out["T"])}
 
     def cost(self, w) -> float:
-        """Unscaled objective ``J`` at a scaled ``w``."""
+        """Unscaled objective ``J`` at a scaled ``w``, with the user's sign (not negated when
+        maximizing)."""
         return float(self._cost(w=np.asarray(w, dtype=float))["J"])
 
     def multipliers(self, lam_g, objective_multiplier: float = 1.0) -> dict:
         """Multipliers of the unscaled constraints, by block.
 
-        CasADi's ``lam_g`` belongs to the scaled NLP ``J / d_J + lam_g . g_scaled``; for the
-        problem's own ``J + nu . g`` they are ``nu = lam_g d_J / row_scale``.
+        CasADi's ``lam_g`` belongs to the scaled NLP ``sign J / d_J + lam_g . g_scaled``; for
+        the minimized objective ``sign J + nu . g`` (``sign`` = `Problem.objective_sign`, so
+        ``-J`` when maximizing) they are ``nu = lam_g d_J / row_scale``.
         """
         parts = self.g.split(np.asarray(lam_g, dtype=float).reshape(-1))
         sc, dJ = self.scaling, self.scaling.objective

@@ -6,7 +6,7 @@ discretized lives in `ocp.transcription`; how it is solved in `ocp.solve`.
 
 The problem, on ``t in [t0, t0 + T]``::
 
-    minimize     phi(x(tf), p, T) + integral_t0^tf L(x, u, p) dt
+    minimize     J = phi(x(tf), p, T) + integral_t0^tf L(x, u, p) dt   (maximize with maximize=True)
     over         x(t), u(t), the free parameters p, and T when it is free
     subject to   xdot = f(x, u, p)                                  (model.f)
                  x_lower <= x(t) <= x_upper, u_lower <= u(t) <= u_upper
@@ -268,6 +268,12 @@ class Problem:
     t0 : float, optional [s]
         Initial time (the dynamics are time-invariant; ``t0`` only offsets output times).
     name : str, optional
+    maximize : bool, optional
+        ``True`` maximizes ``J = phi + integral L`` instead of minimizing it (default
+        ``False``). ``lagrange`` and ``mayer`` are kept as given (`replace` does not negate
+        them again); the NLP minimizes ``objective_sign * J`` = ``-J``, `Solution.cost` is
+        ``J`` itself (the maximized value), and multipliers and costates belong to the
+        minimized objective ``-J`` (``H = -L + lambda . f``). Compare costs with `better`.
 
     Raises
     ------
@@ -277,7 +283,8 @@ class Problem:
         Naming the argument: wrong shapes or unknown names, lower > upper, a bad horizon
         ``T``, boundary values outside the bounds, functions of the wrong signature,
         ``q_final`` without an attitude or not of unit norm, a non-unit fixed initial
-        quaternion, all four final quaternion components fixed (use ``q_final``).
+        quaternion, all four final quaternion components fixed (use ``q_final``),
+        ``maximize`` not ``True``/``False``.
 
     Notes
     -----
@@ -319,6 +326,7 @@ class Problem:
     q_final_tol: float = 0.0
     t0: float = 0.0
     name: str = "ocp"
+    maximize: bool = False
 
     def __post_init__(self):
         model = self.model
@@ -326,6 +334,9 @@ class Problem:
             raise TypeError(f"`model` must be a dynamics.Model, got {type(model).__name__}")
         put = lambda k, v: object.__setattr__(self, k, v)  # noqa: E731
         nx, nu, np_ = model.nx, model.nu, model.np
+        if not isinstance(self.maximize, (bool, np.bool_)):
+            raise ValueError(f"`maximize` must be True or False, got {self.maximize!r}")
+        put("maximize", bool(self.maximize))
 
         # horizon
         T = self.T
@@ -475,6 +486,32 @@ class Problem:
         return self.T if self.free_time else (self.T, self.T)
 
     @property
+    def objective_sign(self) -> float:
+        """``+1.0`` (minimize) or ``-1.0`` (``maximize``): the NLP minimizes ``objective_sign * J``."""
+        return -1.0 if self.maximize else 1.0
+
+    def better(self, a: float, b: float) -> bool:
+        """Whether cost ``a`` is strictly better than cost ``b`` for this problem.
+
+        Parameters
+        ----------
+        a, b : float
+            Values of the objective ``J`` (as `Solution.cost`, the user's sign).
+
+        Returns
+        -------
+        bool
+            ``a < b`` when minimizing, ``a > b`` when ``maximize``; ``False`` if ``a`` is NaN,
+            ``True`` if ``b`` is NaN and ``a`` is not.
+        """
+        a, b = float(a), float(b)
+        if math.isnan(a):
+            return False
+        if math.isnan(b):
+            return True
+        return self.objective_sign * a < self.objective_sign * b
+
+    @property
     def free_params(self) -> np.ndarray:
         """Indices of the optimized parameters, shape (k,)."""
         return np.flatnonzero(self.p_bounds[0] < self.p_bounds[1])
@@ -497,5 +534,9 @@ class Problem:
         return attitude_error(self.q_final, qf)
 
     def replace(self, **changes) -> "Problem":
-        """A copy with some fields changed (validated again), like `dataclasses.replace`."""
+        """A copy with some fields changed (validated again), like `dataclasses.replace`.
+
+        ``lagrange`` and ``mayer`` are stored as given (never negated), so a copy of a
+        ``maximize`` problem maximizes the same ``J``.
+        """
         return replace(self, **changes)

@@ -146,7 +146,8 @@ class Solution:
         Horizon length (optimized when free).
     t0 : float [s]
     cost : float
-        Objective ``phi + integral L`` of the discrete solution (unscaled).
+        Objective ``phi + integral L`` of the discrete solution (unscaled), with the user's
+        sign: the maximized value for a ``maximize`` problem (compare with `Problem.better`).
     t : ndarray, shape (n,) [s]
         Node times: ``t0`` and every state or control node of the transcription.
     x : ndarray, shape (nx, n)
@@ -167,7 +168,8 @@ class Solution:
         mesh with the same scaling and options: `ocp.solve`).
     costates : ndarray, shape (nx, n), or None
         Costate estimates ``lambda(t)`` (``H = L + lambda . f``) at ``t`` from the defect
-        multipliers (Radau only; ``None`` for the other transcriptions).
+        multipliers (Radau only; ``None`` for the other transcriptions). They belong to the
+        minimized objective: for a ``maximize`` problem ``H = -L + lambda . f``.
     transcription : Transcription
     mesh : Mesh
     problem : Problem

@@ -125,6 +125,14 @@ def _message(status: str, iterations: int) -> str:
     return f"IPOPT {status} after {iterations} iterations: {text}"
 
 
+def _default_guess_hint(problem: Problem, T_guess: float) -> str:
+    """The sentence added to the message of a failed solve from the default guess."""
+    horizon = f", T = {T_guess:g} s for the free horizon" if problem.free_time else ""
+    return (f" The default initial guess (states by linear/SLERP interpolation of the boundary "
+            f"values, controls at zero{horizon}) may be the cause: pass a better one as `guess=`, "
+            f"a mapping with 't', 'x', 'u', 'T' (see `ocp.guess`) or a previous Solution.")
+
+
 @interruptible
 def solve(problem: Problem, *, transcription="radau", N: int | None = None, degree: int | None = None,
           mesh=None, guess=None, scale: Mapping | None = None, verbose=False,
@@ -147,7 +155,8 @@ def solve(problem: Problem, *, transcription="radau", N: int | None = None, degr
     guess : None, Solution or mapping, optional
         Initial guess (see `ocp.guess`): default linear/SLERP between boundary values, a
         previous Solution (warm start, any transcription or mesh), or a mapping with ``'t'``,
-        ``'x'``, ``'u'``, ``'T'``, ``'p'``.
+        ``'x'``, ``'u'``, ``'T'``, ``'p'``. A failed solve from the default guess says in
+        its message that the guess may be the cause.
     scale : mapping of str to float, optional
         Scale overrides by state/control/parameter name, ``'T'``, ``'objective'``,
         ``'q_final'`` (see `ocp.scaling`).
@@ -223,13 +232,17 @@ def solve(problem: Problem, *, transcription="radau", N: int | None = None, degr
         with checkout("nlpsol", _nlp_key(problem, tr, m, scaling, nlp_opts),
                       lambda: _build_nlp(problem, tr, m, scaling, nlp_opts, None),
                       keepalive=problem) as built:
-            return _solve_built(problem, tr, m, node_guess, opts, ctol, *built, t_build)
+            return _solve_built(problem, tr, m, node_guess, opts, ctol, *built, t_build,
+                                default_guess=guess is None)
     return _solve_built(problem, tr, m, node_guess, opts, ctol,
-                        *_build_nlp(problem, tr, m, scaling, nlp_opts, sink), t_build)
+                        *_build_nlp(problem, tr, m, scaling, nlp_opts, sink), t_build,
+                        default_guess=guess is None)
 
 
-def _solve_built(problem, tr, m, node_guess, opts, ctol, disc, solver, nlp_opts, t_build):
-    """IPOPT on the transcribed NLP ``disc`` with ``solver`` (used by this call alone)."""
+def _solve_built(problem, tr, m, node_guess, opts, ctol, disc, solver, nlp_opts, t_build, *,
+                 default_guess=False):
+    """IPOPT on the transcribed NLP ``disc`` with ``solver`` (used by this call alone);
+    ``default_guess``: ``node_guess`` is the default one (a failure's message says so)."""
     check_interrupt()  # a Ctrl-C during the build (C++ construction cannot be interrupted)
     w0 = disc.pack(node_guess)
     build_time = time.perf_counter() - t_build
@@ -277,6 +290,8 @@ def _solve_built(problem, tr, m, node_guess, opts, ctol, disc, solver, nlp_opts,
             message = (f"{message}; but the constraint violation {viol:.3g} exceeds "
                        f"constraint_tol {ctol:g}: not verified")
             status = STATUS_CONSTRAINT_TOL
+    if not success and default_guess:
+        message += _default_guess_hint(problem, node_guess.T)
     LOGGER.info("solve %s (%s, N=%d): %s; %.3g s", problem.name, tr.name, m.N, message, solve_time)
     return _make_solution(problem, tr, m, disc, w, lam_g, g, success, status, message,
                           iterations, solve_time, build_time)

@@ -31,7 +31,8 @@ def solve_multistart(problem: Problem, guesses: Sequence, **solve_kwargs) -> Ref
     Returns
     -------
     RefinedSolution
-        The converged solution of least cost (``info['best']`` is its index), or, if no start
+        The converged solution of best cost (least, or largest for a ``maximize`` problem:
+        `Problem.better`; ``info['best']`` is its index), or, if no start
         converged, the one of least constraint violation with ``success=False``.
         ``info['starts']`` (also ``.starts``) lists every start: ``index, success, status,
         cost, T, constraint_violation, iterations, time``.
@@ -69,7 +70,10 @@ def solve_multistart(problem: Problem, guesses: Sequence, **solve_kwargs) -> Ref
         LOGGER.info("multistart %d/%d: %s, cost %.12g", i + 1, len(guesses), sol.status, sol.cost)
     ok = [i for i, s in enumerate(sols) if s.success and np.isfinite(s.cost)]
     if ok:
-        best = min(ok, key=lambda i: sols[i].cost)
+        best = ok[0]
+        for i in ok[1:]:
+            if problem.better(sols[i].cost, sols[best].cost):
+                best = i
         message = (f"best of {len(sols)} starts: start {best} ({len(ok)} converged); "
                    f"{sols[best].message}")
     else:

@@ -112,7 +112,7 @@ def _free_mesh_problem(problem: Problem, T_ref: float, stretch) -> Problem:
                    u_bounds=u_bounds, p=problem.p, p_bounds=p_bounds, lagrange=lagrange, mayer=mayer,
                    path=() if path is None else path, boundary=() if boundary is None else boundary,
                    q_final=problem.q_final, q_final_tol=problem.q_final_tol, t0=0.0,
-                   name=f"{problem.name}_free_mesh")
+                   name=f"{problem.name}_free_mesh", maximize=problem.maximize)
 
 
 def _aligned_mesh(solution: Solution, N: int | None) -> tuple[Mesh, np.ndarray]:
