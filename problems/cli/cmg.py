@@ -17,7 +17,7 @@ import sys
 
 import numpy as np
 
-from problems.cli.common import PLOT_SUFFIXES, same_file, save_figure, write_json, write_outputs
+from problems.cli.common import PLOT_SUFFIXES, finish, same_file, save_figure, write_json
 from problems.cli.common import integer as _integer
 from problems.cli.common import number as _number
 from problems.cli.common import output_file as _output_file
@@ -164,11 +164,7 @@ def _steer(args) -> int:
                 delta0=None if args.delta0 is None else np.radians(args.delta0),
                 steps=args.steps,
                 rate_limit=None if args.rate_limit is None else np.radians(args.rate_limit))
-    print(res)
-    write_outputs(res, plot=args.plot, json=args.json)
-    if not res.success:
-        print(f"appdyn cmg steer: {res.message}", file=sys.stderr)
-    return 0 if res.success else 1
+    return finish(res, "cmg steer", plot=args.plot, json=args.json)
 
 
 def run(args) -> int:

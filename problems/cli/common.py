@@ -236,6 +236,16 @@ def write_json(data, path) -> None:
     Path(path).write_text(strict_json(data) + "\n")
 
 
+def finish(result, command: str, *, plot=None, json=None) -> int:
+    """Print ``result``, write ``--plot``/``--json`` (`write_outputs`), say why on stderr when
+    it is not a success; the exit status: 0 verified, 1 not."""
+    print(result)
+    write_outputs(result, plot=plot, json=json)
+    if not result.success:
+        print(f"appdyn {command}: {result.message}", file=sys.stderr)
+    return 0 if result.success else 1
+
+
 def write_outputs(result, *, plot=None, json=None) -> None:
     """Save the figure of ``result.plot()`` and strict JSON of ``result.to_dict()`` where
     asked, saying so on stdout."""

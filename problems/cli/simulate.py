@@ -15,7 +15,7 @@ from problems.cli.common import output_file as _output_file
 from problems.cli.common import positive as _positive
 from problems.cli.common import same_file, save_figure
 from problems.cli.common import vector as _vector
-from problems.cli.common import write_json, write_outputs
+from problems.cli.common import finish, write_json, write_outputs
 from problems.cli.stability import (add_launch_vehicle_options, call_naming_parts, check_flight,
                                    launch_vehicle_kwargs)
 
@@ -150,11 +150,7 @@ def _run_launch_vehicle(args) -> int:
             rtol=args.rtol, progress=progress if progress.enabled else None)
     finally:
         progress.close()
-    print(result)
-    write_outputs(result, plot=args.plot, json=args.json)
-    if not result.success:
-        print(f"appdyn simulate launch-vehicle: {result.message}", file=sys.stderr)
-    return 0 if result.success else 1
+    return finish(result, "simulate launch-vehicle", plot=args.plot, json=args.json)
 
 
 def run(args) -> int:

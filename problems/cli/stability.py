@@ -53,7 +53,7 @@ from problems.cli.common import output_file as _output_file
 from problems.cli.common import positive as _positive
 from problems.cli.common import progress_enabled, same_file, save_figure
 from problems.cli.common import vector as _floats
-from problems.cli.common import write_outputs
+from problems.cli.common import finish
 
 __all__ = ["add_parser", "check", "run", "main", "parse_damper", "sweep_parameters",
            "add_launch_vehicle_options", "launch_vehicle_kwargs", "check_flight",
@@ -451,15 +451,12 @@ def run(args) -> int:
     else:
         _, case_function = st.resolve_case(args.case)
         result = call_naming_parts(case_function, **_case_kwargs(args, args.case))
-    print(result)
-    if args.case == "launch-vehicle" and args.plot:
+    if args.case == "launch-vehicle" and args.plot:  # the Bode plot with the pole map
+        status = finish(result, f"stability {args.case}", json=args.json)
         save_figure(st.bode_plot(result, pole_map=True), args.plot)
         print(f"plot written to {args.plot}")
-    write_outputs(result, plot=None if args.case == "launch-vehicle" else args.plot,
-                  json=args.json)
-    if not result.success:
-        print(f"appdyn stability {args.case}: {result.message}", file=sys.stderr)
-    return 0 if result.success else 1
+        return status
+    return finish(result, f"stability {args.case}", plot=args.plot, json=args.json)
 
 
 def main(argv=None) -> int:

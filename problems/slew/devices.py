@@ -35,7 +35,7 @@ from ocp import Constraint, Problem, annotate, solve
 
 from .maneuvers import refine_and_verify, solve_time_optimal
 from .problem import attitude_guess, rough_time, seeded_guesses, slew_problem
-from .targets import POINTING_TOL, RATE_TOL, check_tol, targets, vector3
+from .targets import POINTING_TOL, RATE_TOL, check_tol, targets
 
 __all__ = ["wheel_slew", "cmg_slew"]
 
@@ -65,6 +65,22 @@ def _costs(objective):
     if objective == "time":
         return dict(mayer=lambda xf, p, T: T)
     return dict(lagrange=lambda x, u, p: 0.5 * ca.sumsqr(u))
+
+
+def _problems(model, I, objective, horizon, q0, qf, dev0, devf, u_max, body_max, device, *,
+              x_bounds=None, path=()):
+    """The device slew's `ocp.Problem` (rest to rest; device states from ``dev0`` to ``devf``,
+    free where None; controls within ``+-u_max``) and the hub's rigid-body slew problem whose
+    guesses are converted (body torque bound ``body_max``)."""
+    free = np.full(dev0.size, np.nan)
+    problem = Problem(
+        model, T=horizon, x_initial=np.r_[q0, 0.0, 0.0, 0.0, dev0],
+        x_final=np.r_[np.full(4, np.nan), 0.0, 0.0, 0.0, free if devf is None else devf],
+        u_bounds=None if u_max is None else (-u_max, u_max), x_bounds=x_bounds, q_final=qf,
+        path=path, name=f"{device} slew ({objective})", **_costs(objective))
+    rb = slew_problem(I, objective=objective, T=None if objective == "time" else horizon,
+                      q0=q0, qf=qf, u_max=body_max)
+    return problem, rb
 
 
 def _momentum_info(sol, scale) -> dict:
@@ -161,11 +177,11 @@ def wheel_slew(inertia, axes, wheel_inertia, *, objective="time", T=None, angle=
     (True, 0.894427, 0.894427)
     """
     objective, tol, ptol, rtol, starts = _common(objective, tol, pointing_tol, rate_tol, starts)
-    model = wheel_spacecraft(inertia, axes, wheel_inertia)
     I = check_inertia(inertia)
     A = unit_axes(axes, "axes")
     n = A.shape[1]
     J = positive_each(wheel_inertia, "wheel_inertia", n)
+    model = wheel_spacecraft(I, A, J)
     q0, qf = targets(q0, qf, angle, axis)
     W0 = _vector(W0, "W0", n, 0.0)
     Wf = None if Wf is None else _vector(Wf, "Wf", n, 0.0)
@@ -182,13 +198,8 @@ def wheel_slew(inertia, axes, wheel_inertia, *, objective="time", T=None, angle=
     T_ref = rough_time(I, q0, qf, np.full(3, body_max if body_max else 1.0))
     horizon = _horizon(objective, T, T_max, T_ref)
     lo = np.r_[np.full(7, -np.inf), -smax if smax is not None else np.full(n, -np.inf)]
-    problem = Problem(
-        model, T=horizon, x_initial=np.r_[q0, 0.0, 0.0, 0.0, W0],
-        x_final=np.r_[np.full(4, np.nan), 0.0, 0.0, 0.0, Wf if Wf is not None else np.full(n, np.nan)],
-        u_bounds=None if tmax is None else (-tmax, tmax), x_bounds=(lo, -lo), q_final=qf,
-        name=f"wheel slew ({objective})", **_costs(objective))
-    rb = slew_problem(I, objective=objective, T=None if objective == "time" else horizon,
-                      q0=q0, qf=qf, u_max=body_max if body_max else None)
+    problem, rb = _problems(model, I, objective, horizon, q0, qf, W0, Wf, tmax,
+                            body_max if body_max else None, "wheel", x_bounds=(lo, -lo))
     H_in = A @ (J * W0)  # at rest: the wheels carry it all (identity body = inertial at t0)
     H_in = dcm_from_quat(q0).T @ H_in
     AJ_pinv, A_pinv = np.linalg.pinv(A * J), np.linalg.pinv(A)
@@ -280,13 +291,8 @@ def cmg_slew(inertia, geometry, *, objective="time", T=None, angle=None, axis=No
     body_max = float(np.min(geometry.h)) * (float(np.min(rmax)) if rmax is not None else 1.0)
     T_ref = rough_time(I, q0, qf, np.full(3, body_max))
     horizon = _horizon(objective, T, T_max, T_ref)
-    problem = Problem(
-        model, T=horizon, x_initial=np.r_[q0, 0.0, 0.0, 0.0, d0],
-        x_final=np.r_[np.full(4, np.nan), 0.0, 0.0, 0.0, df if df is not None else np.full(n, np.nan)],
-        u_bounds=None if rmax is None else (-rmax, rmax), q_final=qf, path=path,
-        name=f"cmg slew ({objective})", **_costs(objective))
-    rb = slew_problem(I, objective=objective, T=None if objective == "time" else horizon,
-                      q0=q0, qf=qf, u_max=body_max)
+    problem, rb = _problems(model, I, objective, horizon, q0, qf, d0, df, rmax, body_max, "cmg",
+                            path=path)
     H_in = dcm_from_quat(q0).T @ cluster_momentum(geometry, d0)
 
     def convert(g):
