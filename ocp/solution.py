@@ -184,6 +184,11 @@ class Solution:
         ``'boundary'``, ``'quat_norm'``, ``'q_final'``), for ``J + nu . g`` (CasADi's sign).
     dense : DenseOutput
         Interval data and interpolant behind `sample`.
+    nlp_point : mapping or None
+        The NLP point IPOPT returned (``'key'``: the structure of the NLP it belongs to,
+        ``'x'``, ``'lam_x'``, ``'lam_g'``: scaled primal and dual values), used by `ocp.solve`
+        to warm start a solve of the same structure with primal *and* dual values; ``None``
+        when the solution did not come from an NLP of `ocp.solve`.
     """
 
     success: bool
@@ -206,6 +211,7 @@ class Solution:
     constraint_violation: float
     multipliers: Mapping[str, np.ndarray]
     dense: DenseOutput = field(repr=False)
+    nlp_point: Mapping | None = field(default=None, repr=False)
 
     def __getstate__(self) -> dict:
         state = dict(self.__dict__)
