@@ -49,6 +49,16 @@ class Layout:
         inner = ", ".join(f"{k}: {r}x{c}" for k, (r, c) in self.shapes.items())
         return f"Layout({inner}; size {self.size})"
 
+    def offset(self, name: str) -> int:
+        """Position of block ``name``'s first element in the flat vector."""
+        return self._offsets[name]
+
+    def indices(self, name: str) -> np.ndarray:
+        """Flat positions of block ``name`` as an integer array of the block's shape
+        (column-major, like the block itself)."""
+        r, c = self.shapes[name]
+        return self._offsets[name] + np.arange(r * c).reshape((r, c), order="F")
+
     def split(self, v) -> dict:
         """Split a flat vector into its named blocks.
 

@@ -1,16 +1,17 @@
-"""Assembly of the sparse NLP of a transcribed problem.
+"""The NLP of one problem on one mesh: bounds, parameter values, packing and unpacking.
 
-`Discretization` maps the transcription's interval kernel over the mesh (one
-``Function.map`` call: every interval's defects and quadrature at once), evaluates the path
-constraints with one mapped Function over the control nodes, and stacks variables and
-constraints through `ocp.layout.Layout` blocks:
+The symbolic NLP and its derivatives belong to the problem's *structure*
+(`ocp.assembly.Structure`, kept in the one cache and shared by every problem of the same
+structure); a `Discretization` adds what is particular to one problem, mesh and scaling:
 
 * variables ``w``: ``X`` (nx, 1 + N m_x) states at the state nodes, ``U`` (nu, n_u) controls
   at the control nodes, ``P`` (k, 1) free parameters, ``T`` (1, 1) when the horizon is free
   — all scaled (`ocp.scaling`);
 * constraints ``g``: ``defect`` (nx, N m_d), ``path`` (ng, n_u), ``boundary`` (nb, 1),
   ``quat_norm`` (1, 1) when ``|q(t0)|`` must be imposed, ``q_final`` (3, 1) for an attitude
-  target (1, 1 with a pointing tolerance).
+  target (1, 1 with a pointing tolerance);
+* the NLP parameter vector ``P`` (scales, fixed parameter values, a fixed horizon, the mesh
+  fractions, the target quaternion).
 
 Boundary values and bounds are variable bounds (IPOPT treats fixed variables as parameters).
 """
@@ -19,27 +20,26 @@ from __future__ import annotations
 import casadi as ca
 import numpy as np
 
-from .attitude import nlp_rows, target_bounds, target_rows
-from .layout import Layout
+from .assembly import Structure, structure_key, _functions
+from .attitude import target_bounds
+from .cached import cached
 
-__all__ = ["Discretization"]
-
-
-def _diag_scale(M, d: np.ndarray):
-    """``M / d`` row-wise (``d`` shape (rows,)), as a sparse diagonal product."""
-    if M.shape[0] == 0:
-        return M
-    return ca.mtimes(ca.diag(ca.DM(1.0 / d)), M)
+__all__ = ["Discretization", "structure"]
 
 
-def _path_function(problem) -> ca.Function | None:
-    cons = problem.path
-    if not cons:
-        return None
-    m = problem.model
-    syms = [ca.MX.sym("x", m.nx), ca.MX.sym("u", m.nu), ca.MX.sym("p", m.np)]
-    out = ca.vertcat(*[c.fun(*syms) for c in cons])
-    return ca.Function("path", syms, [out], ["x", "u", "p"], ["g"])
+def structure(problem, transcription, N: int, expand: bool = True) -> Structure:
+    """The `Structure` of ``problem`` transcribed by ``transcription`` on ``N`` intervals,
+    from the one cache (built on a miss; in MX when SX construction fails)."""
+    def build():
+        try:
+            return Structure(problem, transcription, N, expand)
+        except RuntimeError:
+            if not expand:
+                raise
+            return Structure(problem, transcription, N, False)
+
+    return cached("nlp_structure", structure_key(problem, transcription, N, expand), build,
+                  keepalive=tuple(f for f in _functions(problem) if f is not None))
 
 
 class Discretization:
@@ -51,97 +51,44 @@ class Discretization:
     transcription : ocp.Transcription
     mesh : ocp.Mesh
     scaling : ocp.scaling.Scaling
+    expand : bool, optional
+        Interval functions in SX when possible (default); see `ocp.assembly`.
 
     Attributes
     ----------
+    structure : ocp.assembly.Structure
+        The symbolic NLP and its derivative Functions (shared by equal structures).
+    key : tuple
+        `ocp.assembly.structure_key` of the structure.
     w, g : Layout
         Structure of the decision and constraint vectors.
     nlp : dict
-        ``{'x': w, 'f': sign J / d_J, 'g': g}`` (MX) for ``casadi.nlpsol``, ``sign`` =
-        `Problem.objective_sign` (``-1`` when maximizing).
+        ``{'x': w, 'p': P, 'f': sign J / d_J, 'g': g}`` (MX) for ``casadi.nlpsol``, ``sign``
+        = `Problem.objective_sign` (``-1`` when maximizing).
+    P : ndarray, shape (n_P,)
+        Value of the NLP parameters for this problem, mesh and scaling.
     lbx, ubx, lbg, ubg : ndarray
         Bounds of the scaled variables and constraints.
     """
 
-    def __init__(self, problem, transcription, mesh, scaling):
+    def __init__(self, problem, transcription, mesh, scaling, expand: bool = True):
         self.problem, self.transcription, self.mesh, self.scaling = problem, transcription, mesh, scaling
-        model = problem.model
-        nx, nu, np_ = model.nx, model.nu, model.np
-        N = mesh.N
-        tr = transcription
-        m_x, m_u = tr.x_sigma.size, tr.u_sigma.size
-        self.n_x, self.n_u = 1 + N * m_x, N * m_u + int(tr.u_at_start)
-        free = problem.free_params
-        sc = scaling
-
-        kernel = tr.kernel(model.f, problem.lagrange)
-        m_d = kernel.size2_out("defect")
-        n_path = sum(c.size for c in problem.path)
-        n_bound = sum(c.size for c in problem.boundary)
-        self.w = Layout({"X": (nx, self.n_x), "U": (nu, self.n_u), "P": (free.size, 1),
-                         "T": (int(problem.free_time), 1)})
-        self.g = Layout({"defect": (nx, N * m_d), "path": (n_path, self.n_u),
-                         "boundary": (n_bound, 1), "quat_norm": (int(problem.quaternion_norm_at_t0), 1),
-                         "q_final": (target_rows(problem), 1)})
-
-        # ------------------------------------------------ symbols (scaled -> physical)
-        wsym = ca.MX.sym("w", self.w.size)
-        v = self.w.split(wsym)
-        X = ca.mtimes(ca.diag(ca.DM(sc.x)), v["X"]) if nx else v["X"]
-        U = ca.mtimes(ca.diag(ca.DM(sc.u)), v["U"]) if nu else v["U"]
-        E = np.zeros((np_, free.size))
-        E[free, np.arange(free.size)] = sc.p[free]
-        p_const = np.array(problem.p, dtype=float)
-        p_const[free] = 0.0
-        p = ca.DM(p_const) + ca.mtimes(ca.DM(E), v["P"]) if free.size else ca.DM(p_const)
-        T = sc.T * v["T"] if problem.free_time else ca.DM(problem.T)
-        self._phys = ca.Function("physical", [wsym], [X, U, p, T], ["w"], ["X", "U", "p", "T"])
-
-        # ------------------------------------------------ intervals: one mapped kernel
-        h = T * ca.DM(mesh.fractions).T  # (1, N)
-        xs = X[:, ca.Slice(0, N * m_x, m_x)]
-        Xo = X[:, 1:]
-        if tr.u_at_start:
-            us, Uo = U[:, ca.Slice(0, N * m_u, m_u)], U[:, 1:]
-        else:
-            us, Uo = ca.DM.zeros(nu, N), U
-        kmap = kernel.map(N, [False] * 5 + [True], [False, False, True])
-        out = kmap(xs=xs, X=Xo, us=us, U=Uo, h=h, p=p)
-        defect, xu, quad = out["defect"], out["xu"], out["quad"]
-        Xu = ca.horzcat(X[:, 0], xu) if tr.u_at_start else xu
-
-        # ------------------------------------------------ objective
-        J = quad
-        if problem.mayer is not None:
-            J = J + problem.mayer(X[:, -1], p, T)
-        self._cost = ca.Function("cost", [wsym], [J], ["w"], ["J"])
-
-        # ------------------------------------------------ constraints
-        parts = {"defect": _diag_scale(defect, sc.x)}
-        path = _path_function(problem)
-        if path is not None:
-            G = path.map(self.n_u, [False, False, True], [False])(Xu, U, p)
-            parts["path"] = _diag_scale(G, sc.path)
-        else:
-            parts["path"] = ca.MX(0, self.n_u)
-        if problem.boundary:
-            c = ca.vertcat(*[b.fun(X[:, 0], X[:, -1], p) for b in problem.boundary])
-            parts["boundary"] = _diag_scale(c, sc.boundary)
-        else:
-            parts["boundary"] = ca.MX(0, 1)
-        parts["quat_norm"], parts["q_final"] = nlp_rows(problem, X, sc.q_final)  # ocp.attitude
-        gsym = self.g.join(parts, symbolic=True)
-        self.nlp = {"x": wsym, "f": problem.objective_sign * J / sc.objective, "g": gsym}
+        self.key = structure_key(problem, transcription, mesh.N, expand)
+        st = self.structure = structure(problem, transcription, mesh.N, expand)
+        self.w, self.g, self.nlp = st.w, st.g, st.nlp
+        self.P = st.params_value(problem, mesh, scaling)
+        free, sc = problem.free_params, scaling
+        n_x, n_u = self.w.shapes["X"][1], self.w.shapes["U"][1]
 
         # ------------------------------------------------ bounds
-        xl = np.repeat(problem.x_bounds[0][:, None], self.n_x, axis=1)
-        xh = np.repeat(problem.x_bounds[1][:, None], self.n_x, axis=1)
+        xl = np.repeat(problem.x_bounds[0][:, None], n_x, axis=1)
+        xh = np.repeat(problem.x_bounds[1][:, None], n_x, axis=1)
         for col, values in ((0, problem.x_initial), (-1, problem.x_final)):
             given = ~np.isnan(values)
             xl[given, col] = values[given]
             xh[given, col] = values[given]
-        ul = np.repeat(problem.u_bounds[0][:, None], self.n_u, axis=1)
-        uh = np.repeat(problem.u_bounds[1][:, None], self.n_u, axis=1)
+        ul = np.repeat(problem.u_bounds[0][:, None], n_u, axis=1)
+        uh = np.repeat(problem.u_bounds[1][:, None], n_u, axis=1)
         pl, ph = problem.p_bounds[0][free], problem.p_bounds[1][free]
         Tl, Th = (np.array(problem.T) / sc.T) if problem.free_time else (np.zeros(0), np.zeros(0))
         self.lbx = self.w.join({"X": xl / sc.x[:, None], "U": ul / sc.u[:, None],
@@ -171,15 +118,37 @@ class Discretization:
 
     def unpack(self, w) -> dict:
         """Physical ``X`` (nx, n_x), ``U`` (nu, n_u), ``p`` (np,), ``T`` from a scaled ``w``."""
-        out = self._phys(w=np.asarray(w, dtype=float))
-        return {"X": np.asarray(out["X"]).reshape(self.w.shapes["X"]),
-                "U": np.asarray(out["U"]).reshape(self.w.shapes["U"]),
-                "p": np.asarray(out["p"]).reshape(-1), "T": float(out["T"])}
+        v = self.w.split(w)
+        sc, problem = self.scaling, self.problem
+        p = np.array(problem.p, dtype=float)
+        free = problem.free_params
+        p[free] = v["P"].reshape(-1) * sc.p[free]
+        T = float(v["T"][0, 0] * sc.T) if problem.free_time else float(problem.T)
+        return {"X": v["X"] * sc.x[:, None], "U": v["U"] * sc.u[:, None], "p": p, "T": T}
 
     def cost(self, w) -> float:
         """Unscaled objective ``J`` at a scaled ``w``, with the user's sign (not negated when
         maximizing)."""
-        return float(self._cost(w=np.asarray(w, dtype=float))["J"])
+        f, _ = self.structure.evaluate(w, self.P)
+        return self.problem.objective_sign * f * self.scaling.objective
+
+    def constraints(self, w) -> np.ndarray:
+        """The scaled constraint vector ``g`` at a scaled ``w``, shape (n_g,)."""
+        return self.structure.evaluate(w, self.P)[1]
+
+    def scales(self) -> tuple[np.ndarray, np.ndarray, float]:
+        """``(s_w, s_g, d_J)``: physical = scale x scaled, for every variable (shape (n_w,)),
+        every constraint row (shape (n_g,)), and the objective."""
+        sc, problem = self.scaling, self.problem
+        free = problem.free_params
+        n_x, n_u = self.w.shapes["X"][1], self.w.shapes["U"][1]
+        sw = self.w.join({"X": np.repeat(sc.x[:, None], n_x, axis=1), "U": np.repeat(sc.u[:, None], n_u, axis=1),
+                          "P": sc.p[free][:, None], "T": sc.T})
+        q = sc.q_final if problem.q_final is not None and problem.q_final_tol == 0 else 1.0
+        sg = self.g.join({"defect": sc.x[:, None], "path": sc.path[:, None] if sc.path.size else 1.0,
+                          "boundary": sc.boundary[:, None] if sc.boundary.size else 1.0,
+                          "quat_norm": 1.0, "q_final": q})
+        return sw, sg, float(sc.objective)
 
     def multipliers(self, lam_g, objective_multiplier: float = 1.0) -> dict:
         """Multipliers of the unscaled constraints, by block.

@@ -28,18 +28,28 @@ Status values besides IPOPT's own return statuses: `STATUS_CONSTRAINT_TOL`
 ``constraint_tol``), `STATUS_EXCEPTION` (``'Exception'``: an evaluation error inside
 CasADi) and `STATUS_REST` (``'Rest_Solution'``: `rest_solution`).
 
-Reuse
------
-Without a progress listener (``verbose=False``, no ``progress``, no DEBUG logging) the
-transcribed NLP and its IPOPT solver are kept in `dynamics.cache` (`ocp.cached`), keyed by
-the problem (by identity), transcription, mesh, every scale factor (`ocp.scaling`: powers
-of two from the bounds and the guess) and the solver options. Solving the same problem again
-with another guess of the same magnitudes (multistart, a warm start on the same mesh)
-reuses them: about 1 s of build time saved for a rigid-body slew at N = 200.
+Reuse: build once, solve many
+-----------------------------
+The symbolic NLP and its derivatives belong to the problem's *structure*
+(`ocp.assembly`): model, cost and constraint functions (by content), transcription, number
+of intervals, which parameters are free, a free or fixed horizon, the kind of attitude
+target. Everything numeric -- boundary values and bounds, fixed parameter values, a fixed
+horizon, the target attitude, the mesh spacing, the scale factors -- is a bound or an NLP
+parameter. So a structure and its IPOPT solver are built once and kept in `dynamics.cache`
+(`ocp.cached`): multistart, refinement rounds that keep the number of intervals, and a slew
+to another target with the same inertia and torque bounds build nothing. Construction takes
+derivatives of one interval only (0.14 s at N = 800 for a rigid-body slew, against 3.6 s
+for the expanded whole NLP of earlier versions; measured on a 2-core machine);
+`Solution.build_time` and `Solution.solve_time` record both parts.
 
-``expand=True`` (the default) makes each IPOPT iteration about 3x faster and construction
-about 5 ms per Radau(3) interval of a rigid body slower (measured on a 2-core machine).
-`dynamics.clear_caches` drops them.
+Warm starts: a ``guess`` that is a `Solution` of the *same* NLP (same structure, numbers and
+mesh) starts IPOPT from its primal and dual values (``lam_x``, ``lam_g``) with IPOPT's
+warm-start options (`WARM_START_OPTIONS`); a Solution of another problem gives primal
+values (`ocp.guess`).
+
+``expand=True`` (the default) builds the interval functions in SX when the model and the
+cost and constraint functions allow it (faster evaluation); ``expand=False`` keeps them in
+MX. `dynamics.clear_caches` drops every built structure and solver.
 
 Threads: `solve` may run in several threads at once, on the same problem. A cached IPOPT
 solver (with its NLP) is lent to one solve at a time (`ocp.cached.checkout`): a second
@@ -48,7 +58,7 @@ afterwards. Every ``casadi.nlpsol`` construction holds `dynamics.cache.construct
 """
 from __future__ import annotations
 
-import dataclasses
+import hashlib
 import time
 from typing import Mapping
 
@@ -62,6 +72,7 @@ from .cached import checkout
 from .guess import NodeGuess, initial_guess
 from .ipopt_options import check_ipopt_options
 from .mesh import Mesh, check_N
+from .nlp import Discretization
 from .problem import Problem
 from .progress import LOGGER, IterationCallback, Progress, iteration_sink
 from .scaling import auto_scaling
@@ -79,6 +90,12 @@ DEFAULT_CONSTRAINT_TOL = 1e-6
 STATUS_CONSTRAINT_TOL = "Constraint_Tol_Not_Met"
 STATUS_REST = "Rest_Solution"
 STATUS_EXCEPTION = "Exception"
+#: IPOPT options of a warm start with primal and dual values (`Solution` of the same structure
+#: on the same mesh as ``guess``); options the caller passes take precedence.
+WARM_START_OPTIONS = {"warm_start_init_point": "yes", "warm_start_bound_push": 1e-9,
+                      "warm_start_bound_frac": 1e-9, "warm_start_slack_bound_push": 1e-9,
+                      "warm_start_slack_bound_frac": 1e-9, "warm_start_mult_bound_push": 1e-9,
+                      "mu_init": 1e-6}
 
 
 def _mesh(N, mesh) -> Mesh:
@@ -154,7 +171,8 @@ def solve(problem: Problem, *, transcription="radau", N: int | None = None, degr
         Interval breakpoints in normalized time, 0 to 1 (non-uniform meshes, refinement).
     guess : None, Solution or mapping, optional
         Initial guess (see `ocp.guess`): default linear/SLERP between boundary values, a
-        previous Solution (warm start, any transcription or mesh), or a mapping with ``'t'``,
+        previous Solution (warm start, any transcription or mesh; primal and dual values
+        when it solved the same NLP), or a mapping with ``'t'``,
         ``'x'``, ``'u'``, ``'T'``, ``'p'``. A failed solve from the default guess says in
         its message that the guess may be the cause.
     scale : mapping of str to float, optional
@@ -177,10 +195,9 @@ def solve(problem: Problem, *, transcription="radau", N: int | None = None, degr
         moves a bound-limited optimum by that much — pass ``{'bound_relax_factor': 0}`` for
         bound-exact solutions).
     expand : bool, optional
-        Expand the whole NLP to SX before solving (default): faster IPOPT iterations,
-        slower construction (measurements in the module docstring); ``expand=False`` builds
-        faster and pays off for easy problems on fine meshes. Falls back to MX when the
-        functions cannot be expanded.
+        Build the per-interval functions in SX (default; faster evaluation), falling back
+        to MX when a function cannot be expanded (e.g. it holds an integrator);
+        ``expand=False`` keeps them in MX (module docstring).
     constraint_tol : float, optional
         Largest `Solution.constraint_violation` (NLP units, see the module docstring) of a
         successful result; default `DEFAULT_CONSTRAINT_TOL` = 1e-6.
@@ -225,31 +242,64 @@ def solve(problem: Problem, *, transcription="radau", N: int | None = None, degr
     t_build = time.perf_counter()
     node_guess = initial_guess(problem, tr, m, guess)
     scaling = auto_scaling(problem, node_guess, scale)
-    nlp_opts = {"ipopt": opts, "print_time": False, "error_on_fail": False, "expand": expand}
+    disc = Discretization(problem, tr, m, scaling, expand)  # its structure comes from the cache
+    warm = _warm_point(guess, disc)
+    if warm is not None:
+        opts = {**WARM_START_OPTIONS, **opts, **check_ipopt_options(ipopt_options)}
+    nlp_opts = {"ipopt": opts, "print_time": False, "error_on_fail": False}
     if sink is None:
-        # the NLP and its solver depend on the guess only through the (power-of-two) scaling;
-        # the solver is lent to this call alone (a pool: threads never share a running IPOPT)
-        with checkout("nlpsol", _nlp_key(problem, tr, m, scaling, nlp_opts),
-                      lambda: _build_nlp(problem, tr, m, scaling, nlp_opts, None),
-                      keepalive=problem) as built:
-            return _solve_built(problem, tr, m, node_guess, opts, ctol, *built, t_build,
-                                default_guess=guess is None)
-    return _solve_built(problem, tr, m, node_guess, opts, ctol,
-                        *_build_nlp(problem, tr, m, scaling, nlp_opts, sink), t_build,
-                        default_guess=guess is None)
+        # one built solver per structure and options, lent to this call alone (a pool:
+        # threads never share a running IPOPT)
+        with checkout("nlpsol", (disc.key, repr(sorted(opts.items()))),
+                      lambda: _build_solver(disc, nlp_opts, None), keepalive=disc.structure) as built:
+            return _solve_built(problem, tr, m, node_guess, opts, ctol, disc, *built, t_build,
+                                default_guess=guess is None, warm=warm)
+    return _solve_built(problem, tr, m, node_guess, opts, ctol, disc,
+                        *_build_solver(disc, nlp_opts, sink), t_build,
+                        default_guess=guess is None, warm=warm)
+
+
+def _numbers(disc) -> bytes:
+    """Digest of everything numeric in the NLP of ``disc`` besides its structure: the
+    parameter values, variable and constraint bounds (physical), the mesh."""
+    sw, sg, _ = disc.scales()
+    P = disc.structure.params.split(disc.P)  # not the scale factors: they depend on the guess
+    parts = (P["pval"], P["Tfix"], P["qf"], P["frac"], disc.lbx * sw, disc.ubx * sw,
+             disc.lbg * sg, disc.ubg * sg)
+    return hashlib.blake2b(b"".join(np.asarray(a, dtype=float).tobytes() for a in parts),
+                           digest_size=16).digest()
+
+
+def _warm_point(guess, disc) -> dict | None:
+    """Primal and dual start values from a `Solution` of the same NLP (`Solution.nlp_point`:
+    same structure, parameter values, bounds and mesh), converted to this NLP's scaling;
+    ``None`` otherwise.
+
+    Only the same NLP: started from the solution of a *different* problem of the same
+    structure (a slew to a nearby target), IPOPT's warm start took more iterations than a
+    cold start from the same primal values (55 against 24 on a time-optimal slew at
+    N = 40), so those get the primal values only (`ocp.guess`)."""
+    point = getattr(guess, "nlp_point", None)
+    if not point or point.get("key") != disc.key or point.get("numbers") != _numbers(disc):
+        return None
+    sw, sg, dJ = disc.scales()
+    x = np.clip(point["x_phys"] / sw, disc.lbx, disc.ubx)
+    return {"x0": x, "lam_x0": point["lam_x_phys"] * sw / dJ, "lam_g0": point["lam_g_phys"] * sg / dJ}
 
 
 def _solve_built(problem, tr, m, node_guess, opts, ctol, disc, solver, nlp_opts, t_build, *,
-                 default_guess=False):
+                 default_guess=False, warm=None):
     """IPOPT on the transcribed NLP ``disc`` with ``solver`` (used by this call alone);
-    ``default_guess``: ``node_guess`` is the default one (a failure's message says so)."""
+    ``default_guess``: ``node_guess`` is the default one (a failure's message says so);
+    ``warm``: primal and dual start values (`_warm_point`)."""
     check_interrupt()  # a Ctrl-C during the build (C++ construction cannot be interrupted)
-    w0 = disc.pack(node_guess)
+    start = warm if warm is not None else {"x0": disc.pack(node_guess)}
+    w0 = start["x0"]
     build_time = time.perf_counter() - t_build
 
     t_solve = time.perf_counter()
-    bounds = dict(lbx=disc.lbx, ubx=disc.ubx, lbg=disc.lbg, ubg=disc.ubg)
-    res, error, status, iterations = _run(solver, dict(x0=w0, **bounds))
+    bounds = dict(lbx=disc.lbx, ubx=disc.ubx, lbg=disc.lbg, ubg=disc.ubg, p=disc.P)
+    res, error, status, iterations = _run(solver, dict(**start, **bounds))
     note = ""
     if res is not None and status == _ACCEPTABLE:
         # not verified: one warm re-solve from the acceptable point, acceptable exit disabled
@@ -259,8 +309,7 @@ def _solve_built(problem, tr, m, node_guess, opts, ctol, disc, solver, nlp_opts,
             again = {**opts, "acceptable_iter": 0, "max_iter": budget,
                      "warm_start_init_point": "yes", "mu_init": 1e-9}
             with construction_lock():
-                resolver = ca.nlpsol("ocp_resolve", "ipopt", disc.nlp,
-                                     {**nlp_opts, "ipopt": again})
+                resolver = disc.structure.nlpsol("ocp_resolve", {**nlp_opts, "ipopt": again})
             build_time += time.perf_counter() - t_re
             res2, error2, status2, it2 = _run(resolver, dict(
                 x0=res["x"], lam_x0=res["lam_x"], lam_g0=res["lam_g"], **bounds))
@@ -275,12 +324,14 @@ def _solve_built(problem, tr, m, node_guess, opts, ctol, disc, solver, nlp_opts,
     solve_time = time.perf_counter() - t_solve
     if res is None:
         w, lam_g, g = w0, np.zeros(disc.g.size), np.full(disc.g.size, np.nan)
+        lam_x = np.zeros(disc.w.size)
         status = status if status != "Unknown" else STATUS_EXCEPTION
         message = f"IPOPT stopped by an error: {error}"
         success = False
     else:
         w = np.asarray(res["x"]).reshape(-1)
         lam_g = np.asarray(res["lam_g"]).reshape(-1)
+        lam_x = np.asarray(res["lam_x"]).reshape(-1)
         g = np.asarray(res["g"]).reshape(-1)
         success = status in _SUCCESS
         message = _message(status, iterations) + note
@@ -294,41 +345,19 @@ def _solve_built(problem, tr, m, node_guess, opts, ctol, disc, solver, nlp_opts,
         message += _default_guess_hint(problem, node_guess.T)
     LOGGER.info("solve %s (%s, N=%d): %s; %.3g s", problem.name, tr.name, m.N, message, solve_time)
     return _make_solution(problem, tr, m, disc, w, lam_g, g, success, status, message,
-                          iterations, solve_time, build_time)
+                          iterations, solve_time, build_time, lam_x=lam_x)
 
 
-def _nlp_key(problem, transcription, mesh, scaling, nlp_opts) -> tuple:
-    """The defining structure of a transcribed NLP and its IPOPT solver, for `ocp.cached`:
-    the problem (by identity: `Problem` is frozen), the transcription, the mesh, every scale
-    factor, and the solver options."""
-    scales = tuple((f.name, np.asarray(getattr(scaling, f.name), dtype=float).tobytes())
-                   for f in dataclasses.fields(scaling))
-    return (problem, transcription, np.asarray(mesh.breaks, dtype=float).tobytes(), scales,
-            repr(sorted(nlp_opts["ipopt"].items())), bool(nlp_opts["expand"]))
-
-
-def _build_nlp(problem, tr, mesh, scaling, nlp_opts, sink):
-    """``(Discretization, IPOPT solver, the nlpsol options used)``; without SX expansion when
-    the functions cannot be expanded (e.g. a model holding an integrator or a Callback).
-    Holds `dynamics.cache.construction_lock` (casadi construction is not thread-safe)."""
-    with construction_lock():
-        return _build_nlp_locked(problem, tr, mesh, scaling, nlp_opts, sink)
-
-
-def _build_nlp_locked(problem, tr, mesh, scaling, nlp_opts, sink):
-    disc = tr.build(problem, mesh, scaling)
+def _build_solver(disc, nlp_opts, sink):
+    """``(IPOPT solver, the nlpsol options used)`` on the structure of ``disc``. Holds
+    `dynamics.cache.construction_lock` (casadi construction is not thread-safe)."""
     nlp_opts = dict(nlp_opts)
     # always attached: stops IPOPT at the next iteration after a (deferred) Ctrl-C; the
     # options dict returned with the solver keeps the Python callback alive
-    nlp_opts["iteration_callback"] = IterationCallback(disc.w.size, disc.g.size, disc.violation, sink)
-    try:
-        solver = ca.nlpsol("ocp", "ipopt", disc.nlp, nlp_opts)
-    except RuntimeError:
-        if not nlp_opts["expand"]:
-            raise
-        nlp_opts["expand"] = False
-        solver = ca.nlpsol("ocp", "ipopt", disc.nlp, nlp_opts)
-    return disc, solver, nlp_opts
+    nlp_opts["iteration_callback"] = IterationCallback(disc.w.size, disc.g.size,
+                                                       disc.violation if sink else None, sink)
+    with construction_lock():
+        return disc.structure.nlpsol("ocp", nlp_opts), nlp_opts
 
 
 def _run(solver, args):
@@ -346,15 +375,21 @@ def _run(solver, args):
 
 
 def _make_solution(problem, tr, mesh, disc, w, lam_g, g, success, status, message,
-                   iterations, solve_time, build_time) -> Solution:
-    """The `Solution` at the scaled NLP point ``w`` (multipliers ``lam_g``, constraints ``g``)."""
+                   iterations, solve_time, build_time, lam_x=None) -> Solution:
+    """The `Solution` at the scaled NLP point ``w`` (multipliers ``lam_g``, ``lam_x``,
+    constraints ``g``)."""
     phys = disc.unpack(w)
     viol = disc.violation(g, w) if np.all(np.isfinite(g)) else float("nan")
+    point = None
+    if lam_x is not None:
+        sw, sg, dJ = disc.scales()
+        point = {"key": disc.key, "numbers": _numbers(disc), "x_phys": w * sw,
+                 "lam_x_phys": lam_x * dJ / sw, "lam_g_phys": np.asarray(lam_g) * dJ / sg}
     return Solution.from_arrays(
         problem, tr, mesh, phys["X"], phys["U"], phys["p"], phys["T"], cost=disc.cost(w),
         success=success, status=status, message=message, iterations=iterations,
         solve_time=solve_time, build_time=build_time, constraint_violation=viol,
-        multipliers=disc.multipliers(lam_g))
+        multipliers=disc.multipliers(lam_g), nlp_point=point)
 
 
 def rest_solution(problem: Problem, *, T: float | None = None, transcription="radau",
@@ -432,15 +467,13 @@ def rest_solution(problem: Problem, *, T: float | None = None, transcription="ra
     node = NodeGuess(X=np.repeat(x0[:, None], n_x, axis=1), U=np.zeros((nu, n_u)),
                      Xu=np.repeat(x0[:, None], n_u, axis=1), p=p, T=T)
     scaling = auto_scaling(problem, node, {"T": 1.0} if T == 0 else None)
-    with construction_lock():
-        disc = tr.build(problem, mesh, scaling)
-        g_of_w = ca.Function("g", [disc.nlp["x"]], [disc.nlp["g"]])
+    disc = Discretization(problem, tr, mesh, scaling)
     free = problem.free_params
     sc = scaling
     w = disc.w.join({"X": node.X / sc.x[:, None], "U": node.U / sc.u[:, None],
                      "P": (p[free] / sc.p[free])[:, None],
                      "T": np.full((int(problem.free_time), 1), T / sc.T)})
-    g = np.asarray(g_of_w(w)).reshape(-1)
+    g = disc.constraints(w)
     viol = disc.violation(g, w) if np.all(np.isfinite(g)) else float("nan")
     success = bool(viol <= ctol)
     if success:

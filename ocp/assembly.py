@@ -1,0 +1,370 @@
+"""The symbolic NLP of one problem *structure*, with derivatives assembled per interval.
+
+Why
+---
+Handing CasADi the whole transcribed NLP and letting it differentiate costs time in the
+number of intervals ``N``: about 4.4 ms per Radau(3) interval of a rigid-body slew when the
+NLP is expanded to SX, 1.3 ms without expansion (mostly the MX Jacobian of the mapped
+kernel), so 3.6 s of construction before a 0.3 s solve at N = 800. Here every derivative is
+taken once, of the functions of *one* interval (a few dozen variables), and the NLP's
+gradient, Jacobian and Hessian of the Lagrangian are sums of the mapped interval derivatives
+placed by integer index maps (`numpy`) — construction no longer grows with symbolic work
+in ``N``.
+
+Structure and parameters
+------------------------
+Everything numeric that does not change the shape of the NLP enters as an NLP *parameter*
+``P`` (the ``p`` input of ``casadi.nlpsol``): the scale factors of `ocp.scaling`, the values
+of fixed model parameters, a fixed horizon, the mesh fractions, the target quaternion.
+Boundary values and bounds are variable and constraint bounds. So one `Structure` — and the
+IPOPT solver built on it — serves every problem with the same model, cost and constraint
+*functions* (compared by content, `content_key`), transcription, number of intervals,
+free parameters, free or fixed horizon and kind of attitude target (`structure_key`).
+
+Pieces
+------
+* ``seg(z, s, c, frac) -> (rows, quad)``: one interval. ``z`` its own scaled variables
+  (start state, own state nodes, start control, own control nodes), ``s`` the shared
+  ones (free parameters, ``T``), ``c`` the common parameters, ``frac`` its mesh fraction.
+  ``rows``: its defects (divided by the state scales) and path rows at its own control
+  nodes (divided by their scales); ``quad``: its share of ``sign J / d_J``.
+* ``ends(e, s, c) -> (rows, mayer)``: the first and last state (and first control): the
+  path rows at a start control node, boundary rows, ``|q(t0)|^2 - 1``, the attitude target
+  rows, and the Mayer term.
+
+Variables ``w`` and constraints ``g`` have the block layout of `ocp.nlp`.
+"""
+from __future__ import annotations
+
+import hashlib
+
+import casadi as ca
+import numpy as np
+import scipy.sparse as sps
+
+from dynamics.attitude import quat_conj, quat_mul
+
+from .cached import function_key
+from .layout import Layout
+from .transcription import sx_compatible
+
+__all__ = ["Structure", "structure_key", "content_key"]
+
+
+def content_key(fun: ca.Function | None):
+    """A hashable key equal for Functions of equal content (name and serialized graph);
+    the identity of ``fun`` when it cannot be serialized (e.g. it holds a Callback)."""
+    if fun is None:
+        return None
+    try:
+        text = fun.serialize()
+    except Exception:  # noqa: BLE001 - not serializable: identity (kept alive by the cache)
+        return ("id", function_key(fun))
+    return (fun.name(), hashlib.blake2b(text.encode(), digest_size=16).hexdigest())
+
+
+def _functions(problem) -> list:
+    return [problem.model.f, problem.lagrange, problem.mayer,
+            *[c.fun for c in problem.path], *[c.fun for c in problem.boundary]]
+
+
+def structure_key(problem, transcription, N: int, expand: bool) -> tuple:
+    """What determines a `Structure`: see the module docstring."""
+    model = problem.model
+    return (transcription, int(N), bool(expand), content_key(model.f), content_key(problem.lagrange),
+            content_key(problem.mayer), tuple((content_key(c.fun), c.size) for c in problem.path),
+            tuple((content_key(c.fun), c.size) for c in problem.boundary),
+            tuple(problem.free_params.tolist()), problem.free_time, problem.quaternion_norm_at_t0,
+            _target_kind(problem), model.attitude[0] if model.attitude is not None else None,
+            problem.objective_sign, model.nx, model.nu, model.np)
+
+
+def _target_kind(problem) -> int:
+    """0 without an attitude target, 1 for a pointing tolerance, 3 for an exact target."""
+    if problem.q_final is None:
+        return 0
+    return 1 if problem.q_final_tol > 0 else 3
+
+
+def _nonzeros(M):
+    """The structural nonzeros of ``M`` as a column (column-major order)."""
+    return ca.sparsity_cast(M, ca.Sparsity.dense(M.nnz(), 1))
+
+
+def _triplets(M) -> tuple[np.ndarray, np.ndarray]:
+    """Row and column of each structural nonzero of a symbolic matrix (column-major)."""
+    r, c = M.sparsity().get_triplet()
+    return np.asarray(r, dtype=np.int64), np.asarray(c, dtype=np.int64)
+
+
+class _Assembly:
+    """Sum of value contributions into the nonzeros of a fixed sparse matrix.
+
+    ``rows``, ``cols``: target positions of each contribution (value ``k`` of a stacked
+    vector). Duplicated positions are summed (a sparse 0/1 matrix); otherwise a plain
+    permutation."""
+
+    def __init__(self, nrow: int, ncol: int, rows: np.ndarray, cols: np.ndarray):
+        n = rows.size
+        coo = sps.coo_matrix((np.arange(1, n + 1, dtype=np.float64), (rows, cols)), shape=(nrow, ncol))
+        csc = coo.tocsc()  # duplicates summed: a first look at which positions repeat
+        csc.sort_indices()
+        self.sparsity = ca.Sparsity(nrow, ncol, csc.indptr.tolist(), csc.indices.tolist())
+        # position of each contribution in the CSC nonzeros
+        key = cols.astype(np.int64) * nrow + rows
+        uniq = (csc.indices.astype(np.int64)
+                + np.repeat(np.arange(ncol, dtype=np.int64), np.diff(csc.indptr)) * nrow)
+        pos = np.searchsorted(uniq, key)
+        self.nnz = uniq.size
+        if uniq.size == n:
+            order = np.empty(n, dtype=np.int64)
+            order[pos] = np.arange(n)
+            self._perm, self._sum = order.tolist(), None
+        else:
+            A = sps.csc_matrix((np.ones(n), (pos, np.arange(n))), shape=(uniq.size, n))
+            A.sort_indices()
+            self._perm = None
+            self._sum = ca.DM(ca.Sparsity(uniq.size, n, A.indptr.tolist(), A.indices.tolist()), A.data)
+
+    def __call__(self, values: ca.MX) -> ca.MX:
+        """The sparse matrix from the stacked contributions ``values`` (MX column)."""
+        if self.nnz == 0:
+            return ca.MX(self.sparsity)
+        if self._sum is None:
+            nz = values[self._perm]
+        else:
+            nz = ca.densify(ca.mtimes(self._sum, values))
+        return ca.MX(self.sparsity, nz)
+
+
+class Structure:
+    """Symbolic NLP, derivative Functions and index maps of one problem structure.
+
+    Parameters
+    ----------
+    problem : ocp.Problem
+        Supplies the structure only (functions, sizes, flags); its numbers go to `params`.
+    transcription : ocp.Transcription
+    N : int
+        Number of mesh intervals.
+    expand : bool
+        Build the interval functions in SX when every function allows it (faster
+        evaluation); MX otherwise.
+
+    Attributes
+    ----------
+    w, g : Layout
+        Decision and constraint vectors (blocks as in `ocp.nlp`).
+    params : Layout
+        The NLP parameter vector ``P`` (`params_value` fills it).
+    nlp : dict
+        ``{'x', 'p', 'f', 'g'}`` (MX) for ``casadi.nlpsol``.
+    derivatives : dict
+        ``grad_f``, ``jac_g``, ``hess_lag`` Functions for the nlpsol options of those names.
+    """
+
+    def __init__(self, problem, transcription, N: int, expand: bool = True):
+        model, tr = problem.model, transcription
+        nx, nu, np_ = model.nx, model.nu, model.np
+        self.N, self.transcription = N, tr
+        m_x, m_u = tr.x_sigma.size, tr.u_sigma.size
+        ua = int(tr.u_at_start)
+        n_x, n_u = 1 + N * m_x, N * m_u + ua
+        free = problem.free_params
+        nf, ft = free.size, int(problem.free_time)
+        kernel = tr.kernel(model.f, problem.lagrange)
+        m_d = kernel.size2_out("defect")
+        n_path = sum(c.size for c in problem.path)
+        n_bound = sum(c.size for c in problem.boundary)
+        n_q = _target_kind(problem)
+        qn = int(problem.quaternion_norm_at_t0)
+        self.w = Layout({"X": (nx, n_x), "U": (nu, n_u), "P": (nf, 1), "T": (ft, 1)})
+        self.g = Layout({"defect": (nx, N * m_d), "path": (n_path, n_u), "boundary": (n_bound, 1),
+                         "quat_norm": (qn, 1), "q_final": (n_q, 1)})
+        self.common = Layout({"sx": (nx, 1), "su": (nu, 1), "sp": (np_, 1), "sT": (1, 1), "sJ": (1, 1),
+                              "spath": (n_path, 1), "sb": (n_bound, 1), "sq": (1, 1), "pval": (np_, 1),
+                              "Tfix": (1, 1), "qf": (4 if n_q else 0, 1)})
+        self.params = Layout({**self.common.shapes, "frac": (N, 1)})
+        sx_ok = expand and all(f is None or sx_compatible(f) for f in _functions(problem))
+        sym = ca.SX if sx_ok else ca.MX
+        self.symbolic = sym.__name__
+        sign = problem.objective_sign
+
+        # ------------------------------------------------ physical values from scaled ones
+        n_z = nx * (1 + m_x) + nu * (ua + m_u)
+        n_s = nf + ft
+        c = sym.sym("c", self.common.size)
+        s = sym.sym("s", n_s)
+        C = self.common.split(c)
+        E = np.zeros((np_, nf))
+        E[free, np.arange(nf)] = 1.0
+        p = C["pval"] + (ca.mtimes(ca.DM(E), s[:nf] * C["sp"][free.tolist()]) if nf else 0)
+        T = C["sT"] * s[nf] if ft else C["Tfix"]
+
+        # ------------------------------------------------ one interval
+        z = sym.sym("z", n_z)
+        frac = sym.sym("frac")
+        o = 0
+        xs = C["sx"] * z[o:o + nx]; o += nx
+        X = ca.reshape(z[o:o + nx * m_x], nx, m_x) * ca.repmat(C["sx"], 1, m_x); o += nx * m_x
+        us = C["su"] * z[o:o + nu] if ua else sym.zeros(nu, 1); o += nu * ua
+        U = ca.reshape(z[o:o + nu * m_u], nu, m_u) * ca.repmat(C["su"], 1, m_u)
+        defect, xu, quad = kernel(xs, X, us, U, T * frac, p)
+        rows = [ca.vec(defect / ca.repmat(C["sx"], 1, m_d))]
+        if n_path:
+            rows += [ca.vertcat(*[cons.fun(xu[:, j], U[:, j], p) for cons in problem.path]) / C["spath"]
+                     for j in range(m_u)]
+        seg_rows = ca.vertcat(*rows)
+        seg_q = sign * quad / C["sJ"]
+        seg_in = [z, s, c, frac]
+
+        # ------------------------------------------------ the ends
+        e = sym.sym("e", 2 * nx + nu * ua)
+        x0, xf = C["sx"] * e[:nx], C["sx"] * e[nx:2 * nx]
+        rows = []
+        if ua and n_path:
+            u0 = C["su"] * e[2 * nx:]
+            rows.append(ca.vertcat(*[cons.fun(x0, u0, p) for cons in problem.path]) / C["spath"])
+        if n_bound:
+            rows.append(ca.vertcat(*[b.fun(x0, xf, p) for b in problem.boundary]) / C["sb"])
+        iq = model.attitude[0] if model.attitude is not None else 0
+        if qn:
+            rows.append(ca.sumsqr(x0[iq:iq + 4]) - 1)
+        if n_q:
+            err = quat_mul(quat_conj(C["qf"]), xf[iq:iq + 4])[0:3]
+            rows.append(ca.sumsqr(err) if n_q == 1 else err / C["sq"])
+        end_rows = ca.vertcat(*rows) if rows else sym(0, 1)
+        end_q = sign * problem.mayer(xf, p, T) / C["sJ"] if problem.mayer is not None else sym.zeros(1, 1)
+        end_in = [e, s, c]
+
+        # ------------------------------------------------ index maps (numpy)
+        Xi, Ui = self.w.indices("X"), self.w.indices("U")
+        k = np.arange(N)
+        own_x = 1 + k[:, None] * m_x + np.arange(m_x)[None, :]          # (N, m_x) X columns
+        own_u = ua + k[:, None] * m_u + np.arange(m_u)[None, :]         # (N, m_u) U columns
+        parts = [Xi[:, k * m_x].T, Xi[:, own_x.reshape(-1)].T.reshape(N, m_x * nx)]
+        if ua:
+            parts.append(Ui[:, k * m_u].T)
+        parts.append(Ui[:, own_u.reshape(-1)].T.reshape(N, m_u * nu))
+        shared = np.concatenate([self.w.indices("P").reshape(-1), self.w.indices("T").reshape(-1)])
+        seg_cols = np.concatenate([*parts, np.repeat(shared[None, :], N, axis=0)], axis=1)
+        end_cols = np.concatenate([Xi[:, 0], Xi[:, -1], Ui[:, 0] if ua else np.zeros(0, int), shared])
+        Gd, Gp = self.g.indices("defect"), self.g.indices("path")
+        seg_g = [Gd[:, k[:, None] * m_d + np.arange(m_d)[None, :]].transpose(1, 2, 0).reshape(N, nx * m_d)]
+        if n_path:
+            seg_g.append(Gp[:, own_u.reshape(-1)].T.reshape(N, m_u * n_path))
+        seg_g = np.concatenate(seg_g, axis=1)
+        end_g = np.concatenate([Gp[:, 0] if (ua and n_path) else np.zeros(0, int),
+                                *[self.g.indices(b).reshape(-1) for b in ("boundary", "quat_norm", "q_final")]])
+        self._maps = (seg_cols, seg_g, end_cols, end_g)
+
+        # ------------------------------------------------ local derivative Functions
+        n_seg, n_end = seg_rows.numel(), end_rows.numel()
+        v_seg, v_end = ca.vertcat(z, s), ca.vertcat(e, s)
+        lam_seg, lam_end, lam_f = sym.sym("lam", n_seg), sym.sym("lam", n_end), sym.sym("lam_f")
+
+        def local(name, ins, rows_, q, v, lam):
+            J = ca.jacobian(rows_, v)
+            gq = ca.jacobian(q, v)
+            H = ca.triu(ca.hessian(lam_f * q + ca.dot(lam, rows_), v)[0])
+            return (ca.Function(f"{name}_val", ins, [rows_, q]),
+                    ca.Function(f"{name}_grad", ins, [q, _nonzeros(gq)]),
+                    ca.Function(f"{name}_jac", ins, [rows_, _nonzeros(J)]),
+                    ca.Function(f"{name}_hess", ins + [lam, lam_f], [_nonzeros(H)]),
+                    _triplets(J), _triplets(gq), _triplets(H))
+
+        seg_f = local("seg", seg_in, seg_rows, seg_q, v_seg, lam_seg)
+        end_f = local("ends", end_in, end_rows, end_q, v_end, lam_end)
+
+        # ------------------------------------------------ the NLP in MX
+        wsym = ca.MX.sym("w", self.w.size)
+        Psym = ca.MX.sym("P", self.params.size)
+        cP = Psym[:self.common.size]
+        fr = ca.reshape(Psym[self.common.size:], 1, N)
+        Z = ca.reshape(wsym[seg_cols[:, :n_z].reshape(-1).tolist()], n_z, N)
+        S = wsym[shared.tolist()] if shared.size else ca.MX(0, 1)
+        Ee = wsym[end_cols[:end_cols.size - shared.size].tolist()]
+        seg_args, end_args = [Z, S, cP, fr], [Ee, S, cP]
+        rep_in = [False, True, True, False]
+
+        def mapped(fun, reduce_out):
+            return fun.map(N, rep_in, reduce_out)
+
+        order = np.empty(self.g.size, dtype=np.int64)
+        order[seg_g.reshape(-1)] = np.arange(N * n_seg)
+        order[end_g] = N * n_seg + np.arange(n_end)
+        order = order.tolist()
+
+        def g_of(rows_seg, rows_end):
+            return ca.vertcat(ca.vec(rows_seg), rows_end)[order] if order else ca.MX(0, 1)
+
+        # values
+        R, q = mapped(seg_f[0], [False, True])(*seg_args)
+        Re, qe = end_f[0](*end_args)
+        f, g = q + qe, g_of(R, Re)
+        self.nlp = {"x": wsym, "p": Psym, "f": f, "g": g}
+
+        # gradient of f
+        q2, Gq = mapped(seg_f[1], [True, False])(*seg_args)
+        qe2, Gqe = end_f[1](*end_args)
+        cs, ce = seg_f[5][1], end_f[5][1]
+        grad_rows = np.concatenate([seg_cols[:, cs].reshape(-1), end_cols[ce]])
+        grad = _Assembly(self.w.size, 1, grad_rows, np.zeros(grad_rows.size, dtype=np.int64))
+        gvec = ca.densify(grad(ca.vertcat(ca.vec(Gq), Gqe)))
+        # Jacobian of g
+        R3, Jz = mapped(seg_f[2], [False, False])(*seg_args)
+        Re3, Je = end_f[2](*end_args)
+        (rs, cs), (re, ce) = seg_f[4], end_f[4]
+        jac = _Assembly(self.g.size, self.w.size,
+                        np.concatenate([seg_g[:, rs].reshape(-1), end_g[re]]),
+                        np.concatenate([seg_cols[:, cs].reshape(-1), end_cols[ce]]))
+        J = jac(ca.vertcat(ca.vec(Jz), Je))
+        # Hessian of the Lagrangian (upper triangle)
+        lf = ca.MX.sym("lam_f")
+        lg = ca.MX.sym("lam_g", self.g.size)
+        Lseg = ca.reshape(lg[seg_g.reshape(-1).tolist()], n_seg, N) if n_seg else ca.MX(0, N)
+        Lend = lg[end_g.tolist()] if n_end else ca.MX(0, 1)
+        Hz = seg_f[3].map(N, rep_in + [False, True], [False])(*seg_args, Lseg, lf)
+        He = end_f[3](*end_args, Lend, lf)
+        (rs, cs), (re, ce) = seg_f[6], end_f[6]
+        hr = np.concatenate([seg_cols[:, rs].reshape(-1), end_cols[re]])
+        hc = np.concatenate([seg_cols[:, cs].reshape(-1), end_cols[ce]])
+        hess = _Assembly(self.w.size, self.w.size, np.minimum(hr, hc), np.maximum(hr, hc))
+        H = hess(ca.vertcat(ca.vec(Hz), He))
+        self.derivatives = {
+            "grad_f": ca.Function("nlp_grad_f", [wsym, Psym], [q2 + qe2, gvec], ["x", "p"], ["f", "grad_f_x"]),
+            "jac_g": ca.Function("nlp_jac_g", [wsym, Psym], [g_of(R3, Re3), J],
+                                 ["x", "p"], ["g", "jac_g_x"]),
+            "hess_lag": ca.Function("nlp_hess_l", [wsym, Psym, lf, lg], [H],
+                                    ["x", "p", "lam_f", "lam_g"], ["hess_gamma_x_x"]),
+        }
+        self._fg = ca.Function("nlp_fg", [wsym, Psym], [f, g], ["x", "p"], ["f", "g"])
+
+    # ---------------------------------------------------------------- use
+    def params_value(self, problem, mesh, scaling) -> np.ndarray:
+        """The parameter vector ``P`` of ``problem`` on ``mesh`` with ``scaling``."""
+        free = problem.free_params
+        pval = np.array(problem.p, dtype=float)
+        pval[free] = 0.0
+        sp = np.ones(problem.model.np)
+        sp[free] = scaling.p[free]
+        qf = np.asarray(problem.q_final, dtype=float) if problem.q_final is not None else np.zeros(0)
+        return self.params.join({
+            "sx": scaling.x[:, None], "su": scaling.u[:, None], "sp": sp[:, None], "sT": scaling.T,
+            "sJ": scaling.objective, "spath": scaling.path[:, None], "sb": scaling.boundary[:, None],
+            "sq": scaling.q_final, "pval": pval[:, None],
+            "Tfix": 0.0 if problem.free_time else problem.T, "qf": qf[:, None],
+            "frac": np.asarray(mesh.fractions, dtype=float)[:, None]})
+
+    def evaluate(self, w, P) -> tuple[float, np.ndarray]:
+        """``(f, g)`` of the scaled NLP at ``w`` with parameters ``P``."""
+        out = self._fg(x=np.asarray(w, dtype=float), p=P)
+        return float(out["f"]), np.asarray(out["g"]).reshape(-1)
+
+    def nlpsol(self, name: str, options: dict) -> ca.Function:
+        """An IPOPT solver on this NLP with the assembled derivatives (``options``: nlpsol
+        options; ``expand`` is dropped — the interval functions are already SX)."""
+        opts = {k: v for k, v in options.items() if k != "expand"}
+        opts.update(self.derivatives)
+        opts.setdefault("calc_lam_p", False)
+        return ca.nlpsol(name, "ipopt", self.nlp, opts)

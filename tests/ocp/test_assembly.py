@@ -1,0 +1,139 @@
+"""The NLP's hand-assembled derivatives (`ocp.assembly`) against CasADi's own automatic
+differentiation of the same NLP, and one structure serving problems of equal structure."""
+import casadi as ca
+import numpy as np
+import pytest
+
+import ocp
+from ocp import Constraint, Mesh, Problem, solve
+from ocp.assembly import content_key
+from ocp.guess import initial_guess
+from ocp.nlp import Discretization
+from ocp.scaling import auto_scaling
+from ocp.transcription import get_transcription
+
+from .reference import bang_bang, bryson_denham, rigid_slew, static_parameter
+
+
+def _loaded_problem():
+    """Path constraints, boundary constraints, a free parameter, Mayer and Lagrange costs,
+    a free horizon, maximization: every block of the NLP."""
+    base, _ = static_parameter()
+    return Problem(base.model, T=(0.5, 2.0), x_initial=[0.0, 0.0], x_final={"v": 0.0},
+                   lagrange=lambda x, u, p: 0.5 * u ** 2 * (1 + x[0] ** 2),
+                   mayer=lambda xf, p, T: 1.5 * p ** 2 + xf[0] * T,
+                   path=[Constraint(lambda x, u, p: x[1] * u - p, upper=1.0),
+                         lambda x, u, p: ca.vertcat(x[0] - 2, u * u - 4)],
+                   boundary=lambda x0, xf, p: xf[0] * p - 1.0,
+                   p_bounds={"k": (0.1, 10.0)}, maximize=True)
+
+
+def _pointing_problem():
+    pr, _ = rigid_slew(theta_f=0.8)
+    return pr.replace(q_final_tol=0.05, T=(0.5, 5.0), u_bounds=([-1] * 3, [1] * 3))
+
+
+PROBLEMS = {
+    "loaded": _loaded_problem,
+    "bryson_denham": lambda: bryson_denham()[0],
+    "bang_bang": lambda: bang_bang()[0],
+    "rigid_slew": lambda: rigid_slew(theta_f=0.8)[0],
+    "pointing": _pointing_problem,
+}
+
+
+@pytest.mark.parametrize("transcription", ["radau", "trapezoid", "hermite-simpson",
+                                           "hermite-simpson-compressed"])
+@pytest.mark.parametrize("name", sorted(PROBLEMS))
+def test_assembled_derivatives_equal_automatic_differentiation(name, transcription):
+    """Gradient, constraint Jacobian and Lagrangian Hessian (upper triangle), values and
+    sparsity, at a random point of a non-uniform mesh, against ``casadi.gradient``,
+    ``jacobian`` and ``hessian`` of the NLP's own value graph."""
+    problem = PROBLEMS[name]()
+    rng = np.random.default_rng(7)
+    tr = get_transcription(transcription)
+    mesh = Mesh(np.concatenate([[0.0], np.sort(rng.uniform(size=4)), [1.0]]))
+    guess = initial_guess(problem, tr, mesh, None)
+    disc = Discretization(problem, tr, mesh, auto_scaling(problem, guess, None))
+    nlp = disc.nlp
+    w, lam_g, lam_f = rng.normal(size=disc.w.size), rng.normal(size=disc.g.size), 0.37
+    lg = ca.MX.sym("lg", disc.g.size)
+    L = lam_f * nlp["f"] + ca.dot(lg, nlp["g"])
+    truth = ca.Function("ad", [nlp["x"], nlp["p"], lg],
+                        [ca.gradient(nlp["f"], nlp["x"]), ca.jacobian(nlp["g"], nlp["x"]),
+                         ca.triu(ca.hessian(L, nlp["x"])[0])])
+    grad, jac, hess = truth(w, disc.P, lam_g)
+    d = disc.structure.derivatives
+    f1, grad1 = d["grad_f"](w, disc.P)
+    g1, jac1 = d["jac_g"](w, disc.P)
+    hess1 = d["hess_lag"](w, disc.P, lam_f, lam_g)
+    f0, g0 = disc.structure.evaluate(w, disc.P)
+    assert float(f1) == pytest.approx(f0, rel=1e-14, abs=1e-14)
+    np.testing.assert_allclose(np.asarray(g1).ravel(), g0, rtol=1e-14, atol=1e-14)
+    for got, want in ((grad1, grad), (jac1, jac), (hess1, hess)):
+        got, want = ca.DM(got), ca.DM(want)
+        scale = max(1.0, float(np.max(np.abs(want.full()))) if want.numel() else 1.0)
+        assert got.shape == want.shape
+        np.testing.assert_allclose(got.full(), want.full(), rtol=0, atol=1e-12 * scale)
+
+
+def _disc(problem, N=30, transcription="radau"):
+    tr = get_transcription(transcription)
+    mesh = Mesh.uniform(N)
+    return Discretization(problem, tr, mesh, auto_scaling(problem, initial_guess(problem, tr, mesh, None), None))
+
+
+def test_problems_of_equal_structure_share_one_structure():
+    """Another target, horizon and scaling: the same symbolic NLP (numbers are NLP
+    parameters); another number of intervals, cost function or model (an inertia is part
+    of the rigid-body right-hand side): another one."""
+    a, ta = rigid_slew(theta_f=1.0)
+    b, tb = rigid_slew(theta_f=0.5, axis=0, T=3.0)
+    da, db = _disc(a), _disc(b)
+    assert da.structure is db.structure and da.key == db.key
+    assert not np.array_equal(da.P, db.P)
+    assert _disc(a, N=31).structure is not da.structure
+    c = a.replace(lagrange=lambda x, u, p: ca.sumsqr(u))
+    assert _disc(c).structure is not da.structure
+    assert _disc(rigid_slew(inertia=2.0)[0]).structure is not da.structure
+    sa, sb = solve(a, N=30), solve(b, N=30)
+    assert sa.success and sb.success
+    assert sa.cost == pytest.approx(ta["J"], rel=1e-6) and sb.cost == pytest.approx(tb["J"], rel=1e-6)
+
+
+def test_content_key_is_equal_for_equal_functions_and_differs_otherwise():
+    x = ca.SX.sym("x")
+    f1 = ca.Function("f", [x], [x ** 2])
+    f2 = ca.Function("f", [x], [x ** 2])
+    f3 = ca.Function("f", [x], [x ** 3])
+    assert content_key(f1) == content_key(f2) != content_key(f3)
+    assert content_key(None) is None
+
+
+def test_warm_start_with_multipliers_converges_at_once():
+    """Re-solving from its own solution (same structure and mesh): primal and dual values
+    handed to IPOPT, which then has nothing to do."""
+    problem, truth = bryson_denham()
+    cold = solve(problem, N=40)
+    warm = solve(problem, N=40, guess=cold)
+    assert cold.success and warm.success
+    assert warm.iterations <= 1 < cold.iterations
+    # the same optimum to IPOPT's tolerance (tol 1e-8 on the scaled NLP; the discretization
+    # error of the cost, against the closed form 4/(9 l), is 6e-6)
+    assert warm.cost == pytest.approx(cold.cost, rel=1e-6)
+    assert abs(warm.cost - truth["J"]) < 1e-5
+    assert cold.nlp_point is not None and set(cold.nlp_point) >= {"x_phys", "lam_x_phys", "lam_g_phys"}
+
+
+def test_warm_start_of_another_problem_uses_primal_values_only():
+    """The dual warm start is kept for the same NLP; a Solution of another problem of the
+    same structure (other target) starts IPOPT from its primal values, as before."""
+    from ocp.solve import _warm_point
+
+    a, _ = rigid_slew(theta_f=1.0)
+    b, tb = rigid_slew(theta_f=1.1)
+    sa = solve(a, N=30)
+    assert _warm_point(sa, _disc(a)) is not None
+    assert _warm_point(sa, _disc(b)) is None
+    warm = solve(b, N=30, guess=sa)
+    assert warm.success and warm.cost == pytest.approx(tb["J"], rel=1e-6)
