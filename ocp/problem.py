@@ -41,6 +41,7 @@ for three degrees of freedom): use ``q_final``.
 """
 from __future__ import annotations
 
+import inspect
 import math
 import re
 from dataclasses import dataclass, replace
@@ -66,8 +67,10 @@ class Constraint:
     ----------
     fun : casadi.Function or callable
         Path constraints: ``g(x, u, p)``; boundary constraints: ``c(x0, xf, p)``. A callable
-        is called once with CasADi SX symbols of those sizes and must return an expression.
-        The output (any shape) is flattened column-major to ``m`` rows.
+        is called once with CasADi SX symbols of those sizes and must return an expression;
+        or it takes scalar components by name (``Constraint(lambda h, v: h * v, 0, 1)``;
+        boundary names ``h_0``/``h_f``; see `Problem`, Notes). The output (any shape) is
+        flattened column-major to ``m`` rows.
     lower, upper : float or array_like, shape (m,)
         Bounds (``-inf``/``inf`` for none). Defaults: ``g <= 0``.
     scale : float or array_like, shape (m,), optional
@@ -178,6 +181,120 @@ def _bounds(arg, names: tuple[str, ...], argname: str) -> np.ndarray:
     return out
 
 
+# ------------------------------------------------------------ callables by name
+# the positional convention of each kind of function and the inputs its names refer to
+_POSITIONAL = {
+    "lagrange": ("x", "u", "p"),
+    "path": ("x", "u", "p"),
+    "mayer": ("xf", "p", "T"),
+    "boundary": ("x0", "xf", "p"),
+}
+
+
+def _vocabulary(kind: str, model: Model) -> dict[str, list[tuple[int, int]]]:
+    """Argument name -> every ``(input, component)`` it may denote for functions of ``kind``
+    (more than one entry: the name is ambiguous)."""
+    vocab: dict[str, list[tuple[int, int]]] = {}
+
+    def add(name, where):
+        if where not in vocab.setdefault(name, []):
+            vocab[name].append(where)
+
+    if kind in ("lagrange", "path"):  # inputs (x, u, p)
+        for i, s in enumerate(model.states):
+            add(s, (0, i))
+        for i, c in enumerate(model.controls):
+            add(c, (1, i))
+        for i, q in enumerate(model.params):
+            add(q, (2, i))
+    elif kind == "mayer":  # inputs (xf, p, T): states are final values
+        for i, s in enumerate(model.states):
+            add(s, (0, i))
+            add(f"{s}_f", (0, i))
+        for i, q in enumerate(model.params):
+            add(q, (1, i))
+        add("T", (2, 0))
+    else:  # boundary, inputs (x0, xf, p): initial values `<state>_0`, final `<state>_f`
+        for i, s in enumerate(model.states):
+            add(f"{s}_0", (0, i))
+            add(f"{s}_f", (1, i))
+        for i, q in enumerate(model.params):
+            add(q, (2, i))
+    return vocab
+
+
+def _valid_names(kind: str, model: Model) -> str:
+    if kind in ("lagrange", "path"):
+        return (f"states {list(model.states)}, controls {list(model.controls)}, "
+                f"parameters {list(model.params)}")
+    if kind == "mayer":
+        return (f"final states {list(model.states)} (or with the suffix '_f'), parameters "
+                f"{list(model.params)}, and 'T' (the horizon)")
+    return (f"initial states {[s + '_0' for s in model.states]}, final states "
+            f"{[s + '_f' for s in model.states]}, parameters {list(model.params)}")
+
+
+def _by_name(fun, kind: str, model: Model, argname: str):
+    """``fun`` itself when it takes the positional arguments of ``kind``; else a positional
+    wrapper that calls it with the scalar components its parameter names denote.
+
+    A plain callable (not a ``casadi.Function``) whose parameters can all be passed by keyword
+    is taken by name when every parameter name is a name of ``kind`` (`_vocabulary`) and the
+    names are not exactly the positional ones; a callable that cannot take the three
+    positional arguments must name its arguments so (ValueError naming the first that does
+    not: unknown or ambiguous). Any other callable keeps the positional convention.
+    """
+    if isinstance(fun, ca.Function) or not callable(fun):
+        return fun
+    try:
+        params = list(inspect.signature(fun).parameters.values())
+    except (TypeError, ValueError):  # no signature (some builtins): positional
+        return fun
+    kinds = {p.kind for p in params}
+    if kinds & {inspect.Parameter.VAR_POSITIONAL, inspect.Parameter.VAR_KEYWORD,
+                inspect.Parameter.POSITIONAL_ONLY}:
+        return fun
+    names = tuple(p.name for p in params)
+    positional = _POSITIONAL[kind]
+    if names == positional:
+        return fun
+    vocab = _vocabulary(kind, model)
+    state_names = set(model.states)
+    # a state name without suffix in `boundary` is recognized but ambiguous (x0 or xf)
+    recognized = [n in vocab or (kind == "boundary" and n in state_names) for n in names]
+    required = sum(p.default is inspect.Parameter.empty for p in params)
+    takes_positional = required <= len(positional) <= len(params)
+    if not all(recognized) and takes_positional:
+        return fun  # the positional convention, under other names (as `lambda xf_, p_, T`)
+    valid = _valid_names(kind, model)
+    where = []
+    for n, ok in zip(names, recognized):
+        if not ok:
+            raise ValueError(
+                f"`{argname}`: argument {n!r} is not a name of this problem; by name it may "
+                f"take {valid}; or write it positionally as {kind}({', '.join(positional)})")
+        if n not in vocab:
+            raise ValueError(
+                f"`{argname}`: argument {n!r} is ambiguous (initial or final value of state "
+                f"{n!r}); write {n + '_0'!r} or {n + '_f'!r}")
+        if len(vocab[n]) > 1:
+            raise ValueError(
+                f"`{argname}`: argument {n!r} is ambiguous: it names more than one input "
+                f"{[positional[i] + f'[{j}]' for i, j in vocab[n]]}; rename the model's "
+                f"component or use the positional form {kind}({', '.join(positional)})")
+        where.append(vocab[n][0])
+
+    def positional_call(*inputs):
+        out = fun(**{n: inputs[i][j] for n, (i, j) in zip(names, where)})
+        if isinstance(out, (list, tuple)):  # rows given as a list of expressions
+            out = ca.vertcat(*[ca.vec(o) if isinstance(o, (ca.SX, ca.MX, ca.DM)) else o
+                               for o in out]) if out else ca.DM.zeros(0, 1)
+        return out
+
+    positional_call.__name__ = getattr(fun, "__name__", kind)
+    return positional_call
+
+
 def _canonical(fun, inputs: Sequence[tuple[str, int]], out_name: str, argname: str, *,
                scalar: bool = False) -> ca.Function:
     """A user Function or callable as a named-I/O Function with one flattened output."""
@@ -250,14 +367,19 @@ class Problem:
         ``lower == upper`` are fixed (at ``p``). Stored as shape (2, np), fixed ones with
         ``lower == upper == p``.
     lagrange : casadi.Function or callable, optional
-        Running cost ``L(x, u, p)`` (scalar) [cost/s].
+        Running cost ``L(x, u, p)`` (scalar) [cost/s]; a callable may instead take states,
+        controls and parameters by name (see Notes): ``lagrange=lambda u: 0.5 * u**2``.
     mayer : casadi.Function or callable, optional
-        Terminal cost ``phi(xf, p, T)`` (scalar). ``mayer=lambda xf, p, T: T`` is minimum time.
+        Terminal cost ``phi(xf, p, T)`` (scalar). ``mayer=lambda xf, p, T: T`` is minimum time
+        By name: ``mayer=lambda T: T``, or ``mayer=lambda h: -h`` (minimizes ``-h(tf)``).
     path : Constraint, casadi.Function, callable, or a sequence of them
         Path constraints ``g(x, u, p)``; a bare Function/callable means ``g <= 0``.
-        Imposed at the control nodes of the transcription.
+        Imposed at the control nodes of the transcription. By name:
+        ``path=lambda h, v: ...``.
     boundary : Constraint, casadi.Function, callable, or a sequence of them
         Boundary constraints ``c(x0, xf, p)``; a bare Function/callable means ``c = 0``.
+        By name, initial values carry the suffix ``_0`` and final values ``_f``:
+        ``boundary=lambda h_f, v_0: h_f - 2 * v_0``.
     q_final : array_like, shape (4,), optional
         Target attitude (scalar-last unit quaternion) at ``tf``, met up to sign. Needs
         ``model.attitude``. Normalized on input (its norm must be 1 to 1e-6).
@@ -288,6 +410,39 @@ class Problem:
 
     Notes
     -----
+    **Functions by name.** A Python callable given as ``lagrange``, ``mayer``, ``path`` or
+    ``boundary`` (also as the ``fun`` of a `Constraint`) is called in one of two ways, told
+    apart by `inspect.signature`:
+
+    * *positional* (as a ``casadi.Function`` always is): with the column vectors
+      ``(x, u, p)`` (``lagrange``, ``path``), ``(xf, p, T)`` (``mayer``) or ``(x0, xf, p)``
+      (``boundary``), whatever the parameter names (``lambda xf_, p_, T`` works);
+    * *by name*: with scalar symbols, when every parameter name is a name of the problem
+      and the names are not exactly the positional ones above:
+
+      ==================  ==========================================================
+      ``lagrange, path``  a state, control or parameter name: its value at time t
+      ``mayer``           a state name, or the state name + ``_f``: its final value;
+                          a parameter name; ``T``: the horizon length [s]
+      ``boundary``        a state name + ``_0`` (initial value) or + ``_f`` (final
+                          value); a parameter name. A bare state name is refused
+                          (ambiguous)
+      ==================  ==========================================================
+
+      Such a callable may return one expression or a list of them (stacked into rows;
+      the positional form takes the first item of a list, as it did before).
+
+    A callable that cannot take the three positional arguments (fewer parameters, or more
+    without defaults) must name its arguments so: a name that is not one of the problem
+    (a typo, a control in ``mayer``) or that is ambiguous (a bare state name in
+    ``boundary``; a name that denotes two inputs, like ``T`` in ``mayer`` for a model
+    with a component ``T``) raises ValueError naming the argument and listing the valid
+    names. A callable with ``*args``, ``**kwargs`` or positional-only parameters is always
+    positional. For a model whose names coincide with the positional ones (the double
+    integrator's state ``x`` and control ``u``), ``lambda x, u, p`` is positional and
+    ``lambda x, u`` by name. Stored attributes are the same either way: canonical
+    Functions of the positional inputs.
+
     Quaternion norm handling and the sign-free attitude target are described in the module
     docstring of `ocp.problem`.
 
@@ -308,6 +463,16 @@ class Problem:
     ...                        u_bounds={"u": (-1, 1)}, mayer=lambda xf, p, T: T)
     >>> energy.free_time, fastest.free_time, fastest.T_bounds
     (False, True, (0.1, 10.0))
+
+    The same two problems with the functions taking the model's names:
+
+    >>> energy = ocp.Problem(model, T=1.0, x_initial=[0, 0], x_final=[1, 0],
+    ...                       lagrange=lambda u: 0.5 * u**2)
+    >>> fastest = ocp.Problem(model, T=(0.1, 10.0), x_initial=[0, 0], x_final=[1, 0],
+    ...                        u_bounds={"u": (-1, 1)}, mayer=lambda T: T,
+    ...                        boundary=lambda x_f, v_0: [x_f - 1, v_0])
+    >>> energy.lagrange.name_in(), fastest.mayer.name_in()
+    (['x', 'u', 'p'], ['xf', 'p', 'T'])
     """
 
     model: Model
@@ -410,13 +575,14 @@ class Problem:
         # cost and constraints
         xs, us, ps = ("x", nx), ("u", nu), ("p", np_)
         if self.lagrange is not None:
-            put("lagrange", _canonical(self.lagrange, [xs, us, ps], "L", "lagrange", scalar=True))
+            put("lagrange", _canonical(_by_name(self.lagrange, "lagrange", model, "lagrange"),
+                                       [xs, us, ps], "L", "lagrange", scalar=True))
         if self.mayer is not None:
-            put("mayer", _canonical(self.mayer, [("xf", nx), ps, ("T", 1)], "phi", "mayer",
-                                    scalar=True))
-        put("path", self._constraints(self.path, "path", [xs, us, ps], (-math.inf, 0.0)))
+            put("mayer", _canonical(_by_name(self.mayer, "mayer", model, "mayer"),
+                                    [("xf", nx), ps, ("T", 1)], "phi", "mayer", scalar=True))
+        put("path", self._constraints(self.path, "path", [xs, us, ps], (-math.inf, 0.0), model))
         put("boundary", self._constraints(self.boundary, "boundary",
-                                          [("x0", nx), ("xf", nx), ps], (0.0, 0.0)))
+                                          [("x0", nx), ("xf", nx), ps], (0.0, 0.0), model))
 
         # attitude (ocp.attitude)
         x0, qf, qtol = check_attitude(model, self.x_initial, self.x_final, self.q_final, self.q_final_tol)
@@ -429,7 +595,7 @@ class Problem:
 
     # ------------------------------------------------------------------ helpers
     @staticmethod
-    def _constraints(arg, argname, inputs, default_bounds) -> tuple[Constraint, ...]:
+    def _constraints(arg, argname, inputs, default_bounds, model) -> tuple[Constraint, ...]:
         if arg is None:
             return ()
         items = list(arg) if isinstance(arg, (list, tuple)) else [arg]
@@ -440,7 +606,8 @@ class Problem:
                 con = item
             else:
                 con = Constraint(item, *default_bounds)
-            fun = _canonical(con.fun, inputs, "g" if argname == "path" else "c", label)
+            fun = _canonical(_by_name(con.fun, argname, model, label), inputs,
+                             "g" if argname == "path" else "c", label)
             m = fun.numel_out(0)
             if m == 0:
                 raise ValueError(f"`{label}` returns no rows")

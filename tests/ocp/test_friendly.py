@@ -136,3 +136,58 @@ def test_solution_reads_states_and_controls_by_name():
     np.testing.assert_allclose(sol["u"], 6.0 - 12.0 * sol.t, atol=1e-6)  # Bryson & Ho
     with pytest.raises(KeyError, match=r"'w'.*\('x', 'v'\).*\('u',\)"):
         sol["w"]
+
+
+# ------------------------------------------------------------------ guesses by name
+def _nodes(problem, guess):
+    from ocp.guess import initial_guess
+    tr, mesh = ocp.Radau(3), ocp.Mesh.uniform(5)
+    return initial_guess(problem, tr, mesh, guess), tr.state_tau(mesh), tr.control_tau(mesh)
+
+
+@pytest.mark.parametrize("x_guess", [
+    {"x": lambda t: 3 * t**2 - 2 * t**3},                       # a callable of t
+    {"x": 3 * np.linspace(0, 1, 201)**2 - 2 * np.linspace(0, 1, 201)**3},  # samples on t
+])
+def test_a_guess_may_name_some_states_the_others_keep_the_default(x_guess):
+    """Bryson & Ho's optimum x = 3t^2 - 2t^3 for the named state; the unnamed v keeps the
+    default (linear between its boundary values 0 and 0), the control its default 0."""
+    problem = min_energy()
+    t = np.linspace(0.0, 1.0, 201)
+    g, tau, _ = _nodes(problem, {"t": t, "x": x_guess})
+    np.testing.assert_allclose(g.X[0], 3 * tau**2 - 2 * tau**3, atol=1e-4)
+    np.testing.assert_array_equal(g.X[1], 0.0)
+    np.testing.assert_array_equal(g.U, 0.0)
+
+
+def test_naming_every_state_and_control_gives_the_exact_solution():
+    """The optimum by name (u = 6 - 12 t, x = 3t^2 - 2t^3, v = 6t - 6t^2) is already optimal."""
+    problem = min_energy()
+    guess = {"x": {"x": lambda t: 3 * t**2 - 2 * t**3, "v": lambda t: 6 * t - 6 * t**2},
+             "u": {"u": lambda t: 6 - 12 * t}}
+    g, tau, tau_u = _nodes(problem, guess)
+    np.testing.assert_allclose(g.X[1], 6 * tau - 6 * tau**2, atol=1e-15)
+    np.testing.assert_allclose(g.U[0], 6 - 12 * tau_u, atol=1e-14)
+    sol = ocp.solve(problem, N=5, guess=guess,
+                    ipopt_options={"tol": 1e-12, "bound_relax_factor": 0.0})
+    assert sol.success and sol.iterations <= 1 and sol.cost == pytest.approx(6.0, abs=1e-9)
+
+
+def test_a_named_constant_and_the_default_elsewhere():
+    problem = min_energy().replace(x_final=[1.0, np.nan], u_bounds={"u": (-1, 1)})
+    g, tau, _ = _nodes(problem, {"x": {"v": 0.25}, "u": {"u": 3.0}})
+    np.testing.assert_allclose(g.X[1, 1:], 0.25)         # v free at the end: the constant
+    np.testing.assert_allclose(g.X[0], tau)              # x linear from 0 to 1 (default)
+    np.testing.assert_allclose(g.U, 1.0)                 # clipped into the bounds
+
+
+@pytest.mark.parametrize("guess, match", [
+    ({"x": {"w": 1.0}}, r"`guess\['x'\]` names unknown state 'w'.*\('x', 'v'\)"),
+    ({"u": {"thrust": 1.0}}, r"`guess\['u'\]` names unknown control 'thrust'.*\('u',\)"),
+    ({"x": {"v": "fast"}}, r"`guess\['x'\]\['v'\]`"),
+    ({"x": {"v": np.ones((2, 2))}}, r"`guess\['x'\]\['v'\]`"),
+    ({"t": [0.0, 0.5, 1.0], "x": {"v": [1.0, 2.0]}}, r"`guess\['x'\]\['v'\]`.*2 columns.*3 times"),
+])
+def test_bad_named_guess_raises_naming_it(guess, match):
+    with pytest.raises(ValueError, match=match):
+        _nodes(min_energy(), guess)
