@@ -142,11 +142,14 @@ def _message(status: str, iterations: int) -> str:
     return f"IPOPT {status} after {iterations} iterations: {text}"
 
 
-def _default_guess_hint(problem: Problem, T_guess: float) -> str:
+def _default_guess_hint(problem: Problem, node_guess) -> str:
     """The sentence added to the message of a failed solve from the default guess."""
-    horizon = f", T = {T_guess:g} s for the free horizon" if problem.free_time else ""
-    return (f" The default initial guess (states by linear/SLERP interpolation of the boundary "
-            f"values, controls at zero{horizon}) may be the cause: pass a better one as `guess=`, "
+    if node_guess.source:  # a free T chosen by simulating the default control (ocp.guess)
+        what = node_guess.source
+    else:
+        horizon = f", T = {node_guess.T:g} s for the free horizon" if problem.free_time else ""
+        what = f"states by linear/SLERP interpolation of the boundary values, controls at zero{horizon}"
+    return (f" The default initial guess ({what}) may be the cause: pass a better one as `guess=`, "
             f"a mapping with 't', 'x', 'u', 'T' (see `ocp.guess`) or a previous Solution.")
 
 
@@ -173,8 +176,10 @@ def solve(problem: Problem, *, transcription="radau", N: int | None = None, degr
         Initial guess (see `ocp.guess`): default linear/SLERP between boundary values, a
         previous Solution (warm start, any transcription or mesh; primal and dual values
         when it solved the same NLP), or a mapping with ``'t'``,
-        ``'x'``, ``'u'``, ``'T'``, ``'p'``. A failed solve from the default guess says in
-        its message that the guess may be the cause.
+        ``'x'``, ``'u'``, ``'T'``, ``'p'`` (states and controls by name allowed). A free
+        ``T`` without a guess is chosen by simulating the default control (`ocp.guess`). A
+        failed solve from the default guess says in its message that the guess may be the
+        cause.
     scale : mapping of str to float, optional
         Scale overrides by state/control/parameter name, ``'T'``, ``'objective'``,
         ``'q_final'`` (see `ocp.scaling`).
@@ -342,7 +347,7 @@ def _solve_built(problem, tr, m, node_guess, opts, ctol, disc, solver, nlp_opts,
                        f"constraint_tol {ctol:g}: not verified")
             status = STATUS_CONSTRAINT_TOL
     if not success and default_guess:
-        message += _default_guess_hint(problem, node_guess.T)
+        message += _default_guess_hint(problem, node_guess)
     LOGGER.info("solve %s (%s, N=%d): %s; %.3g s", problem.name, tr.name, m.N, message, solve_time)
     return _make_solution(problem, tr, m, disc, w, lam_g, g, success, status, message,
                           iterations, solve_time, build_time, lam_x=lam_x)
