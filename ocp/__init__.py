@@ -21,10 +21,11 @@ from .guess import guess_from_simulation
 from .mesh import Mesh
 from .problem import Constraint, Problem
 from .ipopt_options import check_ipopt_options, ipopt_option_table
-from .refine import (IntervalErrors, RefinedSolution, RefinementRound, annotate, control_switches,
+from .refine import (STATUS_STALLED, IntervalErrors, RefinedSolution, RefinementRound, annotate, control_switches,
                      find_switches, interval_errors, polish_switches, refine, solve_multistart)
 from .scaling import Scaling
 from .progress import LOGGER
+from .propagation import SCALE_FLOOR, state_scale
 from .solution import Propagation, Solution
 from .solve import (DEFAULT_CONSTRAINT_TOL, STATUS_CONSTRAINT_TOL, STATUS_EXCEPTION, STATUS_REST,
                     Progress, rest_solution, solve)
@@ -66,4 +67,7 @@ __all__ = [
     "find_switches",
     "control_switches",
     "guess_from_simulation",
+    "STATUS_STALLED",
+    "SCALE_FLOOR",
+    "state_scale",
 ]

@@ -9,6 +9,45 @@ a distance ``d``:
 * `min_time`: minimize ``T`` under ``|u| <= u_max``; bang-bang with one switch at ``T / 2``,
   ``T = 2 sqrt(d / u_max)``.
 
+The Goddard rocket (`goddard_rocket`), a problem with a *singular arc*: maximize the final
+altitude of a vertical ascent with drag, normalized as in COPS 3.0 (Dolan, More & Munson,
+*Benchmarking optimization software with COPS 3.0*, ANL/MCS-TM-273, 2004) and Betts,
+*Practical Methods for Optimal Control* (2010). COPS reports ``h(tf) = 1.01283``. The
+optimal thrust is maximal, then singular (on the surface where the switching function and
+its first two derivatives vanish), then zero until the apogee; integrating that structure
+(thrust 3.5 until the singular surface at ``t1 = 0.0235097``, the singular feedback law until
+the fuel is spent at ``t2 = 0.0726707``, coasting to ``v = 0``) gives
+``h(tf) = 1.0128369183`` at ``tf = 0.1988562621`` (`GODDARD_OPTIMUM`; reproduced in the
+tests).
+
+Singular arcs and collocation
+-----------------------------
+On a singular arc the Hamiltonian does not determine the control: the discrete problem has
+nearly flat directions, the collocated control rings around the singular value, and its
+junctions with the bang arcs are not smooth. Consequences, measured on `goddard_rocket`
+(Radau degree 3):
+
+* the collocated objective can *beat* the true optimum (N = 20: 1.0128648 against
+  1.0128369; a collocation solution is not a feasible trajectory), while the control
+  re-simulated by `Solution.propagate` achieves 1.0128174 (`Solution.simulated_cost`, the
+  value to trust: it is what the control does);
+* `ocp.refine` cannot drive its error estimate down (4.2e-2, 9.1e-3, 7.7e-3 on 20, 39, 70
+  intervals, where a smooth problem gains 16x per round) and stops with status
+  ``'Refinement_Stalled'`` after two rounds, the re-simulated cost then 1.0128361.
+
+The remedy is a small regularization of the control, here ``regularization * integral
+thrust^2 dt`` subtracted from the maximized altitude (penalized with the sign of the
+optimization): the Hamiltonian becomes strictly concave in the thrust, the control
+continuous, and `ocp.refine` converges. It changes the optimum by a measured amount:
+with ``regularization = 1e-4`` refine(tol=1e-6) converges in 3 rounds (62 intervals), the
+re-simulated altitude 1.0128361 is 7.7e-7 below the singular optimum and agrees with the
+collocated one to 4e-8 (the penalty ``eps * integral thrust^2 dt`` is 5.6e-5); with 1e-3 the
+altitude is 1.0128227 (1.4e-5 below), with 3e-4 1.0128345 (2.5e-6 below). Smaller weights
+sharpen the junctions and take more rounds (1e-5: 8). The altitude of a regularized
+solution is ``sol.propagation.x[0, -1]`` (re-simulated) or ``sol["h"][-1]``; ``sol.cost``
+includes the penalty. The exact alternative imposes the structure (phases bang / singular /
+coast, the singular control law on the middle one), as the tests do to compute the optimum.
+
 Examples
 --------
 >>> import ocp
@@ -20,13 +59,17 @@ Examples
 """
 from __future__ import annotations
 
+import math
+import numbers
+from types import MappingProxyType
+
 import casadi as ca
 
 from dynamics.model import Model
 
 from .problem import Problem
 
-__all__ = ["double_integrator", "min_energy", "min_time"]
+__all__ = ["double_integrator", "min_energy", "min_time", "goddard_rocket", "GODDARD_OPTIMUM"]
 
 
 def double_integrator() -> Model:
@@ -74,3 +117,86 @@ def min_time(distance: float = 1.0, u_max: float = 1.0, T_max: float = 10.0) -> 
     return Problem(double_integrator(), T=(0.1, float(T_max)), x_initial=[0.0, 0.0],
                    x_final=[float(distance), 0.0], u_bounds={"u": (-u_max, u_max)},
                    mayer=lambda xf, p, T: T, name="double integrator, minimum time")
+
+
+#: The Goddard rocket's optimal final altitude and time (normalized units, `goddard_rocket`
+#: with ``regularization = 0``): from the bang / singular / coast structure integrated to
+#: 1e-13 (the module docstring); COPS 3.0 reports ``h(tf) = 1.01283``.
+GODDARD_OPTIMUM = MappingProxyType({"h_f": 1.0128369183, "T": 0.1988562621})
+
+
+def _goddard_model() -> Model:
+    h0, g0, m0, c = 1.0, 1.0, 1.0, 0.5  # c = 0.5 sqrt(g0 h0)
+    Dc, hc = 0.5 * 620.0 * m0 / g0, 500.0  # Dc = 0.5 vc m0 / g0, vc = 620
+    x, u, p = ca.SX.sym("x", 3), ca.SX.sym("thrust"), ca.SX.sym("p", 0)
+    h, v, m = x[0], x[1], x[2]
+    drag = Dc * v ** 2 * ca.exp(-hc * (h - h0) / h0)
+    gravity = g0 * (h0 / h) ** 2
+    f = ca.Function("goddard_rocket", [x, u, p],
+                    [ca.vertcat(v, (u - drag) / m - gravity, -u / c)], ["x", "u", "p"], ["xdot"])
+    return Model(f, ("h", "v", "m"), ("thrust",), name="goddard_rocket",
+                 units={"h": "h0", "v": "sqrt(g0 h0)", "m": "m0", "thrust": "g0 m0"})
+
+
+_GODDARD = _goddard_model()
+
+
+def goddard_rocket(regularization: float = 0.0) -> Problem:
+    """Goddard rocket, maximum final altitude (COPS 3.0 / Betts, normalized units).
+
+    States ``h`` (altitude [h0]), ``v`` (velocity [sqrt(g0 h0)]), ``m`` (mass [m0]); control
+    ``thrust`` [g0 m0] in ``[0, 3.5]``; free horizon ``T`` in ``[0.1, 1]`` [sqrt(h0/g0)]::
+
+        h' = v,  v' = (thrust - D(h, v)) / m - g(h),  m' = -thrust / c,
+        D = Dc v^2 exp(-hc (h - h0) / h0),  g = g0 (h0 / h)^2,
+
+    with ``h0 = g0 = m0 = 1``, ``c = 0.5 sqrt(g0 h0)``, ``Dc = 0.5 vc m0 / g0``, ``vc = 620``,
+    ``hc = 500``; from ``(h, v, m) = (1, 0, 1)`` to a final mass ``0.6 m0``, ``h >= 1``,
+    ``v >= 0``, ``0.6 <= m <= 1``. Maximizes ``J = h(T) - regularization * integral
+    thrust^2 dt`` (``maximize=True``: `Solution.cost` is ``J`` itself).
+
+    The optimal thrust has a singular arc (module docstring): without regularization
+    `ocp.refine` stalls (status ``'Refinement_Stalled'``) and the re-simulated cost
+    `Solution.simulated_cost` is the number to trust; a small ``regularization`` (1e-4:
+    the re-simulated altitude 7.7e-7 below the optimum) lets refinement converge.
+
+    Parameters
+    ----------
+    regularization : float, optional
+        Weight ``eps >= 0`` of the penalty ``eps * integral thrust^2 dt`` [h0 / (g0^2 m0^2
+        sqrt(h0/g0))]; 0 (default) is the original problem.
+
+    Returns
+    -------
+    ocp.Problem
+        Optimum ``h(tf) = 1.0128369183`` at ``tf = 0.1988562621`` for ``regularization = 0``
+        (`GODDARD_OPTIMUM`).
+
+    Raises
+    ------
+    ValueError
+        If ``regularization`` is negative or not finite.
+    TypeError
+        If ``regularization`` is not a real number.
+
+    Examples
+    --------
+    >>> import ocp
+    >>> from ocp.examples import goddard_rocket, GODDARD_OPTIMUM
+    >>> sol = ocp.solve(goddard_rocket(), N=20)
+    >>> sol.success, round(sol.cost, 5), round(sol.simulated_cost, 5), GODDARD_OPTIMUM["h_f"]
+    (True, 1.01286, 1.01282, 1.0128369183)
+    """
+    if isinstance(regularization, bool) or not isinstance(regularization, numbers.Real):
+        raise TypeError(f"`regularization` must be a real number, got {type(regularization).__name__}")
+    eps = float(regularization)
+    if not (math.isfinite(eps) and eps >= 0.0):
+        raise ValueError(f"`regularization` must be finite and >= 0, got {regularization!r}")
+    kw = {}
+    if eps > 0.0:
+        kw["lagrange"] = lambda x, u, p: -eps * u[0] ** 2
+    name = "Goddard rocket, maximum altitude" + (f", regularized {eps:g}" if eps > 0.0 else "")
+    return Problem(_GODDARD, T=(0.1, 1.0), x_initial=[1.0, 0.0, 1.0], x_final={"m": 0.6},
+                   x_bounds={"h": (1.0, None), "v": (0.0, None), "m": (0.6, 1.0)},
+                   u_bounds={"thrust": (0.0, 3.5)}, mayer=lambda xf, p, T: xf[0],
+                   maximize=True, name=name, **kw)

@@ -5,116 +5,18 @@ from dataclasses import dataclass, field
 from functools import cached_property
 from typing import Mapping
 
-import casadi as ca
 import numpy as np
 
 from dynamics.attitude import quat_conj, quat_mul
 from dynamics.figures import finish_figure, new_figure
 from dynamics.serialize import text_table, to_json
 
-from .cached import cached, function_key
+from .dense import DenseOutput
+from .propagation import (SCALE_FLOOR, Propagation, interval_integrator, propagate,
+                          stack_interval_controls, state_scale)
 
-__all__ = ["Solution", "Propagation", "DenseOutput", "interval_integrator", "stack_interval_controls"]
-
-
-@dataclass(frozen=True)
-class Propagation:
-    """Re-simulation of a solution's control (see `Solution.propagate`).
-
-    Attributes
-    ----------
-    t : ndarray, shape (n,) [s]
-        The solution's node times.
-    x : ndarray, shape (nx, n)
-        States integrated from ``x[:, 0]`` of the solution under its dense control.
-    error : ndarray, shape (nx,)
-        Largest ``|x_propagated - x_collocated|`` of each state over the nodes [state units]
-        (NaN after a failure).
-    success : bool
-    message : str
-    """
-
-    t: np.ndarray
-    x: np.ndarray
-    error: np.ndarray
-    success: bool
-    message: str
-
-
-class DenseOutput:
-    """Interval data of a solution and the transcription's interpolant (its dense output).
-
-    Attributes
-    ----------
-    xs : ndarray, shape (nx, N)
-        State at each interval start.
-    Xo : ndarray, shape (nx, N, m_x)
-        States at the interval's own state nodes.
-    us : ndarray, shape (nu, N)
-        Control at each interval start (zeros when the transcription has none there).
-    Uo : ndarray, shape (nu, N, m_u)
-        Controls at the interval's own control nodes.
-    p : ndarray, shape (np,)
-    h : ndarray, shape (N,) [s]
-        Interval lengths.
-    t_breaks : ndarray, shape (N + 1,) [s]
-        Mesh points in time.
-    """
-
-    def __init__(self, transcription, mesh, model, X, U, p, T, t0):
-        N = mesh.N
-        tr = transcription
-        m_x, m_u = tr.x_sigma.size, tr.u_sigma.size
-        self.transcription, self.mesh, self.model = tr, mesh, model
-        self.nx, self.nu, self.N, self.m_x, self.m_u = model.nx, model.nu, N, m_x, m_u
-        self.xs = X[:, 0:N * m_x:m_x]
-        self.Xo = X[:, 1:].reshape(model.nx, N, m_x)
-        if tr.u_at_start:
-            self.us, Uo = U[:, 0:N * m_u:m_u], U[:, 1:]
-        else:
-            self.us, Uo = np.zeros((model.nu, N)), U
-        self.Uo = Uo.reshape(model.nu, N, m_u)
-        self.p = p
-        self.h = T * mesh.fractions
-        self.t_breaks = t0 + T * mesh.breaks
-        self.t_breaks[-1] = t0 + T
-        self._interp = tr.interpolant(model.f)
-
-    @property
-    def interp(self) -> ca.Function:
-        """The transcription's interpolant Function (`Transcription.interpolant`; rebuilt on
-        first use after unpickling, from the cache when present)."""
-        fun = self._interp
-        if fun is None:
-            fun = self._interp = self.transcription.interpolant(self.model.f)
-        return fun
-
-    def __getstate__(self) -> dict:
-        state = dict(self.__dict__)
-        state["_interp"] = None  # a cached CasADi Function: rebuilt on load
-        return state
-
-    def __setstate__(self, state: dict) -> None:
-        self.__dict__.update(state)
-
-    def eval(self, k: np.ndarray, s: np.ndarray):
-        """``(x (nx, M), u (nu, M))`` in intervals ``k`` at ``sigma = s``."""
-        M = k.size
-        if M == 0:
-            return np.zeros((self.nx, 0)), np.zeros((self.nu, 0))
-        args = [self.xs[:, k], self.Xo[:, k, :].reshape(self.nx, M * self.m_x),
-                self.us[:, k], self.Uo[:, k, :].reshape(self.nu, M * self.m_u),
-                self.h[k][None, :], self.p[:, None], s[None, :]]
-        fun = self.interp.map(M, [False] * 5 + [True, False], [False, False]) if M > 1 else self.interp
-        x, u = fun(*args)
-        return np.asarray(x).reshape(self.nx, M), np.asarray(u).reshape(self.nu, M)
-
-    def locate(self, t: np.ndarray):
-        """Interval index (intervals are ``(t_k, t_k+1]``, ``t0`` in the first) and sigma."""
-        k = np.clip(np.searchsorted(self.t_breaks, t, side="left") - 1, 0, self.N - 1)
-        h = self.h[k]
-        s = np.divide(t - self.t_breaks[k], h, out=np.zeros(np.shape(t)), where=h > 0)
-        return k, np.clip(s, 0.0, 1.0)
+__all__ = ["Solution", "Propagation", "DenseOutput", "interval_integrator", "stack_interval_controls",
+           "state_scale", "SCALE_FLOOR"]
 
 
 @dataclass(eq=False)
@@ -123,9 +25,15 @@ class Solution:
 
     Build one from arrays with `Solution.from_arrays` (drivers that solve a restated
     problem, e.g. `ocp.polish_switches`). The re-simulation `propagation` (and what derives
-    from it: `propagation_error`, `pointing_error`, `terminal_error`) is computed on first
-    use and cached on the instance (``functools.cached_property``); treat the fields as
-    read-only (the arrays are).
+    from it: `simulated_cost`, `propagation_errors`, `propagation_error`, `pointing_error`,
+    `terminal_error`; also ``str()`` and `to_dict`) is computed on first use and cached on
+    the instance (``functools.cached_property``); treat the fields as read-only (the arrays
+    are).
+
+    Which numbers to trust: `cost` is the collocated objective, `simulated_cost` the one the
+    returned control achieves when re-simulated; they agree on a resolved solution. Judge
+    the trajectory by `propagation_errors` (per state, absolute and relative to the state's
+    magnitude), not by the mixed-unit `propagation_error`.
 
     Attributes
     ----------
@@ -148,6 +56,8 @@ class Solution:
     cost : float
         Objective ``phi + integral L`` of the discrete solution (unscaled), with the user's
         sign: the maximized value for a ``maximize`` problem (compare with `Problem.better`).
+        The *collocated* value: on unresolved solutions (singular arcs, smeared switches) it
+        can beat the true optimum; compare `simulated_cost`.
     t : ndarray, shape (n,) [s]
         Node times: ``t0`` and every state or control node of the transcription.
     x : ndarray, shape (nx, n)
@@ -233,8 +143,13 @@ class Solution:
                 f"iterations={self.iterations}, solve_time={self.solve_time:.3g} s)")
 
     def __str__(self) -> str:
+        sim = self.simulated_cost
+        errs = self.propagation_errors
         rows = [("success", f"{self.success} ({self.status})"),
-                ("cost", f"{self.cost:.10g}"),
+                ("cost (collocated)", f"{self.cost:.10g}"),
+                ("cost (re-simulated)", f"{sim:.10g} (re-simulated - collocated: "
+                                        f"{sim - self.cost:.3g})"),
+                ("propagation error (scaled)", _worst_state(errs)),
                 ("T [s]", f"{self.T:.10g}"),
                 ("mesh", f"{self.transcription.name}, N = {self.mesh.N}"),
                 ("constraint violation", f"{self.constraint_violation:.3g}"),
@@ -284,11 +199,19 @@ class Solution:
 
     def to_dict(self) -> dict:
         """Summary and trajectories as plain Python (``x``, ``u`` by name at the nodes ``t``);
-        JSON-ready through `to_json`. The re-simulation is not run for it."""
+        JSON-ready through `to_json`.
+
+        Besides the fields, ``'simulated_cost'`` (`simulated_cost`) and
+        ``'propagation_errors'`` (`propagation_errors`: ``{state: {'absolute': ...,
+        'scaled': ...}}``) from the re-simulation, which is run (once, `propagation`) for it.
+        """
         model = self.problem.model
+        errs = self.propagation_errors
         return {
             "success": bool(self.success), "status": self.status, "message": self.message,
-            "cost": self.cost, "T": self.T, "t0": self.t0,
+            "cost": self.cost, "simulated_cost": self.simulated_cost,
+            "propagation_errors": {k: {"absolute": a, "scaled": r} for k, (a, r) in errs.items()},
+            "T": self.T, "t0": self.t0,
             "constraint_violation": self.constraint_violation,
             "transcription": self.transcription.name, "N": int(self.mesh.N),
             "iterations": int(self.iterations), "solve_time": self.solve_time,
@@ -471,6 +394,11 @@ class Solution:
         error is typically 10-100x larger, still far below the collocation errors this is
         meant to reveal.
 
+        The running cost ``L`` (``problem.lagrange``) is integrated along as a CVODES
+        quadrature and the terminal cost ``phi`` (``problem.mayer``) is evaluated at the
+        re-simulated final state: `Propagation.cost` is the objective the returned control
+        achieves, to compare with the collocated `cost` (`simulated_cost`).
+
         Parameters
         ----------
         rtol, atol : float
@@ -479,26 +407,24 @@ class Solution:
         Returns
         -------
         Propagation
-            ``success=False`` (with NaN states) if CVODES fails; never raises for that.
+            ``success=False`` (with NaN states and cost) if CVODES fails; never raises for
+            that.
+
+        Raises
+        ------
+        ValueError
+            If ``rtol`` or ``atol`` is not a float in (0, 1).
+
+        Examples
+        --------
+        >>> import ocp
+        >>> from ocp.examples import min_energy
+        >>> sol = ocp.solve(min_energy(), N=4)  # Bryson & Ho: J = 6
+        >>> prop = sol.propagate()
+        >>> prop.success, round(prop.cost, 8), bool(prop.relative_error.max() < 1e-9)
+        (True, 6.0, True)
         """
-        for name, v in (("rtol", rtol), ("atol", atol)):
-            if isinstance(v, bool) or not (isinstance(v, (int, float)) and 0 < v < 1):
-                raise ValueError(f"`{name}` must be a float in (0, 1), got {v!r}")
-        d = self.dense
-        nx = self.problem.model.nx
-        try:
-            run = _propagator(self, rtol, atol)
-            pars = np.concatenate([d.us, stack_interval_controls(d.Uo, np.arange(d.N)), d.h[None, :],
-                                   np.repeat(self.p[:, None], d.N, axis=1)], axis=0)
-            _, xall = run(self.x[:, 0], pars)
-            xp = np.concatenate([self.x[:, :1], np.asarray(xall)], axis=1)
-        except RuntimeError as exc:
-            nan = np.full((nx, self.t.size), np.nan)
-            return Propagation(self.t, nan, np.full(nx, np.nan), False, f"cvodes failed: {exc}")
-        if not np.all(np.isfinite(xp)):
-            return Propagation(self.t, xp, np.full(nx, np.nan), False, "cvodes: non-finite state")
-        err = np.max(np.abs(xp - self.x), axis=1)
-        return Propagation(self.t, xp, err, True, f"cvodes per mesh interval, rtol {rtol:g}, atol {atol:g}")
+        return propagate(self, rtol, atol)
 
     @cached_property
     def propagation(self) -> Propagation:
@@ -543,59 +469,61 @@ class Solution:
 
     @property
     def propagation_error(self) -> float:
-        """``max |x_propagated - x|`` over states and nodes [mixed state units], from
-        `propagate` with its default tolerances (computed on first access)."""
+        """``max |x_propagated - x|`` over states and nodes, from `propagate` with its default
+        tolerances (computed on first access).
+
+        The maximum is taken over states of *different units* (an error of 0.34 m on an
+        altitude of 1e5 m and one of 1e-3 rad/s on a rate are compared as numbers): use
+        `propagation_errors` (per state, absolute and relative to the state's magnitude) or
+        `Propagation.relative_error` to judge accuracy. 0.0 without states.
+        """
         err = self.propagation.error
         return float(np.max(err)) if err.size else 0.0
 
+    @property
+    def propagation_errors(self) -> dict:
+        """Per-state propagation error: ``{state name: (absolute, scaled)}``.
 
-def interval_integrator(sol: "Solution", grid, rtol: float, atol: float) -> ca.Function:
-    """CVODES over one mesh interval in normalized time ``s in [0, 1]`` under the solution's
-    own control polynomial, with outputs at the normalized times ``grid``.
+        ``absolute`` is ``max_n |x_sim,i(t_n) - x_i(t_n)|`` [state units] (`Propagation.error`),
+        ``scaled`` is that divided by the state's typical magnitude
+        ``max(max_n |x_i(t_n)|, SCALE_FLOOR)`` [-] (`Propagation.relative_error`; `SCALE_FLOOR`
+        = 1e-6 state units), so 0.34 m on a 1e5 m altitude reads 3.4e-6. Both NaN if the
+        re-simulation failed.
 
-    Inputs ``x0`` (nx,) and ``p`` = ``[u_start, vec(U_interval), h, p_model]``; output ``xf``
-    (nx, len(grid)). Shared by `Solution.propagate` and mesh refinement (`ocp.refine`);
-    built once per transcription, model right-hand side, grid and tolerances (`ocp.cached`).
-    """
-    tr, f = sol.transcription, sol.problem.model.f
-    grid = tuple(float(v) for v in grid)
-    return cached("interval_integrator", (tr, function_key(f), grid, float(rtol), float(atol)),
-                  lambda: _build_interval_integrator(sol, grid, rtol, atol), keepalive=f)
+        Returns
+        -------
+        dict of str to (float, float)
+        """
+        prop = self.propagation
+        rel = prop.relative_error
+        return {name: (float(prop.error[i]), float(rel[i]))
+                for i, name in enumerate(self.problem.model.states)}
 
+    @property
+    def simulated_cost(self) -> float:
+        """The objective achieved by re-simulating the returned control (`Propagation.cost`)
+        [cost units], with the user's sign like `cost`; NaN if the re-simulation failed.
 
-def _build_interval_integrator(sol, grid, rtol, atol):
-    d = sol.dense
-    model = sol.problem.model
-    nx, nu = model.nx, model.nu
-    sym = ca.SX if d.interp.is_a("SXFunction") else ca.MX
-    x, s = sym.sym("x", nx), sym.sym("s")
-    us, U = sym.sym("us", nu), sym.sym("U", nu, d.m_u)
-    h, p = sym.sym("h"), sym.sym("p", model.np)
-    _, u = d.interp(sym.zeros(nx), sym.zeros(nx, d.m_x), us, U, h, p, s)
-    data = ca.vertcat(us, ca.vec(U), h, p)
-    return ca.integrator("interval", "cvodes", {"x": x, "p": data, "t": s, "ode": h * model.f(x, u, p)},
-                         0.0, [float(v) for v in grid],
-                         {"abstol": atol, "reltol": rtol, "max_num_steps": 100000})
-
-
-def _propagator(sol: "Solution", rtol: float, atol: float) -> ca.Function:
-    """``(x0 (nx,), data (.., N)) -> (xf, x at the owned nodes of every interval)``: the
-    interval integrators chained by ``mapaccum`` over the ``N`` intervals (cached)."""
-    tr, f, N = sol.transcription, sol.problem.model.f, sol.dense.N
-
-    def build():
-        integ = interval_integrator(sol, tr.node_sigma, rtol, atol)
-        x0 = ca.MX.sym("x0", f.numel_in(0))
-        dat = ca.MX.sym("data", integ.numel_in("p"))
-        xs = integ(x0=x0, p=dat)["xf"]
-        return ca.Function("step", [x0, dat], [xs[:, -1], xs]).mapaccum("propagate", N)
-
-    return cached("propagator", (tr, function_key(f), N, float(rtol), float(atol)), build,
-                  keepalive=f)
+        `cost` is the collocated objective (the discrete NLP's value); this one integrates
+        the dynamics and the running cost of the dense control with CVODES from ``x(t0)``
+        and evaluates the terminal cost at the re-simulated final state. On a well
+        resolved solution the two agree to the discretization error; where they differ
+        (singular arcs, chattering, unresolved switches: the collocated cost may even beat
+        the true optimum) this is the value the returned control actually achieves, provided
+        the re-simulated trajectory still meets the constraints (`terminal_error`,
+        `propagation_errors`).
+        """
+        prop = self.propagation
+        return float(prop.cost) if prop.success else float("nan")
 
 
-def stack_interval_controls(Uo: np.ndarray, k: np.ndarray) -> np.ndarray:
-    """``vec(U_k)`` (column-major, as ``casadi.vec``) of intervals ``k``: shape (nu m_u, len(k))."""
-    nu, _, m_u = Uo.shape
-    blocks = Uo[:, k, :]  # (nu, K, m_u)
-    return blocks.transpose(2, 0, 1).reshape(m_u * nu, k.size)
+def _worst_state(errs: Mapping[str, tuple]) -> str:
+    """``'3.4e-06 (h; absolute 0.34)'``: the largest scaled propagation error and its state."""
+    if not errs:
+        return "none (no states)"
+    name, (ab, rel) = max(errs.items(), key=lambda kv: -np.inf if np.isnan(kv[1][1]) else kv[1][1])
+    if np.isnan(rel):
+        return "nan (re-simulation failed)"
+    return f"{rel:.3g} ({name}; absolute {ab:.3g})"
+
+

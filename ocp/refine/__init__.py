@@ -14,12 +14,12 @@ from __future__ import annotations
 
 from ..transcription import RadauConstantControl
 from .errors import IntervalErrors, interval_errors
-from .mesh_update import refine
+from .mesh_update import STATUS_STALLED, refine
 from .multistart import solve_multistart
 from .polish import polish_switches
 from .result import RefinedSolution, RefinementRound, annotate
 from .switches import control_switches, find_switches
 
-__all__ = ["refine", "solve_multistart", "polish_switches", "RefinedSolution", "RefinementRound",
+__all__ = ["refine", "STATUS_STALLED", "solve_multistart", "polish_switches", "RefinedSolution", "RefinementRound",
            "RadauConstantControl", "IntervalErrors", "interval_errors", "find_switches",
            "control_switches", "annotate"]

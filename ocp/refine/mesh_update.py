@@ -21,9 +21,12 @@ from ..transcription import Radau, Transcription, get_transcription
 from .errors import IntervalErrors, interval_errors
 from .result import RefinedSolution, RefinementRound, annotate
 
-__all__ = ["refine"]
+__all__ = ["refine", "STATUS_STALLED"]
 
 _BRACKET = 1.0 / 16.0  # width of the new switch interval relative to the old one
+
+#: `RefinedSolution.status` of a `refine` that stopped because its error estimate stalled.
+STATUS_STALLED = "Refinement_Stalled"
 
 
 def _local_order(tr: Transcription) -> int:
@@ -96,6 +99,38 @@ def _new_mesh(mesh: Mesh, est: IntervalErrors, T: float, t0: float, tol: float, 
     return Mesh(new)
 
 
+def _stalled(history: list, q: int, max_intervals: int, window: int) -> bool:
+    """Whether the error estimate stalled: over the last ``window`` rounds (each on a mesh
+    that grew and stayed below ``max_intervals``) the largest estimated error fell by less
+    than ``2**q``, the gain a single round makes on a smooth solution (see `refine`)."""
+    if len(history) < window + 1:
+        return False
+    last = history[-(window + 1):]
+    errors = [r.max_error for r in last]
+    sizes = [r.n_intervals for r in last]
+    if not all(np.isfinite(errors)):
+        return False
+    grew = all(b > a for a, b in zip(sizes, sizes[1:])) and sizes[-1] < max_intervals
+    return bool(grew and errors[-1] > errors[0] / 2.0 ** q)
+
+
+def _stall_message(history: list, q: int, window: int, sol: Solution) -> str:
+    errors = ", ".join(f"{r.max_error:.2e}" for r in history[-(window + 1):])
+    sizes = ", ".join(str(r.n_intervals) for r in history[-(window + 1):])
+    sim = sol.simulated_cost
+    return (f"refine: the error estimate stalled after {len(history) - 1} rounds ({errors} on "
+            f"{sizes} intervals: less than the factor 2^{q} = {2 ** q} in {window} rounds that "
+            f"one round gains on a smooth solution). This is typical of a singular arc or a "
+            f"non-smooth / chattering control, where collocation converges slowly and the "
+            f"collocated cost can beat the true optimum: trust the re-simulated cost "
+            f"{sim:.10g} (Solution.simulated_cost, what the returned control achieves) rather "
+            f"than the collocated cost {sol.cost:.10g}. Remedy: regularize the control (add "
+            f"eps * integral u^2 to the objective with the sign that penalizes it, or penalize "
+            f"control differences) and refine again, or impose the arc structure; see "
+            f"ocp.refine and ocp.examples.goddard_rocket (a tol below the NLP tolerance also "
+            f"stalls; stall_rounds=None refines on). {sol.message}")
+
+
 def _transcription(transcription, degree) -> Transcription:
     if isinstance(transcription, Transcription):
         return transcription
@@ -118,7 +153,7 @@ def _report(rnd: int, r: RefinementRound, verbose, progress) -> None:
 def refine(problem: Problem, solution: Solution | None = None, *, tol: float = 1e-6,
            max_rounds: int = 6, max_intervals: int = 400, transcription="radau",
            N: int | None = None, degree: int | None = None, verbose=False, progress=None,
-           **solve_kwargs) -> RefinedSolution:
+           stall_rounds: int | None = 2, **solve_kwargs) -> RefinedSolution:
     """Solve ``problem`` and refine the mesh until the estimated error is below ``tol``.
 
     Each round estimates the error of every interval (`interval_errors`: re-integration of
@@ -134,8 +169,35 @@ def refine(problem: Problem, solution: Solution | None = None, *, tol: float = 1
     * two neighbours with ``e 2^(q+1) <= 1e-3 tol`` and no switch are merged;
 
     and the problem is solved again on the new mesh, warm-started from the last solution.
-    It stops when the largest estimated error is ``<= tol``, after ``max_rounds`` rounds, when
-    the mesh would exceed ``max_intervals`` intervals, or when an NLP fails.
+    It stops when the largest estimated error is ``<= tol``, when the estimate stalls (below),
+    after ``max_rounds`` rounds, when the mesh would exceed ``max_intervals`` intervals, or
+    when an NLP fails.
+
+    *Stall.* Every interval above ``tol`` is cut into at least two pieces each round, which
+    gains a factor ``2**q`` in its error where the solution is smooth (a switch bracket gains
+    16). When over ``stall_rounds`` consecutive rounds (default 2), the mesh growing, the
+    largest estimated error falls by less than ``2**q`` in all (an observed order below
+    ``q / stall_rounds``), refinement stops with ``success=False``, status `STATUS_STALLED`
+    (``'Refinement_Stalled'``), ``info['stop'] == 'stalled'`` and a message saying so. This
+    is typical of *singular arcs* and of non-smooth or chattering controls (also of a ``tol``
+    below what the NLP tolerance resolves): the collocated control rings around the singular
+    value, the estimate creeps down (or plateaus and drops late) and more rounds mostly cost
+    time. On such a solution the collocated `Solution.cost` can even beat the true optimum;
+    trust the re-simulated `Solution.simulated_cost`, the objective the returned control
+    achieves (the message quotes both).
+
+    *Remedy for singular arcs.* Regularize the control: add a small ``eps * integral u^2``
+    to the objective with the sign that penalizes it (``- eps * u**2`` in ``lagrange`` when
+    maximizing), or penalize control differences; the Hamiltonian becomes strictly convex in
+    ``u``, the control continuous, and refinement converges. The optimum moves by a small,
+    measurable amount. Goddard rocket (`ocp.examples.goddard_rocket`, singular optimum
+    ``h(tf) = 1.0128369``): unregularized, ``refine(tol=1e-6)`` stalls after 2 rounds (errors
+    4.2e-2, 9.1e-3, 7.7e-3 on 20, 39, 70 intervals; collocated cost 1.0128424, re-simulated
+    1.0128361); with ``eps = 1e-4`` it converges in 3 rounds (62 intervals) to a re-simulated
+    altitude 1.0128361, 7.7e-7 below the singular optimum; ``eps = 1e-3`` costs 1.4e-5 of
+    altitude. Smaller ``eps`` sharpens the junctions and needs more rounds (``1e-5``: 8
+    rounds, with ``stall_rounds=None, max_rounds=8``). The exact alternative imposes the arc
+    structure (phases with the singular control law).
 
     Parameters
     ----------
@@ -160,6 +222,12 @@ def refine(problem: Problem, solution: Solution | None = None, *, tol: float = 1
         Receives each `RefinementRound` as it completes (IPOPT iterations are not passed
         on; give ``verbose`` a callable for those). Each round is also logged (INFO) to the
         logger ``"appdyn.ocp"``.
+    stall_rounds : int or None
+        Window of the stall test (above): stop when the largest error fell by less than
+        ``2**q`` over this many consecutive rounds (default 2); ``None`` never stops for a
+        stall (a pre-asymptotic plateau can end late: unregularized Goddard, given
+        ``max_rounds=9``, reaches 1e-6 after 9 rounds on 304 intervals, its estimate
+        erratic on the way: 1.5e-3, 1.2e-4, 9.0e-4, 8.3e-7 in the last four).
     **solve_kwargs
         Passed to `ocp.solve` (``ipopt_options``, ``scale``, ``expand``; ``guess`` and
         ``mesh`` for the initial solve only).
@@ -172,7 +240,17 @@ def refine(problem: Problem, solution: Solution | None = None, *, tol: float = 1
         solved, and ``info['converged']``, ``info['errors']``, ``info['meshes']``,
         ``info['stop']``. ``success`` is that of the last NLP (its message says so); not
         reaching ``tol`` within the limits keeps ``success=True`` with
-        ``info['converged'] = False`` and a note in the message.
+        ``info['converged'] = False`` and a note in the message; a stalled estimate gives
+        ``success=False``, status `STATUS_STALLED` and ``info['stop'] = 'stalled'``.
+
+    Raises
+    ------
+    TypeError
+        If ``problem`` is not a `Problem`, ``solution`` not a `Solution`, or ``progress``
+        not callable.
+    ValueError
+        Naming the argument: ``tol`` not positive, ``max_rounds`` < 0, ``max_intervals`` or
+        ``stall_rounds`` < 1.
 
     Examples
     --------
@@ -183,6 +261,16 @@ def refine(problem: Problem, solution: Solution | None = None, *, tol: float = 1
     >>> sol = ocp.refine(energy, first, tol=1e-8)
     >>> sol.success, sol.info["converged"], round(sol.cost, 6)
     (True, True, 6.0)
+
+    A singular arc stalls; a small regularization converges:
+
+    >>> from ocp.examples import goddard_rocket
+    >>> rocket = ocp.refine(goddard_rocket(), tol=1e-6)
+    >>> rocket.status, rocket.info["stop"], len(rocket.refinement) - 1
+    ('Refinement_Stalled', 'stalled', 2)
+    >>> smooth = ocp.refine(goddard_rocket(regularization=1e-4), tol=1e-6)
+    >>> smooth.success, smooth.info["converged"], round(float(smooth.propagation.x[0, -1]), 6)
+    (True, True, 1.012836)
     """
     if not isinstance(problem, Problem):
         raise TypeError(f"`problem` must be an ocp.Problem, got {type(problem).__name__}")
@@ -191,6 +279,8 @@ def refine(problem: Problem, solution: Solution | None = None, *, tol: float = 1
     positive(tol, "tol")
     max_rounds = integer(max_rounds, "max_rounds", minimum=0)
     max_intervals = integer(max_intervals, "max_intervals", minimum=1)
+    if stall_rounds is not None:
+        stall_rounds = integer(stall_rounds, "stall_rounds", minimum=1)
     if progress is not None and not callable(progress):
         raise TypeError(f"`progress` must be a callable or None, got {type(progress).__name__}")
     kw = dict(solve_kwargs)
@@ -233,6 +323,9 @@ def refine(problem: Problem, solution: Solution | None = None, *, tol: float = 1
         if est.max_error <= tol:
             stop = "tolerance reached"
             break
+        if stall_rounds is not None and _stalled(history, q, max_intervals, stall_rounds):
+            stop = "stalled"
+            break
         if rnd == max_rounds:
             stop = f"max_rounds = {max_rounds} reached"
             break
@@ -253,4 +346,7 @@ def refine(problem: Problem, solution: Solution | None = None, *, tol: float = 1
                    f"{sol.mesh.N} intervals; {sol.message}")
     info = {"refinement": history, "converged": bool(converged), "errors": est, "meshes": meshes,
             "tol": tol, "stop": stop}
+    if stop == "stalled" and sol.success:
+        return annotate(sol, info, success=False, status=STATUS_STALLED,
+                        message=_stall_message(history, q, stall_rounds, sol))
     return annotate(sol, info, message=message)

@@ -46,7 +46,10 @@ class RefinedSolution(Solution):
         What the driver did. `refine`: ``'refinement'`` (list of `RefinementRound`, one per
         NLP solved, first the initial one), ``'converged'`` (max error <= tol), ``'errors'``
         (the final `IntervalErrors`), ``'meshes'`` (the mesh of each round),
-        ``'tol'``, ``'stop'`` (why it stopped). `solve_multistart`: ``'starts'`` (list of
+        ``'tol'``, ``'stop'`` (why it stopped: ``'tolerance reached'``, ``'stalled'`` (the
+        error estimate stopped falling, status ``'Refinement_Stalled'``, see `refine`),
+        ``'max_rounds = ... reached'``, ``'max_intervals = ... reached'``, ``'the NLP of
+        round ... failed'``). `solve_multistart`: ``'starts'`` (list of
         dicts with ``index, success, status, cost, T, constraint_violation, iterations,
         time``) and ``'best'`` (index of the start returned). `polish_switches`:
         ``'switch_times'`` (knots where the control jumps), ``'initial_switch_times'``,
