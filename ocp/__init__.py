@@ -21,8 +21,9 @@ from .guess import guess_from_simulation
 from .mesh import Mesh
 from .problem import Constraint, Problem
 from .ipopt_options import check_ipopt_options, ipopt_option_table
-from .refine import (STATUS_STALLED, IntervalErrors, RefinedSolution, RefinementRound, annotate, control_switches,
-                     find_switches, interval_errors, polish_switches, refine, solve_multistart)
+from .refine import (STATUS_STALLED, BangArcs, IntervalErrors, RefinedSolution, RefinementRound,
+                     annotate, bang_arcs, control_switches, find_switches, interval_errors,
+                     optimize_switch_times, polish_switches, refine, solve_multistart)
 from .scaling import Scaling
 from .progress import LOGGER
 from .propagation import SCALE_FLOOR, state_scale
@@ -68,6 +69,9 @@ __all__ = [
     "control_switches",
     "guess_from_simulation",
     "STATUS_STALLED",
+    "optimize_switch_times",
+    "bang_arcs",
+    "BangArcs",
     "SCALE_FLOOR",
     "state_scale",
 ]

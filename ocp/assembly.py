@@ -44,6 +44,8 @@ import scipy.sparse as sps
 
 from dynamics.attitude import quat_conj, quat_mul
 
+from dynamics.cache import compile_function, compiler
+
 from .cached import function_key
 from .layout import Layout
 from .transcription import sx_compatible
@@ -68,10 +70,10 @@ def _functions(problem) -> list:
             *[c.fun for c in problem.path], *[c.fun for c in problem.boundary]]
 
 
-def structure_key(problem, transcription, N: int, expand: bool) -> tuple:
+def structure_key(problem, transcription, N: int, expand: bool, codegen: bool = False) -> tuple:
     """What determines a `Structure`: see the module docstring."""
     model = problem.model
-    return (transcription, int(N), bool(expand), content_key(model.f), content_key(problem.lagrange),
+    return (transcription, int(N), bool(expand), bool(codegen), content_key(model.f), content_key(problem.lagrange),
             content_key(problem.mayer), tuple((content_key(c.fun), c.size) for c in problem.path),
             tuple((content_key(c.fun), c.size) for c in problem.boundary),
             tuple(problem.free_params.tolist()), problem.free_time, problem.quaternion_norm_at_t0,
@@ -150,6 +152,10 @@ class Structure:
     expand : bool
         Build the interval functions in SX when every function allows it (faster
         evaluation); MX otherwise.
+    codegen : bool, optional
+        Compile the (SX) interval functions and their derivatives to C
+        (`dynamics.cache.compile_function`; about 1-3 s once per structure, then kept in the
+        cache with it). Ignored without a C compiler or for MX interval functions.
 
     Attributes
     ----------
@@ -163,7 +169,7 @@ class Structure:
         ``grad_f``, ``jac_g``, ``hess_lag`` Functions for the nlpsol options of those names.
     """
 
-    def __init__(self, problem, transcription, N: int, expand: bool = True):
+    def __init__(self, problem, transcription, N: int, expand: bool = True, codegen: bool = False):
         model, tr = problem.model, transcription
         nx, nu, np_ = model.nx, model.nu, model.np
         self.N, self.transcription = N, tr
@@ -263,15 +269,19 @@ class Structure:
         v_seg, v_end = ca.vertcat(z, s), ca.vertcat(e, s)
         lam_seg, lam_end, lam_f = sym.sym("lam", n_seg), sym.sym("lam", n_end), sym.sym("lam_f")
 
+        self.compiled = bool(codegen and sx_ok and compiler() is not None)
+
         def local(name, ins, rows_, q, v, lam):
             J = ca.jacobian(rows_, v)
             gq = ca.jacobian(q, v)
             H = ca.triu(ca.hessian(lam_f * q + ca.dot(lam, rows_), v)[0])
-            return (ca.Function(f"{name}_val", ins, [rows_, q]),
+            funs = (ca.Function(f"{name}_val", ins, [rows_, q]),
                     ca.Function(f"{name}_grad", ins, [q, _nonzeros(gq)]),
                     ca.Function(f"{name}_jac", ins, [rows_, _nonzeros(J)]),
-                    ca.Function(f"{name}_hess", ins + [lam, lam_f], [_nonzeros(H)]),
-                    _triplets(J), _triplets(gq), _triplets(H))
+                    ca.Function(f"{name}_hess", ins + [lam, lam_f], [_nonzeros(H)]))
+            if self.compiled:  # the derivatives; the values stay SX (IPOPT's nlp_grad differentiates them)
+                funs = (funs[0], *(compile_function(fn) for fn in funs[1:]))
+            return (*funs, _triplets(J), _triplets(gq), _triplets(H))
 
         seg_f = local("seg", seg_in, seg_rows, seg_q, v_seg, lam_seg)
         end_f = local("ends", end_in, end_rows, end_q, v_end, lam_end)

@@ -27,18 +27,18 @@ from .cached import cached
 __all__ = ["Discretization", "structure"]
 
 
-def structure(problem, transcription, N: int, expand: bool = True) -> Structure:
+def structure(problem, transcription, N: int, expand: bool = True, codegen: bool = False) -> Structure:
     """The `Structure` of ``problem`` transcribed by ``transcription`` on ``N`` intervals,
     from the one cache (built on a miss; in MX when SX construction fails)."""
     def build():
         try:
-            return Structure(problem, transcription, N, expand)
+            return Structure(problem, transcription, N, expand, codegen)
         except RuntimeError:
             if not expand:
                 raise
             return Structure(problem, transcription, N, False)
 
-    return cached("nlp_structure", structure_key(problem, transcription, N, expand), build,
+    return cached("nlp_structure", structure_key(problem, transcription, N, expand, codegen), build,
                   keepalive=tuple(f for f in _functions(problem) if f is not None))
 
 
@@ -53,6 +53,8 @@ class Discretization:
     scaling : ocp.scaling.Scaling
     expand : bool, optional
         Interval functions in SX when possible (default); see `ocp.assembly`.
+    codegen : bool, optional
+        Compile the interval functions to C (`ocp.assembly.Structure`).
 
     Attributes
     ----------
@@ -71,10 +73,10 @@ class Discretization:
         Bounds of the scaled variables and constraints.
     """
 
-    def __init__(self, problem, transcription, mesh, scaling, expand: bool = True):
+    def __init__(self, problem, transcription, mesh, scaling, expand: bool = True, codegen: bool = False):
         self.problem, self.transcription, self.mesh, self.scaling = problem, transcription, mesh, scaling
-        self.key = structure_key(problem, transcription, mesh.N, expand)
-        st = self.structure = structure(problem, transcription, mesh.N, expand)
+        self.key = structure_key(problem, transcription, mesh.N, expand, codegen)
+        st = self.structure = structure(problem, transcription, mesh.N, expand, codegen)
         self.w, self.g, self.nlp = st.w, st.g, st.nlp
         self.P = st.params_value(problem, mesh, scaling)
         free, sc = problem.free_params, scaling

@@ -157,7 +157,7 @@ def _default_guess_hint(problem: Problem, node_guess) -> str:
 def solve(problem: Problem, *, transcription="radau", N: int | None = None, degree: int | None = None,
           mesh=None, guess=None, scale: Mapping | None = None, verbose=False,
           progress=None, ipopt_options: Mapping | None = None, expand: bool = True,
-          constraint_tol: float | None = None) -> Solution:
+          constraint_tol: float | None = None, codegen: bool = False) -> Solution:
     """Solve ``problem`` by direct collocation and IPOPT.
 
     Parameters
@@ -203,7 +203,11 @@ def solve(problem: Problem, *, transcription="radau", N: int | None = None, degr
         Build the per-interval functions in SX (default; faster evaluation), falling back
         to MX when a function cannot be expanded (e.g. it holds an integrator);
         ``expand=False`` keeps them in MX (module docstring).
-    constraint_tol : float, optional
+    codegen : bool, optional
+        Compile the interval functions and their derivatives to C once per structure (kept
+        in the cache with it): for solvers that will be reused many times on models whose
+        evaluation dominates an iteration. ``False`` (default) when IPOPT's own linear
+        algebra dominates, as on the slews of `problems.slew` (module docstring).    constraint_tol : float, optional
         Largest `Solution.constraint_violation` (NLP units, see the module docstring) of a
         successful result; default `DEFAULT_CONSTRAINT_TOL` = 1e-6.
 
@@ -239,15 +243,16 @@ def solve(problem: Problem, *, transcription="radau", N: int | None = None, degr
     tr = get_transcription(transcription, degree)
     m = _mesh(N, mesh)
     sink = iteration_sink(verbose, progress)
-    if expand not in (True, False):
-        raise ValueError(f"`expand` must be True or False, got {expand!r}")
+    for name, flag in (("expand", expand), ("codegen", codegen)):
+        if flag not in (True, False):
+            raise ValueError(f"`{name}` must be True or False, got {flag!r}")
     ctol = _check_constraint_tol(constraint_tol)
     opts = _ipopt_options(ipopt_options, ctol)
 
     t_build = time.perf_counter()
     node_guess = initial_guess(problem, tr, m, guess)
     scaling = auto_scaling(problem, node_guess, scale)
-    disc = Discretization(problem, tr, m, scaling, expand)  # its structure comes from the cache
+    disc = Discretization(problem, tr, m, scaling, expand, codegen)  # structure from the cache
     warm = _warm_point(guess, disc)
     if warm is not None:
         opts = {**WARM_START_OPTIONS, **opts, **check_ipopt_options(ipopt_options)}

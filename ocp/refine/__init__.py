@@ -5,7 +5,10 @@
   estimate of `interval_errors` (`errors`): re-integration defects, plus the state
   increment a smeared bang-bang switch misses.
 * `solve_multistart` (`multistart`) — solve from several guesses, keep the best.
-* `polish_switches` (`polish`) — moving knots: switch times exactly on free mesh points.
+* `polish_switches` (`polish`) — exact switch times of a bang-bang solution: the arc
+  durations solved for directly (`optimize_switch_times` in `switch_times`, structure from
+  `bang_arcs` in `arcs`, RK8 steps from `rk8_step`), else moving knots (switch times on
+  free mesh points).
 
 `find_switches` / `control_switches` (`switches`) are the engine's one switch detector;
 `RefinedSolution`, `RefinementRound` and `annotate` live in `result`.
@@ -19,7 +22,9 @@ from .multistart import solve_multistart
 from .polish import polish_switches
 from .result import RefinedSolution, RefinementRound, annotate
 from .switches import control_switches, find_switches
+from .arcs import BangArcs, bang_arcs
+from .switch_times import optimize_switch_times
 
-__all__ = ["refine", "STATUS_STALLED", "solve_multistart", "polish_switches", "RefinedSolution", "RefinementRound",
+__all__ = ["refine", "optimize_switch_times", "bang_arcs", "BangArcs", "STATUS_STALLED", "solve_multistart", "polish_switches", "RefinedSolution", "RefinementRound",
            "RadauConstantControl", "IntervalErrors", "interval_errors", "find_switches",
            "control_switches", "annotate"]

@@ -1,7 +1,16 @@
-"""`polish_switches`: moving knots for bang-bang / time-optimal problems.
+"""`polish_switches`: exact switch times for bang-bang / time-optimal problems.
 
-A re-solve with a piecewise-constant control (`ocp.RadauConstantControl`) on a *free* mesh
-whose interval lengths are decision variables, so switch times land exactly on knots: the
+Two methods. ``'switch-times'`` (`ocp.refine.switch_times`): when every control component is
+bang-bang on every arc of the starting solution (`bang_arcs`), the arc durations are the only
+decision variables, the control held at its bang value on each arc, the arcs integrated by
+fixed-step RK8 multiple shooting with exact sensitivities -- a small well-posed NLP that IPOPT
+solves in a handful of iterations. ``'moving-knots'`` (below) handles everything else
+(singular, coast and constrained arcs); ``'auto'`` (the default) tries the first and falls
+back to the second.
+
+The moving-knot polish is a re-solve with a piecewise-constant control
+(`ocp.RadauConstantControl`) on a *free* mesh whose interval lengths are decision
+variables, so switch times land exactly on knots: the
 switching structure no longer costs accuracy (on a fixed mesh a switch inside an interval of
 length ``h`` leaves an ``O(h^2)`` error in ``T``).
 
@@ -36,9 +45,12 @@ from ..solution import Solution
 from ..solve import solve
 from ..transcription import RadauConstantControl, sx_compatible
 from .result import RefinedSolution, annotate
+from .switch_times import bang_arcs, optimize_switch_times
 from .switches import find_switches
 
 __all__ = ["polish_switches"]
+
+METHODS = ("auto", "switch-times", "moving-knots")
 
 _STRICT = {"tol": 1e-10, "bound_relax_factor": 0.0, "max_iter": 3000}
 _CLOCK, _STRETCH = "t_clock", "t_stretch"
@@ -142,9 +154,22 @@ def _aligned_mesh(solution: Solution, N: int | None) -> tuple[Mesh, np.ndarray]:
 
 @interruptible
 def polish_switches(problem: Problem, solution: Solution, *, N: int | None = None, degree: int = 3,
-                    verbose=False, stretch=(0.05, 5.0), **solve_kwargs) -> RefinedSolution:
-    """Re-solve a bang-bang / time-optimal problem with moving knots.
+                    verbose=False, stretch=(0.05, 5.0), method: str = "auto",
+                    **solve_kwargs) -> RefinedSolution:
+    """Re-solve a bang-bang / time-optimal problem with exact switch times.
 
+    ``method='switch-times'``: when ``solution`` is bang-bang (`bang_arcs`: every control
+    component at a bound on every arc between switches), optimize the arc durations directly
+    (`ocp.refine.switch_times.optimize_switch_times`: the control fixed at its bang value per
+    arc, RK8 multiple shooting with exact sensitivities; a few IPOPT iterations, ``T`` to the
+    integration error, about 1e-12). ``method='moving-knots'``: the free-mesh re-solve
+    described below, which also handles singular, coast and constrained arcs.
+    ``method='auto'`` (default): switch times when the solution is bang-bang, else -- or
+    when that NLP fails, or ends with a cost worse than that of ``solution`` by more than
+    ``1e-3 max(1, |cost|)`` (a structure read wrongly) -- moving knots (``info['fallback']``
+    says why).
+
+    Moving knots:
     The control is constant within each mesh interval (`RadauConstantControl` of ``degree``)
     and the interval lengths are decision variables: ``h_k = v_k dsigma_k`` on a mesh
     ``dsigma`` of pseudo time, ``stretch[0] T0 <= v_k <= stretch[1] T0`` (``T0`` the horizon
@@ -170,6 +195,10 @@ def polish_switches(problem: Problem, solution: Solution, *, N: int | None = Non
         Passed to `ocp.solve`.
     stretch : (float, float)
         Bounds of the interval lengths relative to their initial lengths.
+    method : {'auto', 'switch-times', 'moving-knots'}
+        See above. ``'switch-times'`` raises ``ValueError`` when ``solution`` is not
+        bang-bang. The switch-time NLP reads ``N`` (its number of RK8 segments, when at
+        least 2 per arc), ``degree``, ``ipopt_options``, ``scale`` and ``constraint_tol``.
     **solve_kwargs
         Passed to `ocp.solve` (``ipopt_options`` is merged over the defaults
         ``{'tol': 1e-10, 'bound_relax_factor': 0, 'max_iter': 3000}``; ``scale`` may name the
@@ -179,10 +208,21 @@ def polish_switches(problem: Problem, solution: Solution, *, N: int | None = Non
     -------
     RefinedSolution
         A solution of ``problem`` with transcription `RadauConstantControl` on the optimized
-        mesh. ``info``: ``'switch_times'`` (where the control jumps, on knots),
+        mesh. ``info``: ``'method'`` (``'switch-times'`` or ``'moving-knots'``, the one
+        returned), ``'switch_times'`` (where the control jumps, on knots),
         ``'initial_switch_times'``, ``'initial_T'``, ``'N'``,
-        ``'stretch_active'`` (indices of intervals at a ``stretch`` bound),
-        ``'free_mesh_solution'`` (the solution of the restated problem), ``'wall_time'``.
+        ``'stretch_active'`` (indices of intervals at a ``stretch`` bound; empty for switch
+        times), ``'free_mesh_solution'`` (the solution of the restated problem; ``None`` for
+        switch times), ``'wall_time'`` (of the whole call); after a fallback ``'fallback'``
+        (why the switch-time NLP was not used) and ``'switch_time_solution'`` (its result,
+        when one was solved); for switch times ``'short_arcs'`` (whether the structure is
+        the second guess, with the arcs too short to be detected inserted: `bang_arcs`
+        with ``short_arcs=True``, tried when the first fails), ``'attempt_iterations'``
+        (IPOPT iterations of each switch-time structure tried; also after a fallback) and
+        the keys of
+        `optimize_switch_times`
+        (``'durations'``, ``'arc_controls'``, ``'segments'``, ``'integration_error'``,
+        ``'nlp_iterations'``, ``'nlp_status'``).
         ``success=False`` (never an exception) if IPOPT failed.
 
     Notes
@@ -198,8 +238,8 @@ def polish_switches(problem: Problem, solution: Solution, *, N: int | None = Non
     >>> from ocp.examples import min_time
     >>> fastest = min_time()  # x'' = u, |u| <= 1, from rest at 0 to rest at 1
     >>> sol = ocp.polish_switches(fastest, ocp.solve(fastest, N=10))
-    >>> sol.success, round(sol.T, 8), ocp.find_switches(sol).round(8)
-    (True, 2.0, array([1.]))
+    >>> sol.success, round(sol.T, 8), ocp.find_switches(sol).round(8), sol.info["method"]
+    (True, 2.0, array([1.]), 'switch-times')
     """
     if not isinstance(problem, Problem):
         raise TypeError(f"`problem` must be an ocp.Problem, got {type(problem).__name__}")
@@ -215,6 +255,9 @@ def polish_switches(problem: Problem, solution: Solution, *, N: int | None = Non
         raise ValueError(f"`stretch` must be a pair (lower, upper), got {stretch!r}") from None
     if not (0 < lo_s < 1 < hi_s < math.inf):
         raise ValueError(f"`stretch` must satisfy 0 < lower < 1 < upper < inf, got {stretch!r}")
+    if method not in METHODS:
+        raise ValueError(f"`method` must be one of {METHODS}, got {method!r}")
+    degree = integer(degree, "degree", minimum=1)
     tr = RadauConstantControl(degree)
     kw = dict(solve_kwargs)
     for bad in ("transcription", "mesh", "guess", "N", "degree"):
@@ -227,6 +270,48 @@ def polish_switches(problem: Problem, solution: Solution, *, N: int | None = Non
                            for k, v in user_ipopt.items()}}
 
     t_start = time.perf_counter()
+    fallback = {}
+    if method != "moving-knots":
+        arcs, why = bang_arcs(solution)
+        if arcs is None and method == "switch-times":
+            raise ValueError(f"method='switch-times' needs a bang-bang solution: {why}")
+        if arcs is not None:
+            ctol = kw.get("constraint_tol")
+
+            def attempt(a):
+                n_sw = N if N is not None and N >= 2 * a.durations.size else None
+                st = optimize_switch_times(problem, solution, arcs=a, N=n_sw, degree=degree,
+                                           verbose=verbose, ipopt_options=ipopt,
+                                           scale=kw.get("scale"),
+                                           constraint_tol=1e-6 if ctol is None else ctol)
+                # an optimum far worse than the start: the structure read from it is suspect
+                # (a missed arc); the moving knots may find the better one
+                worse = st.success and problem.better(
+                    solution.cost,
+                    st.cost - problem.objective_sign * 1e-3 * max(1.0, abs(solution.cost)))
+                return st, worse, (st.success and not worse) or method == "switch-times"
+
+            st, worse, done = attempt(arcs)
+            short, tried = False, [st.iterations]
+            if not done and method == "auto":  # second guess: arcs too short to be detected
+                more, _ = bang_arcs(solution, short_arcs=True)
+                if more is not None and more.durations.size > arcs.durations.size:
+                    st2, worse2, done = attempt(more)
+                    tried.append(st2.iterations)
+                    if done:
+                        st, worse, short = st2, worse2, True
+            if done:
+                info = {"stretch_active": np.zeros(0, dtype=int), "free_mesh_solution": None,
+                        "short_arcs": short, "attempt_iterations": tried,
+                        "wall_time": time.perf_counter() - t_start}
+                return annotate(st, info, message="polish_switches: " + st.message)
+            why = (f"the switch-time optimum {st.cost:.10g} is worse than the start's "
+                   f"{solution.cost:.10g} (the structure read from it is suspect)" if worse
+                   else f"the switch-time NLP failed: {st.message}")
+            fallback = {"fallback": why, "switch_time_solution": st, "attempt_iterations": tried}
+        else:
+            fallback = {"fallback": f"not bang-bang: {why}"}
+
     mesh, sw0 = _aligned_mesh(solution, N)
     T0 = float(solution.T)
     nx, nu, np_ = problem.model.nx, problem.model.nu, problem.model.np
@@ -272,8 +357,8 @@ def polish_switches(problem: Problem, solution: Solution, *, N: int | None = Non
         constraint_violation=sa.constraint_violation, multipliers=mult)
     v = sa.dense.Uo[nu, :, 0]
     active = np.flatnonzero((v <= lo_s * T0 * (1 + 1e-6)) | (v >= hi_s * T0 * (1 - 1e-6)))
-    info = {"switch_times": find_switches(out), "initial_switch_times": sw0, "initial_T": T0,
-            "N": mesh.N, "stretch_active": active, "free_mesh_solution": sa,
-            "wall_time": time.perf_counter() - t_start}
+    info = {"method": "moving-knots", "switch_times": find_switches(out),
+            "initial_switch_times": sw0, "initial_T": T0, "N": mesh.N, "stretch_active": active,
+            "free_mesh_solution": sa, "wall_time": time.perf_counter() - t_start, **fallback}
     prefix = "polish_switches (constant control and free length per interval): "
     return annotate(out, info, message=prefix + sa.message)

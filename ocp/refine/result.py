@@ -54,8 +54,13 @@ class RefinedSolution(Solution):
         time``) and ``'best'`` (index of the start returned). `polish_switches`:
         ``'switch_times'`` (knots where the control jumps), ``'initial_switch_times'``,
         ``'initial_T'``, ``'N'``, ``'stretch_active'`` (intervals whose length sits at a
-        bound of ``stretch``), ``'free_mesh_solution'`` (the solution of the restated
-        problem) and ``'wall_time'``.
+        bound of ``stretch``; empty for switch times), ``'free_mesh_solution'`` (the
+        solution of the restated problem; ``None`` for switch times), ``'wall_time'``,
+        ``'method'`` (``'switch-times'`` or ``'moving-knots'``), ``'fallback'`` (why the
+        moving knots ran), ``'switch_time_solution'``, ``'short_arcs'``,
+        ``'attempt_iterations'`` and those of `optimize_switch_times` (``'durations'``,
+        ``'arc_controls'``, ``'integration_error'``, ``'nlp_iterations'``,
+        ``'nlp_status'``).
     """
 
     info: Mapping = field(default_factory=dict)

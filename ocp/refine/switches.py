@@ -2,7 +2,8 @@
 leaves them for an interior (singular, coast, constrained) arc.
 
 `control_switches` is the definition; `find_switches` (all components, merged),
-`ocp.interval_errors` (which intervals hold a smeared switch) and `problems.slew.switch_times`
+`ocp.interval_errors` (which intervals hold a smeared switch), `problems.slew.switch_times`
+and the bang-bang structure of the switch-time polish (`ocp.refine.switch_times.bang_arcs`)
 all call it, so their answers agree.
 """
 from __future__ import annotations

@@ -5,6 +5,7 @@ import numpy as np
 import pytest
 
 from ocp import control_switches, find_switches, interval_errors, solve
+from ocp.refine.switch_times import bang_arcs
 
 from .reference import STRICT, bang_bang
 
@@ -29,6 +30,12 @@ def test_detectors_agree_on_a_bang_bang_solution(N):
         assert list(np.flatnonzero(est.switching)) == [3]
     else:  # a jump on a knot: nothing smeared, nothing flagged
         assert not np.any(est.switching)
+    # the bang-bang structure of the switch-time polish: the same switch, +1 then -1
+    arcs, why = bang_arcs(sol)
+    assert why == ""
+    np.testing.assert_array_equal(arcs.switch_times, merged)
+    np.testing.assert_allclose(arcs.durations, [merged[0] - sol.t0, sol.t0 + sol.T - merged[0]])
+    np.testing.assert_array_equal(arcs.controls, [[1.0, -1.0]])
 
 
 def test_detector_checks_its_arguments():

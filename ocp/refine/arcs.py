@@ -1,0 +1,183 @@
+"""The switching structure of a bang-bang solution: `BangArcs` and `bang_arcs`.
+
+Every control component sits at one of its (finite) bounds on every arc between
+consecutive switches; the arcs of all components are merged. `ocp.refine.switch_times`
+optimizes their durations. With ``short_arcs=True`` arcs too short for the starting mesh to
+show (an interval whose mean control falls short of its bound) are inserted as guesses.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..solution import Solution
+from .switches import control_switches
+
+__all__ = ["BangArcs", "bang_arcs"]
+
+
+@dataclass(frozen=True)
+class BangArcs:
+    """The switching structure of a bang-bang solution (`bang_arcs`).
+
+    Attributes
+    ----------
+    switch_times : ndarray, shape (m,) [s]
+        Switches of all components, merged and sorted (strictly inside the horizon).
+    durations : ndarray, shape (m + 1,) [s]
+        Arc lengths between ``t0``, the switches and ``t0 + T``.
+    controls : ndarray, shape (nu, m + 1)
+        The bang value (a bound) of every component on every arc.
+    """
+
+    switch_times: np.ndarray
+    durations: np.ndarray
+    controls: np.ndarray
+
+    def _replace_durations(self, durations) -> "BangArcs":
+        """The same arcs with other durations (switch times moved accordingly)."""
+        d = np.array(durations, dtype=float)
+        t0 = float(self.switch_times[0] - self.durations[0]) if self.switch_times.size else 0.0
+        sw = t0 + np.cumsum(d)[:-1]
+        for a in (d, sw):
+            a.setflags(write=False)
+        return BangArcs(sw, d, self.controls)
+
+
+def bang_arcs(solution: Solution, *, samples: int = 9,
+              short_arcs: bool = False) -> tuple[BangArcs | None, str]:
+    """The bang-bang switching structure of ``solution``, or ``None`` and why not.
+
+    Every control component must have finite bounds and, on each of its own arcs between
+    the switches `control_switches` finds, stay near one bound: at least 75% of the samples
+    of the arc's central 80% in the outer quarter of the range on one side, and consecutive
+    arcs on opposite bounds (a jump). A singular, coast or constrained arc (an arc in
+    between), an unbounded component, or a component that returns to the bound it left
+    (an interior arc in between) is refused.
+
+    Parameters
+    ----------
+    solution : Solution
+    samples : int
+        Samples per interval of `control_switches` (the arcs are sampled at 41 points).
+    short_arcs : bool
+        Also insert the arcs too short for `control_switches` (under 1% of the horizon, or
+        inside one mesh interval): where a component's mean over a mesh interval away from
+        its switches falls short of its bang value, an arc at the opposite bound of the
+        same impulse (centred in the interval; at the end of the horizon in the first and
+        last intervals), if longer than 1e-3 of the interval; the two longest per
+        component. A guess of a structure to try when the plain one fails
+        (`polish_switches`).
+
+    Returns
+    -------
+    (BangArcs or None, str)
+        The structure (and ``""``), or ``None`` and the reason.
+
+    Raises
+    ------
+    TypeError
+        If ``solution`` is not a `Solution` or ``samples`` not an integer.
+
+    Examples
+    --------
+    >>> import ocp
+    >>> from ocp.examples import min_time
+    >>> from ocp.refine.switch_times import bang_arcs
+    >>> arcs, why = bang_arcs(ocp.solve(min_time(), N=10))  # x'' = u, |u| <= 1
+    >>> arcs.switch_times.round(6), arcs.controls
+    (array([1.]), array([[ 1., -1.]]))
+    """
+    if not isinstance(solution, Solution):
+        raise TypeError(f"`solution` must be an ocp.Solution, got {type(solution).__name__}")
+    problem = solution.problem
+    lo, hi = (np.asarray(b, dtype=float) for b in problem.u_bounds)
+    nu = lo.size
+    if nu == 0:
+        return None, "the problem has no controls"
+    bad = ~(np.isfinite(lo) & np.isfinite(hi) & (hi > lo))
+    if np.any(bad):
+        return None, f"control components {np.flatnonzero(bad).tolist()} are not bounded on both sides"
+    t0, T = float(solution.t0), float(solution.T)
+    if not (np.isfinite(T) and T > 0):
+        return None, f"the horizon T = {T!r} is not positive"
+    per = control_switches(solution, samples=samples)
+    mid, half = 0.5 * (lo + hi), 0.5 * (hi - lo)
+    own = []  # per component: (edges, sides) of its own arcs
+    for j in range(nu):
+        edges = np.concatenate([[t0], per[j], [t0 + T]])
+        sides = []
+        for a, b in zip(edges[:-1], edges[1:]):
+            L = b - a
+            if L <= 0:
+                return None, f"component {j}: switches out of order"
+            ts = a + L * np.linspace(0.1, 0.9, 41)
+            z = (solution.sample(ts)[1][j] - mid[j]) / half[j]
+            s = 1.0 if np.median(z) >= 0 else -1.0
+            if np.mean(s * z > 0.5) < 0.75:
+                return None, (f"component {j} is not at a bound on [{a:.6g}, {b:.6g}] s "
+                              "(a singular or interior arc)")
+            sides.append(s)
+        if any(x == y for x, y in zip(sides[:-1], sides[1:])):
+            return None, f"component {j} leaves a bound and returns to it (an interior arc)"
+        if short_arcs:
+            edges, sides = _with_short_arcs(solution, j, edges, sides, mid[j], half[j])
+        own.append((edges, np.asarray(sides)))
+    merged = np.unique(np.concatenate([e[1:-1] for e, _ in own]))
+    if merged.size > 1:
+        merged = merged[np.concatenate([[True], np.diff(merged) > 1e-9 * max(T, 1.0)])]
+    merged = merged[(merged > t0) & (merged < t0 + T)]
+    edges = np.concatenate([[t0], merged, [t0 + T]])
+    centres = 0.5 * (edges[:-1] + edges[1:])
+    U = np.empty((nu, centres.size))
+    for j, (e, sides) in enumerate(own):
+        k = np.clip(np.searchsorted(e, centres) - 1, 0, sides.size - 1)  # own arc of each merged arc
+        U[j] = np.where(sides[k] > 0, hi[j], lo[j])
+    keep = np.concatenate([[True], np.any(U[:, 1:] != U[:, :-1], axis=0)])  # no repeated arc
+    starts = edges[:-1][keep]
+    edges = np.concatenate([starts, [t0 + T]])
+    out = BangArcs(edges[1:-1].copy(), np.diff(edges), U[:, keep].copy())
+    for a in (out.switch_times, out.durations, out.controls):
+        a.setflags(write=False)
+    return out, ""
+
+
+def _with_short_arcs(solution, j, edges, sides, mid, half, m=16, max_new=2):
+    """Component ``j``'s own arcs (``edges``, ``sides``) with the short arcs of `bang_arcs`
+    (``short_arcs=True``) inserted."""
+    d = solution.dense
+    tb, h = d.t_breaks, d.h
+    N = h.size
+    s = (np.arange(m) + 0.5) / m
+    _, u = d.eval(np.repeat(np.arange(N), m), np.tile(s, N))
+    z = ((u[j] - mid) / half).reshape(N, m).mean(axis=1)  # interval means, bounds at +-1
+    T = float(tb[-1] - tb[0])
+    near = np.zeros(N, bool)  # intervals holding or next to a switch of this component
+    for t in edges[1:-1]:
+        k = int(np.clip(np.searchsorted(tb, t) - 1, 0, N - 1))
+        near[max(k - 1, 0):k + 2] = True
+    edges, sides = list(edges), list(sides)
+    cand = []
+    for k in np.flatnonzero(~near):
+        a = int(np.clip(np.searchsorted(edges, 0.5 * (tb[k] + tb[k + 1])) - 1, 0, len(sides) - 1))
+        dur = h[k] * (1.0 - sides[a] * z[k]) / 2.0  # impulse short of the bound, at the other one
+        if dur > max(1e-3 * h[k], 1e-6 * T):
+            cand.append((dur, k))
+    for dur, k in sorted(cand, reverse=True)[:max_new]:  # the largest ones
+        c = 0.5 * (tb[k] + tb[k + 1])
+        a = int(np.clip(np.searchsorted(edges, c) - 1, 0, len(sides) - 1))
+        side = sides[a]
+        dur = min(dur, 0.5 * h[k])
+        if k == N - 1:
+            lo_, hi_ = tb[k + 1] - dur, tb[k + 1]
+        elif k == 0:
+            lo_, hi_ = tb[0], tb[0] + dur
+        else:
+            lo_, hi_ = c - dur / 2, c + dur / 2
+        # split own arc a = [edges[a], edges[a + 1]] around [lo_, hi_] at the other bound
+        pieces = [(edges[a], lo_, side), (lo_, hi_, -side), (hi_, edges[a + 1], side)]
+        pieces = [q for q in pieces if q[1] > q[0]]
+        edges[a:a + 2] = [q[0] for q in pieces] + [pieces[-1][1]]
+        sides[a:a + 1] = [q[2] for q in pieces]
+    return np.asarray(edges), sides

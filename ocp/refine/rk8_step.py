@@ -1,0 +1,53 @@
+"""One fixed step of the DOP853 8th-order Runge-Kutta method as a casadi Function, with the
+running cost integrated alongside, and its state Jacobian (the integrator of
+`ocp.refine.switch_times`), built once per model and running cost (`ocp.cached`)."""
+from __future__ import annotations
+
+import casadi as ca
+
+from dynamics.integrate.tableaux import DOP853
+
+from ..cached import cached, function_key
+from ..transcription import sx_compatible
+
+__all__ = ["step_function", "step_jacobian"]
+
+
+def _rk8_step(f: ca.Function, L: ca.Function | None) -> ca.Function:
+    """One fixed step of the DOP853 8th-order Runge-Kutta method:
+    ``(x, u, p, h) -> (x(t + h), integral of L over the step)``."""
+    A, B = DOP853.a, DOP853.b  # dynamics.integrate.tableaux (the doubles of scipy's DOP853)
+    nx, nu, np_ = f.numel_in(0), f.numel_in(1), f.numel_in(2)
+    funs = [f] + ([L] if L is not None else [])
+    sym = ca.SX if all(sx_compatible(g) for g in funs) else ca.MX
+    x, u, p, h = sym.sym("x", nx), sym.sym("u", nu), sym.sym("p", np_), sym.sym("h")
+    k, kq = [], []
+    for i in range(len(B)):
+        xi = x
+        for j, a in enumerate(A[i]):
+            if a != 0.0:
+                xi = xi + (h * a) * k[j]
+        k.append(f(xi, u, p))
+        if L is not None:
+            kq.append(L(xi, u, p))
+    xn = x + h * sum(float(B[i]) * k[i] for i in range(len(k)) if B[i] != 0.0)
+    qn = h * sum(float(B[i]) * kq[i] for i in range(len(kq)) if B[i] != 0.0) if L is not None else sym(0)
+    return ca.Function(f"{f.name()}_rk8_step", [x, u, p, h], [xn, qn],
+                       ["x", "u", "p", "h"], ["xf", "qf"])
+
+
+def step_function(model, lagrange) -> ca.Function:
+    parts = (function_key(model.f), None if lagrange is None else function_key(lagrange))
+    keep = (model.f,) if lagrange is None else (model.f, lagrange)
+    return cached("rk8_step", parts, lambda: _rk8_step(model.f, lagrange), keepalive=keep)
+
+
+def step_jacobian(step: ca.Function) -> ca.Function:
+    """``(x, u, p, h) -> (d x(t + h) / d x, d q(t + h) / d x)`` (``q`` the running cost)."""
+    def build():
+        sym = ca.SX if step.is_a("SXFunction") else ca.MX
+        x, u, p, h = (sym.sym(n, step.sparsity_in(i)) for i, n in enumerate("xuph"))
+        xn, qn = step(x, u, p, h)
+        return ca.Function(step.name() + "_jac", [x, u, p, h],
+                           [ca.jacobian(xn, x), ca.jacobian(qn, x)])
+    return cached("rk8_step_jacobian", (function_key(step),), build, keepalive=step)
