@@ -2,7 +2,8 @@
 
 A `Problem` says *what* is optimized: the dynamics (a `dynamics.Model`), the horizon (fixed
 or free final time), bounds, boundary conditions, path constraints and the cost. How it is
-discretized lives in `ocp.transcription`; how it is solved in `ocp.solve`.
+discretized lives in `ocp.transcription`; how it is solved in `ocp.solve`. Its numeric
+arguments are parsed by `ocp.arguments`, its functions made canonical by `ocp.functions`.
 
 The problem, on ``t in [t0, t0 + T]``::
 
@@ -41,18 +42,18 @@ for three degrees of freedom): use ``q_final``.
 """
 from __future__ import annotations
 
-import inspect
 import math
-import re
 from dataclasses import dataclass, replace
-from typing import Callable, Mapping, Sequence, Union
+from typing import Callable, Union
 
 import casadi as ca
 import numpy as np
 
 from dynamics.model import Model
 
+from .arguments import boundary_values, bounds, horizon, parameters, row_bounds
 from .attitude import attitude_error, check_attitude, needs_norm_at_t0
+from .functions import named_function
 
 __all__ = ["Problem", "Constraint"]
 
@@ -92,251 +93,9 @@ class Constraint:
         return int(np.size(self.lower))
 
 
-def _as_vector(value, n: int, argname: str, *, allow_nan=False) -> np.ndarray:
-    try:
-        a = np.array(value, dtype=float)
-    except (TypeError, ValueError) as exc:
-        raise ValueError(f"`{argname}` must be numeric: {exc}") from None
-    if a.ndim == 0:
-        a = np.full(n, float(a))
-    a = a.reshape(-1) if a.ndim == 1 or a.size == n else a
-    if a.shape != (n,):
-        raise ValueError(f"`{argname}` must have shape ({n},), got {np.shape(value)}")
-    if not allow_nan and np.any(np.isnan(a)):
-        raise ValueError(f"`{argname}` must not contain NaN, got {a.tolist()}")
-    return a
-
-
 def _read_only(value) -> None:
     if isinstance(value, np.ndarray):
         value.setflags(write=False)
-
-
-def _index(names: tuple[str, ...], key, argname: str) -> int:
-    if key not in names:
-        raise ValueError(f"`{argname}` names unknown component {key!r}; expected one of {names}")
-    return names.index(key)
-
-
-def _values(arg, names: tuple[str, ...], argname: str) -> np.ndarray:
-    """Boundary values: mapping name -> value (others free), or array with NaN = free."""
-    n = len(names)
-    out = np.full(n, np.nan)
-    if arg is None:
-        return out
-    if isinstance(arg, Mapping):
-        for key, value in arg.items():
-            i = _index(names, key, argname)
-            if value is None:
-                continue
-            v = float(value)
-            if not math.isfinite(v):
-                raise ValueError(f"`{argname}`[{key!r}] must be finite or None, got {value!r}")
-            out[i] = v
-        return out
-    if isinstance(arg, (list, tuple)):
-        arg = [np.nan if v is None else v for v in arg]
-    a = _as_vector(arg, n, argname, allow_nan=True)
-    if np.any(np.isinf(a)):
-        raise ValueError(f"`{argname}` must be finite (NaN or None marks a free component), got {a.tolist()}")
-    return a
-
-
-def _bounds(arg, names: tuple[str, ...], argname: str) -> np.ndarray:
-    """Bounds: mapping name -> (lo, hi), or a pair (lower (n,), upper (n,)). Shape (2, n)."""
-    n = len(names)
-    out = np.array([np.full(n, -np.inf), np.full(n, np.inf)])
-    if arg is None:
-        return out
-    if isinstance(arg, Mapping):
-        for key, pair in arg.items():
-            i = _index(names, key, argname)
-            try:
-                lo, hi = pair
-            except (TypeError, ValueError):
-                raise ValueError(f"`{argname}`[{key!r}] must be a pair (lower, upper), got {pair!r}") from None
-            out[0, i] = -np.inf if lo is None else float(lo)
-            out[1, i] = np.inf if hi is None else float(hi)
-    else:
-        try:
-            lo, hi = arg
-        except (TypeError, ValueError):
-            raise ValueError(
-                f"`{argname}` must be a mapping name -> (lower, upper) or a pair (lower, upper) "
-                f"of arrays of shape ({n},)"
-            ) from None
-        lo = -np.inf if lo is None else lo
-        hi = np.inf if hi is None else hi
-        out[0] = _as_vector(lo, n, f"{argname}[0]")
-        out[1] = _as_vector(hi, n, f"{argname}[1]")
-    if np.any(np.isnan(out)):
-        raise ValueError(f"`{argname}` must not contain NaN")
-    bad = np.flatnonzero(out[0] > out[1])
-    if bad.size:
-        raise ValueError(
-            f"`{argname}`: lower bound exceeds upper bound for {[names[i] for i in bad]}: "
-            f"{out[0, bad].tolist()} > {out[1, bad].tolist()}"
-        )
-    out.setflags(write=False)
-    return out
-
-
-# ------------------------------------------------------------ callables by name
-# the positional convention of each kind of function and the inputs its names refer to
-_POSITIONAL = {
-    "lagrange": ("x", "u", "p"),
-    "path": ("x", "u", "p"),
-    "mayer": ("xf", "p", "T"),
-    "boundary": ("x0", "xf", "p"),
-}
-
-
-def _vocabulary(kind: str, model: Model) -> dict[str, list[tuple[int, int]]]:
-    """Argument name -> every ``(input, component)`` it may denote for functions of ``kind``
-    (more than one entry: the name is ambiguous)."""
-    vocab: dict[str, list[tuple[int, int]]] = {}
-
-    def add(name, where):
-        if where not in vocab.setdefault(name, []):
-            vocab[name].append(where)
-
-    if kind in ("lagrange", "path"):  # inputs (x, u, p)
-        for i, s in enumerate(model.states):
-            add(s, (0, i))
-        for i, c in enumerate(model.controls):
-            add(c, (1, i))
-        for i, q in enumerate(model.params):
-            add(q, (2, i))
-    elif kind == "mayer":  # inputs (xf, p, T): states are final values
-        for i, s in enumerate(model.states):
-            add(s, (0, i))
-            add(f"{s}_f", (0, i))
-        for i, q in enumerate(model.params):
-            add(q, (1, i))
-        add("T", (2, 0))
-    else:  # boundary, inputs (x0, xf, p): initial values `<state>_0`, final `<state>_f`
-        for i, s in enumerate(model.states):
-            add(f"{s}_0", (0, i))
-            add(f"{s}_f", (1, i))
-        for i, q in enumerate(model.params):
-            add(q, (2, i))
-    return vocab
-
-
-def _valid_names(kind: str, model: Model) -> str:
-    if kind in ("lagrange", "path"):
-        return (f"states {list(model.states)}, controls {list(model.controls)}, "
-                f"parameters {list(model.params)}")
-    if kind == "mayer":
-        return (f"final states {list(model.states)} (or with the suffix '_f'), parameters "
-                f"{list(model.params)}, and 'T' (the horizon)")
-    return (f"initial states {[s + '_0' for s in model.states]}, final states "
-            f"{[s + '_f' for s in model.states]}, parameters {list(model.params)}")
-
-
-def _by_name(fun, kind: str, model: Model, argname: str):
-    """``fun`` itself when it takes the positional arguments of ``kind``; else a positional
-    wrapper that calls it with the scalar components its parameter names denote.
-
-    A plain callable (not a ``casadi.Function``) whose parameters can all be passed by keyword
-    is taken by name when every parameter name is a name of ``kind`` (`_vocabulary`) and the
-    names are not exactly the positional ones; a callable that cannot take the three
-    positional arguments must name its arguments so (ValueError naming the first that does
-    not: unknown or ambiguous). Any other callable keeps the positional convention.
-    """
-    if isinstance(fun, ca.Function) or not callable(fun):
-        return fun
-    try:
-        params = list(inspect.signature(fun).parameters.values())
-    except (TypeError, ValueError):  # no signature (some builtins): positional
-        return fun
-    kinds = {p.kind for p in params}
-    if kinds & {inspect.Parameter.VAR_POSITIONAL, inspect.Parameter.VAR_KEYWORD,
-                inspect.Parameter.POSITIONAL_ONLY}:
-        return fun
-    names = tuple(p.name for p in params)
-    positional = _POSITIONAL[kind]
-    if names == positional:
-        return fun
-    vocab = _vocabulary(kind, model)
-    state_names = set(model.states)
-    # a state name without suffix in `boundary` is recognized but ambiguous (x0 or xf)
-    recognized = [n in vocab or (kind == "boundary" and n in state_names) for n in names]
-    required = sum(p.default is inspect.Parameter.empty for p in params)
-    takes_positional = required <= len(positional) <= len(params)
-    if not all(recognized) and takes_positional:
-        return fun  # the positional convention, under other names (as `lambda xf_, p_, T`)
-    valid = _valid_names(kind, model)
-    where = []
-    for n, ok in zip(names, recognized):
-        if not ok:
-            raise ValueError(
-                f"`{argname}`: argument {n!r} is not a name of this problem; by name it may "
-                f"take {valid}; or write it positionally as {kind}({', '.join(positional)})")
-        if n not in vocab:
-            raise ValueError(
-                f"`{argname}`: argument {n!r} is ambiguous (initial or final value of state "
-                f"{n!r}); write {n + '_0'!r} or {n + '_f'!r}")
-        if len(vocab[n]) > 1:
-            raise ValueError(
-                f"`{argname}`: argument {n!r} is ambiguous: it names more than one input "
-                f"{[positional[i] + f'[{j}]' for i, j in vocab[n]]}; rename the model's "
-                f"component or use the positional form {kind}({', '.join(positional)})")
-        where.append(vocab[n][0])
-
-    def positional_call(*inputs):
-        out = fun(**{n: inputs[i][j] for n, (i, j) in zip(names, where)})
-        if isinstance(out, (list, tuple)):  # rows given as a list of expressions
-            out = ca.vertcat(*[ca.vec(o) if isinstance(o, (ca.SX, ca.MX, ca.DM)) else o
-                               for o in out]) if out else ca.DM.zeros(0, 1)
-        return out
-
-    positional_call.__name__ = getattr(fun, "__name__", kind)
-    return positional_call
-
-
-def _canonical(fun, inputs: Sequence[tuple[str, int]], out_name: str, argname: str, *,
-               scalar: bool = False) -> ca.Function:
-    """A user Function or callable as a named-I/O Function with one flattened output."""
-    names = [n for n, _ in inputs]
-    sizes = [s for _, s in inputs]
-    signature = f"({', '.join(f'{n} ({s},)' for n, s in inputs)})"
-    if isinstance(fun, ca.Function):
-        if fun.n_in() != len(inputs) or fun.n_out() < 1:
-            raise ValueError(
-                f"`{argname}` must be a casadi.Function of {signature}, got "
-                f"{fun.n_in()} inputs {tuple(fun.name_in())}"
-            )
-        for i, (n, s) in enumerate(inputs):
-            if fun.numel_in(i) != s:
-                raise ValueError(
-                    f"`{argname}`: input {i} ({fun.name_in(i)!r}) must have {s} elements "
-                    f"(the {n} of the problem), got {fun.numel_in(i)}; expected {signature}"
-                )
-        call = lambda *a: fun(*[ca.reshape(ai, fun.size_in(i)) for i, ai in enumerate(a)])  # noqa: E731
-    elif callable(fun):
-        call = fun
-    else:
-        raise ValueError(f"`{argname}` must be a casadi.Function or a callable of {signature}, "
-                         f"got {type(fun).__name__}")
-    last_error = None
-    for sym in (ca.SX, ca.MX):  # SX when the function allows it (cheaper), else MX
-        syms = [sym.sym(n, s) for n, s in zip(names, sizes)]
-        try:
-            out = call(*syms)
-        except Exception as exc:  # noqa: BLE001 - retried with MX, then reported
-            last_error = exc
-            continue
-        if isinstance(out, (list, tuple)):
-            out = out[0]
-        if isinstance(out, (int, float, np.ndarray)):
-            out = sym(ca.DM(np.asarray(out, dtype=float)))
-        out = ca.vec(out)
-        if scalar and out.numel() != 1:
-            raise ValueError(f"`{argname}` must return a scalar, got shape {out.shape}")
-        fname = re.sub(r"_+", "_", re.sub(r"\W", "_", argname)).strip("_")  # 'path[0]' -> 'path_0'
-        return ca.Function(fname, syms, [out], names, [out_name])
-    raise ValueError(f"`{argname}` could not be evaluated on symbols of {signature}: {last_error}")
 
 
 @dataclass(frozen=True, eq=False)
@@ -498,42 +257,22 @@ class Problem:
         if not isinstance(model, Model):
             raise TypeError(f"`model` must be a dynamics.Model, got {type(model).__name__}")
         put = lambda k, v: object.__setattr__(self, k, v)  # noqa: E731
-        nx, nu, np_ = model.nx, model.nu, model.np
         if not isinstance(self.maximize, (bool, np.bool_)):
             raise ValueError(f"`maximize` must be True or False, got {self.maximize!r}")
         put("maximize", bool(self.maximize))
-
-        # horizon
-        T = self.T
-        if isinstance(T, (tuple, list, np.ndarray)):
-            if len(T) != 2:
-                raise ValueError(f"`T` must be a float or a pair (T_min, T_max), got {T!r}")
-            lo, hi = float(T[0]), float(T[1])
-            if not (math.isfinite(lo) and lo >= 0 and hi > lo) or math.isnan(hi):
-                raise ValueError(f"`T` bounds must satisfy 0 <= T_min < T_max, got ({lo}, {hi})")
-            put("T", (lo, hi))
-        else:
-            try:
-                T = float(T)
-            except (TypeError, ValueError):
-                raise ValueError(f"`T` must be a float or a pair (T_min, T_max), got {T!r}") from None
-            if not (math.isfinite(T) and T > 0):
-                raise ValueError(f"`T` (horizon length) must be finite and > 0, got {T}")
-            put("T", T)
+        put("T", horizon(self.T))
         t0 = float(self.t0)
         if not math.isfinite(t0):
             raise ValueError(f"`t0` must be finite, got {self.t0}")
         put("t0", t0)
 
-        # bounds and boundary values
-        xb = _bounds(self.x_bounds, model.states, "x_bounds")
-        ub = _bounds(self.u_bounds, model.controls, "u_bounds")
+        # bounds and boundary values (ocp.arguments)
+        xb = bounds(self.x_bounds, model.states, "x_bounds")
         put("x_bounds", xb)
-        put("u_bounds", ub)
+        put("u_bounds", bounds(self.u_bounds, model.controls, "u_bounds"))
         for argname in ("x_initial", "x_final"):
-            v = _values(getattr(self, argname), model.states, argname)
-            given = ~np.isnan(v)
-            out = given & ((v < xb[0]) | (v > xb[1]))
+            v = boundary_values(getattr(self, argname), model.states, argname)
+            out = ~np.isnan(v) & ((v < xb[0]) | (v > xb[1]))
             if np.any(out):
                 i = np.flatnonzero(out)
                 raise ValueError(
@@ -541,48 +280,16 @@ class Problem:
                     f"{v[i].tolist()} not in [{xb[0, i].tolist()}, {xb[1, i].tolist()}]"
                 )
             put(argname, v)
-
-        # parameters
-        if self.p is None:
-            p = np.array(model.p_default, dtype=float)
-        elif isinstance(self.p, Mapping):
-            p = np.array(model.p_default, dtype=float)
-            for key, value in self.p.items():
-                p[_index(model.params, key, "p")] = float(value)
-        else:
-            p = _as_vector(self.p, np_, "p")
-        if not np.all(np.isfinite(p)):
-            raise ValueError(f"`p` must be finite, got {p.tolist()}")
-        pb = np.array(_bounds(self.p_bounds, model.params, "p_bounds"))
-        if isinstance(self.p_bounds, Mapping):
-            listed = np.zeros(np_, bool)
-            for key in self.p_bounds:
-                listed[model.params.index(key)] = True
-            fixed = ~listed
-        else:  # a pair of arrays: components with lower == upper are fixed at `p`
-            fixed = pb[0] == pb[1]
-        pb[0, fixed] = p[fixed]
-        pb[1, fixed] = p[fixed]
-        outside = (p < pb[0]) | (p > pb[1])
-        if np.any(outside):
-            i = np.flatnonzero(outside)
-            raise ValueError(f"`p` lies outside `p_bounds` for {[model.params[j] for j in i]}")
-        p.setflags(write=False)
-        pb.setflags(write=False)
+        p, pb = parameters(self.p, self.p_bounds, model)
         put("p", p)
         put("p_bounds", pb)
 
-        # cost and constraints
-        xs, us, ps = ("x", nx), ("u", nu), ("p", np_)
-        if self.lagrange is not None:
-            put("lagrange", _canonical(_by_name(self.lagrange, "lagrange", model, "lagrange"),
-                                       [xs, us, ps], "L", "lagrange", scalar=True))
-        if self.mayer is not None:
-            put("mayer", _canonical(_by_name(self.mayer, "mayer", model, "mayer"),
-                                    [("xf", nx), ps, ("T", 1)], "phi", "mayer", scalar=True))
-        put("path", self._constraints(self.path, "path", [xs, us, ps], (-math.inf, 0.0), model))
-        put("boundary", self._constraints(self.boundary, "boundary",
-                                          [("x0", nx), ("xf", nx), ps], (0.0, 0.0), model))
+        # cost and constraints (ocp.functions)
+        for kind in ("lagrange", "mayer"):
+            if getattr(self, kind) is not None:
+                put(kind, named_function(getattr(self, kind), kind, model, kind))
+        put("path", self._constraints(self.path, "path", (-math.inf, 0.0), model))
+        put("boundary", self._constraints(self.boundary, "boundary", (0.0, 0.0), model))
 
         # attitude (ocp.attitude)
         x0, qf, qtol = check_attitude(model, self.x_initial, self.x_final, self.q_final, self.q_final_tol)
@@ -595,36 +302,19 @@ class Problem:
 
     # ------------------------------------------------------------------ helpers
     @staticmethod
-    def _constraints(arg, argname, inputs, default_bounds, model) -> tuple[Constraint, ...]:
+    def _constraints(arg, argname, default_bounds, model) -> tuple[Constraint, ...]:
         if arg is None:
             return ()
         items = list(arg) if isinstance(arg, (list, tuple)) else [arg]
         out = []
         for j, item in enumerate(items):
             label = f"{argname}[{j}]" if isinstance(arg, (list, tuple)) else argname
-            if isinstance(item, Constraint):
-                con = item
-            else:
-                con = Constraint(item, *default_bounds)
-            fun = _canonical(_by_name(con.fun, argname, model, label), inputs,
-                             "g" if argname == "path" else "c", label)
+            con = item if isinstance(item, Constraint) else Constraint(item, *default_bounds)
+            fun = named_function(con.fun, argname, model, label)
             m = fun.numel_out(0)
             if m == 0:
                 raise ValueError(f"`{label}` returns no rows")
-            lo = _as_vector(con.lower, m, f"{label}.lower")
-            hi = _as_vector(con.upper, m, f"{label}.upper")
-            if np.any(lo > hi):
-                raise ValueError(f"`{label}`: lower bound exceeds upper bound ({lo.tolist()} > {hi.tolist()})")
-            if np.all(np.isinf(lo)) and np.all(np.isinf(hi)):
-                raise ValueError(f"`{label}` has no finite bound")
-            scale = None
-            if con.scale is not None:
-                scale = _as_vector(con.scale, m, f"{label}.scale")
-                if not np.all(np.isfinite(scale) & (scale > 0)):
-                    raise ValueError(f"`{label}.scale` must be finite and > 0, got {scale.tolist()}")
-                scale.setflags(write=False)
-            lo.setflags(write=False)
-            hi.setflags(write=False)
+            lo, hi, scale = row_bounds(con.lower, con.upper, con.scale, m, label)
             out.append(Constraint(fun, lo, hi, scale, con.name or label))
         return tuple(out)
 

@@ -51,8 +51,9 @@ def bang_arcs(solution: Solution, *, samples: int = 9,
 
     Every control component must have finite bounds and, on each of its own arcs between
     the switches `control_switches` finds, stay near one bound: at least 75% of the samples
-    of the arc's central 80% in the outer quarter of the range on one side, and consecutive
-    arcs on opposite bounds (a jump). A singular, coast or constrained arc (an arc in
+    of the arc's central 80% in the outer quarter of the range on one side (an arc shorter
+    than two mesh intervals, smeared by the collocation, takes the side of its median), and
+    consecutive arcs on opposite bounds (a jump). A singular, coast or constrained arc (an arc in
     between), an unbounded component, or a component that returns to the bound it left
     (an interior arc in between) is refused.
 
@@ -104,6 +105,7 @@ def bang_arcs(solution: Solution, *, samples: int = 9,
         return None, f"the horizon T = {T!r} is not positive"
     per = control_switches(solution, samples=samples)
     mid, half = 0.5 * (lo + hi), 0.5 * (hi - lo)
+    tb, hmesh = solution.dense.t_breaks, solution.dense.h
     own = []  # per component: (edges, sides) of its own arcs
     for j in range(nu):
         edges = np.concatenate([[t0], per[j], [t0 + T]])
@@ -115,7 +117,12 @@ def bang_arcs(solution: Solution, *, samples: int = 9,
             ts = a + L * np.linspace(0.1, 0.9, 41)
             z = (solution.sample(ts)[1][j] - mid[j]) / half[j]
             s = 1.0 if np.median(z) >= 0 else -1.0
-            if np.mean(s * z > 0.5) < 0.75:
+            # an arc within two mesh intervals is smeared by the collocation (the control
+            # polynomial of the interval holding a switch): its side is that of its median,
+            # and the switch-time NLP checks the guess
+            k0, k1 = np.searchsorted(tb, [a, b])
+            smeared = L < 2.0 * float(np.max(hmesh[max(k0 - 1, 0):max(k1, k0 + 1)]))
+            if not smeared and np.mean(s * z > 0.5) < 0.75:
                 return None, (f"component {j} is not at a bound on [{a:.6g}, {b:.6g}] s "
                               "(a singular or interior arc)")
             sides.append(s)

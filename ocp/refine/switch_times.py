@@ -336,7 +336,12 @@ def _solve_arcs(problem: Problem, guess: Solution, arcs: BangArcs, nseg: np.ndar
                 for k, v in (ipopt_options or {}).items()}
         ipopt = {**_STRICT, "print_level": 5 if verbose is True else 0, "sb": "yes", **user}
         solver = ca.nlpsol("switch_times", "ipopt", {"x": w, "f": sign * J / sJ, "g": ca.vertcat(*g)},
-                           {"ipopt": ipopt, "print_time": False, "error_on_fail": False})
+                           # inputs_check off: the bounds are built consistent here, and casadi's
+                           # count of equalities (fixed variables included) against variables
+                           # would print a warning for the structurally over-determined end
+                           # conditions of a symmetric slew, which IPOPT solves (a quiet library)
+                           {"ipopt": ipopt, "print_time": False, "error_on_fail": False,
+                            "inputs_check": False})
         cost_fun = ca.Function("switch_times_cost", [w], [J])
     build_time = time.perf_counter() - t_build
     check_interrupt()
