@@ -46,11 +46,11 @@ from dynamics.attitude import quat_conj, quat_mul
 
 from dynamics.cache import compile_function, compiler
 
-from .cached import function_key
+from .cached import cached, function_key
 from .layout import Layout
 from .transcription import sx_compatible
 
-__all__ = ["Structure", "structure_key", "content_key"]
+__all__ = ["Structure", "Intervals", "intervals", "structure_key", "content_key"]
 
 
 def content_key(fun: ca.Function | None):
@@ -139,43 +139,33 @@ class _Assembly:
         return ca.MX(self.sparsity, nz)
 
 
-class Structure:
-    """Symbolic NLP, derivative Functions and index maps of one problem structure.
-
-    Parameters
-    ----------
-    problem : ocp.Problem
-        Supplies the structure only (functions, sizes, flags); its numbers go to `params`.
-    transcription : ocp.Transcription
-    N : int
-        Number of mesh intervals.
-    expand : bool
-        Build the interval functions in SX when every function allows it (faster
-        evaluation); MX otherwise.
-    codegen : bool, optional
-        Compile the (SX) interval functions and their derivatives to C
-        (`dynamics.cache.compile_function`; about 1-3 s once per structure, then kept in the
-        cache with it). Ignored without a C compiler or for MX interval functions.
+class Intervals:
+    """The part of a structure that does not depend on the number of intervals: the
+    interval Function ``seg``, the end Function ``ends`` (module docstring) and their
+    derivatives, built once per problem structure and kept in the cache (`intervals`), so
+    refinement rounds that change ``N`` reuse them (and their C code with ``codegen``).
 
     Attributes
     ----------
-    w, g : Layout
-        Decision and constraint vectors (blocks as in `ocp.nlp`).
-    params : Layout
-        The NLP parameter vector ``P`` (`params_value` fills it).
-    nlp : dict
-        ``{'x', 'p', 'f', 'g'}`` (MX) for ``casadi.nlpsol``.
-    derivatives : dict
-        ``grad_f``, ``jac_g``, ``hess_lag`` Functions for the nlpsol options of those names.
+    seg, ends : tuple
+        ``(values, gradient, jacobian, hessian)`` Functions and the ``(rows, cols)`` of the
+        structural nonzeros of the Jacobian, the cost gradient and the Hessian.
+    common : Layout
+        The parameters shared by every interval (scales, fixed values, horizon, target).
+    sizes : dict
+        Dimensions (``nx, nu, m_x, m_u, ua, m_d, n_path, n_bound, n_q, qn, nf, ft, n_z,
+        n_s, n_seg, n_end``).
+    symbolic : str
+        ``'SX'`` or ``'MX'``.
+    compiled : bool
+        Whether the derivatives were compiled to C.
     """
 
-    def __init__(self, problem, transcription, N: int, expand: bool = True, codegen: bool = False):
+    def __init__(self, problem, transcription, expand: bool = True, codegen: bool = False):
         model, tr = problem.model, transcription
         nx, nu, np_ = model.nx, model.nu, model.np
-        self.N, self.transcription = N, tr
         m_x, m_u = tr.x_sigma.size, tr.u_sigma.size
         ua = int(tr.u_at_start)
-        n_x, n_u = 1 + N * m_x, N * m_u + ua
         free = problem.free_params
         nf, ft = free.size, int(problem.free_time)
         kernel = tr.kernel(model.f, problem.lagrange)
@@ -184,13 +174,11 @@ class Structure:
         n_bound = sum(c.size for c in problem.boundary)
         n_q = _target_kind(problem)
         qn = int(problem.quaternion_norm_at_t0)
-        self.w = Layout({"X": (nx, n_x), "U": (nu, n_u), "P": (nf, 1), "T": (ft, 1)})
-        self.g = Layout({"defect": (nx, N * m_d), "path": (n_path, n_u), "boundary": (n_bound, 1),
-                         "quat_norm": (qn, 1), "q_final": (n_q, 1)})
+        self.sizes = dict(nx=nx, nu=nu, m_x=m_x, m_u=m_u, ua=ua, m_d=m_d, n_path=n_path,
+                          n_bound=n_bound, n_q=n_q, qn=qn, nf=nf, ft=ft)
         self.common = Layout({"sx": (nx, 1), "su": (nu, 1), "sp": (np_, 1), "sT": (1, 1), "sJ": (1, 1),
                               "spath": (n_path, 1), "sb": (n_bound, 1), "sq": (1, 1), "pval": (np_, 1),
                               "Tfix": (1, 1), "qf": (4 if n_q else 0, 1)})
-        self.params = Layout({**self.common.shapes, "frac": (N, 1)})
         sx_ok = expand and all(f is None or sx_compatible(f) for f in _functions(problem))
         sym = ca.SX if sx_ok else ca.MX
         self.symbolic = sym.__name__
@@ -243,6 +231,81 @@ class Structure:
         end_q = sign * problem.mayer(xf, p, T) / C["sJ"] if problem.mayer is not None else sym.zeros(1, 1)
         end_in = [e, s, c]
 
+        # ------------------------------------------------ local derivative Functions
+        n_seg, n_end = seg_rows.numel(), end_rows.numel()
+        self.sizes.update(n_z=n_z, n_s=n_s, n_seg=n_seg, n_end=n_end)
+        v_seg, v_end = ca.vertcat(z, s), ca.vertcat(e, s)
+        lam_seg, lam_end, lam_f = sym.sym("lam", n_seg), sym.sym("lam", n_end), sym.sym("lam_f")
+
+        self.compiled = bool(codegen and sx_ok and compiler() is not None)
+
+        def local(name, ins, rows_, q, v, lam):
+            J = ca.jacobian(rows_, v)
+            gq = ca.jacobian(q, v)
+            H = ca.triu(ca.hessian(lam_f * q + ca.dot(lam, rows_), v)[0])
+            funs = (ca.Function(f"{name}_val", ins, [rows_, q]),
+                    ca.Function(f"{name}_grad", ins, [q, _nonzeros(gq)]),
+                    ca.Function(f"{name}_jac", ins, [rows_, _nonzeros(J)]),
+                    ca.Function(f"{name}_hess", ins + [lam, lam_f], [_nonzeros(H)]))
+            if self.compiled:  # the derivatives; the values stay SX (IPOPT's nlp_grad differentiates them)
+                funs = (funs[0], *(compile_function(fn) for fn in funs[1:]))
+            return (*funs, _triplets(J), _triplets(gq), _triplets(H))
+
+        self.seg = local("seg", seg_in, seg_rows, seg_q, v_seg, lam_seg)
+        self.ends = local("ends", end_in, end_rows, end_q, v_end, lam_end)
+
+
+def intervals(problem, transcription, expand: bool = True, codegen: bool = False) -> Intervals:
+    """The `Intervals` of ``problem`` transcribed by ``transcription``, from the one cache."""
+    key = structure_key(problem, transcription, 0, expand, codegen)
+    return cached("nlp_intervals", key, lambda: Intervals(problem, transcription, expand, codegen),
+                  keepalive=tuple(f for f in _functions(problem) if f is not None))
+
+
+class Structure:
+    """Symbolic NLP, derivative Functions and index maps of one problem structure.
+
+    Parameters
+    ----------
+    problem : ocp.Problem
+        Supplies the structure only (functions, sizes, flags); its numbers go to `params`.
+    transcription : ocp.Transcription
+    N : int
+        Number of mesh intervals.
+    expand : bool
+        Build the interval functions in SX when every function allows it (faster
+        evaluation); MX otherwise.
+    codegen : bool, optional
+        Compile the (SX) interval functions and their derivatives to C
+        (`dynamics.cache.compile_function`; about 1-3 s once per structure, then kept in the
+        cache with it). Ignored without a C compiler or for MX interval functions.
+
+    Attributes
+    ----------
+    w, g : Layout
+        Decision and constraint vectors (blocks as in `ocp.nlp`).
+    params : Layout
+        The NLP parameter vector ``P`` (`params_value` fills it).
+    nlp : dict
+        ``{'x', 'p', 'f', 'g'}`` (MX) for ``casadi.nlpsol``.
+    derivatives : dict
+        ``grad_f``, ``jac_g``, ``hess_lag`` Functions for the nlpsol options of those names.
+    """
+
+    def __init__(self, problem, transcription, N: int, expand: bool = True, codegen: bool = False):
+        loc = intervals(problem, transcription, expand, codegen)
+        self.N, self.transcription, self.common = N, transcription, loc.common
+        self.symbolic, self.compiled = loc.symbolic, loc.compiled
+        dims = loc.sizes
+        nx, nu, m_x, m_u, ua, m_d = (dims[k] for k in ("nx", "nu", "m_x", "m_u", "ua", "m_d"))
+        n_path, n_z, n_seg, n_end = dims["n_path"], dims["n_z"], dims["n_seg"], dims["n_end"]
+        n_x, n_u = 1 + N * m_x, N * m_u + ua
+        self.w = Layout({"X": (nx, n_x), "U": (nu, n_u), "P": (dims["nf"], 1), "T": (dims["ft"], 1)})
+        self.g = Layout({"defect": (nx, N * m_d), "path": (n_path, n_u), "boundary": (dims["n_bound"], 1),
+                         "quat_norm": (dims["qn"], 1), "q_final": (dims["n_q"], 1)})
+        self.params = Layout({**self.common.shapes, "frac": (N, 1)})
+        seg_f, end_f = loc.seg, loc.ends
+
         # ------------------------------------------------ index maps (numpy)
         Xi, Ui = self.w.indices("X"), self.w.indices("U")
         k = np.arange(N)
@@ -263,28 +326,6 @@ class Structure:
         end_g = np.concatenate([Gp[:, 0] if (ua and n_path) else np.zeros(0, int),
                                 *[self.g.indices(b).reshape(-1) for b in ("boundary", "quat_norm", "q_final")]])
         self._maps = (seg_cols, seg_g, end_cols, end_g)
-
-        # ------------------------------------------------ local derivative Functions
-        n_seg, n_end = seg_rows.numel(), end_rows.numel()
-        v_seg, v_end = ca.vertcat(z, s), ca.vertcat(e, s)
-        lam_seg, lam_end, lam_f = sym.sym("lam", n_seg), sym.sym("lam", n_end), sym.sym("lam_f")
-
-        self.compiled = bool(codegen and sx_ok and compiler() is not None)
-
-        def local(name, ins, rows_, q, v, lam):
-            J = ca.jacobian(rows_, v)
-            gq = ca.jacobian(q, v)
-            H = ca.triu(ca.hessian(lam_f * q + ca.dot(lam, rows_), v)[0])
-            funs = (ca.Function(f"{name}_val", ins, [rows_, q]),
-                    ca.Function(f"{name}_grad", ins, [q, _nonzeros(gq)]),
-                    ca.Function(f"{name}_jac", ins, [rows_, _nonzeros(J)]),
-                    ca.Function(f"{name}_hess", ins + [lam, lam_f], [_nonzeros(H)]))
-            if self.compiled:  # the derivatives; the values stay SX (IPOPT's nlp_grad differentiates them)
-                funs = (funs[0], *(compile_function(fn) for fn in funs[1:]))
-            return (*funs, _triplets(J), _triplets(gq), _triplets(H))
-
-        seg_f = local("seg", seg_in, seg_rows, seg_q, v_seg, lam_seg)
-        end_f = local("ends", end_in, end_rows, end_q, v_end, lam_end)
 
         # ------------------------------------------------ the NLP in MX
         wsym = ca.MX.sym("w", self.w.size)
