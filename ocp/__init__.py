@@ -25,6 +25,7 @@ from .refine import (STATUS_STALLED, BangArcs, IntervalErrors, RefinedSolution, 
                      annotate, bang_arcs, control_switches, find_switches, interval_errors,
                      optimize_switch_times, polish_switches, refine, solve_multistart)
 from .scaling import Scaling
+from .scenarios import scenario_problem, stack, unstack
 from .progress import LOGGER
 from .propagation import SCALE_FLOOR, state_scale
 from .solution import Propagation, Solution
@@ -69,6 +70,9 @@ __all__ = [
     "control_switches",
     "guess_from_simulation",
     "STATUS_STALLED",
+    "scenario_problem",
+    "stack",
+    "unstack",
     "optimize_switch_times",
     "bang_arcs",
     "BangArcs",
