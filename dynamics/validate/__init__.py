@@ -23,7 +23,8 @@ from __future__ import annotations
 
 from .base import ArgumentTypeError, is_symbolic
 from .inertia import check_inertia
-from .numbers import finite_array, finite_scalar, integer, one_of, positive, positive_each
+from .numbers import (finite_array, finite_scalar, integer, nonnegative, one_of, positive,
+                      positive_each)
 from .rotations import (AXIS_NORM_TOL, DCM_ORTHO_TOL, QUAT_NORM_TOL, rotation_matrix, unit_axes,
                         unit_quaternion, unit_quaternions, unit_vector)
 
@@ -40,6 +41,7 @@ __all__ = [
     "unit_vector",
     "unit_axes",
     "positive_each",
+    "nonnegative",
     "unit_quaternion",
     "unit_quaternions",
     "rotation_matrix",

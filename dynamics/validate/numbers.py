@@ -225,6 +225,28 @@ def positive(value, name: str) -> float:
     return v
 
 
+def nonnegative(value, name: str) -> float:
+    """Check a finite number ``>= 0`` and return it as a float (a weight, a tolerance).
+
+    Raises
+    ------
+    TypeError
+        If ``value`` is not a real number.
+    ValueError
+        If it is not finite or negative.
+
+    Examples
+    --------
+    >>> from dynamics.validate import nonnegative
+    >>> nonnegative(0, "effort_weight")
+    0.0
+    """
+    v = finite_scalar(value, name)
+    if not v >= 0:
+        raise ValueError(f"`{name}` must be a finite number >= 0, got {value!r}")
+    return v
+
+
 def positive_each(value, name: str, n: int) -> np.ndarray:
     """A finite number ``> 0`` per device (a scalar is used for all ``n``).
 

@@ -1,0 +1,187 @@
+"""The closed attitude loop of `problems.gains.spacecraft`: the PD law
+``u = -2 kp q_e - kd w`` on `dynamics.rigid_body` with the gains as parameters, its scenarios
+(initial attitude errors and rates), and what the verification measures (torque, error angle,
+settle time, linearization, the time-optimal reference)."""
+from __future__ import annotations
+
+import math
+from typing import Mapping, Sequence
+
+import casadi as ca
+import numpy as np
+
+from dynamics import simulate
+from dynamics.model import Model
+from dynamics.rigid_body import RIGID_BODY_STATES, rigid_body
+from dynamics.validate import finite_array, nonnegative
+
+__all__ = ["attitude_loop", "initial_state", "settle_time", "error_angle", "check_scenarios",
+           "gain_names", "pd_law", "loop_torque", "linearized_loop", "bang_bang_time",
+           "simulate_loop"]
+
+
+# --------------------------------------------------------------------------- input checks
+def initial_state(angle, axis, w0=None) -> np.ndarray:
+    """The state ``[q1, q2, q3, q4, w1, w2, w3]`` of an attitude error ``angle`` about ``axis``.
+
+    Parameters
+    ----------
+    angle : float [rad]
+        Rotation of the body from the target attitude, ``0 <= angle < pi``.
+    axis : array_like, shape (3,)
+        Rotation axis (body frame), nonzero; normalized here.
+    w0 : array_like, shape (3,), optional
+        Body rates [rad/s] (default rest).
+
+    Returns
+    -------
+    ndarray, shape (7,)
+        ``q = [e sin(angle/2), cos(angle/2)]`` (scalar-last, ``q4 > 0``) and ``w0``.
+
+    Raises
+    ------
+    TypeError, ValueError
+        Naming ``angle``, ``axis`` or ``w0``.
+    """
+    a = nonnegative(angle, "angle")
+    if a >= math.pi:
+        raise ValueError(f"`angle` must be below pi (180 deg; the law u = -2 kp q_e - kd w "
+                         f"needs q4 > 0), got {angle!r}")
+    e = finite_array(axis, "axis", (3,))
+    if not np.linalg.norm(e) > 0:
+        raise ValueError("`axis` must be nonzero")
+    e = e / np.linalg.norm(e)
+    w = np.zeros(3) if w0 is None else finite_array(w0, "w0", (3,))
+    return np.concatenate([e * math.sin(a / 2), [math.cos(a / 2)], w])
+
+
+def check_scenarios(scenarios) -> tuple[np.ndarray, list[dict]]:
+    if isinstance(scenarios, (Mapping, str, bytes)) or not isinstance(scenarios, Sequence):
+        raise TypeError("`scenarios` must be a sequence of mappings with 'angle' [rad], "
+                        f"'axis' (3,) and optionally 'w0' (3,) [rad/s], got {type(scenarios).__name__}")
+    if len(scenarios) < 1:
+        raise ValueError("`scenarios` must hold at least one scenario")
+    cols, info = [], []
+    for k, sc in enumerate(scenarios):
+        if not isinstance(sc, Mapping):
+            raise TypeError(f"`scenarios[{k}]` must be a mapping with 'angle', 'axis'[, 'w0'], "
+                            f"got {type(sc).__name__}")
+        unknown = sorted(set(sc) - {"angle", "axis", "w0"})
+        missing = sorted({"angle", "axis"} - set(sc))
+        if unknown or missing:
+            raise ValueError(f"`scenarios[{k}]`: keys are 'angle', 'axis', 'w0'; "
+                             f"unknown {unknown}, missing {missing}")
+        try:
+            x0 = initial_state(sc["angle"], sc["axis"], sc.get("w0"))
+        except (TypeError, ValueError) as exc:
+            raise type(exc)(f"`scenarios[{k}]`: {exc}") from None
+        if not (np.any(x0[:3] != 0) or np.any(x0[4:] != 0)):
+            raise ValueError(f"`scenarios[{k}]` starts at the target at rest (costs nothing)")
+        axis = np.asarray(sc["axis"], dtype=float)
+        cols.append(x0)
+        info.append({"angle": float(sc["angle"]), "axis": axis / np.linalg.norm(axis),
+                     "w0": x0[4:].copy()})
+    return np.array(cols).T, info
+
+
+# ----------------------------------------------------------------------------- the loop
+def gain_names(per_axis: bool) -> tuple[str, ...]:
+    return ("kp1", "kp2", "kp3", "kd1", "kd2", "kd3") if per_axis else ("kp", "kd")
+
+
+def pd_law(x, p, per_axis: bool):
+    """``u = -2 kp q_e - kd w`` (SX/MX or numbers)."""
+    kp, kd = (p[0:3], p[3:6]) if per_axis else (p[0], p[1])
+    return -2 * kp * x[0:3] - kd * x[4:7]
+
+
+def attitude_loop(inertia, *, per_axis: bool = False) -> Model:
+    """The closed loop ``rigid_body(inertia)`` + ``u = -2 kp q_e - kd w``, gains as parameters.
+
+    Parameters
+    ----------
+    inertia : array_like, shape (3, 3) or (3,) [kg m^2]
+    per_axis : bool
+        Gains ``kp1..3, kd1..3`` (per body axis) instead of ``kp, kd``.
+
+    Returns
+    -------
+    dynamics.Model
+        States ``q1..q4, w1..w3`` (error quaternion w.r.t. the target, scalar-last; body rates
+        [rad/s]), no controls, parameters the gains ([N m/rad], [N m s/rad]), ``attitude``
+        marker ``(0, 4)``, built in SX.
+    """
+    body = rigid_body(inertia)
+    names = gain_names(per_axis)
+    x, p = ca.SX.sym("x", 7), ca.SX.sym("p", len(names))
+    xdot = body.f(x, pd_law(x, p, per_axis), ca.DM(0, 1))
+    f = ca.Function("attitude_pd_loop", [x, ca.SX.sym("u", 0), p], [xdot], ["x", "u", "p"], ["xdot"])
+    units = {**{k: v for k, v in dict(body.units).items() if k in RIGID_BODY_STATES},
+             **{n: ("N m/rad" if n.startswith("kp") else "N m s/rad") for n in names}}
+    return Model(f, RIGID_BODY_STATES, (), names, p_default=np.ones(len(names)), units=units,
+                 name="attitude_pd_loop", attitude=(0, 4))
+
+
+def loop_torque(x: np.ndarray, gains: np.ndarray, per_axis: bool) -> np.ndarray:
+    """Torques (3, n) of the law on states (7, n)."""
+    if per_axis:
+        kp, kd = gains[0:3, None], gains[3:6, None]
+    else:
+        kp, kd = gains[0], gains[1]
+    return -2 * kp * x[0:3] - kd * x[4:7]
+
+
+def error_angle(x) -> np.ndarray:
+    """Attitude error angle [rad] in ``[0, pi]`` of states (7, n) (or quaternions (4, n))."""
+    x = np.asarray(x, dtype=float)
+    return 2 * np.arctan2(np.linalg.norm(x[0:3], axis=0), np.abs(x[3]))
+
+
+def settle_time(t, angle, band: float) -> float:
+    """First time after which ``angle`` stays within ``band`` to the end of ``t``.
+
+    Parameters
+    ----------
+    t : array_like, shape (n,) [s]
+    angle : array_like, shape (n,) [rad]
+    band : float [rad]
+
+    Returns
+    -------
+    float [s]
+        ``t[0]`` if always inside; the linearly interpolated last crossing of ``band``;
+        ``inf`` if still outside at ``t[-1]``.
+    """
+    t, a = np.asarray(t, dtype=float), np.asarray(angle, dtype=float)
+    out = np.flatnonzero(a > band)
+    if out.size == 0:
+        return float(t[0])
+    i = int(out[-1])
+    if i == t.size - 1:
+        return float("inf")
+    return float(t[i] + (t[i + 1] - t[i]) * (a[i] - band) / (a[i] - a[i + 1]))
+
+
+def linearized_loop(loop: Model, gains: np.ndarray) -> np.ndarray:
+    """Jacobian (6, 6) of the loop in ``(q1, q2, q3, w1, w2, w3)`` at the target at rest."""
+    x = ca.SX.sym("x", 7)
+    jac = ca.Function("loop_jacobian", [x], [ca.jacobian(loop.f(x, ca.DM(0, 1), ca.DM(gains)), x)])
+    J = np.asarray(jac(np.array([0, 0, 0, 1.0, 0, 0, 0])), dtype=float)
+    keep = [0, 1, 2, 4, 5, 6]
+    return J[np.ix_(keep, keep)]
+
+
+def bang_bang_time(I: np.ndarray, angle: float, axis: np.ndarray, u_max: np.ndarray) -> float:
+    """``2 sqrt(angle / alpha)``, ``alpha = min_i u_max_i / |(J e)_i|`` (the eigenaxis
+    rest-to-rest bang-bang time; an order of magnitude for any axis)."""
+    Je = np.abs(I @ axis)
+    alpha = np.min(u_max[Je > 0] / Je[Je > 0])
+    return 2 * math.sqrt(angle / alpha)
+
+
+def simulate_loop(loop, x0, gains, t):
+    """The loop from ``x0`` under ``gains`` on ``t`` (CVODES, tight local tolerances)."""
+    return simulate(loop, x0, t, p=gains, method="cvodes", rtol=1e-10, atol=1e-12)
+
+
+# ----------------------------------------------------------------------------- the design
