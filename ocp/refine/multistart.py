@@ -17,7 +17,8 @@ __all__ = ["solve_multistart"]
 
 
 @interruptible
-def solve_multistart(problem: Problem, guesses: Sequence, **solve_kwargs) -> RefinedSolution:
+def solve_multistart(problem: Problem, guesses: Sequence, *, start_options: Sequence | None = None,
+                     **solve_kwargs) -> RefinedSolution:
     """Solve ``problem`` from each guess and keep the best converged solution.
 
     Parameters
@@ -25,6 +26,11 @@ def solve_multistart(problem: Problem, guesses: Sequence, **solve_kwargs) -> Ref
     problem : Problem
     guesses : sequence
         Anything ``solve(guess=...)`` accepts: ``None``, a `Solution`, a mapping.
+    start_options : sequence, optional
+        One entry per guess: a mapping of `ocp.solve` keywords for that start (over
+        ``solve_kwargs``), or a sequence of such mappings tried in order until one
+        converges (e.g. a cheap limited-memory attempt, then the exact Hessian). The start's
+        record counts the iterations and time of all its attempts.
     **solve_kwargs
         Passed to `ocp.solve` (quiet unless ``verbose`` or ``progress`` is given).
 
@@ -59,14 +65,24 @@ def solve_multistart(problem: Problem, guesses: Sequence, **solve_kwargs) -> Ref
     if "guess" in solve_kwargs:
         raise ValueError("pass the guesses as `guesses`, not `guess`")
     kw = dict(solve_kwargs)
+    if start_options is not None and (isinstance(start_options, (str, bytes, Mapping))
+                                      or len(start_options) != len(guesses)):
+        raise ValueError(f"`start_options` must hold one entry per guess ({len(guesses)})")
     sols, starts = [], []
     for i, g in enumerate(guesses):
         t = time.perf_counter()
-        sol = solve(problem, guess=g, **kw)
+        tries = [{}] if start_options is None else start_options[i]
+        tries = [tries] if isinstance(tries, Mapping) else list(tries)
+        iterations = 0
+        for extra in tries:
+            sol = solve(problem, guess=g, **{**kw, **extra})
+            iterations += sol.iterations
+            if sol.success:
+                break
         sols.append(sol)
         starts.append({"index": i, "success": sol.success, "status": sol.status, "cost": sol.cost,
                        "T": sol.T, "constraint_violation": sol.constraint_violation,
-                       "iterations": sol.iterations, "time": time.perf_counter() - t})
+                       "iterations": iterations, "time": time.perf_counter() - t})
         LOGGER.info("multistart %d/%d: %s, cost %.12g", i + 1, len(guesses), sol.status, sol.cost)
     ok = [i for i, s in enumerate(sols) if s.success and np.isfinite(s.cost)]
     if ok:
