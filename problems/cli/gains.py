@@ -1,6 +1,6 @@
 """``appdyn gains ...``: feedback-gain design by direct collocation (`problems.gains`).
 
-    appdyn gains launch-vehicle --config lv.toml [--plot FILE.png] [--json FILE]
+    appdyn gains launch-vehicle (--config lv.toml | --example) [--plot FILE.png] [--json FILE]
 
 ``launch-vehicle`` designs the attitude/rate autopilot gains of a thrust-vectored launch
 vehicle (`problems.gains.launch_vehicle.launch_vehicle_gains`) from a TOML file
@@ -30,6 +30,13 @@ def _config_file(text):
     return str(path)
 
 
+def _example() -> str:
+    """Path of the example configuration installed with the package."""
+    from problems.gains.config import EXAMPLE_CONFIG
+
+    return str(EXAMPLE_CONFIG)
+
+
 def add_parser(subparsers) -> argparse.ArgumentParser:
     """Add ``gains`` (with its case ``launch-vehicle``) to ``subparsers``."""
     gains = subparsers.add_parser("gains", help="feedback-gain design by direct collocation",
@@ -47,9 +54,13 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
                     "problems/gains/launch_vehicle.toml). Exit status 1 when the design "
                     "fails (infeasible limits, unstable loop), 2 for a bad configuration.")
     lv.set_defaults(_parser=lv)
-    lv.add_argument("--config", required=True, metavar="FILE.toml", type=_config_file,
-                    help="the design: [vehicle], [limits], [[scenarios]], optional [weights], "
-                         "[design] (problems/gains/config.py)")
+    source = lv.add_mutually_exclusive_group(required=True)
+    source.add_argument("--config", metavar="FILE.toml", type=_config_file,
+                        help="the design: [vehicle], [limits], [[scenarios]], optional [weights], "
+                             "[design] (problems/gains/config.py)")
+    source.add_argument("--example", dest="config", action="store_const", const=_example(),
+                        help="the example design shipped with appdyn "
+                             "(problems/gains/launch_vehicle.toml: a start for your own)")
     lv.add_argument("--plot", metavar="FILE.png", type=_output_file(PLOT_SUFFIXES),
                     help="save attitude, deflection and rate of every scenario "
                          "(.png, .pdf or .svg)")
