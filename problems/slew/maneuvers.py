@@ -214,7 +214,7 @@ def time_optimal(inertia, *, angle=None, axis=None, q0=None, qf=None, u_max=1.0,
     if guesses is not None and keep_out is None:
         # the eigenaxis start: with the exact Hessian IPOPT creeps along the singular eigenaxis
         # optimum (Bilimoria-Wie: 126 iterations, half the slew's time), a limited-memory
-        # Hessian gets there in 16; should that not converge in 50 iterations, the exact one
+        # Hessian gets there in 16; should that not converge in 20 iterations, the exact one
         lm = {"ipopt_options": {**EIGENAXIS_START, **(ipopt_options or {})}}
         start_options = [[lm, {}]] + [{}] * (len(guesses) - 1)
     return solve_time_optimal(problem, guess, guesses, opts,
@@ -224,9 +224,10 @@ def time_optimal(inertia, *, angle=None, axis=None, q0=None, qf=None, u_max=1.0,
 
 
 #: IPOPT options of the first attempt at the eigenaxis start of `time_optimal` (then the exact
-#: Hessian if it does not converge): 0.69 s -> 0.41 s on Bilimoria-Wie, the same T on the 8
-#: slews of the tests.
-EIGENAXIS_START = {"hessian_approximation": "limited-memory", "max_iter": 50}
+#: Hessian if it does not converge): Bilimoria-Wie 0.69 s -> 0.41 s (16 iterations instead
+#: of 126); on 8 test slews the same T, 3.60 s -> 3.58 s in all (a cap of 50 iterations:
+#: 3.99 s, the limited-memory start being slower than the exact one on some slews).
+EIGENAXIS_START = {"hessian_approximation": "limited-memory", "max_iter": 20}
 
 #: Relative amount by which a switch-time polished T (integrated to ~1e-13) may exceed the
 #: fixed-mesh T and still replace it (the fixed mesh's own discretization error, measured
