@@ -29,8 +29,8 @@ from .scenarios import scenario_problem, stack, unstack
 from .progress import LOGGER
 from .propagation import SCALE_FLOOR, state_scale
 from .solution import Propagation, Solution
-from .solve import (DEFAULT_CONSTRAINT_TOL, STATUS_CONSTRAINT_TOL, STATUS_EXCEPTION, STATUS_REST,
-                    Progress, rest_solution, solve)
+from .rest import STATUS_REST, rest_solution
+from .solve import DEFAULT_CONSTRAINT_TOL, STATUS_CONSTRAINT_TOL, STATUS_EXCEPTION, Progress, solve
 from .transcription import (TRANSCRIPTIONS, HermiteSimpson, Radau, RadauConstantControl,
                             Transcription, Trapezoid, get_transcription)
 

@@ -26,7 +26,7 @@ otherwise the result has ``success=False``.
 Status values besides IPOPT's own return statuses: `STATUS_CONSTRAINT_TOL`
 (``'Constraint_Tol_Not_Met'``: IPOPT succeeded but the violation exceeds
 ``constraint_tol``), `STATUS_EXCEPTION` (``'Exception'``: an evaluation error inside
-CasADi) and `STATUS_REST` (``'Rest_Solution'``: `rest_solution`).
+CasADi) and `ocp.rest.STATUS_REST` (``'Rest_Solution'``: `ocp.rest_solution`).
 
 Reuse: build once, solve many
 -----------------------------
@@ -62,14 +62,13 @@ import hashlib
 import time
 from typing import Mapping
 
-import casadi as ca
 import numpy as np
 
 from dynamics.cache import construction_lock
 from dynamics.interrupts import check_interrupt, interruptible
 
 from .cached import checkout
-from .guess import NodeGuess, initial_guess
+from .guess import initial_guess
 from .ipopt_options import check_ipopt_options
 from .mesh import Mesh, check_N
 from .nlp import Discretization
@@ -79,8 +78,8 @@ from .scaling import auto_scaling
 from .solution import Solution
 from .transcription import get_transcription
 
-__all__ = ["solve", "Progress", "rest_solution", "DEFAULT_CONSTRAINT_TOL", "STATUS_CONSTRAINT_TOL",
-           "STATUS_REST", "STATUS_EXCEPTION"]
+__all__ = ["solve", "Progress", "DEFAULT_CONSTRAINT_TOL", "STATUS_CONSTRAINT_TOL", "STATUS_EXCEPTION",
+           "check_constraint_tol", "make_solution", "WARM_START_OPTIONS"]
 
 _SUCCESS = ("Solve_Succeeded",)
 _ACCEPTABLE = "Solved_To_Acceptable_Level"
@@ -88,7 +87,6 @@ _DEFAULT_N = 20
 _RESOLVE_ITER = 200  # iteration budget of the warm re-solve after an acceptable-level stop
 DEFAULT_CONSTRAINT_TOL = 1e-6
 STATUS_CONSTRAINT_TOL = "Constraint_Tol_Not_Met"
-STATUS_REST = "Rest_Solution"
 STATUS_EXCEPTION = "Exception"
 #: IPOPT options of a warm start with primal and dual values (`Solution` of the same structure
 #: on the same mesh as ``guess``); options the caller passes take precedence.
@@ -113,7 +111,7 @@ def _ipopt_options(ipopt_options, constraint_tol: float) -> dict:
     return opts
 
 
-def _check_constraint_tol(constraint_tol) -> float:
+def check_constraint_tol(constraint_tol) -> float:
     if constraint_tol is None:
         return DEFAULT_CONSTRAINT_TOL
     if (isinstance(constraint_tol, (bool, np.bool_))
@@ -246,7 +244,7 @@ def solve(problem: Problem, *, transcription="radau", N: int | None = None, degr
     for name, flag in (("expand", expand), ("codegen", codegen)):
         if flag not in (True, False):
             raise ValueError(f"`{name}` must be True or False, got {flag!r}")
-    ctol = _check_constraint_tol(constraint_tol)
+    ctol = check_constraint_tol(constraint_tol)
     opts = _ipopt_options(ipopt_options, ctol)
 
     t_build = time.perf_counter()
@@ -354,7 +352,7 @@ def _solve_built(problem, tr, m, node_guess, opts, ctol, disc, solver, nlp_opts,
     if not success and default_guess:
         message += _default_guess_hint(problem, node_guess)
     LOGGER.info("solve %s (%s, N=%d): %s; %.3g s", problem.name, tr.name, m.N, message, solve_time)
-    return _make_solution(problem, tr, m, disc, w, lam_g, g, success, status, message,
+    return make_solution(problem, tr, m, disc, w, lam_g, g, success, status, message,
                           iterations, solve_time, build_time, lam_x=lam_x)
 
 
@@ -384,7 +382,7 @@ def _run(solver, args):
     return res, error, str(stats.get("return_status", "Unknown")), int(stats.get("iter_count", 0))
 
 
-def _make_solution(problem, tr, mesh, disc, w, lam_g, g, success, status, message,
+def make_solution(problem, tr, mesh, disc, w, lam_g, g, success, status, message,
                    iterations, solve_time, build_time, lam_x=None) -> Solution:
     """The `Solution` at the scaled NLP point ``w`` (multipliers ``lam_g``, ``lam_x``,
     constraints ``g``)."""
@@ -400,99 +398,3 @@ def _make_solution(problem, tr, mesh, disc, w, lam_g, g, success, status, messag
         success=success, status=status, message=message, iterations=iterations,
         solve_time=solve_time, build_time=build_time, constraint_violation=viol,
         multipliers=disc.multipliers(lam_g), nlp_point=point)
-
-
-def rest_solution(problem: Problem, *, T: float | None = None, transcription="radau",
-                  constraint_tol: float | None = None) -> Solution:
-    """The trajectory that holds the initial state under zero control, checked against the
-    problem's own NLP constraints.
-
-    For a rest-to-rest problem whose target is the initial state (a slew by a zero angle),
-    this is the exact optimum: with a free final time ``T = T_min`` (default, usually 0),
-    with a fixed one the zero control over the whole horizon. Nothing is optimized: the
-    point ``x(t) = x_initial``, ``u = 0``, ``T`` is transcribed on one mesh interval and its
-    `Solution.constraint_violation` (defects, path and boundary constraints, the attitude
-    target, bounds; NLP units, see the module docstring) decides ``success``.
-
-    Parameters
-    ----------
-    problem : Problem
-        With every initial state given.
-    T : float, optional [s]
-        The horizon (default: the lower bound of a free ``T``, the fixed ``T`` otherwise).
-    transcription : str or Transcription, optional
-        The transcription of the returned solution (default ``'radau'``).
-    constraint_tol : float, optional
-        As in `solve` (default `DEFAULT_CONSTRAINT_TOL`).
-
-    Returns
-    -------
-    Solution
-        ``status`` `STATUS_REST` (``'Rest_Solution'``) and ``success=True`` when the held
-        state satisfies every constraint to ``constraint_tol``, else ``success=False`` and
-        `STATUS_CONSTRAINT_TOL`. ``iterations = 0``; with ``T = 0`` every node time is
-        ``t0`` and `Solution.sample` accepts ``t0`` only.
-
-    Raises
-    ------
-    TypeError
-        If ``problem`` is not a `Problem`.
-    ValueError
-        If an initial state is free, or ``T`` is not a finite horizon within the bounds of ``T``.
-
-    Examples
-    --------
-    Holding the state is the exact answer when the target is the initial state:
-
-    >>> import ocp
-    >>> from ocp.examples import double_integrator
-    >>> model = double_integrator()  # x'' = u
-    >>> stay = ocp.Problem(model, T=1.0, x_initial=[0, 0], x_final=[0, 0],
-    ...                    lagrange=lambda x, u, p: 0.5 * u**2)
-    >>> sol = ocp.rest_solution(stay)
-    >>> sol.success, sol.status, sol.cost, sol.iterations
-    (True, 'Rest_Solution', 0.0, 0)
-    """
-    if not isinstance(problem, Problem):
-        raise TypeError(f"`problem` must be an ocp.Problem, got {type(problem).__name__}")
-    if np.any(np.isnan(problem.x_initial)):
-        raise ValueError("`problem` must give every initial state for a rest solution")
-    lo, hi = problem.T_bounds
-    if T is None:
-        T = lo if problem.free_time else problem.T
-    if isinstance(T, (bool, np.bool_)) or not isinstance(T, (int, float, np.integer, np.floating)):
-        raise ValueError(f"`T` must be a number [s], got {T!r}")
-    T = float(T)
-    if not (np.isfinite(T) and lo <= T <= hi):
-        raise ValueError(f"`T` must be a finite horizon in [{lo}, {hi}] s, got {T}")
-    ctol = _check_constraint_tol(constraint_tol)
-    t_build = time.perf_counter()
-    tr = get_transcription(transcription)
-    mesh = Mesh.uniform(1)
-    nx, nu = problem.model.nx, problem.model.nu
-    n_x = 1 + tr.x_sigma.size
-    n_u = tr.u_sigma.size + int(tr.u_at_start)
-    x0 = np.asarray(problem.x_initial, dtype=float)
-    p = np.asarray(problem.p, dtype=float)
-    node = NodeGuess(X=np.repeat(x0[:, None], n_x, axis=1), U=np.zeros((nu, n_u)),
-                     Xu=np.repeat(x0[:, None], n_u, axis=1), p=p, T=T)
-    scaling = auto_scaling(problem, node, {"T": 1.0} if T == 0 else None)
-    disc = Discretization(problem, tr, mesh, scaling)
-    free = problem.free_params
-    sc = scaling
-    w = disc.w.join({"X": node.X / sc.x[:, None], "U": node.U / sc.u[:, None],
-                     "P": (p[free] / sc.p[free])[:, None],
-                     "T": np.full((int(problem.free_time), 1), T / sc.T)})
-    g = disc.constraints(w)
-    viol = disc.violation(g, w) if np.all(np.isfinite(g)) else float("nan")
-    success = bool(viol <= ctol)
-    if success:
-        status = STATUS_REST
-        message = (f"rest solution: the initial state held under zero control for T = {T:g} s meets "
-                   f"every constraint (violation {viol:.2g} <= constraint_tol {ctol:g})")
-    else:
-        status = STATUS_CONSTRAINT_TOL
-        message = (f"the initial state held under zero control for T = {T:g} s violates the "
-                   f"constraints by {viol:.3g} > constraint_tol {ctol:g}: not a solution")
-    return _make_solution(problem, tr, mesh, disc, w, np.zeros(disc.g.size), g, success, status,
-                          message, 0, 0.0, time.perf_counter() - t_build)

@@ -11,7 +11,8 @@ from dynamics import rigid_body
 from dynamics.attitude import quat_from_axis_angle
 from ocp import (DEFAULT_CONSTRAINT_TOL, Problem, RadauConstantControl, check_ipopt_options,
                  ipopt_option_table, rest_solution, solve)
-from ocp.solve import STATUS_CONSTRAINT_TOL, STATUS_REST
+from ocp.rest import STATUS_REST
+from ocp.solve import STATUS_CONSTRAINT_TOL
 
 from .reference import bang_bang, min_energy
 
