@@ -1,11 +1,17 @@
 """`solve_multistart`: solve from several guesses, keep the best converged solution."""
 from __future__ import annotations
 
+import hashlib
+import pickle
+import threading
 import time
+from collections import OrderedDict
+from concurrent.futures import ThreadPoolExecutor
 from typing import Mapping, Sequence
 
 import numpy as np
 
+from dynamics.executors import check_executor, gather
 from dynamics.interrupts import interruptible
 from ..problem import Problem
 from ..progress import LOGGER
@@ -15,10 +21,14 @@ from .result import RefinedSolution, annotate
 
 __all__ = ["solve_multistart"]
 
+_RECEIVED: OrderedDict = OrderedDict()  # in a worker: digest -> Problem, the latest few
+_RECEIVED_MAX = 4
+_RECEIVED_LOCK = threading.Lock()
+
 
 @interruptible
 def solve_multistart(problem: Problem, guesses: Sequence, *, start_options: Sequence | None = None,
-                     **solve_kwargs) -> RefinedSolution:
+                     executor=None, **solve_kwargs) -> RefinedSolution:
     """Solve ``problem`` from each guess and keep the best converged solution.
 
     Parameters
@@ -31,6 +41,25 @@ def solve_multistart(problem: Problem, guesses: Sequence, *, start_options: Sequ
         ``solve_kwargs``), or a sequence of such mappings tried in order until one
         converges (e.g. a cheap limited-memory attempt, then the exact Hessian). The start's
         record counts the iterations and time of all its attempts.
+    executor : concurrent.futures.Executor, optional
+        Run the starts as tasks of this executor (a ``ThreadPoolExecutor``, a
+        ``ProcessPoolExecutor``, dask.distributed's ``client.get_executor()``, ...), one
+        task per start (its ``start_options`` attempts included). The outcome is the serial
+        one: the same best start (same ranking, ties to the lower index) and the same
+        ``info['starts']`` records but their ``time``. The executor stays the caller's (not
+        shut down). ``None`` (default): serial, in the calling thread.
+
+        A process pool pickles ``problem`` (an `ocp.Problem` pickles, its CasADi functions
+        included), each guess (``None``, a mapping of arrays and numbers, a `Solution`) and
+        ``solve_kwargs``: a callable in them (a guess function, ``progress``) must be
+        picklable, i.e. defined at module level, not a lambda. The problem is pickled once
+        and unpickled once per worker process, so that the starts a worker runs share its
+        NLP and solver (`dynamics.cache` is per process: each worker builds its own, a cost
+        a serial run pays once). The returned solution's ``problem`` is ``problem`` itself
+        (the copy the worker solved is swapped back). Workers import CasADi on first use
+        (about a second with ``spawn``); any start method works, with ``spawn`` the calling
+        script needs the usual ``if __name__ == "__main__":`` guard. A ``ThreadPoolExecutor``
+        shares ``problem`` as it is (concurrent solves are safe: `ocp.solve`).
     **solve_kwargs
         Passed to `ocp.solve` (quiet unless ``verbose`` or ``progress`` is given).
 
@@ -46,7 +75,16 @@ def solve_multistart(problem: Problem, guesses: Sequence, *, start_options: Sequ
     Raises
     ------
     ValueError
-        If ``guesses`` is empty or not a sequence, or a guess is malformed (as `ocp.solve`).
+        If ``guesses`` is empty or not a sequence, or a guess is malformed (as `ocp.solve`;
+        with an ``executor``: the error of the lowest failing start, the starts after it
+        cancelled).
+    TypeError
+        If ``executor`` is not a ``concurrent.futures.Executor``.
+    KeyboardInterrupt
+        On Ctrl-C. With an ``executor`` the wait looks for it every 0.1 s and cancels the
+        starts not yet begun; running starts cannot be stopped from here and finish in
+        the background (threads) or in their worker (processes), and shutting the executor
+        down waits for them.
 
     Examples
     --------
@@ -56,6 +94,14 @@ def solve_multistart(problem: Problem, guesses: Sequence, *, start_options: Sequ
     >>> sol = ocp.solve_multistart(fastest, [None, {"T": 5.0}], N=10)
     >>> sol.success, round(sol.T, 6), len(sol.info["starts"])
     (True, 2.0, 2)
+
+    The same starts on two threads (a ``ProcessPoolExecutor`` is used the same way):
+
+    >>> from concurrent.futures import ThreadPoolExecutor
+    >>> with ThreadPoolExecutor(max_workers=2) as pool:
+    ...     again = ocp.solve_multistart(fastest, [None, {"T": 5.0}], N=10, executor=pool)
+    >>> again.T == sol.T, again.info["best"] == sol.info["best"]
+    (True, True)
     """
     if isinstance(guesses, (str, bytes, Mapping, Solution)) or not isinstance(guesses, Sequence):
         raise ValueError(f"`guesses` must be a sequence of guesses (None, Solution or mapping), "
@@ -68,22 +114,27 @@ def solve_multistart(problem: Problem, guesses: Sequence, *, start_options: Sequ
     if start_options is not None and (isinstance(start_options, (str, bytes, Mapping))
                                       or len(start_options) != len(guesses)):
         raise ValueError(f"`start_options` must hold one entry per guess ({len(guesses)})")
-    sols, starts = [], []
-    for i, g in enumerate(guesses):
-        t = time.perf_counter()
-        tries = [{}] if start_options is None else start_options[i]
-        tries = [tries] if isinstance(tries, Mapping) else list(tries)
-        iterations = 0
-        for extra in tries:
-            sol = solve(problem, guess=g, **{**kw, **extra})
-            iterations += sol.iterations
-            if sol.success:
-                break
-        sols.append(sol)
-        starts.append({"index": i, "success": sol.success, "status": sol.status, "cost": sol.cost,
-                       "T": sol.T, "constraint_violation": sol.constraint_violation,
-                       "iterations": iterations, "time": time.perf_counter() - t})
+    check_executor(executor)
+    # to another process the problem travels pickled once, and is unpickled once per worker
+    sent = problem if executor is None or isinstance(executor, ThreadPoolExecutor) \
+        else _Shipped(problem)
+    tasks = [(sent, g, [{}] if start_options is None else start_options[i], kw)
+             for i, g in enumerate(guesses)]
+    sols, starts = [None] * len(guesses), [None] * len(guesses)
+
+    def record(i, out):
+        sol, iterations, elapsed = out
+        sols[i] = sol
+        starts[i] = {"index": i, "success": sol.success, "status": sol.status, "cost": sol.cost,
+                     "T": sol.T, "constraint_violation": sol.constraint_violation,
+                     "iterations": iterations, "time": elapsed}
         LOGGER.info("multistart %d/%d: %s, cost %.12g", i + 1, len(guesses), sol.status, sol.cost)
+
+    if executor is None:
+        for i, task in enumerate(tasks):
+            record(i, _start(*task))
+    else:
+        gather(executor, _start, tasks, record)
     ok = [i for i, s in enumerate(sols) if s.success and np.isfinite(s.cost)]
     if ok:
         best = ok[0]
@@ -97,5 +148,44 @@ def solve_multistart(problem: Problem, guesses: Sequence, *, start_options: Sequ
         best = int(np.argmin(viol))
         message = (f"none of {len(sols)} starts converged; returning start {best}, the least "
                    f"infeasible: {sols[best].message}")
+    same = {} if sols[best].problem is problem else {"problem": problem}  # from a process
     return annotate(sols[best], {"starts": starts, "best": best}, message=message,
-                     success=bool(ok) and sols[best].success)
+                    success=bool(ok) and sols[best].success, **same)
+
+
+class _Shipped:
+    """A `Problem` pickled once for the tasks of a process executor.
+
+    `get` unpickles it once per worker process (kept by digest, the latest `_RECEIVED_MAX`),
+    so that the starts a worker runs share one problem, and with it the NLP and solver that
+    `ocp.solve` caches by the identity of the problem's functions.
+    """
+
+    def __init__(self, problem):
+        self.data = pickle.dumps(problem, protocol=pickle.HIGHEST_PROTOCOL)
+        self.digest = hashlib.sha256(self.data).hexdigest()
+
+    def get(self) -> Problem:
+        with _RECEIVED_LOCK:
+            problem = _RECEIVED.get(self.digest)
+            if problem is None:
+                problem = _RECEIVED[self.digest] = pickle.loads(self.data)
+                while len(_RECEIVED) > _RECEIVED_MAX:
+                    _RECEIVED.popitem(last=False)
+            _RECEIVED.move_to_end(self.digest)
+        return problem
+
+
+def _start(problem, guess, tries, kw):
+    """One start: ``(solution, iterations of all attempts, wall time)``; an executor task."""
+    t = time.perf_counter()
+    if isinstance(problem, _Shipped):
+        problem = problem.get()
+    tries = [tries] if isinstance(tries, Mapping) else list(tries)
+    iterations = 0
+    for extra in tries:
+        sol = solve(problem, guess=guess, **{**kw, **extra})
+        iterations += sol.iterations
+        if sol.success:
+            break
+    return sol, iterations, time.perf_counter() - t

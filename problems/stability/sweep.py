@@ -2,16 +2,15 @@
 from __future__ import annotations
 
 import inspect
-import json
-from dataclasses import asdict, dataclass
 
 import numpy as np
 
+from dynamics.executors import check_executor, gather
 from dynamics.interrupts import check_interrupt, interruptible
 
 from .cases import resolve_case
-from .common import finish_figure, format_complex, jsonable, param_text, plain
-from .report import STATUS_MISMATCH, STATUS_UNCHECKED, status_message
+from .common import plain
+from .sweep_result import Boundary, SweepResult
 
 __all__ = ["Boundary", "SweepResult", "sweep"]
 
@@ -19,175 +18,8 @@ _STABLE_UNSTABLE = {"asymptotically stable", "unstable"}
 _BAND_RTOL = 1e-4  # a "marginally stable" stretch this narrow between the two is a zero band
 
 
-@dataclass(frozen=True)
-class Boundary:
-    """A change of verdict located by bisection.
-
-    Attributes
-    ----------
-    value : float
-        Midpoint of the final bracket.
-    lower, upper : float
-        The bracket, ``|upper - lower| <= rtol * |value|``.
-    before, after : str
-        Verdicts at ``lower`` and ``upper`` (in sweep order).
-    """
-
-    value: float
-    lower: float
-    upper: float
-    before: str
-    after: str
-
-
-@dataclass(frozen=True)
-class SweepResult:
-    """Verdicts and least-damped eigenvalues of a case along one parameter.
-
-    Attributes
-    ----------
-    case : str
-        The case's name in `CASES`.
-    parameter : str
-        The swept keyword.
-    values : ndarray, shape (n,)
-        The grid.
-    verdicts : tuple of str, length n
-        The verdict at each grid value.
-    least_damped : ndarray of complex, shape (n,) [1/s]
-        The eigenvalue with the largest real part at each grid value.
-    eigenvalues : ndarray of complex, shape (n, m)
-        Sorted by (Re, Im); nan-padded.
-    boundaries : tuple of Boundary
-        The verdict changes, in sweep order.
-    rtol : float
-        Relative bracket width of the bisection.
-    evaluations : int
-        Case evaluations, bisection included.
-    case_kwargs : dict
-        The fixed arguments as plain Python values.
-    statuses : tuple of int, length n
-        The report status at each grid value (`STATUS_VERIFIED`, ...).
-    complete : bool
-        False for the partial result of an interrupted sweep (`sweep`, Ctrl-C): the grid
-        values evaluated before the interrupt, and the boundaries located by then.
-    success : bool
-        False when some report disagreed with its closed forms (property).
-    status : int
-        The worst of ``statuses`` (property).
-    message : str
-        ``status`` in words (property).
-    """
-
-    case: str
-    parameter: str
-    values: np.ndarray
-    verdicts: tuple
-    least_damped: np.ndarray
-    eigenvalues: np.ndarray
-    boundaries: tuple
-    rtol: float
-    evaluations: int
-    case_kwargs: dict
-    statuses: tuple = ()
-    complete: bool = True
-
-    @property
-    def status(self) -> int:
-        """The worst report status along the grid (`STATUS_MISMATCH` > `STATUS_UNCHECKED` >
-        `STATUS_VERIFIED`)."""
-        return max(self.statuses, default=STATUS_UNCHECKED)
-
-    @property
-    def success(self) -> bool:
-        """``False`` when a report along the grid disagreed with its closed forms."""
-        return self.status != STATUS_MISMATCH
-
-    @property
-    def message(self) -> str:
-        """``status`` in words."""
-        text = status_message(self.status)
-        if self.status == STATUS_MISMATCH:
-            bad = [float(v) for v, s in zip(self.values, self.statuses) if s == STATUS_MISMATCH]
-            text += f" at {self.parameter} = {bad}"
-        if not self.complete:
-            text += (f"; interrupted after {len(self.values)} grid values "
-                     f"(boundaries located by then only)")
-        return text
-
-    def to_dict(self) -> dict:
-        """JSON-ready summary (complex as ``[re, im]``)."""
-        return jsonable({"case": self.case, "parameter": self.parameter,
-                          "success": self.success, "status": self.status,
-                          "message": self.message, "statuses": list(self.statuses),
-                          "values": self.values, "verdicts": list(self.verdicts),
-                          "least_damped": self.least_damped, "eigenvalues": self.eigenvalues,
-                          "boundaries": [asdict(b) for b in self.boundaries],
-                          "rtol": self.rtol, "evaluations": self.evaluations,
-                          "case_kwargs": self.case_kwargs, "complete": self.complete})
-
-    def to_json(self) -> str:
-        """`to_dict` as strict JSON text."""
-        return json.dumps(self.to_dict(), indent=2, allow_nan=False)
-
-    def __str__(self) -> str:
-        lines = [f"Sweep of {self.case} over {self.parameter} ({len(self.values)} values, "
-                 f"{self.evaluations} evaluations{'' if self.complete else ', interrupted'})"]
-        if self.case_kwargs:
-            lines.append("  fixed: " + param_text(self.case_kwargs))
-        lines.append(f"  {self.parameter:>16}  {'verdict':<22} "
-                     f"{'least-damped eigenvalue [1/s]':>33}")
-        for v, verdict, z in zip(self.values, self.verdicts, self.least_damped):
-            lines.append(f"  {v:>16.8g}  {verdict:<22} {format_complex(z):>33}")
-        if self.boundaries:
-            lines.append(f"boundaries (bisection to {self.rtol:.0e} relative):")
-            for b in self.boundaries:
-                lines.append(f"  {self.parameter} = {b.value:.12g}   {b.before} -> {b.after}")
-        else:
-            lines.append("no verdict change along the sweep")
-        return "\n".join(lines)
-
-    def plot(self, path=None, *, fig=None):
-        """Real and imaginary parts of every eigenvalue versus the parameter.
-
-        Parameters
-        ----------
-        path : str or path-like, optional
-            Also save the figure there (format from the suffix; PNG without one).
-        fig : matplotlib.figure.Figure, optional
-            Draw two axes on this figure; by default on a new one (no pyplot).
-
-        Returns
-        -------
-        matplotlib.figure.Figure
-        """
-        if fig is None:
-            from matplotlib.figure import Figure
-
-            fig = Figure(figsize=(8.0, 6.5))
-        ax1, ax2 = fig.add_subplot(2, 1, 1), fig.add_subplot(2, 1, 2)
-        ev = self.eigenvalues
-        for j in range(ev.shape[1]):
-            ax1.plot(self.values, ev[:, j].real, ".", ms=3, color="tab:blue")
-            ax2.plot(self.values, ev[:, j].imag, ".", ms=3, color="tab:blue")
-        ax1.plot(self.values, self.least_damped.real, "-", color="tab:red", lw=1,
-                 label="least damped")
-        for b in self.boundaries:
-            for ax in (ax1, ax2):
-                ax.axvline(b.value, color="k", ls="--", lw=0.8)
-        ax1.axhline(0, color="0.5", lw=0.8)
-        ax1.set_ylabel("Re [1/s]")
-        ax2.set_ylabel("Im [rad/s]")
-        ax2.set_xlabel(self.parameter)
-        ax1.set_title(f"{self.case}: eigenvalues vs {self.parameter} (dashed: boundaries)")
-        ax1.legend(fontsize=8)
-        for ax in (ax1, ax2):
-            ax.grid(True, alpha=0.3)
-        return finish_figure(fig, path)
-
-
 @interruptible
-def sweep(case, parameter: str, values, *, rtol: float = 1e-8, progress=None,
+def sweep(case, parameter: str, values, *, rtol: float = 1e-8, progress=None, executor=None,
           **case_kwargs) -> SweepResult:
     """Run ``case`` for each value of ``parameter`` and locate the verdict boundaries.
 
@@ -213,7 +45,24 @@ def sweep(case, parameter: str, values, *, rtol: float = 1e-8, progress=None,
         Relative bracket width of the bisection.
     progress : callable, optional
         ``progress(done, total)`` after each grid value (``total = len(values)``; the
-        bisections that follow are not counted).
+        bisections that follow are not counted). With an ``executor``, called in the calling
+        thread as the grid values complete (in completion order).
+    executor : concurrent.futures.Executor, optional
+        Spread the work over this executor (a ``ThreadPoolExecutor``, a
+        ``ProcessPoolExecutor``, dask.distributed's ``client.get_executor()``, ...): every
+        grid value is one task, then the bisection between each pair of neighbouring grid
+        values whose verdicts differ is one task. The result is the serial one: the same
+        verdicts, eigenvalues, boundaries and ``evaluations`` (each task runs the serial
+        code). The executor stays the caller's (not shut down). ``None`` (default): serial,
+        in the calling thread.
+
+        A process pool receives the case by name (looked up in `CASES` in the worker), so
+        ``case_kwargs`` must pickle (numbers, arrays, the damper and vehicle objects of
+        this package do); the workers import ``problems.stability`` (and CasADi) on first
+        use, about a second each, so a process pool pays off for expensive cases or many
+        values. Any start method works (``fork``, ``spawn``, ``forkserver``); with
+        ``spawn`` the calling script needs the usual ``if __name__ == "__main__":`` guard.
+        The merge of a verdict's zero band around a crossing (below) runs in the caller.
     **case_kwargs
         The case's other arguments (by keyword).
 
@@ -225,7 +74,10 @@ def sweep(case, parameter: str, values, *, rtol: float = 1e-8, progress=None,
     ------
     ValueError
         Naming ``case``, ``parameter``, ``values`` or ``rtol``; a ValueError of the case at
-        one value is re-raised with that value.
+        one value is re-raised with that value (with an ``executor``: the error of the
+        lowest failing grid value, as in a serial run; the tasks after it are cancelled).
+    TypeError
+        If ``executor`` is not a ``concurrent.futures.Executor``.
     KeyboardInterrupt
         On Ctrl-C (within one case evaluation, `dynamics.interrupts`). When some grid values
         were finished, the exception's ``partial`` attribute is their `SweepResult`
@@ -235,6 +87,13 @@ def sweep(case, parameter: str, values, *, rtol: float = 1e-8, progress=None,
                 res = stability.sweep(...)
             except KeyboardInterrupt as exc:
                 res = getattr(exc, "partial", None)
+
+        With an ``executor`` the wait for the tasks looks for Ctrl-C every 0.1 s; the tasks
+        not yet started are cancelled, and ``partial`` holds every grid value finished by
+        then (in grid order; not necessarily a prefix of ``values``) and the boundaries of
+        the finished bisection tasks. Tasks already running cannot be stopped from here:
+        they finish in the background (threads) or in their worker (processes, unless the
+        Ctrl-C reached the workers too), and shutting the executor down waits for them.
 
     Examples
     --------
@@ -249,6 +108,23 @@ def sweep(case, parameter: str, values, *, rtol: float = 1e-8, progress=None,
     >>> b = res.boundaries[0]
     >>> print(f"{b.value:.6f}: {b.before} -> {b.after}")
     24.256937: unstable -> marginally stable
+
+    The same sweep on two threads; in a script, a process pool the same way (the case
+    travels by name, the arguments must pickle)::
+
+        from concurrent.futures import ProcessPoolExecutor
+
+        if __name__ == "__main__":
+            with ProcessPoolExecutor(max_workers=2) as pool:
+                res = stability.sweep("heavy_top", "rate", ..., executor=pool)
+
+    >>> from concurrent.futures import ThreadPoolExecutor
+    >>> with ThreadPoolExecutor(max_workers=2) as pool:
+    ...     again = stability.sweep("heavy_top", "rate", np.linspace(0, 60, 7),
+    ...                             axial_inertia=0.002, transverse_inertia=0.005, mass=0.3,
+    ...                             length=0.04, executor=pool)
+    >>> again.boundaries == res.boundaries and again.to_json() == res.to_json()
+    True
     """
     name, fun = resolve_case(case)
     sig = inspect.signature(fun)
@@ -270,52 +146,32 @@ def sweep(case, parameter: str, values, *, rtol: float = 1e-8, progress=None,
     except TypeError as exc:
         raise ValueError(f"`case_kwargs` do not fit {name}{sig}: {exc}") from None
 
+    check_executor(executor)
+    evaluate = _Case(name, parameter, case_kwargs)
     count = [0]
 
     def run(v):
         check_interrupt()
         count[0] += 1
-        try:
-            return fun(**{parameter: float(v)}, **case_kwargs)
-        except ValueError as exc:
-            raise ValueError(f"{name} at {parameter} = {float(v)!r}: {exc}") from None
-
-    def narrow(lo, hi):
-        return abs(hi - lo) > rtol * max(abs(lo), abs(hi)) and lo < 0.5 * (lo + hi) < hi
+        return evaluate(v)
 
     def crossing(lo, hi, unstable_at_lo):
-        """Bisect the sign of the largest real part (continuous through the crossing)."""
-        while narrow(lo, hi):
-            mid = 0.5 * (lo + hi)
-            if (run(mid).least_damped().real > 0) == unstable_at_lo:
-                lo = mid
-            else:
-                hi = mid
-        return lo, hi
-
-    def locate(a, va, b, vb):
-        if {va, vb} == _STABLE_UNSTABLE:
-            lo, hi = crossing(a, b, va == "unstable")
-            return [Boundary(0.5 * (lo + hi), lo, hi, va, vb)]
-        lo, hi, vhi = a, b, vb
-        while narrow(lo, hi):
-            mid = 0.5 * (lo + hi)
-            vm = run(mid).verdict
-            if vm == va:
-                lo = mid
-            else:
-                hi, vhi = mid, vm
-        here = [Boundary(0.5 * (lo + hi), lo, hi, va, vhi)]
-        if vhi != vb:
-            here += locate(hi, vhi, b, vb)
-        return here
+        return _crossing(run, lo, hi, unstable_at_lo, rtol)
 
     reports, found = [], []
+    done = {}  # grid index -> report, with an executor
 
     def result(boundaries, complete=True):
-        return _result(name, parameter, vals[:len(reports)], reports, boundaries, rtol, count[0],
-                       case_kwargs, complete)
+        if executor is None:
+            return _result(name, parameter, vals[:len(reports)], reports, boundaries, rtol,
+                           count[0], case_kwargs, complete)
+        order = sorted(done)
+        return _result(name, parameter, vals[order], [done[i] for i in order], boundaries,
+                       rtol, count[0], case_kwargs, complete)
 
+    if executor is not None:
+        return _sweep_on(executor, evaluate, vals, rtol, progress, done, count, crossing,
+                         result)
     try:
         for v in vals:
             reports.append(run(v))
@@ -324,13 +180,106 @@ def sweep(case, parameter: str, values, *, rtol: float = 1e-8, progress=None,
         verdicts = tuple(r.verdict for r in reports)
         for i in range(len(vals) - 1):
             if verdicts[i] != verdicts[i + 1]:
-                found += locate(vals[i], verdicts[i], vals[i + 1], verdicts[i + 1])
+                found += _locate(run, vals[i], verdicts[i], vals[i + 1], verdicts[i + 1], rtol)
         return result(_merged(found, rtol, crossing))
     except KeyboardInterrupt as exc:
         if reports:  # what was finished rides on the interrupt
             exc.partial = result(tuple(found), complete=False)
         raise
 
+
+class _Case:
+    """One case at fixed arguments, called with a value of the swept parameter.
+
+    Picklable for a process pool: the case travels by name and is looked up in `CASES` on
+    the worker.
+    """
+
+    def __init__(self, name, parameter, case_kwargs):
+        self.name, self.parameter, self.case_kwargs = name, parameter, case_kwargs
+
+    def __call__(self, v):
+        fun = resolve_case(self.name)[1]
+        try:
+            return fun(**{self.parameter: float(v)}, **self.case_kwargs)
+        except ValueError as exc:
+            raise ValueError(f"{self.name} at {self.parameter} = {float(v)!r}: {exc}") from None
+
+
+def _narrow(lo, hi, rtol) -> bool:
+    return abs(hi - lo) > rtol * max(abs(lo), abs(hi)) and lo < 0.5 * (lo + hi) < hi
+
+
+def _crossing(run, lo, hi, unstable_at_lo, rtol):
+    """Bisect the sign of the largest real part (continuous through the crossing)."""
+    while _narrow(lo, hi, rtol):
+        mid = 0.5 * (lo + hi)
+        if (run(mid).least_damped().real > 0) == unstable_at_lo:
+            lo = mid
+        else:
+            hi = mid
+    return lo, hi
+
+
+def _locate(run, a, va, b, vb, rtol) -> list:
+    """The boundaries between ``a`` (verdict ``va``) and ``b`` (``vb``), by bisection."""
+    if {va, vb} == _STABLE_UNSTABLE:
+        lo, hi = _crossing(run, a, b, va == "unstable", rtol)
+        return [Boundary(0.5 * (lo + hi), lo, hi, va, vb)]
+    lo, hi, vhi = a, b, vb
+    while _narrow(lo, hi, rtol):
+        mid = 0.5 * (lo + hi)
+        vm = run(mid).verdict
+        if vm == va:
+            lo = mid
+        else:
+            hi, vhi = mid, vm
+    here = [Boundary(0.5 * (lo + hi), lo, hi, va, vhi)]
+    if vhi != vb:
+        here += _locate(run, hi, vhi, b, vb, rtol)
+    return here
+
+
+def _locate_task(evaluate, a, va, b, vb, rtol):
+    """`_locate` as one executor task: ``(boundaries, evaluations)``."""
+    count = [0]
+
+    def run(v):
+        count[0] += 1
+        return evaluate(v)
+
+    return _locate(run, a, va, b, vb, rtol), count[0]
+
+
+def _sweep_on(executor, evaluate, vals, rtol, progress, done, count, crossing, result):
+    """The body of `sweep` with an executor: the grid values, then one bisection task per
+    verdict change; ``done`` (grid index -> report) is filled as they finish."""
+    located = {}  # interval index -> boundaries
+    try:
+        def grid_done(i, report):
+            done[i] = report
+            count[0] += 1
+            if progress is not None:
+                progress(len(done), len(vals))
+
+        gather(executor, evaluate, [(v,) for v in vals], grid_done)
+        verdicts = [done[i].verdict for i in range(len(vals))]
+        changes = [i for i in range(len(vals) - 1) if verdicts[i] != verdicts[i + 1]]
+
+        def bisected(k, out):
+            located[changes[k]] = out[0]
+            count[0] += out[1]
+
+        gather(executor, _locate_task,
+                [(evaluate, vals[i], verdicts[i], vals[i + 1], verdicts[i + 1], rtol)
+                 for i in changes], bisected)
+        found = [b for i in sorted(located) for b in located[i]]
+        return result(_merged(found, rtol, crossing))
+    except KeyboardInterrupt as exc:
+        if done:
+            exc.partial = result(tuple(b for i in sorted(located) for b in located[i]),
+                                 complete=False)
+        raise
 
 
 def _merged(found, rtol, crossing) -> tuple:
