@@ -13,10 +13,12 @@
     appdyn cmg envelope --beta 54.74 [--h 1] [--directions N] [--plot F.png] [--json F]
     appdyn cmg steer --beta 54.74 --torque 0,0,0.5 --law sr|pinv|gsr --t-final 10 [--delta0 ...]
     appdyn gains launch-vehicle --config lv.toml [--plot F.png] [--json F]
+    appdyn dispersion spin [--samples N] [--seed S] [--workers N | --scheduler ADDR] [--plot F.png]
     appdyn demo
     appdyn bench [NAME ...]
 
-One module per command (`simulate`, `slew`, `stability`, `cmg`, `gains`, `demo`, `bench`), each with
+One module per command (`simulate`, `slew`, `stability`, `cmg`, `gains`, `dispersion`, `demo`,
+`bench`), each with
 ``add_parser(subparsers)``, ``check(parser, args)`` (checks across options, before any
 computation) and ``run(args) -> exit status``; `common` holds what they share.
 
@@ -37,7 +39,7 @@ import os
 import re
 import sys
 
-from problems.cli import bench, cmg, demo, gains, simulate, slew, stability
+from problems.cli import bench, cmg, demo, dispersion, gains, simulate, slew, stability
 from problems.cli.common import attach_negative_values
 from problems.cli.slew import rest_to_rest_bound
 
@@ -45,7 +47,7 @@ __all__ = ["main", "build_parser", "COMMANDS", "rest_to_rest_bound"]
 
 #: command name -> its module (``add_parser``, ``check``, ``run``), in the order of ``--help``
 COMMANDS = {"simulate": simulate, "slew": slew, "stability": stability, "cmg": cmg,
-            "gains": gains, "demo": demo, "bench": bench}
+            "gains": gains, "dispersion": dispersion, "demo": demo, "bench": bench}
 
 
 def build_parser() -> argparse.ArgumentParser:

@@ -10,6 +10,7 @@ the input can be checked up front).
 from __future__ import annotations
 
 import argparse
+import contextlib
 import math
 import os
 import re
@@ -234,6 +235,40 @@ def save_figure(fig, path) -> None:
 def write_json(data, path) -> None:
     """Write ``data`` to ``path`` as strict JSON."""
     Path(path).write_text(strict_json(data) + "\n")
+
+
+def add_executor_options(parser) -> None:
+    """``--workers N`` (a local process pool) or ``--scheduler ADDRESS`` (a Dask cluster):
+    where the independent runs of a command go (`executor_from`)."""
+    where = parser.add_mutually_exclusive_group()
+    where.add_argument("--workers", type=integer(1), metavar="N",
+                       help="run the independent pieces on N local processes (default: serial)")
+    where.add_argument("--scheduler", metavar="ADDRESS",
+                       help="run them on a Dask cluster (e.g. tcp://host:8786; needs the "
+                            "[distributed] extra and appdyn on every worker)")
+
+
+@contextlib.contextmanager
+def executor_from(args):
+    """The executor of ``--workers`` / ``--scheduler`` (None: serial), shut down on exit."""
+    workers, scheduler = getattr(args, "workers", None), getattr(args, "scheduler", None)
+    if scheduler:
+        try:
+            from distributed import Client
+        except ImportError:
+            raise ValueError("--scheduler needs Dask: pip install 'appdyn[distributed]'") from None
+        client = Client(scheduler)
+        try:
+            yield client.get_executor()
+        finally:
+            client.close()
+    elif workers and workers > 1:
+        from concurrent.futures import ProcessPoolExecutor
+
+        with ProcessPoolExecutor(workers) as pool:
+            yield pool
+    else:
+        yield None
 
 
 def finish(result, command: str, *, plot=None, json=None) -> int:

@@ -18,6 +18,7 @@
     appdyn stability conical-pendulum --mass 1 --length 1 --cone-angle 60 [--inertia I] \\
         [--sequence 3-2-1|3-1-3] [--gravity G]
     appdyn stability sweep CASE --parameter NAME --values START:STOP:NUM  [CASE options]
+                           [--workers N | --scheduler ADDRESS]
 
 ``--damper`` takes a kind and ``key=value`` items (vectors comma-separated):
 
@@ -51,7 +52,8 @@ from problems.cli.common import Progress, attach_negative_values, inertia_matrix
 from problems.cli.common import number as _number
 from problems.cli.common import output_file as _output_file
 from problems.cli.common import positive as _positive
-from problems.cli.common import progress_enabled, same_file, save_figure
+from problems.cli.common import (add_executor_options, executor_from, progress_enabled, same_file,
+                                 save_figure)
 from problems.cli.common import vector as _floats
 from problems.cli.common import finish
 
@@ -337,6 +339,7 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
         p.add_argument("--progress", action="store_true",
                        help="progress lines on stderr (default: only when stderr is a terminal)")
         p.add_argument("--quiet", action="store_true", help="no progress lines")
+        add_executor_options(p)
         _add_case_options(p, case, sweeping=True)
     return stab
 
@@ -444,8 +447,9 @@ def run(args) -> int:
             values = _values(args.values)
             if parameter in _DEGREES:
                 values = np.radians(values)
-            result = st.sweep(case, parameter, values, rtol=args.rtol,
-                              progress=progress if progress.enabled else None, **kwargs)
+            with executor_from(args) as executor:
+                result = st.sweep(case, parameter, values, rtol=args.rtol, executor=executor,
+                                  progress=progress if progress.enabled else None, **kwargs)
         finally:
             progress.close()
     else:
