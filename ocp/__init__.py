@@ -14,6 +14,12 @@ multistart and moving-knot polishing are in `ocp.refine`; attitude targets, quat
 handling and SLERP guesses in `ocp.attitude`. What the engine builds repeatedly (interval
 kernels, integrators, the NLP and its solver) is kept in `dynamics.cache` (`ocp.cached`);
 `ocp.examples` holds the small problems of the docstring Examples.
+
+Built once, solved many times: every number of a problem is an NLP bound or parameter, so
+the NLP of a *structure* (`ocp.assembly`: derivatives of one interval placed by index maps)
+and its IPOPT solver serve every problem of that structure (`ocp.solve`'s module
+docstring). Several scenarios sharing the parameters go into one NLP with
+`scenario_problem` (`ocp.scenarios`: gain design, robust plans).
 """
 from __future__ import annotations
 
