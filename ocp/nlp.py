@@ -17,7 +17,6 @@ Boundary values and bounds are variable bounds (IPOPT treats fixed variables as 
 """
 from __future__ import annotations
 
-import casadi as ca
 import numpy as np
 
 from .assembly import Structure, structure_key, _functions
@@ -27,7 +26,8 @@ from .cached import cached
 __all__ = ["Discretization", "structure"]
 
 
-def structure(problem, transcription, N: int, expand: bool = True, codegen: bool = False) -> Structure:
+def structure(problem, transcription, N: int, expand: bool = True, codegen: bool = False, *,
+              key: tuple | None = None) -> Structure:
     """The `Structure` of ``problem`` transcribed by ``transcription`` on ``N`` intervals,
     from the one cache (built on a miss; in MX when SX construction fails)."""
     def build():
@@ -38,7 +38,9 @@ def structure(problem, transcription, N: int, expand: bool = True, codegen: bool
                 raise
             return Structure(problem, transcription, N, False)
 
-    return cached("nlp_structure", structure_key(problem, transcription, N, expand, codegen), build,
+    if key is None:  # (serializing the functions for their content keys costs about 60 us each)
+        key = structure_key(problem, transcription, N, expand, codegen)
+    return cached("nlp_structure", key, build,
                   keepalive=tuple(f for f in _functions(problem) if f is not None))
 
 
@@ -76,7 +78,7 @@ class Discretization:
     def __init__(self, problem, transcription, mesh, scaling, expand: bool = True, codegen: bool = False):
         self.problem, self.transcription, self.mesh, self.scaling = problem, transcription, mesh, scaling
         self.key = structure_key(problem, transcription, mesh.N, expand, codegen)
-        st = self.structure = structure(problem, transcription, mesh.N, expand, codegen)
+        st = self.structure = structure(problem, transcription, mesh.N, expand, codegen, key=self.key)
         self.w, self.g, self.nlp = st.w, st.g, st.nlp
         self.P = st.params_value(problem, mesh, scaling)
         free, sc = problem.free_params, scaling

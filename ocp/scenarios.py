@@ -39,6 +39,7 @@ import casadi as ca
 import numpy as np
 
 from dynamics.model import Model
+from dynamics.validate import integer
 
 from .arguments import bounds, row_bounds
 from .functions import named_function
@@ -48,9 +49,7 @@ __all__ = ["stack", "scenario_problem", "unstack"]
 
 
 def _count(K) -> int:
-    if isinstance(K, (bool, np.bool_)) or not isinstance(K, (int, np.integer)) or K < 1:
-        raise ValueError(f"`K` (number of scenarios) must be an integer >= 1, got {K!r}")
-    return int(K)
+    return integer(K, "K", minimum=1)  # the number of scenarios
 
 
 def stack(model: Model, K: int) -> Model:
