@@ -92,10 +92,13 @@ def attitude_error(q_final, qf):
 
     Parameters
     ----------
-    q_final : array_like, shape (4,)
+    q_final : array_like, shape (4,), or casadi 4x1 (then ``qf`` is symbolic too)
     qf : casadi 4x1 or array_like, shape (4,)
     """
-    qt = ca.DM(q_final) if isinstance(qf, (ca.SX, ca.MX, ca.DM)) else np.asarray(q_final, dtype=float)
+    if isinstance(q_final, (ca.SX, ca.MX)):
+        qt = q_final
+    else:
+        qt = ca.DM(q_final) if isinstance(qf, (ca.SX, ca.MX, ca.DM)) else np.asarray(q_final, dtype=float)
     return quat_mul(quat_conj(qt), qf)[0:3]
 
 

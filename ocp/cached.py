@@ -4,8 +4,9 @@ Per-model Functions -- a transcription's interval kernel and interpolant, the pe
 CVODES integrators of the re-simulation and of the error estimates, the moving-knot
 right-hand side of `ocp.polish_switches`, the RK8 step and its Jacobian of the switch-time
 polish (``rk8_step``, ``rk8_step_jacobian``), the NLP structures of `ocp.assembly`
-(``nlp_structure``, keyed by content) and their IPOPT solvers (``nlpsol``, pooled: `checkout`)
--- are built once per model right-hand side and
+(``nlp_structure``, keyed by content) and their IPOPT solvers (``nlpsol``, pooled: `checkout`),
+the switch-time NLPs (``switch_times_nlp``, by content and arc count) and their solvers
+(``switch_times_nlpsol``, pooled) -- are built once per model right-hand side and
 defining arguments and reused by every solve, refinement round and `Solution` of that
 model. Keys are ``("ocp.<kind>", ...)`` tuples holding `dynamics.cache.function_key` of the
 model Functions (which are kept alive with the entry); `dynamics.clear_caches` empties

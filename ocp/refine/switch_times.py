@@ -6,8 +6,8 @@ control problem reduces to a small, well-posed NLP in the arc durations ``d_0 ..
 (the control on each arc fixed at its bang value). `optimize_switch_times` states it by
 direct multiple shooting with exact sensitivities:
 
-* arc ``k`` is cut into ``n_k`` equal segments of length ``h_k = d_k / n_k`` (``n_k`` fixed
-  from the starting solution, roughly proportional to the arc's duration);
+* arc ``k`` is cut into ``n`` equal segments of length ``h_k = d_k / n`` (the same ``n`` on
+  every arc, so that the NLP's structure depends only on the number of arcs);
 * each segment is one step of the explicit 8th-order Runge-Kutta method of Dormand & Prince
   (the 12-stage DOP853 tableau, fixed step, with the running cost integrated alongside),
   built once per model as an SX casadi Function (`ocp.cached`) and differentiated exactly
@@ -22,12 +22,18 @@ direct multiple shooting with exact sensitivities:
 The decision variables are the durations, the free parameters and the segment-end states:
 no control variables, no singular directions (the free-mesh polish of `polish_switches`
 carries one dilation per interval, most of which the objective does not see). IPOPT
-(``casadi.nlpsol``, the NLP in MX around the mapped SX step, built under
-`dynamics.cache.construction_lock`) then converges in a handful of iterations to
+(``casadi.nlpsol``, the NLP in MX around the mapped SX step) then converges in a handful of iterations to
 ``Solve_Succeeded`` (Bilimoria & Wie's slew: 3 iterations, 0.03 s of IPOPT, ``T =
 3.2430832775``); the answer carries only the integration error of the RK8 steps
 (``O(h^8)``, estimated by step doubling: ``info['integration_error']``, about 3e-13 on
 Bilimoria & Wie with the default 28 segments) and the NLP tolerance.
+
+The NLP is built once per problem structure (`ocp.assembly.structure_key`: the model, cost
+and constraint functions by content) and number of arcs and segments, with every number --
+the arc controls, fixed parameter values, scales and the target quaternion -- an NLP
+parameter; it and its IPOPT instance (pooled, one caller at a time) live in the one cache
+(`ocp.cached`). A slew to another target with as many arcs builds nothing (a 2 rad slew
+after Bilimoria & Wie's: 0.4 ms instead of 55 ms).
 
 A structure read wrongly shows as an infeasible NLP: too few arcs cannot meet the end
 conditions (`polish_switches` then tries `bang_arcs` with ``short_arcs=True``, then the
@@ -53,7 +59,9 @@ from dynamics.cache import construction_lock
 from dynamics.interrupts import check_interrupt
 from dynamics.validate import integer
 
+from ..assembly import structure_key
 from ..attitude import attitude_error, target_bounds
+from ..cached import cached, checkout
 from ..mesh import Mesh
 from ..problem import Problem
 from ..solution import Solution
@@ -76,12 +84,14 @@ def _pow2(v) -> float:
 
 
 def _segments(durations: np.ndarray, N: int | None) -> np.ndarray:
-    """Segments per arc: ``N`` in all (default ``max(24, 4 arcs)``) in proportion to the
-    durations, at least 2 per arc."""
+    """Segments per arc: the same number on every arc, ``ceil(N / arcs)`` (``N`` default
+    ``max(24, 4 arcs)``), at least 2. Not in proportion to the durations: then the NLP's
+    structure depends only on the number of arcs, and a slew to another target with as many
+    arcs reuses the built NLP (`_arc_nlp`); the step-doubling loop of
+    `optimize_switch_times` looks after the accuracy of the longer arcs."""
     n_arcs = durations.size
     N = max(24, 4 * n_arcs) if N is None else int(N)
-    share = durations / max(float(durations.sum()), 1e-300) * N
-    return np.maximum(2, np.ceil(share - 1e-9).astype(int))
+    return np.full(n_arcs, max(2, -(-N // n_arcs)), dtype=int)
 
 
 def _read_only(a: np.ndarray) -> np.ndarray:
@@ -98,6 +108,117 @@ class _Result:
     status: str
     iterations: int
     integration_error: float
+
+
+# ------------------------------------------------------------------- the NLP structure
+@dataclass(frozen=True, eq=False)
+class _ArcNLP:
+    """The switch-time NLP of one switching structure (`_arc_nlp`), every number a parameter.
+
+    ``nlp``: the casadi NLP (``x``: scaled durations, free parameters and segment-end
+    states; ``p``: the arc controls (nu, S) column-major, the fixed parameter values (np),
+    the state scales (nx), the duration scale, the free-parameter scales, the objective
+    scale, the target quaternion (4) and the target scale). ``cost``: ``(w, par) -> J``
+    (physical). ``blocks``: ``(kind, index, rows)`` of the constraints in order. ``key``:
+    the cache key."""
+
+    nlp: dict
+    cost: ca.Function
+    blocks: tuple
+    key: tuple
+
+
+def _arc_nlp(problem: Problem, step: ca.Function, n_arcs: int, nseg: np.ndarray) -> _ArcNLP:
+    """The switch-time NLP of ``problem`` with ``nseg[k]`` RK8 segments on arc ``k``, from
+    the one cache: built once per problem structure (`ocp.assembly.structure_key`: model,
+    cost and constraint functions by content) and segment counts, so a slew to another
+    target with the same switching structure builds nothing."""
+    nseg = tuple(int(n) for n in nseg)
+    scales = (tuple(None if c.scale is None else tuple(np.asarray(c.scale, float).ravel())
+                    for c in (*problem.path, *problem.boundary)))
+    key = structure_key(problem, "rk8-arcs", sum(nseg), False) + (n_arcs, nseg, scales)
+    return cached("switch_times_nlp", key, lambda: _build_arc_nlp(problem, step, n_arcs,
+                                                                  np.asarray(nseg), key))
+
+
+def _build_arc_nlp(problem, step, n_arcs, nseg, key) -> _ArcNLP:
+    """The NLP of `_arc_nlp` in MX around the mapped SX step (under the construction lock)."""
+    model = problem.model
+    nx, nu, free_p = model.nx, model.nu, problem.free_params
+    S = int(nseg.sum())
+    arc_of = np.repeat(np.arange(n_arcs), nseg)
+    sym = ca.MX
+    dh, ph, Xh = sym.sym("d", n_arcs), sym.sym("p", free_p.size), sym.sym("X", nx, S + 1)
+    U, pfix, sx = sym.sym("U", nu, S), sym.sym("pfix", model.np), sym.sym("sx", nx)
+    sT, sp, sJ = sym.sym("sT"), sym.sym("sp", free_p.size), sym.sym("sJ")
+    qf, sq = sym.sym("qf", 4), sym.sym("sq")
+    d = sT * dh
+    p = pfix
+    if free_p.size:
+        sel = np.zeros((model.np, free_p.size))
+        sel[free_p, np.arange(free_p.size)] = 1.0
+        p = pfix + ca.mtimes(ca.DM(sel), sp * ph)
+    X = ca.mtimes(ca.diag(sx), Xh)
+    spread = np.zeros((n_arcs, S))  # h_j = d_k / n_k for the segments j of arc k
+    spread[arc_of, np.arange(S)] = 1.0 / nseg[arc_of]
+    h = ca.mtimes(d.T, ca.DM(spread))
+    Xn, Q = step.map(S)(X[:, :-1], U, ca.repmat(p, 1, S), h)
+    T = ca.sum1(d)
+    g, blocks = [], []
+
+    def add(kind, index, expr):
+        expr = ca.vec(expr)
+        g.append(expr)
+        blocks.append((kind, index, expr.numel()))
+
+    add("defect", None, (Xn - X[:, 1:]) / ca.repmat(sx, 1, S))  # continuity
+    add("T", None, T / sT)
+    x0, xf = X[:, 0], X[:, -1]
+    if problem.q_final is not None:
+        iq = model.attitude[0]
+        err = attitude_error(qf, xf[iq:iq + 4])
+        add("target", None, ca.sumsqr(err) / sq ** 2 if problem.q_final_tol > 0 else err / sq)
+    if problem.quaternion_norm_at_t0:
+        iq = model.attitude[0]
+        add("qnorm", None, ca.sumsqr(x0[iq:iq + 4]) - 1)
+    for i, c in enumerate(problem.boundary):
+        cs = np.ones(c.size) if c.scale is None else np.asarray(c.scale, float)
+        add("boundary", i, c.fun(x0, xf, p) / ca.DM(cs))
+    for i, c in enumerate(problem.path):
+        cs = np.ones(c.size) if c.scale is None else np.asarray(c.scale, float)
+        fm = c.fun.map(S)
+        for Xe in (X[:, :-1], X[:, 1:]):  # both ends of every segment, the arc's control
+            add("path", i, fm(Xe, U, ca.repmat(p, 1, S)) / ca.repmat(ca.DM(cs), 1, S))
+    J = sym(0)
+    if problem.mayer is not None:
+        J = J + problem.mayer(xf, p, T)
+    if problem.lagrange is not None:
+        J = J + ca.sum2(Q)
+    w = ca.vertcat(dh, ph, ca.vec(Xh))
+    par = ca.vertcat(ca.vec(U), pfix, sx, sT, sp, sJ, qf, sq)
+    nlp = {"x": w, "p": par, "f": problem.objective_sign * J / sJ, "g": ca.vertcat(*g)}
+    cost = ca.Function("switch_times_cost", [w, par], [J])
+    return _ArcNLP(nlp, cost, tuple(blocks), key)
+
+
+def _constraint_bounds(problem: Problem, blocks, sT: float, sq: float):
+    """``(lbg, ubg)`` of the constraint ``blocks`` of an `_ArcNLP` (scaled as its rows)."""
+    lo, hi = [], []
+    T_lo, T_hi = problem.T_bounds
+    for kind, i, n in blocks:
+        if kind == "T":
+            a, b = T_lo / sT, T_hi / sT
+        elif kind == "target" and problem.q_final_tol > 0:
+            a, b = (v / sq ** 2 for v in target_bounds(problem))
+        elif kind in ("defect", "target", "qnorm"):
+            a = b = 0.0
+        else:
+            c = (problem.boundary if kind == "boundary" else problem.path)[i]
+            cs = np.ones(c.size) if c.scale is None else np.asarray(c.scale, float)
+            a, b = np.asarray(c.lower, float) / cs, np.asarray(c.upper, float) / cs
+        lo.append(np.resize(np.asarray(a, float).reshape(-1), n))
+        hi.append(np.resize(np.asarray(b, float).reshape(-1), n))
+    return np.concatenate(lo), np.concatenate(hi)
 
 
 # ------------------------------------------------------------------------------ solve
@@ -119,9 +240,8 @@ def optimize_switch_times(problem: Problem, solution: Solution, *, arcs: BangArc
     arcs : BangArcs, optional
         The switching structure (default: ``bang_arcs(solution)``).
     N : int, optional
-        About the number of RK8 segments (mesh intervals of the result) in all, shared in
-        proportion to the arc durations (rounded up), at least 2 per arc. Default
-        ``max(24, 4 arcs)``, doubled (at most three times, each NLP warm started from the
+        About the number of RK8 segments (mesh intervals of the result) in all, the same
+        number ``ceil(N / arcs)`` on every arc, at least 2. Default ``max(24, 4 arcs)``, doubled (at most three times, each NLP warm started from the
         last) until the estimated integration error is below ``integration_tol``.
     degree : int
         Radau degree of the result's transcription (`RadauConstantControl`): the number of
@@ -252,108 +372,60 @@ def _solve_arcs(problem: Problem, guess: Solution, arcs: BangArcs, nseg: np.ndar
     sp = np.array([float(scale.get(model.params[i], _pow2(p0[i]))) for i in free_p])
     sJ = float(scale["objective"]) if "objective" in scale else _pow2(guess.cost)
 
-    # ---- the NLP in MX (the RK8 step, an SX Function, mapped over the segments), built
-    # under the casadi construction lock
+    sq = 1.0
+    if problem.q_final is not None:
+        if "q_final" in scale:
+            sq = float(scale["q_final"])
+        else:  # as `ocp.scaling`: about the half-angle still to turn, in [1e-8, 1]
+            iq = model.attitude[0]
+            e0 = float(np.linalg.norm(attitude_error(problem.q_final, Xg[iq:iq + 4, 0])))
+            sq = _pow2(min(max(16 * e0, 1e-8), 1.0))
+
+    # ---- the NLP: one built structure (and IPOPT instance) per switching structure, the
+    # numbers as parameters and bounds
     t_build = time.perf_counter()
-    with construction_lock():
-        sym = ca.MX
-        dh, ph, Xh = sym.sym("d", n_arcs), sym.sym("p", free_p.size), sym.sym("X", nx, S + 1)
-        d = sT * dh
-        p = sym(ca.DM(p0))
-        if free_p.size:
-            sel = np.zeros((model.np, free_p.size))
-            sel[free_p, np.arange(free_p.size)] = sp
-            fixed = p0.copy()
-            fixed[free_p] = 0.0
-            p = ca.DM(fixed) + ca.mtimes(ca.DM(sel), ph)
-        X = ca.mtimes(ca.diag(ca.DM(sx)), Xh)
-        spread = np.zeros((n_arcs, S))  # h_j = d_k / n_k for the segments j of arc k
-        spread[arc_of, np.arange(S)] = 1.0 / nseg[arc_of]
-        h = ca.mtimes(d.T, ca.DM(spread))
-        Xn, Q = step.map(S)(X[:, :-1], ca.DM(Ucols), ca.repmat(p, 1, S), h)
-        T = ca.sum1(d)
-        g, lbg, ubg = [], [], []
+    nlp = _arc_nlp(problem, step, n_arcs, nseg)
+    fixed_p = p0.copy()
+    fixed_p[free_p] = 0.0
+    qf = np.zeros(4) if problem.q_final is None else np.asarray(problem.q_final, float)
+    par = np.concatenate([Ucols.reshape(-1, order="F"), fixed_p, sx, [sT], sp, [sJ], qf, [sq]])
+    lbg, ubg = _constraint_bounds(problem, nlp.blocks, sT, sq)
 
-        def add(expr, lo, hi):
-            expr = ca.vec(expr)
-            n = expr.numel()
-            g.append(expr)
-            lbg.append(np.broadcast_to(np.asarray(lo, float).reshape(-1), (n,)).copy())
-            ubg.append(np.broadcast_to(np.asarray(hi, float).reshape(-1), (n,)).copy())
+    # ---- bounds and guess
+    T_hi = problem.T_bounds[1]
+    plo, phi = problem.p_bounds[0][free_p] / sp, problem.p_bounds[1][free_p] / sp
+    XL = np.repeat((xlo / sx)[:, None], S + 1, axis=1)
+    XU = np.repeat((xhi / sx)[:, None], S + 1, axis=1)
+    for col, given in ((0, problem.x_initial), (S, problem.x_final)):
+        fixed = np.isfinite(given)
+        XL[fixed, col] = XU[fixed, col] = given[fixed] / sx[fixed]
+    lbw = np.concatenate([np.zeros(n_arcs), plo, XL.reshape(-1, order="F")])
+    ubw = np.concatenate([np.full(n_arcs, T_hi / sT), phi, XU.reshape(-1, order="F")])
+    Xg0 = np.clip(Xg / sx[:, None], XL, XU)
+    w0 = np.concatenate([D0 / sT, p0[free_p] / sp, Xg0.reshape(-1, order="F")])
 
-        add((Xn - X[:, 1:]) / ca.repmat(ca.DM(sx), 1, S), 0.0, 0.0)  # continuity
-        n_defect = nx * S
-        T_lo, T_hi = problem.T_bounds
-        add(T / sT, T_lo / sT, T_hi / sT)
-        x0, xf = X[:, 0], X[:, -1]
-        if problem.q_final is not None:
-            iq = model.attitude[0]
-            err = attitude_error(problem.q_final, xf[iq:iq + 4])
-            if "q_final" in scale:
-                sq = float(scale["q_final"])
-            else:  # as `ocp.scaling`: about the half-angle still to turn, in [1e-8, 1]
-                e0 = float(np.linalg.norm(attitude_error(problem.q_final, Xg[iq:iq + 4, 0])))
-                sq = _pow2(min(max(16 * e0, 1e-8), 1.0))
-            lo_q, hi_q = target_bounds(problem)
-            if problem.q_final_tol > 0:
-                add(ca.sumsqr(err) / sq ** 2, lo_q / sq ** 2, hi_q / sq ** 2)
-            else:
-                add(err / sq, 0.0, 0.0)
-        if problem.quaternion_norm_at_t0:
-            iq = model.attitude[0]
-            add(ca.sumsqr(x0[iq:iq + 4]) - 1, 0.0, 0.0)
-        for c in problem.boundary:
-            cs = np.ones(c.size) if c.scale is None else np.asarray(c.scale, float)
-            add(c.fun(x0, xf, p) / ca.DM(cs), np.asarray(c.lower, float) / cs,
-                np.asarray(c.upper, float) / cs)
-        for c in problem.path:
-            cs = np.ones(c.size) if c.scale is None else np.asarray(c.scale, float)
-            fm = c.fun.map(S)
-            for Xe in (X[:, :-1], X[:, 1:]):  # both ends of every segment, the arc's control
-                add(fm(Xe, ca.DM(Ucols), ca.repmat(p, 1, S)) / ca.repmat(ca.DM(cs), 1, S),
-                    np.tile(np.asarray(c.lower, float) / cs, S), np.tile(np.asarray(c.upper, float) / cs, S))
-        J = sym(0)
-        if problem.mayer is not None:
-            J = J + problem.mayer(xf, p, T)
-        if problem.lagrange is not None:
-            J = J + ca.sum2(Q)
-        w = ca.vertcat(dh, ph, ca.vec(Xh))
-        lbg, ubg = np.concatenate(lbg), np.concatenate(ubg)
-
-        # ---- bounds and guess
-        plo, phi = problem.p_bounds[0][free_p] / sp, problem.p_bounds[1][free_p] / sp
-        XL = np.repeat((xlo / sx)[:, None], S + 1, axis=1)
-        XU = np.repeat((xhi / sx)[:, None], S + 1, axis=1)
-        for col, given in ((0, problem.x_initial), (S, problem.x_final)):
-            fixed = np.isfinite(given)
-            XL[fixed, col] = XU[fixed, col] = given[fixed] / sx[fixed]
-        lbw = np.concatenate([np.zeros(n_arcs), plo, XL.reshape(-1, order="F")])
-        ubw = np.concatenate([np.full(n_arcs, T_hi / sT), phi, XU.reshape(-1, order="F")])
-        Xg0 = np.clip(Xg / sx[:, None], XL, XU)
-        w0 = np.concatenate([D0 / sT, p0[free_p] / sp, Xg0.reshape(-1, order="F")])
-
-        user = {k[len("ipopt."):] if k.startswith("ipopt.") else k: v
-                for k, v in (ipopt_options or {}).items()}
-        ipopt = {**_STRICT, "print_level": 5 if verbose is True else 0, "sb": "yes", **user}
-        solver = ca.nlpsol("switch_times", "ipopt", {"x": w, "f": sign * J / sJ, "g": ca.vertcat(*g)},
-                           # inputs_check off: the bounds are built consistent here, and casadi's
-                           # count of equalities (fixed variables included) against variables
-                           # would print a warning for the structurally over-determined end
-                           # conditions of a symmetric slew, which IPOPT solves (a quiet library)
-                           {"ipopt": ipopt, "print_time": False, "error_on_fail": False,
-                            "inputs_check": False})
-        cost_fun = ca.Function("switch_times_cost", [w], [J])
-    build_time = time.perf_counter() - t_build
+    user = {k[len("ipopt."):] if k.startswith("ipopt.") else k: v
+            for k, v in (ipopt_options or {}).items()}
+    ipopt = {**_STRICT, "print_level": 5 if verbose is True else 0, "sb": "yes", **user}
+    # inputs_check off: the bounds are built consistent here, and casadi's count of
+    # equalities (fixed variables included) against variables would print a warning for the
+    # structurally over-determined end conditions of a symmetric slew, which IPOPT solves
+    # (a quiet library)
+    nlp_opts = {"ipopt": ipopt, "print_time": False, "error_on_fail": False, "inputs_check": False}
+    with checkout("switch_times_nlpsol", (nlp.key, repr(sorted(ipopt.items()))),
+                  lambda: ca.nlpsol("switch_times", "ipopt", nlp.nlp, nlp_opts),
+                  keepalive=nlp) as solver:
+        build_time = time.perf_counter() - t_build
+        check_interrupt()
+        t_solve = time.perf_counter()
+        error = None
+        try:
+            res = solver(x0=w0, p=par, lbx=lbw, ubx=ubw, lbg=lbg, ubg=ubg)
+        except RuntimeError as exc:  # an evaluation error inside CasADi: report it
+            res, error = None, exc
+        solve_time = time.perf_counter() - t_solve
+        stats = solver.stats()
     check_interrupt()
-    t_solve = time.perf_counter()
-    error = None
-    try:
-        res = solver(x0=w0, lbx=lbw, ubx=ubw, lbg=lbg, ubg=ubg)
-    except RuntimeError as exc:  # an evaluation error inside CasADi: report it
-        res, error = None, exc
-    solve_time = time.perf_counter() - t_solve
-    check_interrupt()
-    stats = solver.stats()
     status = str(stats.get("return_status", "Unknown"))
     iterations = int(stats.get("iter_count", 0))
     if res is None:
@@ -374,7 +446,7 @@ def _solve_arcs(problem: Problem, guess: Solution, arcs: BangArcs, nseg: np.ndar
     popt[free_p] = wopt[n_arcs:n_arcs + free_p.size] * sp
     Xopt = wopt[n_arcs + free_p.size:].reshape(nx, S + 1, order="F") * sx[:, None]
     Topt = float(dopt.sum())
-    cost = float(cost_fun(wopt)) if np.all(np.isfinite(wopt)) else float("nan")
+    cost = float(nlp.cost(wopt, par)) if np.all(np.isfinite(wopt)) else float("nan")
     success = status == "Solve_Succeeded" and np.isfinite(viol) and viol <= constraint_tol
     if not (np.all(np.isfinite(dopt)) and np.all(np.isfinite(Xopt)) and Topt > 0):
         dopt, Xopt, Topt, success = D0.copy(), Xg.copy(), T0, False
@@ -412,6 +484,7 @@ def _solve_arcs(problem: Problem, guess: Solution, arcs: BangArcs, nseg: np.ndar
     # costates at the segment ends; inside a segment lambda(t) = (dx_end/dx(t))^T lambda_end
     # + sign dq/dx(t) (the running cost of the rest of the step)
     costates = None
+    n_defect = nx * S
     if res is not None and np.all(np.isfinite(lam_g[:n_defect])):
         lam_end = lam_g[:n_defect].reshape(nx, S, order="F") * (sJ / sx[:, None])
         n_in = js.size + 1  # the nodes inside the kept segments, then t0

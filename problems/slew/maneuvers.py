@@ -212,21 +212,28 @@ def time_optimal(inertia, *, angle=None, axis=None, q0=None, qf=None, u_max=1.0,
                                                              eigenaxis=keep_out is None)
     start_options = None
     if guesses is not None and keep_out is None:
-        # the eigenaxis start: with the exact Hessian IPOPT creeps along the singular eigenaxis
-        # optimum (Bilimoria-Wie: 126 iterations, half the slew's time), a limited-memory
-        # Hessian gets there in 16; should that not converge in 20 iterations, the exact one
-        lm = {"ipopt_options": {**EIGENAXIS_START, **(ipopt_options or {})}}
-        start_options = [[lm, {}]] + [{}] * (len(guesses) - 1)
+        # the eigenaxis start: the exact Hessian, at most EIGENAXIS_EXACT iterations (most
+        # slews: 15-20), then a limited-memory Hessian (where the exact one creeps along the
+        # singular eigenaxis optimum -- Bilimoria-Wie: 126 iterations, the limited-memory one
+        # 16), then the exact one without the cap
+        tries = [{"ipopt_options": {**EIGENAXIS_EXACT, **(ipopt_options or {})}},
+                 {"ipopt_options": {**EIGENAXIS_START, **(ipopt_options or {})}}, {}]
+        start_options = [tries] + [{}] * (len(guesses) - 1)
     return solve_time_optimal(problem, guess, guesses, opts,
                               polish=polish and not norm_bound and keep_out is None,
                               pointing_tol=ptol, rate_tol=rtol, ipopt_options=ipopt_options,
                               verbose=verbose, start_options=start_options)
 
 
-#: IPOPT options of the first attempt at the eigenaxis start of `time_optimal` (then the exact
-#: Hessian if it does not converge): Bilimoria-Wie 0.69 s -> 0.41 s (16 iterations instead
-#: of 126); on 8 test slews the same T, 3.60 s -> 3.58 s in all (a cap of 50 iterations:
-#: 3.99 s, the limited-memory start being slower than the exact one on some slews).
+#: IPOPT options of the first attempt at the eigenaxis start of `time_optimal`: the exact
+#: Hessian with an iteration cap (a 2 rad slew about (0.2, 1, 0.5), J = E: 17 iterations,
+#: 0.03 s, where the limited-memory attempt ran out of its 20 iterations first).
+EIGENAXIS_EXACT = {"max_iter": 25}
+
+#: IPOPT options of the second attempt at the eigenaxis start of `time_optimal` (then the
+#: exact Hessian without a cap if it does not converge): Bilimoria-Wie 0.69 s -> 0.41 s (16
+#: iterations instead of 126); on 8 test slews the same T (a cap of 50 iterations: slower,
+#: the limited-memory start being slower than the exact one on some slews).
 EIGENAXIS_START = {"hessian_approximation": "limited-memory", "max_iter": 20}
 
 #: Relative amount by which a switch-time polished T (integrated to ~1e-13) may exceed the
@@ -247,9 +254,9 @@ def solve_time_optimal(problem, guess, guesses, opts, *, polish, pointing_tol, r
     else:
         sol = solve_multistart(problem, guesses, start_options=start_options, **opts)
     first = sol
-    sol = verify(sol, pointing_tol=ptol, rate_tol=rtol)
     if not (polish and first.success):
-        return _refined_fallback(problem, first, sol, ptol, rtol, ipopt_options, opts["scale"])
+        return _refined_fallback(problem, first, verify(sol, pointing_tol=ptol, rate_tol=rtol),
+                                 ptol, rtol, ipopt_options, opts["scale"])
     # a bang-bang first solution: switch-time optimization (arc durations only, RK8 shooting;
     # Bilimoria-Wie: 3 IPOPT iterations, T = 3.2430832775, re-simulated pointing error 8e-10
     # rad). Otherwise the moving-knot fallback, at degree 5: at degree 3 the ~4 intervals per
@@ -267,8 +274,10 @@ def solve_time_optimal(problem, guess, guesses, opts, *, polish, pointing_tol, r
     # 2.2075385, 2.4e-6 relative), so an exact polish may come out a hair slower and is kept
     exact = polished.info.get("method") == "switch-times"
     slack = _EXACT_SLACK * sol.T if exact else 1e-9
+    if not (polished.success and polished.T <= sol.T + slack):  # then the first is graded
+        sol = verify(sol, pointing_tol=ptol, rate_tol=rtol)
     if polished.success and (polished.T <= sol.T + slack or not sol.success):
-        first = {k: sol.info[k] for k in ("starts", "best") if k in sol.info}
+        first = {k: v for k, v in getattr(sol, "info", {}).items() if k in ("starts", "best")}
         return annotate(polished, first) if first else polished
     why = (f"polish not used: {polished.message}" if not polished.success else
            f"polish not used: its T = {polished.T:.10g} s is not below {sol.T:.10g} s")

@@ -218,3 +218,34 @@ def test_an_arc_smeared_within_one_mesh_interval_still_gives_the_switch_structur
     assert knots.success
     assert sol.T <= knots.T + 1e-9
     assert abs(sol.T - knots.T) < 1e-6
+
+
+def test_another_target_reuses_the_switch_time_nlp_and_matches_a_fresh_build():
+    """The switch-time NLP is built once per switching structure, the target and scales
+    as parameters: a slew to another target with the same arcs builds nothing, and gives
+    the same answer as an NLP built afresh for it (cache emptied)."""
+    from dynamics import cache, clear_caches
+
+    def first_and_problem(axis):
+        start = slew.time_optimal(np.eye(3), angle=2.0, axis=axis, u_max=1.0, polish=False,
+                                  starts=1)
+        assert start.success
+        return start.problem, start
+
+    p1, s1 = first_and_problem([0.2, 1.0, 0.5])
+    p2, s2 = first_and_problem([0.25, 1.0, 0.45])  # a neighbour: the same switching structure
+    a1, a2 = bang_arcs(s1)[0], bang_arcs(s2)[0]
+    assert a1.durations.size == a2.durations.size
+    np.testing.assert_array_equal(a1.controls, a2.controls)
+    one = optimize_switch_times(p1, s1, N=30)
+    entries = cache.info().kinds.get("ocp.switch_times_nlp", 0)
+    two = optimize_switch_times(p2, s2, N=30)
+    assert cache.info().kinds.get("ocp.switch_times_nlp", 0) == entries  # nothing new built
+    assert two.build_time < 0.25 * one.build_time
+    clear_caches()
+    fresh = optimize_switch_times(p2, s2, N=30)
+    assert one.success and two.success and fresh.success
+    assert abs(two.T - fresh.T) < 1e-12 and two.T != one.T
+    np.testing.assert_allclose(two.info["switch_times"], fresh.info["switch_times"], atol=1e-12)
+    # the target is met (independently of the NLP): re-simulated pointing error
+    assert two.pointing_error < 1e-8
