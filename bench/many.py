@@ -13,6 +13,8 @@ timing, for every variant alike.
    and two processes; per-sample wall time and the identity of the statistics.
 3. A time-optimal slew's multistart (4 starts, `ocp.solve_multistart`): serial and two
    processes.
+4. A maneuver table (`problems.slew.maneuver_table`, the 8 `example_targets`, J = diag(1,
+   2, 3), time-optimal): serial, two threads and two processes; the same T in every row.
 
 Run: ``make bench`` or ``appdyn bench many`` (``--quick`` for a smoke run).
 """
@@ -109,6 +111,23 @@ def multistarts():
     return serial, [("serial", serial_t, True), ("2 processes", t, res.cost == serial.cost)]
 
 
+def tables(starts):
+    J = np.diag([1.0, 2.0, 3.0])
+    targets = slew.example_targets()
+    kw = dict(N=20, starts=starts)
+    clear_caches()
+    slew.maneuver_table(J, targets[:1], **kw)  # builds, as each pool's warm-up
+    serial_t, serial = _timed(slew.maneuver_table, J, targets, **kw)
+    rows = [("serial", serial_t, True)]
+    for name, kind in (("2 threads", ThreadPoolExecutor), ("2 processes", ProcessPoolExecutor)):
+        clear_caches()
+        with kind(2) as pool:
+            slew.maneuver_table(J, targets[:2], executor=pool, **kw)  # start the workers
+            t, res = _timed(slew.maneuver_table, J, targets, executor=pool, **kw)
+        rows.append((name, t, bool(np.array_equal(res.T, serial.T))))
+    return serial, rows
+
+
 def _table(rows, unit=1.0, label="wall [s]"):
     base = rows[0][1]
     for name, t, same in rows:
@@ -136,6 +155,11 @@ def main(argv=()):
         best, rows = multistarts()
         _table(rows)
         print(f"  best T = {best.T:.10f}")
+    starts = 1 if quick else 3
+    print(f"\n4. Maneuver table, 8 example targets, J = diag(1, 2, 3), starts = {starts}, N = 20:")
+    table, rows = tables(starts)
+    _table(rows)
+    print(f"  all verified: {table.success}; T [s] = {np.round(table.T, 4).tolist()}")
 
 
 if __name__ == "__main__":

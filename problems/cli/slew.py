@@ -1,8 +1,13 @@
 """``appdyn slew``: a rest-to-rest optimal rigid-body slew (`problems.slew`), checked against
-the solver's success and, when time-optimal, the rest-to-rest time bound."""
+the solver's success and, when time-optimal, the rest-to-rest time bound.
+
+With ``--targets FILE.csv`` or ``--example-targets`` it solves a maneuver table instead
+(`problems.slew.maneuver_table`: one slew per target, ``--workers N``/``--scheduler ADDRESS``
+to spread them, a progress line on stderr), exit status 0 when every slew is verified."""
 from __future__ import annotations
 
 import argparse
+import csv
 import sys
 
 import numpy as np
@@ -15,8 +20,11 @@ from problems.cli.common import positive as _positive
 from problems.cli.common import same_file
 from problems.cli.common import vector as _vector
 from problems.cli.common import write_json
+from problems.cli.common import (Progress, add_executor_options, executor_from, finish,
+                                 progress_enabled)
 
-__all__ = ["add_parser", "check", "run", "rest_to_rest_bound", "target_angle"]
+__all__ = ["add_parser", "check", "run", "run_table", "read_targets", "rest_to_rest_bound",
+           "target_angle"]
 
 
 def add_parser(subparsers):
@@ -49,13 +57,65 @@ def add_parser(subparsers):
                     help="save quaternion, rates, torques, path (.png, .pdf or .svg)")
     sl.add_argument("--json", metavar="FILE", type=_output_file(),
                     help="write the summary as JSON")
-    sl.add_argument("--quiet", action="store_true", help="no solver progress lines")
+    sl.add_argument("--quiet", action="store_true", help="no solver or table progress lines")
+    table = sl.add_mutually_exclusive_group()
+    table.add_argument("--targets", metavar="FILE.csv",
+                       help="a maneuver table instead of one slew: a CSV with a header and "
+                            "columns name (optional), angle [deg], axis1, axis2, axis3, or "
+                            "q1, q2, q3, q4 (problems.slew.maneuver_table)")
+    table.add_argument("--example-targets", action="store_true",
+                       help="a maneuver table of the 8 targets of problems.slew.example_targets")
+    add_executor_options(sl)
+    sl.add_argument("--progress", action="store_true",
+                    help="table progress lines on stderr (default: when stderr is a terminal)")
     return sl
+
+
+def read_targets(path) -> list:
+    """The targets of a ``--targets`` CSV file (angles in degrees there, radians here)."""
+    with open(path, newline="") as f:
+        rows = list(csv.DictReader(f))
+    out = []
+    for k, row in enumerate(rows):
+        row = {key.strip(): (v or "").strip() for key, v in row.items() if key}
+        target = {"name": row["name"]} if row.get("name") else {}
+        try:
+            if row.get("q1"):
+                target["qf"] = [float(row[f"q{i}"]) for i in range(1, 5)]
+            else:
+                target["angle"] = np.radians(float(row["angle"]))
+                target["axis"] = [float(row[f"axis{i}"]) for i in range(1, 4)]
+        except (KeyError, TypeError, ValueError):
+            raise ValueError(f"`targets` row {k + 1}: expected numbers in columns angle, "
+                             f"axis1..3 or q1..4, got {row}") from None
+        out.append(target)
+    return out
 
 
 def check(parser, args) -> None:
     """Checks across options, as argparse errors on ``parser`` (exit status 2)."""
     p = parser
+    if args.targets is not None or args.example_targets:
+        from problems.slew.table import check_targets, example_targets
+
+        flag = "--targets" if args.targets is not None else "--example-targets"
+        for other, value in (("--axis", args.axis), ("--angle", args.angle), ("--qf", args.qf),
+                             ("--plot", args.plot), ("--norm-bound", args.norm_bound or None)):
+            if value is not None:
+                p.error(f"argument {flag}: not allowed with argument {other}")
+        try:
+            args._targets = example_targets() if args.example_targets else \
+                read_targets(args.targets)
+            check_targets(args._targets)
+        except OSError as exc:
+            p.error(f"argument --targets: cannot read {args.targets!r}: {exc.strerror}")
+        except ValueError as exc:
+            p.error(f"argument {flag}: {exc}")
+        if args.starts is not None and not args.time_optimal:
+            p.error("argument --starts: only with --time-optimal")
+        return
+    if args.workers is not None or args.scheduler is not None:
+        p.error("argument --workers/--scheduler: only with --targets or --example-targets")
     if args.qf is not None:
         for flag, value in (("--axis", args.axis), ("--angle", args.angle)):
             if value is not None:
@@ -117,6 +177,8 @@ def run(args) -> int:
     """Solve, print the summary, write ``--plot``/``--json``; 0 when verified, else 1."""
     from problems import slew
 
+    if getattr(args, "_targets", None) is not None:
+        return run_table(args)
     if args.u_max is None:
         u_max = 1.0 if args.time_optimal else None
     else:
@@ -176,3 +238,28 @@ def run(args) -> int:
     if not success:
         print(f"appdyn slew: failed: {why}", file=sys.stderr)
     return 0 if success else 1
+
+
+def run_table(args) -> int:
+    """``--targets``/``--example-targets``: solve the maneuver table, print it, write
+    ``--json``; 0 when every slew is verified, else 1."""
+    from problems.slew import maneuver_table
+
+    if args.u_max is None:
+        u_max = 1.0 if args.time_optimal else None
+    else:
+        u_max = float(args.u_max[0]) if args.u_max.size == 1 else args.u_max
+    kind = dict(objective="time") if args.time_optimal else \
+        dict(objective="effort", T=args.min_effort)
+    if args.starts is not None:
+        kind["starts"] = args.starts
+    progress = Progress(f"slew table ({len(args._targets)} targets)",
+                        enabled=progress_enabled(args))
+    try:
+        with executor_from(args) as executor:
+            table = maneuver_table(inertia_matrix(args.inertia), args._targets, u_max=u_max,
+                                   executor=executor,
+                                   progress=progress if progress.enabled else None, **kind)
+    finally:
+        progress.close()
+    return finish(table, "slew", json=args.json)

@@ -42,7 +42,8 @@ Modules
 -------
 `targets` (input checks, the target attitude, `KeepOut`, defaults and statuses),
 `problem` (`slew_problem`, `eigenaxis_time`, guesses), `maneuvers` (`time_optimal`,
-`min_effort`, `verify`), `devices` (`wheel_slew`, `cmg_slew`: the same slews by reaction
+`min_effort`, `verify`), `table` (`maneuver_table`: the slew to every target of a
+catalogue, on any executor, as a `ManeuverTable`), `devices` (`wheel_slew`, `cmg_slew`: the same slews by reaction
 wheels or CMGs, momentum exchanged inside the spacecraft), `report` (`switch_times`, `summary`, `format_summary`, `plot_slew`).
 """
 from __future__ import annotations
@@ -51,9 +52,11 @@ from .devices import cmg_slew, wheel_slew
 from .maneuvers import min_effort, time_optimal, verify
 from .problem import attitude_guess, eigenaxis_time, slew_problem
 from .report import format_summary, plot_slew, summary, switch_times
+from .table import ManeuverTable, example_targets, maneuver_table
 from .targets import (MIN_REFINE_TOL, POINTING_TOL, RATE_TOL, STATUS_POINTING, STATUS_REFINE,
                       KeepOut)
 
 __all__ = ["KeepOut", "slew_problem", "time_optimal", "min_effort", "wheel_slew", "cmg_slew", "eigenaxis_time",
            "switch_times", "attitude_guess", "verify", "summary", "format_summary", "plot_slew",
+           "maneuver_table", "ManeuverTable", "example_targets",
            "POINTING_TOL", "RATE_TOL", "MIN_REFINE_TOL", "STATUS_POINTING", "STATUS_REFINE"]
