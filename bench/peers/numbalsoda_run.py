@@ -1,0 +1,74 @@
+"""numbalsoda peer of bench/simulate.py; runs in bench/peers/.venv-numbalsoda (own numpy/numba).
+
+Reads a JSON job from stdin, prints JSON to stdout. Job: ``inertia``, ``t`` (output grid),
+``x0`` (7,), ``tols`` (rtol list; atol = rtol/100), ``repeats``, and optionally ``batch``:
+``{"x0s": (K, 7), "t": grid, "rtol": r}`` for the numba-jitted loop of dop853 runs.
+Answers carry body rates (the main process computes errors against the Jacobi truth).
+"""
+import json
+import sys
+import time
+
+import numba as nb
+import numpy as np
+from numbalsoda import dop853, lsoda, lsoda_sig
+
+
+def make_rhs(inertia):
+    I1, I2, I3 = inertia
+
+    @nb.cfunc(lsoda_sig)
+    def rhs(t, x, dx, p):
+        q1, q2, q3, q4, w1, w2, w3 = x[0], x[1], x[2], x[3], x[4], x[5], x[6]
+        dx[0] = 0.5 * (q4 * w1 + q2 * w3 - q3 * w2)
+        dx[1] = 0.5 * (q4 * w2 + q3 * w1 - q1 * w3)
+        dx[2] = 0.5 * (q4 * w3 + q1 * w2 - q2 * w1)
+        dx[3] = -0.5 * (q1 * w1 + q2 * w2 + q3 * w3)
+        dx[4] = (I2 - I3) * w2 * w3 / I1
+        dx[5] = (I3 - I1) * w3 * w1 / I2
+        dx[6] = (I1 - I2) * w1 * w2 / I3
+
+    return rhs.address
+
+
+def main():
+    job = json.load(sys.stdin)
+    ptr = make_rhs(job["inertia"])
+    t = np.asarray(job["t"], float)
+    x0 = np.asarray(job["x0"], float)
+    out = {"runs": []}
+    for name, solver in (("lsoda", lsoda), ("dop853", dop853)):
+        for rtol in job["tols"]:
+            times = []
+            for k in range(job["repeats"] + 1):
+                t0 = time.perf_counter()
+                usol, ok = solver(ptr, x0, t, rtol=rtol, atol=rtol * 1e-2)
+                times.append(time.perf_counter() - t0)
+            out["runs"].append(dict(solver=name, rtol=rtol, first=times[0], times=times[1:],
+                                    success=bool(ok), w=usol[:, 4:7].tolist()))
+    if job.get("batch"):
+        b = job["batch"]
+        x0s, tb, rtol = np.asarray(b["x0s"], float), np.asarray(b["t"], float), b["rtol"]
+
+        @nb.njit
+        def loop(x0s, tb, rtol):
+            w = np.empty((x0s.shape[0], tb.size, 3))
+            ok = True
+            for k in range(x0s.shape[0]):
+                usol, success = dop853(ptr, x0s[k], tb, rtol=rtol, atol=rtol * 1e-2)
+                w[k] = usol[:, 4:7]
+                ok = ok and success
+            return w, ok
+
+        times = []
+        for _ in range(job["repeats"] + 1):
+            t0 = time.perf_counter()
+            w, ok = loop(x0s, tb, rtol)
+            times.append(time.perf_counter() - t0)
+        out["batch"] = dict(rtol=rtol, first=times[0], times=times[1:], success=bool(ok),
+                            w=w.tolist())
+    json.dump(out, sys.stdout)
+
+
+if __name__ == "__main__":
+    main()
