@@ -22,14 +22,14 @@ import importlib
 from . import attitude, cache, clock, constrained, floquet, mechanisms, momentum
 from .feedback import closed_loop
 from .hinged import hinged_bodies
-from .integrate import METHODS, SimulationResult, simulate
+from .integrate import METHODS, BatchResult, SimulationResult, simulate
 from .launch_vehicle import launch_vehicle
 from .linearize import Linearization, linearization, linearize
 from .model import Model
 from .momentum import cmg_spacecraft, wheel_spacecraft
 from .rigid_body import rigid_body
 
-__all__ = ["METHODS", "Linearization", "Model", "SimulationResult", "attitude", "clear_caches",
+__all__ = ["METHODS", "BatchResult", "Linearization", "Model", "SimulationResult", "attitude", "clear_caches",
            "clock", "closed_loop", "cmg_spacecraft", "constrained", "floquet", "hinged_bodies",
            "launch_vehicle", "linearization", "linearize", "mechanisms", "momentum", "rigid_body", "simulate", "truth",
            "wheel_spacecraft"]

@@ -1,8 +1,8 @@
 """Simulation of a `Model` on a time grid: compiled fixed-step loops, a Lie-group integrator,
 SUNDIALS CVODES, and an ``auto`` mode that meets a requested global tolerance.
 
-The public entry points are `dynamics.simulate`, `dynamics.SimulationResult` and
-`dynamics.METHODS`; the modules of this package are its internals, one job each:
+The public entry points are `dynamics.simulate`, `dynamics.SimulationResult`,
+`dynamics.BatchResult` and `dynamics.METHODS`; the modules of this package are its internals, one job each:
 
 ==============  ===========================================================================
 ``api``         `simulate`: checks the inputs, runs the method, builds the result
@@ -14,6 +14,8 @@ The public entry points are `dynamics.simulate`, `dynamics.SimulationResult` and
 ``auto``        Richardson global-error estimates, round-off floor, stiffness test
 ``result``      `SimulationResult` and its dense output; `Run`, one run's outcome
 ``evaluate``    buffered numeric evaluation of Functions (no per-element conversion)
+``batch``       K runs at once (``x0`` of shape (nx, K)): the chunk loop mapped over the
+                runs on threads, ``auto``'s error control over the batch; `BatchResult`
 ==============  ===========================================================================
 
 Every fixed-step integration (``rk4``, ``rk8``, ``lie`` and the runs ``auto`` makes) calls
@@ -78,6 +80,7 @@ The contract a new method meets (as scipy's ``integrate/_ivp/base.py`` states it
 from __future__ import annotations
 
 from .api import METHODS, Method, simulate
+from .batch import BatchResult
 from .result import SimulationResult
 
-__all__ = ["METHODS", "Method", "SimulationResult", "simulate"]
+__all__ = ["METHODS", "BatchResult", "Method", "SimulationResult", "simulate"]

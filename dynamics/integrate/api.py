@@ -12,6 +12,7 @@ from .. import cache, validate
 from ..clock import check_clock_start, clock_index
 from ..model import Model, check_model
 from .auto import solve_auto
+from .batch import BatchResult, check_batch, simulate_batch
 from .cvodes import run_cvodes
 from .inputs import (Problem, check_cvodes_options, check_invariants, check_t, check_tolerances,
                      check_u, check_x0)
@@ -30,15 +31,20 @@ def simulate(model: Model, x0, t, *, u=None, p=None, method: Method = "auto",
              rtol: float = 1e-8, atol=1e-10, invariants=False, steps: int | None = None,
              jit: bool | None = None, max_steps: int = 100_000_000,
              cvodes_options: Mapping | None = None,
-             progress: Callable[[int, int], None] | None = None) -> SimulationResult:
+             progress: Callable[[int, int], None] | None = None) -> SimulationResult | BatchResult:
     """Integrate ``xdot = f(x, u, p)`` of ``model`` from ``x0`` over the grid ``t``.
 
     Parameters
     ----------
     model : Model
         The dynamics (``model.f``: ``(x, u, p) -> xdot``).
-    x0 : array_like, shape (nx,)
-        State at ``t[0]``, in the model's units.
+    x0 : array_like, shape (nx,) or (nx, K)
+        State at ``t[0]``, in the model's units. Shape ``(nx, K)``, ``K >= 2``: a batch of K
+        runs on the same grid, integrated together (one compiled call per chunk of steps
+        for all runs, spread over the cores; `dynamics.integrate.batch`); ``p`` may then be
+        ``(np, K)`` and ``u`` samples ``(nu, n, K)``, one per run (a callable ``u`` is not
+        taken), and the result is a `BatchResult` with ``x (nx, n, K)`` and per-run
+        ``success``, ``status`` and ``error_estimate``.
     t : array_like, shape (n,) [s]
         Output times, strictly increasing, ``n >= 2``. Fixed-step methods step exactly onto
         every output time.
@@ -46,7 +52,7 @@ def simulate(model: Model, x0, t, *, u=None, p=None, method: Method = "auto",
         Control [model units]: ``None`` is zero; a constant; samples on ``t``, linear in time
         between samples; or ``u(t) -> (nu,)`` for a float ``t`` [s], called at every stage
         time (fixed step) or right-hand-side evaluation (cvodes).
-    p : array_like, shape (np,), optional
+    p : array_like, shape (np,) or, for a batch, (np, K), optional
         Parameters; the model's defaults when omitted.
     method : {'auto', 'cvodes', 'rk4', 'rk8', 'lie'}
         * ``'rk4'``, ``'rk8'`` (DOP853's 8th-order weights), ``'lie'`` (CF4 on the quaternion,
@@ -133,6 +139,9 @@ def simulate(model: Model, x0, t, *, u=None, p=None, method: Method = "auto",
     if method not in METHODS:
         raise ValueError(f"`method` must be one of {METHODS}, got {method!r}")
     t = check_t(t)
+    if np.ndim(x0) == 2 and np.shape(x0)[1] >= 2:
+        return _simulate_batch(model, x0, t, u, p, method, rtol, atol, invariants, steps, jit,
+                               max_steps, cvodes_options, progress, start)
     x0 = check_x0(x0, model)
     if clock_index(model) is not None:  # a time-dependent model: its clock starts at t[0]
         check_clock_start(model, x0, t[0])
@@ -140,21 +149,10 @@ def simulate(model: Model, x0, t, *, u=None, p=None, method: Method = "auto",
     rtol, atol = check_tolerances(rtol, atol, model.nx)
     control = check_u(u, model.nu, t)
     names = check_invariants(invariants, model)
-    max_steps = validate.integer(max_steps, "max_steps", minimum=1)
-    if jit not in (None, True, False):
-        raise ValueError(f"`jit` must be None, True or False, got {jit!r}")
-    if method in _FIXED_STEP:
-        steps = 1 if steps is None else validate.integer(steps, "steps", minimum=1)
-    elif steps is not None:
-        raise ValueError(f"`steps` applies to the fixed-step methods {_FIXED_STEP}, not {method!r}")
-    cvodes_options = check_cvodes_options(cvodes_options)
+    max_steps, steps, cvodes_options, counter = _check_options(method, max_steps, jit, steps,
+                                                               cvodes_options, progress)
     if method == "lie":
         check_lie_model(model, x0, p)
-
-    if progress is not None and not callable(progress):
-        raise TypeError(f"`progress` must be None or a callable (done, total), "
-                        f"got {type(progress).__name__}")
-    counter = Progress(progress)
     problem = Problem(model, x0, t, control, p)
     used, status, estimate = method, OK, math.nan
     if method in _FIXED_STEP:
@@ -175,6 +173,41 @@ def simulate(model: Model, x0, t, *, u=None, p=None, method: Method = "auto",
         invariants=MappingProxyType(values),
         _dense=Dense(model, p, lambda: control.grid(t)),
     )
+
+
+def _simulate_batch(model, x0, t, u, p, method, rtol, atol, invariants, steps, jit, max_steps,
+                    cvodes_options, progress, start) -> BatchResult:
+    """`simulate` for ``x0`` of shape ``(nx, K)`` (`dynamics.integrate.batch`)."""
+    if clock_index(model) is not None:
+        raise ValueError("`x0` of shape (nx, K) (a batch) is not supported for a model with a "
+                         "clock state; simulate its runs one by one")
+    if invariants not in (False, None, ()):
+        raise ValueError("`invariants` are evaluated per run for a batch: use "
+                         "`result.run(k).sample` or `model.invariant` on `result.x[:, :, k]`")
+    batch = check_batch(model, x0, t, u, p)
+    rtol, atol = check_tolerances(rtol, atol, model.nx)
+    max_steps, steps, cvodes_options, counter = _check_options(method, max_steps, jit, steps,
+                                                               cvodes_options, progress)
+    if method == "lie":
+        check_lie_model(model, batch.x0[:, 0], batch.p[:, 0])
+    return simulate_batch(batch, method, steps, rtol, atol, max_steps, jit, cvodes_options,
+                          counter, start)
+
+
+def _check_options(method, max_steps, jit, steps, cvodes_options, progress):
+    """`simulate`'s run options checked: ``(max_steps, steps, cvodes_options, Progress)``."""
+    max_steps = validate.integer(max_steps, "max_steps", minimum=1)
+    if jit not in (None, True, False):
+        raise ValueError(f"`jit` must be None, True or False, got {jit!r}")
+    if method in _FIXED_STEP:
+        steps = 1 if steps is None else validate.integer(steps, "steps", minimum=1)
+    elif steps is not None:
+        raise ValueError(f"`steps` applies to the fixed-step methods {_FIXED_STEP}, not {method!r}")
+    cvodes_options = check_cvodes_options(cvodes_options)
+    if progress is not None and not callable(progress):
+        raise TypeError(f"`progress` must be None or a callable (done, total), "
+                        f"got {type(progress).__name__}")
+    return max_steps, steps, cvodes_options, Progress(progress)
 
 
 def _invariants(model: Model, x: np.ndarray, p: np.ndarray, names) -> dict:

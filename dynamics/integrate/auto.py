@@ -185,21 +185,31 @@ def _spectrum(problem: Problem) -> tuple[float, float] | None:
     decay that only an implicit method steps over cheaply, ``max(-Re lam)`` over the
     eigenvalues with ``Re lam < 0`` and ``|Im lam| <= |Re lam|`` (oscillatory modes must be
     resolved by any method, so they do not count). None when it cannot be evaluated."""
-    model = problem.model
-    key = ("jac_x", cache.function_key(model.f))
-
-    def build():
-        x, u, p = (ca.MX.sym(n, model.f.sparsity_in(n)) for n in ("x", "u", "p"))
-        xdot = model.f.call({"x": x, "u": u, "p": p})["xdot"]
-        return ca.Function("jac_x", [x, u, p], [ca.jacobian(xdot, x)])
-
     t0, H0 = float(problem.t[0]), float(problem.t[1] - problem.t[0])
     u0 = problem.control.at(t0, 0, t0, H0)
     try:
-        J = np.asarray(cache.get(key, build, keepalive=model.f)(problem.x0, u0, problem.p),
-                       dtype=float)
+        J = np.asarray(jacobian_x(problem.model)(problem.x0, u0, problem.p), dtype=float)
+    except RuntimeError:
+        return None
+    return rho_sigma(J[None])
+
+
+def jacobian_x(model) -> ca.Function:
+    """``(x, u, p) -> df/dx`` of ``model`` (cached)."""
+    def build():
+        x, u, p = (ca.MX.sym(n, model.f.sparsity_in(n)) for n in ("x", "u", "p"))
+        xdot = model.f.call({"x": x, "u": u, "p": p})["xdot"]
+        return ca.Function("jac_x", [x, u, p], [ca.densify(ca.jacobian(xdot, x))])
+
+    return cache.get(("jac_x", cache.function_key(model.f)), build, keepalive=model.f)
+
+
+def rho_sigma(J: np.ndarray) -> tuple[float, float] | None:
+    """`_spectrum`'s ``(rho, sigma)`` over the Jacobians ``J (K, nx, nx)`` (the largest of
+    each over the K); None when an eigenvalue is not finite."""
+    try:
         lam = np.linalg.eigvals(J)
-    except (RuntimeError, np.linalg.LinAlgError):
+    except np.linalg.LinAlgError:
         return None
     if not np.all(np.isfinite(lam)):
         return None
@@ -208,23 +218,49 @@ def _spectrum(problem: Problem) -> tuple[float, float] | None:
     return float(np.max(np.abs(lam), initial=0.0)), float(np.max(decay[stiff], initial=0.0))
 
 
-def _auto(problem: Problem, rtol, atol, max_steps, jit_pref, progress: Progress):
-    """Run ``rk8`` with step counts chosen until the global error estimate meets the tolerance.
+class Single:
+    """What `auto_runs` asks of the runs it controls: here one `Problem` (a batch of runs:
+    `dynamics.integrate.batch.BatchTarget`). States are flat: ``x0 (N,)``, a run's ``x``
+    ``(N, n)``."""
+
+    runs = 1  # independent runs whose flat states are stacked (a batch: K)
+
+    def __init__(self, problem: Problem):
+        self.problem, self.t, self.x0 = problem, problem.t, problem.x0
+
+    def run(self, x0: np.ndarray, m: int, jit: bool, progress) -> Run:
+        """``m`` rk8 steps per output interval from ``x0``."""
+        return run_fixed(replace(self.problem, x0=x0), "rk8", m, jit, progress)
+
+    def spectrum(self, rtol, atol):
+        """``(rho, sigma)`` as `_spectrum` (``(L, 0)`` from `_initial_step` when that fails)."""
+        spectrum = _spectrum(self.problem)
+        return (_initial_step(self.problem, rtol, atol, 8)[1], 0.0) if spectrum is None else spectrum
+
+    def rhs(self, X: np.ndarray, cols: np.ndarray) -> np.ndarray:
+        """The right-hand side at the states ``X (N, c)`` taken at output times ``t[cols]``."""
+        problem = self.problem
+        if problem.control.mode == "linear":
+            U = problem.control.grid(problem.t)[:, cols]
+        else:
+            U = np.stack([problem.control.fun(float(problem.t[c])) for c in cols], axis=1)
+        return map_eval(problem.model.f, [X, U, problem.p])
+
+
+def auto_runs(target, rtol, atol, max_steps, jit_pref, progress: Progress):
+    """Run ``rk8`` with step counts chosen until the global error estimate meets the tolerance
+    (``target``: a `Single` problem or a batch; ``atol`` per flat state).
 
     Returns ``(run or None, estimate, status, reason, total_steps, total_rhs)``: ``None`` and
     reason ``"stiff"`` hand the problem to `_auto_cvodes`. ``status`` is ``OK``,
     ``ROUNDOFF`` (the tolerance lies below the round-off floor) or ``UNVERIFIED`` (not
     within ``max_steps`` or the run budget); the best run found is returned with them.
     """
-    nint = problem.nint
-    horizon = float(problem.t[-1] - problem.t[0])
-    Hmax = float(np.max(np.diff(problem.t)))
-    spectrum = _spectrum(problem)
-    if spectrum is None:
-        _, lipschitz = _initial_step(problem, rtol, atol, 8)
-        sigma = 0.0
-    else:
-        lipschitz, sigma = spectrum
+    t = target.t
+    nint = t.size - 1
+    horizon = float(t[-1] - t[0])
+    Hmax = float(np.max(np.diff(t)))
+    lipschitz, sigma = target.spectrum(rtol, atol)
     if horizon * sigma / _RK8_STABILITY > _STIFF_STEPS:
         return (None, math.nan, 0, f"stiff: a decay rate of {sigma:.3g}/s needs "
                 f"~{horizon * sigma / _RK8_STABILITY:.3g} explicit steps for stability alone",
@@ -251,9 +287,8 @@ def _auto(problem: Problem, rtol, atol, max_steps, jit_pref, progress: Progress)
         if m in runs or len(runs) >= _AUTO_RUNS:
             reason = f"the error estimates did not settle in {len(runs)} runs"
             break
-        run = run_fixed(_perturbed(problem, m), "rk8", m,
-                        _auto_jit(problem, m, jit_pref), progress)
-        run.x[:, 0] = problem.x0
+        run = target.run(_perturbed(target.x0, m), m, _auto_jit(jit_pref), progress)
+        run.x[:, 0] = target.x0
         runs[m] = run
         total[0] += run.n_steps
         total[1] += run.n_rhs
@@ -267,8 +302,8 @@ def _auto(problem: Problem, rtol, atol, max_steps, jit_pref, progress: Progress)
         asymptotic = asymptotic or est.trusted
         if est.accept:
             best = runs[max(k for k, r in runs.items() if r.ok)]
-            floor, extra = _floor(problem, best, rtol, atol, lipschitz,
-                                  _auto_jit(problem, best.substeps, jit_pref), progress)
+            floor, extra = _floor(target, best, rtol, atol, lipschitz, _auto_jit(jit_pref),
+                                  progress)
             total[0] += extra
             total[1] += extra * DOP853.stages
             if est.value + floor > 1.0:
@@ -283,7 +318,7 @@ def _auto(problem: Problem, rtol, atol, max_steps, jit_pref, progress: Progress)
     return best, est.value, UNVERIFIED, reason, *total
 
 
-def _floor(problem: Problem, run: Run, rtol, atol, lipschitz: float, jit: bool,
+def _floor(target, run: Run, rtol, atol, lipschitz: float, jit: bool,
            progress) -> tuple[float, int]:
     """Scaled error floor of ``run`` from rounding; returns ``(floor, extra steps made)``.
 
@@ -305,18 +340,14 @@ def _floor(problem: Problem, run: Run, rtol, atol, lipschitz: float, jit: bool,
     16-400 steps per interval and scipy's DOP853 alike, was off by 900 ulps of ``|w|``
     while they agreed to 90).
     """
-    x, model = run.x, problem.model
-    horizon = float(problem.t[-1] - problem.t[0])
+    x = run.x
+    horizon = float(target.t[-1] - target.t[0])
     cols = np.unique(np.linspace(0, x.shape[1] - 1, min(16, x.shape[1])).round().astype(int))
     rng = np.random.default_rng(0)
     X = x[:, cols]
     pert = [X] + [X * (1 + _EPS * rng.choice((-1.0, 1.0), size=X.shape)) for _ in range(3)]
-    if problem.control.mode == "linear":
-        U = problem.control.grid(problem.t)[:, cols]
-    else:
-        U = np.stack([problem.control.fun(float(problem.t[c])) for c in cols], axis=1)
-    F = map_eval(model.f, [np.concatenate(pert, axis=1), np.tile(U, (1, len(pert))),
-                           problem.p]).reshape(model.nx, len(pert), cols.size)
+    F = target.rhs(np.concatenate(pert, axis=1),
+                   np.tile(cols, len(pert))).reshape(x.shape[0], len(pert), cols.size)
     if not np.all(np.isfinite(F)):
         return math.inf, 0
     noise = np.max(np.abs(F[:, 1:] - F[:, :1]), axis=(1, 2))
@@ -326,25 +357,27 @@ def _floor(problem: Problem, run: Run, rtol, atol, lipschitz: float, jit: bool,
     ulps = _roundoff(x, _FLOOR_ULPS, scale)
     local = _scaled_diff(np.broadcast_to(e[:, None], scale.shape), np.zeros(scale.shape), scale)
     # the flow may carry the noise of any state into any other (the spin-rate noise of a
-    # flat body into the phase of its transverse rates): a screening bound across states
-    bound = float(np.max(e)) * (1 + lipschitz * horizon) / float(np.min(scale))
+    # flat body into the phase of its transverse rates): a screening bound across the states
+    # of each run (the runs of a batch do not share noise), the largest over the runs
+    runs = target.runs
+    bound = float(np.max(np.max(e.reshape(runs, -1), axis=1)
+                         / np.min(scale.reshape(runs, -1), axis=1))) * (1 + lipschitz * horizon)
     if bound <= 0.1 * _AUTO_ACCEPT:
         return max(bound, ulps), 0
     signs = rng.choice((-1.0, 1.0), size=e.size)
-    check = run_fixed(replace(problem, x0=problem.x0 + signs * e), "rk8", run.substeps, jit,
-                      progress)
+    check = target.run(target.x0 + signs * e, run.substeps, jit, progress)
     return max(local, ulps, _scaled_diff(check.x[:, 1:], x[:, 1:], scale)), check.n_steps
 
 
-def _perturbed(problem: Problem, m: int) -> Problem:
-    """``problem`` with ``x0`` moved by 2 ulp in a sign pattern that differs between step
+def _perturbed(x0: np.ndarray, m: int) -> np.ndarray:
+    """``x0`` moved by 2 ulp in a sign pattern that differs between step
     counts ``m`` (reproducibly): the differences between ``auto``'s runs then also show how
     strongly the problem amplifies double-precision representation errors (of ``x0`` and of
     the model's constants, rounded alike). Near a separatrix this amplification put a common
     error of 3e-13 into every run at 16-400 steps per interval that step-count differences
     alone cannot see; a well-conditioned problem just carries the 2 ulp."""
-    signs = np.random.default_rng(m).choice((-1.0, 1.0), size=problem.x0.size)
-    return replace(problem, x0=problem.x0 + 2 * _EPS * signs * problem.x0)
+    signs = np.random.default_rng(m).choice((-1.0, 1.0), size=x0.size)
+    return x0 + 2 * _EPS * signs * x0
 
 
 def _first_bad(x: np.ndarray) -> int:
@@ -353,7 +386,7 @@ def _first_bad(x: np.ndarray) -> int:
     return int(np.argmax(bad)) if bad.any() else x.shape[1]
 
 
-def _auto_jit(problem: Problem, m: int, jit_pref) -> bool:
+def _auto_jit(jit_pref) -> bool:
     """jit for ``auto``'s runs: `cache.should_compile` with unbounded work, as for the
     fixed-step methods (one compiled chunk per model, reused by every run and call)."""
     return cache.should_compile(jit_pref, math.inf)
@@ -387,8 +420,8 @@ def _auto_cvodes(problem: Problem, rtol, atol, extra):
 
 def solve_auto(problem: Problem, rtol, atol, max_steps, jit, cvodes_options, progress):
     """``auto``: -> (run, method used, status, error estimate); counters cover every run."""
-    run, estimate, status, reason, n_steps, n_rhs = _auto(problem, rtol, atol, max_steps, jit,
-                                                          progress)
+    run, estimate, status, reason, n_steps, n_rhs = auto_runs(Single(problem), rtol, atol,
+                                                          max_steps, jit, progress)
     if run is None and reason.startswith("stiff"):
         crun, estimate, status, cs, cr = _auto_cvodes(problem, rtol, atol, cvodes_options)
         verdict = {OK_STIFF: f"estimated error {estimate:.2g} of tolerance (from runs at "

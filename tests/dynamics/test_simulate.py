@@ -409,7 +409,7 @@ GOOD = dict(x0=X3, t=np.linspace(0.0, 1.0, 5))
 @pytest.mark.parametrize("kwargs, name", [
     ({"x0": [1.0, np.nan, 0.0]}, "x0"),
     ({"x0": [1.0, 2.0]}, "x0"),
-    ({"x0": np.ones((3, 2))}, "x0"),
+    ({"x0": np.ones((2, 3))}, "x0"),  # (3, K) is a batch; (2, 3) fits neither
     ({"t": [0.0]}, "t"),
     ({"t": [0.0, 1.0, 1.0]}, "t"),
     ({"t": [1.0, 0.0]}, "t"),

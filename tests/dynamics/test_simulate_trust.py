@@ -154,8 +154,9 @@ def test_one_compiled_chunk_serves_every_grid_and_step_count():
     model = rigid_body([1.0, 2.0, 3.0])
 
     def chunks():
-        return {k for k in cache._CACHE._items
-                if k[0] == "chunk" and k[1] == cache.function_key(model.f) and k[3] == "rk4"}
+        return {k for k in cache._CACHE._items  # single-run chunks (a batch's key adds its size)
+                if k[0] == "chunk" and k[1] == cache.function_key(model.f) and k[3] == "rk4"
+                and len(k) == 6}
 
     simulate(model, X0, np.linspace(0.0, 1.0, 11), method="rk4", steps=1)
     before = chunks()

@@ -1,0 +1,329 @@
+"""Batched simulation: K runs of one model on one output grid in one compiled call per chunk.
+
+`simulate` comes here when ``x0`` has shape ``(nx, K)``. Every run shares the grid, the
+method and the step count; each has its own initial state, parameters (``p`` of shape
+``(np, K)``) and control samples (``u`` of shape ``(nu, n, K)``). The fixed-step methods
+call the model's one compiled chunk loop (`dynamics.integrate.loops.chunk_function`,
+the same Function single runs use: no new compile) through a casadi ``map`` over the K runs,
+split over the machine's cores (``thread`` map; `BATCH_THREADS`). ``auto`` runs the
+same error control as a single run (`dynamics.integrate.auto`) on the whole batch: one
+step count for all runs, chosen until the global error estimate of every run meets the
+tolerance; each run's own estimate is reported. ``cvodes`` (a variable-step integrator per
+run) is a loop of single runs.
+"""
+from __future__ import annotations
+
+import contextlib
+import math
+import os
+import time
+from dataclasses import dataclass
+from types import MappingProxyType
+
+import numpy as np
+
+from .. import cache
+from ..interrupts import check_interrupt, deferred_interrupts
+from ..model import Model
+from ..validate import finite_array, integer, unit_quaternion
+from ..validate.rotations import QUAT_NORM_TOL
+from .auto import Single, auto_runs, jacobian_x, rho_sigma
+from .cvodes import run_cvodes
+from .evaluate import call_buffered, map_eval
+from .inputs import Control, Problem
+from .loops import BATCH_CHUNK as CHUNK
+from .loops import Progress, chunk_function
+from .result import FAILED, OK, OK_STIFF, ROUNDOFF, UNVERIFIED, Dense, Run, SimulationResult
+from .tableaux import TABLEAUX
+
+__all__ = ["Batch", "BatchResult", "check_batch", "run_fixed_batch", "simulate_batch",
+           "BATCH_THREADS"]
+
+#: Threads of the casadi ``map`` over the runs of a batch (the machine's cores, at most 8).
+BATCH_THREADS = max(1, min(8, os.cpu_count() or 1))
+
+
+@dataclass(frozen=True)
+class Batch:
+    """K runs on one grid: ``x0 (nx, K)``, ``p (np, K)``, controls ``ua, ub (K, nint, nu)``
+    (the values at the start and end of each output interval, linear in between)."""
+
+    model: Model
+    x0: np.ndarray
+    t: np.ndarray
+    p: np.ndarray
+    ua: np.ndarray
+    ub: np.ndarray
+
+    @property
+    def K(self) -> int:
+        return self.x0.shape[1]
+
+    @property
+    def nint(self) -> int:
+        return self.t.size - 1
+
+    def problem(self, k: int) -> Problem:
+        """Run ``k`` as a single-run `Problem`."""
+        return Problem(self.model, self.x0[:, k].copy(), self.t,
+                       Control("linear", self.ua[k], self.ub[k]), self.p[:, k].copy())
+
+
+def check_batch(model: Model, x0, t: np.ndarray, u, p) -> Batch:
+    """The batch of ``x0 (nx, K)`` with ``p`` ``(np,)`` or ``(np, K)`` and ``u`` None,
+    ``(nu,)``, ``(nu, n)`` (shared) or ``(nu, n, K)`` (per run); raises naming the argument."""
+    nx, nu, n = model.nx, model.nu, t.size
+    X0 = np.array(finite_array(x0, "x0"), dtype=float)
+    if X0.ndim != 2 or X0.shape[0] != nx or X0.shape[1] < 1:
+        raise ValueError(f"`x0` must have shape ({nx},) or ({nx}, K) for a batch of K runs, "
+                         f"got {X0.shape}")
+    K = X0.shape[1]
+    if model.attitude is not None:
+        iq = model.attitude[0]
+        bad = np.abs(np.linalg.norm(X0[iq:iq + 4], axis=0) - 1.0) > QUAT_NORM_TOL
+        if bad.any():  # the message of the single-run check, naming the run
+            k = int(np.argmax(bad))
+            unit_quaternion(X0[iq:iq + 4, k], f"x0[{iq}:{iq + 4}, {k}] (the attitude quaternion)")
+    if p is None:
+        P = np.repeat(model.resolve_p(None)[:, None], K, axis=1)
+    else:
+        a = np.asarray(finite_array(p, "p"), dtype=float)
+        if a.ndim == 2 and a.shape == (model.np, K):
+            P = np.array(a)
+        elif a.ndim <= 1:
+            P = np.repeat(model.resolve_p(a)[:, None], K, axis=1)
+        else:
+            raise ValueError(f"`p` must have shape ({model.np},) or ({model.np}, {K}) for a "
+                             f"batch of {K} runs, got {a.shape}")
+    if callable(u):
+        raise ValueError("`u` must be None or an array for a batch of runs (x0 of shape "
+                         f"({nx}, K)): give samples of shape ({nu}, {n}) or ({nu}, {n}, K)")
+    if u is None:
+        U = np.zeros((K, n, nu))
+    else:
+        a = np.asarray(finite_array(u, "u"), dtype=float)
+        if a.shape == (nu,):
+            U = np.broadcast_to(a, (K, n, nu))
+        elif a.shape == (nu, n):
+            U = np.broadcast_to(a.T, (K, n, nu))
+        elif a.shape == (nu, n, K):
+            U = a.transpose(2, 1, 0)
+        else:
+            raise ValueError(f"`u` must be None, ({nu},), ({nu}, {n}) or ({nu}, {n}, {K}) for "
+                             f"a batch of {K} runs, got {a.shape}")
+    return Batch(model, X0, t, P, np.ascontiguousarray(U[:, :-1]), np.ascontiguousarray(U[:, 1:]))
+
+
+def _mapped(fun, K: int):
+    """``fun`` mapped over K runs on `BATCH_THREADS` threads (cached; no compile)."""
+    key = ("batch_map", cache.function_key(fun), K, BATCH_THREADS)
+    if BATCH_THREADS > 1 and K > 1:
+        return cache.get(key, lambda: fun.map(K, "thread", BATCH_THREADS), keepalive=fun)
+    return cache.get(key, lambda: fun.map(K, "serial"), keepalive=fun)
+
+
+def run_fixed_batch(batch: Batch, method: str, m: int, jit: bool, x0: np.ndarray | None = None,
+                    progress: Progress | None = None) -> tuple[np.ndarray, np.ndarray, Run]:
+    """``m`` steps of ``method`` per output interval for every run of ``batch`` (from
+    ``x0 (nx, K)``, default ``batch.x0``), chunk by chunk in one mapped call per chunk.
+
+    Returns ``(x (nx, n, K), ok (K,), run)``: a run whose state became non-finite has its
+    later columns NaN and ``ok`` False; ``run`` carries the counts of one run (steps per run,
+    right-hand sides per run) and its ``x`` is the batch stacked run by run ``(K nx, n)``.
+    """
+    model, K, nint = batch.model, batch.K, batch.nint
+    nx = model.nx
+    fun, compiled = chunk_function(model, method, "linear", jit, CHUNK)
+    mapped = _mapped(fun, K)
+    hm = np.diff(batch.t) / m
+    total = m * nint
+    progress = Progress(None) if progress is None else progress
+    progress.start(total)
+    X0 = batch.x0 if x0 is None else x0
+    x = np.full((K, nint + 1, nx), np.nan)
+    x[:, 0] = X0.T
+    xk = np.ascontiguousarray(X0.T)
+    slope = (batch.ub - batch.ua) / np.diff(batch.t)[None, :, None]  # (K, nint, nu)
+    constant = not np.any(slope) and bool(np.all(batch.ua == batch.ua[:, :1]))
+    ua = np.zeros((K, CHUNK, model.nu))
+    ud = np.zeros((K, CHUNK, model.nu))
+    if constant:
+        ua[:] = batch.ua[:, :1]
+    P = np.ascontiguousarray(batch.p.T)
+    nn, hh = np.empty(K), np.empty((K, CHUNK))
+    done = 0
+    with deferred_interrupts() if total > CHUNK else contextlib.nullcontext():
+        for s0 in range(0, total, CHUNK):
+            check_interrupt()
+            n = min(CHUNK, total - s0)
+            s = np.arange(s0, s0 + n)
+            k = s // m
+            h = np.zeros(CHUNK)
+            h[:n] = hm[k]
+            if not constant:
+                ud[:, :n] = slope[:, k]
+                ua[:, :n] = batch.ua[:, k] + ((s - k * m) * h[:n])[None, :, None] * ud[:, :n]
+            nn[:], hh[:] = n, h
+            X = call_buffered(mapped, [xk, nn, hh, ua, ud, P],
+                              (K * CHUNK, nx)).reshape(K, CHUNK, nx)
+            k_lo, k_hi = (s0 + m) // m - 1, (s0 + n) // m
+            last = (np.arange(k_lo, k_hi) + 1) * m - 1 - s0
+            x[:, k_lo + 1:k_hi + 1] = X[:, last]
+            xk = np.ascontiguousarray(X[:, n - 1])
+            done = s0 + n
+            progress.advance(n)
+    progress.abandon(total - done)
+    x = x.transpose(2, 1, 0)  # (nx, n, K)
+    finite = np.isfinite(x).all(axis=0)  # (n, K)
+    ok = finite.all(axis=0)
+    for j in np.flatnonzero(~ok):
+        x[:, int(np.argmax(~finite[:, j])):, j] = np.nan
+    stages = 4 if method == "lie" else TABLEAUX[method].stages
+    stacked = np.ascontiguousarray(x.transpose(2, 0, 1).reshape(K * nx, nint + 1))
+    message = (f"{method}: {m} step(s) per output interval, {done} steps per run, {K} runs"
+               + ("" if ok.all() else f"; {int((~ok).sum())} run(s) became non-finite"))
+    return x, ok, Run(stacked, done, stages * done, m, compiled, bool(ok.all()), message)
+
+
+class BatchTarget:
+    """`dynamics.integrate.auto`'s view of a batch: flat states stacked run by run
+    (``x0 (K nx,)``, a run's ``x (K nx, n)``), one step count for all runs."""
+
+    def __init__(self, batch: Batch):
+        self.batch, self.t, self.runs = batch, batch.t, batch.K
+        self.x0 = np.ascontiguousarray(batch.x0.T).reshape(-1)
+
+    def _unstack(self, flat: np.ndarray) -> np.ndarray:
+        return flat.reshape(self.batch.K, self.batch.model.nx).T
+
+    def run(self, x0: np.ndarray, m: int, jit: bool, progress) -> Run:
+        return run_fixed_batch(self.batch, "rk8", m, jit, self._unstack(x0), progress)[2]
+
+    def spectrum(self, rtol, atol):
+        b = self.batch
+        J = map_eval(jacobian_x(b.model), [b.x0, b.ua[:, 0].T, b.p])  # (nx nx, K)
+        nx = b.model.nx
+        found = rho_sigma(J.T.reshape(b.K, nx, nx).transpose(0, 2, 1)) if np.all(np.isfinite(J)) else None
+        if found is not None:
+            return found
+        return max(Single(b.problem(k)).spectrum(rtol, atol[k * nx:(k + 1) * nx])[0]
+                   for k in range(b.K)), 0.0
+
+    def rhs(self, X: np.ndarray, cols: np.ndarray) -> np.ndarray:
+        b = self.batch
+        K, nx, c = b.K, b.model.nx, cols.size
+        U = np.concatenate([b.ua, b.ub[:, -1:]], axis=1)[:, cols]  # (K, c, nu)
+        F = map_eval(b.model.f, [X.reshape(K, nx, c).transpose(1, 0, 2).reshape(nx, K * c),
+                                 U.transpose(2, 0, 1).reshape(-1, K * c),
+                                 np.repeat(b.p, c, axis=1)])
+        return F.reshape(nx, K, c).transpose(1, 0, 2).reshape(K * nx, c)
+
+
+def simulate_batch(batch: Batch, method: str, steps: int, rtol: float, atol: np.ndarray,
+                   max_steps: int, jit, cvodes_options, progress: Progress, start: float
+                   ) -> "BatchResult":
+    """`simulate` for a batch (see the module docstring)."""
+    K, nx = batch.K, batch.model.nx
+    estimate = np.full(K, math.nan)
+    if method in ("rk4", "rk8", "lie"):
+        x, ok, run = run_fixed_batch(batch, method, steps, cache.should_compile(jit, math.inf),
+                                     progress=progress)
+        status = np.where(ok, OK, FAILED)
+        used, message, n_steps, compiled = method, run.message, run.n_steps, run.compiled
+    elif method == "cvodes":
+        runs = [run_cvodes(batch.problem(k), rtol, atol, cvodes_options) for k in range(K)]
+        x = np.stack([r.x for r in runs], axis=2)
+        ok = np.array([r.ok for r in runs])
+        status = np.where(ok, OK, FAILED)
+        used, n_steps, compiled = "cvodes", max(r.n_steps for r in runs), False
+        message = f"cvodes: {K} runs, one after another" + (
+            "" if ok.all() else f"; {int((~ok).sum())} failed: {runs[int(np.argmin(ok))].message}")
+    else:
+        target = BatchTarget(batch)
+        run, value, st, reason, n_steps, _ = auto_runs(target, rtol, np.tile(atol, K), max_steps,
+                                                   jit, progress)
+        if run is None:  # stiff, or too many steps: no rk8 run was made
+            raise_or = "a stiff batch (give method='cvodes')" if reason.startswith("stiff") else reason
+            x = np.full((nx, batch.t.size, K), np.nan)
+            x[:, 0] = batch.x0
+            ok, status = np.zeros(K, bool), np.full(K, st if st else UNVERIFIED)
+            used, message, compiled = "rk8", f"auto: tolerance not verified: {raise_or}", False
+        else:
+            x = run.x.reshape(K, nx, -1).transpose(1, 2, 0).copy()
+            ok = np.isfinite(x).all(axis=(0, 1))
+            status = np.where(ok, st, FAILED)
+            estimate[:] = value
+            used, compiled = "rk8", run.compiled
+            verdict = {OK: f"estimated error {value:.2g} of tolerance (the largest over the runs)",
+                       ROUNDOFF: "tolerance not verified: at the round-off floor of fixed-step runs",
+                       UNVERIFIED: f"tolerance not verified: {reason}",
+                       FAILED: "a run became non-finite"}.get(st, "")
+            message = f"auto: {run.message}; {verdict}"
+    x.setflags(write=False)
+    return BatchResult(t=batch.t, x=x, success=ok & np.isin(status, (OK, OK_STIFF)),
+                       status=status, message=message, method=used,
+                       wall_time=time.perf_counter() - start, n_steps=int(n_steps),
+                       error_estimate=estimate, compiled=bool(compiled), _batch=batch)
+
+
+@dataclass(frozen=True)
+class BatchResult:
+    """What `simulate` returns for a batch of K runs (``x0`` of shape ``(nx, K)``).
+
+    Attributes
+    ----------
+    t : ndarray, shape (n,) [s]
+    x : ndarray, shape (nx, n, K)
+        Run ``k`` is ``x[:, :, k]`` (read-only).
+    success : ndarray of bool, shape (K,)
+        Run ``k`` finished with finite states and, for ``auto``, its error estimate meets
+        the tolerance.
+    status : ndarray of int, shape (K,)
+        `SimulationResult`'s codes per run (0 ok, 1 ok with cvodes, 2 round-off floor,
+        3 not verified, -1 failed).
+    message : str
+    method : str
+        The method used.
+    wall_time : float [s]
+    n_steps : int
+        Steps per run (``auto``: summed over its runs; cvodes: the most of any run).
+    error_estimate : ndarray, shape (K,)
+        ``auto``: the estimated global error in units of the tolerance, the largest over
+        the batch (one step count serves all runs); NaN for the other methods.
+    compiled : bool
+    """
+
+    t: np.ndarray
+    x: np.ndarray
+    success: np.ndarray
+    status: np.ndarray
+    message: str
+    method: str
+    wall_time: float
+    n_steps: int
+    error_estimate: np.ndarray
+    compiled: bool
+    _batch: Batch
+
+    def __len__(self) -> int:
+        return self.x.shape[2]
+
+    @property
+    def all_success(self) -> bool:
+        """Whether every run succeeded."""
+        return bool(np.all(self.success))
+
+    def run(self, k: int) -> SimulationResult:
+        """Run ``k`` as a `SimulationResult` (dense output, invariants, drift)."""
+        k = integer(k, "k", minimum=0)
+        if k >= len(self):
+            raise ValueError(f"`k` must be below the number of runs {len(self)}, got {k}")
+        b = self._batch
+        problem = b.problem(k)
+        x = self.x[:, :, k]
+        return SimulationResult(
+            t=self.t, x=x, success=bool(self.success[k]), status=int(self.status[k]),
+            message=self.message, method=self.method, wall_time=self.wall_time,
+            n_steps=self.n_steps, n_rhs=0, substeps=0, error_estimate=float(self.error_estimate[k]),
+            compiled=self.compiled, invariants=MappingProxyType({}),
+            _dense=Dense(b.model, problem.p, lambda: problem.control.grid(problem.t)))
