@@ -29,7 +29,8 @@ from dynamics.model import Model, check_model
 
 from .distributions import check_spec, draw_samples
 from .result import DispersionResult, assemble
-from .sample import ATTITUDE, SampleTask, accepted, check_callable, picked, run_sample, run_samples
+from .sample import (ATTITUDE, SampleTask, accepted, check_callable, picked, run_batch,
+                     run_sample, run_samples)
 
 __all__ = ["dispersion"]
 
@@ -121,7 +122,8 @@ def dispersion(model, x0, t, *, samples: int, seed: int | None, outputs: Mapping
                executor: Executor | None = None,
                progress: Callable[[int, int], None] | None = None,
                percentiles=(1.0, 50.0, 99.0), units: Mapping | None = None,
-               chunksize: int | None = None, **simulate_kwargs) -> DispersionResult:
+               chunksize: int | None = None, batch: bool = False,
+               **simulate_kwargs) -> DispersionResult:
     """Simulate ``samples`` draws of the inputs and collect statistics of named outputs.
 
     Parameters
@@ -168,6 +170,13 @@ def dispersion(model, x0, t, *, samples: int, seed: int | None, outputs: Mapping
         ``ceil(samples / (4 * os.cpu_count()))``: a fixed `Model` crosses to the worker once
         per job, and a model unpickled in a worker is new to its cache (its integration
         loop is rebuilt, ~20 ms for a rigid body), so small jobs waste that per sample.
+    batch : bool, optional
+        With a fixed `Model` (not a factory) and no executor: all samples in ONE batched
+        `dynamics.simulate` call (``x0`` of shape ``(nx, K)``, the compiled loop mapped over
+        the samples on the cores). ``method='auto'`` then steps every sample with the step
+        count its hardest sample needs, so the results differ from per-sample runs within
+        the tolerance. ``progress`` is called once, when all are done; a Ctrl-C keeps no
+        partial result.
     **simulate_kwargs
         Passed to `dynamics.simulate` (``method``, ``rtol``, ``atol``, ``u``, ``p``,
         ``steps``, ``jit``, ...). With a factory, ``jit`` defaults to ``False`` (each sample
@@ -246,6 +255,11 @@ def dispersion(model, x0, t, *, samples: int, seed: int | None, outputs: Mapping
     chunksize = validate.integer(chunksize, "chunksize", minimum=1)
     factory = not isinstance(model, Model)
     kwargs = _check_simulate_kwargs(dict(simulate_kwargs), factory)
+    if batch not in (True, False):
+        raise TypeError(f"`batch` must be True or False, got {batch!r}")
+    if batch and (factory or executor is not None):
+        raise ValueError("`batch=True` needs a fixed Model (not a factory) and no executor: "
+                         "the batch is one simulate call in this process")
 
     if factory:
         check_callable(model, params, "model")
@@ -277,7 +291,12 @@ def dispersion(model, x0, t, *, samples: int, seed: int | None, outputs: Mapping
                          time.perf_counter() - start, complete, tuple(float(p) for p in pct))
 
     try:
-        _execute(tasks, executor, progress, done, chunksize)
+        if batch:
+            done.update((o.index, o) for o in run_batch(tasks))
+            if progress is not None:
+                progress(len(done), samples)
+        else:
+            _execute(tasks, executor, progress, done, chunksize)
     except BaseException as exc:
         if done and isinstance(exc, KeyboardInterrupt):
             exc.partial = result(False)

@@ -317,3 +317,40 @@ def test_ctrl_c_stops_between_samples():
     with pytest.raises(KeyboardInterrupt) as info:
         spin_dispersion(samples=5, progress=sigint)
     assert info.value.partial.index.tolist() == [0, 1]
+
+
+# ------------------------------------------------------------------ one batched simulate
+def _raising_flag(res, flag):
+    if flag > 0.8:
+        raise RuntimeError("too wobbly")
+    return flag
+
+
+def test_batch_of_a_fixed_model_meets_the_closed_form_and_the_serial_run():
+    """``batch=True``: all samples in one `simulate` call; each sample's transverse rate
+    equals the axisymmetric closed form ``w1(t) = w1(0) cos(lambda t)``, ``lambda = (I_a -
+    I_t) w3 / I_t``, as the per-sample runs do, and an output that raises fails its sample
+    only."""
+    it, ia = 1000.0, 1500.0
+    body = rigid_body([it, it, ia])
+    params = {"w1": Normal(0.02, 0.004), "w3": Normal(1.0, 0.05),
+              "attitude": SmallRotation(0.01), "flag": Uniform(0.0, 1.0)}
+    args = dict(samples=40, seed=5, params=params,
+                outputs={"w1h": "w1", "flag": _raising_flag})
+    many = dispersion(body, X0, T, batch=True, **args)
+    one = dispersion(body, X0, T, **args)
+    ok = many.inputs["flag"] <= 0.8
+    assert 0 < np.count_nonzero(~ok) < 40
+    np.testing.assert_array_equal(many.sample_success, ok)
+    np.testing.assert_array_equal(one.sample_success, ok)
+    lam = (ia - it) / it * many.inputs["w3"]
+    truth = many.inputs["w1"][:, None] * np.cos(lam[:, None] * T[None, :])
+    assert np.max(np.abs(many.outputs["w1h"][ok] - truth[ok])) < 1e-9
+    np.testing.assert_allclose(many.outputs["w1h"][ok], one.outputs["w1h"][ok], atol=1e-9)
+    assert "RuntimeError: too wobbly" in many.sample_messages[int(np.argmin(ok))]
+    with pytest.raises(ValueError, match="`batch=True`"):
+        spin_dispersion(batch=True)  # a factory
+    with ThreadPoolExecutor(2) as pool, pytest.raises(ValueError, match="`batch=True`"):
+        dispersion(body, X0, T, batch=True, executor=pool, **args)
+    with pytest.raises(TypeError, match="`batch`"):
+        dispersion(body, X0, T, batch="yes", **args)
