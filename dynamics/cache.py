@@ -63,8 +63,9 @@ shared models, grids and problems; results are identical to a serial run. How:
   integrators and `ocp.solve`'s IPOPT solvers (with their transcribed NLP) are pooled;
   the ocp's per-interval cvodes integrators are kept per thread (`ocp.cached`).
 * **Pure Functions are shared freely.** Fixed-step chunk loops (``rk4``, ``rk8``,
-  ``lie``, compiled or not) are called through a fresh ``Function.buffer()`` per call
-  (`dynamics.integrate.evaluate.call_buffered`), which reserves its own memory object;
+  ``lie``, compiled or not) are called through a ``Function.buffer()`` kept per thread and
+  per Function (`dynamics.integrate.evaluate.call_buffered`; dropped with its Function),
+  which reserves its own memory object;
   Jacobians and linearizations are SX/MX Functions without solver state.
 
 Cost on a single thread: one pool look-up per cvodes or IPOPT call, about 3 us (a cvodes

@@ -18,7 +18,7 @@ from .inputs import (Problem, check_cvodes_options, check_invariants, check_t, c
                      check_u, check_x0)
 from .kernels import check_lie_model
 from .loops import Progress, run_fixed
-from .result import FAILED, OK, OK_STIFF, Dense, SimulationResult
+from .result import FAILED, OK, OK_STIFF, Dense, SimulationResult, make_result
 
 __all__ = ["simulate", "METHODS", "Method"]
 
@@ -166,7 +166,7 @@ def simulate(model: Model, x0, t, *, u=None, p=None, method: Method = "auto",
     x.setflags(write=False)
     values = _invariants(model, x, p, names)
     success = run.ok and status in (OK, OK_STIFF)
-    return SimulationResult(
+    return make_result(
         t=t, x=x, success=success, status=status if run.ok else FAILED, message=run.message,
         method=used, wall_time=time.perf_counter() - start, n_steps=run.n_steps, n_rhs=run.n_rhs,
         substeps=run.substeps, error_estimate=estimate, compiled=run.compiled,

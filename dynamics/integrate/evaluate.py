@@ -1,6 +1,9 @@
 """Numeric evaluation of CasADi Functions without per-element data conversion."""
 from __future__ import annotations
 
+import threading
+import weakref
+
 import casadi as ca
 import numpy as np
 
@@ -13,16 +16,47 @@ def call_buffered(fun: ca.Function, args, out_shape) -> np.ndarray:
     """Evaluate ``fun`` through a buffer: numpy in, numpy out, no per-element conversion.
 
     Arrays are passed in casadi's column-major layout: a C-ordered ``(ncol, nrow)`` numpy
-    array is the casadi ``nrow x ncol`` matrix.
+    array is the casadi ``nrow x ncol`` matrix; inputs not given are zero. The buffer (a
+    memory object of ``fun``) is kept per thread and per Function when every input is
+    given: a repeated call saves the ``Function.buffer()`` (about 6 us), and no two threads
+    ever share one.
     """
-    args = [np.ascontiguousarray(a, dtype=float) for a in args]
+    args = [np.ascontiguousarray(a, dtype=float) for a in args]  # alive until trigger()
     out = np.empty(out_shape)
-    buf, trigger = fun.buffer()
+    buffers = _thread_buffers()
+    key = id(fun)
+    entry = buffers.pop(key, None)  # taken out while in use: a nested call makes its own
+    if entry is None or entry[0]() is not fun:
+        entry = _new_buffer(fun, buffers, key)
+    _, buf, trigger, n_in = entry
+    if len(args) != n_in:  # an input left out must be a null pointer, as in a new buffer
+        buf, trigger = fun.buffer()
     for i, a in enumerate(args):
         buf.set_arg(i, memoryview(a))
     buf.set_res(0, memoryview(out))
     trigger()
+    buffers[key] = entry
     return out
+
+
+_LOCAL = threading.local()
+
+
+def _thread_buffers() -> dict:
+    """This thread's buffers: ``id(fun) -> (weakref to fun, buffer, trigger, n_in)``."""
+    try:
+        return _LOCAL.buffers
+    except AttributeError:
+        _LOCAL.buffers = {}
+        return _LOCAL.buffers
+
+
+def _new_buffer(fun: ca.Function, buffers: dict, key: int) -> tuple:
+    """A buffer of ``fun`` for this thread, dropped with ``fun`` (a Function evicted from
+    `dynamics.cache` releases its memory objects and compiled library)."""
+    buf, trigger = fun.buffer()
+    ref = weakref.ref(fun, lambda _ref: buffers.pop(key, None))
+    return ref, buf, trigger, fun.n_in()
 
 
 def map_eval(fun: ca.Function, args) -> np.ndarray:

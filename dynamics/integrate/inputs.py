@@ -6,6 +6,7 @@ from __future__ import annotations
 import contextlib
 import difflib
 import io
+import math
 import re
 from dataclasses import dataclass
 from typing import Callable, Mapping
@@ -15,7 +16,7 @@ import numpy as np
 
 from .. import cache
 from ..model import Model
-from ..validate import finite_array, finite_scalar, unit_quaternion
+from ..validate import check_unit_quaternion, finite_array, finite_scalar
 
 __all__ = ["Control", "Problem", "check_t", "check_x0", "check_tolerances",
            "check_u", "check_invariants", "check_cvodes_options"]
@@ -28,14 +29,23 @@ def check_t(t) -> np.ndarray:
     t = np.array(finite_array(t, "t"), dtype=float)
     if t.ndim != 1 or t.size < 2:
         raise ValueError(f"`t` must be a 1-D grid of at least 2 times, got shape {t.shape}")
-    dt = t[1:] - t[:-1]
-    if not (dt > 0).all():
+    if not _increasing(t):
+        dt = t[1:] - t[:-1]
         k = int(np.argmin(dt))
         raise ValueError(
             f"`t` must be strictly increasing, got t[{k}] = {t[k]} >= t[{k + 1}] = {t[k + 1]}"
         )
     t.setflags(write=False)
     return t
+
+
+def _increasing(t: np.ndarray) -> bool:
+    """Whether the finite 1-D ``t`` is strictly increasing (a short one compared in Python,
+    without numpy's per-call overhead)."""
+    if t.size <= 16:
+        v = t.tolist()
+        return all(map(float.__lt__, v[:-1], v[1:]))
+    return bool((t[1:] > t[:-1]).all())
 
 
 def check_x0(x0, model: Model) -> np.ndarray:
@@ -47,7 +57,7 @@ def check_x0(x0, model: Model) -> np.ndarray:
     x = np.array(x, dtype=float).reshape(nx)
     if model.attitude is not None:
         iq = model.attitude[0]
-        unit_quaternion(x[iq:iq + 4], f"x0[{iq}:{iq + 4}] (the attitude quaternion)")
+        check_unit_quaternion(x[iq:iq + 4], f"x0[{iq}:{iq + 4}] (the attitude quaternion)")
     return x
 
 
@@ -99,6 +109,8 @@ def check_tolerances(rtol, atol, nx: int) -> tuple[float, np.ndarray]:
     rtol_f = finite_scalar(rtol, "rtol")
     if not 100 * _EPS <= rtol_f < 1:
         raise ValueError(f"`rtol` must be in [{100 * _EPS:.3g}, 1), got {rtol!r}")
+    if type(atol) is float and 0 <= atol < math.inf:  # fast path: the common case
+        return rtol_f, np.full(nx, atol)
     a = finite_array(atol, "atol")
     if a.shape not in ((), (nx,)):
         raise ValueError(f"`atol` must be a scalar or have shape ({nx},), got {a.shape}")
@@ -113,13 +125,16 @@ class Control:
     """The control input, normalized.
 
     ``mode == "linear"``: ``ua[k], ub[k]`` (shape (nint, nu)) are the values at the start and
-    end of interval ``k``. ``mode == "stages"``: ``fun(t) -> (nu,)`` is called at stage times.
+    end of interval ``k``; ``constant`` when known to be one value throughout (``False``
+    leaves it to be found from the values). ``mode == "stages"``: ``fun(t) -> (nu,)`` is
+    called at stage times.
     """
 
     mode: str
     ua: np.ndarray | None = None
     ub: np.ndarray | None = None
     fun: Callable | None = None
+    constant: bool = False
 
     def at(self, t: float, k: int, tk: float, H: float) -> np.ndarray:
         if self.mode == "stages":
@@ -136,7 +151,7 @@ class Control:
         """The control of the first ``nint`` intervals."""
         if self.mode == "stages":
             return self
-        return Control("linear", self.ua[:nint], self.ub[:nint])
+        return Control("linear", self.ua[:nint], self.ub[:nint], constant=self.constant)
 
     def cvodes_input(self, t: np.ndarray) -> np.ndarray:
         """Piecewise-constant integrator input ``[u_k, slope_k, t_k]``, shape (nint, 2 nu + 1)."""
@@ -150,13 +165,13 @@ def check_u(u, nu: int, t: np.ndarray) -> Control:
     n = t.size
     if u is None:
         z = np.zeros((n - 1, nu))
-        return Control("linear", z, z)
+        return Control("linear", z, z, constant=True)
     if callable(u):
         fun = _checked_callable(u, nu)
         fun(float(t[0]))  # raises ValueError naming `u` on a wrong shape
         if nu == 0:
             z = np.zeros((n - 1, 0))
-            return Control("linear", z, z)
+            return Control("linear", z, z, constant=True)
         return Control("stages", fun=fun)
     try:
         a = np.array(u, dtype=float)
@@ -168,7 +183,7 @@ def check_u(u, nu: int, t: np.ndarray) -> Control:
         if not np.all(np.isfinite(a)):
             raise ValueError(f"`u` must be finite, got {a.tolist()}")
         c = np.broadcast_to(a, (n - 1, nu))
-        return Control("linear", c, c)
+        return Control("linear", c, c, constant=True)
     if a.shape == (nu, n):
         if not np.all(np.isfinite(a)):
             raise ValueError("`u` must be finite")

@@ -133,28 +133,29 @@ class _Steps:
 
     def __init__(self, problem: Problem, method: str, m: int):
         self.m, self.total = m, m * problem.nint
-        self.hm = np.diff(problem.t) / m
+        t = problem.t
+        H = t[1:] - t[:-1]
+        self.hm = H if m == 1 else H / m  # H / 1 is H
         ctrl = problem.control
         self.mode = ctrl.mode
         if self.mode == "linear":
             self.ua = ctrl.ua
-            self.ud = (ctrl.ub - ctrl.ua) / np.diff(problem.t)[:, None]
-            self.constant = not np.any(self.ud) and bool(np.all(ctrl.ua == ctrl.ua[:1]))
+            self.constant = ctrl.constant or _constant(ctrl, H)
+            if not self.constant:
+                self.ud = (ctrl.ub - ctrl.ua) / H[:, None]
         else:
             s = _stage_samples(problem, method, m)  # (nint, m, nodes, nu)
             self.us = s.reshape(self.total, -1)
-        nu = problem.model.nu
-        self._pad_h = np.zeros(CHUNK)
         if self.mode == "linear" and self.constant:
-            self._ua_c = np.broadcast_to(ctrl.ua[:1], (CHUNK, nu)).copy()
-            self._ud_c = np.zeros((CHUNK, nu))
+            self._ua_c = np.empty((CHUNK, problem.model.nu))
+            self._ua_c[:] = ctrl.ua[:1]
+            self._ud_c = np.zeros((CHUNK, problem.model.nu))
 
     def chunk(self, s0: int) -> list:
         """Arrays for steps ``s0 .. s0 + CHUNK - 1`` in casadi's column-major layout."""
         n = min(CHUNK, self.total - s0)
-        s = np.arange(s0, s0 + n)
-        k = s // self.m
-        h = self._pad_h.copy()
+        k = slice(s0, s0 + n) if self.m == 1 else np.arange(s0, s0 + n) // self.m
+        h = np.zeros(CHUNK)
         h[:n] = self.hm[k]
         if self.mode != "linear":
             us = np.zeros((CHUNK, self.us.shape[1]))
@@ -162,10 +163,18 @@ class _Steps:
             return [h, us]
         if self.constant:
             return [h, self._ua_c, self._ud_c]
+        s = np.arange(s0, s0 + n)
+        k = s // self.m
         ua, ud = np.zeros((CHUNK, self.ua.shape[1])), np.zeros((CHUNK, self.ua.shape[1]))
         ud[:n] = self.ud[k]
         ua[:n] = self.ua[k] + ((s - k * self.m) * h[:n])[:, None] * ud[:n]
         return [h, ua, ud]
+
+
+def _constant(ctrl, H: np.ndarray) -> bool:
+    """Whether a linear control is one value on every interval (zero slope)."""
+    return (not np.any((ctrl.ub - ctrl.ua) / H[:, None])
+            and bool(np.all(ctrl.ua == ctrl.ua[:1])))
 
 
 class Progress:
@@ -210,20 +219,18 @@ def run_fixed(problem: Problem, method: str, m: int, jit: bool,
             X = call_buffered(fun, [xk, np.array([float(n)]), *steps.chunk(s0), problem.p],
                               (CHUNK, model.nx))
             k_lo, k_hi = (s0 + m) // m - 1, (s0 + n) // m  # intervals ending in this chunk
-            last = (np.arange(k_lo, k_hi) + 1) * m - 1 - s0
-            x[:, k_lo + 1:k_hi + 1] = X[last].T
+            x[:, k_lo + 1:k_hi + 1] = X[m - 1 - s0 % m:n:m].T
             xk = X[n - 1]
             done = s0 + n
             progress.advance(n)
-            if not np.all(np.isfinite(xk)):
-                break
+            if done < steps.total and not np.isfinite(xk).all():
+                break  # (after the last chunk, the check of x below tells)
     progress.abandon(steps.total - done)
     n_steps = done
-    if done < steps.total or not np.all(np.isfinite(x)):
+    if done < steps.total or not np.isfinite(x).all():
         k = int(np.argmax(~np.isfinite(x).all(axis=0)))
         x[:, k:] = np.nan
         return Run(x, n_steps, stages * n_steps, m, compiled, False,
                    f"{method}: the state became non-finite before t = {t[k]:.6g}")
     return Run(x, n_steps, stages * n_steps, m, compiled, True,
                f"{method}: {m} step(s) per output interval, {n_steps} steps")
-

@@ -26,7 +26,7 @@ from .inertia import check_inertia
 from .numbers import (finite_array, finite_scalar, integer, nonnegative, one_of, positive,
                       positive_each)
 from .rotations import (AXIS_NORM_TOL, DCM_ORTHO_TOL, QUAT_NORM_TOL, rotation_matrix, unit_axes,
-                        unit_quaternion, unit_quaternions, unit_vector)
+                        check_unit_quaternion, unit_quaternion, unit_quaternions, unit_vector)
 
 ArgumentTypeError.__module__ = __name__  # shown where users import it from
 
@@ -42,6 +42,7 @@ __all__ = [
     "unit_axes",
     "positive_each",
     "nonnegative",
+    "check_unit_quaternion",
     "unit_quaternion",
     "unit_quaternions",
     "rotation_matrix",

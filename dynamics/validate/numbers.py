@@ -1,6 +1,8 @@
 """Checks of numbers: finite arrays and scalars, integers, positive values, choices."""
 from __future__ import annotations
 
+import math
+
 import casadi as ca
 import numpy as np
 
@@ -82,6 +84,8 @@ def finite_scalar(x, name: str) -> float:
         ...
     dynamics.validate.ArgumentTypeError: `rate` must be real numbers, got a string: 'fast'
     """
+    if type(x) is float and math.isfinite(x):  # fast path: the common case
+        return x
     a = real_array(x, name)
     if a.ndim != 0 and not (isinstance(x, ca.DM) and a.size == 1):
         raise ValueError(f"`{name}` must be a scalar, got shape {a.shape}")
@@ -177,6 +181,8 @@ def integer(value, name: str, *, minimum: int | None = None) -> int:
         ...
     ValueError: `steps` must be an integer >= 1, got 0
     """
+    if type(value) is int and (minimum is None or value >= minimum):  # fast path
+        return value
     bound = "" if minimum is None else f" >= {minimum}"
     number = isinstance(value, (int, np.integer, float, np.floating))
     if isinstance(value, (bool, np.bool_)) or not number:
