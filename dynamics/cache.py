@@ -256,10 +256,11 @@ class _Pool:
         self.idle: list = []
 
 
-def compile_function(fun: ca.Function) -> ca.Function | None:
+def compile_function(fun: ca.Function, opt: str = "-O3") -> ca.Function | None:
     """``fun`` compiled to C and loaded with ``casadi.external``; None without a C compiler.
 
-    The code is generated into a scratch directory, compiled with ``-O3`` by the C compiler
+    The code is generated into a scratch directory, compiled with ``opt`` (``-O3``; the
+    chunk loops of `dynamics.simulate` use ``-O1``) by the C compiler
     found on the ``PATH`` (`compiler` tells which), loaded, and the files are deleted at
     once (a loaded shared library stays mapped): unlike casadi's own jit, which leaves two
     file descriptors open per compile (casadi issue #4295) and its files on disk, nothing is
@@ -275,7 +276,7 @@ def compile_function(fun: ca.Function) -> ca.Function | None:
         gen = ca.CodeGenerator(f"{name}.c", {"with_header": False})
         gen.add(fun)
         gen.generate(work + os.sep)
-        done = subprocess.run([compiler, "-O3", "-w", "-fPIC", "-shared", source, "-o", library,
+        done = subprocess.run([compiler, opt, "-w", "-fPIC", "-shared", source, "-o", library,
                                "-lm"], capture_output=True, text=True)
         if done.returncode != 0:
             raise RuntimeError(f"C compilation of {name} failed: {done.stderr.strip()[-500:]}")

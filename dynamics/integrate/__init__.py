@@ -23,7 +23,7 @@ ONE CasADi Function per (model, method, control mode): a ``mapaccum`` of 512 ste
 with its own step size and control data, wrapped in an MX Function (so the generated code is
 a loop, never an unrolled SX graph) and jit-compiled to C under the policy of
 `dynamics.cache`. A run of any length is a Python loop over such chunks, so neither the
-generated code nor the compile time (about 0.4 s, once per model and method) depends on the
+generated code nor the compile time (about 0.25 s at -O1 for the rigid body, once per model and method) depends on the
 grid length or the step count: 1e7 steps cost only their arithmetic. Built Functions are
 kept in `dynamics.cache` by their defining arguments and called through
 ``Function.buffer()``, so a call costs microseconds of Python, not a data conversion per
@@ -33,7 +33,7 @@ inside the loop.
 Costs measured on a 2-core machine (rigid body, 7 states): per step about 55 ns (rk4),
 140 ns (lie), 180-250 ns (rk8) compiled, 2-3 us interpreted, plus a few us of Python per
 chunk of 512 steps. The default ``max_steps`` of ``auto`` (1e8 rk8 steps) is thus
-about 20 s of compiled work. Compiling a model's chunk takes about 0.4 s, once; after it a
+about 20 s of compiled work. Compiling a model's chunk takes about 0.25-0.4 s, once; after it a
 100 s torque-free run at rtol 1e-10 takes 3-4 ms (23 ms interpreted).
 
 Controls

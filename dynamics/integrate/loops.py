@@ -54,7 +54,7 @@ def chunk_function(model: Model, method: str, mode: str, jit: bool, size: int = 
     def build_compiled():
         loop = _build_chunk(model, method, mode, size)
         try:
-            return cache.compile_function(loop), True
+            return cache.compile_function(loop, _OPT), True
         except RuntimeError:  # e.g. a right-hand side that cannot be code-generated
             return loop, False
 
@@ -65,6 +65,12 @@ def chunk_key(model: Model, method: str, mode: str) -> tuple:
     return ("chunk", cache.function_key(model.f), model.attitude if method == "lie" else None,
             method, mode)
 
+
+#: C optimization of the chunk loops. The rigid body's 512-step rk8 chunk compiles in 0.25 s
+#: at -O1 against 0.41 s at -O3 and runs as fast (242 against 242 ns per step); rk4 and lie
+#: steps are 5-6% slower at -O1 (100 against 95 ns, 148 against 140 ns). The first call of
+#: a model pays the compile, so -O1 keeps it within 0.5 s.
+_OPT = "-O1"
 
 _BLOCK = 16  # steps per block of a chunk: a chunk is `CHUNK // _BLOCK` blocks
 
