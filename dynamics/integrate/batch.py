@@ -243,11 +243,11 @@ def simulate_batch(batch: Batch, method: str, steps: int, rtol: float, atol: np.
         run, value, st, reason, n_steps, _ = auto_runs(target, rtol, np.tile(atol, K), max_steps,
                                                    jit, progress)
         if run is None:  # stiff, or too many steps: no rk8 run was made
-            raise_or = "a stiff batch (give method='cvodes')" if reason.startswith("stiff") else reason
+            why = "a stiff batch (give method='cvodes')" if reason.startswith("stiff") else reason
             x = np.full((nx, batch.t.size, K), np.nan)
             x[:, 0] = batch.x0
             ok, status = np.zeros(K, bool), np.full(K, st if st else UNVERIFIED)
-            used, message, compiled = "rk8", f"auto: tolerance not verified: {raise_or}", False
+            used, message, compiled = "rk8", f"auto: tolerance not verified: {why}", False
         else:
             x = run.x.reshape(K, nx, -1).transpose(1, 2, 0).copy()
             ok = np.isfinite(x).all(axis=(0, 1))
