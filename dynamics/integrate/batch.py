@@ -8,7 +8,7 @@ the same Function single runs use: no new compile) through a casadi ``map`` over
 split over the machine's cores (``thread`` map; `BATCH_THREADS`). ``auto`` runs the
 same error control as a single run (`dynamics.integrate.auto`) on the whole batch: one
 step count for all runs, chosen until the global error estimate of every run meets the
-tolerance; each run's own estimate is reported. ``cvodes`` (a variable-step integrator per
+tolerance (a stiff batch goes, run by run, to auto's cvodes as a single run does). ``cvodes`` (a variable-step integrator per
 run) is a loop of single runs.
 """
 from __future__ import annotations
@@ -27,7 +27,7 @@ from ..interrupts import check_interrupt, deferred_interrupts
 from ..model import Model
 from ..validate import finite_array, integer, unit_quaternion
 from ..validate.rotations import QUAT_NORM_TOL
-from .auto import Single, auto_runs, jacobian_x, rho_sigma
+from .auto import Single, auto_runs, jacobian_x, rho_sigma, solve_auto
 from .cvodes import run_cvodes
 from .evaluate import call_buffered, map_eval
 from .inputs import Control, Problem
@@ -242,12 +242,21 @@ def simulate_batch(batch: Batch, method: str, steps: int, rtol: float, atol: np.
         target = BatchTarget(batch)
         run, value, st, reason, n_steps, _ = auto_runs(target, rtol, np.tile(atol, K), max_steps,
                                                    jit, progress)
-        if run is None:  # stiff, or too many steps: no rk8 run was made
-            why = "a stiff batch (give method='cvodes')" if reason.startswith("stiff") else reason
+        if run is None and reason.startswith("stiff"):  # as a single run: auto's cvodes, per run
+            outs = [solve_auto(batch.problem(k), rtol, atol, max_steps, jit, cvodes_options,
+                               progress) for k in range(K)]
+            x = np.stack([o[0].x for o in outs], axis=2)
+            ok = np.array([o[0].ok for o in outs])
+            status = np.array([o[2] if o[0].ok else FAILED for o in outs])
+            estimate[:] = [o[3] for o in outs]
+            used, compiled = "cvodes", False
+            n_steps = max(o[0].n_steps for o in outs)
+            message = f"auto, run by run ({K} runs): {outs[int(np.argmax(status != OK_STIFF))][0].message}"
+        elif run is None:  # too many steps: no rk8 run was made
             x = np.full((nx, batch.t.size, K), np.nan)
             x[:, 0] = batch.x0
             ok, status = np.zeros(K, bool), np.full(K, st if st else UNVERIFIED)
-            used, message, compiled = "rk8", f"auto: tolerance not verified: {why}", False
+            used, message, compiled = "rk8", f"auto: tolerance not verified: {reason}", False
         else:
             x = run.x.reshape(K, nx, -1).transpose(1, 2, 0).copy()
             ok = np.isfinite(x).all(axis=(0, 1))
@@ -289,7 +298,8 @@ class BatchResult:
         Steps per run (``auto``: summed over its runs; cvodes: the most of any run).
     error_estimate : ndarray, shape (K,)
         ``auto``: the estimated global error in units of the tolerance, the largest over
-        the batch (one step count serves all runs); NaN for the other methods.
+        the batch (one step count serves all runs; a stiff batch, run by run with cvodes:
+        each run's own); NaN for the other methods.
     compiled : bool
     """
 
