@@ -7,8 +7,8 @@
 * `solve_multistart` (`multistart`) — solve from several guesses, keep the best.
 * `polish_switches` (`polish`) — exact switch times of a bang-bang solution: the arc
   durations solved for directly (`optimize_switch_times` in `switch_times`, structure from
-  `bang_arcs` in `arcs`, RK8 steps from `rk8_step`), else moving knots (switch times on
-  free mesh points).
+  `bang_arcs` in `arcs`, RK8 steps from `rk8_step`, the cached NLP from `arc_nlp`), else
+  moving knots (switch times on free mesh points).
 
 `find_switches` / `control_switches` (`switches`) are the engine's one switch detector;
 `RefinedSolution`, `RefinementRound` and `annotate` live in `result`.
