@@ -32,7 +32,7 @@ from .cvodes import run_cvodes
 from .evaluate import call_buffered, map_eval
 from .inputs import Control, Problem
 from .loops import BATCH_CHUNK as CHUNK
-from .loops import Progress, chunk_function
+from .loops import Progress, chunk_function, interval_ends
 from .result import FAILED, OK, OK_STIFF, ROUNDOFF, UNVERIFIED, Dense, Run, SimulationResult
 from .tableaux import TABLEAUX
 
@@ -166,9 +166,8 @@ def run_fixed_batch(batch: Batch, method: str, m: int, jit: bool, x0: np.ndarray
             nn[:], hh[:] = n, h
             X = call_buffered(mapped, [xk, nn, hh, ua, ud, P],
                               (K * CHUNK, nx)).reshape(K, CHUNK, nx)
-            k_lo, k_hi = (s0 + m) // m - 1, (s0 + n) // m
-            last = (np.arange(k_lo, k_hi) + 1) * m - 1 - s0
-            x[:, k_lo + 1:k_hi + 1] = X[:, last]
+            outputs, ends = interval_ends(s0, n, m)
+            x[:, outputs] = X[:, ends]
             xk = np.ascontiguousarray(X[:, n - 1])
             done = s0 + n
             progress.advance(n)

@@ -17,7 +17,8 @@ from .kernels import kernel
 from .result import Run
 from .tableaux import TABLEAUX, unique_nodes
 
-__all__ = ["CHUNK", "BATCH_CHUNK", "Progress", "chunk_function", "chunk_key", "run_fixed"]
+__all__ = ["CHUNK", "BATCH_CHUNK", "Progress", "chunk_function", "chunk_key", "interval_ends",
+           "run_fixed"]
 
 _BASE = 4  # unroll base of mapaccum: casadi's construction cost grows ~5x from base 4 to 10
 
@@ -183,6 +184,13 @@ def _constant(ctrl, H: np.ndarray) -> bool:
             and bool(np.all(ctrl.ua == ctrl.ua[:1])))
 
 
+def interval_ends(s0: int, n: int, m: int) -> tuple[slice, slice]:
+    """Which output columns a chunk of steps ``s0 .. s0 + n - 1`` (``m`` per output
+    interval) completes, and the chunk's steps that end them: ``(outputs, steps)``."""
+    k_lo, k_hi = (s0 + m) // m - 1, (s0 + n) // m  # intervals ending in this chunk
+    return slice(k_lo + 1, k_hi + 1), slice(m - 1 - s0 % m, n, m)
+
+
 class Progress:
     """Counts steps for a ``progress(done, total)`` callback across all runs of one call:
     ``total`` grows by each run's step count when the run starts."""
@@ -224,8 +232,8 @@ def run_fixed(problem: Problem, method: str, m: int, jit: bool,
             n = min(CHUNK, steps.total - s0)
             X = call_buffered(fun, [xk, np.array([float(n)]), *steps.chunk(s0), problem.p],
                               (CHUNK, model.nx))
-            k_lo, k_hi = (s0 + m) // m - 1, (s0 + n) // m  # intervals ending in this chunk
-            x[:, k_lo + 1:k_hi + 1] = X[m - 1 - s0 % m:n:m].T
+            outputs, ends = interval_ends(s0, n, m)
+            x[:, outputs] = X[ends].T
             xk = X[n - 1]
             done = s0 + n
             progress.advance(n)
