@@ -118,11 +118,12 @@ try:
 except KeyboardInterrupt as exc:
     part = exc.partial
     n = len(part.values)
-    check = stability.sweep("spin", "rate", part.values[[0, n // 2, n - 1]], inertia=[2.0, 3.0, 4.5],
+    pick = sorted({0, n // 2, n - 1})  # distinct: a slow machine may have finished only one or two
+    check = stability.sweep("spin", "rate", part.values[pick], inertia=[2.0, 3.0, 4.5],
                             axis=[1, 0, 0])
     print(json.dumps({"n": n, "complete": part.complete, "prefix": bool(np.array_equal(part.values, values[:n])),
-                      "same": [part.verdicts[i] for i in (0, n // 2, n - 1)] == list(check.verdicts),
-                      "ld": bool(np.array_equal(part.least_damped[[0, n // 2, n - 1]], check.least_damped)),
+                      "same": [part.verdicts[i] for i in pick] == list(check.verdicts),
+                      "ld": bool(np.array_equal(part.least_damped[pick], check.least_damped)),
                       "message": part.message}))
 """
 
@@ -131,7 +132,7 @@ def test_interrupted_sweep_keeps_the_values_it_finished():
     proc = subprocess.Popen([sys.executable, "-c", PARTIAL], cwd=ROOT, text=True,
                             stdout=subprocess.PIPE, stderr=subprocess.PIPE)
     assert proc.stdout.readline().strip() == "start"
-    time.sleep(1.5)
+    time.sleep(3.0)  # a loaded CI machine spends over a second on imports and the first build
     proc.send_signal(signal.SIGINT)
     out, err = proc.communicate(timeout=30)
     assert proc.returncode == 0, err
