@@ -21,7 +21,7 @@ test: $(STAMP)
 	MPLBACKEND=Agg $(BIN)/python -m pytest -q
 
 bench: $(STAMP)
-	MPLBACKEND=Agg $(BIN)/appdyn bench
+	MPLBACKEND=Agg $(BIN)/appdyn bench --readme
 
 clean:
 	rm -rf $(VENV) build *.egg-info

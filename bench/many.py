@@ -16,13 +16,17 @@ timing, for every variant alike.
 4. A maneuver table (`problems.slew.maneuver_table`, the 8 `example_targets`, J = diag(1,
    2, 3), time-optimal): serial, two threads and two processes; the same T in every row.
 
-Run: ``make bench`` or ``appdyn bench many`` (``--quick`` for a smoke run).
+Writes ``many.csv`` (every variant's wall time) into the output folder and returns the
+summary rows (`run`): the serial wall time and each executor's speed-up per workload.
+Run: ``make bench`` or ``appdyn bench many`` (``--quick`` for a smoke run: 11 sweep values,
+20 samples, no multistart, 4 targets without the thread pool, no Dask).
 """
 from __future__ import annotations
 
 import sys
 import time
 from concurrent.futures import ProcessPoolExecutor, ThreadPoolExecutor
+from pathlib import Path
 
 import numpy as np
 
@@ -31,6 +35,8 @@ from ocp import solve_multistart
 from problems import slew
 from problems import stability as st
 from problems.dispersion import nutation_spread
+
+from _common import Row, script_main, write_csv
 
 GYRO = dict(inertia=[3.0, 4.0, 5.0], axis=[1, 0, 0], rate=2.0)
 
@@ -52,7 +58,7 @@ def _dask():
     return cluster, distributed.Client(cluster)
 
 
-def sweeps(values):
+def sweeps(values, dask=True):
     rows = []
     clear_caches()
     st.sweep("gyrostat", "wheel_momentum", values[:2], **GYRO)  # builds, as each pool's warm-up
@@ -69,9 +75,10 @@ def sweeps(values):
         t, res = _timed(st.sweep, "gyrostat", "wheel_momentum", values, executor=pool, **GYRO)
         rows.append(("2 processes", t, res.to_json() == serial.to_json()))
     clear_caches()
-    dask = _dask()
+    wanted, dask = dask, (_dask() if dask else None)
     if dask is None:
-        print("  (Dask LocalCluster skipped: pip install -e '.[distributed]')")
+        print("  (Dask LocalCluster skipped: "
+              + ("--quick)" if not wanted else "pip install -e '.[distributed]')"))
     else:
         cluster, client = dask
         try:
@@ -111,15 +118,16 @@ def multistarts():
     return serial, [("serial", serial_t, True), ("2 processes", t, res.cost == serial.cost)]
 
 
-def tables(starts):
+def tables(starts, n_targets=None, threads=True):
     J = np.diag([1.0, 2.0, 3.0])
-    targets = slew.example_targets()
+    targets = slew.example_targets()[:n_targets]
     kw = dict(N=20, starts=starts)
     clear_caches()
     slew.maneuver_table(J, targets[:1], **kw)  # builds, as each pool's warm-up
     serial_t, serial = _timed(slew.maneuver_table, J, targets, **kw)
     rows = [("serial", serial_t, True)]
-    for name, kind in (("2 threads", ThreadPoolExecutor), ("2 processes", ProcessPoolExecutor)):
+    kinds = (("2 threads", ThreadPoolExecutor),) if threads else ()
+    for name, kind in kinds + (("2 processes", ProcessPoolExecutor),):
         clear_caches()
         with kind(2) as pool:
             slew.maneuver_table(J, targets[:2], executor=pool, **kw)  # start the workers
@@ -135,17 +143,31 @@ def _table(rows, unit=1.0, label="wall [s]"):
               f"identical to serial: {same}")
 
 
-def main(argv=()):
-    quick = "--quick" in argv
+def run(quick: bool, out: Path) -> list:
+    """Run the benchmark, write ``many.csv`` into ``out``; the summary `Row`s."""
+    detail, summary = [], []
+
+    def record(case, rows):
+        _table(rows)
+        base = rows[0][1]
+        for name, t, same in rows:
+            detail.append(dict(case=case, variant=name, wall_time=t, speed_up=base / t,
+                               identical=same))
+            if name == "serial":
+                summary.append(Row("many", case, "wall time, serial", t, "s"))
+            else:
+                summary.append(Row("many", case, f"speed-up, {name}", base / t, "x",
+                                   "identical to serial" if same else "DIFFERS from serial"))
+
     values = np.linspace(-2, 8, 11 if quick else 41)
     print(f"1. Stability sweep, gyrostat, {values.size} wheel-momentum values:")
-    serial, rows = sweeps(values)
+    serial, rows = sweeps(values, dask=not quick)
     print(f"  {serial.evaluations} case evaluations, {len(serial.boundaries)} boundaries")
-    _table(rows)
+    record(f"stability sweep, {values.size} values", rows)
     samples = 20 if quick else 100
     print(f"\n2. Dispersion, spinning spacecraft, {samples} samples (a new model per sample):")
     res, rows = dispersions(samples)
-    _table(rows)
+    record(f"dispersion, {samples} samples", rows)
     print(f"  per sample: serial {1e3 * rows[0][1] / samples:.1f} ms, "
           f"2 processes {1e3 * rows[1][1] / samples:.1f} ms; nutation max spread: mean "
           f"{np.degrees(res.statistics['nutation_max'].mean):.3f} deg, std "
@@ -153,14 +175,22 @@ def main(argv=()):
     if not quick:
         print("\n3. Multistart of the Bilimoria-Wie slew, 4 tilted starts, N = 30:")
         best, rows = multistarts()
-        _table(rows)
+        record("multistart, 4 starts, N = 30", rows)
         print(f"  best T = {best.T:.10f}")
     starts = 1 if quick else 3
-    print(f"\n4. Maneuver table, 8 example targets, J = diag(1, 2, 3), starts = {starts}, N = 20:")
-    table, rows = tables(starts)
-    _table(rows)
+    n_targets = 4 if quick else 8
+    print(f"\n4. Maneuver table, {n_targets} example targets, J = diag(1, 2, 3), "
+          f"starts = {starts}, N = 20:")
+    table, rows = tables(starts, n_targets, threads=not quick)
+    record(f"maneuver table, {n_targets} targets, {starts} start(s)", rows)
     print(f"  all verified: {table.success}; T [s] = {np.round(table.T, 4).tolist()}")
+    write_csv(detail, Path(out) / "many.csv")
+    return summary
+
+
+def main(argv=None) -> int:
+    return script_main(run, argv)
 
 
 if __name__ == "__main__":
-    main(sys.argv[1:])
+    sys.exit(main(sys.argv[1:]))

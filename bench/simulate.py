@@ -22,18 +22,17 @@ Batch: 1,000 runs, w0 = (1.5, 0, 0) + U(-1, 1)^3 (seed 0), 20 s, 41 outputs, eve
 loops of appdyn ``rk8`` (smallest ``steps`` meeting 1e-8) and ``auto``, and a batched
 ``simulate`` (x0 of shape (7, K)) when the installed appdyn accepts one.
 
-Writes ``bench/out/simulate.csv`` and ``bench/out/simulate.png``; then the hard cases
-(``bench/out/simulate_hard.csv``). Run: ``make bench`` or ``appdyn bench simulate``
-(``--quick`` for a smoke run).
+Writes ``simulate.csv`` (every single run), ``simulate.png``, ``simulate_batch.csv`` and the
+hard cases (``simulate_hard.csv``) into the output folder, and returns the summary rows
+(`run`): the cheapest actual time per solver at each target error, the speed-ups of the best
+appdyn run against scipy DOP853 and numbalsoda dop853, the batch times and ratios, the hard
+cases. Run: ``make bench`` or ``appdyn bench simulate`` (``--quick`` for a smoke run: fewer
+tolerances and repeats, scipy's slow methods at loose tolerances only, a 100-run batch).
 """
 from __future__ import annotations
 
 
-import csv
-import datetime
 import json
-import os
-import platform
 import subprocess
 import sys
 import time
@@ -45,46 +44,22 @@ from scipy.integrate import solve_ivp
 from dynamics import rigid_body, simulate
 from dynamics.truth import torque_free_omega
 
+from _common import Row, machine, save_figure, script_main, timed, write_csv
+
 INERTIA = np.array([1.0, 2.0, 3.0])
 W0 = np.array([1.0, 0.1, 0.8])
 T_FINAL = 100.0
 N_OUT = 101
 TARGETS = (1e-6, 1e-10)
-OUT = Path(__file__).resolve().parent / "out"
 PEERS = Path(__file__).resolve().parent / "peers"
 NUMBALSODA_PY = PEERS / ".venv-numbalsoda" / "bin" / "python"
 # the batch workload
 BATCH_K, BATCH_T, BATCH_N, BATCH_TOL = 1000, 20.0, 41, 1e-8
 
 
-def timed(fun, repeats):
-    """Run ``fun`` once (first call) then ``repeats`` times; returns (first, times, result)."""
-    t0 = time.perf_counter()
-    result = fun()
-    first = time.perf_counter() - t0
-    times = []
-    for _ in range(repeats):
-        t0 = time.perf_counter()
-        result = fun()
-        times.append(time.perf_counter() - t0)
-    return first, times or [first], result
-
-
 def row(solver, setting, first, times, error, success, n_steps=0):
     return dict(solver=solver, setting=setting, first_call=first, wall_time=min(times),
                 median=float(np.median(times)), error=error, n_steps=n_steps, success=success)
-
-
-def machine():
-    cpu = platform.processor()
-    try:
-        for line in open("/proc/cpuinfo"):
-            if line.startswith("model name"):
-                cpu = line.split(":", 1)[1].strip()
-                break
-    except OSError:
-        pass
-    return f"{cpu}, {os.cpu_count()} cores, {platform.system()}; {datetime.date.today()}"
 
 
 def numpy_rhs(_t, x):
@@ -102,9 +77,9 @@ def numpy_rhs(_t, x):
     ])
 
 
-def run(quick=False):
+def single_runs(quick=False):
     """All single-run rows (actual runs, one per method and setting)."""
-    repeats = 3 if quick else 7
+    repeats = 2 if quick else 7
     t = np.linspace(0.0, T_FINAL, N_OUT)
     x0 = np.r_[0.0, 0.0, 0.0, 1.0, W0]
     w_exact = torque_free_omega(INERTIA, W0, t)
@@ -113,7 +88,7 @@ def run(quick=False):
     def error(w):
         return float(np.max(np.abs(np.asarray(w) - w_exact)))
 
-    tols = [1e-5, 1e-7, 1e-9, 1e-11, 1e-12] if quick else [1e-4, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10,
+    tols = [1e-5, 1e-7, 1e-9, 1e-12] if quick else [1e-4, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10,
                                                              1e-11, 1e-12, 1e-13]
     per_interval = [4, 8, 16, 32] if quick else [2, 3, 4, 5, 6, 8, 10, 12, 16, 20, 24, 32, 48, 64]
     rows = []
@@ -132,6 +107,8 @@ def run(quick=False):
         for tol in tols:
             if (meth == "RK45" and tol < 1e-10) or (meth == "Radau" and tol < 1e-9):
                 continue  # minutes per run and nothing learned
+            if quick and meth in ("RK45", "Radau") and tol < 1e-5:
+                continue  # 0.1-1 s per run: the loose end is enough for a smoke run
             reps = 1 if meth in ("RK45", "Radau") else repeats
             first, times, sol = timed(lambda: solve_ivp(numpy_rhs, (0, T_FINAL), x0, method=meth,
                                                         t_eval=t, rtol=tol, atol=tol * 1e-2), reps)
@@ -278,7 +255,10 @@ def batch(quick=False):
             rows.append(row("diffrax Dopri8 jit(vmap)", {"rtol": rtol}, first, times, e, True))
             if e <= BATCH_TOL:
                 break
-    for rtol in (1e-9, 1e-10, 1e-11):
+    if quick:
+        print("numbalsoda batch: skipped (--quick; its process start and numba compile take "
+              "several seconds)")
+    for rtol in () if quick else (1e-9, 1e-10, 1e-11):
         ans = numbalsoda(dict(inertia=INERTIA.tolist(), t=t.tolist(), x0=x0s[0].tolist(),
                               tols=[], repeats=3,
                               batch=dict(x0s=x0s.tolist(), t=t.tolist(), rtol=rtol)))
@@ -322,6 +302,8 @@ def hard_cases(quick=False):
             continue
         # DOP853 costs ~1 min per run on the long horizon: two tolerances there
         dop_tols = [1e-9, 1e-11] if t_final > 1e4 else [1e-7, 1e-9, 1e-11, 1e-13]
+        if quick:
+            dop_tols = [1e-9, 1e-13]
         t = np.linspace(0.0, t_final, n)
         w_exact = torque_free_omega(INERTIA, W0, t)
         for tol in auto_tols:
@@ -376,16 +358,8 @@ def overheads(model, x0):
     return f_call, min(times)
 
 
-def main(argv=()):
-    quick = "--quick" in argv
-    print(f"machine: {machine()}")
-    rows, model, x0, t = run(quick)
-    OUT.mkdir(exist_ok=True)
-    with open(OUT / "simulate.csv", "w", newline="") as fh:
-        w = csv.DictWriter(fh, fieldnames=list(rows[0]))
-        w.writeheader()
-        w.writerows(rows)
-
+def print_single(rows):
+    """The single-run tables; returns ``{target: {solver: cheapest row or None}}``."""
     print("\nAll runs (min / median of repeats; first = first call of a fresh model, "
           "compiling included):")
     print(f"{'solver':<20} {'setting':<24} {'first [ms]':>10} {'min [ms]':>10} {'median':>10} "
@@ -423,11 +397,10 @@ def main(argv=()):
         r0 = next(r for r in rows if r["solver"] == s)
         print(f"  {s:<20} first {1e3 * first[s]:9.1f} ms | steady min {1e3 * r0['wall_time']:8.3f}"
               f" ms, median {1e3 * r0['median']:8.3f} ms")
-    f_call, sim_call = overheads(model, x0)
-    print(f"  Python-call overhead: model.f {1e6 * f_call:.1f} us/call, "
-          f"simulate (2-point rk8) {1e6 * sim_call:.1f} us/call")
+    return summary
 
-    brows, k = batch(quick)
+
+def print_batch(brows, k):
     print(f"\nBatch: {k} runs, w0 = (1.5, 0, 0) + U(-1, 1)^3 (seed 0), {BATCH_T:g} s, {BATCH_N} "
           f"outputs, target max rate error <= {BATCH_TOL:.0e} over all runs:")
     print(f"{'solver':<30} {'setting':<14} {'first [s]':>10} {'min [s]':>9} {'median':>9} "
@@ -447,37 +420,121 @@ def main(argv=()):
     for kind in ("rk8", "auto"):
         one, many = by.get(f"appdyn {kind} loop"), by.get(f"appdyn {kind} batched")
         if one and many:
-            print(f"  batch vs loop, appdyn {kind}: {one['wall_time'] / many['wall_time']:.1f}x faster "
-                  f"(target 20x)")
+            print(f"  batch vs loop, appdyn {kind}: {one['wall_time'] / many['wall_time']:.1f}x "
+                  "faster (target 20x)")
 
+
+def figure(rows):
+    """Work-precision figure of the single runs (a `matplotlib.figure.Figure`), or None."""
     try:
-        import matplotlib
-
-        matplotlib.use("Agg")
-        import matplotlib.pyplot as plt
-
-        fig, ax = plt.subplots(figsize=(8, 6))
-        for s in solvers:
-            pts = sorted((r["error"], r["wall_time"]) for r in rows if r["solver"] == s)
-            e, wt = zip(*pts)
-            ax.loglog(e, np.array(wt) * 1e3, "o-" if s.startswith("appdyn") else "s--", label=s)
-        ax.set(xlabel="max rate error vs Jacobi truth [rad/s]", ylabel="wall time [ms]",
-               title="Torque-free body, 100 s: work-precision (actual runs)")
-        ax.grid(True, which="both", alpha=0.3)
-        ax.legend(fontsize=8)
-        fig.savefig(OUT / "simulate.png", dpi=110)
-        plt.close(fig)
+        from matplotlib.figure import Figure
     except ImportError:
-        pass
+        return None
+    fig = Figure(figsize=(8, 6))
+    ax = fig.subplots()
+    for s in dict.fromkeys(r["solver"] for r in rows):
+        pts = sorted((r["error"], r["wall_time"]) for r in rows if r["solver"] == s)
+        e, wt = zip(*pts)
+        ax.loglog(e, np.array(wt) * 1e3, "o-" if s.startswith("appdyn") else "s--", label=s)
+    ax.set(xlabel="max rate error vs Jacobi truth [rad/s]", ylabel="wall time [ms]",
+           title="Torque-free body, 100 s: work-precision (actual runs)")
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend(fontsize=8)
+    return fig
+
+
+def summary_rows(best, brows, k, hard, first_call, f_call, sim_call):
+    """The headline numbers (`Row`s) of the single runs, the batch and the hard cases."""
+    out = []
+
+    def add(case, metric, value, unit="", note=""):
+        out.append(Row("simulate", case, metric, float(value), unit, note))
+
+    for target, by in best.items():
+        case = f"torque-free body 100 s, error <= {target:.0e}"
+        met = {s: r for s, r in by.items() if r is not None}
+        for s, r in sorted(met.items(), key=lambda kv: kv[1]["wall_time"]):
+            add(case, f"wall time, {s}", 1e3 * r["wall_time"], "ms", fmt_setting(r["setting"]))
+        ours = [r for s, r in met.items() if s.startswith("appdyn")]
+        if not ours:
+            continue
+        top = min(ours, key=lambda r: r["wall_time"])
+        for peer in ("scipy DOP853", "numbalsoda dop853"):
+            if peer in met:
+                add(case, f"speed-up vs {peer}", met[peer]["wall_time"] / top["wall_time"], "x",
+                    f"{top['solver']} {fmt_setting(top['setting'])}")
+    add("torque-free body 100 s", "first simulate of a fresh model", 1e3 * first_call, "ms",
+        "builds and compiles the loop")
+    add("torque-free body 100 s", "Python-call overhead, model.f", 1e6 * f_call, "us")
+    add("torque-free body 100 s", "Python-call overhead, simulate", 1e6 * sim_call, "us",
+        "2-point rk8")
+
+    case = f"batch of {k} runs, error <= {BATCH_TOL:.0e}"
+    met = [r for r in brows if r["error"] <= BATCH_TOL]
+    for r in sorted(met, key=lambda r: r["wall_time"]):
+        add(case, f"wall time, {r['solver']}", 1e3 * r["wall_time"], "ms",
+            fmt_setting(r["setting"]))
+    by = {r["solver"]: r for r in met}
+    for kind in ("rk8", "auto"):
+        one, many = by.get(f"appdyn {kind} loop"), by.get(f"appdyn {kind} batched")
+        if one and many:
+            add(case, f"speed-up of one batched call vs a loop, {kind}",
+                one["wall_time"] / many["wall_time"], "x")
+    ours = [r for r in met if r["solver"].startswith("appdyn")]
+    if ours:
+        top = min(ours, key=lambda r: r["wall_time"])
+        for r in met:
+            if not r["solver"].startswith("appdyn"):
+                add(case, f"speed-up vs {r['solver']}", r["wall_time"] / top["wall_time"], "x",
+                    top["solver"])
+
+    for name in dict.fromkeys(r["case"] for r in hard):
+        sub = [r for r in hard if r["case"] == name]
+        ref = min((r for r in sub if r["solver"] == "scipy DOP853"), key=lambda r: r["error"])
+        better = [r for r in sub if r["solver"] == "appdyn auto" and r["error"] <= ref["error"]]
+        if not better:
+            continue
+        best_auto = min(better, key=lambda r: r["wall_time"])
+        state = "verified" if best_auto["success"] else f"not verified, status {best_auto['status']}"
+        add(name, "wall time, appdyn auto", best_auto["wall_time"], "s",
+            f"rtol {best_auto['setting']['rtol']:.0e}, error {best_auto['error']:.1e}, {state}")
+        add(name, "wall time, scipy DOP853 (tightest)", ref["wall_time"], "s",
+            f"rtol {ref['setting']['rtol']:.0e}, error {ref['error']:.1e}")
+        add(name, "speed-up vs scipy DOP853", ref["wall_time"] / best_auto["wall_time"], "x",
+            f"and {ref['error'] / max(best_auto['error'], 1e-300):.3g}x more accurate")
+    return out
+
+
+def run(quick: bool, out: Path) -> list:
+    """Run the benchmark, write ``simulate*.csv`` and ``simulate.png`` into ``out``; the
+    summary `Row`s."""
+    out = Path(out)
+    m = machine()
+    print(f"machine: {m['cpu']}, {m['cores']} cores, {m['platform']}; {m['date']}")
+    rows, model, x0, t = single_runs(quick)
+    write_csv(rows, out / "simulate.csv")
+    best = print_single(rows)
+    first_call = next(r for r in rows if r["solver"].startswith("appdyn"))["first_call"]
+    f_call, sim_call = overheads(model, x0)
+    print(f"  Python-call overhead: model.f {1e6 * f_call:.1f} us/call, "
+          f"simulate (2-point rk8) {1e6 * sim_call:.1f} us/call")
+
+    brows, k = batch(quick)
+    print_batch(brows, k)
+    write_csv(brows, out / "simulate_batch.csv")
+    fig = figure(rows)
+    if fig is not None:
+        save_figure(fig, out / "simulate.png")
     hard = hard_cases(quick)
     print_hard_cases(hard)
-    with open(OUT / "simulate_hard.csv", "w", newline="") as fh:
-        w = csv.DictWriter(fh, fieldnames=list(hard[0]))
-        w.writeheader()
-        w.writerows(hard)
-    print(f"\nwrote {OUT / 'simulate.csv'}, {OUT / 'simulate_hard.csv'} and {OUT / 'simulate.png'}")
-    return summary
+    write_csv(hard, out / "simulate_hard.csv")
+    print(f"\nwrote simulate.csv, simulate_batch.csv, simulate_hard.csv and simulate.png in {out}")
+    return summary_rows(best, brows, k, hard, first_call, f_call, sim_call)
+
+
+def main(argv=None) -> int:
+    return script_main(run, argv)
 
 
 if __name__ == "__main__":
-    main(sys.argv[1:])
+    sys.exit(main(sys.argv[1:]))

@@ -18,17 +18,24 @@
    degree 3), the log-log slopes, and the build time of a second problem of the same
    structure (another target) at each N.
 
-Run: ``make bench`` or ``appdyn bench slew``; ``--quick`` for a smoke run.
+Writes ``slew.csv`` (the scaling table) into the output folder and returns the summary rows
+(`run`): Bilimoria–Wie time and T, the second slew's times, the rockit ratio when it ran,
+the minimum-effort check, and the build / IPOPT slopes in N.
+Run: ``make bench`` or ``appdyn bench slew``; ``--quick`` for a smoke run (two repeats, N up
+to 200, no rockit).
 """
 from __future__ import annotations
 
 import sys
 import time
+from pathlib import Path
 
 import numpy as np
 
 from ocp import solve
 from problems import slew
+
+from _common import Row, script_main, write_csv
 
 BW = dict(angle=np.pi, axis=[0.0, 0.0, 1.0], u_max=1.0)
 SECOND = dict(angle=2.0, axis=[0.2, 1.0, 0.5], u_max=1.0)
@@ -99,9 +106,14 @@ def scaling(Ns):
     return rows
 
 
-def main(argv=()):
-    quick = "--quick" in argv
+def run(quick: bool, out: Path) -> list:
+    """Run the benchmark, write ``slew.csv`` into ``out``; the summary `Row`s."""
     runs = 2 if quick else 5
+    summary = []
+
+    def add(case, metric, value, unit="", note=""):
+        summary.append(Row("slew", case, metric, float(value), unit, note))
+
     first, times, Ts, sol = bilimoria_wie(runs)
     eig = slew.eigenaxis_time(np.eye(3), np.pi, [0, 0, 1])
     ok = bool(np.all((Ts >= 3.2428) & (Ts <= 3.2435)))
@@ -115,6 +127,12 @@ def main(argv=()):
     print(f"  switch-time polish: {sol.info.get('nlp_iterations', '?')} IPOPT iterations, "
           f"{sol.info.get('nlp_status', '?')}")
     print(slew.format_summary(slew.summary(sol, eigenaxis=eig)))
+    bw = "Bilimoria-Wie 180 deg, no user guess"
+    add(bw, "wall time, median", np.median(times), "s",
+        f"{runs} calls after the first; 3 starts + switch-time polish")
+    add(bw, "wall time, first call of the process", first, "s", "builds structures and solvers")
+    add(bw, "maneuver time T", np.median(Ts), "s",
+        f"in [3.2428, 3.2435]: {ok}; eigenaxis {eig:.4f} s")
 
     first_one, one, three, sols = second_target(runs)
     print("\n2. Second slew, same inertia and torque bounds, 2 rad about (0.2, 1, 0.5):")
@@ -124,6 +142,12 @@ def main(argv=()):
           f"T = {sols['first'].T:.10f}, success {sols['first'].success}; target < 0.1 s")
     print(f"  one start + polish, later calls: median {np.median(one):.3f} s (min {one.min():.3f}), "
           f"T = {sols['one'].T:.10f}, success {sols['one'].success}; target < 0.1 s")
+    second = "second slew, 2 rad about (0.2, 1, 0.5)"
+    add(second, "wall time, 3 starts + polish", np.median(three), "s",
+        f"median of {runs}; T = {sols['three'].T:.6f} s")
+    add(second, "wall time, 1 start + polish, first call", first_one, "s",
+        "structures and solvers of slew 1 reused")
+    add(second, "wall time, 1 start + polish", np.median(one), "s", f"median of {runs}")
 
     print("\n3. rockit DirectCollocation (N = 40) on slew 1, same process:")
     peer = None if quick else rockit_bilimoria_wie()
@@ -133,6 +157,8 @@ def main(argv=()):
         t_peer, T_peer = peer
         print(f"  rockit: {t_peer:.2f} s, T = {T_peer:.6f} (eigenaxis optimum {eig:.6f}); appdyn "
               f"{np.median(times):.3f} s, T = {np.median(Ts):.6f}: {t_peer / np.median(times):.0f}x faster; target >= 30x")
+        add(bw, "wall time, rockit DirectCollocation N = 40", t_peer, "s", f"T = {T_peer:.4f} s")
+        add(bw, "speed-up vs rockit", t_peer / np.median(times), "x")
 
     J, theta, T = np.array([2.0, 3.0, 4.0]), 1.0, 2.0
     t0 = time.perf_counter()
@@ -144,9 +170,14 @@ def main(argv=()):
     print(f"  cost {me.cost:.12f} (re-simulated {me.simulated_cost:.12f}) vs closed form {exact:.12f}: "
           f"rel. error {abs(me.cost / exact - 1):.1e}; worst scaled propagation error {worst[1][1]:.2e} "
           f"({worst[0]}); wall {wall:.3f} s; {me.t.size} nodes")
+    eff = "minimum-effort single-axis slew, refined"
+    add(eff, "wall time", wall, "s", f"{me.t.size} nodes")
+    add(eff, "cost error vs closed form", abs(me.cost / exact - 1), "", "relative")
 
     Ns = [50, 100, 200] if quick else [50, 100, 200, 400, 800, 1600, 2000]
     rows = scaling(Ns)
+    write_csv([dict(N=N, build=b, ipopt=s_, iterations=it, success=ok_, build_second_target=b2)
+               for N, b, s_, it, ok_, b2 in rows], Path(out) / "slew.csv")
     print("\n5. Scaling with N (min-effort slew, Radau degree 3):")
     print(f"  {'N':>5} {'build [s]':>10} {'IPOPT [s]':>10} {'iters':>6} {'build, 2nd target [s]':>22}")
     for N, b, s, it, success, b2 in rows:
@@ -156,9 +187,23 @@ def main(argv=()):
         y = np.array([r[2] / r[3] if col is None else r[col] for r in rows])
         slope = np.polyfit(n, np.log(y), 1)[0]
         print(f"  log-log slope of {label} time vs N ({Ns[0]}..{Ns[-1]}): {slope:.2f}")
+        add(f"min-effort slew, Radau 3, N = {Ns[0]}..{Ns[-1]}", f"log-log slope of {label} time",
+            slope)
     worst = max(r[1] / r[2] for r in rows)
     print(f"  largest build / IPOPT time ratio: {worst:.2f} (target <= 1)")
+    for N, b, s_, it, ok_, b2 in rows:
+        if N == Ns[-1]:
+            case = f"min-effort slew, Radau 3, N = {N}"
+            add(case, "build time", b, "s", f"another target: {b2:.4f} s")
+            add(case, "IPOPT time", s_, "s", f"{it} iterations")
+    add(f"min-effort slew, Radau 3, N = {Ns[0]}..{Ns[-1]}", "largest build / IPOPT time ratio",
+        worst)
+    return summary
+
+
+def main(argv=None) -> int:
+    return script_main(run, argv)
 
 
 if __name__ == "__main__":
-    main(sys.argv[1:])
+    sys.exit(main(sys.argv[1:]))

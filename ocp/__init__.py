@@ -26,6 +26,7 @@ from __future__ import annotations
 from .guess import guess_from_simulation
 from .mesh import Mesh
 from .problem import Constraint, Problem
+from .phases import Link, MultiPhaseProblem, MultiPhaseSolution, Phase, PhaseEnd, solve_phases
 from .ipopt_options import check_ipopt_options, ipopt_option_table
 from .refine import (STATUS_STALLED, BangArcs, IntervalErrors, RefinedSolution, RefinementRound,
                      annotate, bang_arcs, control_switches, find_switches, interval_errors,
@@ -43,6 +44,12 @@ from .transcription import (TRANSCRIPTIONS, HermiteSimpson, Radau, RadauConstant
 __all__ = [
     "Problem",
     "Constraint",
+    "Phase",
+    "Link",
+    "MultiPhaseProblem",
+    "MultiPhaseSolution",
+    "PhaseEnd",
+    "solve_phases",
     "Solution",
     "Propagation",
     "Progress",

@@ -13,6 +13,7 @@ from typing import Mapping
 import numpy as np
 
 from dynamics.model import Model
+from dynamics.validate.base import real_array
 
 __all__ = ["as_vector", "index", "boundary_values", "bounds", "horizon", "parameters",
            "row_bounds"]
@@ -168,14 +169,13 @@ def horizon(T):
     if isinstance(T, (tuple, list, np.ndarray)):
         if len(T) != 2:
             raise ValueError(f"`T` must be a float or a pair (T_min, T_max), got {T!r}")
-        lo, hi = float(T[0]), float(T[1])
+        lo, hi = (float(real_array(v, "T")) if np.ndim(v) == 0 else math.nan for v in T)
         if not (math.isfinite(lo) and lo >= 0 and hi > lo) or math.isnan(hi):
             raise ValueError(f"`T` bounds must satisfy 0 <= T_min < T_max, got ({lo}, {hi})")
         return (lo, hi)
-    try:
-        T = float(T)
-    except (TypeError, ValueError):
-        raise ValueError(f"`T` must be a float or a pair (T_min, T_max), got {T!r}") from None
+    if np.ndim(T) != 0:
+        raise ValueError(f"`T` must be a float or a pair (T_min, T_max), got {T!r}")
+    T = float(real_array(T, "T"))  # (refuses strings and booleans, naming `T`)
     if not (math.isfinite(T) and T > 0):
         raise ValueError(f"`T` (horizon length) must be finite and > 0, got {T}")
     return T
@@ -189,8 +189,8 @@ def parameters(p, p_bounds, model: Model) -> tuple[np.ndarray, np.ndarray]:
     p : None, mapping of str to float, or array_like, shape (np,)
         Values; default (and for parameters a mapping leaves out) ``model.p_default``.
     p_bounds : None, mapping of str to (lower, upper), or (lower, upper)
-        A mapping frees the parameters it lists; in the array form, components with
-        ``lower == upper`` are fixed.
+        ``None`` fixes every parameter; a mapping frees the parameters it lists; in the
+        array form, components with ``lower == upper`` are fixed.
     model : dynamics.Model
 
     Returns
@@ -211,7 +211,9 @@ def parameters(p, p_bounds, model: Model) -> tuple[np.ndarray, np.ndarray]:
     if not np.all(np.isfinite(p_out)):
         raise ValueError(f"`p` must be finite, got {p_out.tolist()}")
     pb = np.array(bounds(p_bounds, model.params, "p_bounds"))
-    if isinstance(p_bounds, Mapping):
+    if p_bounds is None:  # nothing listed: every parameter fixed at `p`
+        fixed = np.ones(np_, bool)
+    elif isinstance(p_bounds, Mapping):
         listed = np.zeros(np_, bool)
         for key in p_bounds:
             listed[model.params.index(key)] = True

@@ -47,9 +47,12 @@ from typing import Callable, Mapping
 
 import numpy as np
 
+from dynamics.validate.base import real_array
+
 from .attitude import quaternion_path, slerp  # slerp: re-exported (compatibility)
 from .horizon import default_T as _default_T, simulate_control as _simulate
 from .horizon import simulated_horizon as _simulated_horizon
+from .problem import Problem
 
 __all__ = ["NodeGuess", "initial_guess", "slerp", "guess_from_simulation"]
 
@@ -363,8 +366,11 @@ def guess_from_simulation(problem, u, *, T=None, n=201, method="auto", rtol=1e-8
 
     Raises
     ------
+    TypeError
+        If ``problem`` is not an `ocp.Problem`, or an array ``u`` is not real numbers.
     ValueError
-        If the initial state is not fully given or the simulation fails.
+        If an array ``u`` has the wrong shape, the initial state is not fully given or the
+        simulation fails.
 
     Examples
     --------
@@ -378,6 +384,8 @@ def guess_from_simulation(problem, u, *, T=None, n=201, method="auto", rtol=1e-8
     >>> sol.success, round(sol.T, 6)
     (True, 2.0)
     """
+    if not isinstance(problem, Problem):
+        raise TypeError(f"`problem` must be an ocp.Problem, got {type(problem).__name__}")
     x0 = np.asarray(problem.x_initial, dtype=float)
     if np.any(np.isnan(x0)):
         free = [problem.model.states[i] for i in np.flatnonzero(np.isnan(x0))]
@@ -388,8 +396,12 @@ def guess_from_simulation(problem, u, *, T=None, n=201, method="auto", rtol=1e-8
     if callable(u):
         uc = np.stack([np.asarray(u(tk), dtype=float).reshape(-1) for tk in t], 1).reshape(nu, -1)
     else:
-        ua = np.asarray(u, dtype=float)
-        uc = np.broadcast_to(ua.reshape(-1, 1) if ua.ndim <= 1 else ua, (nu, t.size)).copy()
+        ua = real_array(u, "u")
+        try:
+            uc = np.broadcast_to(ua.reshape(-1, 1) if ua.ndim <= 1 else ua, (nu, t.size)).copy()
+        except ValueError:
+            raise ValueError(f"`u` must have shape ({nu},) or ({nu}, {t.size}), "
+                             f"got {ua.shape}") from None
     res, uc = _simulate(problem, uc, t, problem.p, method=method, rtol=rtol, atol=atol)
     if not res.success or not np.all(np.isfinite(res.x)):
         raise ValueError(f"the simulation for the guess failed: {res.message}")

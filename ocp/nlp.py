@@ -175,13 +175,41 @@ class Discretization:
     def violation(self, g, w=None) -> float:
         """Largest violation of the constraint bounds by ``g`` and, when given, of the
         variable bounds by ``w``, both in the units of the NLP handed to IPOPT (scaled by
-        `ocp.scaling`, not by IPOPT's internal scaling)."""
+        `ocp.scaling`, not by IPOPT's internal scaling).
+
+        A scale far above the natural size of its variable (a ``scale=`` override of 1e6 on
+        a control of size 1) would hide a real violation: IPOPT relaxes a bound by 1e-8 of
+        its scaled value, which is 0.01 in physical units there. With ``w`` given, a
+        variable's (and its defect rows') violation is therefore measured against
+        ``max(1, |value|, |finite bounds|)`` (states: over all nodes) wherever its scale
+        exceeds 4x that size; elsewhere the scaled measure is unchanged.
+        """
         g = np.asarray(g, dtype=float).reshape(-1)
-        out = 0.0
-        if g.size:
-            out = float(np.max(np.maximum(0.0, np.maximum(self.lbg - g, g - self.ubg))))
+        fw = fg = 1.0
         if w is not None:
             w = np.asarray(w, dtype=float).reshape(-1)
-            if w.size:
-                out = max(out, float(np.max(np.maximum(0.0, np.maximum(self.lbx - w, w - self.ubx)))))
+            fw, fg = self._oversize(w)
+        out = 0.0
+        if g.size:
+            out = float(np.max(np.maximum(0.0, np.maximum(self.lbg - g, g - self.ubg)) * fg))
+        if w is not None and w.size:
+            out = max(out, float(np.max(np.maximum(0.0, np.maximum(self.lbx - w, w - self.ubx)) * fw)))
         return out
+
+    def _oversize(self, w) -> tuple[np.ndarray, np.ndarray]:
+        """Factors ``scale / natural size`` (1 unless the scale exceeds 4x the size) for
+        every variable and constraint row (`violation`)."""
+        sw, _, _ = self.scales()
+        finite = lambda b: np.where(np.isfinite(b), np.abs(b), 0.0)  # noqa: E731
+        size = self.w.split(np.maximum.reduce([np.ones_like(sw), np.abs(w * sw),
+                                               finite(self.lbx * sw), finite(self.ubx * sw)]))
+        for block in ("X", "U"):  # a state's or control's size: its largest over the nodes
+            size[block] = np.repeat(size[block].max(axis=1, keepdims=True), size[block].shape[1], axis=1)
+        size = self.w.join(size)
+        fw = np.where(sw > 4 * size, sw / size, 1.0)
+        sx, nat = self.scaling.x, self.w.split(size)["X"][:, 0]
+        fx = np.where(sx > 4 * nat, sx / nat, 1.0)
+        n_d = self.g.shapes["defect"][1]
+        ones = {k: np.ones(shape) for k, shape in self.g.shapes.items()}
+        fg = self.g.join({**ones, "defect": np.repeat(fx[:, None], n_d, axis=1)})
+        return fw, fg

@@ -79,7 +79,8 @@ from .solution import Solution
 from .transcription import get_transcription
 
 __all__ = ["solve", "Progress", "DEFAULT_CONSTRAINT_TOL", "STATUS_CONSTRAINT_TOL", "STATUS_EXCEPTION",
-           "check_constraint_tol", "make_solution", "WARM_START_OPTIONS"]
+           "check_constraint_tol", "make_solution", "WARM_START_OPTIONS", "run_ipopt",
+           "read_result"]
 
 _SUCCESS = ("Solve_Succeeded",)
 _ACCEPTABLE = "Solved_To_Acceptable_Level"
@@ -307,8 +308,29 @@ def _solve_built(problem, tr, m, node_guess, opts, ctol, disc, solver, nlp_opts,
 
     t_solve = time.perf_counter()
     bounds = dict(lbx=disc.lbx, ubx=disc.ubx, lbg=disc.lbg, ubg=disc.ubg, p=disc.P)
+    res, error, status, iterations, note, t_re = run_ipopt(
+        solver, start, bounds, opts, lambda again: disc.structure.nlpsol(
+            "ocp_resolve", {**nlp_opts, "ipopt": again}))
+    build_time += t_re
+    solve_time = time.perf_counter() - t_solve - t_re
+    w, lam_g, lam_x, g, success, status, message = read_result(
+        res, error, status, iterations, note, w0, disc.g.size, disc.violation, ctol)
+    if not success and default_guess:
+        message += _default_guess_hint(problem, node_guess)
+    LOGGER.info("solve %s (%s, N=%d): %s; %.3g s", problem.name, tr.name, m.N, message, solve_time)
+    return make_solution(problem, tr, m, disc, w, lam_g, g, success, status, message,
+                          iterations, solve_time, build_time, lam_x=lam_x)
+
+
+def run_ipopt(solver, start: dict, bounds: dict, opts: dict, resolver):
+    """One IPOPT solve, and the warm re-solve an acceptable-level stop gets (module
+    docstring). ``resolver(options)`` builds the re-solving IPOPT on the same NLP.
+
+    Returns ``(result or None, error, status, iterations, note, build_time)``: ``note`` is
+    the sentence the message gets about a re-solve, ``build_time`` [s] the re-solver's
+    construction time."""
     res, error, status, iterations = _run(solver, dict(**start, **bounds))
-    note = ""
+    note, t_build = "", 0.0
     if res is not None and status == _ACCEPTABLE:
         # not verified: one warm re-solve from the acceptable point, acceptable exit disabled
         budget = min(max(int(opts.get("max_iter", 3000)) - iterations, 0), _RESOLVE_ITER)
@@ -317,9 +339,9 @@ def _solve_built(problem, tr, m, node_guess, opts, ctol, disc, solver, nlp_opts,
             again = {**opts, "acceptable_iter": 0, "max_iter": budget,
                      "warm_start_init_point": "yes", "mu_init": 1e-9}
             with construction_lock():
-                resolver = disc.structure.nlpsol("ocp_resolve", {**nlp_opts, "ipopt": again})
-            build_time += time.perf_counter() - t_re
-            res2, error2, status2, it2 = _run(resolver, dict(
+                re_solver = resolver(again)
+            t_build = time.perf_counter() - t_re
+            res2, error2, status2, it2 = _run(re_solver, dict(
                 x0=res["x"], lam_x0=res["lam_x"], lam_g0=res["lam_g"], **bounds))
             if res2 is not None and status2 in _SUCCESS:
                 note = (f" (after {_ACCEPTABLE} in {iterations} iterations, a warm re-solve "
@@ -329,31 +351,31 @@ def _solve_built(problem, tr, m, node_guess, opts, ctol, disc, solver, nlp_opts,
                 note = (f"; a warm re-solve without the acceptable-level exit ended with "
                         f"{status2} after {it2} iterations")
             iterations += it2
-    solve_time = time.perf_counter() - t_solve
+    return res, error, status, iterations, note, t_build
+
+
+def read_result(res, error, status: str, iterations: int, note: str, w0, n_g: int,
+                violation, ctol: float):
+    """``(w, lam_g, lam_x, g, success, status, message)`` of a `run_ipopt` result: success
+    only for ``Solve_Succeeded`` with ``violation(g, w) <= ctol`` (module docstring); the
+    start ``w0`` and NaN constraints when IPOPT stopped by an error."""
     if res is None:
-        w, lam_g, g = w0, np.zeros(disc.g.size), np.full(disc.g.size, np.nan)
-        lam_x = np.zeros(disc.w.size)
         status = status if status != "Unknown" else STATUS_EXCEPTION
-        message = f"IPOPT stopped by an error: {error}"
+        return (np.asarray(w0, dtype=float), np.zeros(n_g), np.zeros(np.size(w0)),
+                np.full(n_g, np.nan), False, status, f"IPOPT stopped by an error: {error}")
+    w = np.asarray(res["x"]).reshape(-1)
+    lam_g = np.asarray(res["lam_g"]).reshape(-1)
+    lam_x = np.asarray(res["lam_x"]).reshape(-1)
+    g = np.asarray(res["g"]).reshape(-1)
+    success = status in _SUCCESS
+    message = _message(status, iterations) + note
+    viol = violation(g, w)
+    if success and not viol <= ctol:
         success = False
-    else:
-        w = np.asarray(res["x"]).reshape(-1)
-        lam_g = np.asarray(res["lam_g"]).reshape(-1)
-        lam_x = np.asarray(res["lam_x"]).reshape(-1)
-        g = np.asarray(res["g"]).reshape(-1)
-        success = status in _SUCCESS
-        message = _message(status, iterations) + note
-        viol = disc.violation(g, w)
-        if success and not viol <= ctol:
-            success = False
-            message = (f"{message}; but the constraint violation {viol:.3g} exceeds "
-                       f"constraint_tol {ctol:g}: not verified")
-            status = STATUS_CONSTRAINT_TOL
-    if not success and default_guess:
-        message += _default_guess_hint(problem, node_guess)
-    LOGGER.info("solve %s (%s, N=%d): %s; %.3g s", problem.name, tr.name, m.N, message, solve_time)
-    return make_solution(problem, tr, m, disc, w, lam_g, g, success, status, message,
-                          iterations, solve_time, build_time, lam_x=lam_x)
+        message = (f"{message}; but the constraint violation {viol:.3g} exceeds "
+                   f"constraint_tol {ctol:g}: not verified")
+        status = STATUS_CONSTRAINT_TOL
+    return w, lam_g, lam_x, g, success, status, message
 
 
 def _build_solver(disc, nlp_opts, sink):

@@ -14,7 +14,8 @@ from .. import validate
 
 __all__ = [
     "CA_TYPES", "NumpyOps", "CasadiOps", "ops_for", "checked", "finite3", "finite4",
-    "unit_quat", "rotation_matrix", "finite_any", "nonzero3", "nonzero4", "unit_axis",
+    "unit_quat", "rotation_matrix", "finite_any", "finite_scalar", "finite_vector", "nonzero3",
+    "nonzero4", "unit_axis",
 ]
 
 
@@ -106,6 +107,17 @@ def rotation_matrix(x, name):
 
 def finite_any(x, name):
     return validate.finite_array(x, name)
+
+
+finite_scalar = validate.finite_scalar  # (the one check; re-exported for the attitude modules)
+
+
+def finite_vector(x, name):
+    """A finite scalar or 1-D array (e.g. angles ``(n,)``); refuses higher dimensions."""
+    a = validate.finite_array(x, name)
+    if a.ndim > 1:
+        raise ValueError(f"`{name}` must be a scalar or have shape (n,), got {a.shape}")
+    return a
 
 
 def nonzero3(x, name):

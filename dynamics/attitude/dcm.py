@@ -8,7 +8,8 @@ from __future__ import annotations
 import numpy as np
 
 from .. import validate
-from .backend import checked, finite_any, ops_for, rotation_matrix, unit_axis, unit_quat
+from .backend import (checked, finite_scalar, finite_vector, ops_for, rotation_matrix, unit_axis,
+                      unit_quat)
 
 __all__ = [
     "dcm_from_quat", "quat_from_dcm", "dcm_from_axis_angle", "quat_from_axis_angle",
@@ -147,7 +148,8 @@ def dcm_from_axis_angle(axis, angle):
     TypeError
         If an argument is not real numbers (e.g. a string, a dict or ``None``).
     ValueError
-        If ``axis`` is not 3 finite numbers or is zero, or ``angle`` is not finite.
+        If ``axis`` is not 3 finite numbers or is zero, or ``angle`` is not one finite number
+        (an array of angles is refused: use `quat_from_axis_angle` for a batch).
 
     Examples
     --------
@@ -159,7 +161,7 @@ def dcm_from_axis_angle(axis, angle):
            [ 0.,  0.,  1.]])
     """
     e = unit_axis(axis)
-    d = checked(angle, "angle", (), finite_any)
+    d = checked(angle, "angle", (), finite_scalar)
     o = ops_for(e, d)
     c, s = o.cos(d), o.sin(d)
     ca_, cb, cg = e[0], e[1], e[2]  # direction cosines cos(alpha), cos(beta), cos(gamma)
@@ -190,7 +192,8 @@ def quat_from_axis_angle(axis, angle):
     TypeError
         If an argument is not real numbers (e.g. a string, a dict or ``None``).
     ValueError
-        If ``axis`` is not 3 finite numbers or is zero, or ``angle`` is not finite.
+        If ``axis`` is not 3 finite numbers or is zero, or ``angle`` is not finite or not
+        a scalar or 1-D array.
 
     Examples
     --------
@@ -200,7 +203,7 @@ def quat_from_axis_angle(axis, angle):
     array([1., 0., 0., 0.])
     """
     e = unit_axis(axis)
-    d = checked(angle, "angle", (), finite_any)
+    d = checked(angle, "angle", (), finite_vector)
     o = ops_for(e, d)
     s, c = o.sin(d / 2), o.cos(d / 2)
     return o.stack([e[0] * s, e[1] * s, e[2] * s, c])

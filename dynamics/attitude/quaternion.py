@@ -10,8 +10,8 @@ import casadi as ca
 import numpy as np
 
 from .. import validate
-from .backend import (CA_TYPES, NumpyOps, checked, finite3, finite4, finite_any, nonzero4, ops_for,
-                      unit_quat)
+from .backend import (CA_TYPES, NumpyOps, checked, finite3, finite4, finite_scalar,
+                      nonzero4, ops_for, unit_quat)
 
 __all__ = [
     "skew", "quat_mul", "quat_conj", "quat_normalize", "quat_kinematics_matrix", "quat_rate",
@@ -307,8 +307,8 @@ def propagate_quat(q, w, h):
     TypeError
         If an argument is not real numbers (e.g. a string, a dict or ``None``).
     ValueError
-        If (numeric) ``q`` is not a finite unit quaternion, ``w`` or ``h`` is not finite,
-        or ``|w| h`` is too large to represent.
+        If (numeric) ``q`` is not a finite unit quaternion, ``w`` is not finite, ``h`` is not
+        one finite number, or ``|w| h`` is too large to represent.
 
     References
     ----------
@@ -323,7 +323,7 @@ def propagate_quat(q, w, h):
     array([0.      , 0.      , 0.707107, 0.707107])
     """
     q, w = checked(q, "q", (4,), unit_quat), checked(w, "w", (3,), finite3)
-    h = checked(h, "h", (), finite_any)
+    h = checked(h, "h", (), finite_scalar)
     o = ops_for(q, w, h)
     if o is NumpyOps:
         with np.errstate(over="ignore", invalid="ignore"):

@@ -106,6 +106,12 @@ def residual_invariant(x, p, terms: ConstraintTerms) -> ca.Function:
     casadi.Function
         ``(x, p) -> constraint_residual`` (2 x 1: position-level, velocity-level norm).
 
+    Raises
+    ------
+    TypeError
+        If ``x`` or ``p`` is not a casadi SX/MX symbol, or ``terms`` is not a
+        `ConstraintTerms`.
+
     Examples
     --------
     >>> import casadi as ca
@@ -115,6 +121,13 @@ def residual_invariant(x, p, terms: ConstraintTerms) -> ca.Function:
     >>> residual_invariant(x, p, terms)(ca.DM([2.0, 0.0, 1.0, 0.0]), [])
     DM([1.5, 2])
     """
+    for name, a in (("x", x), ("p", p)):
+        if not is_symbolic(a):
+            raise ArgumentTypeError(f"`{name}` must be a casadi SX/MX symbol, "
+                                    f"got {type(a).__name__}")
+    if not isinstance(terms, ConstraintTerms):
+        raise ArgumentTypeError(f"`terms` must be a ConstraintTerms (from `constraint_terms`), "
+                                f"got {type(terms).__name__}")
     pos = 0 if terms.position is None else ca.norm_2(terms.position)
     value = ca.vertcat(pos, ca.norm_2(terms.residual))
     return ca.Function("constraint_residual", [x, p], [value], ["x", "p"], ["constraint_residual"])

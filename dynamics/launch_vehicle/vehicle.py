@@ -107,7 +107,7 @@ import numpy as np
 
 from .. import cache
 from ..model import Model
-from ..validate import finite_scalar, positive
+from ..validate import ArgumentTypeError, finite_scalar, is_symbolic, positive
 from .parts import Actuator, Aero, Bending, MassFlow, Slosh
 
 __all__ = ["launch_vehicle", "rigid_part", "RIGID_STATES"]
@@ -151,6 +151,15 @@ def rigid_part(slosh: Slosh | None, m, I):
         Rigid mass ``m - m_s``, reduced mass ``m_s m_r / m`` and the rigid part's inertia about
         its own centre, ``I - m m_s rho0^2 / m_r`` (``rho0``: slosh mass at rest from ``O``).
 
+    Raises
+    ------
+    TypeError
+        If ``slosh`` is neither a `Slosh` nor ``None``, or ``m`` or ``I`` is neither a real
+        number nor a CasADi symbol.
+    ValueError
+        If a numeric ``m`` or ``I`` is not finite and ``> 0``, or ``m`` is not larger than the
+        slosh mass.
+
     Examples
     --------
     >>> from dynamics.launch_vehicle import Slosh
@@ -158,9 +167,15 @@ def rigid_part(slosh: Slosh | None, m, I):
     >>> rigid_part(Slosh(mass=1.0, hinge=2.0, length=1.0), 4.0, 10.0)  # 10 - 4 * 1 * 1 / 3
     (3.0, 0.75, 8.666666666666666)
     """
+    if slosh is not None and not isinstance(slosh, Slosh):
+        raise ArgumentTypeError(f"`slosh` must be a Slosh or None, got {type(slosh).__name__}")
+    m = m if is_symbolic(m) else positive(m, "m")
+    I = I if is_symbolic(I) else positive(I, "I")  # noqa: E741
     if slosh is None:
         return m, 0.0, I
     ms = slosh.mass
+    if not is_symbolic(m) and not is_symbolic(ms) and not m > ms:
+        raise ValueError(f"`m` must be larger than the slosh mass {ms!r}, got {m!r}")
     rho0 = slosh.hinge - (slosh.length or 0.0)
     return m - ms, ms * (m - ms) / m, I - m * ms * rho0 ** 2 / (m - ms)
 

@@ -27,7 +27,7 @@ def lagrange_terms(T, V, q, v):
     Parameters
     ----------
     T, V : casadi.SX
-        Kinetic and potential energy (scalars).
+        Kinetic and potential energy (scalars); ``V`` may also be a finite number.
     q, v : casadi.SX
         Coordinates and their rates (symbols).
 
@@ -35,6 +35,14 @@ def lagrange_terms(T, V, q, v):
     -------
     (casadi.SX, casadi.SX)
         ``M`` (n x n) and ``Q`` (n x 1).
+
+    Raises
+    ------
+    TypeError
+        If ``T``, ``q`` or ``v`` is not a CasADi SX/MX expression, or ``V`` is neither one
+        nor a real number.
+    ValueError
+        If ``T`` or ``V`` is not a scalar (1 x 1), or a numeric ``V`` is not finite.
 
     Examples
     --------
@@ -45,6 +53,15 @@ def lagrange_terms(T, V, q, v):
     >>> float(M), ca.Function("Q", [q], [Q])(0.5)
     (2.0, DM(-4))
     """
+    V = V if validate.is_symbolic(V) else validate.finite_scalar(V, "V")
+    for name, a in (("T", T), ("V", V), ("q", q), ("v", v)):
+        if name == "V" and not validate.is_symbolic(V):
+            continue
+        if not validate.is_symbolic(a):
+            raise validate.ArgumentTypeError(f"`{name}` must be a casadi SX/MX expression, "
+                                             f"got {type(a).__name__}")
+        if name in ("T", "V") and a.shape != (1, 1):
+            raise ValueError(f"`{name}` must be a scalar (1x1) expression, got shape {a.shape}")
     M = ca.hessian(T, v)[0]
     Q = ca.gradient(T - V, q) - ca.jtimes(ca.gradient(T, v), q, v)
     return M, Q

@@ -127,13 +127,21 @@ def rod_reaction(theta, theta_dot, *, mass=1.0, length=1.0, gravity=GRAVITY):
     -------
     numpy.ndarray or float
 
+    Raises
+    ------
+    TypeError
+        If ``theta`` or ``theta_dot`` is not real numbers (a string, ``None``, a symbol).
+    ValueError
+        If ``theta`` or ``theta_dot`` has a NaN or infinite entry (refused rather than
+        propagated), or the two do not broadcast.
+
     Examples
     --------
     >>> from dynamics.mechanisms import rod_reaction
     >>> rod_reaction(0.0, 0.0, gravity=9.81)
     -9.81
     """
-    th, w = np.asarray(theta, float), np.asarray(theta_dot, float)
+    th, w = validate.finite_array(theta, "theta"), validate.finite_array(theta_dot, "theta_dot")
     out = -mass * length * w ** 2 - mass * gravity * np.cos(th)
     return float(out) if out.ndim == 0 else out
 
@@ -319,20 +327,58 @@ def sliding_bead(*, mass=1.0, rate=1.0, rate_amp=0.0, rate_freq=0.0,
 def bead_torque(r, r_dot, rate, rate_dot, *, mass=1.0):
     """Eq. 5.79: ``m r^2 f' + 2 m r r' f`` [N m] for the rate ``f`` and its derivative.
 
+    Parameters
+    ----------
+    r, r_dot, rate, rate_dot : float or array_like [m, m/s, rad/s, rad/s^2]
+        Element-wise (arrays broadcast).
+    mass : float [kg]
+
+    Returns
+    -------
+    numpy.ndarray or float
+
+    Raises
+    ------
+    TypeError
+        If an argument is not real numbers (a string, ``None``, a symbol).
+    ValueError
+        If an argument has a NaN or infinite entry (refused rather than propagated).
+
     Examples
     --------
     >>> from dynamics.mechanisms import bead_torque
     >>> bead_torque(1.0, 0.0, 2.0, 0.5)
     0.5
     """
-    r, rd = np.asarray(r, float), np.asarray(r_dot, float)
-    out = mass * r ** 2 * np.asarray(rate_dot, float) + 2 * mass * r * rd * np.asarray(rate, float)
+    r, rd = validate.finite_array(r, "r"), validate.finite_array(r_dot, "r_dot")
+    f, fd = validate.finite_array(rate, "rate"), validate.finite_array(rate_dot, "rate_dot")
+    mass = validate.finite_scalar(mass, "mass")
+    out = mass * r ** 2 * fd + 2 * mass * r * rd * f
     return float(out) if out.ndim == 0 else out
 
 
 def bead_motion(t, r0, r0_dot, rate):
     """``(r, r')`` of the bead on a wire turning at the constant ``rate``:
     ``r = r0 cosh(w t) + (r0'/w) sinh(w t)``.
+
+    Parameters
+    ----------
+    t, r0, r0_dot : float or array_like [s, m, m/s]
+        Element-wise (arrays broadcast).
+    rate : float [rad/s]
+        Nonzero.
+
+    Returns
+    -------
+    r, r_dot : numpy.ndarray or float
+
+    Raises
+    ------
+    TypeError
+        If an argument is not real numbers (a string, ``None``, a symbol).
+    ValueError
+        If an argument has a NaN or infinite entry (refused rather than propagated), or
+        ``rate`` is zero or not a scalar.
 
     Examples
     --------
@@ -343,6 +389,7 @@ def bead_motion(t, r0, r0_dot, rate):
     w = validate.finite_scalar(rate, "rate")
     if w == 0.0:
         raise ValueError(f"`rate` must be nonzero, got {rate!r}")
-    t = np.asarray(t, float)
+    t = validate.finite_array(t, "t")
+    r0, r0_dot = validate.finite_array(r0, "r0"), validate.finite_array(r0_dot, "r0_dot")
     ch, sh = np.cosh(w * t), np.sinh(w * t)
     return r0 * ch + r0_dot / w * sh, r0 * w * sh + r0_dot * ch

@@ -256,7 +256,10 @@ def pendulum_swing(t, theta0, *, length=1.0, gravity=GRAVITY) -> np.ndarray:
     Raises
     ------
     ValueError
-        Naming ``t``, ``theta0`` (not finite, ``|theta0| >= pi``), ``length`` or ``gravity``.
+        Naming ``t`` (not finite, or not a scalar or 1-D array), ``theta0`` (not finite,
+        ``|theta0| >= pi``), ``length`` or ``gravity``.
+    TypeError
+        If an argument is not real numbers (a string, ``None``, ...).
 
     Examples
     --------
@@ -267,6 +270,8 @@ def pendulum_swing(t, theta0, *, length=1.0, gravity=GRAVITY) -> np.ndarray:
     array([ 2.,  0., -2.])
     """
     t = validate.finite_array(t, "t")
+    if t.ndim > 1:
+        raise ValueError(f"`t` must be a scalar or have shape (n,), got {t.shape}")
     k, w0 = _swing_constants(theta0, length, gravity)
     sn, cn, dn, _ = ellipj(w0 * t, k * k)
     return 2.0 * np.arcsin(np.clip(k * cn / dn, -1.0, 1.0))

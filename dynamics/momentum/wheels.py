@@ -34,7 +34,8 @@ from .. import cache
 from ..attitude import dcm_from_quat, quat_rate
 from ..model import Model
 from ..rigid_body import RIGID_BODY_STATES
-from ..validate import check_inertia, finite_array, positive, positive_each, unit_axes
+from ..validate import (check_inertia, finite_array, is_symbolic, positive, positive_each,
+                        unit_axes)
 
 __all__ = ["ATTITUDE_UNITS", "rotor_dynamics",
            "attitude_invariants", "wheel_spacecraft"]
@@ -80,8 +81,13 @@ def rotor_dynamics(inertia, axes, w, h, torque=None, *, wheel_inertia=None, moto
 
     Raises
     ------
+    TypeError
+        If ``inertia`` or ``axes`` is not real numbers, or ``w`` or ``h`` is neither real
+        numbers nor a CasADi expression.
     ValueError
-        If ``motor`` is given without ``wheel_inertia``.
+        If ``inertia`` is not a finite symmetric positive definite (3, 3) matrix, ``axes`` not
+        finite unit columns (3, n), ``w`` not 3 entries, ``h`` not n entries, a numeric ``w``
+        or ``h`` not finite, or ``motor`` is given without ``wheel_inertia``.
 
     Examples
     --------
@@ -92,8 +98,19 @@ def rotor_dynamics(inertia, axes, w, h, torque=None, *, wheel_inertia=None, moto
     >>> H.T, wdot.T  # w x H = (0, 2, 0), I_L wdot = -w x H
     (DM([[2, 0, 3]]), DM([[0, -1, 0]]))
     """
-    IL = ca.DM(np.asarray(inertia, dtype=float))
-    A = ca.DM(np.asarray(axes, dtype=float))
+    IL = ca.DM(check_inertia(inertia, triangle=False))
+    A = ca.DM(unit_axes(axes, "axes"))
+    n = A.shape[1]
+    if is_symbolic(w):
+        if w.shape != (3, 1):
+            raise ValueError(f"`w` must be a 3x1 CasADi column, got shape {w.shape}")
+    else:
+        w = ca.DM(finite_array(w, "w", (3,)))
+    symbolic_h = is_symbolic(h) or (isinstance(h, (list, tuple))
+                                    and any(is_symbolic(e) for e in h))
+    size = (h.numel() if is_symbolic(h) else len(h)) if symbolic_h else finite_array(h, "h").size
+    if size != n:
+        raise ValueError(f"`h` must have {n} entries (one per wheel), got {size}")
     H = ca.mtimes(IL, w) + ca.mtimes(A, ca.vertcat(*[h[i] for i in range(A.shape[1])]))
     L = ca.DM.zeros(3) if torque is None else torque
     if motor is None:

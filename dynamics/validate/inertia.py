@@ -3,7 +3,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .base import ArgumentTypeError
+from .base import real_array
 
 __all__ = ["check_inertia"]
 
@@ -45,10 +45,7 @@ def check_inertia(inertia, *, name="inertia", triangle=True):
         ...
     ValueError: `inertia` violates the triangle inequality I1 + I2 >= I3 ...
     """
-    try:
-        a = np.array(inertia, dtype=float)
-    except (TypeError, ValueError) as exc:
-        raise ArgumentTypeError(f"`{name}` must be a 3x3 matrix of numbers: {exc}") from None
+    a = np.array(real_array(inertia, name), dtype=float)  # refuses strings and booleans
     if a.shape == (3,):
         a = np.diag(a)
     if a.shape != (3, 3):

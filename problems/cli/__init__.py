@@ -14,10 +14,11 @@
     appdyn cmg steer --beta 54.74 --torque 0,0,0.5 --law sr|pinv|gsr --t-final 10 [--delta0 ...]
     appdyn gains launch-vehicle --config lv.toml [--plot F.png] [--json F]
     appdyn dispersion spin [--samples N] [--seed S] [--workers N | --scheduler ADDR] [--plot F.png]
+    appdyn ascent delta3 [--N N] [--refine-tol TOL | --no-refine] [--plot F.png] [--json F]
     appdyn demo
-    appdyn bench [NAME ...]
+    appdyn bench [NAME ...] [--quick] [--out DIR] [--readme]
 
-One module per command (`simulate`, `slew`, `stability`, `cmg`, `gains`, `dispersion`, `demo`,
+One module per command (`simulate`, `slew`, `stability`, `cmg`, `gains`, `dispersion`, `ascent`, `demo`,
 `bench`), each with
 ``add_parser(subparsers)``, ``check(parser, args)`` (checks across options, before any
 computation) and ``run(args) -> exit status``; `common` holds what they share.
@@ -39,7 +40,7 @@ import os
 import re
 import sys
 
-from problems.cli import bench, cmg, demo, dispersion, gains, simulate, slew, stability
+from problems.cli import ascent, bench, cmg, demo, dispersion, gains, simulate, slew, stability
 from problems.cli.common import attach_negative_values
 from problems.cli.slew import rest_to_rest_bound
 
@@ -47,7 +48,8 @@ __all__ = ["main", "build_parser", "COMMANDS", "rest_to_rest_bound"]
 
 #: command name -> its module (``add_parser``, ``check``, ``run``), in the order of ``--help``
 COMMANDS = {"simulate": simulate, "slew": slew, "stability": stability, "cmg": cmg,
-            "gains": gains, "dispersion": dispersion, "demo": demo, "bench": bench}
+            "gains": gains, "dispersion": dispersion, "ascent": ascent, "demo": demo,
+            "bench": bench}
 
 
 def build_parser() -> argparse.ArgumentParser:

@@ -241,6 +241,14 @@ def generators(seed: int, samples: int) -> list:
 def draw_samples(params: Mapping, seed: int, samples: int) -> list[dict]:
     """``samples`` dicts of drawn values, each spec of ``params`` in mapping order.
 
+    Raises
+    ------
+    TypeError
+        If ``params`` is not a mapping of names to specs, or ``seed`` (unless ``None``: fresh
+        entropy) or ``samples`` is not an integer.
+    ValueError
+        If ``seed`` or ``samples`` is negative.
+
     Examples
     --------
     >>> from problems.dispersion import Normal, Uniform, draw_samples
@@ -251,6 +259,11 @@ def draw_samples(params: Mapping, seed: int, samples: int) -> list[dict]:
     >>> draw_samples(specs, 7, 5)[:2] == draws  # sample i does not depend on `samples`
     True
     """
+    if not isinstance(params, Mapping):
+        raise ArgumentTypeError(f"`params` must be a mapping of names to specs, "
+                                f"got {type(params).__name__}")
+    seed = None if seed is None else validate.integer(seed, "seed", minimum=0)
+    samples = validate.integer(samples, "samples", minimum=0)
     return [{name: draw(spec, rng) for name, spec in params.items()}
             for rng in generators(seed, samples)]
 

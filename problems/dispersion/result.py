@@ -7,6 +7,7 @@ import numpy as np
 
 from dynamics.figures import cleared_figure, finish_figure
 from dynamics.serialize import jsonable, text_table, to_json
+from dynamics.validate.base import real_array
 
 from .distributions import describe
 
@@ -50,7 +51,15 @@ def statistics(values, percentiles=(1.0, 50.0, 99.0)) -> Statistics:
     Parameters
     ----------
     values : array_like, shape (m, ...)
+        Real numbers, samples first (NaN entries are not refused: they propagate).
     percentiles : sequence of float in [0, 100]
+
+    Raises
+    ------
+    TypeError
+        If ``values`` is not real numbers (a string, ``None``, ...).
+    ValueError
+        If ``values`` is a scalar (it must have the sample axis 0).
 
     Examples
     --------
@@ -59,7 +68,10 @@ def statistics(values, percentiles=(1.0, 50.0, 99.0)) -> Statistics:
     >>> s.count, s.mean, round(s.std, 6), s.min, s.max, s.percentiles
     (4, 2.5, 1.290994, 1.0, 4.0, {50.0: 2.5})
     """
-    v = np.asarray(values, dtype=float)
+    v = real_array(values, "values")
+    if v.ndim == 0:
+        raise ValueError(f"`values` must have shape (m, ...) (samples first), got a scalar "
+                         f"{values!r}")
     m = v.shape[0]
     if m == 0:
         nan = _num(np.full(v.shape[1:], np.nan))

@@ -132,7 +132,14 @@ def run_sample(task: SampleTask) -> SampleOutcome:
 
     Any ``Exception`` (of the factory, ``x0``, ``simulate`` or an output) makes the sample a
     failure with the exception's text; ``KeyboardInterrupt`` propagates.
+
+    Raises
+    ------
+    TypeError
+        If ``task`` is not a `SampleTask` (a programming error, not a failed sample).
     """
+    if not isinstance(task, SampleTask):
+        raise validate.ArgumentTypeError(f"`task` must be a SampleTask, got {type(task).__name__}")
     start = time.perf_counter()
     status = NOT_SIMULATED
     try:

@@ -16,7 +16,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from dynamics import rigid_body
+from dynamics import rigid_body, validate
 from dynamics.attitude import dcm_from_quat
 
 from .distributions import Normal
@@ -27,9 +27,21 @@ __all__ = ["spinner", "nutation_history", "nutation_max", "nutation_closed_form"
 
 
 def _moments(transverse_inertia, axial_inertia, transverse_asymmetry):
-    d = float(transverse_asymmetry)
-    return np.array([transverse_inertia * (1 + d / 2), transverse_inertia * (1 - d / 2),
-                     axial_inertia], dtype=float)
+    d = validate.finite_scalar(transverse_asymmetry, "transverse_asymmetry")
+    it = validate.positive(transverse_inertia, "transverse_inertia")
+    ia = validate.positive(axial_inertia, "axial_inertia")
+    return np.array([it * (1 + d / 2), it * (1 - d / 2), ia], dtype=float)
+
+
+def _states(res) -> np.ndarray:
+    """``res.x`` of a `spinner` run, checked: finite, shape (7, n)."""
+    if not hasattr(res, "x"):
+        raise validate.ArgumentTypeError(f"`res` must be a SimulationResult (with states `x`), "
+                                         f"got {type(res).__name__}")
+    x = validate.finite_array(res.x, "res.x")
+    if x.ndim != 2 or x.shape[0] != 7 or x.shape[1] == 0:
+        raise ValueError(f"`res.x` must have shape (7, n) (a spinner run), got {x.shape}")
+    return x
 
 
 def spinner(transverse_inertia, axial_inertia, transverse_asymmetry=0.0):
@@ -76,6 +88,13 @@ def nutation_history(res, transverse_inertia, axial_inertia, transverse_asymmetr
     -------
     ndarray, shape (n,) [rad]
 
+    Raises
+    ------
+    TypeError
+        If ``res`` is not a simulation result, or an inertia is not a real number.
+    ValueError
+        If ``res.x`` is not finite of shape (7, n), or an inertia is not finite and ``> 0``.
+
     Examples
     --------
     >>> import numpy as np
@@ -88,14 +107,14 @@ def nutation_history(res, transverse_inertia, axial_inertia, transverse_asymmetr
     True
     """
     inertia = _moments(transverse_inertia, axial_inertia, transverse_asymmetry)
-    x = res.x
+    x = _states(res)
     h = dcm_from_quat(x[0:4, 0]).T @ (inertia * x[4:7, 0])
     b = np.einsum("jik,j->ik", dcm_from_quat(x[0:4]), np.array([0.0, 0.0, 1.0]))
     return np.arctan2(np.linalg.norm(np.cross(b.T, h), axis=1), b.T @ h)
 
 
 def nutation_max(res, transverse_inertia, axial_inertia, transverse_asymmetry=0.0) -> float:
-    """Largest `nutation_history` angle along ``res`` [rad]."""
+    """Largest `nutation_history` angle along ``res`` [rad] (errors as for it)."""
     return float(np.max(nutation_history(res, transverse_inertia, axial_inertia,
                                          transverse_asymmetry)))
 
@@ -109,6 +128,13 @@ def nutation_closed_form(transverse_inertia, axial_inertia, w0) -> float:
     w0 : array_like, shape (3,) [rad/s]
         Body rates (any time: ``|w_t|`` and ``w3`` are constant).
 
+    Raises
+    ------
+    TypeError
+        If an argument is not real numbers.
+    ValueError
+        If an inertia is not finite and ``> 0``, or ``w0`` is not 3 finite numbers.
+
     Examples
     --------
     >>> import numpy as np
@@ -116,8 +142,10 @@ def nutation_closed_form(transverse_inertia, axial_inertia, w0) -> float:
     >>> round(float(np.degrees(nutation_closed_form(1000.0, 1500.0, [0.02, 0.0, 1.0]))), 6)
     0.763898
     """
-    w = np.asarray(w0, dtype=float)
-    return float(np.arctan2(transverse_inertia * np.hypot(w[0], w[1]), axial_inertia * w[2]))
+    it = validate.positive(transverse_inertia, "transverse_inertia")
+    ia = validate.positive(axial_inertia, "axial_inertia")
+    w = validate.finite_array(w0, "w0", (3,))
+    return float(np.arctan2(it * np.hypot(w[0], w[1]), ia * w[2]))
 
 
 def _closed_form_output(res, transverse_inertia, axial_inertia):

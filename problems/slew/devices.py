@@ -19,7 +19,6 @@ collocation accuracy: momentum is conserved by the dynamics, not imposed).
 """
 from __future__ import annotations
 
-import math
 
 import casadi as ca
 import numpy as np
@@ -56,9 +55,9 @@ def _vector(value, name, n, default) -> np.ndarray:
 def _horizon(objective, T, T_max, T_ref):
     if objective == "time":
         return (0.0, float(T_max) if T_max is not None else 20.0 * T_ref)
-    if T is None or not (math.isfinite(float(T)) and float(T) > 0):
-        raise ValueError(f"`T` must be a positive finite horizon [s], got {T!r}")
-    return float(T)
+    if T is None:
+        raise ValueError("`T` must be a positive finite horizon [s], got None")
+    return positive(T, "T")
 
 
 def _costs(objective):

@@ -10,7 +10,7 @@ import numpy as np
 from dynamics import rigid_body
 from dynamics.attitude import quat_conj, quat_from_axis_angle, quat_mul, quat_normalize, rotation_angle
 from dynamics.rigid_body import check_inertia
-from dynamics.validate import unit_vector
+from dynamics.validate import positive, unit_vector
 from ocp import Problem
 from ocp.attitude import slerp
 
@@ -94,9 +94,9 @@ def slew_problem(inertia, *, objective, T=None, angle=None, axis=None, q0=None, 
         horizon = (0.0, float(T_max) if T_max is not None else 20.0 * T_ref)
         costs = dict(mayer=lambda xf, p, T: T)
     else:
-        if T is None or not (math.isfinite(float(T)) and float(T) > 0):
-            raise ValueError(f"`T` must be a positive finite horizon [s], got {T!r}")
-        horizon = float(T)
+        if T is None:
+            raise ValueError("`T` must be a positive finite horizon [s], got None")
+        horizon = positive(T, "T")
         x, u, p = ca.SX.sym("x", 7), ca.SX.sym("u", 3), ca.SX.sym("p", 0)
         costs = dict(lagrange=ca.Function("effort", [x, u, p], [0.5 * ca.sumsqr(u)],
                                           ["x", "u", "p"], ["L"]))
@@ -196,6 +196,13 @@ def attitude_guess(problem: Problem, *, tilt_axis=None, tilt=0.0, T=None, n=201)
     -------
     dict with keys ``t``, ``x`` (7, n), ``u`` (3, n), ``T`` — accepted by `ocp.solve`
 
+    Raises
+    ------
+    TypeError
+        If ``problem`` is not an `ocp.Problem`.
+    ValueError
+        If ``problem`` has no attitude target ``q_final`` (not a slew problem).
+
     Examples
     --------
     >>> import numpy as np
@@ -205,6 +212,10 @@ def attitude_guess(problem: Problem, *, tilt_axis=None, tilt=0.0, T=None, n=201)
     >>> guess["x"].shape, guess["u"].shape, guess["T"]
     ((7, 11), (3, 11), 2.0)
     """
+    if not isinstance(problem, Problem):
+        raise TypeError(f"`problem` must be an ocp.Problem, got {type(problem).__name__}")
+    if getattr(problem, "q_final", None) is None:
+        raise ValueError("`problem` must be a slew problem (with an attitude target `q_final`)")
     model = problem.model
     q0 = problem.x_initial[:4]
     qf = np.array(problem.q_final)

@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import warnings
+from collections.abc import Mapping
 
 import numpy as np
 
@@ -81,6 +82,11 @@ def summary(solution: Solution, *, eigenaxis=None) -> dict:
     the re-integrated trajectory from the collocated states), quaternion_norm_error, and
     ``eigenaxis_T`` [s] when given. Re-simulation numbers are NaN when it failed.
 
+    Raises
+    ------
+    TypeError
+        If ``solution`` is not an `ocp.Solution`.
+
     Examples
     --------
     >>> import numpy as np
@@ -92,6 +98,8 @@ def summary(solution: Solution, *, eigenaxis=None) -> dict:
     >>> [np.round(s, 4).tolist() for s in data["switch_times"]]
     [[], [], [0.3162]]
     """
+    if not isinstance(solution, Solution):
+        raise TypeError(f"`solution` must be an ocp.Solution, got {type(solution).__name__}")
     sw = switch_times(solution) if solution.success else [np.array([])] * 3
     info = getattr(solution, "info", {}) or {}
     perr = info.get("pointing_error", solution.pointing_error)
@@ -119,8 +127,20 @@ def summary(solution: Solution, *, eigenaxis=None) -> dict:
     return out
 
 
+_SUMMARY_KEYS = ("success", "status", "T", "cost", "switch_times", "iterations", "solve_time",
+                 "constraint_violation", "pointing_error_arcsec", "final_rate_error",
+                 "propagation_error", "quaternion_norm_error")
+
+
 def format_summary(data: dict) -> str:
     """A readable table of `summary` output.
+
+    Raises
+    ------
+    TypeError
+        If ``data`` is not a mapping (a `summary` dict).
+    ValueError
+        If ``data`` lacks a key of `summary`.
 
     Examples
     --------
@@ -137,6 +157,11 @@ def format_summary(data: dict) -> str:
       switch times u3 [s]       0.3162
       IPOPT iterations          ...
     """
+    if not isinstance(data, Mapping):
+        raise TypeError(f"`data` must be a dict from `summary`, got {type(data).__name__}")
+    missing = [k for k in _SUMMARY_KEYS if k not in data]
+    if missing:
+        raise ValueError(f"`data` must be a dict from `summary`; missing keys {missing}")
     rows = [
         ("success", f"{data['success']} ({data['status']})"),
         ("maneuver time T [s]", f"{data['T']:.6f}"),
@@ -178,7 +203,14 @@ def plot_slew(solution: Solution, path=None, *, fig=None, dpi: int = 110):
     Returns
     -------
     matplotlib.figure.Figure
+
+    Raises
+    ------
+    TypeError
+        If ``solution`` is not an `ocp.Solution`, or ``fig`` not a matplotlib Figure.
     """
+    if not isinstance(solution, Solution):
+        raise TypeError(f"`solution` must be an ocp.Solution, got {type(solution).__name__}")
     from matplotlib.figure import Figure
 
     if fig is None:

@@ -105,7 +105,8 @@ def test_scipy_rotation_peer_for_momentum():
         ([[1, 0.1, 0], [0, 1, 0], [0, 0, 1]], "symmetric"),
         ([1.0, -2.0, 2.0], "positive definite"),
         ([1.0, 1.0, 3.0], "triangle inequality"),
-        ("abc", "3x3 matrix of numbers"),
+        ("abc", "`inertia` must be real numbers"),
+        (["1", "2", "3"], "`inertia` must be real numbers"),
     ],
 )
 def test_invalid_inertia_raises(inertia, match):

@@ -53,6 +53,10 @@ def test_parameters_fixed_unless_bounded():
     assert np.array_equal(pr.p, [1.0, -0.5])
     assert np.array_equal(pr.free_params, [0])
     assert np.array_equal(pr.p_bounds, [[0.5, -0.5], [2.0, -0.5]])
+    # no p_bounds: every parameter fixed (it once freed them all)
+    pr = Problem(m, T=1.0, p={"g": -0.5})
+    assert pr.free_params.size == 0
+    assert np.array_equal(pr.p_bounds, [[1.0, -0.5], [1.0, -0.5]])
 
 
 def test_q_final_and_initial_quaternion_are_normalized():

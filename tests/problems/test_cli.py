@@ -110,18 +110,21 @@ def test_umax_is_a_hidden_alias_of_u_max(capsys):
     assert "--u-max" in text and "--umax" not in text
 
 
-def test_bench_passes_quick_to_the_script(tmp_path, monkeypatch, capsys):
-    """`appdyn bench NAME --quick` runs bench/NAME.py as __main__ with --quick in sys.argv."""
-    import sys
-
+def test_bench_passes_quick_and_out_to_run(tmp_path, monkeypatch, capsys):
+    """`appdyn bench NAME --quick --out DIR` calls bench/NAME.py's run(True, DIR)."""
     from problems.cli import bench
 
-    out = tmp_path / "argv.txt"
+    seen = tmp_path / "seen.txt"
     (tmp_path / "probe.py").write_text(
-        "import sys\nopen(%r, 'w').write(' '.join(sys.argv[1:]))\n" % str(out))
+        "def run(quick, out):\n"
+        "    open(%r, 'w').write(f'{quick} {out}')\n"
+        "    return []\n" % str(seen))
     monkeypatch.setattr(bench, "BENCH_DIR", tmp_path)
-    argv = list(sys.argv)
-    assert main(["bench", "probe", "--quick"]) == 0
-    assert out.read_text() == "--quick" and sys.argv == argv
-    assert main(["bench", "probe"]) == 0 and out.read_text() == ""
+    out = tmp_path / "res"
+    assert main(["bench", "probe", "--quick", "--out", str(out)]) == 0
+    assert seen.read_text() == f"True {out}" and (out / "machine.json").is_file()
+    assert main(["bench", "probe", "--out", str(out)]) == 0 and seen.read_text() == f"False {out}"
     assert main(["bench", "missing"]) == 2
+    with pytest.raises(SystemExit) as exc:
+        main(["bench", "probe", "--out", str(seen)])  # a file, not a folder
+    assert exc.value.code == 2

@@ -1,0 +1,113 @@
+"""The README's "Performance" tables, generated from a results folder.
+
+``render(results_dir)`` turns ``summary.csv`` and ``machine.json`` (written by ``appdyn
+bench``) into markdown: one line naming the machine and versions, then one table per
+benchmark. ``update_readme(readme_path, results_dir)`` puts that text between the markers
+``<!-- bench:begin -->`` and ``<!-- bench:end -->`` of the README. The numbers in that part
+of the README are never edited by hand (``tests/test_bench_readme.py`` checks that they are
+exactly ``render(bench/results)``); ``make bench`` regenerates them.
+"""
+from __future__ import annotations
+
+import csv
+import json
+import math
+from pathlib import Path
+
+__all__ = ["BEGIN", "END", "render", "update_readme", "current", "format_value"]
+
+BEGIN = "<!-- bench:begin -->"
+END = "<!-- bench:end -->"
+
+#: what each benchmark measures, the line above its table; the tables follow this order
+#: (benchmarks not listed come after, in the order of ``summary.csv``)
+TITLES = {
+    "simulate": "Simulation, torque-free rigid body against its Jacobi-elliptic truth "
+                "(`bench/simulate.py`)",
+    "workprecision": "Work-precision of every integration method against scipy, every model "
+                     "with a truth (`bench/workprecision.py`)",
+    "slew": "Optimal slews (`bench/slew.py`)",
+    "ocp_precision": "Optimal control: objective error against work for every transcription "
+                     "(`bench/ocp_precision.py`)",
+    "ascent": "Delta III ascent to GTO, 4 phases (`bench/ascent.py`)",
+    "many": "Many runs: serial against thread and process pools (`bench/many.py`)",
+    "stress": "Stress cases (`bench/stress.py`)",
+}
+
+
+def format_value(value: float) -> str:
+    """A number with 4 significant digits (3 in exponent form): ``0.1234``, ``12.34``,
+    ``7530``, ``1.23e-09``."""
+    value = float(value)
+    if not math.isfinite(value):
+        return str(value)
+    if value == 0:
+        return "0"
+    exp = math.floor(math.log10(abs(value)))
+    if -3 <= exp < 5:
+        text = f"{value:.{max(0, 3 - exp)}f}"
+        # rounding may carry into a new digit (9.9996 -> "10.000"): one digit fewer then
+        if len(text.lstrip("-").replace(".", "").lstrip("0")) > 4 and "." in text:
+            text = text[:-1].rstrip(".")
+        return text
+    return f"{value:.2e}"
+
+
+def _cell(text) -> str:
+    return str(text).replace("|", "\\|").replace("\n", " ").strip()
+
+
+def _read(results_dir: Path):
+    results_dir = Path(results_dir)
+    with open(results_dir / "summary.csv", newline="") as fh:
+        rows = list(csv.DictReader(fh))
+    machine = json.loads((results_dir / "machine.json").read_text())
+    return rows, machine
+
+
+def render(results_dir) -> str:
+    """Markdown of the results in ``results_dir`` (``summary.csv``, ``machine.json``)."""
+    rows, m = _read(results_dir)
+    lines = [f"Measured on {m.get('cpu')}, {m.get('cores')} cores, {m.get('date')}; "
+             f"casadi {m.get('casadi')}, numpy {m.get('numpy')}, scipy {m.get('scipy')}, "
+             f"IPOPT linear solver {m.get('ipopt_linear_solver')}; "
+             "regenerate with `make bench`."]
+    names = list(dict.fromkeys(r["benchmark"] for r in rows))
+    order = list(TITLES)
+    names = sorted(names, key=lambda b: (order.index(b) if b in order else len(order),
+                                         names.index(b)))
+    for bench in names:
+        lines += ["", f"**{TITLES.get(bench, f'`bench/{bench}.py`')}**", "",
+                  "| case | metric | value | note |", "| --- | --- | ---: | --- |"]
+        for r in rows:
+            if r["benchmark"] != bench:
+                continue
+            value = format_value(r["value"]) + (f" {r['unit']}" if r.get("unit") else "")
+            lines.append(f"| {_cell(r['case'])} | {_cell(r['metric'])} | {_cell(value)} | "
+                         f"{_cell(r.get('note', ''))} |")
+    return "\n".join(lines) + "\n"
+
+
+def update_readme(readme_path, results_dir) -> bool:
+    """Replace the text between `BEGIN` and `END` in ``readme_path`` by
+    ``render(results_dir)``; True when the file changed. Raises ``ValueError`` when the
+    markers are missing."""
+    path = Path(readme_path)
+    text = path.read_text()
+    i, j = text.find(BEGIN), text.find(END)
+    if i < 0 or j < i:
+        raise ValueError(f"`readme_path` {path} has no {BEGIN} ... {END} markers")
+    new = text[:i + len(BEGIN)] + "\n" + render(results_dir) + text[j:]
+    if new != text:
+        path.write_text(new)
+    return new != text
+
+
+def current(readme_path) -> str:
+    """The generated text now between the markers of ``readme_path`` (what `render` gave when
+    it was last regenerated)."""
+    text = Path(readme_path).read_text()
+    i, j = text.find(BEGIN), text.find(END)
+    if i < 0 or j < i:
+        raise ValueError(f"`readme_path` {readme_path} has no {BEGIN} ... {END} markers")
+    return text[i + len(BEGIN):j].removeprefix("\n")

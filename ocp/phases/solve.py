@@ -1,0 +1,297 @@
+"""`solve_phases`: transcribe every phase of a `MultiPhaseProblem`, solve the stacked NLP
+(`ocp.phases.nlp`) with IPOPT, optionally refine each phase's mesh, and return a
+`MultiPhaseSolution`.
+
+Success means verified, as for `ocp.solve`: IPOPT's ``Solve_Succeeded`` and the largest
+violation of any phase row, link or event row and variable bound (NLP units) at most
+``constraint_tol``.
+"""
+from __future__ import annotations
+
+import time
+from dataclasses import replace
+from typing import Mapping, Sequence
+
+import numpy as np
+
+from dynamics.cache import construction_lock
+from dynamics.interrupts import check_interrupt, interruptible
+
+from ..cached import checkout
+from ..guess import initial_guess
+from ..nlp import Discretization
+from ..progress import LOGGER, IterationCallback, iteration_sink
+from ..refine.errors import interval_errors
+from ..refine.mesh_update import _local_order, _new_mesh
+from ..scaling import auto_scaling
+from ..solve import (WARM_START_OPTIONS, _ipopt_options, _mesh, _numbers, check_constraint_tol,
+                     make_solution, read_result, run_ipopt)
+from ..transcription import get_transcription
+from .nlp import PhasedDiscretization, event_row_scales
+from .problem import MultiPhaseProblem
+from .solution import MultiPhaseSolution
+
+__all__ = ["solve_phases"]
+
+
+def _phase_guesses(problem: MultiPhaseProblem, guess) -> list:
+    """The guess of each phase: ``guess`` (a `MultiPhaseSolution` or a sequence, one item per
+    phase) over the phases' own ``guess``; ``None`` where neither gives one."""
+    if guess is None:
+        return [ph.guess for ph in problem.phases]
+    if isinstance(guess, MultiPhaseSolution):
+        if len(guess.phases) != problem.n_phases:
+            raise ValueError(f"`guess` has {len(guess.phases)} phases, the problem {problem.n_phases}")
+        return list(guess.phases)
+    if isinstance(guess, Sequence) and not isinstance(guess, (str, bytes)):
+        if len(guess) != problem.n_phases:
+            raise ValueError(f"`guess` must give one guess per phase ({problem.n_phases}), got {len(guess)}")
+        return [g if g is not None else ph.guess for g, ph in zip(guess, problem.phases)]
+    raise ValueError("`guess` must be None, a MultiPhaseSolution or a sequence of per-phase guesses, "
+                     f"got {type(guess).__name__}")
+
+
+def _discretize(problem: MultiPhaseProblem, meshes, guesses, expand, codegen):
+    """Per phase ``(transcription, mesh, node guess, Discretization)``."""
+    out = []
+    for i, ph in enumerate(problem.phases):
+        tr = get_transcription(ph.transcription, ph.degree)
+        m = meshes[i] if meshes is not None else _mesh(ph.N, ph.mesh)
+        pb = replace(ph.problem, t0=0.0) if ph.problem.t0 != 0.0 else ph.problem
+        try:
+            ng = initial_guess(pb, tr, m, guesses[i])  # (a Solution is read in normalized time)
+        except ValueError as exc:
+            raise ValueError(f"phases[{i}]: {exc}") from exc
+        scaling = auto_scaling(pb, ng, ph.scale)
+        out.append((tr, m, ng, Discretization(pb, tr, m, scaling, expand, codegen)))
+    return out
+
+
+@interruptible
+def solve_phases(problem: MultiPhaseProblem, *, guess=None, objective_scale: float = 1.0,
+                 refine_tol: float | None = None, max_rounds: int = 4, max_intervals: int = 200,
+                 verbose=False, progress=None, ipopt_options: Mapping | None = None,
+                 constraint_tol: float | None = None, expand: bool = True,
+                 codegen: bool = False) -> MultiPhaseSolution:
+    """Solve a multi-phase problem by direct collocation (every phase its own transcription
+    and mesh) and IPOPT.
+
+    Parameters
+    ----------
+    problem : MultiPhaseProblem
+    guess : None, MultiPhaseSolution or sequence, optional
+        A previous solution (each phase's solution becomes that phase's guess; primal and dual
+        values when it solved the same NLP), or one guess per phase (``None`` items take the
+        phase's own ``Phase.guess``). A phase guess is what `ocp.solve` takes, its times from
+        the phase's start.
+    objective_scale : float, optional
+        ``d_J``: IPOPT sees ``J / d_J`` (default 1).
+    refine_tol : float, optional
+        Refine each phase's mesh until its largest estimated interval error
+        (`ocp.refine.interval_errors`) is below this (as `ocp.refine` does for one phase),
+        re-solving warm after each round; default: no refinement.
+    max_rounds, max_intervals : int, optional
+        Refinement limits (rounds; intervals per phase).
+    verbose, progress, ipopt_options, constraint_tol, expand, codegen
+        As for `ocp.solve`.
+
+    Returns
+    -------
+    MultiPhaseSolution
+        ``success=False`` with IPOPT's status on a failure; never raises for one.
+
+    Raises
+    ------
+    TypeError
+        If ``problem`` is not a `MultiPhaseProblem`.
+    ValueError
+        Naming the argument: a bad ``guess``, ``objective_scale``, ``refine_tol``,
+        ``max_rounds``, ``max_intervals``, ``constraint_tol`` or IPOPT option, or a phase's
+        mesh/guess (``phases[i]: ...``).
+
+    Examples
+    --------
+    Rest at 0 to rest at 1 in 2 s with minimum ``integral u^2 / 2``, split at t = 1 s (the
+    merged problem's optimum is ``6 d^2 / T^3 = 0.75``):
+
+    >>> import ocp
+    >>> from ocp.examples import double_integrator
+    >>> di, energy = double_integrator(), (lambda u: 0.5 * u**2)
+    >>> first = ocp.Problem(di, T=1.0, x_initial=[0, 0], lagrange=energy)
+    >>> second = ocp.Problem(di, T=1.0, x_final=[1, 0], lagrange=energy)
+    >>> two = ocp.MultiPhaseProblem([ocp.Phase(first, N=10), ocp.Phase(second, N=10)],
+    ...                             links=[ocp.Link(0, 1)])
+    >>> sol = ocp.solve_phases(two)
+    >>> sol.success, round(sol.cost, 9), sol.tf.tolist()
+    (True, 0.75, [1.0, 2.0])
+    """
+    if not isinstance(problem, MultiPhaseProblem):
+        raise TypeError(f"`problem` must be an ocp.MultiPhaseProblem, got {type(problem).__name__}")
+    objective_scale = _positive(objective_scale, "objective_scale")
+    if refine_tol is not None:
+        refine_tol = _positive(refine_tol, "refine_tol")
+    for name, v in (("max_rounds", max_rounds), ("max_intervals", max_intervals)):
+        if isinstance(v, bool) or not isinstance(v, (int, np.integer)) or v < (0 if name == "max_rounds" else 1):
+            raise ValueError(f"`{name}` must be an int >= {0 if name == 'max_rounds' else 1}, got {v!r}")
+    ctol = check_constraint_tol(constraint_tol)
+    opts = _ipopt_options(ipopt_options, ctol)
+    sink = iteration_sink(verbose, progress)
+    guesses = _phase_guesses(problem, guess)
+
+    sol = _solve_once(problem, None, guesses, guess if isinstance(guess, MultiPhaseSolution) else None,
+                      objective_scale, opts, ipopt_options, ctol, sink, expand, codegen)
+    if refine_tol is None:
+        return sol
+    rounds, totals = [], [0.0, 0.0, 0]
+    for _ in range(max_rounds + 1):
+        totals = [totals[0] + sol.solve_time, totals[1] + sol.build_time, totals[2] + sol.iterations]
+        errors = [interval_errors(s).max_error if sol.success else float("inf") for s in sol.phases]
+        rounds.append((tuple(s.mesh.N for s in sol.phases), tuple(errors), sol.cost, sol.iterations))
+        LOGGER.info("solve_phases %s: intervals %s, errors %s", problem.name,
+                    rounds[-1][0], ", ".join(f"{e:.2g}" for e in errors))
+        if not sol.success or max(errors) <= refine_tol or len(rounds) > max_rounds:
+            break
+        meshes = []
+        for s, e in zip(sol.phases, errors):
+            new = None
+            if e > refine_tol:
+                est = interval_errors(s)
+                new = _new_mesh(s.mesh, est, s.T, s.t0, refine_tol, _local_order(s.transcription),
+                                max_intervals)
+            meshes.append(new or s.mesh)
+        if all(m is s.mesh for m, s in zip(meshes, sol.phases)):
+            break
+        sol = _solve_once(problem, meshes, list(sol.phases), None, objective_scale, opts,
+                          ipopt_options, ctol, sink, expand, codegen)
+    converged = sol.success and max(rounds[-1][1]) <= refine_tol
+    note = "" if converged or not sol.success else (
+        f"; mesh refinement stopped above refine_tol {refine_tol:g} (largest interval error "
+        f"{max(rounds[-1][1]):.2g})")
+    return replace(sol, message=sol.message + note,
+                   info={"rounds": tuple(rounds), "converged": converged, "solve_time": totals[0],
+                         "build_time": totals[1], "iterations": totals[2]})
+
+
+def _positive(value, name: str) -> float:
+    try:
+        v = float(value)
+    except (TypeError, ValueError):
+        raise ValueError(f"`{name}` must be a finite number > 0, got {value!r}") from None
+    if isinstance(value, bool) or not (0 < v < np.inf):
+        raise ValueError(f"`{name}` must be a finite number > 0, got {value!r}")
+    return v
+
+
+def _solve_once(problem, meshes, guesses, warm_from, objective_scale, opts, ipopt_options, ctol,
+                sink, expand, codegen) -> MultiPhaseSolution:
+    t_build = time.perf_counter()
+    parts = _discretize(problem, meshes, guesses, expand, codegen)
+    discs = [p[3] for p in parts]
+    node_guesses = [p[2] for p in parts]
+    ends0 = np.concatenate([np.concatenate([ng.X[:, 0], ng.X[:, -1], ng.p, [ng.T]])
+                            for ng in node_guesses])
+    scale_e = event_row_scales(problem, ends0, discs)
+    disc = PhasedDiscretization(problem, discs, objective_scale, scale_e)
+    start = {"x0": disc.pack(node_guesses)}
+    warm = _warm_point(warm_from, disc)
+    if warm is not None:
+        start = warm
+        opts = {**WARM_START_OPTIONS, **opts}
+    nlp_opts = {"ipopt": opts, "print_time": False, "error_on_fail": False}
+
+    def build(options=nlp_opts):
+        options = dict(options)
+        options["iteration_callback"] = IterationCallback(disc.structure.w.size, disc.structure.g.size,
+                                                          disc.violation if sink else None, sink)
+        with construction_lock():
+            return disc.structure.nlpsol("ocp_phases", options), options
+
+    bounds = dict(lbx=disc.lbx, ubx=disc.ubx, lbg=disc.lbg, ubg=disc.ubg, p=disc.P)
+
+    def run(solver):
+        check_interrupt()
+        build_time = time.perf_counter() - t_build
+        t_solve = time.perf_counter()
+        out = run_ipopt(solver, start, bounds, opts, lambda again: disc.structure.nlpsol(
+            "ocp_phases_resolve", {**nlp_opts, "ipopt": again}))
+        return out, build_time + out[5], time.perf_counter() - t_solve - out[5]
+
+    if sink is None:
+        with checkout("phased_nlpsol", (disc.key, repr(sorted(opts.items()))),
+                      lambda: build(), keepalive=disc.structure) as built:
+            (res, error, status, iterations, note, _), build_time, solve_time = run(built[0])
+    else:
+        (res, error, status, iterations, note, _), build_time, solve_time = run(build()[0])
+    w, lam_g, lam_x, g, success, status, message = read_result(
+        res, error, status, iterations, note, start["x0"], disc.lbg.size, disc.violation, ctol)
+    LOGGER.info("solve_phases %s (%d phases): %s; %.3g s", problem.name, problem.n_phases, message,
+                solve_time)
+    return _solution(problem, disc, parts, w, lam_g, lam_x, g, success, status, message,
+                     iterations, solve_time, build_time)
+
+
+def _solution(problem, disc, parts, w, lam_g, lam_x, g, success, status, message, iterations,
+              solve_time, build_time) -> MultiPhaseSolution:
+    ws = disc.split_w(w)
+    lgs, _ = disc.split_g(lam_g)
+    gs, ge = disc.split_g(g)
+    ends = disc.ends(w)
+    t0s, phases, start = [], [], problem.t0
+    for i, ((tr, m, _, d), wi, li, gi) in enumerate(zip(parts, ws, lgs, gs)):
+        T = float(d.unpack(wi)["T"])
+        pb = replace(d.problem, t0=start)
+        d_t = _Shifted(d, pb)
+        phases.append(make_solution(pb, tr, m, d_t, wi, li, gi, success, status, message,
+                                    iterations, solve_time, build_time))
+        t0s.append(start)
+        start += T
+    t0 = np.array(t0s)
+    tf = np.array([s.t0 + s.T for s in phases])
+    lo, hi = problem.event_bounds()
+    ev = ge * disc.event_scale
+    ev_viol = float(np.max(np.maximum(0.0, np.maximum(lo - ev, ev - hi)), initial=0.0)) \
+        if np.all(np.isfinite(ev)) else float("nan")
+    viol = disc.violation(g, w) if np.all(np.isfinite(g)) else float("nan")
+    sw, sg, dJ = _phys_scales(disc)
+    point = {"key": disc.key, "numbers": _phased_numbers(disc), "x_phys": w * sw,
+             "lam_x_phys": lam_x * dJ / sw, "lam_g_phys": lam_g * dJ / sg}
+    return MultiPhaseSolution(
+        success=bool(success), status=str(status), message=message, cost=disc.cost(w),
+        phases=tuple(phases), t0=t0, tf=tf, ends=ends, events=ev, event_violation=ev_viol,
+        constraint_violation=viol, iterations=int(iterations), solve_time=float(solve_time),
+        build_time=float(build_time), problem=problem, nlp_point=point)
+
+
+class _Shifted:
+    """A phase `Discretization` seen with its problem's ``t0`` set to the phase start (for
+    `make_solution`; the NLP is that of the phase started at 0)."""
+
+    def __init__(self, disc, problem):
+        self._disc, self.problem = disc, problem
+
+    def __getattr__(self, name):
+        return getattr(self._disc, name)
+
+
+def _phys_scales(disc) -> tuple[np.ndarray, np.ndarray, float]:
+    """``(s_w, s_g, d_J)`` of the stacked NLP: physical = scale x scaled."""
+    parts = [d.scales() for d in disc.discs]
+    return (np.concatenate([p[0] for p in parts]),
+            np.concatenate([*[p[1] for p in parts], disc.event_scale]), disc.objective_scale)
+
+
+def _phased_numbers(disc) -> bytes:
+    import hashlib
+    parts = [_numbers(d) for d in disc.discs]
+    return hashlib.blake2b(b"".join(parts), digest_size=16).digest()
+
+
+def _warm_point(sol, disc) -> dict | None:
+    """Primal and dual start values from a `MultiPhaseSolution` of the same NLP (same phase
+    structures, numbers and meshes), in this NLP's scaling; ``None`` otherwise."""
+    point = getattr(sol, "nlp_point", None)
+    if not point or point.get("key") != disc.key or point.get("numbers") != _phased_numbers(disc):
+        return None
+    sw, sg, dJ = _phys_scales(disc)
+    return {"x0": np.clip(point["x_phys"] / sw, disc.lbx, disc.ubx),
+            "lam_x0": point["lam_x_phys"] * sw / dJ, "lam_g0": point["lam_g_phys"] * sg / dJ}
