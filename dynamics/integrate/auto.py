@@ -118,6 +118,10 @@ def _estimate(runs: dict, rtol, atol, asymptotic: bool) -> _Estimate:
       the tolerance: truncation is below the rounding; accepted at ``2 max(d_ab, d_bc)``.
       Otherwise that is the measured round-off floor:
       ``next_m = 0`` (stop). At the modelled level otherwise, the next run doubles the steps.
+    * Three runs that agree to the modelled round-off (``d_ab, d_bc <= 4 rho``; a solution
+      rk8 integrates exactly, such as a body at rest, where no order can be seen): accepted
+      at ``2 max(d_ab, d_bc) + rho`` when that is at most 0.5. A truncation error above the
+      round-off would make the differences differ by ``(b/a)^8``.
     * Otherwise the next count aims at ``e = 0.1`` (1.25x to 8x the last count).
     """
     order = 8
@@ -169,6 +173,12 @@ def _estimate(runs: dict, rtol, atol, asymptotic: bool) -> _Estimate:
         # more steps no longer shrink the differences (truncation alone would shrink them
         # (c/b)^8 >= 6x): the measured round-off floor; stop
         return _Estimate(d_bc + e_c, False, 0, trusted)
+    if len(finite) >= 3 and max(d_ab, d_bc) <= 4 * rho and 2 * max(d_ab, d_bc) + rho <= \
+            _AUTO_ACCEPT:
+        # three step counts agree to the modelled round-off: the truncation error of the
+        # coarsest is below it (a solution rk8 integrates exactly, e.g. a body at rest);
+        # truncation that large would differ by (b/a)^8 between the runs
+        return _Estimate(2 * max(d_ab, d_bc) + rho, True, c, trusted)
     if d_bc <= 4 * rho:  # the runs agree to the modelled round-off: try twice the steps
         return _Estimate(d_bc + rho, False, 2 * c, trusted)
     if math.isfinite(e_c) and e_c > 0:

@@ -26,7 +26,7 @@ import casadi as ca
 import numpy as np
 
 from .. import validate
-from ..attitude.backend import CA_TYPES, checked, finite3, finite_any, ops_for
+from ..attitude.backend import CA_TYPES, checked, finite3, finite_any, finite_vector, ops_for
 from ..validate.base import cross3
 
 __all__ = ["wheel_torque", "cmg_torque", "coriolis_torque", "propeller_torque",
@@ -201,6 +201,13 @@ def propeller_torque(yaw_rate, spin_rate, inertia, t, *, blades=2, phase=0.0):
     -------
     L : ndarray, shape (3,) or (3, m) [N m] (airplane axes X, Y, Z), or CasADi 3x1
 
+    Raises
+    ------
+    ValueError
+        Naming the argument: ``yaw_rate``, ``spin_rate`` or ``inertia`` not a finite scalar
+        (``inertia`` also not positive), ``t`` not finite or of more than one dimension,
+        ``blades`` below 2, ``phase`` not finite.
+
     Examples
     --------
     >>> import numpy as np
@@ -212,8 +219,10 @@ def propeller_torque(yaw_rate, spin_rate, inertia, t, *, blades=2, phase=0.0):
     >>> np.round(propeller_torque(0.1, 100.0, 2.0, 0.3, blades=3), 12) + 0.0  # steady
     array([  0., -20.,   0.])
     """
-    scalars = [checked(x, name, (), finite_any) for x, name in
-               ((yaw_rate, "yaw_rate"), (spin_rate, "spin_rate"), (inertia, "inertia"), (t, "t"))]
+    scalars = [checked(x, name, (), check) for x, name, check in
+               ((yaw_rate, "yaw_rate", validate.finite_scalar),
+                (spin_rate, "spin_rate", validate.finite_scalar),
+                (inertia, "inertia", validate.positive), (t, "t", finite_vector))]
     yaw_rate, spin_rate, inertia, t = scalars
     n = validate.integer(blades, "blades", minimum=2)
     phase = validate.finite_scalar(phase, "phase")

@@ -98,10 +98,11 @@ class Margins:
     gain_margin_db : float [dB]
     phase_margin : float [deg] (``inf``: no gain crossover)
     stability_margin : float
-        Minimum distance of the Nyquist curve to -1.
+        Minimum distance of the Nyquist curve to -1 (``inf`` when python-control finds
+        no finite minimum).
     phase_crossover : float [rad/s] (nan if none)
     gain_crossover : float [rad/s] (nan if none)
-    stability_margin_frequency : float [rad/s]
+    stability_margin_frequency : float [rad/s] (nan where ``stability_margin`` is ``inf``)
     """
 
     gain_margin: float

@@ -105,6 +105,23 @@ def test_no_false_alarm_on_a_fast_spin():
     assert np.max(np.abs(res.x[:4] - q_true) / (1e-10 + 1e-8 * np.abs(q_true))) <= 1.0
 
 
+@pytest.mark.parametrize("x0, t", [
+    ([1.0, 0, 0, 0, 0, 0, 0], [0.0, 0.1]),                       # at rest, one interval
+    ([0, 0, 0, 1.0, 0, 0, 0], np.linspace(0.0, 100.0, 11)),      # at rest, long
+    ([0.6, 0, 0, 0.8, 0, 0, 1e-12], [0.0, 10.0]),                # all but at rest
+])
+def test_auto_verifies_a_solution_rk8_integrates_exactly(x0, t):
+    """Found by the random valid-input sweep: a body at rest gave runs that agree to the last
+    bit, so no order could be seen, and auto doubled its steps until its run budget was spent
+    and said "did not settle" (success=False) for the easiest problem there is."""
+    res = simulate(rigid_body([1.0, 2.0, 3.0]), x0, t)
+    assert res.success and res.status == 0 and res.error_estimate <= 0.5, res.message
+    q_true = constant_rate_quat(np.asarray(x0[:4]), np.asarray(x0[4:]), np.asarray(t))
+    assert np.max(np.abs(res.x[:4] - q_true)) <= 1e-14
+    w0 = np.asarray(x0[4:])
+    assert np.max(np.abs(res.x[4:] - w0[:, None])) <= 4 * np.finfo(float).eps * np.max(np.abs(w0))
+
+
 @pytest.mark.parametrize("rtol", [1e-8, 1e-9, 1e-10])
 def test_near_symmetric_flat_body_is_verified_or_honestly_at_its_floor(rtol):
     """I = (1, 1e4, 1e4): w x (I w) cancels 800 - 800 in double, a model floor of about

@@ -243,6 +243,11 @@ def test_casadi_expressions_agree_with_numpy(sym):
     (lambda: propeller_torque(0.1, 30.0, 1.0, 0.0, blades=2.5), TypeError, "blades"),
     (lambda: propeller_torque(0.1, np.inf, 1.0, 0.0), ValueError, "spin_rate"),
     (lambda: propeller_torque(0.1, 30.0, 1.0, 0.0, phase="up"), TypeError, "phase"),
+    # a 3x3 inertia once broadcast against a 3-sample t into a silent wrong answer
+    (lambda: propeller_torque(0.1, 30.0, np.eye(3), [0.0, 0.1, 0.2]), ValueError, "inertia"),
+    (lambda: propeller_torque(0.1, 30.0, -1.0, 0.0), ValueError, "inertia"),
+    (lambda: propeller_torque([0.1, 0.2], 30.0, 1.0, 0.0), ValueError, "yaw_rate"),
+    (lambda: propeller_torque(0.1, 30.0, 1.0, np.zeros((2, 2))), ValueError, "t"),
     (lambda: gyroscope_reaction_torque([1, 2, 3], [[1, 2, 3]]), ValueError, "H"),
     (lambda: gyroscope_reaction_torque(ca.SX.sym("w", 2), [1, 2, 3]), ValueError, "Omega"),
 ])

@@ -1,0 +1,456 @@
+"""The public functions of appdyn and a valid example value for each of their parameters.
+
+Shared by the garbage sweep (`test_public_inputs`) and the random valid-input sweep
+(`test_valid_inputs`): the public plain functions (``inspect.isfunction``) in ``__all__`` of
+``MODULES``, their required parameters, and ``VALID`` example values by parameter name
+(``OVERRIDES`` per function, ``EXTRA`` optional keywords that make a call valid).
+"""
+from __future__ import annotations
+
+import functools
+import importlib
+import inspect
+
+import casadi as ca
+import numpy as np
+
+MODULES = (
+    "dynamics", "dynamics.attitude", "dynamics.truth", "dynamics.momentum",
+    "dynamics.constrained", "dynamics.launch_vehicle", "dynamics.mechanisms", "ocp",
+    "problems.slew", "problems.stability", "problems.gains", "problems.dispersion",
+    "problems.ascent",
+)
+
+
+def _enumerate():
+    out = {}
+    for modname in MODULES:
+        mod = importlib.import_module(modname)
+        for name in mod.__all__:
+            obj = getattr(mod, name)
+            if inspect.isfunction(obj):
+                out[f"{modname}.{name}"] = obj
+    return out
+
+
+FUNCTIONS = _enumerate()
+
+
+def _required(fn):
+    return [p.name for p in inspect.signature(fn).parameters.values()
+            if p.default is inspect.Parameter.empty
+            and p.kind not in (inspect.Parameter.VAR_POSITIONAL, inspect.Parameter.VAR_KEYWORD)]
+
+
+# --------------------------------------------------------------------------------------------
+# valid example values: by parameter name, overridden per function
+# --------------------------------------------------------------------------------------------
+
+
+@functools.cache
+def _rigid():
+    import dynamics
+    return dynamics.rigid_body(np.diag([1.0, 2.0, 3.0]))
+
+
+@functools.cache
+def _min_energy():
+    from ocp import examples
+    return examples.min_energy()
+
+
+@functools.cache
+def _solution():
+    import ocp
+    return ocp.solve(_min_energy(), N=5)
+
+
+@functools.cache
+def _slew_problem():
+    from problems import slew
+    return slew.slew_problem(np.diag([1.0, 2.0, 3.0]), objective="time", angle=1.0,
+                             axis=[0.0, 0.0, 1.0])
+
+
+@functools.cache
+def _slew_solution():
+    import ocp
+    return ocp.rest_solution(_slew_problem())
+
+
+@functools.cache
+def _pyramid():
+    from dynamics import momentum
+    return momentum.pyramid(0.9553)
+
+
+def _jacobian():
+    from dynamics import momentum
+    return momentum.cluster_jacobian(_pyramid(), np.full(4, 0.3))
+
+
+@functools.cache
+def _spinner_run():
+    import dynamics
+    from problems import dispersion
+    m = dispersion.spinner(1000.0, 1500.0)
+    return dynamics.simulate(m, [0, 0, 0, 1, 0.02, 0.0, 1.0], np.linspace(0, 1, 3))
+
+
+@functools.cache
+def _constrained_symbols():
+    """``(x, p, terms)`` of a point on a line: ``x = (q, v)``, ``q' = v``, ``q1 = 1``."""
+    from dynamics import constrained
+    q, v = ca.SX.sym("q", 2), ca.SX.sym("v", 2)
+    return ca.vertcat(q, v), ca.SX.sym("p", 0), constrained.constraint_terms(
+        q, v, v, position=q[0] - 1)
+
+
+def _terms():
+    return _constrained_symbols()[2]
+
+
+def _controller():
+    x = ca.SX.sym("x", 7)
+    return ca.Function("k", [x], [-x[4:7]], ["x"], ["u"])
+
+
+def _lv_kwargs():
+    return dict(thrust=1.0e6, inertia=2.0e6, arm=10.0, mass=5.0e4)
+
+
+@functools.cache
+def _lv_report():
+    from problems import stability
+    return stability.launch_vehicle(**_lv_kwargs(), k_psi=2.0, k_psidot=0.5)
+
+
+@functools.cache
+def _slew_optimal():
+    """A solved time-optimal slew (bang-bang torques): ``(problem, solution)``."""
+    from problems import slew
+    res = slew.time_optimal(np.diag([1.0, 2.0, 3.0]), angle=1.0, axis=[0.0, 0.0, 1.0], N=20)
+    return _slew_problem(), res
+
+
+@functools.cache
+def _planar_ascent():
+    from problems import ascent
+    return ascent.planar_ascent(target_altitude=65e3, target_gamma=np.radians(40.0),
+                                q_max=45e3, qalpha_max=2000.0, N=30)
+
+
+@functools.cache
+def _gain_design():
+    from problems import gains
+    return gains.launch_vehicle_gains(_lv_kwargs(), [{"psi0": 0.05}], delta_max=0.1, delta_rate_max=0.5)
+
+
+def _config_path():
+    import problems.gains
+    from pathlib import Path
+    return Path(problems.gains.__file__).with_name("launch_vehicle.toml")
+
+
+def _config_data():
+    import tomllib
+    return tomllib.loads(_config_path().read_text())
+
+
+def _split_energy():
+    """Rest at 0 to rest at 1 in 2 s, minimum integral u^2/2, as two 1 s phases."""
+    import ocp
+    from ocp.examples import double_integrator
+    energy = lambda x, u, p: 0.5 * u ** 2  # noqa: E731
+    first = ocp.Problem(double_integrator(), T=1.0, x_initial=[0.0, 0.0], lagrange=energy)
+    second = ocp.Problem(double_integrator(), T=1.0, x_final=[1.0, 0.0], lagrange=energy)
+    return ocp.MultiPhaseProblem([ocp.Phase(first, N=6), ocp.Phase(second, N=6)],
+                                 links=[ocp.Link(0, 1)])
+
+
+def _sample_task():
+    from problems.dispersion.sample import SampleTask
+    return SampleTask(0, {}, _rigid(), np.array([0.0, 0.0, 0.0, 1.0, 0.1, 0.2, 0.3]),
+                      np.linspace(0.0, 1.0, 3), {"w1": "w1"}, (), None, {})
+
+
+VALID = {
+    # attitude and rigid bodies
+    "inertia": lambda: np.diag([1.0, 2.0, 3.0]),
+    "inertia_diag": lambda: np.array([1.0, 2.0, 3.0]),
+    "q": lambda: np.array([0.0, 0.0, 0.0, 1.0]),
+    "p": lambda: np.array([0.0, 0.0, 0.0, 1.0]),
+    "q0": lambda: np.array([0.0, 0.0, 0.0, 1.0]),
+    "w": lambda: np.array([0.1, 0.2, 0.3]),
+    "w0": lambda: np.array([0.1, 0.2, 0.3]),
+    "v": lambda: np.array([0.1, 0.2, 0.3]),
+    "t": lambda: np.linspace(0.0, 1.0, 3),
+    "A": lambda: np.eye(3),
+    "axis": lambda: np.array([0.0, 0.0, 1.0]),
+    "angle": lambda: 0.5,
+    "angles": lambda: np.array([0.1, 0.2, 0.3]),
+    "h": lambda: 0.1,
+    "model": _rigid,
+    "x0": lambda: np.array([0.0, 0.0, 0.0, 1.0, 0.1, 0.2, 0.3]),
+    "x": lambda: np.array([0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 1.0]),
+    "controller": _controller,
+    # momentum exchange
+    "axes": lambda: np.eye(3),
+    "wheel_inertia": lambda: np.array([0.01, 0.01, 0.01]),
+    "gimbal_axes": lambda: np.eye(3),
+    "spin_axes0": lambda: np.column_stack([[0, 1, 0], [0, 0, 1], [1, 0, 0]]).astype(float),
+    "beta": lambda: 0.9553,
+    "geometry": _pyramid,
+    "delta": lambda: np.full(4, 0.3),
+    "C": _jacobian,
+    "torque": lambda: np.array([0.1, 0.0, 0.0]),
+    "gradient": lambda: np.full(4, 0.1),
+    "count": lambda: 10,
+    "directions": lambda: np.array([1.0, 0.0, 0.0]),
+    "signs": lambda: np.ones(4),
+    "wheel_accel": lambda: np.array([0.0, 0.0, 1.0]),
+    "gimbal_rate_vector": lambda: np.array([0.1, 0.0, 0.0]),
+    "rotor_momentum": lambda: np.array([0.0, 1.0, 0.0]),
+    "Omega": lambda: np.array([0.0, 0.0, 1.0]),
+    "omega": lambda: np.array([0.1, 0.0, 0.0]),
+    "yaw_rate": lambda: 0.5,
+    "spin_rate": lambda: 10.0,
+    "H": lambda: np.array([0.0, 1.0, 0.0]),
+    # constrained
+    "M": lambda: np.eye(2),
+    "Q": lambda: np.array([1.0, 0.0]),
+    "B": lambda: np.array([[1.0, 1.0]]),
+    "c": lambda: np.array([0.0]),
+    "lam": lambda: np.array([1.0]),
+    "residual": lambda: np.array([0.0]),
+    "jacobian": lambda: (lambda x: 2.0 * np.asarray(x)[None, :]),
+    "terms": _terms,
+    "slosh": lambda: None,
+    "m": lambda: 1000.0,
+    "I": lambda: 500.0,
+    # mechanisms
+    "r0": lambda: 0.1,
+    "r0_dot": lambda: 0.0,
+    "rate": lambda: 1.0,
+    "r": lambda: 0.1,
+    "r_dot": lambda: 0.0,
+    "rate_dot": lambda: 0.0,
+    "theta": lambda: 0.3,
+    "psi_dot": lambda: 1.0,
+    "phi_dot": lambda: 10.0,
+    "path_radius": lambda: 0.5,
+    "cone_angle": lambda: 0.3,
+    "alpha": lambda: 0.1,
+    "alpha_dot": lambda: 0.0,
+    "amp_y": lambda: 0.02,
+    "theta0": lambda: 0.3,
+    "theta_dot": lambda: 0.0,
+    "sequence": lambda: "3-2-1",
+    # ocp
+    "problem": _min_energy,
+    "options": lambda: {"tol": 1e-6},
+    "solution": _solution,
+    "guesses": lambda: [None],
+    "u": lambda: np.array([0.0]),
+    "x_initial": lambda: np.array([0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0]),
+    "T": lambda: 1.0,
+    "K": lambda: 2,
+    # slew
+    "objective": lambda: "time",
+    "targets": lambda: [{"angle": 1.0, "axis": [0.0, 0.0, 1.0]}],
+    "data": lambda: {},
+    # stability
+    "sys": lambda: None,
+    "axial_inertia": lambda: 1.0,
+    "transverse_inertia": lambda: 2.0,
+    "mass": lambda: 1.0,
+    "length": lambda: 0.5,
+    "dynamic_pressure": lambda: 1.0e4,
+    "area": lambda: 0.01,
+    "cn_alpha": lambda: 2.0,
+    "cp_offset": lambda: 0.05,
+    "stiffness": lambda: 1.0e4,
+    "bearing_distance": lambda: 0.5,
+    "wheel_momentum": lambda: 1.0,
+    "thrust": lambda: 1.0e6,
+    "arm": lambda: 10.0,
+    "k_psi": lambda: 2.0,
+    "k_psidot": lambda: 0.5,
+    "case": lambda: "spin",
+    "parameter": lambda: "rate",
+    "values": lambda: np.array([0.5, 1.0]),
+    "freq": lambda: 200.0,
+    "m1": lambda: 1.0,
+    "m2": lambda: 1.0,
+    "I1": lambda: np.diag([1.0, 2.0, 3.0]),
+    "I2": lambda: np.diag([1.0, 2.0, 3.0]),
+    "inertia1": lambda: np.diag([1.0, 2.0, 3.0]),
+    "inertia2": lambda: np.diag([1.0, 2.0, 3.0]),
+    "r1": lambda: np.array([0.0, 0.0, 1.0]),
+    "r2": lambda: np.array([0.0, 0.0, -1.0]),
+    # gains
+    "R": lambda: np.array([[1.0]]),
+    "initial_states": lambda: np.eye(2),
+    "horizon": lambda: 10.0,
+    "scenarios": lambda: [{"angle": 0.5, "axis": [0.0, 0.0, 1.0]}],
+    "u_max": lambda: 1.0,
+    "vehicle": lambda: dict(_lv_kwargs()),
+    "delta_max": lambda: 0.1,
+    "delta_rate_max": lambda: 0.5,
+    # dispersion
+    "samples": lambda: 2,
+    "seed": lambda: 0,
+    "outputs": lambda: {"w1": "w1"},
+    "params": lambda: {},
+    "res": _spinner_run,
+    # ascent
+    "phase": lambda: 1,
+    "a": lambda: 2.4e7,
+    "e": lambda: 0.7,
+    "i": lambda: 0.5,
+    "raan": lambda: 1.0,
+    "argp": lambda: 2.0,
+    "nu": lambda: 0.5,
+    "speed": lambda: 50.0,
+    "target_altitude": lambda: 2.0e5,
+    "target_gamma": lambda: 0.0,
+    "q_max": lambda: 5.0e4,
+    "qalpha_max": lambda: 1.0e5,
+}
+
+_ASC_R = lambda: np.array([6.4e6, 0.0, 0.0])  # noqa: E731
+_ASC_V = lambda: np.array([0.0, 7.5e3, 0.0])  # noqa: E731
+
+OVERRIDES = {
+    "dynamics.launch_vehicle": {"inertia": lambda: 2.0e6, "mass": lambda: 5.0e4},
+    "dynamics.launch_vehicle.launch_vehicle": {"inertia": lambda: 2.0e6, "mass": lambda: 5.0e4},
+    "problems.stability.launch_vehicle": {"inertia": lambda: 2.0e6, "mass": lambda: 5.0e4},
+    "problems.stability.launch_vehicle_response": {"inertia": lambda: 2.0e6,
+                                                   "mass": lambda: 5.0e4},
+    "dynamics.cmg_spacecraft": {"h": lambda: 1.0},
+    "dynamics.momentum.cmg_spacecraft": {"h": lambda: 1.0},
+    "dynamics.momentum.rotor_dynamics": {"w": lambda: ca.DM([0.1, 0.2, 0.3]),
+                                         "h": lambda: np.array([0.1, 0.1, 0.1])},
+    "dynamics.momentum.wheel_torque": {"wheel_inertia": lambda: 0.01},
+    "dynamics.momentum.propeller_torque": {"inertia": lambda: 0.5},
+    "dynamics.momentum.steer": {"torque": lambda: np.array([0.1, 0.0, 0.0])},
+    "dynamics.constrained.constraint_terms": {"q": lambda: ca.SX.sym("q", 2),
+                                              "qdot": lambda: ca.SX.sym("v", 2),
+                                              "v": lambda: ca.SX.sym("v", 2)},
+    "dynamics.constrained.project_velocities": {"v": lambda: np.array([1.0, 0.0])},
+    "dynamics.constrained.project_positions": {
+        "residual": lambda: (lambda x: np.array([np.dot(x, x) - 1.0])),
+        "x": lambda: np.array([1.1, 0.0])},
+    "dynamics.constrained.residual_invariant": {"x": lambda: _constrained_symbols()[0],
+                                                "p": lambda: _constrained_symbols()[1]},
+    "dynamics.truth.axisymmetric": {"inertia_diag": lambda: np.array([1.0, 1.0, 2.0])},
+    "dynamics.truth.symmetric_precession": {"inertia_diag": lambda: np.array([1.0, 1.0, 2.0])},
+    "ocp.scenario_problem": {"T": lambda: 1.0, "x_initial": lambda: np.tile(
+        np.array([[0.0], [0.0], [0.0], [1.0], [0.0], [0.0], [0.0]]), (1, 2))},
+    "dynamics.mechanisms.bead_motion": {"t": lambda: np.linspace(0.0, 1.0, 3)},
+    "dynamics.mechanisms.dumbbell_disk_state": {"w": lambda: np.array([0.0, 0.0, 1.0])},
+    "dynamics.mechanisms.lagrange_terms": {
+        "T": lambda: 0.5 * ca.SX.sym("v") ** 2, "V": lambda: ca.SX(0),
+        "q": lambda: ca.SX.sym("q"), "v": lambda: ca.SX.sym("v")},
+    "dynamics.mechanisms.spherical_mass_matrix": {"q": lambda: np.array([0.1, 0.2])},
+    "ocp.unstack": {"x": lambda: np.zeros((4, 3))},
+    "ocp.state_scale": {"x": lambda: np.zeros((2, 5))},
+    "problems.slew.min_effort": {"T": lambda: 5.0},
+    "problems.slew.eigenaxis_time": {"angle": lambda: 1.0},
+    "problems.slew.attitude_guess": {"problem": _slew_problem},
+    "problems.slew.switch_times": {"solution": _slew_solution},
+    "problems.slew.verify": {"solution": _slew_solution},
+    "problems.slew.summary": {"solution": _slew_solution},
+    "problems.slew.plot_slew": {"solution": _slew_solution},
+    "problems.slew.format_summary": {
+        "data": lambda: __import__("problems.slew", fromlist=["summary"]).summary(
+            _slew_solution())},
+    "problems.stability.classify": {"A": lambda: np.array([[0.0, 1.0], [-1.0, -0.1]])},
+    "problems.stability.spin": {"axis": lambda: np.array([0.0, 0.0, 1.0])},
+    "problems.stability.heavy_top": {"rate": lambda: 20.0},
+    "problems.stability.spinning_projectile": {"axial_inertia": lambda: 0.01,
+                                               "transverse_inertia": lambda: 0.1,
+                                               "rate": lambda: 100.0},
+    "problems.stability.rotor": {"rate": lambda: 10.0},
+    "problems.stability.loop": {"plant": lambda: __import__("control").tf([1.0], [1.0, 0.0, 0.0]),
+                                "controller": lambda: np.array([[1.0]])},
+    "problems.stability.shaken_pendulum": {"inertia": lambda: 0.0208, "length": lambda: 0.25},
+    "problems.stability.conical_pendulum": {"length": lambda: 1.0},
+    "problems.gains.state_feedback_gains": {
+        "A": lambda: np.array([[0.0, 1.0], [0.0, 0.0]]), "B": lambda: np.array([[0.0], [1.0]]),
+        "Q": lambda: np.eye(2)},
+    "problems.gains.launch_vehicle_gains": {"scenarios": lambda: [{"psi0": 0.1}]},
+    "problems.dispersion.nutation_history": {"transverse_inertia": lambda: 1000.0,
+                                             "axial_inertia": lambda: 1500.0},
+    "problems.dispersion.nutation_max": {"transverse_inertia": lambda: 1000.0,
+                                         "axial_inertia": lambda: 1500.0},
+    "problems.dispersion.spinner": {"transverse_inertia": lambda: 1000.0,
+                                    "axial_inertia": lambda: 1500.0},
+    "problems.dispersion.nutation_closed_form": {"transverse_inertia": lambda: 1000.0,
+                                                 "axial_inertia": lambda: 1500.0,
+                                                 "w0": lambda: np.array([0.02, 0.0, 1.0])},
+    "problems.dispersion.draw_samples": {
+        "params": lambda: {"a": __import__("problems.dispersion", fromlist=["Normal"]).Normal(0.0, 1.0)}},
+    "problems.dispersion.statistics": {"values": lambda: np.array([1.0, 2.0, 3.0])},
+    "problems.ascent.drag_force": {"r": _ASC_R, "v": _ASC_V},
+    "problems.ascent.dynamic_pressure": {"r": _ASC_R, "v": _ASC_V},
+    "problems.ascent.orbit_residuals": {"r": _ASC_R, "v": _ASC_V},
+    "problems.ascent.orbital_elements": {"r": _ASC_R, "v": _ASC_V},
+    "problems.ascent.vertical_rise": {"vehicle": lambda: None},
+    "problems.ascent.fly_pitch_program": {"ascent": _planar_ascent},
+    "problems.dispersion.run_sample": {"task": _sample_task},
+    "problems.gains.load_config": {"path": _config_path},
+    "problems.gains.parse_config": {"data": _config_data},
+    "problems.gains.plot_design": {"design": _gain_design},
+    "problems.stability.bode_plot": {"report": _lv_report},
+    "problems.stability.nichols_plot": {"report": _lv_report},
+    "problems.stability.loop_transfer": {"report": _lv_report},
+    "problems.stability.analyze": {"sys": lambda: __import__("dynamics").linearize(
+        _rigid(), np.array([0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 1.0]))},
+    "ocp.solve_phases": {"problem": _split_energy},
+    "ocp.rest_solution": {"problem": lambda: __import__(
+        "problems.slew", fromlist=["slew_problem"]).slew_problem(
+            np.diag([1.0, 2.0, 3.0]), objective="effort", T=2.0, angle=0.0, axis=[0, 0, 1])},
+    "ocp.polish_switches": {"problem": lambda: _slew_optimal()[0],
+                            "solution": lambda: _slew_optimal()[1]},
+    "ocp.optimize_switch_times": {"problem": lambda: _slew_optimal()[0],
+                                  "solution": lambda: _slew_optimal()[1]},
+    "problems.slew.verify": {"solution": lambda: _slew_optimal()[1]},
+}
+
+# optional keywords that make the all-valid call valid (a target, a spin rate, ...)
+EXTRA = {
+    "dynamics.constrained.constraint_terms": lambda: {"position": ca.SX.sym("q", 2)[0]},
+    "dynamics.truth.small_asymmetry_rates": lambda: {"rate": 1.0},
+    "dynamics.truth.small_asymmetry_frequency": lambda: {"rate": 1.0},
+    "problems.slew.slew_problem": lambda: {"angle": 1.0, "axis": [0.0, 0.0, 1.0]},
+    "problems.slew.time_optimal": lambda: {"angle": 1.0, "axis": [0.0, 0.0, 1.0]},
+    "problems.slew.min_effort": lambda: {"angle": 1.0, "axis": [0.0, 0.0, 1.0]},
+    "problems.slew.wheel_slew": lambda: {"angle": 1.0, "axis": [0.0, 0.0, 1.0]},
+    "problems.slew.cmg_slew": lambda: {"angle": 1.0, "axis": [0.0, 0.0, 1.0]},
+    "problems.stability.sweep": lambda: {"inertia": np.diag([1.0, 2.0, 3.0]),
+                                         "axis": np.array([0.0, 0.0, 1.0])},
+}
+
+_NO_VALID = object()
+
+
+def _valid(func, param):
+    table = OVERRIDES.get(func, {})
+    factory = table.get(param, VALID.get(param))
+    if factory is None:
+        return _NO_VALID
+    return factory()
+
+
+# Functions whose all-valid call solves an NLP or runs many simulations: not run by
+# ``test_valid_examples`` (their garbage cases are cheap refusals before any solve).
+EXPENSIVE = {
+    "ocp.solve", "ocp.solve_phases", "ocp.refine", "ocp.solve_multistart",
+    "ocp.polish_switches", "ocp.optimize_switch_times", "problems.slew.time_optimal",
+    "problems.slew.min_effort", "problems.slew.wheel_slew", "problems.slew.cmg_slew",
+    "problems.slew.maneuver_table", "problems.gains.state_feedback_gains",
+    "problems.gains.attitude_gains", "problems.gains.launch_vehicle_gains",
+    "problems.ascent.planar_ascent", "problems.dispersion.dispersion",
+    "problems.stability.sweep", "dynamics.momentum.momentum_envelope",
+}
