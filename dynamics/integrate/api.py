@@ -9,22 +9,23 @@ from typing import Callable, Literal, Mapping
 import numpy as np
 
 from .. import cache, validate
-from ..clock import check_clock_start, clock_index
+from ..clock import CLOCK_STATE, check_clock_start, clock_index
 from ..model import Model, check_model
 from .auto import solve_auto
 from .batch import BatchResult, check_batch, simulate_batch
 from .cvodes import run_cvodes
 from .inputs import (Problem, check_cvodes_options, check_invariants, check_t, check_tolerances,
-                     check_u, check_x0)
+                     check_u, check_x0, fast_x0)
 from .kernels import check_lie_model
-from .loops import Progress, run_fixed
-from .result import FAILED, OK, OK_STIFF, Dense, SimulationResult, make_result
+from .loops import Progress, run_fixed, run_short
+from .result import FAILED, OK, OK_STIFF, Dense, SimulationResult, new_result
 
 __all__ = ["simulate", "METHODS", "Method"]
 
 Method = Literal["auto", "cvodes", "rk4", "rk8", "lie"]
 METHODS = ("auto", "cvodes", "rk4", "rk8", "lie")
 _FIXED_STEP = ("rk4", "rk8", "lie")
+_RTOL_MIN = 100 * np.finfo(float).eps  # `check_tolerances`' least rtol
 
 
 def simulate(model: Model, x0, t, *, u=None, p=None, method: Method = "auto",
@@ -139,40 +140,60 @@ def simulate(model: Model, x0, t, *, u=None, p=None, method: Method = "auto",
     if method not in METHODS:
         raise ValueError(f"`method` must be one of {METHODS}, got {method!r}")
     t = check_t(t)
-    if np.ndim(x0) == 2 and np.shape(x0)[1] >= 2:
-        return _simulate_batch(model, x0, t, u, p, method, rtol, atol, invariants, steps, jit,
-                               max_steps, cvodes_options, progress, start)
-    x0 = check_x0(x0, model)
-    if clock_index(model) is not None:  # a time-dependent model: its clock starts at t[0]
+    x = fast_x0(x0, model)  # the common x0 at once (shape (nx,): no batch); else in full
+    if x is None:
+        if np.ndim(x0) == 2 and np.shape(x0)[1] >= 2:
+            return _simulate_batch(model, x0, t, u, p, method, rtol, atol, invariants, steps,
+                                   jit, max_steps, cvodes_options, progress, start)
+        x = check_x0(x0, model)
+    x0 = x
+    if CLOCK_STATE in model.states:  # a time-dependent model: its clock starts at t[0]
         check_clock_start(model, x0, t[0])
     p = model.resolve_p(p)
-    rtol, atol = check_tolerances(rtol, atol, model.nx)
-    control = check_u(u, model.nu, t)
+    if (method in _FIXED_STEP and type(rtol) is float and type(atol) is float
+            and _RTOL_MIN <= rtol < 1 and 0 <= atol < math.inf):
+        pass  # checked as `check_tolerances` would; a fixed-step method does not use them
+    else:
+        rtol, atol = check_tolerances(rtol, atol, model.nx)
+    control = None if u is None else check_u(u, model.nu, t)  # None: zero, made if needed
     names = check_invariants(invariants, model)
-    max_steps, steps, cvodes_options, counter = _check_options(method, max_steps, jit, steps,
-                                                               cvodes_options, progress)
+    if (method in _FIXED_STEP and type(max_steps) is int and max_steps >= 1 and jit is None
+            and cvodes_options is None and progress is None):  # as `_check_options` finds them
+        steps = 1 if steps is None else validate.integer(steps, "steps", minimum=1)
+        counter = None  # Progress(None), made when needed
+    else:
+        max_steps, steps, cvodes_options, counter = _check_options(
+            method, max_steps, jit, steps, cvodes_options, progress)
     if method == "lie":
         check_lie_model(model, x0, p)
-    problem = Problem(model, x0, t, control, p)
     used, status, estimate = method, OK, math.nan
-    if method in _FIXED_STEP:
-        run = run_fixed(problem, method, steps, cache.should_compile(jit, math.inf), counter)
-    elif method == "cvodes":
-        run = run_cvodes(problem, rtol, atol, cvodes_options)
-    else:
-        run, used, status, estimate = solve_auto(problem, rtol, atol, max_steps, jit,
-                                                 cvodes_options, counter)
+    run = None
+    if control is None and method in _FIXED_STEP and progress is None:
+        # the common short run (one chunk, zero control) without `run_fixed`'s machinery
+        run = run_short(model, x0, t, p, method, steps, cache.should_compile(jit, math.inf))
+    if run is None:
+        if control is None:
+            control = check_u(None, model.nu, t)
+        problem = Problem.new(model, x0, t, control, p)
+        if counter is None:
+            counter = Progress(None)
+        if method in _FIXED_STEP:
+            run = run_fixed(problem, method, steps, cache.should_compile(jit, math.inf), counter)
+        elif method == "cvodes":
+            run = run_cvodes(problem, rtol, atol, cvodes_options)
+        else:
+            run, used, status, estimate = solve_auto(problem, rtol, atol, max_steps, jit,
+                                                     cvodes_options, counter)
     x = run.x
     x.setflags(write=False)
-    values = _invariants(model, x, p, names)
+    values = _invariants(model, x, p, names) if names else {}
     success = run.ok and status in (OK, OK_STIFF)
-    return make_result(
-        t=t, x=x, success=success, status=status if run.ok else FAILED, message=run.message,
-        method=used, wall_time=time.perf_counter() - start, n_steps=run.n_steps, n_rhs=run.n_rhs,
-        substeps=run.substeps, error_estimate=estimate, compiled=run.compiled,
-        invariants=MappingProxyType(values),
-        _dense=Dense(model, p, lambda: control.grid(t)),
-    )
+    return new_result(  # (t, x, success, status, message, method, wall_time, n_steps,
+        t, x, success, status if run.ok else FAILED, run.message, used,  # n_rhs, substeps,
+        time.perf_counter() - start, run.n_steps, run.n_rhs, run.substeps,  # error_estimate,
+        estimate, run.compiled, MappingProxyType(values),  # compiled, invariants, _dense)
+        Dense(model, p, lambda: _zero_grid(t, model.nu) if control is None
+              else control.grid(t)))
 
 
 def _simulate_batch(model, x0, t, u, p, method, rtol, atol, invariants, steps, jit, max_steps,
@@ -208,6 +229,12 @@ def _check_options(method, max_steps, jit, steps, cvodes_options, progress):
         raise TypeError(f"`progress` must be None or a callable (done, total), "
                         f"got {type(progress).__name__}")
     return max_steps, steps, cvodes_options, Progress(progress)
+
+
+def _zero_grid(t: np.ndarray, nu: int) -> np.ndarray:
+    """The zero control on the grid, shape (nu, n): ``Control.grid`` of ``u=None``, to the
+    memory layout."""
+    return np.zeros((t.size, nu)).T
 
 
 def _invariants(model: Model, x: np.ndarray, p: np.ndarray, names) -> dict:

@@ -3,6 +3,7 @@ optionally jit-compiled) and the Python loop over chunks that runs it."""
 from __future__ import annotations
 
 import contextlib
+import math
 from typing import Callable
 
 import casadi as ca
@@ -11,14 +12,14 @@ import numpy as np
 from .. import cache
 from ..interrupts import check_interrupt, deferred_interrupts
 from ..model import Model
-from .evaluate import call_buffered
+from .evaluate import borrow_bound, return_bound
 from .inputs import Problem
 from .kernels import kernel
 from .result import Run
 from .tableaux import TABLEAUX, unique_nodes
 
 __all__ = ["CHUNK", "BATCH_CHUNK", "Progress", "chunk_function", "chunk_key", "interval_ends",
-           "run_fixed"]
+           "run_fixed", "run_short"]
 
 _BASE = 4  # unroll base of mapaccum: casadi's construction cost grows ~5x from base 4 to 10
 
@@ -46,7 +47,10 @@ def chunk_function(model: Model, method: str, mode: str, jit: bool, size: int = 
     ``h``, ``us (nu*s x B)`` control at the distinct stage nodes of each step, ``p``.
     Output ``X (nx x B)``: the state after each step.
     """
-    base_key = chunk_key(model, method, mode) + ((size,) if size != CHUNK else ())
+    att = model.attitude if method == "lie" else None
+    base_key = ("chunk", cache.function_key(model.f), att, method, mode)  # `chunk_key`
+    if size != CHUNK:
+        base_key += (size,)
     if not jit or cache.compiler() is None:
         return cache.get(base_key + (False,),
                          lambda: (_build_chunk(model, method, mode, size), False),
@@ -131,7 +135,8 @@ def _stage_samples(problem: Problem, method: str, m: int) -> np.ndarray:
 
 
 class _Steps:
-    """Per-step data of a fixed-step run, served a chunk at a time (padded to ``CHUNK``).
+    """Per-step data of a fixed-step run, written a chunk at a time (padded to ``CHUNK``)
+    into the input arrays of the chunk Function's `BoundBuffer`.
 
     Step ``s`` is substep ``j = s mod m`` of output interval ``k = s // m``: size
     ``h = H_k / m``; linear control ``ua = u_k + j h ud_k`` with slope ``ud_k``; or, for a
@@ -148,34 +153,70 @@ class _Steps:
         if self.mode == "linear":
             self.ua = ctrl.ua
             self.constant = ctrl.constant or _constant(ctrl, H)
-            if not self.constant:
+            if self.constant:
+                self._ua0 = ctrl.ua[0]
+                self._tag = self._ua0.tobytes()  # the constant's bits (never None)
+            else:
                 self.ud = (ctrl.ub - ctrl.ua) / H[:, None]
         else:
             s = _stage_samples(problem, method, m)  # (nint, m, nodes, nu)
             self.us = s.reshape(self.total, -1)
-        if self.mode == "linear" and self.constant:
-            self._ua_c = np.empty((CHUNK, problem.model.nu))
-            self._ua_c[:] = ctrl.ua[:1]
-            self._ud_c = np.zeros((CHUNK, problem.model.nu))
 
-    def chunk(self, s0: int) -> list:
-        """Arrays for steps ``s0 .. s0 + CHUNK - 1`` in casadi's column-major layout."""
+    def fill(self, s0: int, buffer) -> int:
+        """Write the data of steps ``s0 .. s0 + CHUNK - 1`` into ``buffer.args[2:-1]``
+        (``h`` and the control data; zero past the run's end, a constant control on every
+        row); returns the number of steps ``n`` of the chunk.
+
+        ``buffer.tag`` is ``[steps written into h, control written]``: ``h`` past the
+        chunk is zeroed only where a longer chunk left values, and a constant control
+        already in the buffer is not written again."""
         n = min(CHUNK, self.total - s0)
-        k = slice(s0, s0 + n) if self.m == 1 else np.arange(s0, s0 + n) // self.m
-        h = np.zeros(CHUNK)
-        h[:n] = self.hm[k]
+        if self.m == 1:
+            _put_h(buffer, self.hm[s0:s0 + n], n)
+        else:
+            _put_h(buffer, self.hm[np.arange(s0, s0 + n) // self.m], n)
+        args, tag, h = buffer.args, buffer.tag, buffer.args[2]
         if self.mode != "linear":
-            us = np.zeros((CHUNK, self.us.shape[1]))
+            us = args[3]
             us[:n] = self.us[s0:s0 + n]
-            return [h, us]
-        if self.constant:
-            return [h, self._ua_c, self._ud_c]
-        s = np.arange(s0, s0 + n)
-        k = s // self.m
-        ua, ud = np.zeros((CHUNK, self.ua.shape[1])), np.zeros((CHUNK, self.ua.shape[1]))
-        ud[:n] = self.ud[k]
-        ua[:n] = self.ua[k] + ((s - k * self.m) * h[:n])[:, None] * ud[:n]
-        return [h, ua, ud]
+            us[n:] = 0.0
+            tag[1] = None
+        elif self.constant:
+            _put_constant(buffer, self._ua0, self._tag)
+        else:
+            ua, ud = args[3], args[4]
+            s = np.arange(s0, s0 + n)
+            k = s // self.m
+            ud[:n] = self.ud[k]
+            ud[n:] = 0.0
+            ua[:n] = self.ua[k] + ((s - k * self.m) * h[:n])[:, None] * ud[:n]
+            ua[n:] = 0.0
+            tag[1] = None
+        return n
+
+
+def _put_h(buffer, hvals, n: int) -> None:
+    """``h`` of a chunk of ``n`` steps into ``buffer`` (zero past ``n``; see `_Steps.fill`)."""
+    tag = buffer.tag
+    if tag is None:
+        tag = buffer.tag = [CHUNK, None]
+    h = buffer.args[2]
+    if hvals is not None:  # (None: the caller writes h[:n])
+        h[:n] = hvals
+    if tag[0] > n:
+        h[n:tag[0]] = 0.0
+    tag[0] = n
+
+
+def _put_constant(buffer, ua0, bits: bytes) -> None:
+    """A constant control ``ua0`` (its ``bits``) on every row of ``buffer``'s ``ua``, zero
+    slope; not written again when the buffer already holds it."""
+    tag = buffer.tag
+    if tag[1] != bits:
+        args = buffer.args
+        args[3][:] = ua0
+        args[4][:] = 0.0
+        tag[1] = bits
 
 
 def _constant(ctrl, H: np.ndarray) -> bool:
@@ -215,36 +256,115 @@ def run_fixed(problem: Problem, method: str, m: int, jit: bool,
     """``m`` steps of ``method`` per output interval, chunk by chunk; stops at a non-finite
     state (the columns not reached are NaN)."""
     model, nint, t = problem.model, problem.nint, problem.t
-    fun, compiled = chunk_function(model, method, problem.control.mode, jit)
+    mode = problem.control.mode
+    fun, compiled = chunk_function(model, method, mode, jit)
     steps = _Steps(problem, method, m)
     progress = Progress(None) if progress is None else progress
     progress.start(steps.total)
-    x = np.full((model.nx, nint + 1), np.nan)
+    nx = model.nx
+    x = np.empty((nx, nint + 1))
+    x.fill(np.nan)  # (`np.full` costs twice as much)
     x[:, 0] = problem.x0
-    xk = problem.x0
     stages = 4 if method == "lie" else TABLEAUX[method].stages
     done = 0
+    buffer = borrow_bound(fun, lambda: (_chunk_shapes(model, method, mode), (CHUNK, nx)))
+    buffer.args[0][:] = problem.x0
+    buffer.args[-1][:] = problem.p
     # Ctrl-C is deferred to the next chunk of a run of several chunks (a one-chunk run is
     # over in well under a second and skips the ~13 us of handler switching)
-    with deferred_interrupts() if steps.total > CHUNK else contextlib.nullcontext():
-        for s0 in range(0, steps.total, CHUNK):
-            check_interrupt()
-            n = min(CHUNK, steps.total - s0)
-            X = call_buffered(fun, [xk, np.array([float(n)]), *steps.chunk(s0), problem.p],
-                              (CHUNK, model.nx))
-            outputs, ends = interval_ends(s0, n, m)
-            x[:, outputs] = X[ends].T
-            xk = X[n - 1]
-            done = s0 + n
-            progress.advance(n)
-            if done < steps.total and not np.isfinite(xk).all():
-                break  # (after the last chunk, the check of x below tells)
+    if steps.total > CHUNK:
+        with deferred_interrupts():
+            done = _chunks(steps, buffer, x, m, progress)
+    else:
+        done = _chunks(steps, buffer, x, m, progress)
+    # given back only after a run that ended normally: after an exception (a Ctrl-C between
+    # two writes) its contents may not be what its tag says, and the next run makes another
+    return_bound(fun, buffer)
     progress.abandon(steps.total - done)
     n_steps = done
-    if done < steps.total or not np.isfinite(x).all():
+    if done < steps.total or not _all_finite(x):
         k = int(np.argmax(~np.isfinite(x).all(axis=0)))
         x[:, k:] = np.nan
         return Run(x, n_steps, stages * n_steps, m, compiled, False,
                    f"{method}: the state became non-finite before t = {t[k]:.6g}")
-    return Run(x, n_steps, stages * n_steps, m, compiled, True,
-               f"{method}: {m} step(s) per output interval, {n_steps} steps")
+    return Run.new(x, n_steps, stages * n_steps, m, compiled, True,
+                   f"{method}: {m} step(s) per output interval, {n_steps} steps")
+
+
+def run_short(model: Model, x0: np.ndarray, t: np.ndarray, p: np.ndarray, method: str,
+              m: int, jit: bool) -> Run | None:
+    """`run_fixed` of the common short run, without its general machinery: zero control
+    (``u=None``), all ``m (len(t) - 1)`` steps in one chunk, no progress callback. The same
+    compiled call on the same inputs, so the same ``x`` to the bit; ``None`` when the run is
+    not such a run or its state became non-finite (`run_fixed` then runs and tells)."""
+    nint = t.size - 1
+    total = m * nint
+    if total > CHUNK:
+        return None
+    fun, compiled = chunk_function(model, method, "linear", jit)
+    nx = model.nx
+    buffer = borrow_bound(fun, lambda: (_chunk_shapes(model, method, "linear"), (CHUNK, nx)))
+    args = buffer.args
+    args[0][:] = x0
+    args[1][0] = total
+    args[-1][:] = p
+    if m == 1:  # h = t[1:] - t[:-1], as `_Steps` (a float difference, the same in Python)
+        _put_h(buffer, None, total)
+        h = args[2]
+        if total <= 4:
+            v = t.tolist()
+            for i in range(total):
+                h[i] = v[i + 1] - v[i]
+        else:
+            np.subtract(t[1:], t[:-1], out=h[:total])
+    else:
+        _put_h(buffer, ((t[1:] - t[:-1]) / m)[np.arange(total) // m], total)
+    _put_constant(buffer, 0.0, bytes(8 * model.nu))  # == zeros(nu).tobytes(), as `_Steps`
+    check_interrupt()
+    buffer.trigger()
+    x = np.empty((nx, nint + 1))
+    x[:, 0] = x0
+    x[:, 1:] = buffer.out[m - 1:total:m].T  # the steps that end the intervals
+    return_bound(fun, buffer)
+    if not _all_finite(x):
+        return None
+    stages = 4 if method == "lie" else TABLEAUX[method].stages
+    return Run.new(x, total, stages * total, m, compiled, True,
+                   f"{method}: {m} step(s) per output interval, {total} steps")
+
+
+def _chunks(steps: _Steps, buffer, x: np.ndarray, m: int, progress: Progress) -> int:
+    """`run_fixed`'s loop over chunks (``buffer`` holds ``x0`` and ``p``): fills ``x``;
+    returns the steps done (fewer than planned after a non-finite state)."""
+    args, X, trigger = buffer.args, buffer.out, buffer.trigger
+    done = 0
+    for s0 in range(0, steps.total, CHUNK):
+        check_interrupt()
+        n = steps.fill(s0, buffer)
+        args[1][0] = n
+        trigger()
+        outputs, ends = interval_ends(s0, n, m)
+        x[:, outputs] = X[ends].T
+        xk = X[n - 1]
+        args[0][:] = xk
+        done = s0 + n
+        progress.advance(n)
+        if done < steps.total and not np.isfinite(xk).all():
+            break  # (after the last chunk, the check of x in `run_fixed` tells)
+    return done
+
+
+def _all_finite(x: np.ndarray) -> bool:
+    """``np.isfinite(x).all()``, for a small ``x`` in Python (a third of the time)."""
+    if x.size <= 64:
+        return all(map(math.isfinite, x.ravel().tolist()))
+    return bool(np.isfinite(x).all())
+
+
+def _chunk_shapes(model: Model, method: str, mode: str) -> list:
+    """numpy shapes of the chunk Function's inputs (casadi's column-major layout)."""
+    if mode == "linear":
+        data = [(CHUNK, model.nu), (CHUNK, model.nu)]
+    else:
+        data = [(CHUNK, model.nu * len(unique_nodes(method)))]
+    return [(model.nx,), (1,), (CHUNK,)] + data + [(model.np,)]

@@ -15,7 +15,7 @@ from ..model import Model
 from ..serialize import text_table, to_json
 from .evaluate import map_eval
 
-__all__ = ["SimulationResult", "make_result", "Dense", "Run", "OK", "OK_STIFF", "ROUNDOFF",
+__all__ = ["SimulationResult", "make_result", "new_result", "Dense", "Run", "OK", "OK_STIFF", "ROUNDOFF",
            "UNVERIFIED", "FAILED"]
 
 # status codes of SimulationResult (documented in its docstring)
@@ -313,6 +313,18 @@ def make_result(**values) -> SimulationResult:
     return result
 
 
+def new_result(t, x, success, status, message, method, wall_time, n_steps, n_rhs, substeps,
+               error_estimate, compiled, invariants, _dense) -> SimulationResult:
+    """`make_result` with the fields in order (`simulate`'s one call site), without the
+    check of the keyword names (about 0.3 us less)."""
+    result = object.__new__(SimulationResult)
+    result.__dict__.update(
+        t=t, x=x, success=success, status=status, message=message, method=method,
+        wall_time=wall_time, n_steps=n_steps, n_rhs=n_rhs, substeps=substeps,
+        error_estimate=error_estimate, compiled=compiled, invariants=invariants, _dense=_dense)
+    return result
+
+
 def _hermite(t, x, xdot, tq):
     i = np.clip(np.searchsorted(t, tq, side="right") - 1, 0, t.size - 2)
     dt = t[i + 1] - t[i]
@@ -332,6 +344,14 @@ class Run:
     compiled: bool
     ok: bool
     message: str
+
+    @classmethod
+    def new(cls, x, n_steps, n_rhs, substeps, compiled, ok, message) -> "Run":
+        """``Run(...)`` without the frozen dataclass's per-field ``object.__setattr__``."""
+        run = object.__new__(cls)
+        run.__dict__.update(x=x, n_steps=n_steps, n_rhs=n_rhs, substeps=substeps,
+                            compiled=compiled, ok=ok, message=message)
+        return run
 
 
 def _drift(model: Model, x: np.ndarray, p: np.ndarray) -> dict:

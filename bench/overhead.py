@@ -1,0 +1,100 @@
+"""Per-call overhead of `dynamics.simulate`: Python time around the compiled loop.
+
+A repeated short call on a cached model (the torque-free rigid body, J = diag(1, 2, 3), a
+2-point grid ``[0, 1]`` s, ``x0`` a list) for ``rk8`` and ``rk4`` with ``steps=1`` and for
+``auto``. For each: the time per `simulate` call, the time of the compiled chunk call
+alone (its buffer triggered with the same inputs already in place: the floor no Python
+wrapper can go under), and their difference, the overhead. Each time is the median over
+7 batches of 5,000 calls (3 batches of 1,000 with ``--quick``). ``auto`` makes several
+runs (Richardson estimates), so its overhead is counted against one chunk call only.
+
+Writes ``overhead.csv`` into the output folder and returns the summary rows (`run`).
+Run: ``appdyn bench overhead`` or ``python bench/overhead.py [--quick]``.
+"""
+from __future__ import annotations
+
+import statistics
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+from dynamics import rigid_body, simulate
+from dynamics.integrate.loops import CHUNK, _chunk_shapes, chunk_function
+
+from _common import Row, script_main, write_csv
+
+INERTIA = [1.0, 2.0, 3.0]
+X0 = [0, 0, 0, 1, 1.0, 0.1, 0.8]
+GRID = np.array([0.0, 1.0])
+CASES = (("rk8", dict(method="rk8", steps=1)), ("rk4", dict(method="rk4", steps=1)),
+         ("auto", dict(method="auto")))
+
+
+def per_call(fun, calls: int, batches: int) -> float:
+    """Median over ``batches`` of the mean time of one of ``calls`` calls of ``fun()`` [s]."""
+    times = []
+    for _ in range(batches):
+        t0 = time.perf_counter()
+        for _ in range(calls):
+            fun()
+        times.append((time.perf_counter() - t0) / calls)
+    return statistics.median(times)
+
+
+_KEEP: list = []
+
+
+def compiled_call(model, method: str):
+    """``trigger()`` of a buffer of the (cached, compiled) chunk Function of ``method``,
+    its inputs set as `simulate` sets them for one step over ``GRID``."""
+    fun, compiled = chunk_function(model, method, "linear", True)
+    ins = [np.zeros(shape) for shape in _chunk_shapes(model, method, "linear")]
+    ins[0][:] = X0
+    ins[1][0] = 1.0
+    ins[2][0] = GRID[1] - GRID[0]
+    ins[-1][:] = model.p_default
+    out = np.empty((CHUNK, model.nx))
+    buf, trigger = fun.buffer()
+    for i, a in enumerate(ins):
+        buf.set_arg(i, memoryview(a))
+    buf.set_res(0, memoryview(out))
+    _KEEP.append((buf, ins, out))  # the buffer points into these arrays: keep them alive
+    return trigger, compiled
+
+
+def run(quick: bool, out: Path) -> list[Row]:
+    calls, batches = (1000, 3) if quick else (5000, 7)
+    model = rigid_body(INERTIA)
+    detail, summary = [], []
+    print(f"simulate on a 2-point grid, torque-free body; median of {batches} batches of "
+          f"{calls} calls")
+    for name, kwargs in CASES:
+        res = simulate(model, X0, GRID, **kwargs)  # warm: compiles once
+        n = max(1, calls // 50) if name == "auto" else calls
+        total = per_call(lambda: simulate(model, X0, GRID, **kwargs), n, batches)
+        trigger, compiled = compiled_call(model, res.method)
+        trigger()
+        chunk = per_call(trigger, calls, batches)
+        over = total - chunk
+        print(f"  {name:5s} total {1e6 * total:8.2f} us   compiled call {1e6 * chunk:6.2f} us   "
+              f"overhead {1e6 * over:8.2f} us   (n_steps {res.n_steps}, compiled {compiled})")
+        detail.append(dict(method=name, calls=n, batches=batches, total_us=1e6 * total,
+                           compiled_call_us=1e6 * chunk, overhead_us=1e6 * over,
+                           n_steps=res.n_steps, compiled=compiled))
+        case = f"repeated call, 2-point grid, {name}"
+        note = "steps 1" if name != "auto" else "several runs per call"
+        summary += [Row("overhead", case, "per call", 1e6 * total, "us", note),
+                    Row("overhead", case, "compiled call", 1e6 * chunk, "us", note),
+                    Row("overhead", case, "Python overhead", 1e6 * over, "us", note)]
+    write_csv(detail, Path(out) / "overhead.csv")
+    return summary
+
+
+def main(argv=None) -> int:
+    return script_main(run, argv)
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv[1:]))

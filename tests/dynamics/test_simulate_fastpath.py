@@ -1,0 +1,246 @@
+"""The per-call fast paths of `simulate` (issue 18, item 3): a common ``x0``/``t`` taken at
+once, tolerances and options checked inline, the chunk Function's bound buffer reused
+between calls. They must give bit-identical results to the general path and refuse bad
+inputs with the same errors. No timing is asserted (``bench/overhead.py`` measures)."""
+from __future__ import annotations
+
+import casadi as ca
+import numpy as np
+import pytest
+
+import dynamics
+from dynamics import cache
+from dynamics.integrate import api, evaluate, inputs
+from dynamics.integrate.inputs import check_t
+
+INERTIA = [1.5, 2.0, 3.25]  # a body of its own: other tests count the chunks of theirs
+X0 = [0, 0, 0, 1, 1.0, 0.1, 0.8]
+GRID = np.array([0.0, 0.5, 1.25])
+
+
+@pytest.fixture(scope="module")
+def body():
+    return dynamics.rigid_body(INERTIA)
+
+
+@pytest.fixture
+def general(monkeypatch):
+    """Switch the fast paths of ``x0`` and ``t`` off (the general checks run)."""
+    def use():
+        monkeypatch.setattr(api, "fast_x0", lambda x0, model: None)
+        monkeypatch.setattr(inputs, "fast_x0", lambda x0, model: None)
+        monkeypatch.setattr(api, "check_t", _general_t)
+    return use
+
+
+def _general_t(t):
+    """`check_t` through its general path (a list of Python ints/objects skips the fast one)."""
+    return check_t(np.asarray(t, dtype=object).tolist() if np.ndim(t) else t)
+
+
+def _x0_variants():
+    base = np.array(X0, dtype=float)
+    wide = np.zeros((7, 2))
+    wide[:, 0] = base
+    return {
+        "list": list(X0), "tuple": tuple(X0), "float64": base.copy(),
+        "float32": base.astype(np.float32), "int": np.array([0, 0, 0, 1, 1, 0, 0]),
+        "int-list": [0, 0, 0, 1, 1, 0, 0], "non-contiguous": wide[:, 0],
+        "column": base.reshape(7, 1), "DM": ca.DM(base), "bool-mixed": [0, 0, 0, True, 1.0, 0.1, 0.8],
+        "uint": np.array([0, 0, 0, 1, 1, 0, 0], dtype=np.uint8),
+    }
+
+
+def _same(a, b):
+    np.testing.assert_array_equal(a.x, b.x)
+    np.testing.assert_array_equal(a.t, b.t)
+    assert (a.success, a.status, a.message, a.method, a.n_steps, a.n_rhs, a.substeps,
+            a.compiled) == (b.success, b.status, b.message, b.method, b.n_steps, b.n_rhs,
+                            b.substeps, b.compiled)
+    assert a.x.dtype == b.x.dtype == np.float64
+    assert not a.x.flags.writeable and not a.t.flags.writeable
+
+
+@pytest.mark.parametrize("name", list(_x0_variants()))
+@pytest.mark.parametrize("method", ["rk8", "rk4", "lie"])
+def test_x0_fast_path_is_bit_identical(body, general, name, method):
+    x0 = _x0_variants()[name]
+    fast = dynamics.simulate(body, x0, GRID, method=method, steps=3)
+    general()
+    slow = dynamics.simulate(body, x0, GRID, method=method, steps=3)
+    _same(fast, slow)
+    np.testing.assert_array_equal(fast.x[:, 0], np.asarray(x0, dtype=float).reshape(-1))
+
+
+@pytest.mark.parametrize("t", [
+    np.array([0.0, 1.0]), [0.0, 1.0], (0.0, 0.5, 1.0), [0, 1], np.array([0, 1]),
+    np.array([0.0, 1.0], dtype=np.float32), np.linspace(0.0, 1.0, 11)[::5],
+    np.linspace(0.0, 2.0, 40),
+])
+def test_t_fast_path_is_bit_identical(body, general, t):
+    fast = dynamics.simulate(body, X0, t, method="rk8", steps=2)
+    general()
+    slow = dynamics.simulate(body, X0, t, method="rk8", steps=2)
+    _same(fast, slow)
+    np.testing.assert_array_equal(fast.t, np.asarray(t, dtype=float))
+    if isinstance(t, np.ndarray):
+        assert fast.t is not t and not np.shares_memory(fast.t, t)
+
+
+def test_inputs_are_copied_not_shared(body):
+    x0, t = np.array(X0, dtype=float), np.array([0.0, 1.0])
+    res = dynamics.simulate(body, x0, t, method="rk8")
+    x0[4] = 99.0
+    t[1] = 5.0
+    assert res.x[4, 0] == 1.0 and res.t[1] == 1.0
+    again = dynamics.simulate(body, [0, 0, 0, 1, 1.0, 0.1, 0.8], [0.0, 1.0], method="rk8")
+    np.testing.assert_array_equal(res.x, again.x)
+
+
+def test_default_options_path_matches_explicit_options(body):
+    base = dynamics.simulate(body, X0, GRID, method="rk8", steps=2)
+    for kwargs in (dict(jit=True), dict(max_steps=10, cvodes_options=None),
+                   dict(progress=lambda done, total: None), dict(rtol=1e-6, atol=[1e-9] * 7),
+                   dict(rtol=np.float64(1e-6), atol=0)):
+        _same(base, dynamics.simulate(body, X0, GRID, method="rk8", steps=2, **kwargs))
+
+
+def _message(fun):
+    with pytest.raises(Exception) as info:
+        fun()
+    return type(info.value), str(info.value)
+
+
+BAD = [
+    (dict(x0=[0, 0, 0, 1.0, 1, 0, float("nan")]), "`x0` must be finite"),
+    (dict(x0=[0, 0, 0, 1.0, 1, 0, float("inf")]), "`x0` must be finite"),
+    (dict(x0=[0, 0, 0, 2.0, 1, 0, 0]), "unit quaternion"),
+    (dict(x0=np.array([0, 0, 0, 1 + 3e-6, 1, 0, 0])), "got norm 1.000003"),
+    (dict(x0=[0, 0, 0, 1.0, 1, 0]), "`x0` must have shape"),
+    (dict(x0=[True] * 7), "`x0` must be real numbers"),
+    (dict(x0=["0"] * 7), "`x0` must be real numbers"),
+    (dict(x0=np.zeros(7, dtype=complex)), "`x0` must be real numbers"),
+    (dict(x0=None), "`x0`"),
+    (dict(t=np.array([0.0, 0.0])), "`t` must be strictly increasing"),
+    (dict(t=np.array([1.0, 0.0])), "`t` must be strictly increasing"),
+    (dict(t=np.array([0.0, np.nan])), "`t` must be finite"),
+    (dict(t=[0.0, np.inf]), "`t` must be finite"),
+    (dict(t=[-np.inf, 0.0]), "`t` must be finite"),
+    (dict(t=[0.0, np.nan, 1.0]), "`t` must be finite"),
+    (dict(t=np.array([0.0])), "`t` must be a 1-D grid of at least 2 times"),
+    (dict(t=[True, False]), "`t` must be real numbers"),
+    (dict(rtol=float("nan")), "`rtol` must be finite"),
+    (dict(rtol=1.0), "`rtol` must be in"),
+    (dict(rtol=1e-17), "`rtol` must be in"),
+    (dict(atol=-1e-3), "`atol` must be non-negative"),
+    (dict(atol=float("inf")), "`atol` must be finite"),
+    (dict(max_steps=1e8), "`max_steps` must be an integer"),
+    (dict(max_steps=0), "`max_steps` must be an integer >= 1"),
+    (dict(jit="yes"), "`jit` must be None, True or False"),
+    (dict(steps=0), "`steps` must be an integer >= 1"),
+    (dict(steps=1.5), "`steps` must be an integer"),
+    (dict(progress=3), "`progress` must be None or a callable"),
+    (dict(cvodes_options=[1]), "`cvodes_options` must be a mapping"),
+]
+
+
+@pytest.mark.parametrize("bad, match", BAD, ids=[m for _, m in BAD])
+def test_bad_inputs_refused_alike(body, general, bad, match):
+    kwargs = dict(x0=X0, t=GRID, method="rk8")
+    kwargs.update(bad)
+    x0, t = kwargs.pop("x0"), kwargs.pop("t")
+    fast = _message(lambda: dynamics.simulate(body, x0, t, **kwargs))
+    assert match in fast[1]
+    general()
+    assert _message(lambda: dynamics.simulate(body, x0, t, **kwargs)) == fast
+
+
+def test_bound_buffer_reused_across_grids_and_controls(body):
+    """The buffer keeps h and the control between calls: every call still sees only its own."""
+    calls = [(GRID, 700, None), (GRID, 1, None), (np.array([0.0, 1.0]), 3, [0.01, 0.0, -0.02]),
+             (GRID, 2, [0.01, 0.0, -0.02]), (GRID, 2, None),
+             (np.linspace(0.0, 1.0, 4), 1, np.full((3, 4), 0.03) + np.arange(4) * 0.01),
+             (GRID, 1, None), (np.array([0.0, 1.0]), 3, [0.02, 0.0, -0.02])]
+    for jit in (None, False):
+        got = [dynamics.simulate(body, X0, t, u=u, method="rk8", steps=s, jit=jit).x
+               for t, s, u in calls]
+        for (t, s, u), x in zip(calls, got):
+            evaluate._thread_bound().clear()  # a fresh buffer, zero-filled
+            fresh = dynamics.simulate(body, X0, t, u=u, method="rk8", steps=s, jit=jit).x
+            np.testing.assert_array_equal(x, fresh)
+
+
+def test_callable_control_unchanged_by_buffer_reuse(body):
+    t = np.linspace(0.0, 1.0, 5)
+    u = lambda s: [0.01 * s, 0.0, -0.02]  # noqa: E731
+    first = dynamics.simulate(body, X0, t, u=u, method="rk8", steps=3).x
+    dynamics.simulate(body, X0, GRID, u=[0.5, 0.5, 0.5], method="rk8", steps=3)
+    np.testing.assert_array_equal(dynamics.simulate(body, X0, t, u=u, method="rk8", steps=3).x,
+                                  first)
+
+
+def test_function_key_remembered_and_dropped():
+    x = ca.SX.sym("x")
+    f = ca.Function("f", [x], [2 * x])
+    assert cache.function_key(f) == hash(f) == cache.function_key(f)
+    key = id(f)
+    assert key in cache._KEYS
+    del f
+    import gc
+    gc.collect()
+    assert key not in cache._KEYS
+
+
+def test_bound_buffer_dropped_with_its_function(body):
+    x = ca.SX.sym("x", 2)
+    f = ca.Function("twice", [x], [2 * x])
+    buf = evaluate.borrow_bound(f, lambda: ([(2,)], (2,)))
+    buf.args[0][:] = [1.0, 2.0]
+    buf.trigger()
+    np.testing.assert_array_equal(buf.out, [2.0, 4.0])
+    evaluate.return_bound(f, buf)
+    key = id(f)
+    assert key in evaluate._thread_bound()
+    del f, buf
+    import gc
+    gc.collect()
+    assert key not in evaluate._thread_bound()
+
+
+@pytest.mark.parametrize("method", ["rk8", "rk4", "lie"])
+@pytest.mark.parametrize("t, steps", [
+    (np.array([0.0, 1.0]), 1), (GRID, 3), (np.linspace(0.0, 2.0, 17), 32),  # 512: one chunk
+    (np.array([0.0, 0.1, 0.35, 0.4, 1.0]), 1), (np.linspace(0.0, 1.0, 6), 1),
+    (np.linspace(0.0, 1.0, 513), 1),
+    (np.linspace(0.0, 2.0, 18), 32),  # 544 steps: two chunks, the general loop
+    (np.array([0.0, 1e-3]), 700),
+])
+@pytest.mark.parametrize("jit", [None, False])
+def test_short_run_path_is_bit_identical(body, monkeypatch, method, t, steps, jit):
+    """`run_short` (zero control, one chunk) against `run_fixed` (the general loop)."""
+    fast = dynamics.simulate(body, X0, t, method=method, steps=steps, jit=jit)
+    monkeypatch.setattr(api, "run_short", lambda *args: None)
+    slow = dynamics.simulate(body, X0, t, method=method, steps=steps, jit=jit)
+    _same(fast, slow)
+    assert fast.wall_time > 0
+    np.testing.assert_array_equal(fast.xdot, slow.xdot)
+    np.testing.assert_array_equal(fast.sample(t[-1] / 3), slow.sample(t[-1] / 3))
+    assert dict(fast.invariant_drift) == dict(slow.invariant_drift)
+    np.testing.assert_array_equal(fast._dense._controls(), slow._dense._controls())
+    assert fast._dense._controls().flags.f_contiguous == slow._dense._controls().flags.f_contiguous
+
+
+def test_short_run_with_invariants_and_a_non_finite_state(body, monkeypatch):
+    x0 = [0, 0, 0, 1, 1e200, 1e200, 1e200]  # the rates overflow in the first step
+    t = np.array([0.0, 1.0, 2.0])
+    fast = [dynamics.simulate(body, x0, t, method="rk8"),
+            dynamics.simulate(body, X0, t, method="rk4", invariants=True)]
+    monkeypatch.setattr(api, "run_short", lambda *args: None)
+    slow = [dynamics.simulate(body, x0, t, method="rk8"),
+            dynamics.simulate(body, X0, t, method="rk4", invariants=True)]
+    assert not fast[0].success and "non-finite" in fast[0].message
+    for a, b in zip(fast, slow):
+        _same(a, b)
+        assert a.invariants.keys() == b.invariants.keys()
+        for k in a.invariants:
+            np.testing.assert_array_equal(a.invariants[k], b.invariants[k])
