@@ -30,8 +30,9 @@ from ..serialize import text_table, to_json
 from .cluster import ClusterGeometry, cluster_jacobian, cluster_momentum, singularity_measure
 from .steering import gsr_inverse_steering, pseudo_inverse_steering, sr_inverse_steering
 
-__all__ = ["LAWS", "LAW_OPTIONS", "MOMENTUM_TOL", "OK", "RATE_LIMIT", "MOMENTUM_BALANCE", "FAILED",
-           "steering_model", "steer", "SteeringResult"]
+__all__ = ["LAWS", "LAW_OPTIONS", "MOMENTUM_TOL", "TORQUE_TOL", "OK", "RATE_LIMIT",
+           "MOMENTUM_BALANCE", "TORQUE_ERROR", "FAILED", "steering_model", "steer",
+           "SteeringResult"]
 
 #: Steering laws: Moore-Penrose, singularity-robust, generalized SR (dither; adds a clock).
 LAWS = ("pinv", "sr", "gsr")
@@ -39,9 +40,14 @@ LAWS = ("pinv", "sr", "gsr")
 LAW_OPTIONS = {"pinv": (), "sr": ("lam0", "mu"), "gsr": ("lam0", "mu", "eps0", "omega", "phase")}
 #: Largest ``|H(delta) - H_int|``, relative to ``sum(h)``, of a trusted run.
 MOMENTUM_TOL = 1e-8
+#: Default largest ``|delivered - commanded|`` torque of a successful run, relative to the
+#: largest commanded ``|torque|`` (`steer`'s ``torque_tol``).
+TORQUE_TOL = 0.01
 #: `SteeringResult.status`: done; gimbal rates above ``rate_limit``; momentum balance broken
-#: (a step jumped across a singular state); integration failed (non-finite state or rate).
-OK, RATE_LIMIT, MOMENTUM_BALANCE, FAILED = 0, 1, 2, -1
+#: (a step jumped across a singular state); the commanded torque not delivered (a
+#: singularity-robust law at a singular state, or a saturated cluster); integration failed
+#: (non-finite state or rate).
+OK, RATE_LIMIT, MOMENTUM_BALANCE, TORQUE_ERROR, FAILED = 0, 1, 2, 3, -1
 
 
 def _geometry(geometry) -> ClusterGeometry:
@@ -185,7 +191,7 @@ def _nanmax(a) -> float:
 
 
 def steer(geometry: ClusterGeometry, torque, t, *, law="sr", delta0=None, steps: int = 20,
-          rate_limit=None, **law_options) -> "SteeringResult":
+          rate_limit=None, torque_tol: float = TORQUE_TOL, **law_options) -> "SteeringResult":
     """Simulate the gimbal angles under a commanded body torque and a steering law.
 
     Parameters
@@ -204,6 +210,12 @@ def steer(geometry: ClusterGeometry, torque, t, *, law="sr", delta0=None, steps:
     rate_limit : float [rad/s], optional
         Largest allowed ``|delta_i'|`` (checked at the output times); a run beyond it is
         ``success=False`` (status `RATE_LIMIT`).
+    torque_tol : float, optional
+        Largest ``|delivered - commanded|`` at the output times, relative to the largest
+        commanded ``|torque|`` (default 1 %); a run beyond it delivered something else than
+        was asked and is ``success=False`` (status `TORQUE_ERROR`): a singularity-robust law
+        trading torque for bounded rates at a singular state, a gimbal lock, a saturated
+        cluster. ``numpy.inf`` accepts any torque error (the error is still reported).
     **law_options
         Options of the law (`steering_model`).
 
@@ -215,7 +227,7 @@ def steer(geometry: ClusterGeometry, torque, t, *, law="sr", delta0=None, steps:
     ------
     TypeError, ValueError
         Naming the argument: ``geometry``, ``law`` or an option, ``torque`` (shape, values),
-        ``t``, ``delta0``, ``steps``, ``rate_limit``.
+        ``t``, ``delta0``, ``steps``, ``rate_limit``, ``torque_tol``.
 
     Examples
     --------
@@ -239,6 +251,7 @@ def steer(geometry: ClusterGeometry, torque, t, *, law="sr", delta0=None, steps:
               else validate.finite_array(delta0, "delta0", (geo.n,)))
     if rate_limit is not None:
         rate_limit = validate.positive(rate_limit, "rate_limit")
+    torque_tol = _torque_tol(torque_tol)
     law, options = _law_options(law, law_options)
     model = steering_model(geo, law, momentum_states=True, **dict(options))
     clock = [float(t[0])] if law == "gsr" else []
@@ -260,12 +273,26 @@ def steer(geometry: ClusterGeometry, torque, t, *, law="sr", delta0=None, steps:
                          momentum_error=balance, success=True, status=OK, message="",
                          law=law, law_options=dict(options), geometry=geo,
                          rate_limit=rate_limit, steps=sim.substeps, simulation=sim)
-    status, message = _verdict(res, sim, ok, MOMENTUM_TOL * float(np.sum(geo.h)))
+    scale = float(np.max(np.linalg.norm(commanded, axis=0)))
+    status, message = _verdict(res, sim, ok, MOMENTUM_TOL * float(np.sum(geo.h)),
+                               torque_tol * scale)
     return replace(res, success=status == OK, status=status, message=message,
                    wall_time=time.perf_counter() - start)
 
 
-def _verdict(res, sim, ok, tol) -> tuple:
+def _torque_tol(value) -> float:
+    """``torque_tol``: a number >= 0 (``inf`` allowed: any torque error accepted)."""
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, float, np.number)):
+        raise validate.ArgumentTypeError(
+            f"`torque_tol` must be a number >= 0 (a fraction of the largest commanded torque, "
+            f"inf for any), got {type(value).__name__}")
+    value = float(value)
+    if not value >= 0:
+        raise ValueError(f"`torque_tol` must be >= 0 (inf for any torque error), got {value}")
+    return value
+
+
+def _verdict(res, sim, ok, tol, torque_tol) -> tuple:
     """``(status, message)`` of a run: the first failed check, in the order of the statuses."""
     if not sim.success or not np.all(ok):
         bad = res.t[~ok][0] if not np.all(ok) else res.t[-1]
@@ -283,6 +310,16 @@ def _verdict(res, sim, ok, tol) -> tuple:
             f"{res.max_momentum_error:.3g} N m s > {tol:.1g} from t = {res.t[k]:g} s: the gimbal "
             f"rates blew up between output points (a step jumped across a singular state), or "
             f"`steps` is too coarse for them (more steps tell which)")
+    if res.max_torque_error > torque_tol:
+        bad = res.torque_error > torque_tol
+        k = int(np.argmax(bad))
+        spent = float(np.sum(np.diff(res.t)[bad[:-1]]))
+        return TORQUE_ERROR, (
+            f"commanded torque not delivered: |delivered - commanded| up to "
+            f"{res.max_torque_error:.3g} N m > torque_tol {torque_tol:.3g} N m, from t = "
+            f"{res.t[k]:g} s, for about {spent:.3g} s (singularity measure there "
+            f"{res.measure[k]:.3g}; a singular state or a saturated cluster; torque_tol=inf "
+            f"accepts it)")
     return OK, (f"{sim.message}; momentum balance {res.max_momentum_error:.2g} N m s")
 
 

@@ -3,13 +3,15 @@
 
     appdyn cmg envelope --beta 54.74 [--h 1] [--directions N] [--plot env.png] [--json F]
     appdyn cmg steer --beta 54.74 --torque 0,0,0.5 --law sr|pinv|gsr --t-final 10 \\
-        [--delta0 deg,deg,deg,deg] [--points 201] [--rate-limit DEG/S] [--plot F] [--json F]
+        [--delta0 deg,deg,deg,deg] [--points 201] [--rate-limit DEG/S] [--torque-tol FRAC]
+        [--plot F] [--json F]
 
 Angles on the command line are in degrees (``--beta``, ``--delta0``, ``--rate-limit`` in
 deg/s). ``envelope`` checks the computed envelope against the pyramid's closed forms
 (`pyramid_extent`) and exits 1 when they differ by more than `CHECK_TOL`; ``steer`` exits 1
-when the run is not a success (non-finite, above the rate limit, or the momentum balance
-broken by a step across a singular state).
+when the run is not a success (non-finite, above the rate limit, the momentum balance
+broken by a step across a singular state, or the commanded torque not delivered within
+``--torque-tol``).
 """
 from __future__ import annotations
 
@@ -90,8 +92,9 @@ def add_parser(subparsers):
         description="Integrate the gimbal angles of a four-CMG pyramid under a constant "
                     "commanded body torque (rk8) and report the singularity measure, gimbal "
                     "rates and torque error. Angles in degrees. Exit status 1 when the run "
-                    "fails: non-finite, above --rate-limit, or momentum balance broken (the "
-                    "rates blew up at a singular state).")
+                    "fails: non-finite, above --rate-limit, momentum balance broken (the "
+                    "rates blew up at a singular state), or the torque not delivered within "
+                    "--torque-tol (a singular state, a saturated cluster).")
     st.add_argument("--torque", type=_vector((3,)), required=True,
                     help="commanded body torque T1,T2,T3 [N m] (the cluster momentum changes "
                          "by -torque per second)")
@@ -104,6 +107,9 @@ def add_parser(subparsers):
                     help="rk8 steps per output interval (20)")
     st.add_argument("--rate-limit", type=_positive,
                     help="largest gimbal rate [deg/s]; a run above it fails (no limit)")
+    st.add_argument("--torque-tol", type=float, default=0.01, metavar="FRAC",
+                    help="largest torque error, as a fraction of |torque|; a run beyond it "
+                         "fails (0.01; inf accepts any)")
     _common(st, "save angles, measure, rates and torque error against time")
     return cmg
 
@@ -163,7 +169,8 @@ def _steer(args) -> int:
     res = steer(_geometry(args), args.torque, t, law=args.law,
                 delta0=None if args.delta0 is None else np.radians(args.delta0),
                 steps=args.steps,
-                rate_limit=None if args.rate_limit is None else np.radians(args.rate_limit))
+                rate_limit=None if args.rate_limit is None else np.radians(args.rate_limit),
+                torque_tol=args.torque_tol)
     return finish(res, "cmg steer", plot=args.plot, json=args.json)
 
 

@@ -269,9 +269,11 @@ def attitude_gains(inertia, scenarios, *, u_max, horizon=None, per_axis: bool = 
     tau = float(1.0 / np.min(-poles.real)) if stable else float("inf")
 
     t_sim = np.linspace(0.0, 2 * horizon, 4001)
-    scen, peaks, settles, sim_ok, end_angles = [], [], [], True, []
+    scen, peaks, settles, sim_ok, end_angles, sim_message = [], [], [], True, [], ""
     for k in range(K):
         sim = simulate_loop(loop, X0[:, k], gains, t_sim)
+        if sim_ok and not sim.success:
+            sim_message = f"scenario {k}: {sim.message}"
         sim_ok &= bool(sim.success)
         u = loop_torque(sim.x, gains, bool(per_axis))
         ang = error_angle(sim.x)
@@ -330,6 +332,9 @@ def attitude_gains(inertia, scenarios, *, u_max, horizon=None, per_axis: bool = 
         success, status = False, STATUS_UNSTABLE
         message = (f"the NLP converged but the loop linearized at the target is not stable "
                    f"(largest real part {np.max(poles.real):.4g} 1/s)")
+    elif not sim_ok:  # before the limits: a failed run's peaks and settle times are NaN
+        success, status = False, "Simulation_Failed"
+        message = f"the re-simulation of the designed loop failed: {sim_message}"
     elif not limits_met:
         success, status = False, STATUS_LIMITS
         message = (f"the re-simulated peak torque exceeds the {_TORQUE} by "
@@ -338,9 +343,6 @@ def attitude_gains(inertia, scenarios, *, u_max, horizon=None, per_axis: bool = 
         success, status = False, STATUS_LIMITS
         message = (f"the re-simulation violates the {settle_name}: largest error at the horizon "
                    f"{math.degrees(max(end_angles)):.4g} deg")
-    elif not sim_ok:
-        success, status = False, "Simulation_Failed"
-        message = "the re-simulation of the designed loop failed"
     else:
         success, status = True, sol.status
         worst = float(np.max(settles))

@@ -57,7 +57,7 @@ def test_envelope_failed_check_exits_1(monkeypatch, capsys):
 def test_steer_sr_report_plot_and_json(tmp_path, capsys):
     plot, out = tmp_path / "steer.png", tmp_path / "steer.json"
     argv = [*STEER, "--torque", "0,0,0.5", "--law", "sr", "--t-final", "10", "--plot",
-            str(plot), "--json", str(out)]
+            str(plot), "--json", str(out), "--torque-tol", "inf"]
     assert main(argv) == 0
     text = capsys.readouterr().out
     assert "CMG steering" in text and "d1 [deg]" in text and "-90.000" in text  # degrees
@@ -65,6 +65,17 @@ def test_steer_sr_report_plot_and_json(tmp_path, capsys):
     data = strict_loads(out.read_text())
     assert data["success"] is True and data["law"] == "sr"
     assert np.array(data["delta"]).shape == (4, 201)
+
+
+def test_steer_saturated_cluster_exits_1_unless_the_torque_error_is_accepted(capsys):
+    """0.5 N m along z saturates the cluster (4 h sin beta = 3.27 N m s) after 6.5 s: 6 s is a
+    success; 10 s is not (the torque is not delivered), unless --torque-tol accepts it."""
+    assert main([*STEER, "--torque", "0,0,0.5", "--law", "sr", "--t-final", "6"]) == 0
+    capsys.readouterr()
+    assert main([*STEER, "--torque", "0,0,0.5", "--law", "sr", "--t-final", "10"]) == 1
+    assert "not delivered" in capsys.readouterr().out
+    assert main([*STEER, "--torque", "0,0,0.5", "--law", "sr", "--t-final", "10",
+                 "--torque-tol", "2"]) == 0
 
 
 def test_steer_negative_torque_and_delta0_in_degrees(tmp_path, capsys):

@@ -122,6 +122,30 @@ def test_infeasible_torque_limit_fails_naming_the_constraint():
     assert "torque limit" in res.message and "settle constraint" in res.message
 
 
+def test_a_failed_re_simulation_is_reported_as_such(monkeypatch):
+    """Found by the random valid-input sweep (an axis with components of 1e-175 made CVODES
+    give up): the failed run's NaN peaks were reported as 'exceeds the torque limit by nan %'.
+    A failed re-simulation now says so, with the simulator's message."""
+    import problems.gains.spacecraft as spacecraft
+
+    def failing(loop, x0, gains, t):
+        return _Failed(loop.nx, t.size)
+
+    monkeypatch.setattr(spacecraft, "simulate_loop", failing)
+    res = attitude_gains(J_DIAG, SINGLE_AXIS[:1], u_max=U_MAX, time_optimal_reference=False)
+    assert not res.success and res.status == "Simulation_Failed"
+    assert "re-simulation of the designed loop failed" in res.message
+    assert "cvodes failed near t = 1" in res.message and "nan" not in res.message
+
+
+class _Failed:
+    """What a failed `simulate` run hands back: NaN states, success False, a message."""
+
+    def __init__(self, nx, n):
+        self.success, self.message = False, "cvodes failed near t = 1"
+        self.x = np.full((nx, n), np.nan)
+
+
 def test_settle_time_and_error_angle_helpers():
     t = np.array([0.0, 1.0, 2.0, 3.0])
     assert settle_time(t, [1.0, 0.5, 0.05, 0.0], 0.1) == pytest.approx(1.0 + 0.4 / 0.45)

@@ -83,7 +83,7 @@ def test_pinv_into_the_elliptic_singularity_reports_the_blow_up():
 
 def test_sr_stays_bounded_at_the_singularity_with_a_torque_error():
     t = np.linspace(0.0, 15.0, 301)
-    res = steer(GEO, [-0.1, 0.0, 0.0], t, law="sr")
+    res = steer(GEO, [-0.1, 0.0, 0.0], t, law="sr", torque_tol=np.inf)
     assert res.success
     assert res.max_rate <= 0.1 / (2 * np.sqrt(0.01)) + 1e-12  # |T| / (2 sqrt(lam0))
     assert res.measure[-1] < 1e-6  # parked at the singular state ...
@@ -94,12 +94,32 @@ def test_sr_stays_bounded_at_the_singularity_with_a_torque_error():
     assert 0 < np.max(res.torque_error[big]) < 1e-6
 
 
+def test_sr_at_the_singularity_is_not_a_success_by_default():
+    """The stress bench found SR parked at the elliptic singularity delivering none of the
+    commanded torque for 8.7 s with success=True; the torque check now says so."""
+    t = np.linspace(0.0, 15.0, 301)
+    res = steer(GEO, [-0.1, 0.0, 0.0], t, law="sr")
+    assert not res.success and res.status == STEER.TORQUE_ERROR
+    assert "not delivered" in res.message and "torque_tol" in res.message
+    first = res.t[np.argmax(res.torque_error > STEER.TORQUE_TOL * 0.1)]
+    assert f"from t = {first:g} s" in res.message
+    # away from the singularity the same law delivers the torque: a short run succeeds
+    short = steer(GEO, [-0.1, 0.0, 0.0], np.linspace(0.0, 5.0, 51), law="sr")
+    assert short.success and short.max_torque_error < 1e-6
+    with pytest.raises(ValueError, match="`torque_tol`"):
+        steer(GEO, [-0.1, 0.0, 0.0], t, torque_tol=-1.0)
+    with pytest.raises(TypeError, match="`torque_tol`"):
+        steer(GEO, [-0.1, 0.0, 0.0], t, torque_tol="1%")
+
+
 def test_gsr_dither_moves_the_gimbals_where_sr_locks():
     t = np.linspace(0.0, 4.0, 81)
     delta0 = np.deg2rad([-90, 0, 90, 0])
-    sr = steer(GEO, [-0.1, 0.0, 0.0], t, law="sr", delta0=delta0)
-    gsr = steer(GEO, [-0.1, 0.0, 0.0], t, law="gsr", delta0=delta0, eps0=0.05)
+    sr = steer(GEO, [-0.1, 0.0, 0.0], t, law="sr", delta0=delta0, torque_tol=np.inf)
+    gsr = steer(GEO, [-0.1, 0.0, 0.0], t, law="gsr", delta0=delta0, eps0=0.05, torque_tol=np.inf)
     assert sr.success and gsr.success
+    locked = steer(GEO, [-0.1, 0.0, 0.0], t, law="sr", delta0=delta0)
+    assert locked.status == STEER.TORQUE_ERROR  # gimbal lock delivers nothing: not a success
     assert sr.max_rate < 1e-12  # gimbal lock: the torque is along the singular direction
     assert np.ptp(gsr.delta, axis=1).max() > 1e-3
     assert gsr.simulation.x[4] == pytest.approx(t, abs=1e-12)  # the clock state
@@ -139,7 +159,9 @@ def test_report_json_and_plot():
         raise ValueError(name)
 
     data = json.loads(res.to_json(), parse_constant=refuse)
-    assert data["success"] is True and data["law"] == "sr"
+    # saturated: the torque is not delivered after 6.5 s, which the result says
+    assert data["success"] is False and data["status"] == STEER.TORQUE_ERROR
+    assert data["law"] == "sr"
     assert np.array(data["delta"]).shape == (4, 101)
     assert data["max_torque_error"] == pytest.approx(0.5, rel=1e-6)
     fig = res.plot()
