@@ -31,6 +31,8 @@ TITLES = {
                      "(`bench/ocp_precision.py`)",
     "ascent": "Delta III ascent to GTO, 4 phases (`bench/ascent.py`)",
     "many": "Many runs: serial against thread and process pools (`bench/many.py`)",
+    "overhead": "Per-call Python overhead of `simulate` on a 2-point grid, cached model "
+                "(`bench/overhead.py`)",
     "stress": "Stress cases (`bench/stress.py`)",
 }
 
@@ -68,7 +70,10 @@ def _read(results_dir: Path):
 def render(results_dir) -> str:
     """Markdown of the results in ``results_dir`` (``summary.csv``, ``machine.json``)."""
     rows, m = _read(results_dir)
-    lines = [f"Measured on {m.get('cpu')}, {m.get('cores')} cores, {m.get('date')}; "
+    dates = m.get("dates") or {}
+    when = sorted(set(dates.values()) - {""}) or [m.get("date")]
+    span = when[0] if len(when) == 1 else f"{when[0]} to {when[-1]} (each table's date below)"
+    lines = [f"Measured on {m.get('cpu')}, {m.get('cores')} cores, {span}; "
              f"casadi {m.get('casadi')}, numpy {m.get('numpy')}, scipy {m.get('scipy')}, "
              f"IPOPT linear solver {m.get('ipopt_linear_solver')}; "
              "regenerate with `make bench`."]
@@ -77,7 +82,8 @@ def render(results_dir) -> str:
     names = sorted(names, key=lambda b: (order.index(b) if b in order else len(order),
                                          names.index(b)))
     for bench in names:
-        lines += ["", f"**{TITLES.get(bench, f'`bench/{bench}.py`')}**", "",
+        dated = f", {dates[bench]}" if len(when) > 1 and dates.get(bench) else ""
+        lines += ["", f"**{TITLES.get(bench, f'`bench/{bench}.py`')}**{dated}", "",
                   "| case | metric | value | note |", "| --- | --- | ---: | --- |"]
         for r in rows:
             if r["benchmark"] != bench:

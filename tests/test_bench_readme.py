@@ -130,9 +130,20 @@ def test_runner_writes_merges_and_reports_failures(tmp_path, monkeypatch, capsys
     printed = capsys.readouterr().out
     assert "== summary ==" in printed and "one" in printed and "two" in printed
 
+    first = json.loads((out / "machine.json").read_text())
+    assert first["dates"] == {"one": first["date"], "two": first["date"]}
+    then = "2026-01-01 00:00 UTC"
+    (out / "machine.json").write_text(json.dumps({**first, "date": then, "dates": {
+        "one": then, "two": then}}))
+
     _fake(bench_dir, "two", 3.0)  # a partial run replaces only its own rows
     assert main(["bench", "two", "--out", str(out)]) == 0
     assert _summary(out) == [("one", 1.0, "quick"), ("two", 3.0, "full")]
+    now = json.loads((out / "machine.json").read_text())
+    assert now["dates"] == {"one": then, "two": now["date"]}  # each table keeps its date
+    text = bench_cli._helper("_readme").render(out)
+    assert f"{then} to {now['date']} (each table's date below)" in text
+    assert f"`bench/two.py`**, {now['date']}" in text and f"`bench/one.py`**, {then}" in text
 
     _fake(bench_dir, "one", 5.0, body="raise RuntimeError('boom')")  # the others still run
     _fake(bench_dir, "two", 4.0)

@@ -106,6 +106,17 @@ def merge_rows(old, new, ran):
     return sorted(rows, key=lambda r: order.index(r.benchmark))
 
 
+def merged_dates(machine_path: Path, ran, date: str, present) -> dict:
+    """``{benchmark: date of its rows}``: ``date`` for those in ``ran``, the earlier record
+    (``machine.json``'s ``dates``, else its ``date``) for the others in ``present``."""
+    old: dict = {}
+    if Path(machine_path).is_file():
+        previous = json.loads(Path(machine_path).read_text())
+        old = dict(previous.get("dates") or {})
+        old = {b: old.get(b, previous.get("date", "")) for b in present}
+    return {b: (date if b in ran else old.get(b, "")) for b in sorted(present)}
+
+
 def run(args) -> int:
     """Run the named benchmarks (all by default); see the module docstring for exit status."""
     if not BENCH_DIR.is_dir():
@@ -146,7 +157,10 @@ def run(args) -> int:
     rows = merge_rows(read_summary(summary), new, ran)
     if rows:
         common.write_rows(rows, summary)
-    (out / "machine.json").write_text(json.dumps(common.machine(), indent=2) + "\n")
+    machine = common.machine()
+    machine["dates"] = merged_dates(out / "machine.json", ran, machine["date"],
+                                    {r.benchmark for r in rows})
+    (out / "machine.json").write_text(json.dumps(machine, indent=2) + "\n")
     print("\n== summary ==")
     print(common.format_rows(new))
     print(f"wrote {summary} and {out / 'machine.json'}")
