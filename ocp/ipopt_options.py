@@ -240,7 +240,8 @@ def check_ipopt_options(options) -> dict:
     if options is None:
         return {}
     if not isinstance(options, Mapping):
-        raise ValueError(f"`ipopt_options` must be a mapping, got {type(options).__name__}")
+        raise TypeError(f"`ipopt_options` (`options`) must be a mapping, got "
+                        f"{type(options).__name__}")
     out = {}
     for key, value in options.items():
         if not isinstance(key, str):

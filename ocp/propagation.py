@@ -8,6 +8,8 @@ from typing import TYPE_CHECKING
 import casadi as ca
 import numpy as np
 
+from dynamics.validate.base import real_array
+
 from .cached import cached, function_key
 
 if TYPE_CHECKING:
@@ -78,7 +80,7 @@ def state_scale(x: np.ndarray) -> np.ndarray:
     -------
     ndarray, shape (nx,) [state units]
     """
-    x = np.asarray(x, dtype=float)
+    x = real_array(x, "x")
     if x.ndim != 2:
         raise ValueError(f"`x` must have shape (nx, n), got {x.shape}")
     if x.shape[1] == 0:

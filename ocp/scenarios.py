@@ -40,6 +40,7 @@ import numpy as np
 
 from dynamics.model import Model
 from dynamics.validate import integer
+from dynamics.validate.base import real_array
 
 from .arguments import bounds, row_bounds
 from .functions import named_function
@@ -100,7 +101,7 @@ def _columns(value, nx: int, K: int | None, argname: str, *, allow_nan: bool) ->
     if isinstance(value, (list, tuple)) and value and all(isinstance(v, Mapping) for v in value):
         raise ValueError(f"`{argname}`: give arrays (nx, K); mappings by name are per-scenario "
                          "values of `ocp.Problem`, not of `scenario_problem`")
-    a = np.array(value, dtype=float)
+    a = np.array(real_array(value, argname))
     if a.ndim == 1 and K is not None and a.size == nx:
         a = np.repeat(a[:, None], K, axis=1)
     if a.ndim != 2 or a.shape[0] != nx or (K is not None and a.shape[1] != K):
@@ -255,7 +256,7 @@ def unstack(x, K: int) -> np.ndarray:
         If ``K`` does not divide the number of rows.
     """
     K = _count(K)
-    a = np.asarray(x, dtype=float)
+    a = real_array(x, "x")
     if a.ndim != 2 or a.shape[0] % K:
         raise ValueError(f"`x` must have K n rows (K = {K}), got shape {a.shape}")
     n = a.shape[0] // K

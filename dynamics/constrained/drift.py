@@ -176,8 +176,14 @@ def project_positions(residual: Callable, jacobian: Callable, x, *, retract: Cal
     """
     tol = positive(tol, "tol")
     max_iter = integer(max_iter, "max_iter", minimum=0)
+    for fun, name in ((residual, "residual"), (jacobian, "jacobian"), (retract, "retract")):
+        if not callable(fun) and (fun is not None or name != "retract"):
+            raise TypeError(f"`{name}` must be a callable of the state x, got "
+                            f"{type(fun).__name__}")
     retract = retract or (lambda x, d: x + d)
     x = np.array(finite_array(x, "x"), dtype=float)
+    if x.ndim != 1:
+        raise ValueError(f"`x` must be a state of shape (k,), got shape {x.shape}")
     phi = np.atleast_1d(np.asarray(residual(x), float)).reshape(-1)
     it = 0
     while np.linalg.norm(phi) > tol and it < max_iter:

@@ -253,6 +253,7 @@ def planar_ascent(*, target_altitude, target_gamma, q_max, qalpha_max,
     if not lo_th < hi_th:
         raise ValueError(f"`theta_bounds` must be (lower, upper) with lower < upper, got "
                          f"{theta_bounds!r}")
+    initial_speed = positive(initial_speed, "initial_speed")
     t0, h0, m0 = vertical_rise(veh, initial_speed)
     V0, gamma0 = float(initial_speed), math.pi / 2 - kick
     hf = finite_scalar(target_altitude, "target_altitude")

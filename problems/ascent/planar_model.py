@@ -340,7 +340,7 @@ def vertical_rise(vehicle: AscentVehicle | None, speed: float, g0: float = G0):
     (4.747, 117.38, 96677.2)
     """
     veh = _vehicle(vehicle)
-    V1 = positive(speed, "initial_speed")
+    V1 = positive(speed, "speed")
     ve, a = veh.exhaust_velocity, veh.mass_flow_rate / veh.mass
     if veh.thrust <= veh.mass * g0:
         raise ValueError(f"`vehicle`: thrust {veh.thrust!r} N does not lift the mass "

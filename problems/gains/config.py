@@ -57,6 +57,7 @@ reports it as bad input (exit status 2).
 from __future__ import annotations
 
 import math
+import os
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Mapping
@@ -261,7 +262,8 @@ def parse_config(data: Mapping, *, source: str = "<mapping>") -> LaunchVehicleCo
     ValueError: vehicle.thrust must be > 0, got -1
     """
     if not isinstance(data, Mapping):
-        raise ValueError(f"the configuration must be a table, got {type(data).__name__}")
+        raise TypeError(f"`data` (the configuration) must be a table (a mapping), got "
+                        f"{type(data).__name__}")
     unknown = sorted(set(data) - set(_TOP))
     if unknown:
         raise ValueError(f"unknown key {unknown[0]} (known: {', '.join(_TOP)})")
@@ -325,6 +327,9 @@ def load_config(path) -> LaunchVehicleConfig:
     """
     if tomllib is None:
         raise RuntimeError("reading TOML needs Python >= 3.11 (tomllib); use parse_config")
+    if not isinstance(path, (str, os.PathLike)):
+        raise TypeError(f"`path` must be a file path (str or os.PathLike), got "
+                        f"{type(path).__name__}")
     p = Path(path)
     try:
         text = p.read_text(encoding="utf-8")

@@ -57,6 +57,8 @@ def slew_problem(inertia, *, objective, T=None, angle=None, axis=None, q0=None, 
     (7, 3, 2.0, 'slew (effort)')
     """
     I = check_inertia(inertia)
+    if not isinstance(objective, str):
+        raise TypeError(f"`objective` must be 'time' or 'effort', got {type(objective).__name__}")
     if objective not in ("time", "effort"):
         raise ValueError(f"`objective` must be 'time' or 'effort', got {objective!r}")
     if objective == "time" and T is not None:

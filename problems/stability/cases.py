@@ -56,6 +56,9 @@ def resolve_case(case):
             if fun is case:
                 return name, fun
         raise ValueError(f"`case` must be one of {sorted(CASES)} (or the function), got {case!r}")
+    if not isinstance(case, str):
+        raise TypeError(f"`case` must be a case name (one of {sorted(CASES)}) or a case "
+                        f"function, got {type(case).__name__}")
     name = CASE_ALIASES.get(case, case)
     if name not in CASES:
         raise ValueError(f"`case` must be one of {sorted(CASES)}, got {case!r}")

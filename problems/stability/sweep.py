@@ -128,6 +128,9 @@ def sweep(case, parameter: str, values, *, rtol: float = 1e-8, progress=None, ex
     """
     name, fun = resolve_case(case)
     sig = inspect.signature(fun)
+    if not isinstance(parameter, str):
+        raise TypeError(f"`parameter` must be the name of an argument of {name}: "
+                        f"{list(sig.parameters)}, got {type(parameter).__name__}")
     if parameter not in sig.parameters:
         raise ValueError(f"`parameter` must be an argument of {name}: {list(sig.parameters)}, "
                          f"got {parameter!r}")

@@ -18,6 +18,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from dynamics.validate.base import real_array
+
 from .common import format_complex
 
 __all__ = ["ZERO_RTOL", "VERDICTS", "classify", "least_damped", "spectral_scale"]
@@ -82,7 +84,7 @@ def classify(A, *, rtol: float = ZERO_RTOL):
     >>> classify([[0.0, 1.0], [-1.0, -0.1]])[0]
     'asymptotically stable'
     """
-    A = np.asarray(A, dtype=float)
+    A = real_array(A, "A")
     if A.ndim != 2 or A.shape[0] != A.shape[1] or not np.all(np.isfinite(A)):
         raise ValueError(f"`A` must be a finite square matrix, got shape {A.shape}")
     if not (np.isfinite(rtol) and 0 < rtol < 1):

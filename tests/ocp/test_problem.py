@@ -155,7 +155,7 @@ def test_attitude_inputs(kw, name):
     (dict(guess={"T": 2.0}), "`guess\\['T'\\]`", ValueError),  # T is fixed at 1
     (dict(scale={"q": 1.0}), "`scale`", ValueError),
     (dict(scale={"x": 0.0}), "`scale`", ValueError),
-    (dict(ipopt_options=["tol"]), "`ipopt_options`", ValueError),
+    (dict(ipopt_options=["tol"]), "`ipopt_options`", TypeError),  # not a mapping: a type
     (dict(verbose="loud"), "`verbose`", ValueError),
 ])
 def test_bad_solve_arguments_raise_naming_argument(kw, name, exc):

@@ -8,8 +8,8 @@ the table ``VALID`` (built lazily, some need a cheap solve or simulation). The c
 raise ``TypeError`` or ``ValueError`` (subclasses count): never another exception type and
 never a silent result. A returned result whose ``success`` is False with a message is
 accepted (numerical drivers); such cases are reported through ``GarbageAcceptedWarning``.
-A refusal whose message does not name the parameter is reported through
-``UnnamedArgumentWarning`` (not a failure). ``test_valid_examples`` checks that the example
+A refusal whose message does not name the parameter fails (it was a warning until the
+last 40 such messages were fixed). ``test_valid_examples`` checks that the example
 values are accepted (functions that would solve an NLP excepted), so that each refusal is
 caused by its garbage.
 
@@ -24,10 +24,6 @@ import numpy as np
 import pytest
 
 from .public_api import _NO_VALID, EXPENSIVE, EXTRA, FUNCTIONS, _required, _valid
-
-class UnnamedArgumentWarning(UserWarning):
-    """A refusal whose message does not name the offending parameter."""
-
 
 class GarbageAcceptedWarning(UserWarning):
     """Garbage answered by a result object with ``success=False`` (allowed, reported)."""
@@ -191,9 +187,9 @@ def test_garbage_is_refused(func, param, gid):
             result = fn(**kwargs)
     except (TypeError, ValueError) as exc:
         message = str(exc)
-        if not _names(message, param):
-            warnings.warn(f"{func}({param}={gid}): {type(exc).__name__}: {message[:200]}",
-                          UnnamedArgumentWarning, stacklevel=1)
+        assert _names(message, param), (  # DESIGN.md: the error names the argument
+            f"{func}({param}={gid}): {type(exc).__name__} does not name `{param}`: "
+            f"{message[:200]}")
         return
     except Exception as exc:  # noqa: BLE001 -- the point of the test
         pytest.fail(f"{func}({param}={gid}) raised {type(exc).__name__}, "
