@@ -3,6 +3,7 @@ the round-off floor of a run, the stiffness test, and cvodes with an estimated g
 for stiff problems."""
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass, replace
 
@@ -11,7 +12,7 @@ import numpy as np
 
 from .. import cache
 from .cvodes import run_cvodes
-from .evaluate import map_eval
+from .evaluate import call_buffered, map_eval
 from .inputs import Problem
 from .loops import Progress, run_fixed
 from .result import FAILED, OK, OK_STIFF, ROUNDOFF, UNVERIFIED, Run
@@ -198,7 +199,8 @@ def _spectrum(problem: Problem) -> tuple[float, float] | None:
     t0, H0 = float(problem.t[0]), float(problem.t[1] - problem.t[0])
     u0 = problem.control.at(t0, 0, t0, H0)
     try:
-        J = np.asarray(jacobian_x(problem.model)(problem.x0, u0, problem.p), dtype=float)
+        nx = problem.model.nx  # (a C-ordered (nx, nx) buffer holds J^T: same eigenvalues)
+        J = call_buffered(jacobian_x(problem.model), [problem.x0, u0, problem.p], (nx, nx)).T
     except RuntimeError:
         return None
     return rho_sigma(J[None])
@@ -353,9 +355,9 @@ def _floor(target, run: Run, rtol, atol, lipschitz: float, jit: bool,
     x = run.x
     horizon = float(target.t[-1] - target.t[0])
     cols = np.unique(np.linspace(0, x.shape[1] - 1, min(16, x.shape[1])).round().astype(int))
-    rng = np.random.default_rng(0)
     X = x[:, cols]
-    pert = [X] + [X * (1 + _EPS * rng.choice((-1.0, 1.0), size=X.shape)) for _ in range(3)]
+    flips = _signs(0, X.size, 4)  # three perturbations of X, then the signs of `check`
+    pert = [X] + [X * (1 + _EPS * flips[k].reshape(X.shape)) for k in range(3)]
     F = target.rhs(np.concatenate(pert, axis=1),
                    np.tile(cols, len(pert))).reshape(x.shape[0], len(pert), cols.size)
     if not np.all(np.isfinite(F)):
@@ -374,7 +376,7 @@ def _floor(target, run: Run, rtol, atol, lipschitz: float, jit: bool,
                          / np.min(scale.reshape(runs, -1), axis=1))) * (1 + lipschitz * horizon)
     if bound <= 0.1 * _AUTO_ACCEPT:
         return max(bound, ulps), 0
-    signs = rng.choice((-1.0, 1.0), size=e.size)
+    signs = _signs(1, e.size)
     check = target.run(target.x0 + signs * e, run.substeps, jit, progress)
     return max(local, ulps, _scaled_diff(check.x[:, 1:], x[:, 1:], scale)), check.n_steps
 
@@ -386,8 +388,18 @@ def _perturbed(x0: np.ndarray, m: int) -> np.ndarray:
     the model's constants, rounded alike). Near a separatrix this amplification put a common
     error of 3e-13 into every run at 16-400 steps per interval that step-count differences
     alone cannot see; a well-conditioned problem just carries the 2 ulp."""
-    signs = np.random.default_rng(m).choice((-1.0, 1.0), size=x0.size)
-    return x0 + 2 * _EPS * signs * x0
+    return x0 + 2 * _EPS * _signs(m, x0.size) * x0
+
+
+@functools.lru_cache(maxsize=256)
+def _signs(seed: int, size: int, count: int = 1) -> np.ndarray:
+    """``count`` reproducible random sign patterns of ``size`` entries, shape (count, size)
+    (or (size,) for one), read-only. Cached: seeding a generator costs about 40 us, more
+    than an rk8 run of a small model."""
+    out = np.random.default_rng(seed).choice((-1.0, 1.0), size=(count, size))
+    out = out[0] if count == 1 else out
+    out.setflags(write=False)
+    return out
 
 
 def _first_bad(x: np.ndarray) -> int:
