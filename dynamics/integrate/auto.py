@@ -356,8 +356,8 @@ def _floor(target, run: Run, rtol, atol, lipschitz: float, jit: bool,
     horizon = float(target.t[-1] - target.t[0])
     cols = np.unique(np.linspace(0, x.shape[1] - 1, min(16, x.shape[1])).round().astype(int))
     X = x[:, cols]
-    flips = _signs(0, X.size, 4)  # three perturbations of X, then the signs of `check`
-    pert = [X] + [X * (1 + _EPS * flips[k].reshape(X.shape)) for k in range(3)]
+    flips, signs = _floor_signs(X.shape, x.shape[0])
+    pert = [X] + [X * (1 + _EPS * f) for f in flips]
     F = target.rhs(np.concatenate(pert, axis=1),
                    np.tile(cols, len(pert))).reshape(x.shape[0], len(pert), cols.size)
     if not np.all(np.isfinite(F)):
@@ -376,7 +376,6 @@ def _floor(target, run: Run, rtol, atol, lipschitz: float, jit: bool,
                          / np.min(scale.reshape(runs, -1), axis=1))) * (1 + lipschitz * horizon)
     if bound <= 0.1 * _AUTO_ACCEPT:
         return max(bound, ulps), 0
-    signs = _signs(1, e.size)
     check = target.run(target.x0 + signs * e, run.substeps, jit, progress)
     return max(local, ulps, _scaled_diff(check.x[:, 1:], x[:, 1:], scale)), check.n_steps
 
@@ -392,14 +391,25 @@ def _perturbed(x0: np.ndarray, m: int) -> np.ndarray:
 
 
 @functools.lru_cache(maxsize=256)
-def _signs(seed: int, size: int, count: int = 1) -> np.ndarray:
-    """``count`` reproducible random sign patterns of ``size`` entries, shape (count, size)
-    (or (size,) for one), read-only. Cached: seeding a generator costs about 40 us, more
-    than an rk8 run of a small model."""
-    out = np.random.default_rng(seed).choice((-1.0, 1.0), size=(count, size))
-    out = out[0] if count == 1 else out
+def _signs(seed: int, size: int) -> np.ndarray:
+    """A reproducible random sign pattern of ``size`` entries (read-only). Cached: seeding a
+    numpy generator costs about 40 us, more than an rk8 run of a small model."""
+    out = np.random.default_rng(seed).choice((-1.0, 1.0), size=size)
     out.setflags(write=False)
     return out
+
+
+@functools.lru_cache(maxsize=256)
+def _floor_signs(shape: tuple, n: int) -> tuple:
+    """`_floor`'s sign patterns (cached, read-only): three of ``shape`` for the ulp moves of
+    the sampled states, then ``n`` for the start of its check run, drawn in that order from
+    one generator seeded 0."""
+    rng = np.random.default_rng(0)
+    flips = [rng.choice((-1.0, 1.0), size=shape) for _ in range(3)]
+    signs = rng.choice((-1.0, 1.0), size=n)
+    for a in (*flips, signs):
+        a.setflags(write=False)
+    return tuple(flips), signs
 
 
 def _first_bad(x: np.ndarray) -> int:
