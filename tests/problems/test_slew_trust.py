@@ -130,6 +130,22 @@ def test_pointing_error_is_reported_and_gates_success():
         slew.min_effort(E, 1.0, angle=1.0, axis=[1, 0, 0], rate_tol="1e-6")
 
 
+def test_general_inertia_near_miss_is_verified_on_a_finer_mesh():
+    """Found by the random valid-input sweep: 4 of 80 random full inertias (1 rad about z)
+    ended success=False, pointing 1.0-15x over 1e-6 rad, after the polish stopped at IPOPT's
+    acceptable level and the mesh refinement stalled on the switches. The uniform mesh twice
+    as fine, warm from the first solution, verifies them; checked here by re-simulation."""
+    inertia = np.array([[9.51003944005232, 0.08993414809458342, 2.083123331131754],
+                        [0.08993414809458372, 9.89508968108077, -0.5917497279706797],
+                        [2.0831233311317545, -0.5917497279706796, 0.6474290357928307]])
+    sol = slew.time_optimal(inertia, angle=1.0, axis=[0, 0, 1])
+    assert sol.success, sol.message
+    assert "uniform mesh of 60 intervals" in sol.info["fallback"]
+    xf = resimulate(sol, inertia, [0, 0, 0, 1.0], np.zeros(3))
+    assert angle_between(xf[:4], target(1.0, [0, 0, 1])) <= slew.POINTING_TOL
+    assert np.max(np.abs(sol.u)) <= 1.0 + 1e-9 and sol.T == pytest.approx(2.51199, abs=1e-4)
+
+
 def test_refinement_tol_is_required(monkeypatch):
     with pytest.raises(ValueError, match="`tol`"):
         slew.min_effort(E, 2.0, angle=1.0, axis=[1, 0, 0], tol=1e-16)
