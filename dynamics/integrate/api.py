@@ -25,7 +25,6 @@ __all__ = ["simulate", "METHODS", "Method"]
 Method = Literal["auto", "cvodes", "rk4", "rk8", "lie"]
 METHODS = ("auto", "cvodes", "rk4", "rk8", "lie")
 _FIXED_STEP = ("rk4", "rk8", "lie")
-_RTOL_MIN = 100 * np.finfo(float).eps  # `check_tolerances`' least rtol
 
 
 def simulate(model: Model, x0, t, *, u=None, p=None, method: Method = "auto",
@@ -150,20 +149,11 @@ def simulate(model: Model, x0, t, *, u=None, p=None, method: Method = "auto",
     if CLOCK_STATE in model.states:  # a time-dependent model: its clock starts at t[0]
         check_clock_start(model, x0, t[0])
     p = model.resolve_p(p)
-    if (method in _FIXED_STEP and type(rtol) is float and type(atol) is float
-            and _RTOL_MIN <= rtol < 1 and 0 <= atol < math.inf):
-        pass  # checked as `check_tolerances` would; a fixed-step method does not use them
-    else:
-        rtol, atol = check_tolerances(rtol, atol, model.nx)
+    rtol, atol = check_tolerances(rtol, atol, model.nx)
     control = None if u is None else check_u(u, model.nu, t)  # None: zero, made if needed
     names = check_invariants(invariants, model)
-    if (method in _FIXED_STEP and type(max_steps) is int and max_steps >= 1 and jit is None
-            and cvodes_options is None and progress is None):  # as `_check_options` finds them
-        steps = 1 if steps is None else validate.integer(steps, "steps", minimum=1)
-        counter = None  # Progress(None), made when needed
-    else:
-        max_steps, steps, cvodes_options, counter = _check_options(
-            method, max_steps, jit, steps, cvodes_options, progress)
+    max_steps, steps, cvodes_options, counter = _check_options(method, max_steps, jit, steps,
+                                                               cvodes_options, progress)
     if method == "lie":
         check_lie_model(model, x0, p)
     used, status, estimate = method, OK, math.nan
@@ -175,8 +165,6 @@ def simulate(model: Model, x0, t, *, u=None, p=None, method: Method = "auto",
         if control is None:
             control = check_u(None, model.nu, t)
         problem = Problem.new(model, x0, t, control, p)
-        if counter is None:
-            counter = Progress(None)
         if method in _FIXED_STEP:
             run = run_fixed(problem, method, steps, cache.should_compile(jit, math.inf), counter)
         elif method == "cvodes":

@@ -161,6 +161,9 @@ def _cvodes_option_names() -> frozenset:
 
 def check_tolerances(rtol, atol, nx: int) -> tuple[float, np.ndarray]:
     """``rtol`` in ``[100 eps, 1)``; ``atol`` a scalar or (nx,), finite and >= 0 -> (nx,)."""
+    if (type(rtol) is float and type(atol) is float and 100 * _EPS <= rtol < 1
+            and 0 <= atol < math.inf):  # fast path: the common case, every check passed
+        return rtol, np.full(nx, atol)
     rtol_f = finite_scalar(rtol, "rtol")
     if not 100 * _EPS <= rtol_f < 1:
         raise ValueError(f"`rtol` must be in [{100 * _EPS:.3g}, 1), got {rtol!r}")
