@@ -271,21 +271,56 @@ def compile_function(fun: ca.Function, opt: str = "-O3") -> ca.Function | None:
     file descriptors open per compile (casadi issue #4295) and its files on disk, nothing is
     left behind. Raises ``RuntimeError`` when the code cannot be generated or compiled.
     """
+    return compile_c([fun], "", opt, lambda library: ca.external(fun.name(), library))
+
+
+def compile_c(functions: list, extra: str, opt: str, load: Callable[[str], object]):
+    """Generate C for the casadi ``functions``, append the C source ``extra`` (which may call
+    them by name), compile to a shared library with the flags ``opt`` (space-separated) and
+    return ``load(path)`` (e.g. ``ctypes.CDLL``); the files are deleted after loading. None
+    without a C compiler; ``RuntimeError`` when generating or compiling fails (see
+    `compile_function`)."""
+    out = compile_parallel([(functions, extra, opt, load)])[0]
+    if isinstance(out, RuntimeError):
+        raise out
+    return out
+
+
+def compile_parallel(jobs: list) -> list:
+    """`compile_c` of several ``(functions, extra, opt, load)`` jobs, the C compilers running
+    at once (one process each): per job, in order, the loaded result or the ``RuntimeError``
+    saying why it failed (returned, not raised); a list of None without a C compiler."""
     compiler = _CACHE.compiler()
     if compiler is None:
-        return None
+        return [None] * len(jobs)
     with tempfile.TemporaryDirectory(prefix="appdyn-cc-") as work:
-        name = fun.name()
-        source = os.path.join(work, f"{name}.c")
-        library = os.path.join(work, f"{name}.so")
-        gen = ca.CodeGenerator(f"{name}.c", {"with_header": False})
-        gen.add(fun)
-        gen.generate(work + os.sep)
-        done = subprocess.run([compiler, opt, "-w", "-fPIC", "-shared", source, "-o", library,
-                               "-lm"], capture_output=True, text=True)
-        if done.returncode != 0:
-            raise RuntimeError(f"C compilation of {name} failed: {done.stderr.strip()[-500:]}")
-        return ca.external(name, library)
+        procs = []
+        for functions, extra, opt, _ in jobs:
+            name = functions[0].name()
+            source = os.path.join(work, f"{name}.c")
+            library = os.path.join(work, f"{name}.so")
+            gen = ca.CodeGenerator(f"{name}.c", {"with_header": False})
+            for fun in functions:
+                gen.add(fun)
+            gen.generate(work + os.sep)
+            if extra:
+                with open(source, "a") as out:
+                    out.write(extra)
+            procs.append((name, library, subprocess.Popen(
+                [compiler, *opt.split(), "-w", "-fPIC", "-shared", source, "-o", library, "-lm"],
+                stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)))
+        results = []
+        for (name, library, proc), job in zip(procs, jobs):
+            _, err = proc.communicate()
+            if proc.returncode != 0:
+                results.append(RuntimeError(f"C compilation of {name} failed: "
+                                            f"{err.strip()[-500:]}"))
+                continue
+            try:
+                results.append(job[3](library))
+            except (OSError, RuntimeError) as exc:  # (a library that does not load)
+                results.append(RuntimeError(f"loading {name} failed: {exc}"))
+        return results
 
 
 _CACHE = FunctionCache()

@@ -47,8 +47,10 @@ made from Python before the compiled loop runs) or at every right-hand-side eval
 (``cvodes``, through a ``casadi.Callback``).
 
 The error of a fixed-step run is controlled by the number of substeps; ``auto`` chooses it
-from Richardson step-halving estimates of the *global* error at the output times (see
-`simulate`), which is what a tolerance should mean to a user. ``cvodes`` tolerances are local
+per output interval from DOP853's embedded error estimate in one compiled pass and checks the
+*global* error at the output times against a run with half the steps (`adaptive`), or, when
+that check fails, from Richardson estimates of runs with different step counts (`auto`; see
+`simulate`): the global error is what a tolerance should mean to a user. ``cvodes`` tolerances are local
 error controls: they are not errors (on a 100 s tumbling body, rtol = 1e-10 gives 1e-7).
 
 Adding a method

@@ -62,9 +62,12 @@ def simulate(model: Model, x0, t, *, u=None, p=None, method: Method = "auto",
         * ``'cvodes'``: SUNDIALS CVODES (BDF by default) through ``casadi.integrator`` with
           ``rtol``/``atol`` as its local tolerances (the smallest ``atol`` when a vector).
         * ``'auto'``: ``rk8`` with the step count chosen from global error estimates so
-          that ``|error| <= atol + rtol |x|`` at every output time (Richardson estimates
-          from runs with different step counts, checked for 8th-order behaviour; see
-          `dynamics.integrate.auto`). A stiff problem (a decaying mode of the Jacobian at
+          that ``|error| <= atol + rtol |x|`` at every output time. First one compiled C
+          pass (no callable ``u``, a C compiler, a tolerance at least 1e6 ulps above the
+          states): steps per interval from DOP853's embedded error estimate, checked
+          against a run with half the steps carried alongside (`dynamics.integrate.adaptive`);
+          then, if that check is not met, Richardson estimates from runs with different
+          step counts, checked for 8th-order behaviour (`dynamics.integrate.auto`). A stiff problem (a decaying mode of the Jacobian at
           ``x0`` faster than ``1e6`` explicit steps over the horizon can follow) goes to
           cvodes, whose global error is then estimated from runs at tightened local
           tolerances (``status`` 1). A tolerance that cannot be verified is ``success=False`` with

@@ -11,6 +11,7 @@ import casadi as ca
 import numpy as np
 
 from .. import cache
+from .adaptive import BMAX, CHECK_EVERY, NOISE, run_pass
 from .cvodes import run_cvodes
 from .evaluate import call_buffered, map_eval
 from .inputs import Problem
@@ -30,6 +31,10 @@ _FLOOR_ULPS = 1000     # least error floor of a run in ulps of a state's size (`
 _STIFF_STEPS = 1e6     # explicit steps for stability alone beyond which auto uses cvodes
 _CVODES_RTOL_MIN = 1e-14  # tightest local rtol auto asks cvodes for
 _RK8_STABILITY = 6.0   # DOP853's stability interval on the negative real axis is about [-6, 0]
+_PASS_THETA = 1.0      # the check run's embedded estimates over the horizon, in tolerances
+_PASS_TRIES = 3        # passes (each aimed tighter) before the multi-run search
+_PASS_ULPS = 10 ** 4   # the one-pass path needs the tolerance this many ulps above the state
+_PASS_MEASURED = 10 ** 6  # and below this many it measures the model's rounding (`_floor`)
 
 
 def _scaled_diff(xa: np.ndarray, xb: np.ndarray, scale: np.ndarray) -> float:
@@ -363,21 +368,35 @@ def _floor(target, run: Run, rtol, atol, lipschitz: float, jit: bool,
     if not np.all(np.isfinite(F)):
         return math.inf, 0
     noise = np.max(np.abs(F[:, 1:] - F[:, :1]), axis=(1, 2))
-    tau = horizon if lipschitz <= 0 else min(horizon, 1.0 / lipschitz)
-    e = 2 * math.sqrt(horizon * tau) * noise
+    e = _carried(noise, horizon, lipschitz)
     scale = atol[:, None] + rtol * np.abs(x[:, 1:])
     ulps = _roundoff(x, _FLOOR_ULPS, scale)
     local = _scaled_diff(np.broadcast_to(e[:, None], scale.shape), np.zeros(scale.shape), scale)
-    # the flow may carry the noise of any state into any other (the spin-rate noise of a
-    # flat body into the phase of its transverse rates): a screening bound across the states
-    # of each run (the runs of a batch do not share noise), the largest over the runs
-    runs = target.runs
-    bound = float(np.max(np.max(e.reshape(runs, -1), axis=1)
-                         / np.min(scale.reshape(runs, -1), axis=1))) * (1 + lipschitz * horizon)
+    bound = _screen(e, np.min(scale, axis=1), horizon, lipschitz, target.runs)
     if bound <= 0.1 * _AUTO_ACCEPT:
         return max(bound, ulps), 0
     check = target.run(target.x0 + signs * e, run.substeps, jit, progress)
     return max(local, ulps, _scaled_diff(check.x[:, 1:], x[:, 1:], scale)), check.n_steps
+
+
+def _carried(noise: np.ndarray, horizon: float, lipschitz: float) -> np.ndarray:
+    """`_floor`'s rounding error ``2 sqrt(T min(T, 1 / L)) noise`` carried over the horizon
+    ``T`` from the right-hand side's rounding ``noise`` per state (``L`` the spectral
+    radius)."""
+    tau = horizon if lipschitz <= 0 else min(horizon, 1.0 / lipschitz)
+    return 2 * math.sqrt(horizon * tau) * noise
+
+
+def _screen(e: np.ndarray, smin: np.ndarray, horizon: float, lipschitz: float,
+            runs: int = 1) -> float:
+    """`_floor`'s screening bound of the carried rounding ``e`` against the least tolerance
+    ``smin`` of each state: the flow may carry the noise of any state into any other (the
+    spin-rate noise of a flat body into the phase of its transverse rates), so across the
+    states of each run (the runs of a batch do not share noise), the largest over the runs,
+    grown by ``1 + L T``."""
+    top, least = np.max(e.reshape(runs, -1), axis=1), np.min(smin.reshape(runs, -1), axis=1)
+    worst = np.divide(top, least, out=np.where(top > 0, np.inf, 0.0), where=least > 0)
+    return float(np.max(worst)) * (1 + lipschitz * horizon)
 
 
 def _perturbed(x0: np.ndarray, m: int) -> np.ndarray:
@@ -450,10 +469,119 @@ def _auto_cvodes(problem: Problem, rtol, atol, extra):
 
 
 
+def one_pass(problem: Problem, rtol, atol, max_steps, jit_pref, progress):
+    """``auto`` in one compiled pass (`dynamics.integrate.adaptive`) where it applies:
+    returns ``(run, estimate, steps)``, or ``(None, nan, steps)`` to leave the problem to
+    the multi-run search (`auto_runs`) with ``steps`` already spent.
+
+    The check run (``b`` steps per interval, chosen by DOP853's embedded estimate) and the
+    answer (``n = 2 b + 1``, or 2 for ``b = 1``; ``r`` the least ``n / b``) differ by ``d``
+    (scaled, max over the outputs). Accepted:
+
+    * when the two runs show the method's order (in at least half of at least 3 intervals
+      where both estimates were measured clear of rounding, ``e > 30 eps / rtol`` in
+      tolerance units, ``log(ec / e) / log(n / b)`` lies in [5, 10]: measured 7-8 on the
+      rigid body, the estimate being of order h^7-h^8): at ``d / (r^6 - 1)`` (the Richardson
+      estimate of `_estimate`, two orders low) plus 1000 ulps of each state, when that is
+      at most 0.5;
+    * when no estimate of the answer stands clear of rounding (``e <= 30 eps / rtol`` in
+      every one of at least 12 intervals): as above, the answer's steps times that level
+      added (its truncation, step by step, is at most the rounding level);
+    * otherwise at ``2 d`` plus the ulps when at most 1 (the answer is at least twice as
+      accurate as the check: ``e <= d``), every check step measured being within DOP853's
+      local tolerance.
+
+    Within `_PASS_MEASURED` ulps of a state's size, the tolerance may meet the rounding of
+    the model's own formulas, which both runs share: the pass measures it (the change of
+    ``f`` when its state moves by one ulp) and `_floor`'s screening bound, carried over the
+    horizon with the spectral radius at ``x0``, must be below 0.05 (it is added to the
+    estimate); otherwise the multi-run search measures the flow's real amplification.
+
+    Not accepted, the pass is repeated aimed tighter (`_PASS_TRIES` in all). Not taken: a
+    callable control, no compiled pass, a tolerance within `_PASS_ULPS` ulps of a state, a
+    non-finite state or an interval that needs more than ``2 adaptive.BMAX + 1`` steps.
+    """
+    if problem.control.mode != "linear" or not _auto_jit(jit_pref):
+        return None, math.nan, 0
+    if _size_over_tolerance(problem, rtol, atol) * _EPS * _PASS_ULPS > 1.0:
+        return None, math.nan, 0  # (the states' sizes put the tolerance near round-off)
+    horizon = float(problem.t[-1] - problem.t[0])
+    theta = _PASS_THETA / horizon
+    xc0 = _perturbed(problem.x0, 1)
+    spent, bmin = 0, 1
+    for _ in range(_PASS_TRIES):
+        got = run_pass(problem, rtol, atol, theta, xc0, max_steps - spent, progress, bmin,
+                       _PASS_ULPS)
+        if got is None:
+            return None, math.nan, spent
+        spent += got.n_steps
+        if not got.ok:
+            return None, math.nan, spent
+        d, ulps = got.d, got.ulp * _FLOOR_ULPS
+        if got.ulp * _PASS_MEASURED > 1.0:  # near round-off: the model's rounding, measured
+            lipschitz = Single(problem).spectrum(rtol, atol)[0]
+            bound = _screen(_carried(got.rounding, horizon, lipschitz), got.smin, horizon,
+                            lipschitz)
+            if not bound <= 0.1 * _AUTO_ACCEPT:
+                return None, math.nan, spent  # (the multi-run search measures the flow's)
+            ulps = max(ulps, bound)
+        shown, measured = got.orders
+        richardson = d / (got.ratio ** 6 - 1)
+        if measured == 0 and got.stats.shape[0] >= 3 * CHECK_EVERY:
+            # the answer's own estimates are all at the rounding level: its truncation is
+            # at most that level per step, added up over its steps
+            richardson += got.answer_steps * NOISE * _EPS / rtol
+            trusted = True
+        else:
+            trusted = measured >= 3 and 2 * shown >= measured
+        if trusted and richardson + ulps <= _AUTO_ACCEPT:
+            estimate = richardson + ulps
+        elif got.ec <= 1.0 and 2 * d + ulps <= 1.0:
+            estimate = 2 * d + ulps
+        else:
+            if not math.isfinite(d):
+                return None, math.nan, spent
+            # aim at an estimate of 0.05 (d ~ h^8, the embedded estimate ~ h^7)
+            factor = max(1.1, ((richardson if trusted else 2 * d) / 0.05) ** (1 / 8))
+            theta /= factor ** 7
+            bmin = max(bmin, math.ceil(factor * (got.stats[:, 3] - got.stats[:, 0]).mean()))
+            if bmin > BMAX:
+                return None, math.nan, spent
+            continue
+        lo, hi = got.n_range
+        message = (f"auto: rk8 with embedded error control: {got.answer_steps} steps ({lo}-{hi} "
+                   "per output interval), checked against a run with fewer than half the steps; "
+                   f"estimated error {estimate:.2g} of tolerance")
+        run = Run.new(np.ascontiguousarray(got.x), spent, DOP853.stages * spent, hi, True, True,
+                      message)
+        return run, estimate, spent
+    return None, math.nan, spent
+
+
+def _size_over_tolerance(problem: Problem, rtol: float, atol: np.ndarray) -> float:
+    """The largest ``|x0_i| / (atol_i + rtol |x0_i|)`` (inf for a zero tolerance); a unit
+    quaternion's parts (``model.attitude``) count at its norm over ``atol`` (they reach
+    both). In Python floats: a few microseconds less than numpy for a small state."""
+    size = [abs(v) for v in problem.x0.tolist()]
+    a = atol.tolist()
+    least = [ai + rtol * si for ai, si in zip(a, size)]
+    if problem.model.attitude is not None:
+        iq = problem.model.attitude[0]
+        norm = math.sqrt(sum(v * v for v in size[iq:iq + 4]))
+        size[iq:iq + 4] = [norm] * 4
+        least[iq:iq + 4] = a[iq:iq + 4]
+    return max((si / li if li > 0 else math.inf for si, li in zip(size, least) if si > 0),
+               default=0.0)
+
+
 def solve_auto(problem: Problem, rtol, atol, max_steps, jit, cvodes_options, progress):
     """``auto``: -> (run, method used, status, error estimate); counters cover every run."""
+    run, estimate, spent = one_pass(problem, rtol, atol, max_steps, jit, progress)
+    if run is not None:
+        return run, "rk8", OK, estimate
     run, estimate, status, reason, n_steps, n_rhs = auto_runs(Single(problem), rtol, atol,
-                                                          max_steps, jit, progress)
+                                                          max_steps - spent, jit, progress)
+    n_steps, n_rhs = n_steps + spent, n_rhs + DOP853.stages * spent
     if run is None and reason.startswith("stiff"):
         crun, estimate, status, cs, cr = _auto_cvodes(problem, rtol, atol, cvodes_options)
         verdict = {OK_STIFF: f"estimated error {estimate:.2g} of tolerance (from runs at "

@@ -8,7 +8,7 @@ import numpy as np
 from .. import cache
 from ..attitude import propagate_quat, quat_rate
 from ..model import Model
-from .tableaux import TABLEAUX, unique_nodes
+from .tableaux import DOP853_E3, DOP853_E5, TABLEAUX, unique_nodes
 
 __all__ = ["kernel", "check_lie_model"]
 
@@ -43,8 +43,13 @@ def _stage_control(mode, ins, nu, nodes_unique, linear_u):
     return u_at
 
 
-def _rk_kernel(f: ca.Function, method: str, mode: str) -> ca.Function:
-    """One explicit Runge-Kutta step ``(x, h, u-data, p) -> x_next`` as a Function."""
+def _rk_kernel(f: ca.Function, method: str, mode: str, error: bool = False) -> ca.Function:
+    """One explicit Runge-Kutta step ``(x, h, u-data, p) -> x_next`` as a Function.
+
+    ``error`` (``rk8`` only): inputs ``rtol`` (scalar) and ``atol (nx)`` follow, and a
+    second output is DOP853's embedded error estimate of the step (`DOP853_E5`), in units
+    of the tolerance ``atol + rtol max(|x|, |x_next|)``.
+    """
     tab = TABLEAUX[method]
     nx, nu, np_ = f.numel_in(0), f.numel_in(1), f.numel_in(2)
     nodes = unique_nodes(method)
@@ -59,11 +64,25 @@ def _rk_kernel(f: ca.Function, method: str, mode: str) -> ca.Function:
             if aij != 0.0:
                 xi = xi + (aij * h) * k[j]
         k.append(f.call([xi, u_at(tab.c[i]), p])[0])
-    incr = 0
-    for bi, ki in zip(tab.b, k):
-        if bi != 0.0:
-            incr = incr + bi * ki
-    return ca.Function(f"{method}_step", ins, [x + h * incr])
+    x_next = x + h * _combine(tab.b, k)
+    if not error:
+        return ca.Function(f"{method}_step", ins, [x_next])
+    rtol, atol = sym.sym("rtol"), sym.sym("atol", nx)
+    scale = atol + rtol * ca.fmax(ca.fabs(x), ca.fabs(x_next))
+    e5 = ca.sumsqr(_combine(DOP853_E5, k) / scale)
+    e3 = ca.sumsqr(_combine(DOP853_E3, k) / scale)
+    # (0/0 where both vanish: the floor keeps the quotient 0)
+    err = ca.fabs(h) * e5 / ca.sqrt(nx * ca.fmax(e5 + 0.01 * e3, 1e-300))
+    return ca.Function(f"{method}_step_err", ins + [rtol, atol], [x_next, err])
+
+
+def _combine(weights, k: list):
+    """``sum w_i k_i`` over the nonzero weights."""
+    out = 0
+    for w, ki in zip(weights, k):
+        if w != 0.0:
+            out = out + w * ki
+    return out
 
 
 def _lie_kernel(f: ca.Function, attitude: tuple[int, int], mode: str) -> ca.Function:
@@ -156,14 +175,16 @@ def _lie_kinematics_check(model: Model, x0: np.ndarray, p: np.ndarray) -> bool:
     return True
 
 
-def kernel(model: Model, method: str, mode: str) -> ca.Function:
+def kernel(model: Model, method: str, mode: str, error: bool = False) -> ca.Function:
+    """The step Function of ``model`` and ``method`` (cached); ``error``: with DOP853's
+    embedded error estimate (``rk8``; see `_rk_kernel`)."""
     key = ("kernel", cache.function_key(model.f), model.attitude if method == "lie" else None,
-           method, mode)
+           method, mode) + (("error",) if error else ())
 
     def build():
         if method == "lie":
             return _lie_kernel(model.f, model.attitude, mode)
-        return _rk_kernel(model.f, method, mode)
+        return _rk_kernel(model.f, method, mode, error)
 
     return cache.get(key, build, keepalive=model.f)
 

@@ -2,7 +2,6 @@
 optionally jit-compiled) and the Python loop over chunks that runs it."""
 from __future__ import annotations
 
-import contextlib
 import math
 from typing import Callable
 
@@ -18,8 +17,8 @@ from .kernels import kernel
 from .result import Run
 from .tableaux import TABLEAUX, unique_nodes
 
-__all__ = ["CHUNK", "BATCH_CHUNK", "Progress", "chunk_function", "chunk_key", "interval_ends",
-           "run_fixed", "run_short"]
+__all__ = ["CHUNK", "BATCH_CHUNK", "Progress", "chunk_compile_job", "chunk_function",
+           "chunk_key", "interval_ends", "run_fixed", "run_short"]
 
 _BASE = 4  # unroll base of mapaccum: casadi's construction cost grows ~5x from base 4 to 10
 
@@ -64,6 +63,24 @@ def chunk_function(model: Model, method: str, mode: str, jit: bool, size: int = 
             return loop, False
 
     return cache.get(base_key + (True,), build_compiled, keepalive=model.f)
+
+
+def chunk_compile_job(model: Model, method: str, mode: str):
+    """The compile of the (default-size) chunk Function, for `cache.compile_parallel`, when
+    it is not cached yet and would be compiled: ``(job, store)``, ``store(result)`` putting
+    the compiled Function (or, after a failure, the interpreted one) into the cache as
+    `chunk_function` would; else None."""
+    key = chunk_key(model, method, mode) + (True,)
+    if cache.compiler() is None or cache.contains(key):
+        return None
+    loop = _build_chunk(model, method, mode)
+
+    def store(result):
+        value = (loop, False) if isinstance(result, RuntimeError) else (result, True)
+        return cache.get(key, lambda: value, keepalive=model.f)
+
+    name = loop.name()
+    return ([loop], "", _OPT, lambda library: ca.external(name, library)), store
 
 
 def chunk_key(model: Model, method: str, mode: str) -> tuple:

@@ -116,7 +116,8 @@ class SimulationResult:
         Steps taken and right-hand-side evaluations made, summed over every run the call made
         (``auto`` makes several).
     substeps : int
-        Fixed-step methods: steps per output interval of the returned solution; 0 for cvodes.
+        Fixed-step methods: steps per output interval of the returned solution (``auto``'s
+        one-pass path: the most in any interval); 0 for cvodes.
     error_estimate : float
         ``auto`` with a fixed-step result: estimated max over states and output times of
         ``|error| / (atol + rtol |x|)`` (1.0 is exactly the tolerance); NaN otherwise.

@@ -7,7 +7,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-__all__ = ["Tableau", "RK4", "DOP853", "CF4_NODES", "TABLEAUX", "unique_nodes"]
+__all__ = ["Tableau", "RK4", "DOP853", "DOP853_E3", "DOP853_E5", "CF4_NODES", "TABLEAUX",
+           "unique_nodes"]
 
 
 @dataclass(frozen=True)
@@ -66,6 +67,17 @@ DOP853 = Tableau(
        0.8571428571428571, 1.0),
     order=8,
 )
+
+# DOP853's embedded error weights over its 12 stages (Hairer's ``er`` and ``b - bhh``; the
+# doubles of scipy's E5 and E3 without their zero 13th entry): with ``s = atol + rtol
+# max(|x|, |x+|)``, ``e5 = sum E5_i k_i / s``, ``e3 = sum E3_i k_i / s``, the step's error
+# estimate is ``|h| |e5|^2 / sqrt(n (|e5|^2 + 0.01 |e3|^2))`` (dop853.f), of order h^8.
+DOP853_E5 = (0.01312004499419488, 0.0, 0.0, 0.0, 0.0, -1.2251564463762044, -0.4957589496572502,
+             1.6643771824549864, -0.35032884874997366, 0.3341791187130175, 0.08192320648511571,
+             -0.022355307863886294)
+DOP853_E3 = (-0.18980075407240762, 0.0, 0.0, 0.0, 0.0, 4.450312892752409, 1.8915178993145003,
+             -5.801203960010585, -0.4226823213237919, -0.1521609496625161, 0.20136540080403034,
+             0.02265179219836082)
 
 # Stage nodes of the commutator-free method CF4 used by "lie" (four right-hand sides a step).
 CF4_NODES = (0.0, 0.5, 0.5, 1.0)

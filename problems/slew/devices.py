@@ -248,7 +248,10 @@ def cmg_slew(inertia, geometry, *, objective="time", T=None, angle=None, axis=No
     N, starts, seed, tol, verbose, ipopt_options, pointing_tol, rate_tol
         As in `wheel_slew`. A time-optimal CMG slew is not polished (its gimbal rates are
         not bang-bang: singular and measure-constrained arcs); a fixed mesh that misses the
-        target is refined (`ocp.refine`) instead.
+        target is refined (`ocp.refine`) instead, and where a singular arc stalls the
+        refinement, the fallbacks of `time_optimal` (``info['fallback']``: the uniform mesh
+        twice as fine, then the slightly regularized problem, ``T`` within about 1e-5
+        relative of the unregularized one on the tests).
 
     Returns
     -------

@@ -1,0 +1,183 @@
+"""``auto``'s one-pass path (`dynamics.integrate.adaptive`): rk8 with DOP853's embedded error
+control and a check run at half the steps, in one compiled C pass. Judged against the
+Jacobi-elliptic torque-free truth and the closed form of a spin-up under a ramped torque."""
+import math
+
+import numpy as np
+import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+
+from dynamics import cache, rigid_body, simulate
+from dynamics.integrate import adaptive
+from dynamics.integrate.auto import one_pass
+from dynamics.integrate.inputs import Problem, check_u
+from dynamics.integrate.loops import Progress
+from dynamics.integrate.result import FAILED
+from dynamics.truth import torque_free_omega, torque_free_parameters
+
+INERTIA = [1.0, 2.0, 3.0]
+X0 = np.array([0.0, 0.0, 0.0, 1.0, 1.0, 0.1, 0.8])
+ONE_PASS = "embedded error control"
+
+pytestmark = pytest.mark.skipif(cache.compiler() is None, reason="needs a C compiler")
+
+
+def ratio(res, inertia, rtol, atol):
+    """max |w - w_true| / (atol + rtol |w_true|) over the rates and output times."""
+    w_true = torque_free_omega(inertia, res.x[4:, 0], res.t)
+    return float(np.max(np.abs(res.x[4:] - w_true) / (atol + rtol * np.abs(w_true))))
+
+
+def test_one_pass_at_loose_tolerance_meets_it_in_one_pass():
+    """The benchmark body, 100 s, 101 outputs, rtol 1e-3: one pass (1-2 check steps and 2-5
+    answer steps per interval: about 300 steps; a second pass would at least double it),
+    accepted, and the error far inside the tolerance."""
+    t = np.linspace(0.0, 100.0, 101)
+    res = simulate(rigid_body(INERTIA), X0, t, rtol=1e-3, atol=1e-5)
+    assert res.success and res.status == 0 and res.method == "rk8", res.message
+    assert ONE_PASS in res.message
+    assert 300 <= res.n_steps <= 350 and res.n_rhs == 12 * res.n_steps
+    assert 2 <= res.substeps <= 5 and res.compiled
+    assert res.error_estimate <= 0.5
+    assert ratio(res, INERTIA, 1e-3, 1e-5) <= res.error_estimate
+    assert np.array_equal(res.x[:, 0], X0) and res.x.flags.c_contiguous
+
+
+@settings(max_examples=30, deadline=None, derandomize=True,
+          suppress_health_check=[HealthCheck.too_slow])
+@given(
+    inertia=st.sampled_from([(1.0, 2.0, 3.0), (1.0, 1.5, 2.0), (2.0, 3.0, 4.5), (5.0, 4.0, 2.0),
+                             (3.0, 1.0, 3.5)]),
+    w0=st.lists(st.floats(-3.0, 3.0), min_size=3, max_size=3),
+    t_final=st.floats(1.0, 100.0),
+    n=st.integers(2, 600),
+    log_rtol=st.floats(-8.0, -2.0),
+)
+def test_one_pass_success_implies_the_tolerance_is_met(inertia, w0, t_final, n, log_rtol):
+    """Random torque-free runs at tolerances where the one-pass path applies: success means
+    the true rate error is within the tolerance at every output (and within the estimate
+    when the estimate is the check's ``2 d``)."""
+    rtol = 10.0 ** log_rtol
+    atol = rtol / 100
+    w0 = np.array(w0)
+    if np.linalg.norm(w0) < 1e-3:
+        w0 = w0 + 0.1
+    if 1 - float(torque_free_parameters(list(inertia), w0).m) <= 1e-3:
+        w0 = w0 * np.array([1.0, 0.5, 1.0]) + np.array([0.0, 0.0, 0.3])  # off the separatrix
+    t = np.linspace(0.0, t_final, n)
+    res = simulate(rigid_body(list(inertia)), np.r_[0, 0, 0, 1.0, w0], t, rtol=rtol, atol=atol)
+    assert res.success or res.status in (2, 3), res.message
+    if res.success:
+        assert ratio(res, list(inertia), rtol, atol) <= 1.0, res.message
+
+
+def test_ramped_torque_matches_the_closed_form():
+    """Spin-up from rest about the 3-axis under ``tau = a + b t`` (samples on the grid, linear
+    in between: the pass's per-interval control): ``w3 = (a t + b t^2 / 2) / I3`` and the
+    quaternion turns by ``phi = (a t^2 / 2 + b t^3 / 6) / I3`` about z."""
+    a, b, i3 = 0.2, 0.05, INERTIA[2]
+    t = np.linspace(0.0, 10.0, 41)
+    u = np.zeros((3, t.size))
+    u[2] = a + b * t
+    res = simulate(rigid_body(INERTIA), [0, 0, 0, 1, 0, 0, 0], t, u=u, rtol=1e-7, atol=1e-9)
+    assert res.success and ONE_PASS in res.message, res.message
+    w3 = (a * t + b * t ** 2 / 2) / i3
+    phi = (a * t ** 2 / 2 + b * t ** 3 / 6) / i3
+    q = np.stack([0 * t, 0 * t, np.sin(phi / 2), np.cos(phi / 2)])
+    assert np.max(np.abs(res.x[6] - w3) / (1e-9 + 1e-7 * np.abs(w3))) <= 1.0
+    # the scalar-last quaternion's sign is fixed by the start q = [0, 0, 0, 1]
+    assert np.max(np.abs(res.x[:4] - q) / (1e-9 + 1e-7 * np.abs(q))) <= 1.0
+
+
+def test_many_calls_of_the_pass_match_the_truth_across_their_boundaries():
+    """600 output intervals: three calls of the compiled pass (`INTERVALS` each), the
+    controller's state carried across; the answer meets the tolerance everywhere."""
+    assert adaptive.INTERVALS < 600
+    t = np.linspace(0.0, 300.0, 601)
+    res = simulate(rigid_body(INERTIA), X0, t, rtol=1e-6, atol=1e-8)
+    assert res.success and ONE_PASS in res.message, res.message
+    assert ratio(res, INERTIA, 1e-6, 1e-8) <= 1.0
+
+
+def test_the_pass_reports_progress_and_counts_every_step():
+    seen = []
+    t = np.linspace(0.0, 50.0, 51)
+    res = simulate(rigid_body(INERTIA), X0, t, rtol=1e-4, atol=1e-6,
+                   progress=lambda done, total: seen.append((done, total)))
+    assert res.success and ONE_PASS in res.message
+    assert seen and seen[-1][0] == seen[-1][1] == res.n_steps
+
+
+def test_a_callable_control_or_no_compile_takes_the_multi_run_search():
+    t = np.linspace(0.0, 10.0, 11)
+    model = rigid_body(INERTIA)
+    res = simulate(model, X0, t, u=lambda s: np.zeros(3), rtol=1e-6)
+    assert res.success and ONE_PASS not in res.message
+    res = simulate(model, X0, t, rtol=1e-6, jit=False)
+    assert res.success and ONE_PASS not in res.message
+
+
+def test_a_tolerance_near_round_off_is_left_to_the_floor_measurement():
+    """rtol 1e-12 (atol 1e-14) is within 1e6 ulps of the states: the multi-run search with
+    its measured round-off floor decides, never the one pass."""
+    t = np.linspace(0.0, 10.0, 11)
+    res = simulate(rigid_body(INERTIA), X0, t, rtol=1e-12, atol=1e-14)
+    assert ONE_PASS not in res.message
+
+
+def test_a_blow_up_is_a_failure_not_a_pass():
+    """A right-hand side that overflows: the pass stops at the non-finite state and auto's
+    search reports the failure (status FAILED), as it did before the pass."""
+    import casadi as ca
+    from dynamics import Model
+    x = ca.SX.sym("x")
+    model = Model(ca.Function("f", [x, ca.SX.sym("u", 0), ca.SX.sym("p", 0)], [x ** 2],
+                              ["x", "u", "p"], ["xdot"]), ("x",), ())
+    res = simulate(model, [1.0], np.linspace(0.0, 2.0, 21), rtol=1e-6)
+    assert not res.success and res.status == FAILED, res.message
+    assert "non-finite" in res.message
+
+
+def test_max_steps_stops_the_pass_and_the_search_says_why():
+    t = np.linspace(0.0, 100.0, 101)
+    res = simulate(rigid_body(INERTIA), X0, t, rtol=1e-8, atol=1e-10, max_steps=150)
+    assert not res.success and res.status == 3 and "max_steps" in res.message
+
+
+def test_the_pass_is_compiled_once_per_model():
+    model = rigid_body([1.0, 2.5, 3.0])
+    t = np.linspace(0.0, 10.0, 11)
+    simulate(model, X0, t, rtol=1e-6)
+    lib = adaptive.pass_library(model)
+    assert lib is not None
+    simulate(model, X0, np.linspace(0.0, 3.0, 301), rtol=1e-4, u=np.ones(3))
+    assert adaptive.pass_library(model) is lib
+
+
+def test_not_accepted_passes_hand_their_steps_to_the_search():
+    """A pass that cannot be completed (one 100 s interval: more than ``2 BMAX + 1`` steps
+    needed) returns no run and the steps it spent."""
+    model = rigid_body(INERTIA)
+    t = np.linspace(0.0, 100.0, 2)
+    problem = Problem.new(model, X0, t, check_u(None, model.nu, t), model.resolve_p(None))
+    run, estimate, spent = one_pass(problem, 1e-8, np.full(7, 1e-10), 10 ** 8, None,
+                                    Progress(None))
+    assert run is None and math.isnan(estimate) and spent > 0
+
+
+def test_the_first_auto_call_also_compiles_the_fallback_loop():
+    """No hidden compile later: the first ``auto`` call of a model compiles the pass and,
+    at the same time, the rk8 chunk loop its multi-run search runs, so a later call that
+    falls back (here a tolerance near round-off) finds both in the cache."""
+    from dynamics.integrate.loops import chunk_key
+    model = rigid_body([1.0, 2.2, 3.0])
+    t = np.linspace(0.0, 10.0, 11)
+    simulate(model, X0, t, rtol=1e-4)
+    key = chunk_key(model, "rk8", "linear") + (True,)
+    assert cache.contains(key)
+    before = cache.info().kinds
+    res = simulate(model, X0, t, rtol=1e-12, atol=1e-14)
+    assert ONE_PASS not in res.message and res.compiled
+    after = cache.info().kinds  # (interpreted helpers such as the Jacobian may be new)
+    assert after["chunk"] == before["chunk"] and after["rk8_pass"] == before["rk8_pass"]
