@@ -3,16 +3,20 @@
 `check_executor` validates an ``executor=`` argument (``None`` = serial in the calling
 thread); `gather` runs tasks on it and hands each result back in the calling thread as it
 finishes, with the error and Ctrl-C behaviour of a serial loop (`dynamics.interrupts`). Used
-by `problems.stability.sweep` and `ocp.solve_multistart`.
+by `problems.stability.sweep` and `ocp.solve_multistart`. `worker_pool` is the process's own
+pool of threads for appdyn's internal parallel loops and `run_split` hands work to it (the
+runs of a batched `simulate`).
 """
 from __future__ import annotations
 
-from concurrent.futures import FIRST_COMPLETED, Executor, wait
+import os
+import threading
+from concurrent.futures import FIRST_COMPLETED, Executor, ThreadPoolExecutor, wait
 from typing import Callable, Sequence
 
 from .interrupts import check_interrupt
 
-__all__ = ["check_executor", "gather", "POLL"]
+__all__ = ["check_executor", "gather", "worker_pool", "run_split", "POLL"]
 
 POLL = 0.1  # [s] how often the wait on an executor looks for a deferred Ctrl-C
 
@@ -68,3 +72,60 @@ def gather(executor: Executor, fun: Callable, tasks: Sequence[tuple], on_done: C
         raise
     if errors:
         raise errors[min(errors)]
+
+
+_POOL: dict = {"pid": None, "pool": None, "workers": 0}
+_POOL_LOCK = threading.Lock()
+
+
+def worker_pool(workers: int) -> ThreadPoolExecutor:
+    """The process's shared pool of at least ``workers`` threads for appdyn's own loops.
+
+    Made on first use and kept (its idle threads cost nothing); made again in a child
+    process after ``os.fork`` (the parent's threads do not exist there) or when more workers
+    are asked for (the smaller pool ends once unused). Tasks given to it must not wait on
+    other tasks of the pool.
+
+    Parameters
+    ----------
+    workers : int
+        Threads wanted, ``>= 1``.
+
+    Returns
+    -------
+    concurrent.futures.ThreadPoolExecutor
+    """
+    pool = _POOL["pool"]
+    if pool is not None and _POOL["pid"] == os.getpid() and _POOL["workers"] >= workers:
+        return pool
+    with _POOL_LOCK:
+        if _POOL["pool"] is None or _POOL["pid"] != os.getpid() or _POOL["workers"] < workers:
+            _POOL.update(pid=os.getpid(), workers=workers,
+                         pool=ThreadPoolExecutor(workers, thread_name_prefix="appdyn"))
+        return _POOL["pool"]
+
+
+def run_split(fun: Callable, tasks: Sequence) -> None:
+    """``fun(task)`` for every task: the first in the calling thread, the others at the same
+    time on `worker_pool`; returns when all have finished.
+
+    For work that releases the GIL (compiled CasADi calls). An error is raised once every
+    task has finished, so that no task still runs on the caller's data after the call: the
+    calling thread's own, else the first (in the order of ``tasks``) of the others. Tasks
+    the pool no longer takes (while the interpreter exits) run in the calling thread.
+    """
+    futures = []
+    if len(tasks) > 1:
+        pool = worker_pool(len(tasks) - 1)
+        for task in tasks[1:]:
+            try:
+                futures.append(pool.submit(fun, task))
+            except RuntimeError:  # no new threads after the interpreter's shutdown began
+                break
+    try:
+        for task in [tasks[0], *tasks[1 + len(futures):]]:
+            fun(task)
+    finally:
+        wait(futures)
+    for fut in futures:
+        fut.result()

@@ -9,7 +9,8 @@ import numpy as np
 
 from .. import cache
 
-__all__ = ["call_buffered", "map_eval", "BoundBuffer", "borrow_bound", "return_bound"]
+__all__ = ["call_buffered", "map_eval", "BoundBuffer", "borrow_bound", "return_bound",
+           "borrow_state", "return_state"]
 
 
 def call_buffered(fun: ca.Function, args, out_shape) -> np.ndarray:
@@ -23,7 +24,7 @@ def call_buffered(fun: ca.Function, args, out_shape) -> np.ndarray:
     """
     args = [np.ascontiguousarray(a, dtype=float) for a in args]  # alive until trigger()
     out = np.empty(out_shape)
-    buffers = _thread_buffers()
+    buffers = _thread_table("buffers")
     key = id(fun)
     entry = buffers.pop(key, None)  # taken out while in use: a nested call makes its own
     if entry is None or entry[0]() is not fun:
@@ -42,13 +43,15 @@ def call_buffered(fun: ca.Function, args, out_shape) -> np.ndarray:
 _LOCAL = threading.local()
 
 
-def _thread_buffers() -> dict:
-    """This thread's buffers: ``id(fun) -> (weakref to fun, buffer, trigger, n_in)``."""
-    try:
-        return _LOCAL.buffers
-    except AttributeError:
-        _LOCAL.buffers = {}
-        return _LOCAL.buffers
+def _thread_table(name: str) -> dict:
+    """This thread's table ``name``: ``"buffers"`` (`call_buffered`: ``id(fun) -> (weakref
+    to fun, buffer, trigger, n_in)``), ``"bound"`` (``id(fun) -> BoundBuffer``) or
+    ``"state"`` (``id(fun) ->`` a `borrow_state` object)."""
+    table = getattr(_LOCAL, name, None)
+    if table is None:
+        table = {}
+        setattr(_LOCAL, name, table)
+    return table
 
 
 def _new_buffer(fun: ca.Function, buffers: dict, key: int) -> tuple:
@@ -88,28 +91,44 @@ def borrow_bound(fun: ca.Function, shapes) -> BoundBuffer:
     """This thread's `BoundBuffer` of ``fun``, taken out of the table until `return_bound`;
     made on first use with ``shapes() -> (input shapes, output shape)``, those ``fun``
     always takes. Dropped with ``fun``, like `call_buffered`'s buffers."""
-    table = _thread_bound()
-    key = id(fun)
-    entry = table.pop(key, None)
-    if entry is None or entry.ref() is not fun:
-        entry = BoundBuffer(fun, *shapes(),
-                            weakref.ref(fun, lambda _ref: table.pop(key, None)))
-    return entry
+    return _borrow(_thread_table("bound"), fun, lambda ref: BoundBuffer(fun, *shapes(), ref))
 
 
 def return_bound(fun: ca.Function, entry: BoundBuffer) -> None:
     """Put ``entry`` (from `borrow_bound`) back for the next call of this thread."""
     if entry.ref() is fun:
-        _thread_bound()[id(fun)] = entry
+        _thread_table("bound")[id(fun)] = entry
 
 
-def _thread_bound() -> dict:
-    """This thread's bound buffers: ``id(fun) -> BoundBuffer``."""
-    try:
-        return _LOCAL.bound
-    except AttributeError:
-        _LOCAL.bound = {}
-        return _LOCAL.bound
+def borrow_state(fun: ca.Function, make):
+    """This thread's state object of ``fun`` (e.g. arrays a caller keeps bound to its
+    buffers), taken out of the table until `return_state`, as `borrow_bound`.
+
+    Parameters
+    ----------
+    fun : casadi.Function
+        The Function the state belongs to; the state is dropped with it.
+    make : callable
+        ``make(ref) -> state`` on first use, ``ref`` a weak reference to ``fun`` that the
+        state keeps as its attribute ``ref``.
+    """
+    return _borrow(_thread_table("state"), fun, make)
+
+
+def return_state(fun: ca.Function, entry) -> None:
+    """Put ``entry`` (from `borrow_state`) back for the next call of this thread."""
+    if entry.ref() is fun:
+        _thread_table("state")[id(fun)] = entry
+
+
+def _borrow(table: dict, fun: ca.Function, make):
+    """``table``'s entry of ``fun`` taken out, or a new one ``make(ref)`` dropped from the
+    table with ``fun`` (``ref`` a weak reference to ``fun``, kept as the entry's ``ref``)."""
+    key = id(fun)
+    entry = table.pop(key, None)
+    if entry is None or entry.ref() is not fun:
+        entry = make(weakref.ref(fun, lambda _ref: table.pop(key, None)))
+    return entry
 
 
 def map_eval(fun: ca.Function, args) -> np.ndarray:

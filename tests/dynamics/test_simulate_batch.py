@@ -136,3 +136,221 @@ def test_a_stiff_batch_goes_to_cvodes_run_by_run_as_single_runs_do():
         assert one.method == "cvodes" and one.status == 1
         np.testing.assert_array_equal(res.x[:, :, k], one.x)
         assert res.error_estimate[k] == one.error_estimate <= 1.0
+
+
+# ------------------------------------------------ parts of a batch spread over threads
+from dynamics import executors  # noqa: E402
+from dynamics.integrate import batch as batch_module  # noqa: E402
+
+
+@pytest.fixture
+def spread(monkeypatch):
+    """``spread(threads, part_runs)``: every chunk split into parts of at most ``part_runs``
+    runs on ``threads`` threads, however small the batch."""
+    def use(threads, part_runs):
+        monkeypatch.setattr(batch_module, "BATCH_THREADS", threads)
+        monkeypatch.setattr(batch_module, "PART_RUNS", part_runs)
+        monkeypatch.setattr(batch_module, "PARALLEL_STEPS", 0)
+    return use
+
+
+@pytest.mark.parametrize("K, steps", [(1000, 64), (23, 64), (3, 5), (1, 64), (5, 1)])
+def test_parts_cover_the_runs_in_near_equal_contiguous_slices(spread, K, steps):
+    spread(2, 8)
+    parts, threads = batch_module._parts(K, steps)
+    assert threads == min(2, K)
+    assert parts[0].start == 0 and parts[-1].stop == K
+    assert all(a.stop == b.start for a, b in zip(parts[:-1], parts[1:]))
+    sizes = [p.stop - p.start for p in parts]
+    assert max(sizes) <= 8 and max(sizes) - min(sizes) <= 1 and min(sizes) >= 1
+    assert len(parts) >= min(K, K * steps // batch_module.PART_STEPS) and len(parts) >= threads
+
+
+def test_parts_of_a_large_batch_are_small_enough_to_balance_the_threads(monkeypatch):
+    monkeypatch.setattr(batch_module, "BATCH_THREADS", 2)
+    parts, threads = batch_module._parts(1000, 64)
+    assert threads == 2 and len(parts) == 1000 * 64 // batch_module.PART_STEPS
+
+
+def test_a_small_chunk_stays_on_one_thread():
+    parts, threads = batch_module._parts(3, 10)  # 30 run-steps: not worth a hand-over
+    assert threads == 1 and parts == [slice(0, 3)]
+
+
+def _controlled_batch(K, seed):
+    """Runs with their own rates, parameters-free torques (``u (3, n, K)``) and grid."""
+    rng = np.random.default_rng(seed)
+    t = np.linspace(0.0, 3.0, 31)
+    W, X0 = _rates(K, seed)
+    U = 0.1 * rng.normal(size=(3, t.size, K))
+    return t, X0, U
+
+
+@pytest.mark.parametrize("method", ["rk8", "rk4", "lie"])
+def test_threads_and_parts_give_the_bits_of_one_serial_call(spread, method):
+    """Any split (threads, part sizes, uneven last parts, lanes reused between calls of
+    other sizes and controls) gives the same bits as one thread with one part."""
+    model = rigid_body(INERTIA)
+    t, X0, U = _controlled_batch(23, 3)
+    spread(1, 10_000)
+    ref = [simulate(model, X0, t, method=method, steps=9).x.copy(),  # 270 steps: 5 chunks
+           simulate(model, X0, t, u=U, method=method, steps=9).x.copy(),
+           simulate(model, X0[:, :7], t, method=method, steps=2).x.copy()]
+    for threads, part_runs in [(2, 4), (2, 10_000), (3, 5), (1, 6)]:
+        spread(threads, part_runs)
+        for _ in range(2):  # the second time through lanes that hold data of other calls
+            np.testing.assert_array_equal(simulate(model, X0, t, method=method, steps=9).x,
+                                          ref[0])
+            np.testing.assert_array_equal(
+                simulate(model, X0, t, u=U, method=method, steps=9).x, ref[1])
+            np.testing.assert_array_equal(
+                simulate(model, X0[:, :7], t, method=method, steps=2).x, ref[2])
+
+
+def test_a_run_that_blows_up_fails_alone_in_any_part(spread):
+    x = ca.SX.sym("x")
+    model = Model.from_expressions({"x": x}, {"x": x ** 2})
+    t = np.linspace(0.0, 0.9, 10)
+    x0 = np.full((1, 9), 0.1)
+    x0[0, [2, 7]] = 2.0
+    spread(2, 2)
+    res = simulate(model, x0, t, method="rk8", steps=50)
+    assert np.flatnonzero(~res.success).tolist() == [2, 7]
+    assert np.all(np.isnan(res.x[0, -1, [2, 7]])) and np.all(np.isfinite(res.x[0, :, 0]))
+    np.testing.assert_allclose(res.x[0, :, 8], 0.1 / (1 - 0.1 * t), rtol=1e-12)
+
+
+def test_progress_and_ctrl_c_of_a_batch_spread_over_threads(spread):
+    """The progress callback runs in the calling thread after every chunk; a Ctrl-C during
+    the call stops it at the next chunk with KeyboardInterrupt, and the next call is whole."""
+    import os
+    import signal
+    import threading
+
+    if signal.getsignal(signal.SIGINT) is not signal.default_int_handler:
+        pytest.skip("SIGINT has a handler of its own here")
+    model = rigid_body(INERTIA)
+    t, X0, _ = _controlled_batch(23, 4)
+    spread(2, 4)
+    calls = []
+
+    def record(done, total):
+        calls.append((done, total, threading.current_thread() is threading.main_thread()))
+
+    ref = simulate(model, X0, t, method="rk8", steps=9, progress=record).x.copy()
+    assert [c[:2] for c in calls] == [(64, 270), (128, 270), (192, 270), (256, 270),
+                                      (270, 270)] and all(c[2] for c in calls)
+
+    def interrupt(done, total):
+        if done == 128:
+            os.kill(os.getpid(), signal.SIGINT)
+
+    with pytest.raises(KeyboardInterrupt):
+        simulate(model, X0, t, method="rk8", steps=9, progress=interrupt)
+    np.testing.assert_array_equal(simulate(model, X0, t, method="rk8", steps=9).x, ref)
+
+
+def test_an_error_in_a_part_is_raised_after_every_part_finished(spread, monkeypatch):
+    model = rigid_body(INERTIA)
+    t, X0, _ = _controlled_batch(12, 5)
+    spread(2, 3)
+    ref = simulate(model, X0, t, method="rk8", steps=2).x.copy()
+    advance = batch_module._FixedBatch.advance
+    finished = []
+
+    def failing(self, fun, lane, runs, chunk):
+        if runs.stop == 12:  # the last part
+            raise RuntimeError("part failed")
+        advance(self, fun, lane, runs, chunk)
+        finished.append(runs.start)
+
+    monkeypatch.setattr(batch_module._FixedBatch, "advance", failing)
+    with pytest.raises(RuntimeError, match="part failed"):
+        simulate(model, X0, t, method="rk8", steps=2)
+    assert finished and 11 not in finished
+    monkeypatch.setattr(batch_module._FixedBatch, "advance", advance)
+    np.testing.assert_array_equal(simulate(model, X0, t, method="rk8", steps=2).x, ref)
+
+
+def test_run_split_runs_every_task_and_raises_the_first_error():
+    import threading
+    import time
+
+    seen, lock = [], threading.Lock()
+
+    def task(i):
+        time.sleep(0.01 * (3 - i))
+        with lock:
+            seen.append(i)
+        if i in (1, 2):
+            raise ValueError(f"task {i}")
+
+    with pytest.raises(ValueError, match="task 1"):
+        executors.run_split(task, [0, 1, 2])
+    assert sorted(seen) == [0, 1, 2]  # all finished before the error was raised
+    out = []
+    executors.run_split(out.append, ["only"])
+    assert out == ["only"]
+    assert executors.worker_pool(2) is executors.worker_pool(1)
+
+
+def test_run_split_runs_here_what_the_pool_no_longer_takes(monkeypatch):
+    """At the interpreter's exit a pool refuses new tasks: they run in the calling thread."""
+    import threading
+
+    class Closed:
+        def submit(self, fun, task):
+            raise RuntimeError("cannot schedule new futures after interpreter shutdown")
+
+    monkeypatch.setattr(executors, "worker_pool", lambda workers: Closed())
+    where = []
+    executors.run_split(lambda i: where.append((i, threading.current_thread().name)), [0, 1, 2])
+    assert where == [(i, threading.current_thread().name) for i in range(3)]
+
+
+def test_worker_pool_is_made_again_in_a_forked_child():
+    import os
+
+    if not hasattr(os, "fork"):
+        pytest.skip("no fork")
+    executors.worker_pool(1)
+    pid = os.fork()
+    if pid == 0:  # child: the pool's threads are not here; a task must still run
+        try:
+            out = []
+            executors.run_split(out.append, [1, 2])
+            os._exit(0 if sorted(out) == [1, 2] else 1)
+        except BaseException:
+            os._exit(2)
+    _, status = os.waitpid(pid, 0)
+    assert os.WEXITSTATUS(status) == 0
+
+
+def test_lanes_are_dropped_with_their_chunk_function():
+    """A thread's lane does not hold the chunk Function; its table entry goes with it."""
+    import gc
+
+    from dynamics.integrate import evaluate
+
+    x, n = ca.SX.sym("x", 2), ca.SX.sym("n")
+    f = ca.Function("chunkish", [x, n], [ca.repmat(x, 1, 4)])
+    lane = evaluate.borrow_state(f, lambda ref: batch_module._Lane(ref, f, 3))
+    assert lane.args[0].shape == (3, 2) and lane.out.shape == (3, 4, 2)
+    evaluate.return_state(f, lane)
+    key = id(f)
+    assert evaluate._thread_table("state")[key] is lane
+    del f
+    gc.collect()
+    assert lane.ref() is None and key not in evaluate._thread_table("state")
+
+
+def test_nan_after_failure_tells_huge_finite_runs_from_non_finite_ones():
+    x = np.ones((4, 5, 2))
+    x[1] = 1e308  # finite terms whose sum overflows
+    x[2, 3, 1] = np.inf
+    x[3, 1, 0] = np.nan
+    out, ok = batch_module._nan_after_failure(x.copy())
+    assert ok.tolist() == [True, True, False, False] and out.shape == (2, 5, 4)
+    np.testing.assert_array_equal(out[:, :, 1], x[1].T)
+    assert np.all(np.isnan(out[:, 3:, 2])) and np.all(out[:, :3, 2] == 1.0)
+    assert np.all(np.isnan(out[:, 1:, 3])) and np.all(out[:, 0, 3] == 1.0)

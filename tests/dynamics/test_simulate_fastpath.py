@@ -165,7 +165,7 @@ def test_bound_buffer_reused_across_grids_and_controls(body):
         got = [dynamics.simulate(body, X0, t, u=u, method="rk8", steps=s, jit=jit).x
                for t, s, u in calls]
         for (t, s, u), x in zip(calls, got):
-            evaluate._thread_bound().clear()  # a fresh buffer, zero-filled
+            evaluate._thread_table("bound").clear()  # a fresh buffer, zero-filled
             fresh = dynamics.simulate(body, X0, t, u=u, method="rk8", steps=s, jit=jit).x
             np.testing.assert_array_equal(x, fresh)
 
@@ -200,11 +200,11 @@ def test_bound_buffer_dropped_with_its_function(body):
     np.testing.assert_array_equal(buf.out, [2.0, 4.0])
     evaluate.return_bound(f, buf)
     key = id(f)
-    assert key in evaluate._thread_bound()
+    assert key in evaluate._thread_table("bound")
     del f, buf
     import gc
     gc.collect()
-    assert key not in evaluate._thread_bound()
+    assert key not in evaluate._thread_table("bound")
 
 
 @pytest.mark.parametrize("method", ["rk8", "rk4", "lie"])

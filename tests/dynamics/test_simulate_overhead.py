@@ -126,10 +126,10 @@ def test_buffer_dropped_with_its_function():
     f = ca.Function("twice", [x], [2 * x])
     np.testing.assert_array_equal(call_buffered(f, [np.array([1.0, 2.0])], (2,)), [2.0, 4.0])
     key = id(f)
-    assert key in evaluate._thread_buffers()
+    assert key in evaluate._thread_table("buffers")
     del f
     gc.collect()
-    assert key not in evaluate._thread_buffers()
+    assert key not in evaluate._thread_table("buffers")
 
 
 def test_inputs_left_out_are_zero_after_a_full_call():
