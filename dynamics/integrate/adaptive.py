@@ -3,23 +3,23 @@ in one compiled C loop per model.
 
 Each output interval is integrated twice, side by side:
 
-* the answer: ``n`` rk8 steps, ``n`` predicted from the embedded error estimate of the
-  interval before (error per unit time aimed at ``theta``), and the interval redone once,
-  with more steps, when its own estimate exceeds the target;
-* a check run: ``b = floor(n / 2)`` steps per interval, carried on its own from a start 2 ulp
-  away (so that the amplification of representation errors shows as well).
+* a check run: ``b`` rk8 steps, ``b`` predicted from its embedded error estimate in the
+  interval before (error per unit time aimed at ``theta``), the interval redone once with
+  more steps when its own estimate exceeds the target; it is carried on its own from a start
+  2 ulp away (so that the amplification of representation errors shows as well);
+* the answer: ``n = 2 b + 1`` steps (2 for ``b = 1``), so at least twice as many.
 
 The scaled difference ``d`` of the two runs at the output times bounds the global error of
-the answer by ``d`` whenever the answer is at least twice as accurate as the check
-(``n / b >= 2``: 2^8-fold in the asymptotic range of an 8th-order method). `run_pass`
-returns both runs and the statistics `dynamics.integrate.auto.one_pass` decides on; it
-falls back to the multi-run Richardson search when they do not suffice.
+the answer by ``d`` whenever the answer is at least twice as accurate as the check (2^8-fold
+in the asymptotic range of an 8th-order method with ``n / b >= 2``). `run_pass` returns
+both runs and the statistics `dynamics.integrate.auto.one_pass` decides on; it falls back to
+the multi-run Richardson search when they do not suffice.
 
 The loop is plain C (`_DRIVER`) around the casadi-generated steps (`kernels.kernel` with and
-without the estimate), compiled once per model and loaded with ``ctypes``; one call covers
-`INTERVALS` output intervals. The pass costs 1.5x the answer's steps, so an accepted
-``auto`` call is one pass of compiled C (measured on the 100 s benchmark body at rtol 1e-3:
-300 steps, about 0.1 ms, against 1.3 ms for the multi-run search).
+without the estimate) and right-hand side, compiled once per model for this machine and
+loaded with ``ctypes``; one call covers `INTERVALS` output intervals. An accepted ``auto``
+call is one pass of compiled C: on the 100 s benchmark body at rtol 1e-3, 315 steps in
+about 0.1 ms (the multi-run search took 1.3 ms).
 """
 from __future__ import annotations
 
@@ -149,7 +149,8 @@ int rk8_pass(casadi_real* xf, casadi_real* xc, casadi_real* state, int nint,
              const casadi_real* H, const casadi_real* ua, const casadi_real* ud, int ustride,
              const casadi_real* p, casadi_real rtol, const casadi_real* atol, casadi_real theta,
              int bmax, int bmin, casadi_real noise, casadi_real ratio_max,
-             const casadi_real* signs, casadi_real* X, casadi_real* XC, casadi_real* stats) {
+             const casadi_real* signs, casadi_real* X, casadi_real* XC, int ldx,
+             casadi_real* stats) {
   pass_ctx c;
   casadi_real tmp[PASS_NX], e, ec, sc, o, b_prev = state[ST_B], ec_prev = state[ST_EC];
   casadi_real* size = state + ST_SIZE;
@@ -177,8 +178,8 @@ int rk8_pass(casadi_real* xf, casadi_real* xc, casadi_real* state, int nint,
     s += n;
     bad = 0;
     for (i = 0; i < PASS_NX; ++i) {
-      X[k * PASS_NX + i] = xf[i];
-      XC[k * PASS_NX + i] = xc[i];
+      X[i * ldx + k] = xf[i];
+      XC[i * ldx + k] = xc[i];
       if (!isfinite(xf[i]) || !isfinite(xc[i])) bad = 1;
       sc = atol[i] + rtol * fabs(xf[i]);
       if (fabs(xf[i]) > size[i]) size[i] = fabs(xf[i]);
@@ -223,16 +224,24 @@ int rk8_pass(casadi_real* xf, casadi_real* xc, casadi_real* state, int nint,
 }
 
 /* `rk8_pass` on a workspace: `ws + off[i]` are xf, xc, state, H, ua, ud, p, atol, stats,
-   signs and the parameters (rtol, theta, bmax, bmin, noise, ratio_max, ustride); intervals
-   `done` to `done + k`, their outputs written from X and XC on (one call of few arguments) */
+   signs and the parameters (rtol, theta, bmax, bmin, noise, ratio_max, ustride, ldx);
+   intervals `done` to `done + k`; X and XC (nx, ldx) get the states (one call of few
+   arguments). The first call (done = 0) sets the check run's start and the first column. */
 int rk8_pass_ws(casadi_real* ws, const long long* off, int done, int k, casadi_real* X,
                 casadi_real* XC) {
   const casadi_real* par = ws + off[10];
-  int ustride = (int) par[6];
+  int ustride = (int) par[6], ldx = (int) par[7], i;
+  if (done == 0)  /* the check run starts 2 ulp away: xc = x0 (1 + 2 eps signs) */
+    for (i = 0; i < PASS_NX; ++i) {
+      ws[off[1] + i] = ws[off[0] + i] * (1 + 2 * DBL_EPSILON * ws[off[9] + i]);
+      X[i * ldx] = ws[off[0] + i];
+      XC[i * ldx] = ws[off[1] + i];
+    }
   return rk8_pass(ws + off[0], ws + off[1], ws + off[2], k, ws + off[3] + done,
                   ws + off[4] + done * ustride, ws + off[5] + done * ustride, ustride,
                   ws + off[6], par[0], ws + off[7], par[1], (int) par[2], (int) par[3], par[4],
-                  par[5], ws + off[9], X, XC, ws + off[8] + 4 * done);
+                  par[5], ws + off[9], X + done + 1, XC + done + 1, ldx,
+                  ws + off[8] + 4 * done);
 }
 """
 
@@ -343,6 +352,7 @@ class _Work:
             offsets.append(offsets[-1] + size)
         work = np.zeros(offsets[-1])
         self.arrays = [work[offsets[i]:offsets[i + 1]] for i in range(len(sizes))]
+        self.arrays[9][:] = _signs(sizes[0])  # (the sign pattern: see `rk8_pass_ws`)
         self.base = work.ctypes.data
         self.offsets = np.array(offsets[:-1], dtype=np.int64)
         self.off_addr = self.offsets.ctypes.data
@@ -375,11 +385,12 @@ def _return_work(work: _Work) -> None:
     table[work.key] = work
 
 
-def run_pass(problem: Problem, rtol: float, atol: np.ndarray, theta: float, xc0: np.ndarray,
-             max_steps: int, progress, bmin: int = 1, ulps: float = math.inf) -> Pass | None:
+def run_pass(problem: Problem, rtol: float, atol: np.ndarray, theta: float, max_steps: int,
+             progress, bmin: int = 1, ulps: float = math.inf) -> Pass | None:
     """The pass over ``problem`` (linear control) with the check run's embedded estimate
     aimed at ``theta`` tolerances per unit time, at least ``bmin >= 1`` check steps per
-    interval; the check run starts from ``xc0``. It stops (``ok`` False) as soon as a
+    interval; the check run starts from ``x0 (1 + 2 eps s)`` (``s`` a fixed pattern of
+    signs: the amplification of a representation error shows as well). It stops (``ok`` False) as soon as a
     state's tolerance ``atol + rtol |x|`` comes within ``ulps`` ulps of the state's size.
     None when there is no compiled pass for the model (`pass_library`)."""
     model, t = problem.model, problem.t
@@ -392,9 +403,9 @@ def run_pass(problem: Problem, rtol: float, atol: np.ndarray, theta: float, xc0:
     nctl = nu if const else nu * nint
     key = (nx, nctl, nint, model.np)
     work = _borrow_work(key, (nx, nx, _ST + 3 * nx, nint, nctl, nctl, model.np, nx, 4 * nint,
-                              nx, 7))
+                              nx, 8))
     xf, xc, state, H, ua, ud, p, at, stats, signs, par = work.arrays
-    xf[:], xc[:], p[:], at[:], signs[:] = problem.x0, xc0, problem.p, atol, _signs(nx)
+    xf[:], p[:], at[:] = problem.x0, problem.p, atol
     state[:] = _state0(nx)
     state[0] = bmin
     np.abs(problem.x0, out=state[_ST:_ST + nx])
@@ -405,11 +416,10 @@ def run_pass(problem: Problem, rtol: float, atol: np.ndarray, theta: float, xc0:
         ua[:] = ctrl.ua.ravel()
         np.divide(ctrl.ub - ctrl.ua, H[:, None], out=ud.reshape(nint, nu))
     par[:] = (rtol, theta, BMAX, bmin, NOISE * _EPS / rtol,
-              math.inf if ulps == math.inf else 1.0 / (_EPS * ulps), 0 if const else nu)
-    XX = np.empty((2, nint + 1, nx))
-    X, XC = XX[0], XX[1]
-    X[0], XC[0] = xf, xc
-    ax = XX.ctypes.data + 8 * nx
+              math.inf if ulps == math.inf else 1.0 / (_EPS * ulps), 0 if const else nu,
+              nint + 1)
+    XX = np.empty((2, nx, nint + 1))
+    ax = XX.ctypes.data
     axc = ax + 8 * nx * (nint + 1)
     done, reason = 0, ""
     with deferred_interrupts() if nint > INTERVALS else contextlib.nullcontext():
@@ -417,7 +427,7 @@ def run_pass(problem: Problem, rtol: float, atol: np.ndarray, theta: float, xc0:
             check_interrupt()
             k = min(INTERVALS, nint - done)
             before = state[2]
-            got = fun(work.base, work.off_addr, done, k, ax + 8 * nx * done, axc + 8 * nx * done)
+            got = fun(work.base, work.off_addr, done, k, ax, axc)
             if progress.fun is not None:
                 new = int(state[2] - before)
                 progress.start(new)
@@ -429,7 +439,7 @@ def run_pass(problem: Problem, rtol: float, atol: np.ndarray, theta: float, xc0:
                 reason = f"more than max_steps = {max_steps} steps"
             if reason:
                 break
-    x, xcheck = X.T, XC.T
+    x, xcheck = XX[0], XX[1]
     if reason:
         x[:, done + 1:] = np.nan
         xcheck[:, done + 1:] = np.nan

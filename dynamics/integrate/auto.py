@@ -507,11 +507,9 @@ def one_pass(problem: Problem, rtol, atol, max_steps, jit_pref, progress):
         return None, math.nan, 0  # (the states' sizes put the tolerance near round-off)
     horizon = float(problem.t[-1] - problem.t[0])
     theta = _PASS_THETA / horizon
-    xc0 = _perturbed(problem.x0, 1)
     spent, bmin = 0, 1
     for _ in range(_PASS_TRIES):
-        got = run_pass(problem, rtol, atol, theta, xc0, max_steps - spent, progress, bmin,
-                       _PASS_ULPS)
+        got = run_pass(problem, rtol, atol, theta, max_steps - spent, progress, bmin, _PASS_ULPS)
         if got is None:
             return None, math.nan, spent
         spent += got.n_steps
@@ -552,8 +550,7 @@ def one_pass(problem: Problem, rtol, atol, max_steps, jit_pref, progress):
         message = (f"auto: rk8 with embedded error control: {got.answer_steps} steps ({lo}-{hi} "
                    "per output interval), checked against a run with fewer than half the steps; "
                    f"estimated error {estimate:.2g} of tolerance")
-        run = Run.new(np.ascontiguousarray(got.x), spent, DOP853.stages * spent, hi, True, True,
-                      message)
+        run = Run.new(got.x, spent, DOP853.stages * spent, hi, True, True, message)
         return run, estimate, spent
     return None, math.nan, spent
 
