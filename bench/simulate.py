@@ -23,6 +23,10 @@ Batch: 1,000 runs, w0 = (1.5, 0, 0) + U(-1, 1)^3 (seed 0), 20 s, 41 outputs, eve
 loops of appdyn ``rk8`` (smallest ``steps`` meeting 1e-8) and ``auto``, and a batched
 ``simulate`` (x0 of shape (7, K)) when the installed appdyn accepts one.
 
+Ratios against numbalsoda: besides those of the sweep's times, the cheapest appdyn ``auto``
+run and numbalsoda ``dop853`` run of each target (and the two batches) are timed again in 3
+interleaved rounds (`paired`): this VM's speed drifts by 20-60% within minutes.
+
 Writes ``simulate.csv`` (every single run), ``simulate.png``, ``simulate_batch.csv`` and the
 hard cases (``simulate_hard.csv``) into the output folder, and returns the summary rows
 (`run`): the cheapest actual time per solver at each target error, the speed-ups of the best
@@ -449,8 +453,10 @@ def figure(rows):
     return fig
 
 
-def summary_rows(best, brows, k, hard, first_call, f_call, sim_call):
-    """The headline numbers (`Row`s) of the single runs, the batch and the hard cases."""
+def summary_rows(best, brows, k, hard, first_call, f_call, sim_call, pairs=None):
+    """The headline numbers (`Row`s) of the single runs, the batch and the hard cases;
+    ``pairs`` (`paired`) the interleaved ratios against numbalsoda."""
+    pairs = pairs or {}
     out = []
 
     def add(case, metric, value, unit="", note=""):
@@ -473,8 +479,11 @@ def summary_rows(best, brows, k, hard, first_call, f_call, sim_call):
                 auto = met["appdyn auto"]
                 add(case, f"speed-up of auto vs {peer}",
                     met[peer]["wall_time"] / auto["wall_time"], "x",
-                    f"auto {fmt_setting(auto['setting'])}, verified" if auto["success"]
-                    else f"auto {fmt_setting(auto['setting'])}, not verified")
+                    f"auto {fmt_setting(auto['setting'])}, verified; times of the sweep")
+        if target in pairs:
+            a, b, note = pairs[target]
+            add(case, "speed-up of auto vs numbalsoda dop853, paired", b / a, "x",
+                f"{note}; 3 interleaved rounds: {1e3 * a:.4f} against {1e3 * b:.4f} ms")
     add("torque-free body 100 s", "first simulate of a fresh model", 1e3 * first_call, "ms",
         "builds and compiles the loop")
     add("torque-free body 100 s", "Python-call overhead, model.f", 1e6 * f_call, "us")
@@ -499,6 +508,10 @@ def summary_rows(best, brows, k, hard, first_call, f_call, sim_call):
             if not r["solver"].startswith("appdyn"):
                 add(case, f"speed-up vs {r['solver']}", r["wall_time"] / top["wall_time"], "x",
                     top["solver"])
+    if "batch" in pairs:
+        a, b, note = pairs["batch"]
+        add(case, "speed-up of rk8 batched vs numbalsoda dop853 numba loop, paired", b / a, "x",
+            f"{note}; 3 interleaved rounds: {1e3 * a:.2f} against {1e3 * b:.2f} ms")
 
     for name in dict.fromkeys(r["case"] for r in hard):
         sub = [r for r in hard if r["case"] == name]
@@ -514,6 +527,48 @@ def summary_rows(best, brows, k, hard, first_call, f_call, sim_call):
             f"rtol {ref['setting']['rtol']:.0e}, error {ref['error']:.1e}")
         add(name, "speed-up vs scipy DOP853", ref["wall_time"] / best_auto["wall_time"], "x",
             f"and {ref['error'] / max(best_auto['error'], 1e-300):.3g}x more accurate")
+    return out
+
+
+def paired(best, brows, model, x0, t, rounds=3):
+    """The headline ratios against numbalsoda, timed in interleaved rounds: this VM's speed
+    drifts by 20-60% within minutes, so the two solvers' cheapest runs of the sweep are
+    timed again back to back (``rounds`` rounds, each the cheapest of 31 calls of appdyn
+    ``auto`` then of numbalsoda ``dop853`` in its own process; the batch: 3 calls each).
+    Returns ``{case: (appdyn time, numbalsoda time, note)}`` [s]; empty without numbalsoda."""
+    out = {}
+    for target, by in best.items():
+        ours, peer = by.get("appdyn auto"), by.get("numbalsoda dop853")
+        if ours is None or peer is None:
+            continue
+        a, b = [], []
+        for _ in range(rounds):
+            a.append(min(timed(lambda: simulate(model, x0, t, **ours["setting"]), 31)[1]))
+            ans = numbalsoda(dict(inertia=INERTIA.tolist(), t=t.tolist(), x0=x0.tolist(),
+                                  tols=[peer["setting"]["rtol"]], repeats=31))
+            if ans is None:
+                return out
+            b.append(min(next(r for r in ans["runs"] if r["solver"] == "dop853")["times"]))
+        out[target] = (min(a), min(b), f"auto {fmt_setting(ours['setting'])} against "
+                                       f"rtol={peer['setting']['rtol']:g}")
+    by = {r["solver"]: r for r in brows if r["error"] <= BATCH_TOL}
+    ours, peer = by.get("appdyn rk8 batched"), by.get("numbalsoda dop853 numba loop")
+    if ours is not None and peer is not None:
+        x0s, tb, _ = batch_workload(BATCH_K)
+        a, b = [], []
+        for _ in range(rounds):
+            a.append(min(timed(lambda: appdyn_batch(model, x0s, tb, method="rk8",
+                                                     **ours["setting"]), 3)[1]))
+            ans = numbalsoda(dict(inertia=INERTIA.tolist(), t=tb.tolist(), x0=x0s[0].tolist(),
+                                  tols=[], repeats=3,
+                                  batch=dict(x0s=x0s.tolist(), t=tb.tolist(),
+                                             rtol=peer["setting"]["rtol"])))
+            if ans is None:
+                break
+            b.append(min(ans["batch"]["times"]))
+        if len(b) == rounds:
+            out["batch"] = (min(a), min(b), f"rk8 batched {fmt_setting(ours['setting'])} "
+                                             f"against rtol={peer['setting']['rtol']:g}")
     return out
 
 
@@ -540,8 +595,12 @@ def run(quick: bool, out: Path) -> list:
     hard = hard_cases(quick)
     print_hard_cases(hard)
     write_csv(hard, out / "simulate_hard.csv")
+    pairs = {} if quick else paired(best, brows, model, x0, t)
+    for case, (a, b, note) in pairs.items():
+        print(f"paired rounds, {case}: appdyn {1e3 * a:.4f} ms, numbalsoda {1e3 * b:.4f} ms, "
+              f"ratio {b / a:.2f} ({note})")
     print(f"\nwrote simulate.csv, simulate_batch.csv, simulate_hard.csv and simulate.png in {out}")
-    return summary_rows(best, brows, k, hard, first_call, f_call, sim_call)
+    return summary_rows(best, brows, k, hard, first_call, f_call, sim_call, pairs)
 
 
 def main(argv=None) -> int:
