@@ -37,6 +37,7 @@ tolerances and repeats, scipy's slow methods at loose tolerances only, a 100-run
 from __future__ import annotations
 
 
+import functools
 import json
 import subprocess
 import sys
@@ -530,11 +531,21 @@ def summary_rows(best, brows, k, hard, first_call, f_call, sim_call, pairs=None)
     return out
 
 
+def warm(call, seconds=0.5):
+    """``call()`` repeated for ``seconds``: after the seconds spent waiting for the peer's
+    process this VM ran the next calls up to 40% slower (measured: 107 -> 147 us, for the
+    first of them) -- the peer itself times after its numba compile, on a busy core."""
+    end = time.perf_counter() + seconds
+    while time.perf_counter() < end:
+        call()
+
+
 def paired(best, brows, model, x0, t, rounds=3):
     """The headline ratios against numbalsoda, timed in interleaved rounds: this VM's speed
     drifts by 20-60% within minutes, so the two solvers' cheapest runs of the sweep are
     timed again back to back (``rounds`` rounds, each the cheapest of 31 calls of appdyn
-    ``auto`` then of numbalsoda ``dop853`` in its own process; the batch: 3 calls each).
+    ``auto``, after 0.5 s of the same calls to warm up (`warm`), then of numbalsoda
+    ``dop853`` in its own process, after its compile; the batch: 3 calls each).
     Returns ``{case: (appdyn time, numbalsoda time, note)}`` [s]; empty without numbalsoda."""
     out = {}
     for target, by in best.items():
@@ -543,7 +554,9 @@ def paired(best, brows, model, x0, t, rounds=3):
             continue
         a, b = [], []
         for _ in range(rounds):
-            a.append(min(timed(lambda: simulate(model, x0, t, **ours["setting"]), 31)[1]))
+            call = functools.partial(simulate, model, x0, t, **ours["setting"])
+            warm(call)
+            a.append(min(timed(call, 31)[1]))
             ans = numbalsoda(dict(inertia=INERTIA.tolist(), t=t.tolist(), x0=x0.tolist(),
                                   tols=[peer["setting"]["rtol"]], repeats=31))
             if ans is None:
@@ -557,8 +570,10 @@ def paired(best, brows, model, x0, t, rounds=3):
         x0s, tb, _ = batch_workload(BATCH_K)
         a, b = [], []
         for _ in range(rounds):
-            a.append(min(timed(lambda: appdyn_batch(model, x0s, tb, method="rk8",
-                                                     **ours["setting"]), 3)[1]))
+            call = functools.partial(appdyn_batch, model, x0s, tb, method="rk8",
+                                     **ours["setting"])
+            warm(call)
+            a.append(min(timed(call, 3)[1]))
             ans = numbalsoda(dict(inertia=INERTIA.tolist(), t=tb.tolist(), x0=x0s[0].tolist(),
                                   tols=[], repeats=3,
                                   batch=dict(x0s=x0s.tolist(), t=tb.tolist(),

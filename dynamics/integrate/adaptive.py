@@ -15,278 +15,31 @@ in the asymptotic range of an 8th-order method with ``n / b >= 2``). `run_pass` 
 both runs and the statistics `dynamics.integrate.auto.one_pass` decides on; it falls back to
 the multi-run Richardson search when they do not suffice.
 
-The loop is plain C (`_DRIVER`) around the casadi-generated steps (`kernels.kernel` with and
-without the estimate) and right-hand side, compiled once per model for this machine and
-loaded with ``ctypes``; one call covers `INTERVALS` output intervals. An accepted ``auto``
+The loop is plain C (`dynamics.integrate.cpass`) around the casadi-generated steps
+(`kernels.kernel` with and without the estimate) and right-hand side, compiled once per
+model for this machine and loaded with ``ctypes``; one call covers `INTERVALS` output
+intervals. An accepted ``auto``
 call is one pass of compiled C: on the 100 s benchmark body at rtol 1e-3, 315 steps in
 about 0.1 ms (the multi-run search took 1.3 ms).
 """
 from __future__ import annotations
 
 import contextlib
-import ctypes
 import functools
 import math
 import threading
 from typing import NamedTuple
 
-import casadi as ca
 import numpy as np
 
-from .. import cache
 from ..interrupts import check_interrupt, deferred_interrupts
-from ..model import Model
+from .cpass import BMAX, NOISE, pass_library
 from .inputs import Problem
-from .kernels import kernel
-from .loops import chunk_compile_job
 
-__all__ = ["BMAX", "CHECK_EVERY", "INTERVALS", "NOISE", "Pass", "pass_library", "run_pass"]
+__all__ = ["INTERVALS", "Pass", "run_pass"]
 
-#: Most check-run steps in one output interval (the answer takes ``2 b + 1``; a longer
-#: interval, or a problem that needs more, leaves the pass to the multi-run search).
-BMAX = 32
-#: An embedded estimate at most this many ``eps / rtol`` (tolerance units) is rounding.
-NOISE = 30
 #: Output intervals per call of the compiled pass (Ctrl-C is looked at between calls).
 INTERVALS = 256
-
-#: C flags of the pass, tried in turn: compiled for this machine's instruction set (the
-#: library is built and used here only; FMA and AVX made the pass 22% faster on the 2-core
-#: VM, 742 steps in 149 against 191 us), else plain -O1 (as the chunk loops; -O2/-O3 were
-#: no faster and compile 30-80% longer).
-_OPTS = ("-O1 -march=native", "-O1")
-
-#: The answer's embedded estimate (and the model's rounding) is taken in every
-#: `CHECK_EVERY`-th interval (-1 in the others): it only tells whether the two runs show the
-#: method's order.
-CHECK_EVERY = 4
-
-# columns of the pass statistics per interval: answer steps, its embedded estimate (first
-# step), the check run's (-1 where not taken), steps taken (a redone interval included)
-_N, _E, _EC, _S = range(4)
-
-# The driver: the generated steps `rk8_step_err` (x, h, ua, ud, p, rtol, atol) -> (x+, err)
-# and `rk8_step` (x, h, ua, ud, p) -> x+ called from a plain C loop over the output intervals.
-_DRIVER = r"""
-#include <float.h>
-#define PASS_NX %(nx)d
-#define PASS_NU %(nu)d
-#define PASS_NW %(nw)d
-#define PASS_NIW %(niw)d
-#define PASS_NARG %(narg)d
-#define PASS_NRES %(nres)d
-#define PASS_U (PASS_NU > 0 ? PASS_NU : 1)
-#define CHECK_EVERY %(every)d
-
-typedef struct {
-  const casadi_real *p, *atol, *ud;
-  casadi_real rtol;
-  casadi_real w[PASS_NW + 1];
-  casadi_int iw[PASS_NIW + 1];
-} pass_ctx;
-
-/* n steps of H / n from x0 into x (x0 may be x); returns the embedded estimate of the
-   first step when `estimate` (else -1: the estimate costs about half a step) */
-static casadi_real pass_steps(pass_ctx* c, const casadi_real* x0, casadi_real* x, int n,
-                              casadi_real H, const casadi_real* ua, int estimate) {
-  const casadi_real* arg[PASS_NARG + 7];
-  casadi_real* res[PASS_NRES + 2];
-  casadi_real h = H / n, err = -1, xn[PASS_NX], u[PASS_U];
-  int i, j;
-  for (i = 0; i < PASS_NX; ++i) x[i] = x0[i];
-  arg[0] = x; arg[1] = &h; arg[2] = u; arg[3] = c->ud; arg[4] = c->p; arg[5] = &c->rtol;
-  arg[6] = c->atol; res[0] = xn; res[1] = &err;
-  for (j = 0; j < n; ++j) {
-    for (i = 0; i < PASS_NU; ++i) u[i] = ua[i] + (j * h) * c->ud[i];
-    if (j == 0 && estimate) rk8_step_err(arg, res, c->iw, c->w, 0);
-    else rk8_step(arg, res, c->iw, c->w, 0);
-    for (i = 0; i < PASS_NX; ++i) x[i] = xn[i];
-  }
-  return err;
-}
-
-/* the model's right-hand side at (x, u): its rounding noise is measured with it */
-static void pass_rhs_at(pass_ctx* c, const casadi_real* x, const casadi_real* u,
-                        casadi_real* xdot) {
-  const casadi_real* arg[PASS_NARG + 3];
-  casadi_real* res[PASS_NRES + 1];
-  arg[0] = x; arg[1] = u; arg[2] = c->p; res[0] = xdot;
-  pass_rhs(arg, res, c->iw, c->w, 0);
-}
-
-static int pass_predict(casadi_real n, casadi_real e, casadi_real target, casadi_real lo, int kmax) {
-  /* steps for an estimate of `target` per unit time, from `e` at `n` steps (e ~ h^7) */
-  casadi_real want = e > 0 ? ceil(n * pow(e * n / target, 1.0 / 6.0)) : lo;
-  if (!(want >= lo)) want = lo;
-  if (want > kmax) want = kmax;
-  return (int) want;
-}
-
-/* `state` (in and out): the accumulators ST_... below, then max |x_i| (answer, every
-   output), then min (atol_i + rtol |x_i|) over the outputs after the first, then the
-   rounding noise max |f_i(x (1 + eps s)) - f_i(x)| of the right-hand side at the answer's
-   states (every CHECK_EVERY-th output; s = +-`signs`, alternating) */
-#define ST_B 0      /* check steps in the last interval */
-#define ST_EC 1     /* their embedded estimate */
-#define ST_STEPS 2  /* steps taken (redone check intervals included) */
-#define ST_D 3      /* max |answer - check| / (atol + rtol |answer|) */
-#define ST_ORDER 4  /* intervals whose estimates show order 5-10 ... */
-#define ST_ORDERS 5 /* ... of the intervals where both were measured above `noise` */
-#define ST_ECMAX 6  /* the check run's largest estimate */
-#define ST_FLAG 7   /* 1: a non-finite state, 2: an interval needs more than bmax steps,
-                       3: a state's size over its tolerance exceeds `ratio_max` */
-#define ST_NMIN 8   /* least answer steps in an interval */
-#define ST_NMAX 9   /* most */
-#define ST_ANSWER 10 /* answer steps */
-#define ST_RMIN 11  /* least n / b */
-#define ST_ULP 12   /* max_i max|x_i| / min (atol_i + rtol |x_i|) (eps times it: one ulp) */
-#define ST_SIZE 13
-
-/* The pass over `nint` intervals; returns the intervals done (fewer when ST_FLAG is set;
-   the last one done is the one that failed). The check run's steps b follow its embedded
-   estimate (per unit time `theta`); the answer takes n = 2 b + 1 (n = 2 for b = 1). */
-int rk8_pass(casadi_real* xf, casadi_real* xc, casadi_real* state, int nint,
-             const casadi_real* H, const casadi_real* ua, const casadi_real* ud, int ustride,
-             const casadi_real* p, casadi_real rtol, const casadi_real* atol, casadi_real theta,
-             int bmax, int bmin, casadi_real noise, casadi_real ratio_max,
-             const casadi_real* signs, casadi_real* X, casadi_real* XC, int ldx,
-             casadi_real* stats) {
-  pass_ctx c;
-  casadi_real tmp[PASS_NX], e, ec, sc, o, b_prev = state[ST_B], ec_prev = state[ST_EC];
-  casadi_real* size = state + ST_SIZE;
-  casadi_real* smin = state + ST_SIZE + PASS_NX;
-  casadi_real* rnoise = state + ST_SIZE + 2 * PASS_NX;
-  casadi_real f0[PASS_NX], f1[PASS_NX], uend[PASS_U];
-  const casadi_real* u;
-  int k, i, n, b, b2, s, bad;
-  c.p = p; c.atol = atol; c.rtol = rtol;
-  for (k = 0; k < nint; ++k) {
-    c.ud = ud + k * ustride;
-    u = ua + k * ustride;
-    b = pass_predict(b_prev, ec_prev, theta * H[k], fmax(bmin, floor(b_prev / 2)), bmax);
-    ec = pass_steps(&c, xc, tmp, b, H[k], u, 1);
-    s = b;
-    if (ec > theta * H[k] / b && b < bmax) {
-      b2 = pass_predict(b, 1.2 * ec, theta * H[k], b + 1, bmax);
-      ec = pass_steps(&c, xc, tmp, b2, H[k], u, 1);
-      b = b2;
-      s += b2;
-    }
-    for (i = 0; i < PASS_NX; ++i) xc[i] = tmp[i];
-    n = b >= 2 ? 2 * b + 1 : 2;
-    e = pass_steps(&c, xf, xf, n, H[k], u, k %% CHECK_EVERY == 0);
-    s += n;
-    bad = 0;
-    for (i = 0; i < PASS_NX; ++i) {
-      X[i * ldx + k] = xf[i];
-      XC[i * ldx + k] = xc[i];
-      if (!isfinite(xf[i]) || !isfinite(xc[i])) bad = 1;
-      sc = atol[i] + rtol * fabs(xf[i]);
-      if (fabs(xf[i]) > size[i]) size[i] = fabs(xf[i]);
-      if (sc < smin[i]) smin[i] = sc;
-      if (size[i] > ratio_max * smin[i]) bad = bad ? bad : 3;
-      sc = fabs(xf[i] - xc[i]) / sc;
-      if (!(sc <= state[ST_D])) state[ST_D] = sc;
-    }
-    if (k %% CHECK_EVERY == 0 && !bad) {
-      for (i = 0; i < PASS_NU; ++i) uend[i] = u[i] + H[k] * c.ud[i];
-      pass_rhs_at(&c, xf, uend, f0);
-      sc = (k / CHECK_EVERY) %% 2 ? -DBL_EPSILON : DBL_EPSILON;
-      for (i = 0; i < PASS_NX; ++i) tmp[i] = xf[i] * (1 + sc * signs[i]);
-      pass_rhs_at(&c, tmp, uend, f1);
-      for (i = 0; i < PASS_NX; ++i)
-        if (fabs(f1[i] - f0[i]) > rnoise[i]) rnoise[i] = fabs(f1[i] - f0[i]);
-    }
-    stats[4 * k] = n; stats[4 * k + 1] = e; stats[4 * k + 2] = ec; stats[4 * k + 3] = s;
-    state[ST_STEPS] += s;
-    state[ST_ANSWER] += n;
-    if (ec > state[ST_ECMAX]) state[ST_ECMAX] = ec;
-    if (n < state[ST_NMIN]) state[ST_NMIN] = n;
-    if (n > state[ST_NMAX]) state[ST_NMAX] = n;
-    if ((casadi_real) n / b < state[ST_RMIN]) state[ST_RMIN] = (casadi_real) n / b;
-    if (e > noise && ec > 0) {
-      o = log(ec / e) / log((casadi_real) n / b);
-      state[ST_ORDERS] += 1;
-      if (o >= 5 && o <= 10) state[ST_ORDER] += 1;
-    }
-    b_prev = b; ec_prev = ec;
-    if (bad || (b >= bmax && !(ec <= theta * H[k] / b))) {
-      state[ST_FLAG] = bad ? bad : 2;
-      break;
-    }
-  }
-  state[ST_B] = b_prev; state[ST_EC] = ec_prev;
-  for (i = 0; i < PASS_NX; ++i) {
-    sc = smin[i] > 0 ? size[i] / smin[i] : (size[i] > 0 ? INFINITY : 0);
-    if (!(sc <= state[ST_ULP])) state[ST_ULP] = sc;
-  }
-  return k < nint ? k + 1 : nint;
-}
-
-/* `rk8_pass` on a workspace: `ws + off[i]` are xf, xc, state, H, ua, ud, p, atol, stats,
-   signs and the parameters (rtol, theta, bmax, bmin, noise, ratio_max, ustride, ldx);
-   intervals `done` to `done + k`; X and XC (nx, ldx) get the states (one call of few
-   arguments). The first call (done = 0) sets the check run's start and the first column. */
-int rk8_pass_ws(casadi_real* ws, const long long* off, int done, int k, casadi_real* X,
-                casadi_real* XC) {
-  const casadi_real* par = ws + off[10];
-  int ustride = (int) par[6], ldx = (int) par[7], i;
-  if (done == 0)  /* the check run starts 2 ulp away: xc = x0 (1 + 2 eps signs) */
-    for (i = 0; i < PASS_NX; ++i) {
-      ws[off[1] + i] = ws[off[0] + i] * (1 + 2 * DBL_EPSILON * ws[off[9] + i]);
-      X[i * ldx] = ws[off[0] + i];
-      XC[i * ldx] = ws[off[1] + i];
-    }
-  return rk8_pass(ws + off[0], ws + off[1], ws + off[2], k, ws + off[3] + done,
-                  ws + off[4] + done * ustride, ws + off[5] + done * ustride, ustride,
-                  ws + off[6], par[0], ws + off[7], par[1], (int) par[2], (int) par[3], par[4],
-                  par[5], ws + off[9], X + done + 1, XC + done + 1, ldx,
-                  ws + off[8] + 4 * done);
-}
-"""
-
-
-def pass_library(model: Model) -> object | None:
-    """The compiled pass of ``model`` (a ``ctypes`` function, cached); None without a C
-    compiler or when the model cannot be code-generated (the pass is worth it only as C)."""
-    def build():
-        step = kernel(model, "rk8", "linear", error=True)
-        rhs = _renamed(model.f, "pass_rhs")
-        sizes = dict(every=CHECK_EVERY, nx=model.nx, nu=model.nu, nw=max(step.sz_w(), rhs.sz_w()), niw=max(step.sz_iw(), rhs.sz_iw()),
-                     narg=max(step.sz_arg(), rhs.sz_arg()), nres=max(step.sz_res(), rhs.sz_res()))  # (the plain step needs less)
-        steps = [_renamed(step, "rk8_step_err"), _renamed(kernel(model, "rk8", "linear"),
-                                                           "rk8_step"), rhs]
-        # auto's multi-run search (the fallback) runs the rk8 chunk loop: compiled now, at
-        # the same time (a later call with this model then compiles nothing)
-        chunk = chunk_compile_job(model, "rk8", "linear")
-        jobs = [(steps, _DRIVER % sizes, _OPTS[0], ctypes.CDLL)] + ([chunk[0]] if chunk else [])
-        lib, *rest = cache.compile_parallel(jobs)
-        if chunk:
-            chunk[1](rest[0])
-        if isinstance(lib, RuntimeError):  # (e.g. a compiler without -march=native)
-            try:
-                lib = cache.compile_c(steps, _DRIVER % sizes, _OPTS[1], ctypes.CDLL)
-            except RuntimeError:
-                return None
-        if lib is None:
-            return None
-        fun = lib.rk8_pass_ws
-        ptr, i32 = ctypes.c_void_p, ctypes.c_int
-        fun.argtypes = [ptr, ptr, i32, i32, ptr, ptr]
-        fun.restype = i32
-        fun.library = lib  # (kept alive with the function)
-        return fun
-
-    return cache.get(("rk8_pass", cache.function_key(model.f)), build, keepalive=model.f)
-
-
-def _renamed(fun: ca.Function, name: str) -> ca.Function:
-    """``fun`` under ``name`` (the generated C function's name)."""
-    if fun.name() == name:
-        return fun
-    ins = [fun.sx_in(i) for i in range(fun.n_in())] if fun.is_a("SXFunction") else \
-        [fun.mx_in(i) for i in range(fun.n_in())]
-    return ca.Function(name, ins, fun.call(ins))
 
 
 class Pass(NamedTuple):
@@ -325,7 +78,7 @@ class Pass(NamedTuple):
     reason: str = ""
 
 
-_ST = 13  # accumulators of the C `state` before max |x| and min scale (see _DRIVER)
+_ST = 13  # accumulators of the C `state` before max |x| and min scale (see `cpass._DRIVER`)
 _STATE0 = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, math.inf, 0.0, 0.0, math.inf, 0.0)
 
 
@@ -341,7 +94,7 @@ def _state0(nx: int) -> np.ndarray:
 class _Work:
     """The inputs of the compiled pass that need no fresh memory (one workspace per thread
     and shape, its addresses taken once): ``xf, xc, state, H, ua, ud, p, atol, stats,
-    signs, par`` (see ``rk8_pass_ws`` in `_DRIVER`)."""
+    signs, par`` (see ``rk8_pass_ws`` in `cpass._DRIVER`)."""
 
     __slots__ = ("arrays", "base", "offsets", "off_addr", "key")
 

@@ -3,17 +3,18 @@ the round-off floor of a run, the stiffness test, and cvodes with an estimated g
 for stiff problems."""
 from __future__ import annotations
 
-import functools
 import math
 from dataclasses import dataclass, replace
 
-import casadi as ca
 import numpy as np
 
 from .. import cache
-from .adaptive import BMAX, CHECK_EVERY, NOISE, run_pass
+from .adaptive import run_pass
+from .cpass import BMAX, CHECK_EVERY, NOISE
 from .cvodes import run_cvodes
-from .evaluate import call_buffered, map_eval
+from .estimates import (_AUTO_ACCEPT, _EPS, _FLOOR_ULPS, _carried, _floor, _initial_step,
+                        _perturbed, _roundoff, _scaled_diff, _screen, _spectrum)
+from .evaluate import map_eval
 from .inputs import Problem
 from .loops import Progress, run_fixed
 from .result import FAILED, OK, OK_STIFF, ROUNDOFF, UNVERIFIED, Run
@@ -21,13 +22,10 @@ from .tableaux import DOP853
 
 __all__ = ["solve_auto"]
 
-_EPS = np.finfo(float).eps
-_AUTO_ACCEPT = 0.5     # accept a trusted estimate (truncation + round-off) below this
 _AUTO_AIM = 0.1        # predict the step count for this estimated scaled error
 _AUTO_RUNS = 8         # give up (status 3) after this many fixed-step runs
 
 _AUTO_CONFIRM = 1024   # below this many steps a trusted triple must be confirmed by another
-_FLOOR_ULPS = 1000     # least error floor of a run in ulps of a state's size (`_floor`)
 _STIFF_STEPS = 1e6     # explicit steps for stability alone beyond which auto uses cvodes
 _CVODES_RTOL_MIN = 1e-14  # tightest local rtol auto asks cvodes for
 _RK8_STABILITY = 6.0   # DOP853's stability interval on the negative real axis is about [-6, 0]
@@ -35,57 +33,6 @@ _PASS_THETA = 1.0      # the check run's embedded estimates over the horizon, in
 _PASS_TRIES = 3        # passes (each aimed tighter) before the multi-run search
 _PASS_ULPS = 10 ** 4   # the one-pass path needs the tolerance this many ulps above the state
 _PASS_MEASURED = 10 ** 6  # and below this many it measures the model's rounding (`_floor`)
-
-
-def _scaled_diff(xa: np.ndarray, xb: np.ndarray, scale: np.ndarray) -> float:
-    """max |xa - xb| / scale over states and output times; inf if anything is non-finite."""
-    if not (np.all(np.isfinite(xa)) and np.all(np.isfinite(xb))):
-        return math.inf
-    diff = np.abs(xa - xb)
-    ratio = np.divide(diff, scale, out=np.where(diff == 0, 0.0, np.inf), where=scale > 0)
-    return float(ratio.max())
-
-
-def _roundoff(x: np.ndarray, n_steps: int, scale: np.ndarray) -> float:
-    """Scaled round-off model of a fixed-step run: ``n_steps eps max_t |x_i|`` per state.
-
-    Measured on a 100 s tumbling body (double against long double with the same DOP853
-    weights, 1000-16000 steps) the accumulated round-off was 0.15-3 eps per step relative
-    to the state's size, growing about linearly in the number of steps.
-    """
-    size = np.max(np.abs(x), axis=1, keepdims=True)
-    floor = np.broadcast_to(n_steps * _EPS * size, scale.shape)
-    ratio = np.divide(floor, scale, out=np.where(floor == 0, 0.0, np.inf), where=scale > 0)
-    return float(ratio.max())
-
-
-def _initial_step(problem: Problem, rtol, atol, order: int) -> tuple[float | None, float]:
-    """Starting step and Lipschitz estimate ``(h, L)`` [s, 1/s].
-
-    ``h``: Hairer's heuristic (Hairer, Norsett & Wanner I, II.4), capped at ``2 / L`` for
-    explicit stability, with ``L = |f(x0 + h0 f0) - f0| / |h0 f0|`` (scaled norms). ``h`` is
-    None when the heuristic is degenerate (a zero state or zero derivative); ``L`` is then 0.
-    """
-    model, x0 = problem.model, problem.x0
-    t0, H0 = float(problem.t[0]), float(problem.t[1] - problem.t[0])
-    u0 = problem.control.at(t0, 0, t0, H0)
-    scale = atol + rtol * np.abs(x0)
-    if np.any(scale == 0):
-        return None, 0.0
-    f0 = model.rhs(x0, u0, problem.p)
-    d0 = np.sqrt(np.mean((x0 / scale) ** 2))
-    d1 = np.sqrt(np.mean((f0 / scale) ** 2))
-    if not (np.isfinite(d1) and d0 > 1e-5 and d1 > 1e-5):
-        return None, 0.0
-    h0 = 0.01 * d0 / d1
-    f1 = model.rhs(x0 + h0 * f0, problem.control.at(t0 + min(h0, H0), 0, t0, H0), problem.p)
-    d2 = np.sqrt(np.mean(((f1 - f0) / scale) ** 2)) / h0
-    if not np.isfinite(d2):
-        return None, 0.0
-    h1 = (0.01 / max(d1, d2)) ** (1.0 / (order + 1)) if max(d1, d2) > 1e-15 else 100 * h0
-    lipschitz = d2 / d1
-    h = min(100 * h0, h1)
-    return (min(h, 2.0 / lipschitz) if lipschitz > 0 else h), lipschitz
 
 
 @dataclass(frozen=True)
@@ -195,46 +142,6 @@ def _estimate(runs: dict, rtol, atol, asymptotic: bool) -> _Estimate:
     return _Estimate(e_c + rho if trusted else math.inf, False, int(nxt), trusted)
 
 
-def _spectrum(problem: Problem) -> tuple[float, float] | None:
-    """``(rho, sigma)`` [1/s] from the eigenvalues ``lam`` of ``df/dx`` at ``x0``: the
-    spectral radius ``max |lam|`` (what explicit stability must resolve) and the fastest
-    decay that only an implicit method steps over cheaply, ``max(-Re lam)`` over the
-    eigenvalues with ``Re lam < 0`` and ``|Im lam| <= |Re lam|`` (oscillatory modes must be
-    resolved by any method, so they do not count). None when it cannot be evaluated."""
-    t0, H0 = float(problem.t[0]), float(problem.t[1] - problem.t[0])
-    u0 = problem.control.at(t0, 0, t0, H0)
-    try:
-        nx = problem.model.nx  # (a C-ordered (nx, nx) buffer holds J^T: same eigenvalues)
-        J = call_buffered(jacobian_x(problem.model), [problem.x0, u0, problem.p], (nx, nx)).T
-    except RuntimeError:
-        return None
-    return rho_sigma(J[None])
-
-
-def jacobian_x(model) -> ca.Function:
-    """``(x, u, p) -> df/dx`` of ``model`` (cached)."""
-    def build():
-        x, u, p = (ca.MX.sym(n, model.f.sparsity_in(n)) for n in ("x", "u", "p"))
-        xdot = model.f.call({"x": x, "u": u, "p": p})["xdot"]
-        return ca.Function("jac_x", [x, u, p], [ca.densify(ca.jacobian(xdot, x))])
-
-    return cache.get(("jac_x", cache.function_key(model.f)), build, keepalive=model.f)
-
-
-def rho_sigma(J: np.ndarray) -> tuple[float, float] | None:
-    """`_spectrum`'s ``(rho, sigma)`` over the Jacobians ``J (K, nx, nx)`` (the largest of
-    each over the K); None when an eigenvalue is not finite."""
-    try:
-        lam = np.linalg.eigvals(J)
-    except np.linalg.LinAlgError:
-        return None
-    if not np.all(np.isfinite(lam)):
-        return None
-    decay = -lam.real
-    stiff = (decay > 0) & (np.abs(lam.imag) <= decay)
-    return float(np.max(np.abs(lam), initial=0.0)), float(np.max(decay[stiff], initial=0.0))
-
-
 class Single:
     """What `auto_runs` asks of the runs it controls: here one `Problem` (a batch of runs:
     `dynamics.integrate.batch.BatchTarget`). States are flat: ``x0 (N,)``, a run's ``x``
@@ -335,102 +242,6 @@ def auto_runs(target, rtol, atol, max_steps, jit_pref, progress: Progress):
     return best, est.value, UNVERIFIED, reason, *total
 
 
-def _floor(target, run: Run, rtol, atol, lipschitz: float, jit: bool,
-           progress) -> tuple[float, int]:
-    """Scaled error floor of ``run`` from rounding; returns ``(floor, extra steps made)``.
-
-    Rounding that every run shares (the model's own formulas) does not show in differences
-    between runs, so it is measured. ``f`` is evaluated at up to 16 states of ``run`` and
-    again with those states moved by one ulp in random sign patterns; the largest change
-    ``noise_i`` is the rounding noise of ``f_i``, catastrophic cancellation included
-    (``w x (I w)`` of I = (1, 1e4, 1e4) rounds to 1e4 eps |w2 w3|). While the state changes
-    little, over a time ``tau = 1 / L`` (``L`` the spectral radius at ``x0``), the rounding
-    repeats and adds up linearly; beyond, at random: ``e_i = 2 sqrt(T min(T, tau)) noise_i``
-    over the horizon ``T`` (2 for the sampled noise; measured on that body: 1.1e-12 after
-    1 s where the samples gave 5.5e-13/s, while a Richardson triple looked 8th order).
-    If ``max_i e_i``, grown by ``1 + L T``, is far
-    inside the smallest tolerance of any state, that bound is the floor; otherwise the
-    flow's real amplification is measured by repeating ``run`` from ``x0 + e`` (random
-    signs, same steps): the floor is the scaled difference (an error injected at the start,
-    the worst time for it). The floor is never below ``_FLOOR_ULPS`` ulps of a state's size
-    (the rounding of the state itself, shared alike: near a separatrix every run, rk8 at
-    16-400 steps per interval and scipy's DOP853 alike, was off by 900 ulps of ``|w|``
-    while they agreed to 90).
-    """
-    x = run.x
-    horizon = float(target.t[-1] - target.t[0])
-    cols = np.unique(np.linspace(0, x.shape[1] - 1, min(16, x.shape[1])).round().astype(int))
-    X = x[:, cols]
-    flips, signs = _floor_signs(X.shape, x.shape[0])
-    pert = [X] + [X * (1 + _EPS * f) for f in flips]
-    F = target.rhs(np.concatenate(pert, axis=1),
-                   np.tile(cols, len(pert))).reshape(x.shape[0], len(pert), cols.size)
-    if not np.all(np.isfinite(F)):
-        return math.inf, 0
-    noise = np.max(np.abs(F[:, 1:] - F[:, :1]), axis=(1, 2))
-    e = _carried(noise, horizon, lipschitz)
-    scale = atol[:, None] + rtol * np.abs(x[:, 1:])
-    ulps = _roundoff(x, _FLOOR_ULPS, scale)
-    local = _scaled_diff(np.broadcast_to(e[:, None], scale.shape), np.zeros(scale.shape), scale)
-    bound = _screen(e, np.min(scale, axis=1), horizon, lipschitz, target.runs)
-    if bound <= 0.1 * _AUTO_ACCEPT:
-        return max(bound, ulps), 0
-    check = target.run(target.x0 + signs * e, run.substeps, jit, progress)
-    return max(local, ulps, _scaled_diff(check.x[:, 1:], x[:, 1:], scale)), check.n_steps
-
-
-def _carried(noise: np.ndarray, horizon: float, lipschitz: float) -> np.ndarray:
-    """`_floor`'s rounding error ``2 sqrt(T min(T, 1 / L)) noise`` carried over the horizon
-    ``T`` from the right-hand side's rounding ``noise`` per state (``L`` the spectral
-    radius)."""
-    tau = horizon if lipschitz <= 0 else min(horizon, 1.0 / lipschitz)
-    return 2 * math.sqrt(horizon * tau) * noise
-
-
-def _screen(e: np.ndarray, smin: np.ndarray, horizon: float, lipschitz: float,
-            runs: int = 1) -> float:
-    """`_floor`'s screening bound of the carried rounding ``e`` against the least tolerance
-    ``smin`` of each state: the flow may carry the noise of any state into any other (the
-    spin-rate noise of a flat body into the phase of its transverse rates), so across the
-    states of each run (the runs of a batch do not share noise), the largest over the runs,
-    grown by ``1 + L T``."""
-    top, least = np.max(e.reshape(runs, -1), axis=1), np.min(smin.reshape(runs, -1), axis=1)
-    worst = np.divide(top, least, out=np.where(top > 0, np.inf, 0.0), where=least > 0)
-    return float(np.max(worst)) * (1 + lipschitz * horizon)
-
-
-def _perturbed(x0: np.ndarray, m: int) -> np.ndarray:
-    """``x0`` moved by 2 ulp in a sign pattern that differs between step
-    counts ``m`` (reproducibly): the differences between ``auto``'s runs then also show how
-    strongly the problem amplifies double-precision representation errors (of ``x0`` and of
-    the model's constants, rounded alike). Near a separatrix this amplification put a common
-    error of 3e-13 into every run at 16-400 steps per interval that step-count differences
-    alone cannot see; a well-conditioned problem just carries the 2 ulp."""
-    return x0 + 2 * _EPS * _signs(m, x0.size) * x0
-
-
-@functools.lru_cache(maxsize=256)
-def _signs(seed: int, size: int) -> np.ndarray:
-    """A reproducible random sign pattern of ``size`` entries (read-only). Cached: seeding a
-    numpy generator costs about 40 us, more than an rk8 run of a small model."""
-    out = np.random.default_rng(seed).choice((-1.0, 1.0), size=size)
-    out.setflags(write=False)
-    return out
-
-
-@functools.lru_cache(maxsize=256)
-def _floor_signs(shape: tuple, n: int) -> tuple:
-    """`_floor`'s sign patterns (cached, read-only): three of ``shape`` for the ulp moves of
-    the sampled states, then ``n`` for the start of its check run, drawn in that order from
-    one generator seeded 0."""
-    rng = np.random.default_rng(0)
-    flips = [rng.choice((-1.0, 1.0), size=shape) for _ in range(3)]
-    signs = rng.choice((-1.0, 1.0), size=n)
-    for a in (*flips, signs):
-        a.setflags(write=False)
-    return tuple(flips), signs
-
-
 def _first_bad(x: np.ndarray) -> int:
     """Index of the first output time with a non-finite state (``x.shape[1]`` if none)."""
     bad = ~np.isfinite(x).all(axis=0)
@@ -468,7 +279,6 @@ def _auto_cvodes(problem: Problem, rtol, atol, extra):
         prev, factor = run, factor * 1e-2
 
 
-
 def one_pass(problem: Problem, rtol, atol, max_steps, jit_pref, progress):
     """``auto`` in one compiled pass (`dynamics.integrate.adaptive`) where it applies:
     returns ``(run, estimate, steps)``, or ``(None, nan, steps)`` to leave the problem to
@@ -499,7 +309,7 @@ def one_pass(problem: Problem, rtol, atol, max_steps, jit_pref, progress):
 
     Not accepted, the pass is repeated aimed tighter (`_PASS_TRIES` in all). Not taken: a
     callable control, no compiled pass, a tolerance within `_PASS_ULPS` ulps of a state, a
-    non-finite state or an interval that needs more than ``2 adaptive.BMAX + 1`` steps.
+    non-finite state or an interval that needs more than ``2 cpass.BMAX + 1`` steps.
     """
     if problem.control.mode != "linear" or not _auto_jit(jit_pref):
         return None, math.nan, 0

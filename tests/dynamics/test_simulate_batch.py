@@ -140,7 +140,7 @@ def test_a_stiff_batch_goes_to_cvodes_run_by_run_as_single_runs_do():
 
 # ------------------------------------------------ parts of a batch spread over threads
 from dynamics import executors  # noqa: E402
-from dynamics.integrate import batch as batch_module  # noqa: E402
+from dynamics.integrate import batch_fixed as batch_module  # noqa: E402
 
 
 @pytest.fixture
