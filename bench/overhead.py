@@ -5,8 +5,9 @@ A repeated short call on a cached model (the torque-free rigid body, J = diag(1,
 ``auto``. For each: the time per `simulate` call, the time of the compiled call alone (the
 chunk's buffer triggered with the same inputs already in place; for ``auto``, the call of its
 compiled pass, `dynamics.integrate.adaptive`, replayed with the arguments `simulate` gave
-it: the floor no Python wrapper can go under), and their difference, the overhead. Each
-time is the median over 7 batches of 5,000 calls (3 batches of 1,000 with ``--quick``).
+it: the floor no Python wrapper can go under), and their difference, the overhead. The two
+are timed in 15 interleaved rounds of 2,000 calls each (3 of 1,000 with ``--quick``); each
+time is the median over the rounds, the overhead the median of the per-round differences.
 
 Writes ``overhead.csv`` into the output folder and returns the summary rows (`run`).
 Run: ``appdyn bench overhead`` or ``python bench/overhead.py [--quick]``.
@@ -33,15 +34,26 @@ CASES = (("rk8", dict(method="rk8", steps=1)), ("rk4", dict(method="rk4", steps=
          ("auto", dict(method="auto")))
 
 
-def per_call(fun, calls: int, batches: int) -> float:
-    """Median over ``batches`` of the mean time of one of ``calls`` calls of ``fun()`` [s]."""
-    times = []
+def batch_time(fun, calls: int) -> float:
+    """The mean time of one of ``calls`` calls of ``fun()`` [s]."""
+    t0 = time.perf_counter()
+    for _ in range(calls):
+        fun()
+    return (time.perf_counter() - t0) / calls
+
+
+def paired_per_call(total, floor, calls: int, batches: int) -> tuple[float, float, float]:
+    """Medians over ``batches`` rounds, each a batch of ``calls`` calls of ``total()`` then
+    of ``floor()``: ``(total, floor, overhead)`` [s], the overhead the median of the
+    per-round differences. Interleaved, because this VM's speed drifts by 20-60% within
+    seconds: timed one after the other, the two medians once differed by 8 to 32 us for
+    the same call."""
+    tt, ff = [], []
     for _ in range(batches):
-        t0 = time.perf_counter()
-        for _ in range(calls):
-            fun()
-        times.append((time.perf_counter() - t0) / calls)
-    return statistics.median(times)
+        tt.append(batch_time(total, calls))
+        ff.append(batch_time(floor, calls))
+    diff = [a - b for a, b in zip(tt, ff)]
+    return statistics.median(tt), statistics.median(ff), statistics.median(diff)
 
 
 _KEEP: list = []
@@ -87,20 +99,19 @@ def compiled_pass_call(model):
 
 
 def run(quick: bool, out: Path) -> list[Row]:
-    calls, batches = (1000, 3) if quick else (5000, 7)
+    calls, batches = (1000, 3) if quick else (2000, 15)
     model = rigid_body(INERTIA)
     detail, summary = [], []
-    print(f"simulate on a 2-point grid, torque-free body; median of {batches} batches of "
-          f"{calls} calls")
+    print(f"simulate on a 2-point grid, torque-free body; medians of {batches} interleaved "
+          f"rounds of {calls} calls each")
     for name, kwargs in CASES:
         res = simulate(model, X0, GRID, **kwargs)  # warm: compiles once
         n = calls
-        total = per_call(lambda: simulate(model, X0, GRID, **kwargs), n, batches)
         trigger, compiled = (compiled_pass_call(model) if "embedded" in res.message
                              else compiled_call(model, res.method))
         trigger()
-        chunk = per_call(trigger, calls, batches)
-        over = total - chunk
+        total, chunk, over = paired_per_call(lambda: simulate(model, X0, GRID, **kwargs),
+                                             trigger, n, batches)
         print(f"  {name:5s} total {1e6 * total:8.2f} us   compiled call {1e6 * chunk:6.2f} us   "
               f"overhead {1e6 * over:8.2f} us   (n_steps {res.n_steps}, compiled {compiled})")
         detail.append(dict(method=name, calls=n, batches=batches, total_us=1e6 * total,
