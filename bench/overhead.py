@@ -5,7 +5,9 @@ A repeated short call on a cached model (the torque-free rigid body, J = diag(1,
 ``auto``. For each: the time per `simulate` call, the time of the compiled call alone (the
 chunk's buffer triggered with the same inputs already in place; for ``auto``, the call of its
 compiled pass, `dynamics.integrate.adaptive`, replayed with the arguments `simulate` gave
-it: the floor no Python wrapper can go under), and their difference, the overhead. The two
+it: the floor no Python wrapper can go under), and their difference, the overhead; for the
+fixed-step methods also the Python time before the compiled call starts (`before_compiled`,
+what the per-call target of issue "Simulation at compiled-C speed" counts). The two
 are timed in 15 interleaved rounds of 2,000 calls each (3 of 1,000 with ``--quick``); each
 time is the median over the rounds, the overhead the median of the per-round differences.
 
@@ -22,7 +24,7 @@ from pathlib import Path
 import numpy as np
 
 from dynamics import rigid_body, simulate
-from dynamics.integrate import adaptive
+from dynamics.integrate import adaptive, evaluate
 from dynamics.integrate.loops import CHUNK, _chunk_shapes, chunk_function
 
 from _common import Row, script_main, write_csv
@@ -98,6 +100,35 @@ def compiled_pass_call(model):
     return (lambda: lib(*args)), True
 
 
+def before_compiled(model, kwargs, calls: int, batches: int) -> float:
+    """Median over ``batches`` rounds of the mean Python time of a `simulate` call BEFORE
+    its compiled call starts (what the issue's per-call target counts) [s], for the
+    fixed-step methods: the thread's bound buffer of the chunk Function gets a ``trigger``
+    that notes the time and then calls the real one."""
+    fun, _ = chunk_function(model, kwargs["method"], "linear", True)
+    simulate(model, X0, GRID, **kwargs)
+    entry = evaluate._thread_table("bound")[id(fun)]
+    real, stamp = entry.trigger, [0.0]
+
+    def noted():
+        stamp[0] = time.perf_counter()
+        real()
+
+    entry.trigger = noted
+    rounds = []
+    try:
+        for _ in range(batches):
+            spent = 0.0
+            for _ in range(calls):
+                t0 = time.perf_counter()
+                simulate(model, X0, GRID, **kwargs)
+                spent += stamp[0] - t0
+            rounds.append(spent / calls)
+    finally:
+        entry.trigger = real
+    return statistics.median(rounds)
+
+
 def run(quick: bool, out: Path) -> list[Row]:
     calls, batches = (1000, 3) if quick else (2000, 15)
     model = rigid_body(INERTIA)
@@ -122,6 +153,12 @@ def run(quick: bool, out: Path) -> list[Row]:
         summary += [Row("overhead", case, "per call", 1e6 * total, "us", note),
                     Row("overhead", case, "compiled call", 1e6 * chunk, "us", note),
                     Row("overhead", case, "Python overhead", 1e6 * over, "us", note)]
+        if name != "auto":
+            before = before_compiled(model, kwargs, n, batches)
+            print(f"        Python before the compiled call {1e6 * before:6.2f} us")
+            detail[-1]["before_us"] = 1e6 * before
+            summary.append(Row("overhead", case, "Python before the compiled call",
+                               1e6 * before, "us", note))
     write_csv(detail, Path(out) / "overhead.csv")
     return summary
 
