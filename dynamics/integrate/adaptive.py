@@ -34,6 +34,7 @@ import numpy as np
 
 from ..interrupts import check_interrupt, deferred_interrupts
 from .cpass import BMAX, NOISE, pass_library
+from .estimates import _signs
 from .inputs import Problem
 
 __all__ = ["INTERVALS", "Pass", "run_pass"]
@@ -105,7 +106,7 @@ class _Work:
             offsets.append(offsets[-1] + size)
         work = np.zeros(offsets[-1])
         self.arrays = [work[offsets[i]:offsets[i + 1]] for i in range(len(sizes))]
-        self.arrays[9][:] = _signs(sizes[0])  # (the sign pattern: see `rk8_pass_ws`)
+        self.arrays[9][:] = _signs(1, sizes[0])  # (`_perturbed`'s pattern for m = 1)
         self.base = work.ctypes.data
         self.offsets = np.array(offsets[:-1], dtype=np.int64)
         self.off_addr = self.offsets.ctypes.data
@@ -114,12 +115,6 @@ class _Work:
 _LOCAL = threading.local()
 
 
-@functools.lru_cache(maxsize=64)
-def _signs(n: int) -> np.ndarray:
-    """The sign pattern of the rounding-noise probe (reproducible, read-only)."""
-    out = np.random.default_rng(1).choice((-1.0, 1.0), size=n)
-    out.setflags(write=False)
-    return out
 
 
 def _borrow_work(key, sizes) -> _Work:
