@@ -2,7 +2,7 @@
 SUNDIALS CVODES, and an ``auto`` mode that meets a requested global tolerance.
 
 The public entry points are `dynamics.simulate`, `dynamics.SimulationResult`,
-`dynamics.BatchResult` and `dynamics.METHODS`; the modules of this package are its internals, one job each:
+`dynamics.BatchResult`, `dynamics.Event` and `dynamics.METHODS`; the modules of this package are its internals, one job each:
 
 ==============  ===========================================================================
 ``api``         `simulate`: checks the inputs, runs the method, builds the result
@@ -14,6 +14,8 @@ The public entry points are `dynamics.simulate`, `dynamics.SimulationResult`,
 ``auto``        Richardson global-error estimates, round-off floor, stiffness test
 ``result``      `SimulationResult` and its dense output; `Run`, one run's outcome
 ``evaluate``    buffered numeric evaluation of Functions (no per-element conversion)
+``events``      event functions (``events=``): zero crossings located on the solution,
+                `Event`; a terminal event truncates the result
 ``batch``       K runs at once (``x0`` of shape (nx, K)): the chunk loop mapped over the
                 runs on threads, ``auto``'s error control over the batch; `BatchResult`
 ==============  ===========================================================================
@@ -83,6 +85,7 @@ from __future__ import annotations
 
 from .api import METHODS, Method, simulate
 from .batch import BatchResult
+from .events import Event
 from .result import SimulationResult
 
-__all__ = ["METHODS", "BatchResult", "Method", "SimulationResult", "simulate"]
+__all__ = ["METHODS", "BatchResult", "Event", "Method", "SimulationResult", "simulate"]

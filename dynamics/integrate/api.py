@@ -14,6 +14,7 @@ from ..model import Model, check_model
 from .auto import solve_auto
 from .batch import BatchResult, check_batch, simulate_batch
 from .cvodes import run_cvodes
+from .events import apply_events, check_events
 from .inputs import (Problem, check_cvodes_options, check_invariants, check_t, check_tolerances,
                      check_u, check_x0, fast_x0)
 from .kernels import check_lie_model
@@ -31,7 +32,8 @@ def simulate(model: Model, x0, t, *, u=None, p=None, method: Method = "auto",
              rtol: float = 1e-8, atol=1e-10, invariants=False, steps: int | None = None,
              jit: bool | None = None, max_steps: int = 100_000_000,
              cvodes_options: Mapping | None = None,
-             progress: Callable[[int, int], None] | None = None) -> SimulationResult | BatchResult:
+             progress: Callable[[int, int], None] | None = None,
+             events=None) -> SimulationResult | BatchResult:
     """Integrate ``xdot = f(x, u, p)`` of ``model`` from ``x0`` over the grid ``t``.
 
     Parameters
@@ -98,13 +100,20 @@ def simulate(model: Model, x0, t, *, u=None, p=None, method: Method = "auto",
         ``progress(done, total)`` is called after every chunk of 512 fixed steps with the
         steps done and planned so far (``total`` grows when ``auto`` starts another run);
         for a progress line on long runs. Not called by ``cvodes``.
+    events : callable, casadi.Function, Event, or a sequence of them, optional
+        Event functions ``g(t, x, u, p) -> scalar`` whose zero crossings are located on the
+        solution to the integrator's accuracy (`dynamics.integrate.events`: what is
+        detected on which steps), with scipy's attributes ``terminal`` (bool or number of
+        occurrences) and ``direction``; `dynamics.Event` gives them to a Function. Results
+        in ``t_events`` and ``x_events``; a terminal event ends ``t`` at the event (status
+        4). Single runs only (not with ``x0`` of shape (nx, K)).
 
     Returns
     -------
     SimulationResult
         ``t``, ``x (nx, n)``, ``success``, ``status``, ``message``, ``method``, ``wall_time``,
         ``n_steps``, ``n_rhs``, ``substeps``, ``error_estimate``, ``compiled``,
-        ``invariants`` and ``sample(t)``.
+        ``invariants``, ``t_events``, ``x_events`` and ``sample(t)``.
 
     Raises
     ------
@@ -116,8 +125,10 @@ def simulate(model: Model, x0, t, *, u=None, p=None, method: Method = "auto",
         ``u`` returning the wrong shape), an unknown ``method``, bad ``rtol``/``atol``,
         ``steps`` with a method that does not take it, ``'lie'`` on a model without an
         attitude, unknown ``invariants``, an attitude quaternion in ``x0`` whose norm is
-        not 1 to 1e-6, an unknown or ill-typed ``cvodes_options`` entry.
-        ``TypeError`` for ``cvodes_options`` that is not a mapping.
+        not 1 to 1e-6, an unknown or ill-typed ``cvodes_options`` entry, ``events`` with a
+        batch, an event Function of the wrong inputs or outputs, an event function whose
+        value is not one finite number. ``TypeError`` for ``cvodes_options`` that is not a
+        mapping, ``events`` that are not callables.
 
     Notes
     -----
@@ -145,6 +156,9 @@ def simulate(model: Model, x0, t, *, u=None, p=None, method: Method = "auto",
     x = fast_x0(x0, model)  # the common x0 at once (shape (nx,): no batch); else in full
     if x is None:
         if np.ndim(x0) == 2 and np.shape(x0)[1] >= 2:
+            if events is not None:
+                raise ValueError("`events` are located for single runs only; simulate the "
+                                 "runs of a batch (`x0` of shape (nx, K)) one by one")
             return _simulate_batch(model, x0, t, u, p, method, rtol, atol, invariants, steps,
                                    jit, max_steps, cvodes_options, progress, start)
         x = check_x0(x0, model)
@@ -155,6 +169,7 @@ def simulate(model: Model, x0, t, *, u=None, p=None, method: Method = "auto",
     rtol, atol = check_tolerances(rtol, atol, model.nx)
     control = None if u is None else check_u(u, model.nu, t)  # None: zero, made if needed
     names = check_invariants(invariants, model)
+    specs = None if events is None else check_events(events, model, t, x0, control, p)
     max_steps, steps, cvodes_options, counter = _check_options(method, max_steps, jit, steps,
                                                                cvodes_options, progress)
     if method == "lie":
@@ -179,12 +194,18 @@ def simulate(model: Model, x0, t, *, u=None, p=None, method: Method = "auto",
     x.setflags(write=False)
     values = _invariants(model, x, p, names) if names else {}
     success = run.ok and status in (OK, OK_STIFF)
-    return new_result(  # (t, x, success, status, message, method, wall_time, n_steps,
+    result = new_result(  # (t, x, success, status, message, method, wall_time, n_steps,
         t, x, success, status if run.ok else FAILED, run.message, used,  # n_rhs, substeps,
         time.perf_counter() - start, run.n_steps, run.n_rhs, run.substeps,  # error_estimate,
         estimate, run.compiled, MappingProxyType(values),  # compiled, invariants, _dense)
         Dense(model, p, lambda: _zero_grid(t, model.nu) if control is None
               else control.grid(t)))
+    if specs is None:
+        return result
+    problem = Problem.new(model, x0, t, check_u(None, model.nu, t) if control is None
+                          else control, p)
+    return apply_events(result, specs, problem, method, rtol, atol, cvodes_options,
+                        cache.should_compile(jit, math.inf))
 
 
 def _simulate_batch(model, x0, t, u, p, method, rtol, atol, invariants, steps, jit, max_steps,

@@ -15,11 +15,12 @@ from .. import cache
 from .inputs import Problem
 from .result import Run
 
-__all__ = ["run_cvodes"]
+__all__ = ["ControlCallback", "integrator_options", "run_cvodes"]
 
 
-class _ControlCallback(ca.Callback):
-    """``u(t)`` of a Python callable as a casadi Function of time, for cvodes."""
+class ControlCallback(ca.Callback):
+    """``u(t)`` of a Python callable as a casadi Function of time, for cvodes. Its
+    ``error`` holds the first exception the callable raised (re-raise it after the call)."""
 
     def __init__(self, fun, nu: int):
         ca.Callback.__init__(self)
@@ -77,7 +78,9 @@ def _build_cvodes_integrator(model, mode, t, opts, callback):
     return ca.integrator("simulate_cvodes", "cvodes", dae, float(t[0]), t[1:].tolist(), opts)
 
 
-def _cvodes_options(rtol, atol, extra) -> dict:
+def integrator_options(rtol, atol, extra) -> dict:
+    """Options of ``casadi.integrator('cvodes')``: the defaults, ``rtol`` and the least
+    ``atol`` as its local tolerances, then ``extra`` (``cvodes_options``) over them."""
     opts = dict(_CVODES_DEFAULTS)
     opts.update({"reltol": rtol, "abstol": float(np.min(atol))})
     opts.update(dict(extra or {}))
@@ -86,7 +89,7 @@ def _cvodes_options(rtol, atol, extra) -> dict:
 
 def run_cvodes(problem: Problem, rtol, atol, extra) -> Run:
     model, t, ctrl = problem.model, problem.t, problem.control
-    opts = _cvodes_options(rtol, atol, extra)
+    opts = integrator_options(rtol, atol, extra)
     if ctrl.mode == "linear":
         key = ("cvodes", cache.function_key(model.f), t.tobytes(),
                repr(sorted(opts.items(), key=str)))
@@ -94,7 +97,7 @@ def run_cvodes(problem: Problem, rtol, atol, extra) -> Run:
                             keepalive=model.f) as integ:
             return _run(problem, integ, opts, rtol, atol, None)
     with cache.construction_lock():
-        callback = _ControlCallback(ctrl.fun, model.nu)
+        callback = ControlCallback(ctrl.fun, model.nu)
     integ = _cvodes_integrator(model, "stages", t, opts, callback)
     return _run(problem, integ, opts, rtol, atol, callback)
 

@@ -16,10 +16,11 @@ from ..serialize import text_table, to_json
 from .evaluate import map_eval
 
 __all__ = ["SimulationResult", "make_result", "new_result", "Dense", "Run", "OK", "OK_STIFF", "ROUNDOFF",
-           "UNVERIFIED", "FAILED"]
+           "UNVERIFIED", "FAILED", "TERMINAL_EVENT"]
 
 # status codes of SimulationResult (documented in its docstring)
 OK, OK_STIFF, ROUNDOFF, UNVERIFIED, FAILED = 0, 1, 2, 3, -1
+TERMINAL_EVENT = 4  # a terminal event stopped the solution (`simulate(events=...)`)
 
 
 class Dense:
@@ -104,7 +105,8 @@ class SimulationResult:
         tolerance lies below the round-off floor of fixed-step runs on this grid (more steps
         no longer reduce the differences between runs); ``3`` not verified: ``max_steps``
         or the run budget was reached first; ``-1`` failure (integrator error, or a
-        non-finite state). With 2 and 3 ``x`` is the finest run made and
+        non-finite state); ``4`` success, stopped by a terminal event (``events``): ``t``
+        ends at the event time. With 2 and 3 ``x`` is the finest run made and
         ``error_estimate`` says how far off it is thought to be.
     message : str
         What happened, in words.
@@ -126,6 +128,11 @@ class SimulationResult:
     invariants : mapping of str to ndarray
         Each requested invariant along ``x``: shape ``(n,)`` for a scalar, ``(m, n)`` for a
         vector invariant. Empty unless asked for.
+    t_events : list of ndarray, shape (k_i,) [s], or None
+        With ``events``: for each event function, the times of its occurrences (as scipy's
+        ``solve_ivp``); ``None`` without ``events``.
+    x_events : list of ndarray, shape (k_i, nx), or None
+        The states at those times (scipy's ``y_events``).
     """
 
     t: np.ndarray
@@ -142,6 +149,8 @@ class SimulationResult:
     compiled: bool = False
     invariants: Mapping[str, np.ndarray] = field(default_factory=dict)
     _dense: Dense | None = field(default=None, repr=False)
+    t_events: list | None = None
+    x_events: list | None = None
 
     def __getstate__(self) -> dict:
         state = dict(self.__dict__)
@@ -204,6 +213,7 @@ class SimulationResult:
             "error_estimate": self.error_estimate, "compiled": bool(self.compiled),
             "t": self.t, "x": dict(zip(self.states, self.x)),
             "invariants": dict(self.invariants),
+            "t_events": self.t_events, "x_events": self.x_events,
         }
 
     def to_json(self) -> str:
@@ -219,6 +229,9 @@ class SimulationResult:
                 ("error estimate", f"{self.error_estimate:.3g} of tolerance"),
                 ("wall time", f"{1e3 * self.wall_time:.3f} ms"),
                 ("message", self.message)]
+        if self.t_events is not None:
+            rows.insert(-1, ("events", ", ".join(str(te.size) for te in self.t_events)
+                             + " occurrence(s)"))
         return text_table("Simulation", rows)
 
     def plot(self, path=None, *, ax=None, states=None):
@@ -322,7 +335,8 @@ def new_result(t, x, success, status, message, method, wall_time, n_steps, n_rhs
     result.__dict__.update(
         t=t, x=x, success=success, status=status, message=message, method=method,
         wall_time=wall_time, n_steps=n_steps, n_rhs=n_rhs, substeps=substeps,
-        error_estimate=error_estimate, compiled=compiled, invariants=invariants, _dense=_dense)
+        error_estimate=error_estimate, compiled=compiled, invariants=invariants, _dense=_dense,
+        t_events=None, x_events=None)
     return result
 
 

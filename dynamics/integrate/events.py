@@ -1,0 +1,551 @@
+"""Event detection for `simulate` (``events=``): zero crossings of ``g(t, x, u, p)`` located
+on the solution to the integrator's accuracy, reported as scipy's ``solve_ivp`` does.
+
+An event function is a callable or a CasADi Function ``g(t, x, u, p) -> scalar`` with
+scipy's attributes ``terminal`` (bool, or the number of occurrences after which the solution
+stops) and ``direction`` (``0`` every crossing, ``+1`` from negative to positive, ``-1``
+from positive to negative); `Event` attaches them to a Function, which cannot carry
+attributes.
+
+What is detected
+----------------
+The sign of ``g`` is looked at on the *internal steps* of the solution, not only at the
+output times:
+
+* ``rk4``, ``rk8``, ``lie``: at every step (``steps`` per output interval), the same steps
+  as the answer, re-taken from the answer at the start of each block of output intervals
+  (with one step per interval the answer itself is scanned, nothing is re-run);
+* ``auto`` (rk8): at ``substeps`` rk8 steps per output interval (the steps of the answer;
+  after the one-pass path the most it took in any interval), re-integrated from the answer
+  at the start of each block of output intervals; ``auto`` through cvodes as ``cvodes``
+  below at its tightened tolerances (1e-3 of the asked ones);
+* ``cvodes``: on a sub-grid of ``ceil(n_steps / (n - 1))`` points per output interval (at
+  most `CVODES_SUBGRID`), integrated by cvodes at the same tolerances from the answer at
+  each output time.
+
+A change of sign between two neighbouring points (``g < 0`` then ``g >= 0`` upwards, ``g >
+0`` then ``g <= 0`` downwards; a zero at ``t[0]`` is no event) is then located by Brent's
+method on the solution itself: the state at a trial time is one step of the same method of
+that length from the point before (fixed step, ``auto``), or a cvodes run at the same
+tolerances (``cvodes``), never an interpolant of the output grid. A crossing and re-crossing
+between two neighbouring points (within one internal step), or a zero that only touches, is
+not seen (as with scipy, whose points are its own steps).
+
+The solution is integrated over the whole grid first; a terminal event then truncates it:
+``t`` ends at the event time (the output times before it, then the event time), ``status``
+is `TERMINAL_EVENT`. A run that failed (a non-finite state) after a terminal event is that
+success; events are looked for only up to a failure.
+"""
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass
+from types import MappingProxyType
+
+import casadi as ca
+import numpy as np
+from scipy.optimize import brentq
+
+from .. import cache
+from ..model import Model
+from .cvodes import ControlCallback, integrator_options
+from .evaluate import map_eval
+from .inputs import Control, Problem
+from .kernels import kernel
+from .loops import run_fixed
+from .result import FAILED, OK, OK_STIFF, TERMINAL_EVENT, Dense, SimulationResult, make_result
+from .tableaux import TABLEAUX, unique_nodes
+
+__all__ = ["Event", "EventSpec", "CVODES_SUBGRID", "check_events", "controls_at",
+           "apply_events"]
+
+#: Most sub-grid points per output interval on which a cvodes solution is scanned.
+CVODES_SUBGRID = 64
+
+#: Internal points per block of the scan (bounds the memory of a long run's scan; a
+#: terminal event ends the scan at its block).
+_BLOCK_POINTS = 4096
+
+#: ``auto`` through cvodes: the event scan's tolerances relative to the asked ones (the
+#: accepted run of `auto._auto_cvodes` is at 1e-3 of them or tighter).
+_AUTO_CVODES_TIGHTEN = 1e-3
+
+_EPS = np.finfo(float).eps
+
+
+class Event:
+    """An event function with scipy's attributes, for a CasADi Function (which cannot carry
+    attributes) or any callable.
+
+    Parameters
+    ----------
+    fun : casadi.Function or callable
+        ``g(t, x, u, p) -> scalar``: ``t`` [s] a float, ``x (nx,)``, ``u (nu,)``, ``p (np,)``
+        (a Function: four inputs of these sizes and one scalar output).
+    terminal : bool or int, optional
+        ``False``/``0``: only record; ``True``: stop the solution at the first occurrence;
+        an integer ``k >= 1``: at the ``k``-th.
+    direction : float, optional
+        ``0`` every crossing; ``> 0`` only from negative to positive; ``< 0`` only from
+        positive to negative.
+    name : str, optional
+        Named in the result's message (default the Function's name or the callable's
+        ``__name__``).
+
+    Examples
+    --------
+    >>> import casadi as ca
+    >>> import numpy as np
+    >>> from dynamics import Event, Model, simulate
+    >>> x, u, p, t = ca.SX.sym("x", 2), ca.SX.sym("u", 0), ca.SX.sym("p", 0), ca.SX.sym("t")
+    >>> fall = Model(f=ca.Function("fall", [x, u, p], [ca.vertcat(x[1], -9.81)],
+    ...                            ["x", "u", "p"], ["xdot"]), states=("h", "v"), controls=())
+    >>> ground = Event(ca.Function("ground", [t, x, u, p], [x[0]]), terminal=True, direction=-1)
+    >>> res = simulate(fall, [10.0, 0.0], np.linspace(0.0, 5.0, 6), events=ground)
+    >>> res.status, bool(abs(res.t[-1] - np.sqrt(2 * 10.0 / 9.81)) < 1e-12)
+    (4, True)
+    """
+
+    def __init__(self, fun, terminal: bool | int = False, direction: float = 0.0,
+                 name: str | None = None):
+        self.fun = fun
+        self.terminal = terminal
+        self.direction = direction
+        self.name = name
+        _occurrences(terminal, "`Event` `terminal`")
+        _direction(direction, "`Event` `direction`")
+
+    def __call__(self, t, x, u, p) -> float:
+        """``g(t, x, u, p)`` as a float."""
+        value = self.fun(t, x, u, p)
+        return float(np.asarray(value, dtype=float).reshape(-1)[0])
+
+    def __repr__(self) -> str:
+        return (f"Event({self.name or _name_of(self.fun, 'g')!r}, terminal={self.terminal!r}, "
+                f"direction={self.direction!r})")
+
+
+@dataclass(frozen=True)
+class EventSpec:
+    """One checked event function: ``fun`` (a Function when ``function``), ``count`` the
+    occurrences that stop the solution (0: never), ``direction`` in {-1, 0, 1}, ``name``,
+    ``label`` (``events[i]``, for messages)."""
+
+    fun: object
+    function: bool
+    count: int
+    direction: int
+    name: str
+    label: str
+
+
+def _occurrences(terminal, what: str) -> int:
+    """``terminal`` as a count of occurrences (0: not terminal)."""
+    if isinstance(terminal, (bool, np.bool_)):
+        return int(terminal)
+    if isinstance(terminal, (int, np.integer)) and terminal >= 0:
+        return int(terminal)
+    raise ValueError(f"{what} must be a bool or an integer >= 0 (occurrences before the "
+                     f"solution stops), got {terminal!r}")
+
+
+def _direction(direction, what: str) -> int:
+    """``direction`` as its sign."""
+    try:
+        value = float(direction)
+    except (TypeError, ValueError):
+        value = math.nan
+    if not math.isfinite(value) or isinstance(direction, (bool, np.bool_)):
+        raise ValueError(f"{what} must be a finite number (0, > 0 or < 0), got {direction!r}")
+    return int(np.sign(value))
+
+
+def _name_of(fun, default: str) -> str:
+    if isinstance(fun, ca.Function):
+        return fun.name()
+    return getattr(fun, "__name__", default)
+
+
+def check_events(events, model: Model, t: np.ndarray, x0: np.ndarray, control: Control | None,
+                 p: np.ndarray) -> tuple[EventSpec, ...]:
+    """``events`` of `simulate` checked: a callable, a CasADi Function or an `Event`, or a
+    sequence of them; each evaluated once at ``(t[0], x0)``.
+
+    Returns
+    -------
+    tuple of EventSpec
+
+    Raises
+    ------
+    TypeError
+        ``events`` (or an item of it) is neither callable nor a sequence of callables.
+    ValueError
+        A Function without the inputs ``(t (1), x (nx), u (nu), p (np))`` and one scalar
+        output; a ``terminal`` or ``direction`` of the wrong kind; a value at ``t[0]``
+        that is not one finite number.
+    """
+    if callable(events) or isinstance(events, Event):
+        items = [events]
+    elif isinstance(events, (str, bytes)):
+        items = None
+    else:
+        try:
+            items = list(events)
+        except TypeError:
+            items = None
+    if items is None:
+        raise TypeError("`events` must be a callable g(t, x, u, p), a casadi Function, an "
+                        f"Event or a sequence of them, got {type(events).__name__}")
+    u0 = controls_at(control, t, t[:1], model.nu)[:, 0]
+    specs = tuple(_spec(item, f"events[{i}]", model) for i, item in enumerate(items))
+    for spec in specs:
+        value = _value(spec, float(t[0]), x0, u0, p)
+        if not math.isfinite(value):
+            raise ValueError(f"`{spec.label}` ({spec.name}) must return a finite number, "
+                             f"got {value} at t = {t[0]}")
+    return specs
+
+
+def _spec(item, label: str, model: Model) -> EventSpec:
+    fun = item.fun if isinstance(item, Event) else item
+    if isinstance(fun, ca.Function):
+        sizes = tuple(fun.numel_in(i) for i in range(fun.n_in()))
+        outs = tuple(fun.numel_out(i) for i in range(fun.n_out()))
+        want = (1, model.nx, model.nu, model.np)
+        if sizes != want or outs != (1,):
+            raise ValueError(
+                f"`{label}` must be a Function (t, x, u, p) -> g with input sizes {want} and "
+                f"one scalar output; {fun.name()!r} has input sizes {sizes} and output sizes "
+                f"{outs}")
+    elif not callable(fun):
+        raise TypeError(f"`{label}` must be a callable g(t, x, u, p), a casadi Function or an "
+                        f"Event, got {type(fun).__name__}")
+    count = _occurrences(getattr(item, "terminal", False), f"`{label}.terminal`")
+    direction = _direction(getattr(item, "direction", 0), f"`{label}.direction`")
+    name = (item.name if isinstance(item, Event) else None) or _name_of(fun, label)
+    return EventSpec(fun, isinstance(fun, ca.Function), count, direction, name, label)
+
+
+def _value(spec: EventSpec, t: float, x: np.ndarray, u: np.ndarray, p: np.ndarray) -> float:
+    """``g(t, x, u, p)`` as a float; ValueError naming the event when it is not a scalar."""
+    if spec.function:
+        return float(spec.fun(t, x, u, p))
+    value = np.asarray(spec.fun(t, x.copy(), u.copy(), p.copy()), dtype=float)
+    if value.size != 1:
+        raise ValueError(f"`{spec.label}` ({spec.name}) must return a scalar, got shape "
+                         f"{value.shape} at t = {t}")
+    return float(value.reshape(()))
+
+
+def _values(spec: EventSpec, ts: np.ndarray, X: np.ndarray, U: np.ndarray,
+            p: np.ndarray) -> np.ndarray:
+    """``g`` at the points ``ts (N,)``, ``X (nx, N)``, ``U (nu, N)``: shape (N,) (a Function
+    mapped over the points, a callable called at each)."""
+    if spec.function:
+        return map_eval(spec.fun, [ts[None, :], X, U, p])[0]
+    return np.array([_value(spec, float(ts[j]), X[:, j], U[:, j], p) for j in range(ts.size)])
+
+
+def controls_at(control: Control | None, t: np.ndarray, ts: np.ndarray, nu: int) -> np.ndarray:
+    """The control of `simulate` (``None``: zero) at the times ``ts (N,)`` within the grid
+    ``t``: shape (nu, N), linear between samples or the callable's values."""
+    if control is None:
+        return np.zeros((nu, ts.size))
+    if control.mode == "stages":
+        return np.stack([control.fun(float(tj)) for tj in ts], axis=1).reshape(nu, ts.size)
+    k = np.clip(np.searchsorted(t, ts, side="right") - 1, 0, t.size - 2)
+    w = ((ts - t[k]) / (t[k + 1] - t[k]))[:, None]
+    return (control.ua[k] + w * (control.ub[k] - control.ua[k])).T
+
+
+# ----------------------------------------------------------------- solutions between points
+class _FixedSteps:
+    """The solution of a fixed-step method (``m`` steps per output interval) between the
+    output points: its internal steps, and one step of any length from a point."""
+
+    def __init__(self, problem: Problem, method: str, m: int, jit: bool):
+        self.problem, self.method, self.m, self.jit = problem, method, m, jit
+        self.per_interval = m  # points per output interval
+        self.step = kernel(problem.model, method, problem.control.mode)
+        self.stages = 4 if method == "lie" else TABLEAUX[method].stages
+        self.n_steps = 0
+
+    def points(self, k0: int, k1: int, x: np.ndarray):
+        """Times (N,) and states (nx, N) of the internal steps of output intervals
+        ``k0 .. k1 - 1`` (``x``: the answer on the grid, kept at the output points)."""
+        t, m = self.problem.t, self.m
+        if m == 1:
+            return t[k0:k1 + 1], x[:, k0:k1 + 1]
+        H = (t[k0 + 1:k1 + 1] - t[k0:k1]) / m
+        ts = np.append((t[k0:k1, None] + np.arange(m) * H[:, None]).ravel(), t[k1])
+        ctrl = self.problem.control
+        if ctrl.mode == "linear":
+            U = controls_at(ctrl, t, ts, self.problem.model.nu).T
+            ctrl = Control("linear", U[:-1], U[1:], constant=ctrl.constant)
+        sub = Problem.new(self.problem.model, x[:, k0], ts, ctrl, self.problem.p)
+        run = run_fixed(sub, self.method, 1, self.jit)
+        self.n_steps += run.n_steps
+        X = np.array(run.x)
+        X[:, ::m] = x[:, k0:k1 + 1]
+        return ts, X
+
+    def hop(self, xa: np.ndarray, ta: float, tb: float) -> np.ndarray:
+        """The state at ``tb``: one step of the method from ``(ta, xa)``."""
+        problem, h = self.problem, tb - ta
+        ctrl, t = problem.control, problem.t
+        if ctrl.mode == "linear":
+            k = min(max(int(np.searchsorted(t, ta, side="right")) - 1, 0), t.size - 2)
+            ud = (ctrl.ub[k] - ctrl.ua[k]) / (t[k + 1] - t[k])
+            data = [ctrl.at(ta, k, t[k], t[k + 1] - t[k]), ud]
+        else:
+            data = [np.concatenate([ctrl.fun(ta + c * h) for c in unique_nodes(self.method)])]
+        self.n_steps += 1
+        return np.asarray(self.step(xa, h, *data, problem.p), dtype=float).reshape(-1)
+
+    @property
+    def n_rhs(self) -> int:
+        return self.stages * self.n_steps
+
+
+class _CvodesSteps:
+    """The solution of cvodes between the output points: a sub-grid of ``sub`` points per
+    output interval, and a run from a point to any time, both by cvodes at the same
+    tolerances from a point of the answer (time scaled to ``[0, 1]``: one integrator for
+    every hop)."""
+
+    def __init__(self, problem: Problem, rtol, atol, extra, sub: int):
+        self.problem, self.sub = problem, sub
+        self.per_interval = sub  # points per output interval
+        self.opts = integrator_options(rtol, atol, extra)
+        self.callback = None
+        if problem.control.mode == "stages":
+            with cache.construction_lock():
+                self.callback = ControlCallback(problem.control.fun, problem.model.nu)
+        self.n_steps = self.n_rhs = 0
+
+    def _integrate(self, fractions: tuple, xa: np.ndarray, ta: float, h: float) -> np.ndarray:
+        """States at ``ta + h * fractions`` from ``(ta, xa)``: shape (nx, len(fractions));
+        NaN when cvodes fails."""
+        problem = self.problem
+        model, ctrl, t = problem.model, problem.control, problem.t
+        params = [problem.p, [ta, h]]
+        if ctrl.mode == "linear":
+            k = min(max(int(np.searchsorted(t, ta, side="right")) - 1, 0), t.size - 2)
+            params += [ctrl.ua[k], (ctrl.ub[k] - ctrl.ua[k]) / (t[k + 1] - t[k]), [t[k]]]
+        P = np.concatenate([np.asarray(v, dtype=float).reshape(-1) for v in params])
+        if self.callback is None:
+            key = ("event-cvodes", cache.function_key(model.f), fractions,
+                   repr(sorted(self.opts.items(), key=str)))
+            with cache.checkout(key, lambda: _scaled_integrator(model, fractions, self.opts),
+                                keepalive=model.f) as integ:
+                return self._call(integ, xa, P, len(fractions))
+        integ = _scaled_integrator(model, fractions, self.opts, self.callback)
+        return self._call(integ, xa, P, len(fractions))
+
+    def _call(self, integ, xa, P, n: int) -> np.ndarray:
+        try:
+            out = np.asarray(integ(x0=xa, p=P)["xf"], dtype=float).reshape(xa.size, n)
+        except RuntimeError:
+            if self.callback is not None and self.callback.error is not None:
+                raise self.callback.error from None
+            out = np.full((xa.size, n), np.nan)
+        stats = integ.stats()
+        self.n_steps += int(stats.get("nsteps", 0))
+        self.n_rhs += int(stats.get("nfevals", 0))
+        return out
+
+    def points(self, k0: int, k1: int, x: np.ndarray):
+        t, sub = self.problem.t, self.sub
+        if sub == 1:
+            return t[k0:k1 + 1], x[:, k0:k1 + 1]
+        fractions = tuple(np.arange(1, sub) / sub)
+        ts, cols = [], []
+        for k in range(k0, k1):
+            H = t[k + 1] - t[k]
+            ts.append(t[k] + H * np.arange(sub) / sub)
+            cols += [x[:, k:k + 1], self._integrate(fractions, x[:, k], float(t[k]), H)]
+        ts.append(t[k1:k1 + 1])
+        cols.append(x[:, k1:k1 + 1])
+        return np.concatenate(ts), np.concatenate(cols, axis=1)
+
+    def hop(self, xa: np.ndarray, ta: float, tb: float) -> np.ndarray:
+        return self._integrate((1.0,), xa, ta, tb - ta)[:, 0]
+
+
+def _scaled_integrator(model: Model, fractions: tuple, opts: dict, callback=None):
+    """cvodes on ``dx/ds = h f(x, u(ta + s h), p)``, ``s`` in [0, 1] to the outputs
+    ``fractions``; its ``p`` is ``[p, ta, h]`` and, for a linear control, the control at the
+    interval's start ``ua``, its slope ``ud`` and the start ``tk``."""
+    with cache.construction_lock():
+        sym = ca.SX if callback is None else ca.MX
+        x, s = sym.sym("x", model.nx), sym.sym("s")
+        p, ta, h = sym.sym("p", model.np), sym.sym("ta"), sym.sym("h")
+        tau = ta + s * h
+        extra = []
+        if callback is None:
+            ua, ud, tk = sym.sym("ua", model.nu), sym.sym("ud", model.nu), sym.sym("tk")
+            u, extra = ua + (tau - tk) * ud, [ua, ud, tk]
+        else:
+            u = callback(tau)
+        ode = h * model.f.call([x, u, p])[0]
+        dae = {"x": x, "t": s, "p": ca.vertcat(p, ta, h, *extra), "ode": ode}
+        return ca.integrator("event_cvodes", "cvodes", dae, 0.0, list(fractions), opts)
+
+
+def _stepper(result: SimulationResult, problem: Problem, method: str, rtol, atol, extra,
+             jit: bool):
+    """The solution between the output points for the method that made ``result``."""
+    if result.method == "cvodes":
+        if method == "auto":
+            rtol, atol = max(rtol * _AUTO_CVODES_TIGHTEN, 100 * _EPS), atol * _AUTO_CVODES_TIGHTEN
+        nint = problem.t.size - 1
+        sub = min(CVODES_SUBGRID, max(1, math.ceil(result.n_steps / nint)))
+        return _CvodesSteps(problem, rtol, atol, extra, sub)
+    return _FixedSteps(problem, result.method, max(1, result.substeps), jit)
+
+
+# ------------------------------------------------------------------------------ the scan
+def _sign_changes(g: np.ndarray, direction: int) -> np.ndarray:
+    """Indices ``j`` where ``g`` changes sign from point ``j`` to ``j + 1`` in ``direction``."""
+    a, b = g[:-1], g[1:]
+    up, down = (a < 0) & (b >= 0), (a > 0) & (b <= 0)
+    return np.flatnonzero(up if direction > 0 else down if direction < 0 else up | down)
+
+
+def _locate(spec: EventSpec, stepper, problem: Problem, ta: float, tb: float, ga: float,
+            gb: float, xa: np.ndarray, xb: np.ndarray):
+    """The event time in ``(ta, tb]`` (``ga``, ``gb`` of opposite signs or ``gb = 0``) and
+    the state there, by Brent's method on the solution from ``(ta, xa)``."""
+    if gb == 0.0:
+        return tb, xb
+    nu, p = problem.model.nu, problem.p
+
+    def g(tau: float) -> float:
+        if tau == ta:
+            return ga
+        if tau == tb:
+            return gb
+        x = stepper.hop(xa, ta, tau)
+        value = _value(spec, tau, x, controls_at(problem.control, problem.t,
+                                                  np.array([tau]), nu)[:, 0], p)
+        if not math.isfinite(value):
+            raise _LocationFailed(f"`{spec.label}` ({spec.name}) is not finite at t = {tau:.15g}"
+                                  " on the solution between the points")
+        return value
+
+    te = brentq(g, ta, tb, xtol=4 * _EPS * max(abs(ta), abs(tb)) + 1e-300, rtol=4 * _EPS,
+                maxiter=200)
+    return te, (xb if te == tb else stepper.hop(xa, ta, te))
+
+
+class _LocationFailed(Exception):
+    """The solution between two points could not be evaluated (a numerical failure)."""
+
+
+@dataclass
+class _Found:
+    times: list            # per event function, the occurrence times
+    states: list           # per event function, the states
+    stop: tuple | None = None  # (event index, time, state) of the terminal occurrence
+    failure: str = ""
+
+
+def _scan(specs, stepper, problem: Problem, x: np.ndarray) -> _Found:
+    """Every occurrence of every event on the answer ``x`` (nx, n) up to its last finite
+    column, in time order, until a terminal one."""
+    found = _Found([[] for _ in specs], [[] for _ in specs])
+    finite = np.isfinite(x).all(axis=0)
+    last = x.shape[1] - 1 if finite.all() else int(np.argmin(finite)) - 1
+    block = max(1, _BLOCK_POINTS // stepper.per_interval)
+    counts = [0] * len(specs)
+    nu = problem.model.nu
+    for k0 in range(0, last, block):
+        ts, X = stepper.points(k0, min(last, k0 + block), x)
+        U = controls_at(problem.control, problem.t, ts, nu)
+        G = [_values(spec, ts, X, U, problem.p) for spec in specs]
+        hits = sorted((j, i) for i, spec in enumerate(specs)
+                      for j in _sign_changes(G[i], spec.direction))
+        n = 0
+        while n < len(hits):
+            j = hits[n][0]
+            same = [i for jj, i in hits[n:] if jj == j]
+            n += len(same)
+            located = []
+            for i in same:
+                try:
+                    te, xe = _locate(specs[i], stepper, problem, float(ts[j]), float(ts[j + 1]),
+                                     float(G[i][j]), float(G[i][j + 1]), X[:, j], X[:, j + 1])
+                except _LocationFailed as exc:
+                    found.failure = str(exc)
+                    return found
+                located.append((te, i, xe))
+            for te, i, xe in sorted(located, key=lambda item: item[:2]):
+                found.times[i].append(te)
+                found.states[i].append(xe)
+                counts[i] += 1
+                if counts[i] == specs[i].count:
+                    found.stop = (i, te, xe)
+                    return found
+    return found
+
+
+# ------------------------------------------------------------------------------- result
+def apply_events(result: SimulationResult, specs: tuple[EventSpec, ...], problem: Problem,
+                 method: str, rtol: float, atol: np.ndarray, cvodes_options: dict,
+                 jit: bool) -> SimulationResult:
+    """``result`` of `simulate` with the occurrences of ``specs`` (``t_events``,
+    ``x_events``), truncated at a terminal one (``status`` `TERMINAL_EVENT`).
+
+    ``problem``: the simulated problem; ``method`` the one asked for (``result.method`` the
+    one used); ``jit`` whether fixed-step runs compile.
+    """
+    start = time.perf_counter()
+    stepper = _stepper(result, problem, method, rtol, atol, cvodes_options, jit)
+    found = _scan(specs, stepper, problem, np.asarray(result.x))
+    nx = problem.model.nx
+    t_events = [_frozen(np.array(times, dtype=float)) for times in found.times]
+    x_events = [_frozen(np.array(states, dtype=float).reshape(len(states), nx))
+                for states in found.states]
+    values = dict(result.__dict__, t_events=t_events, x_events=x_events,
+                  n_steps=result.n_steps + stepper.n_steps, n_rhs=result.n_rhs + stepper.n_rhs)
+    if found.failure:
+        values.update(success=False, status=FAILED,
+                      message=f"{result.message}; event location failed: {found.failure} "
+                              "(a numerical failure of the solution; try a tighter tolerance "
+                              "or another method)")
+    elif found.stop is not None:
+        values.update(_truncated(result, specs, found.stop, problem, method))
+    values["wall_time"] = result.wall_time + time.perf_counter() - start
+    return make_result(**values)
+
+
+def _truncated(result: SimulationResult, specs, stop: tuple, problem: Problem,
+               method: str) -> dict:
+    """The fields of ``result`` that change when the terminal occurrence ``stop`` ends it."""
+    i, te, xe = stop
+    t = problem.t
+    kk = int(np.searchsorted(t, te, side="left"))  # t[:kk] < te
+    t_new = _frozen(np.append(t[:kk], te))
+    x_new = _frozen(np.concatenate([result.x[:, :kk], np.asarray(xe)[:, None]], axis=1))
+    model, p, control = problem.model, problem.p, problem.control
+    invariants = {name: _frozen(np.asarray(model.invariant(name, x_new, p)))
+                  for name in result.invariants}
+    # a failure after the event is past the returned solution; auto's unverified or failed
+    # error control is not
+    verified = result.status in (OK, OK_STIFF) or (result.status == FAILED and method != "auto")
+    spec = specs[i]
+    what = (f"terminal event {i} ({spec.name}) at t = {te:.15g} s"
+            + (f" (occurrence {spec.count})" if spec.count > 1 else ""))
+    message = (f"stopped by {what}; {result.message}" if verified
+               else f"{result.message}; the solution was stopped by {what}")
+    out = dict(t=t_new, x=x_new, invariants=MappingProxyType(invariants), message=message,
+               _dense=Dense(model, p, lambda: controls_at(control, t, t_new, model.nu)))
+    if verified:
+        out.update(success=True, status=TERMINAL_EVENT)
+    return out
+
+
+def _frozen(a: np.ndarray) -> np.ndarray:
+    a.setflags(write=False)
+    return a
