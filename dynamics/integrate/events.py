@@ -9,32 +9,40 @@ attributes.
 
 What is detected
 ----------------
-The sign of ``g`` is looked at on the *internal steps* of the solution, not only at the
-output times:
+The sign of ``g`` is looked at on a scan of the solution finer than the output grid, in
+blocks of about 4096 points (a terminal event ends the scan at its block):
 
-* ``rk4``, ``rk8``, ``lie``: at every step (``steps`` per output interval), the same steps
-  as the answer, re-taken from the answer at the start of each block of output intervals
-  (with one step per interval the answer itself is scanned, nothing is re-run);
-* ``auto`` (rk8): at ``substeps`` rk8 steps per output interval (the steps of the answer;
+* ``rk4``, ``rk8``, ``lie``: at every step (``steps`` per output interval), the answer's
+  own steps, re-taken from the answer at the start of each block (with one step per
+  interval the answer itself is scanned: nothing is re-run);
+* ``auto`` with rk8: at ``min(substeps, SUBGRID)`` equal parts of every output interval,
+  with rk8 steps between them no longer than the answer's (``substeps`` of the result:
   after the one-pass path the most it took in any interval), re-integrated from the answer
-  at the start of each block of output intervals; ``auto`` through cvodes as ``cvodes``
-  below at its tightened tolerances (1e-3 of the asked ones);
-* ``cvodes``: on a sub-grid of ``ceil(n_steps / (n - 1))`` points per output interval (at
-  most `CVODES_SUBGRID`), integrated by cvodes at the same tolerances from the answer at
-  each output time.
+  at the start of each block; ``auto`` through cvodes as ``cvodes`` below at 1e-3 of the
+  asked tolerances (those of its accepted run or looser);
+* ``cvodes``: at ``min(ceil(n_steps / (n - 1)), SUBGRID)`` equal parts of every output
+  interval, integrated by cvodes at the same tolerances from the answer at the interval's
+  start.
 
-A change of sign between two neighbouring points (``g < 0`` then ``g >= 0`` upwards, ``g >
-0`` then ``g <= 0`` downwards; a zero at ``t[0]`` is no event) is then located by Brent's
-method on the solution itself: the state at a trial time is one step of the same method of
-that length from the point before (fixed step, ``auto``), or a cvodes run at the same
-tolerances (``cvodes``), never an interpolant of the output grid. A crossing and re-crossing
-between two neighbouring points (within one internal step), or a zero that only touches, is
-not seen (as with scipy, whose points are its own steps).
+The answer's states are used at the output points. A change of sign between two
+neighbouring points (upwards ``g < 0`` then ``g >= 0``, downwards ``g > 0`` then ``g <= 0``;
+a zero at ``t[0]`` is no event) is then located by Brent's method (scipy's ``brentq``, to
+a few ulps of ``t``) on the solution itself: the state at a trial time is integrated from
+the point before by the same method at the same accuracy (fixed step: equal steps no
+longer than the scan's, one step between neighbouring points of a scan on every step;
+cvodes: a run at the same tolerances), never an interpolant of the output grid. A crossing
+and re-crossing between two neighbouring points, or a zero that only touches, is not seen
+(as with scipy, whose points are its own steps).
+
+Cost: a Function ``g`` is evaluated mapped over a block; a Python callable once a point.
+``auto`` and cvodes pay about one more run for the scan, plus a few short runs a located
+event (Brent takes 5-10 trial times on smooth problems).
 
 The solution is integrated over the whole grid first; a terminal event then truncates it:
 ``t`` ends at the event time (the output times before it, then the event time), ``status``
-is `TERMINAL_EVENT`. A run that failed (a non-finite state) after a terminal event is that
-success; events are looked for only up to a failure.
+is `TERMINAL_EVENT` and ``success`` True. A run of a fixed-step method or cvodes that
+failed (a non-finite state) after a terminal event is that success too; events are looked
+for only up to a failure.
 """
 from __future__ import annotations
 
@@ -52,16 +60,16 @@ from ..model import Model
 from .cvodes import ControlCallback, integrator_options
 from .evaluate import map_eval
 from .inputs import Control, Problem
-from .kernels import kernel
 from .loops import run_fixed
 from .result import FAILED, OK, OK_STIFF, TERMINAL_EVENT, Dense, SimulationResult, make_result
-from .tableaux import TABLEAUX, unique_nodes
+from .tableaux import TABLEAUX
 
-__all__ = ["Event", "EventSpec", "CVODES_SUBGRID", "check_events", "controls_at",
+__all__ = ["Event", "EventSpec", "SUBGRID", "scan_times", "check_events", "controls_at",
            "apply_events"]
 
-#: Most sub-grid points per output interval on which a cvodes solution is scanned.
-CVODES_SUBGRID = 64
+#: Most scan points per output interval of ``auto`` and ``cvodes`` (fixed-step methods are
+#: scanned at every step).
+SUBGRID = 64
 
 #: Internal points per block of the scan (bounds the memory of a long run's scan; a
 #: terminal event ends the scan at its block).
@@ -261,51 +269,70 @@ def controls_at(control: Control | None, t: np.ndarray, ts: np.ndarray, nu: int)
 
 # ----------------------------------------------------------------- solutions between points
 class _FixedSteps:
-    """The solution of a fixed-step method (``m`` steps per output interval) between the
-    output points: its internal steps, and one step of any length from a point."""
+    """The solution of a fixed-step method between the output points: ``per`` scan points
+    per output interval, ``r`` steps of the method between neighbouring points (``per r``
+    at least the answer's steps per interval), and from any point a run of steps no longer
+    than those to any later time."""
 
-    def __init__(self, problem: Problem, method: str, m: int, jit: bool):
-        self.problem, self.method, self.m, self.jit = problem, method, m, jit
-        self.per_interval = m  # points per output interval
-        self.step = kernel(problem.model, method, problem.control.mode)
-        self.stages = 4 if method == "lie" else TABLEAUX[method].stages
+    def __init__(self, problem: Problem, method: str, per: int, r: int, jit: bool):
+        self.problem, self.method, self.r, self.jit = problem, method, r, jit
+        self.per_interval = per
         self.n_steps = 0
+        self.stages = 4 if method == "lie" else TABLEAUX[method].stages
 
-    def points(self, k0: int, k1: int, x: np.ndarray):
-        """Times (N,) and states (nx, N) of the internal steps of output intervals
-        ``k0 .. k1 - 1`` (``x``: the answer on the grid, kept at the output points)."""
-        t, m = self.problem.t, self.m
-        if m == 1:
-            return t[k0:k1 + 1], x[:, k0:k1 + 1]
-        H = (t[k0 + 1:k1 + 1] - t[k0:k1]) / m
-        ts = np.append((t[k0:k1, None] + np.arange(m) * H[:, None]).ravel(), t[k1])
+    def points(self, i0: int, i1: int, x: np.ndarray, carry: np.ndarray):
+        """Times (N,) and states (nx, N) of the scan points ``i0 .. i1`` (point ``i``:
+        ``i mod per`` of output interval ``i // per``), integrated from the answer ``x``
+        (nx, n) when ``i0`` is an output point, else from ``carry`` (the state at point
+        ``i0``); the answer is kept at the output points."""
+        t, per = self.problem.t, self.per_interval
+        ts, outputs = scan_times(t, per, i0, i1)
+        if per == 1 and self.r == 1:
+            return ts, x[:, i0:i1 + 1]
         ctrl = self.problem.control
         if ctrl.mode == "linear":
             U = controls_at(ctrl, t, ts, self.problem.model.nu).T
             ctrl = Control("linear", U[:-1], U[1:], constant=ctrl.constant)
-        sub = Problem.new(self.problem.model, x[:, k0], ts, ctrl, self.problem.p)
-        run = run_fixed(sub, self.method, 1, self.jit)
+        start = x[:, i0 // per] if i0 % per == 0 else carry
+        run = run_fixed(Problem.new(self.problem.model, start, ts, ctrl, self.problem.p),
+                        self.method, self.r, self.jit)
         self.n_steps += run.n_steps
         X = np.array(run.x)
-        X[:, ::m] = x[:, k0:k1 + 1]
+        X[:, outputs] = x[:, (i0 + outputs) // per]
         return ts, X
 
     def hop(self, xa: np.ndarray, ta: float, tb: float) -> np.ndarray:
-        """The state at ``tb``: one step of the method from ``(ta, xa)``."""
-        problem, h = self.problem, tb - ta
-        ctrl, t = problem.control, problem.t
+        """The state at ``tb`` from ``(ta, xa)``: the fewest equal steps of the method no
+        longer than the scan's steps in that output interval (one, between neighbouring
+        points of a scan on the answer's own steps)."""
+        problem, t = self.problem, self.problem.t
+        k = min(max(int(np.searchsorted(t, ta, side="right")) - 1, 0), t.size - 2)
+        h = (t[k + 1] - t[k]) / (self.per_interval * self.r)
+        n = max(1, math.ceil((tb - ta) / h * (1 - 1e-12)))
+        ctrl = problem.control
         if ctrl.mode == "linear":
-            k = min(max(int(np.searchsorted(t, ta, side="right")) - 1, 0), t.size - 2)
-            ud = (ctrl.ub[k] - ctrl.ua[k]) / (t[k + 1] - t[k])
-            data = [ctrl.at(ta, k, t[k], t[k + 1] - t[k]), ud]
-        else:
-            data = [np.concatenate([ctrl.fun(ta + c * h) for c in unique_nodes(self.method)])]
-        self.n_steps += 1
-        return np.asarray(self.step(xa, h, *data, problem.p), dtype=float).reshape(-1)
+            U = controls_at(ctrl, t, np.array([ta, tb]), problem.model.nu).T
+            ctrl = Control("linear", U[:1], U[1:], constant=ctrl.constant)
+        run = run_fixed(Problem.new(problem.model, xa, np.array([ta, tb]), ctrl, problem.p),
+                        self.method, n, self.jit)
+        self.n_steps += run.n_steps
+        return run.x[:, 1]
 
     @property
     def n_rhs(self) -> int:
         return self.stages * self.n_steps
+
+
+def scan_times(t: np.ndarray, per: int, i0: int, i1: int) -> tuple[np.ndarray, np.ndarray]:
+    """Scan points ``i0 .. i1`` of ``per`` equal parts of every interval of the grid ``t``:
+    their times (N,) (the grid's own at its points) and the positions of the grid points
+    among them."""
+    i = np.arange(i0, i1 + 1)
+    k = np.minimum(i // per, t.size - 2)
+    ts = t[k] + (i - k * per) * ((t[k + 1] - t[k]) / per)
+    outputs = np.flatnonzero(i % per == 0)
+    ts[outputs] = t[(i0 + outputs) // per]
+    return ts, outputs
 
 
 class _CvodesSteps:
@@ -355,19 +382,20 @@ class _CvodesSteps:
         self.n_rhs += int(stats.get("nfevals", 0))
         return out
 
-    def points(self, k0: int, k1: int, x: np.ndarray):
+    def points(self, i0: int, i1: int, x: np.ndarray, carry: np.ndarray):
+        """As `_FixedSteps.points`, for ``i0`` and ``i1`` output points (whole intervals)."""
         t, sub = self.problem.t, self.sub
+        ts, _ = scan_times(t, sub, i0, i1)
+        k0, k1 = i0 // sub, i1 // sub
         if sub == 1:
-            return t[k0:k1 + 1], x[:, k0:k1 + 1]
+            return ts, x[:, k0:k1 + 1]
         fractions = tuple(np.arange(1, sub) / sub)
-        ts, cols = [], []
+        cols = []
         for k in range(k0, k1):
-            H = t[k + 1] - t[k]
-            ts.append(t[k] + H * np.arange(sub) / sub)
-            cols += [x[:, k:k + 1], self._integrate(fractions, x[:, k], float(t[k]), H)]
-        ts.append(t[k1:k1 + 1])
+            cols += [x[:, k:k + 1], self._integrate(fractions, x[:, k], float(t[k]),
+                                                    float(t[k + 1] - t[k]))]
         cols.append(x[:, k1:k1 + 1])
-        return np.concatenate(ts), np.concatenate(cols, axis=1)
+        return ts, np.concatenate(cols, axis=1)
 
     def hop(self, xa: np.ndarray, ta: float, tb: float) -> np.ndarray:
         return self._integrate((1.0,), xa, ta, tb - ta)[:, 0]
@@ -396,13 +424,17 @@ def _scaled_integrator(model: Model, fractions: tuple, opts: dict, callback=None
 def _stepper(result: SimulationResult, problem: Problem, method: str, rtol, atol, extra,
              jit: bool):
     """The solution between the output points for the method that made ``result``."""
+    nint = problem.t.size - 1
     if result.method == "cvodes":
         if method == "auto":
             rtol, atol = max(rtol * _AUTO_CVODES_TIGHTEN, 100 * _EPS), atol * _AUTO_CVODES_TIGHTEN
-        nint = problem.t.size - 1
-        sub = min(CVODES_SUBGRID, max(1, math.ceil(result.n_steps / nint)))
+        sub = min(SUBGRID, max(1, math.ceil(result.n_steps / nint)))
         return _CvodesSteps(problem, rtol, atol, extra, sub)
-    return _FixedSteps(problem, result.method, max(1, result.substeps), jit)
+    m = max(1, result.substeps)
+    if method != "auto":
+        return _FixedSteps(problem, result.method, m, 1, jit)  # every step
+    r = math.ceil(m / SUBGRID)
+    return _FixedSteps(problem, "rk8", math.ceil(m / r), r, jit)
 
 
 # ------------------------------------------------------------------------------ the scan
@@ -457,11 +489,14 @@ def _scan(specs, stepper, problem: Problem, x: np.ndarray) -> _Found:
     found = _Found([[] for _ in specs], [[] for _ in specs])
     finite = np.isfinite(x).all(axis=0)
     last = x.shape[1] - 1 if finite.all() else int(np.argmin(finite)) - 1
-    block = max(1, _BLOCK_POINTS // stepper.per_interval)
+    per = stepper.per_interval
+    block = per * (_BLOCK_POINTS // per) if per <= _BLOCK_POINTS else _BLOCK_POINTS
     counts = [0] * len(specs)
     nu = problem.model.nu
-    for k0 in range(0, last, block):
-        ts, X = stepper.points(k0, min(last, k0 + block), x)
+    carry = x[:, 0]
+    for i0 in range(0, last * per, block):
+        ts, X = stepper.points(i0, min(last * per, i0 + block), x, carry)
+        carry = X[:, -1]
         U = controls_at(problem.control, problem.t, ts, nu)
         G = [_values(spec, ts, X, U, problem.p) for spec in specs]
         hits = sorted((j, i) for i, spec in enumerate(specs)
