@@ -134,7 +134,7 @@ def simulate(model: Model, x0, t, *, u=None, p=None, method: Method = "auto",
     -----
     A numerical failure (cvodes gives up, a fixed-step state becomes non-finite) returns
     ``success=False`` with the reason; it never raises. An exception raised by a callable
-    ``u`` propagates.
+    ``u`` or an event function propagates.
 
     Examples
     --------

@@ -40,9 +40,12 @@ event (Brent takes 5-10 trial times on smooth problems).
 
 The solution is integrated over the whole grid first; a terminal event then truncates it:
 ``t`` ends at the event time (the output times before it, then the event time), ``status``
-is `TERMINAL_EVENT` and ``success`` True. A run of a fixed-step method or cvodes that
-failed (a non-finite state) after a terminal event is that success too; events are looked
-for only up to a failure.
+is `TERMINAL_EVENT` and ``success`` True. Events are looked for only up to the last output
+time before a failure (a non-finite state). A run of a fixed-step method or cvodes that
+failed after a terminal event is that success too (e.g. a stop before a singularity);
+``auto``'s is not (its error control covers the whole grid and did not succeed: the
+result keeps ``success=False`` and its status, truncated at the event; simulate again on a
+grid that ends near the event).
 """
 from __future__ import annotations
 
@@ -572,8 +575,13 @@ def _truncated(result: SimulationResult, specs, stop: tuple, problem: Problem,
     spec = specs[i]
     what = (f"terminal event {i} ({spec.name}) at t = {te:.15g} s"
             + (f" (occurrence {spec.count})" if spec.count > 1 else ""))
-    message = (f"stopped by {what}; {result.message}" if verified
-               else f"{result.message}; the solution was stopped by {what}")
+    if not verified:
+        message = f"{result.message}; the solution was stopped by {what}"
+    elif result.status == FAILED:
+        message = (f"stopped by {what}; {result.message} (past the event: not part of the "
+                   "returned solution)")
+    else:
+        message = f"stopped by {what}; {result.message}"
     out = dict(t=t_new, x=x_new, invariants=MappingProxyType(invariants), message=message,
                _dense=Dense(model, p, lambda: controls_at(control, t, t_new, model.nu)))
     if verified:

@@ -161,6 +161,35 @@ def test_non_terminal_events_leave_the_solution_as_without_them():
     assert res.to_dict()["t_events"][0].size == 6 and "events" in str(res)
 
 
+@functools.lru_cache(maxsize=None)
+def blow_up() -> Model:
+    """x' = x^2: x = 1 / (1 - t) from 1, infinite at t = 1."""
+    x = ca.SX.sym("x", 1)
+    f = ca.Function("blow_up", [x, U0, P0], [x ** 2], ["x", "u", "p"], ["xdot"])
+    return Model(f=f, states=("x",), controls=(), name="blow_up")
+
+
+@pytest.mark.parametrize("method, kwargs", [("rk8", {"steps": 100}),
+                                            ("cvodes", {"rtol": 1e-12, "atol": 1e-12})])
+def test_a_terminal_event_before_a_singularity_is_a_success(method, kwargs):
+    level = Event(lambda t, x, u, p: x[0] - 8.0, terminal=True, name="level")
+    res = simulate(blow_up(), [1.0], np.linspace(0.0, 2.0, 21), method=method, events=level,
+                   **kwargs)
+    assert res.success and res.status == TERMINAL_EVENT
+    # cvodes's global error: 1.1e-9 relative in x at t = 0.8 (growth amplifies the local
+    # 1e-12), i.e. 2.3e-10 in the time x reaches 8
+    tol = 1e-9 if method == "cvodes" else TOL
+    assert abs(res.t[-1] - 0.875) < tol and res.x[0, -1] == pytest.approx(8.0, abs=1e-9)
+    assert np.all(np.isfinite(res.x)) and "not part of the returned solution" in res.message
+
+
+def test_auto_failing_after_a_terminal_event_stays_a_failure():
+    level = Event(lambda t, x, u, p: x[0] - 8.0, terminal=True, name="level")
+    res = simulate(blow_up(), [1.0], np.linspace(0.0, 2.0, 21), events=level)
+    assert not res.success and res.status == -1
+    assert "stopped by terminal event 0 (level)" in res.message and res.t[-1] < 1.0
+
+
 # ------------------------------------------------------------------ the rigid body
 def test_torque_free_w1_zeros_match_the_elliptic_solution():
     inertia, w0 = [1.0, 2.0, 3.0], [0.1, 0.5, 0.3]  # w1 oscillates through zero
