@@ -49,6 +49,7 @@ grid that ends near the event).
 """
 from __future__ import annotations
 
+import itertools
 import math
 import time
 from dataclasses import dataclass
@@ -352,6 +353,7 @@ class _CvodesSteps:
         if problem.control.mode == "stages":
             with cache.construction_lock():
                 self.callback = ControlCallback(problem.control.fun, problem.model.nu)
+        self.own = {}  # fractions -> integrator of the callable control (this call's own)
         self.n_steps = self.n_rhs = 0
 
     def _integrate(self, fractions: tuple, xa: np.ndarray, ta: float, h: float) -> np.ndarray:
@@ -370,8 +372,9 @@ class _CvodesSteps:
             with cache.checkout(key, lambda: _scaled_integrator(model, fractions, self.opts),
                                 keepalive=model.f) as integ:
                 return self._call(integ, xa, P, len(fractions))
-        integ = _scaled_integrator(model, fractions, self.opts, self.callback)
-        return self._call(integ, xa, P, len(fractions))
+        if fractions not in self.own:
+            self.own[fractions] = _scaled_integrator(model, fractions, self.opts, self.callback)
+        return self._call(self.own[fractions], xa, P, len(fractions))
 
     def _call(self, integ, xa, P, n: int) -> np.ndarray:
         try:
@@ -469,8 +472,11 @@ def _locate(spec: EventSpec, stepper, problem: Problem, ta: float, tb: float, ga
                                   " on the solution between the points")
         return value
 
-    te = brentq(g, ta, tb, xtol=4 * _EPS * max(abs(ta), abs(tb)) + 1e-300, rtol=4 * _EPS,
-                maxiter=200)
+    try:
+        te = brentq(g, ta, tb, xtol=4 * _EPS * max(abs(ta), abs(tb)) + 1e-300, rtol=4 * _EPS,
+                    maxiter=200)
+    except RuntimeError as exc:  # (not converged)
+        raise _LocationFailed(f"`{spec.label}` ({spec.name}): {exc}") from None
     return te, (xb if te == tb else stepper.hop(xa, ta, te))
 
 
@@ -495,30 +501,24 @@ def _scan(specs, stepper, problem: Problem, x: np.ndarray) -> _Found:
     per = stepper.per_interval
     block = per * (_BLOCK_POINTS // per) if per <= _BLOCK_POINTS else _BLOCK_POINTS
     counts = [0] * len(specs)
-    nu = problem.model.nu
     carry = x[:, 0]
     for i0 in range(0, last * per, block):
         ts, X = stepper.points(i0, min(last * per, i0 + block), x, carry)
         carry = X[:, -1]
-        U = controls_at(problem.control, problem.t, ts, nu)
+        U = controls_at(problem.control, problem.t, ts, problem.model.nu)
         G = [_values(spec, ts, X, U, problem.p) for spec in specs]
         hits = sorted((j, i) for i, spec in enumerate(specs)
                       for j in _sign_changes(G[i], spec.direction))
-        n = 0
-        while n < len(hits):
-            j = hits[n][0]
-            same = [i for jj, i in hits[n:] if jj == j]
-            n += len(same)
-            located = []
-            for i in same:
-                try:
-                    te, xe = _locate(specs[i], stepper, problem, float(ts[j]), float(ts[j + 1]),
-                                     float(G[i][j]), float(G[i][j + 1]), X[:, j], X[:, j + 1])
-                except _LocationFailed as exc:
-                    found.failure = str(exc)
-                    return found
-                located.append((te, i, xe))
-            for te, i, xe in sorted(located, key=lambda item: item[:2]):
+        for j, group in itertools.groupby(hits, key=lambda hit: hit[0]):
+            try:  # every crossing between points j and j + 1, then in time order
+                located = sorted(
+                    [_locate(specs[i], stepper, problem, float(ts[j]), float(ts[j + 1]),
+                             float(G[i][j]), float(G[i][j + 1]), X[:, j], X[:, j + 1]) + (i,)
+                     for _, i in group], key=lambda item: (item[0], item[2]))
+            except _LocationFailed as exc:
+                found.failure = str(exc)
+                return found
+            for te, xe, i in located:
                 found.times[i].append(te)
                 found.states[i].append(xe)
                 counts[i] += 1

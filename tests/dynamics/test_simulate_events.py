@@ -151,6 +151,14 @@ def test_several_events_are_ordered_and_the_first_terminal_one_stops():
     assert res.t_events[2].size == 1
 
 
+def test_the_same_crossing_twice_is_recorded_by_both_and_stops_at_the_terminal_one():
+    stop = Event(ground_function(), terminal=True)
+    res = simulate(oscillator(), [1.0, 0.0], np.linspace(0.0, 20.0, 4), events=[height, stop])
+    assert res.t_events[0].size == res.t_events[1].size == 1
+    assert res.t_events[0][0] == res.t_events[1][0] == res.t[-1]
+    assert abs(res.t[-1] - np.pi / 2) < TOL
+
+
 def test_non_terminal_events_leave_the_solution_as_without_them():
     t = np.linspace(0.0, 20.0, 9)
     plain = simulate(oscillator(), [1.0, 0.0], t)
