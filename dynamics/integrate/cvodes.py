@@ -87,9 +87,13 @@ def integrator_options(rtol, atol, extra) -> dict:
     return opts
 
 
-def run_cvodes(problem: Problem, rtol, atol, extra) -> Run:
+def run_cvodes(problem: Problem, rtol, atol, extra, pooled: bool = True) -> Run:
+    """cvodes on ``problem``'s grid; ``pooled=False`` builds an integrator for this call
+    alone (a grid used once, e.g. an event scan's: it is not kept in `dynamics.cache`)."""
     model, t, ctrl = problem.model, problem.t, problem.control
     opts = integrator_options(rtol, atol, extra)
+    if ctrl.mode == "linear" and not pooled:
+        return _run(problem, _cvodes_integrator(model, "linear", t, opts), opts, rtol, atol, None)
     if ctrl.mode == "linear":
         key = ("cvodes", cache.function_key(model.f), t.tobytes(),
                repr(sorted(opts.items(), key=str)))

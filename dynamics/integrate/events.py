@@ -21,8 +21,8 @@ blocks of about 4096 points (a terminal event ends the scan at its block):
   at the start of each block; ``auto`` through cvodes as ``cvodes`` below at 1e-3 of the
   asked tolerances (those of its accepted run or looser);
 * ``cvodes``: at ``min(ceil(n_steps / (n - 1)), SUBGRID)`` equal parts of every output
-  interval, integrated by cvodes at the same tolerances from the answer at the interval's
-  start.
+  interval, integrated by cvodes at the same tolerances from the answer at the start of each
+  block.
 
 The answer's states are used at the output points. A change of sign between two
 neighbouring points (upwards ``g < 0`` then ``g >= 0``, downwards ``g > 0`` then ``g <= 0``;
@@ -61,7 +61,7 @@ from scipy.optimize import brentq
 
 from .. import cache
 from ..model import Model
-from .cvodes import ControlCallback, integrator_options
+from .cvodes import ControlCallback, integrator_options, run_cvodes
 from .evaluate import map_eval
 from .inputs import Control, Problem
 from .loops import run_fixed
@@ -293,17 +293,10 @@ class _FixedSteps:
         ts, outputs = scan_times(t, per, i0, i1)
         if per == 1 and self.r == 1:
             return ts, x[:, i0:i1 + 1]
-        ctrl = self.problem.control
-        if ctrl.mode == "linear":
-            U = controls_at(ctrl, t, ts, self.problem.model.nu).T
-            ctrl = Control("linear", U[:-1], U[1:], constant=ctrl.constant)
         start = x[:, i0 // per] if i0 % per == 0 else carry
-        run = run_fixed(Problem.new(self.problem.model, start, ts, ctrl, self.problem.p),
-                        self.method, self.r, self.jit)
+        run = run_fixed(on_grid(self.problem, ts, start), self.method, self.r, self.jit)
         self.n_steps += run.n_steps
-        X = np.array(run.x)
-        X[:, outputs] = x[:, (i0 + outputs) // per]
-        return ts, X
+        return ts, _with_outputs(run.x, x, i0, per, outputs)
 
     def hop(self, xa: np.ndarray, ta: float, tb: float) -> np.ndarray:
         """The state at ``tb`` from ``(ta, xa)``: the fewest equal steps of the method no
@@ -313,18 +306,32 @@ class _FixedSteps:
         k = min(max(int(np.searchsorted(t, ta, side="right")) - 1, 0), t.size - 2)
         h = (t[k + 1] - t[k]) / (self.per_interval * self.r)
         n = max(1, math.ceil((tb - ta) / h * (1 - 1e-12)))
-        ctrl = problem.control
-        if ctrl.mode == "linear":
-            U = controls_at(ctrl, t, np.array([ta, tb]), problem.model.nu).T
-            ctrl = Control("linear", U[:1], U[1:], constant=ctrl.constant)
-        run = run_fixed(Problem.new(problem.model, xa, np.array([ta, tb]), ctrl, problem.p),
-                        self.method, n, self.jit)
+        run = run_fixed(on_grid(problem, np.array([ta, tb]), xa), self.method, n, self.jit)
         self.n_steps += run.n_steps
         return run.x[:, 1]
 
     @property
     def n_rhs(self) -> int:
         return self.stages * self.n_steps
+
+
+def on_grid(problem: Problem, ts: np.ndarray, x0: np.ndarray) -> Problem:
+    """``problem`` from ``x0`` on the grid ``ts`` (increasing, within ``problem.t``), with
+    the same control (samples: the same piecewise-linear function, sampled on ``ts``)."""
+    ctrl = problem.control
+    if ctrl.mode == "linear":
+        U = controls_at(ctrl, problem.t, ts, problem.model.nu).T
+        ctrl = Control("linear", U[:-1], U[1:], constant=ctrl.constant)
+    return Problem.new(problem.model, x0, ts, ctrl, problem.p)
+
+
+def _with_outputs(X: np.ndarray, x: np.ndarray, i0: int, per: int,
+                  outputs: np.ndarray) -> np.ndarray:
+    """The scan's states ``X`` (a copy) with the answer ``x`` at the output points
+    (``outputs``: their positions in a block starting at scan point ``i0``)."""
+    X = np.array(X)
+    X[:, outputs] = x[:, (i0 + outputs) // per]
+    return X
 
 
 def scan_times(t: np.ndarray, per: int, i0: int, i1: int) -> tuple[np.ndarray, np.ndarray]:
@@ -340,77 +347,69 @@ def scan_times(t: np.ndarray, per: int, i0: int, i1: int) -> tuple[np.ndarray, n
 
 
 class _CvodesSteps:
-    """The solution of cvodes between the output points: a sub-grid of ``sub`` points per
-    output interval, and a run from a point to any time, both by cvodes at the same
-    tolerances from a point of the answer (time scaled to ``[0, 1]``: one integrator for
-    every hop)."""
+    """The solution of cvodes between the output points: ``sub`` scan points per output
+    interval (one cvodes run over a block of them from the answer at its start), and from
+    any point a cvodes run to any later time (time scaled to ``[0, 1]``: one integrator for
+    every such hop), both at the same tolerances."""
 
     def __init__(self, problem: Problem, rtol, atol, extra, sub: int):
         self.problem, self.sub = problem, sub
+        self.rtol, self.atol, self.extra = rtol, atol, extra
         self.per_interval = sub  # points per output interval
         self.opts = integrator_options(rtol, atol, extra)
-        self.callback = None
+        self.n_steps = self.n_rhs = 0
+        self.callback = self.own = None  # a callable control: this call's own integrator
         if problem.control.mode == "stages":
             with cache.construction_lock():
                 self.callback = ControlCallback(problem.control.fun, problem.model.nu)
-        self.own = {}  # fractions -> integrator of the callable control (this call's own)
-        self.n_steps = self.n_rhs = 0
 
-    def _integrate(self, fractions: tuple, xa: np.ndarray, ta: float, h: float) -> np.ndarray:
-        """States at ``ta + h * fractions`` from ``(ta, xa)``: shape (nx, len(fractions));
-        NaN when cvodes fails."""
+    def points(self, i0: int, i1: int, x: np.ndarray, carry: np.ndarray):
+        """As `_FixedSteps.points`, for ``i0`` an output point."""
+        ts, outputs = scan_times(self.problem.t, self.sub, i0, i1)
+        if self.sub == 1:
+            return ts, x[:, i0:i1 + 1]
+        run = run_cvodes(on_grid(self.problem, ts, x[:, i0 // self.sub]), self.rtol, self.atol,
+                         self.extra, pooled=False)
+        self.n_steps += run.n_steps
+        self.n_rhs += run.n_rhs
+        return ts, _with_outputs(run.x, x, i0, self.sub, outputs)
+
+    def hop(self, xa: np.ndarray, ta: float, tb: float) -> np.ndarray:
+        """The state at ``tb`` from ``(ta, xa)`` (NaN when cvodes fails)."""
         problem = self.problem
         model, ctrl, t = problem.model, problem.control, problem.t
-        params = [problem.p, [ta, h]]
+        params = [problem.p, [ta, tb - ta]]
         if ctrl.mode == "linear":
             k = min(max(int(np.searchsorted(t, ta, side="right")) - 1, 0), t.size - 2)
             params += [ctrl.ua[k], (ctrl.ub[k] - ctrl.ua[k]) / (t[k + 1] - t[k]), [t[k]]]
         P = np.concatenate([np.asarray(v, dtype=float).reshape(-1) for v in params])
         if self.callback is None:
-            key = ("event-cvodes", cache.function_key(model.f), fractions,
+            key = ("event-cvodes", cache.function_key(model.f),
                    repr(sorted(self.opts.items(), key=str)))
-            with cache.checkout(key, lambda: _scaled_integrator(model, fractions, self.opts),
+            with cache.checkout(key, lambda: _scaled_integrator(model, self.opts),
                                 keepalive=model.f) as integ:
-                return self._call(integ, xa, P, len(fractions))
-        if fractions not in self.own:
-            self.own[fractions] = _scaled_integrator(model, fractions, self.opts, self.callback)
-        return self._call(self.own[fractions], xa, P, len(fractions))
+                return self._call(integ, xa, P)
+        if self.own is None:
+            self.own = _scaled_integrator(model, self.opts, self.callback)
+        return self._call(self.own, xa, P)
 
-    def _call(self, integ, xa, P, n: int) -> np.ndarray:
+    def _call(self, integ, xa, P) -> np.ndarray:
         try:
-            out = np.asarray(integ(x0=xa, p=P)["xf"], dtype=float).reshape(xa.size, n)
+            out = np.asarray(integ(x0=xa, p=P)["xf"], dtype=float).reshape(-1)
         except RuntimeError:
             if self.callback is not None and self.callback.error is not None:
                 raise self.callback.error from None
-            out = np.full((xa.size, n), np.nan)
+            out = np.full(xa.size, np.nan)
         stats = integ.stats()
         self.n_steps += int(stats.get("nsteps", 0))
         self.n_rhs += int(stats.get("nfevals", 0))
         return out
 
-    def points(self, i0: int, i1: int, x: np.ndarray, carry: np.ndarray):
-        """As `_FixedSteps.points`, for ``i0`` and ``i1`` output points (whole intervals)."""
-        t, sub = self.problem.t, self.sub
-        ts, _ = scan_times(t, sub, i0, i1)
-        k0, k1 = i0 // sub, i1 // sub
-        if sub == 1:
-            return ts, x[:, k0:k1 + 1]
-        fractions = tuple(np.arange(1, sub) / sub)
-        cols = []
-        for k in range(k0, k1):
-            cols += [x[:, k:k + 1], self._integrate(fractions, x[:, k], float(t[k]),
-                                                    float(t[k + 1] - t[k]))]
-        cols.append(x[:, k1:k1 + 1])
-        return ts, np.concatenate(cols, axis=1)
 
-    def hop(self, xa: np.ndarray, ta: float, tb: float) -> np.ndarray:
-        return self._integrate((1.0,), xa, ta, tb - ta)[:, 0]
-
-
-def _scaled_integrator(model: Model, fractions: tuple, opts: dict, callback=None):
-    """cvodes on ``dx/ds = h f(x, u(ta + s h), p)``, ``s`` in [0, 1] to the outputs
-    ``fractions``; its ``p`` is ``[p, ta, h]`` and, for a linear control, the control at the
-    interval's start ``ua``, its slope ``ud`` and the start ``tk``."""
+def _scaled_integrator(model: Model, opts: dict, callback=None):
+    """cvodes on ``dx/ds = h f(x, u(ta + s h), p)`` from ``s = 0`` to 1; its ``p`` is
+    ``[p, ta, h]`` and, for a linear control, the control at the interval's start ``ua``,
+    its slope ``ud`` and the start ``tk``."""
     with cache.construction_lock():
         sym = ca.SX if callback is None else ca.MX
         x, s = sym.sym("x", model.nx), sym.sym("s")
@@ -424,7 +423,7 @@ def _scaled_integrator(model: Model, fractions: tuple, opts: dict, callback=None
             u = callback(tau)
         ode = h * model.f.call([x, u, p])[0]
         dae = {"x": x, "t": s, "p": ca.vertcat(p, ta, h, *extra), "ode": ode}
-        return ca.integrator("event_cvodes", "cvodes", dae, 0.0, list(fractions), opts)
+        return ca.integrator("event_cvodes", "cvodes", dae, 0.0, [1.0], opts)
 
 
 def _stepper(result: SimulationResult, problem: Problem, method: str, rtol, atol, extra,
