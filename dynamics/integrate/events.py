@@ -62,7 +62,7 @@ from scipy.optimize import brentq
 from .. import cache
 from ..model import Model
 from .cvodes import ControlCallback, integrator_options, run_cvodes
-from .evaluate import map_eval
+from .evaluate import call_buffered, map_eval
 from .inputs import Control, Problem
 from .loops import run_fixed
 from .result import FAILED, OK, OK_STIFF, TERMINAL_EVENT, Dense, SimulationResult, make_result
@@ -242,7 +242,7 @@ def _spec(item, label: str, model: Model) -> EventSpec:
 def _value(spec: EventSpec, t: float, x: np.ndarray, u: np.ndarray, p: np.ndarray) -> float:
     """``g(t, x, u, p)`` as a float; ValueError naming the event when it is not a scalar."""
     if spec.function:
-        return float(spec.fun(t, x, u, p))
+        return float(call_buffered(spec.fun, [np.array([t]), x, u, p], (1,))[0])
     value = np.asarray(spec.fun(t, x.copy(), u.copy(), p.copy()), dtype=float)
     if value.size != 1:
         raise ValueError(f"`{spec.label}` ({spec.name}) must return a scalar, got shape "
