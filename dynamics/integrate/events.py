@@ -168,7 +168,7 @@ def _direction(direction, what: str) -> int:
         value = float(direction)
     except (TypeError, ValueError):
         value = math.nan
-    if not math.isfinite(value) or isinstance(direction, (bool, np.bool_)):
+    if not math.isfinite(value) or isinstance(direction, (bool, np.bool_, str, bytes)):
         raise ValueError(f"{what} must be a finite number (0, > 0 or < 0), got {direction!r}")
     return int(np.sign(value))
 
