@@ -282,6 +282,23 @@ def test_callable_control_event(method, kwargs):
     assert res.sample(res.t).shape == (2, res.t.size)
 
 
+@pytest.mark.parametrize("method", ["auto", "rk8", "cvodes"])
+def test_an_event_on_the_control_and_the_parameters(method):
+    # y'' = -w^2 y with w = p = 2 from (1, 0): y = cos 2t; u = t / 4 sampled on the grid.
+    # g1 = u - 0.3 crosses at t = 1.2; g2 = y - p / 4 (y = 1/2) at t = pi / 6
+    x, u, p = ca.SX.sym("x", 2), ca.SX.sym("u", 1), ca.SX.sym("p", 1)
+    f = ca.Function("spring", [x, u, p], [ca.vertcat(x[1], -p[0] ** 2 * x[0])],
+                    ["x", "u", "p"], ["xdot"])
+    model = Model(f=f, states=("y", "v"), controls=("u",), params=("w",), p_default=[2.0])
+    on_u = Event(ca.Function("on_u", [T_SYM, x, u, p], [u[0] - 0.3]))
+    t = np.linspace(0.0, 2.0, 3)
+    kwargs = {"auto": {}, "rk8": {"steps": 20}, "cvodes": {"rtol": 1e-12, "atol": 1e-12}}[method]
+    res = simulate(model, [1.0, 0.0], t, u=(t / 4)[None, :], method=method,
+                   events=[on_u, lambda t, x, u, p: x[0] - p[0] / 4], **kwargs)
+    assert abs(res.t_events[0][0] - 1.2) < 1e-13 and res.t_events[0].size == 1
+    assert abs(res.t_events[1][0] - np.pi / 6) < (1e-9 if method == "cvodes" else TOL)
+
+
 def test_fixed_steps_are_scanned_at_every_internal_step():
     # one output interval of 20 s, 200 rk8 steps: six zeros, all inside the interval
     res = simulate(oscillator(), [1.0, 0.0], [0.0, 20.0], method="rk8", steps=200,
