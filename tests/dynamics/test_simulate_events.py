@@ -4,6 +4,7 @@ pointing error under a constant spin, and driven double integrators with sampled
 callable controls."""
 import functools
 import math
+import pickle
 
 import casadi as ca
 import numpy as np
@@ -167,6 +168,9 @@ def test_non_terminal_events_leave_the_solution_as_without_them():
     assert res.status == plain.status and plain.t_events is None
     assert res.n_steps > plain.n_steps  # the scan's steps are counted
     assert res.to_dict()["t_events"][0].size == 6 and "events" in str(res)
+    back = pickle.loads(pickle.dumps(res))
+    np.testing.assert_array_equal(back.t_events[0], res.t_events[0])
+    np.testing.assert_array_equal(back.x_events[0], res.x_events[0])
 
 
 @functools.lru_cache(maxsize=None)
@@ -231,8 +235,10 @@ def test_stop_when_the_pointing_error_is_small(method, kwargs):
 
     pointing_error.terminal, pointing_error.direction = True, -1
     res = simulate(rigid_body([1.0, 2.0, 3.0]), [0, 0, 0, 1, *w], np.linspace(0.0, 10.0, 3),
-                   method=method, events=pointing_error, **kwargs)
+                   method=method, events=pointing_error, invariants=["energy"], **kwargs)
     assert res.success and res.status == TERMINAL_EVENT
+    np.testing.assert_allclose(res.invariants["energy"], np.full(res.t.size, 1.5 * rate ** 2),
+                               rtol=1e-12)  # 1/2 I3 w3^2 along the truncated solution
     expected = t_target - 0.01 / rate  # the angle is rate * t
     tol = {"lie": 1e-9, "cvodes": 1e-9}.get(method, TOL)
     assert abs(res.t[-1] - expected) < tol
