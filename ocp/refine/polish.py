@@ -38,6 +38,7 @@ from dynamics.model import Model
 from dynamics.interrupts import interruptible
 
 from ..cached import cached, function_key
+from ..ipopt_options import check_ipopt_options
 from dynamics.validate import integer
 from ..mesh import Mesh
 from ..problem import Constraint, Problem
@@ -266,8 +267,7 @@ def polish_switches(problem: Problem, solution: Solution, *, N: int | None = Non
     user_ipopt = kw.pop("ipopt_options", None) or {}
     if not isinstance(user_ipopt, Mapping):
         raise ValueError(f"`ipopt_options` must be a mapping, got {type(user_ipopt).__name__}")
-    ipopt = {**_STRICT, **{k[len("ipopt."):] if k.startswith("ipopt.") else k: v
-                           for k, v in user_ipopt.items()}}
+    ipopt = {**_STRICT, **check_ipopt_options(user_ipopt)}
 
     t_start = time.perf_counter()
     fallback = {}

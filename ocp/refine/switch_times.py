@@ -61,6 +61,7 @@ from dynamics.validate import integer
 
 from ..attitude import attitude_error
 from ..cached import checkout
+from ..ipopt_options import check_ipopt_options
 from ..mesh import Mesh
 from ..problem import Problem
 from ..solution import Solution
@@ -293,8 +294,7 @@ def _solve_arcs(problem: Problem, guess: Solution, arcs: BangArcs, nseg: np.ndar
     Xg0 = np.clip(Xg / sx[:, None], XL, XU)
     w0 = np.concatenate([D0 / sT, p0[free_p] / sp, Xg0.reshape(-1, order="F")])
 
-    user = {k[len("ipopt."):] if k.startswith("ipopt.") else k: v
-            for k, v in (ipopt_options or {}).items()}
+    user = check_ipopt_options(ipopt_options)
     ipopt = {**_STRICT, "print_level": 5 if verbose is True else 0, "sb": "yes", **user}
     # inputs_check off: the bounds are built consistent here, and casadi's count of
     # equalities (fixed variables included) against variables would print a warning for the
