@@ -371,7 +371,8 @@ def polish_switches(problem: Problem, solution: Solution, *, N: int | None = Non
                                            verbose=verbose, ipopt_options=ipopt,
                                            scale=kw.get("scale"),
                                            constraint_tol=1e-6 if ctol is None else ctol,
-                                           max_wall_time=left())
+                                           max_wall_time=None if budget is None
+                                           else max(left(), 1e-9))
                 # an optimum worse than the start: the structure read from it is suspect
                 # (a missed arc); the moving knots may find the better one
                 worse = st.success and worse_than(problem, st.cost, solution.cost)
