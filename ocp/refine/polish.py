@@ -46,27 +46,15 @@ from ..problem import Constraint, Problem
 from ..solution import Solution
 from ..solve import solve
 from ..transcription import RadauConstantControl, sx_compatible
-from .result import RefinedSolution, annotate
+from .result import STATUS_WORSE, RefinedSolution, annotate, graded
 from .switch_times import bang_arcs, optimize_switch_times
 from .switches import find_switches
 
-__all__ = ["polish_switches", "worse_than", "WORSE_SLACK", "STATUS_WORSE"]
+__all__ = ["polish_switches", "STATUS_BUDGET"]
 
 METHODS = ("auto", "switch-times", "moving-knots")
 
 _STRICT = {"tol": 1e-10, "bound_relax_factor": 0.0, "max_iter": 3000}
-
-#: Relative slack by which a polished cost may be worse than the cost of the solution it
-#: started from and still be a success: the start's own discretization error. A fixed mesh
-#: can put a minimum time *below* the exact optimum: 2.4e-6 relative on the slews of the
-#: tests (J = diag(1, 2, 3), 1 rad: 2.2075331 s against the exact 2.2075385 s), 1.8e-4 on
-#: the bang-coast-bang double integrator on 10 intervals (its path constraint met at the
-#: nodes only: 2.2662682 s against the exact 2.2666667 s); 1e-3 leaves a margin of 5 over
-#: the larger. (The user's case that asked for this check: 39.997 s from 39.655 s, 8.6e-3.)
-WORSE_SLACK = 1e-3
-
-#: ``status`` of a polish whose cost is worse than its start's beyond `WORSE_SLACK`.
-STATUS_WORSE = "Worse_Than_Start"
 
 #: ``status`` of a polish stopped by its ``budget``.
 STATUS_BUDGET = "Maximum_WallTime_Exceeded"
@@ -144,36 +132,6 @@ def _free_mesh_problem(problem: Problem, T_ref: float, stretch) -> Problem:
                    name=f"{problem.name}_free_mesh", maximize=problem.maximize)
 
 
-def worse_than(problem: Problem, cost: float, start: float, slack: float = WORSE_SLACK) -> bool:
-    """Whether ``cost`` is worse than ``start`` by more than ``slack |start|`` (the
-    direction of `Problem.better`; a NaN ``cost`` is worse, a NaN ``start`` is not beaten).
-
-    Examples
-    --------
-    >>> from ocp.examples import min_time
-    >>> from ocp.refine.polish import worse_than
-    >>> worse_than(min_time(), 2.01, 2.0), worse_than(min_time(), 2.001, 2.0)
-    (True, False)
-    """
-    if not np.isfinite(start):
-        return False
-    return problem.better(start, cost - problem.objective_sign * slack * abs(start))
-
-
-def _graded(problem: Problem, start: Solution, out: RefinedSolution) -> RefinedSolution:
-    """``out`` with ``info['initial_cost']`` and ``info['gain']`` (how much better than
-    ``start``, in the objective's units: positive is better), failed (`STATUS_WORSE`) if
-    a success worse than ``start`` beyond `WORSE_SLACK`."""
-    gain = problem.objective_sign * (float(start.cost) - float(out.cost))
-    info = {"initial_cost": float(start.cost), "gain": gain}
-    if out.success and worse_than(problem, out.cost, start.cost):
-        return annotate(out, info, success=False, status=STATUS_WORSE, message=(
-            f"{out.message}; NOT used: the polished cost {out.cost:.10g} is worse than the "
-            f"start's {start.cost:.10g} by {-gain:.3g} (more than {WORSE_SLACK:g} relative, "
-            f"the start's discretization error): keep the start, or refine it (ocp.refine)"))
-    return annotate(out, info)
-
-
 def _out_of_budget(out: RefinedSolution, budget: float, what: str) -> RefinedSolution:
     """``out`` failed with `STATUS_BUDGET`: the ``budget`` [s] ran out before ``what``."""
     return annotate(out, {"budget_spent": True}, success=False, status=STATUS_BUDGET,
@@ -219,14 +177,13 @@ def polish_switches(problem: Problem, solution: Solution, *, N: int | None = Non
     integration error, about 1e-12). ``method='moving-knots'``: the free-mesh re-solve
     described below, which also handles singular, coast and constrained arcs.
     ``method='auto'`` (default): switch times when the solution is bang-bang, else -- or
-    when that NLP fails, or ends with a cost worse than that of ``solution`` (`worse_than`:
-    by more than `WORSE_SLACK` = 1e-3 relative; a structure read wrongly) -- moving knots
-    (``info['fallback']`` says why).
+    when that NLP fails, or ends with a cost worse than that of ``solution`` (a structure
+    read wrongly) -- moving knots (``info['fallback']`` says why).
 
     Never worse as a success: a polished cost worse than ``solution.cost`` by more than
-    `WORSE_SLACK` relative (the start's own discretization error: a fixed mesh can put a
+    `ocp.refine.result.WORSE_SLACK` = 1e-3 relative (`ocp.refine.result.worse_than`) (the start's own discretization error: a fixed mesh can put a
     minimum time slightly *below* the exact optimum) is returned with ``success=False``,
-    ``status`` `STATUS_WORSE` (``'Worse_Than_Start'``) and a message saying so; the caller
+    ``status`` ``'Worse_Than_Start'`` (`ocp.refine.result.graded`) and a message saying so; the caller
     keeps ``solution``.
 
     Moving knots:
@@ -355,7 +312,7 @@ def polish_switches(problem: Problem, solution: Solution, *, N: int | None = Non
         out = annotate(out, info, message=message)
         if out.status == STATUS_BUDGET:
             out = _out_of_budget(out, budget, "the NLP converged")
-        return _graded(problem, solution, out)
+        return graded(problem, solution, out)
 
     fallback = {}
     if method != "moving-knots":
@@ -375,7 +332,7 @@ def polish_switches(problem: Problem, solution: Solution, *, N: int | None = Non
                                            else max(left(), 1e-9))
                 # an optimum worse than the start: the structure read from it is suspect
                 # (a missed arc); the moving knots may find the better one
-                worse = st.success and worse_than(problem, st.cost, solution.cost)
+                worse = st.status == STATUS_WORSE  # `optimize_switch_times` graded it
                 return st, worse, (st.success and not worse) or method == "switch-times"
 
             st, worse, done = attempt(arcs)

@@ -70,7 +70,7 @@ from ..solution import Solution
 from ..transcription import RadauConstantControl
 from .arc_nlp import arc_nlp, constraint_bounds
 from .arcs import BangArcs, bang_arcs
-from .result import RefinedSolution, annotate
+from .result import RefinedSolution, annotate, graded
 from .rk8_step import step_function, step_jacobian
 
 __all__ = ["BangArcs", "bang_arcs", "optimize_switch_times"]
@@ -164,8 +164,10 @@ def optimize_switch_times(problem: Problem, solution: Solution, *, arcs: BangArc
     Returns
     -------
     RefinedSolution
-        ``success`` when IPOPT returned ``Solve_Succeeded`` and the violation is at most
-        ``constraint_tol``. Transcription `RadauConstantControl` on the mesh of the RK8
+        ``success`` when IPOPT returned ``Solve_Succeeded``, the violation is at most
+        ``constraint_tol`` and the cost is not worse than that of ``solution`` by more than
+        `ocp.refine.result.WORSE_SLACK` relative (else ``status`` ``'Worse_Than_Start'``;
+        ``info['initial_cost']``, ``info['gain']``). Transcription `RadauConstantControl` on the mesh of the RK8
         segments (knots at the switches). ``iterations`` and ``solve_time`` sum over the NLPs
         solved. ``info``: ``'method'`` (``'switch-times'``), ``'switch_times'`` [s],
         ``'initial_switch_times'``, ``'durations'`` (arc lengths [s]), ``'arc_controls'``
@@ -234,9 +236,10 @@ def optimize_switch_times(problem: Problem, solution: Solution, *, arcs: BangArc
             "initial_T": float(solution.T),
             "nlp_iterations": [r.iterations for r in runs], "nlp_status": [r.status for r in runs],
             "wall_time": time.perf_counter() - t_start}
-    return annotate(out, info, iterations=sum(r.iterations for r in runs),
-                    solve_time=sum(r.solution.solve_time for r in runs),
-                    build_time=sum(r.solution.build_time for r in runs))
+    return graded(problem, solution, annotate(
+        out, info, iterations=sum(r.iterations for r in runs),
+        solve_time=sum(r.solution.solve_time for r in runs),
+        build_time=sum(r.solution.build_time for r in runs)))
 
 
 def _solve_arcs(problem: Problem, guess: Solution, arcs: BangArcs, nseg: np.ndarray, *, degree,

@@ -156,14 +156,23 @@ def time_optimal(inertia, *, angle=None, axis=None, q0=None, qf=None, u_max=1.0,
         Default True where it applies: not with ``norm_bound`` or ``keep_out`` (their
         optimal torques are not bang-bang per axis), where ``polish=True`` is ignored with a
         warning. Polish the switch times (`ocp.polish_switches`, IPOPT ``tol`` 1e-9 unless
-        ``ipopt_options`` says otherwise): when the first solution is bang-bang on every
-        axis, the arc durations are solved for directly (``info['method'] ==
-        'switch-times'``: a few IPOPT iterations, ``T`` exact to about 1e-12 s; 3 iterations
-        on Bilimoria-Wie), else the moving-knot re-solve (``'moving-knots'``, Radau degree 5)
-        runs. The polished result is returned only if it is verified and not slower than
-        the first (a switch-time result may be slower by 1e-4 relative: the first's fixed
-        mesh can put T below the exact optimum by its discretization error); otherwise the
-        first solution (``info['polish']`` says why). Should
+        ``ipopt_options`` says otherwise) when the first solution is bang-bang on every axis
+        (`ocp.bang_arcs`, read from a few samples before anything is built; an axis whose
+        torque is zero throughout, as off the axis of a principal-axis slew, is held at
+        zero): the arc durations are solved for directly (``'switch-times'``: a few IPOPT
+        iterations, ``T`` exact to about 1e-12 s; 3 iterations on Bilimoria-Wie; should that
+        fail, the moving-knot re-solve at Radau degree 5 within what is left of the budget).
+        The polish has a wall-time budget: the first solve's wall time (all starts), at
+        least `POLISH_MIN_BUDGET` = 0.5 s. A first solution that is not bang-bang (a
+        singular arc) is not polished (the moving-knot re-solve took 6-70 s there, 20-200
+        times the first solve, and was rarely kept). The polished result is returned only
+        if it is verified and not slower than the first (a switch-time result may be slower
+        by 1e-4 relative: the first's fixed mesh can put T below the exact optimum by its
+        discretization error); otherwise the first solution. ``info['polish']`` records
+        what happened: ``ran``, ``used``, ``why``, ``method``, ``wall_time`` and ``budget``
+        [s], ``T_before``, ``T_polished``, ``T_after`` [s] and ``gain`` (``T_before -
+        T_after`` [s] when used, else 0); the message ends with the same in words
+        (`polish_text`) and ``info['wall_time']`` is the wall time of the whole call. Should
         neither be verified (the first's fixed mesh can smear the switches beyond
         ``pointing_tol``), the first is mesh-refined (`ocp.refine`, tol 1e-6, at most 4
         rounds) and verified again; should that stall too (its error estimates do not
@@ -174,7 +183,8 @@ def time_optimal(inertia, *, angle=None, axis=None, q0=None, qf=None, u_max=1.0,
         refined warm from the first and returned if verified (``info['fallback']`` quotes
         its ``T`` and the unregularized one; ``cost`` is its ``T``).
     verbose : bool
-        IPOPT progress lines
+        IPOPT progress lines, to stderr, labelled by stage (``[slew: start 2/3]``,
+        ``[polish]``)
     ipopt_options : dict, optional
     pointing_tol : float [rad]
         Largest re-simulated final attitude error of a success
