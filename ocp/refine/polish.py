@@ -181,10 +181,10 @@ def polish_switches(problem: Problem, solution: Solution, *, N: int | None = Non
     read wrongly) -- moving knots (``info['fallback']`` says why).
 
     Never worse as a success: a polished cost worse than ``solution.cost`` by more than
-    `ocp.refine.result.WORSE_SLACK` = 1e-3 relative (`ocp.refine.result.worse_than`) (the start's own discretization error: a fixed mesh can put a
-    minimum time slightly *below* the exact optimum) is returned with ``success=False``,
-    ``status`` ``'Worse_Than_Start'`` (`ocp.refine.result.graded`) and a message saying so; the caller
-    keeps ``solution``.
+    `ocp.refine.result.WORSE_SLACK` = 1e-3 relative (the start's own discretization error:
+    a fixed mesh can put a minimum time slightly *below* the exact optimum) is returned
+    with ``success=False``, ``status`` ``'Worse_Than_Start'`` and a message saying so
+    (`ocp.refine.result.graded`); the caller keeps ``solution``.
 
     Moving knots:
     The control is constant within each mesh interval (`RadauConstantControl` of ``degree``)
@@ -342,8 +342,11 @@ def polish_switches(problem: Problem, solution: Solution, *, N: int | None = Non
                 info = {"stretch_active": np.zeros(0, dtype=int), "free_mesh_solution": None,
                         "short_arcs": False, "attempt_iterations": tried}
                 out = finish(st, info, "polish_switches: " + st.message)
-                return out if not out.success else _out_of_budget(
-                    out, budget, "a better structure than the first could be tried")
+                if out.status == STATUS_BUDGET:
+                    return out
+                return annotate(out, {"budget_spent": True}, message=(
+                    f"{out.message}; the polish budget of {budget:.3g} s was spent before a "
+                    "second structure or the moving knots could be tried"))
             if not done and method == "auto":  # second guess: arcs too short to be detected
                 more, _ = bang_arcs(solution, short_arcs=True)
                 if more is not None and more.durations.size > arcs.durations.size:

@@ -291,6 +291,14 @@ def test_budget_stops_the_polish_and_says_so():
     assert "budget" in spent.message
     with pytest.raises(ValueError, match="`budget`"):
         polish_switches(problem, start, budget=0.0)
+    # not bang-bang (the brachistochrone's angle is smooth): the moving knots, out of time
+    from .reference import brachistochrone
+
+    smooth, truth = brachistochrone()
+    first = solve(smooth, N=20, guess=truth["guess"])
+    cut = polish_switches(smooth, first, budget=1e-6)
+    assert not cut.success and cut.status == "Maximum_WallTime_Exceeded", cut.message
+    assert cut.info["budget_spent"] and "budget" in cut.message
 
 
 def test_verbose_polish_prints_labelled_lines_to_stderr_only(capfd):
