@@ -14,11 +14,20 @@ type) is captured once in a subprocess (so nothing reaches this process's stdout
 parsed (`ipopt_option_table`; the result is kept for the life of the process). If that
 capture fails, names and values are not checked here and the solver's own error is
 reported instead (see `ocp.solve`).
+
+A ``linear_solver`` that the installed IPOPT cannot load (the HSL solvers ``ma27`` ...
+``ma97`` without the HSL library, ``pardiso`` without its library) is not an option error for
+IPOPT: the solve returns ``Invalid_Option`` with garbage counters. `available_linear_solvers`
+probes which of `LINEAR_SOLVERS` load -- a one-variable NLP per name, solved in a
+subprocess (a missing Pardiso library can crash the process that tries it) -- once per
+process and library setting; `check_ipopt_options` then rejects an unavailable one before
+anything is built.
 """
 from __future__ import annotations
 
 import difflib
 import functools
+import json
 import math
 import re
 import subprocess
@@ -28,7 +37,16 @@ from typing import Mapping
 
 import numpy as np
 
-__all__ = ["IpoptOption", "ipopt_option_table", "check_ipopt_options", "parse_documentation"]
+__all__ = ["IpoptOption", "ipopt_option_table", "check_ipopt_options", "parse_documentation",
+           "available_linear_solvers", "LINEAR_SOLVERS"]
+
+#: The linear solvers IPOPT may be built with or load at run time, probed by
+#: `available_linear_solvers` (in this order).
+LINEAR_SOLVERS = ("mumps", "ma27", "ma57", "ma77", "ma86", "ma97", "pardiso", "pardisomkl",
+                  "spral", "wsmp")
+
+#: IPOPT options that say where a linear solver's library is: part of the probe.
+_LIBRARY_OPTIONS = ("hsllib", "pardisolib", "linear_solver_load_library")
 
 # accepted by CasADi's IPOPT interface but not in IPOPT's documentation output
 _UNDOCUMENTED = {"sb": ("String", ("yes", "no"))}
@@ -41,6 +59,26 @@ s = ca.nlpsol("doc", "ipopt", {"x": x, "f": x ** 2},
                "print_advanced_options": "yes", "print_options_mode": "doxygen",
                "max_iter": 0, "sb": "yes"}})
 s(x0=1.0)
+"""
+
+# one line "@probe <name> <yes|no>" per linear solver named in argv[2:], flushed as it goes
+# (a solver that crashes the process leaves the rest unreported); argv[1]: the library
+# options as JSON
+_PROBE = r"""
+import json, sys
+import casadi as ca
+x = ca.SX.sym("x")
+extra = json.loads(sys.argv[1])
+for name in sys.argv[2:]:
+    try:
+        s = ca.nlpsol("probe", "ipopt", {"x": x, "f": (x - 1) ** 2},
+                      {"print_time": False, "error_on_fail": False,
+                       "ipopt": {"linear_solver": name, "print_level": 0, "sb": "yes", **extra}})
+        s(x0=0.0)
+        ok = s.stats().get("return_status") == "Solve_Succeeded"
+    except Exception:
+        ok = False
+    print("@probe", name, "yes" if ok else "no", flush=True)
 """
 
 _NAME = re.compile(r"^<strong>(\w+)</strong>")
@@ -164,6 +202,79 @@ def ipopt_option_table() -> Mapping[str, IpoptOption] | None:
     return table
 
 
+def _probe(names, library: tuple) -> dict:
+    """``{name: loads?}`` for ``names``, each solved in the subprocess of `_PROBE`; a name
+    that ended the subprocess without a report counts as unavailable and the rest are
+    probed in a new one. A failed capture (no subprocess) leaves the names unreported."""
+    names, found = list(names), {}
+    while names:
+        try:
+            out = subprocess.run([sys.executable, "-c", _PROBE, json.dumps(dict(library)), *names],
+                                 capture_output=True, text=True, timeout=120, check=False)
+        except (OSError, subprocess.SubprocessError):
+            return found
+        for line in out.stdout.splitlines():
+            parts = line.split()
+            if len(parts) == 3 and parts[0] == "@probe" and parts[1] in names:
+                found[parts[1]] = parts[2] == "yes"
+        rest = [n for n in names if n not in found]
+        if rest and out.returncode == 0:  # finished without a word on them: give up
+            return found
+        if rest:  # the first unreported one crashed the process
+            found[rest[0]] = False
+        names = rest[1:]
+    return found
+
+
+@functools.lru_cache(maxsize=8)
+def _available(library: tuple) -> tuple | None:
+    found = _probe(LINEAR_SOLVERS, library)
+    if not found.get("mumps", False) and not any(found.values()):
+        return None  # the probe itself did not work: nothing known
+    return tuple(n for n in LINEAR_SOLVERS if found.get(n, False))
+
+
+def available_linear_solvers(options=None) -> tuple | None:
+    """The IPOPT linear solvers that load in this installation (probed once per process and
+    library setting; about 1 s, in a subprocess).
+
+    Parameters
+    ----------
+    options : mapping, optional
+        IPOPT options; only the ones that locate a solver's library (``hsllib``,
+        ``pardisolib``, ``linear_solver_load_library``) are read.
+
+    Returns
+    -------
+    tuple of str, or None
+        The names of `LINEAR_SOLVERS` that solve a one-variable NLP (``'mumps'`` in a
+        CasADi wheel), or ``None`` when the probe could not be run.
+
+    Examples
+    --------
+    >>> from ocp.ipopt_options import available_linear_solvers
+    >>> "mumps" in available_linear_solvers()
+    True
+    """
+    library = tuple(sorted((k, str(v)) for k, v in (options or {}).items()
+                           if k in _LIBRARY_OPTIONS))
+    return _available(library)
+
+
+def _check_linear_solver(out: dict) -> None:
+    """Raise a ValueError if ``out['linear_solver']`` does not load (`available_linear_solvers`)."""
+    name = str(out["linear_solver"]).lower()
+    available = available_linear_solvers(out)
+    if available is None or name in available or name not in LINEAR_SOLVERS:
+        return
+    library = {k: out[k] for k in _LIBRARY_OPTIONS if k in out}
+    where = f" with {library}" if library else ""
+    raise ValueError(
+        f"`ipopt_options`['linear_solver'] = {out['linear_solver']!r} is not available in this "
+        f"IPOPT installation{where}: available {list(available)} (the HSL solvers ma27-ma97 "
+        f"need the HSL library, e.g. `hsllib`; pardiso its own library)")
+
+
 def _common() -> dict:
     """The options this package sets itself, as IPOPT documents them: checked without
     capturing the documentation (no subprocess on the common path)."""
@@ -235,7 +346,9 @@ def check_ipopt_options(options) -> dict:
     ValueError
         Naming ``ipopt_options`` and the option: not a mapping, a key that is not an IPOPT
         option (with the closest name, if any), or a value of the wrong type or out of range
-        (Number: int or float; Integer: int; String: str, one of the allowed values).
+        (Number: int or float; Integer: int; String: str, one of the allowed values), or a
+        ``linear_solver`` that does not load here (with the ones that do:
+        `available_linear_solvers`).
     """
     if options is None:
         return {}
@@ -258,4 +371,6 @@ def check_ipopt_options(options) -> dict:
                 raise ValueError(f"`ipopt_options` names unknown IPOPT option {key!r}{hint}")
             value = _check_value(table[name], value)
         out[name] = value
+    if "linear_solver" in out:
+        _check_linear_solver(out)
     return out

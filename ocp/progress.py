@@ -7,13 +7,16 @@ Library code never prints on its own. Progress goes
 * to the `logging` module, logger ``"appdyn.ocp"`` (`LOGGER`): one INFO record per solve
   and refinement round, one DEBUG record per IPOPT iteration (only when DEBUG is enabled).
 
-``verbose=True`` still prints IPOPT iteration lines to ``sys.stdout`` for a caller (the CLI)
-that asks for it.
+``verbose=True`` prints one line per IPOPT iteration to ``sys.stderr`` (never stdout: a
+CLI's stdout stays its summary) for a caller that asks for it; a pipeline of several NLPs
+labels each stage's lines (`StagePrinter`, `stage_sink`: ``[slew: start 2/3]``,
+``[polish]``).
 """
 from __future__ import annotations
 
 import logging
 import sys
+import time
 from typing import Callable
 
 import casadi as ca
@@ -21,7 +24,8 @@ import numpy as np
 
 from dynamics.interrupts import interrupt_pending
 
-__all__ = ["LOGGER", "Progress", "IterationCallback", "printer", "iteration_sink"]
+__all__ = ["LOGGER", "Progress", "IterationCallback", "printer", "iteration_sink",
+           "StagePrinter", "stage_sink"]
 
 LOGGER = logging.getLogger("appdyn.ocp")
 
@@ -53,7 +57,9 @@ class IterationCallback(ca.Callback):
 
     It stops IPOPT (``User_Requested_Stop``) at the first iteration after a Ctrl-C deferred
     by `dynamics.interrupts.deferred_interrupts` (`ocp.solve` then raises
-    ``KeyboardInterrupt``), and, given a ``sink``, hands every iterate to ``sink(Progress)``;
+    ``KeyboardInterrupt``) or past ``deadline`` (a `time.perf_counter` value, ``None`` for
+    none; an attribute the owner of a pooled solver sets before each solve: a wall-time
+    budget that does not rebuild the solver), and, given a ``sink``, hands every iterate to ``sink(Progress)``;
     ``violation(g)`` measures the constraint violation of an iterate. Without a sink it
     receives no data (empty inputs): about 1 us per iteration.
     """
@@ -63,6 +69,7 @@ class IterationCallback(ca.Callback):
         ca.Callback.__init__(self)
         self._nx, self._ng, self._violation, self._sink = nx, ng, violation, sink
         self._count = 0
+        self.deadline = None
         self.construct("ocp_progress" if sink is not None else "ocp_interrupt", {})
 
     def get_n_in(self):
@@ -94,20 +101,56 @@ class IterationCallback(ca.Callback):
             g = np.asarray(arg[2]).reshape(-1)
             self._sink(Progress(self._count, float(arg[1]), self._violation(g)))
             self._count += 1
-        return [1 if interrupt_pending() else 0]
+        late = self.deadline is not None and time.perf_counter() > self.deadline
+        return [1 if late or interrupt_pending() else 0]
+
+
+_HEADER = " iter   objective (scaled)  inf_pr"
+
+
+class StagePrinter:
+    """A progress sink printing a header and one `Progress` line per iteration, prefixed by
+    ``[label] `` when a label is given, to ``stream`` (default ``sys.stderr``, looked up at
+    each call). Picklable without a stream (a start of `ocp.solve_multistart` on a process
+    pool).
+
+    Parameters
+    ----------
+    label : str, optional
+        The stage, e.g. ``'slew: start 2/3'`` or ``'polish'``.
+    stream : file-like, optional
+    """
+
+    def __init__(self, label: str | None = None, stream=None):
+        self.label, self.stream, self._header = label, stream, False
+
+    def __call__(self, progress: Progress) -> None:
+        stream = sys.stderr if self.stream is None else self.stream
+        prefix = "" if self.label is None else f"[{self.label}] "
+        if not self._header:
+            print(prefix + _HEADER, file=stream, flush=True)
+            self._header = True
+        print(prefix + str(progress), file=stream, flush=True)
 
 
 def printer(stream):
-    """A progress sink printing a header and one `Progress` line per iteration to ``stream``."""
-    state = {"header": False}
+    """A progress sink printing a header and one `Progress` line per iteration to ``stream``
+    (`StagePrinter` without a label)."""
+    return StagePrinter(None, stream)
 
-    def sink(progress: Progress):
-        if not state["header"]:
-            print(" iter   objective (scaled)  inf_pr", file=stream, flush=True)
-            state["header"] = True
-        print(str(progress), file=stream, flush=True)
 
-    return sink
+def stage_sink(verbose, label: str):
+    """``verbose`` for one stage of a pipeline: ``True`` becomes a `StagePrinter` of
+    ``label`` (to stderr); ``False``, a callable or an existing `StagePrinter` are returned
+    unchanged.
+
+    Examples
+    --------
+    >>> from ocp.progress import stage_sink
+    >>> stage_sink(True, "polish").label, stage_sink(False, "polish")
+    ('polish', False)
+    """
+    return StagePrinter(label) if verbose is True else verbose
 
 
 
@@ -128,7 +171,7 @@ def iteration_sink(verbose, progress) -> Callable | None:
         raise TypeError(f"`progress` must be a callable or None, got {type(progress).__name__}")
     sinks = []
     if verbose is True:
-        sinks.append(printer(sys.stdout))
+        sinks.append(StagePrinter())
     elif callable(verbose):
         sinks.append(verbose)
     if progress is not None:

@@ -185,7 +185,7 @@ def solve(problem: Problem, *, transcription="radau", N: int | None = None, degr
     verbose : bool or callable, optional
         ``False`` (default) prints nothing. ``True`` prints one line per IPOPT iteration
         (iteration, scaled objective, largest scaled constraint violation) to
-        ``sys.stdout`` as it runs; a callable is taken as ``progress``.
+        ``sys.stderr`` as it runs; a callable is taken as ``progress``.
     progress : callable, optional
         Receives a `Progress` per IPOPT iteration. Independently, every solve logs one INFO
         record (and, when enabled, one DEBUG record per iteration) to the logger

@@ -144,7 +144,7 @@ def _report(rnd: int, r: RefinementRound, verbose, progress) -> None:
             f"cost {r.cost:.12g}, {r.iterations} iterations")
     LOGGER.info(line)
     if verbose is True:
-        print(line, file=sys.stdout, flush=True)
+        print(line, file=sys.stderr, flush=True)
     if progress is not None:
         progress(r)
 
@@ -217,7 +217,7 @@ def refine(problem: Problem, solution: Solution | None = None, *, tol: float = 1
         Number of uniform intervals of the initial mesh (default 20); ignored with a warning
         when ``solution`` or ``mesh`` gives the mesh.
     verbose : bool or callable
-        Passed to `ocp.solve`; ``True`` also prints one line per round to ``sys.stdout``.
+        Passed to `ocp.solve`; ``True`` also prints one line per round to ``sys.stderr``.
     progress : callable, optional
         Receives each `RefinementRound` as it completes (IPOPT iterations are not passed
         on; give ``verbose`` a callable for those). Each round is also logged (INFO) to the

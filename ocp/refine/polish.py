@@ -38,21 +38,26 @@ from dynamics.model import Model
 from dynamics.interrupts import interruptible
 
 from ..cached import cached, function_key
+from ..ipopt_options import check_ipopt_options
+from ..progress import stage_sink
 from dynamics.validate import integer
 from ..mesh import Mesh
 from ..problem import Constraint, Problem
 from ..solution import Solution
 from ..solve import solve
 from ..transcription import RadauConstantControl, sx_compatible
-from .result import RefinedSolution, annotate
+from .result import STATUS_WORSE, RefinedSolution, annotate, graded
 from .switch_times import bang_arcs, optimize_switch_times
 from .switches import find_switches
 
-__all__ = ["polish_switches"]
+__all__ = ["polish_switches", "STATUS_BUDGET"]
 
 METHODS = ("auto", "switch-times", "moving-knots")
 
 _STRICT = {"tol": 1e-10, "bound_relax_factor": 0.0, "max_iter": 3000}
+
+#: ``status`` of a polish stopped by its ``budget``.
+STATUS_BUDGET = "Maximum_WallTime_Exceeded"
 _CLOCK, _STRETCH = "t_clock", "t_stretch"
 
 
@@ -127,6 +132,13 @@ def _free_mesh_problem(problem: Problem, T_ref: float, stretch) -> Problem:
                    name=f"{problem.name}_free_mesh", maximize=problem.maximize)
 
 
+def _out_of_budget(out: RefinedSolution, budget: float, what: str) -> RefinedSolution:
+    """``out`` failed with `STATUS_BUDGET`: the ``budget`` [s] ran out before ``what``."""
+    return annotate(out, {"budget_spent": True}, success=False, status=STATUS_BUDGET,
+                    message=f"{out.message}; the polish budget of {budget:.3g} s was spent "
+                            f"before {what}")
+
+
 def _aligned_mesh(solution: Solution, N: int | None) -> tuple[Mesh, np.ndarray]:
     """A mesh with knots at the detected switches (also returned [s]), the arcs between them
     cut evenly."""
@@ -155,7 +167,7 @@ def _aligned_mesh(solution: Solution, N: int | None) -> tuple[Mesh, np.ndarray]:
 @interruptible
 def polish_switches(problem: Problem, solution: Solution, *, N: int | None = None, degree: int = 3,
                     verbose=False, stretch=(0.05, 5.0), method: str = "auto",
-                    **solve_kwargs) -> RefinedSolution:
+                    budget: float | None = None, **solve_kwargs) -> RefinedSolution:
     """Re-solve a bang-bang / time-optimal problem with exact switch times.
 
     ``method='switch-times'``: when ``solution`` is bang-bang (`bang_arcs`: every control
@@ -165,9 +177,14 @@ def polish_switches(problem: Problem, solution: Solution, *, N: int | None = Non
     integration error, about 1e-12). ``method='moving-knots'``: the free-mesh re-solve
     described below, which also handles singular, coast and constrained arcs.
     ``method='auto'`` (default): switch times when the solution is bang-bang, else -- or
-    when that NLP fails, or ends with a cost worse than that of ``solution`` by more than
-    ``1e-3 max(1, |cost|)`` (a structure read wrongly) -- moving knots (``info['fallback']``
-    says why).
+    when that NLP fails, or ends with a cost worse than that of ``solution`` (a structure
+    read wrongly) -- moving knots (``info['fallback']`` says why).
+
+    Never worse as a success: a polished cost worse than ``solution.cost`` by more than
+    `ocp.refine.result.WORSE_SLACK` = 1e-3 relative (the start's own discretization error:
+    a fixed mesh can put a minimum time slightly *below* the exact optimum) is returned
+    with ``success=False``, ``status`` ``'Worse_Than_Start'`` and a message saying so
+    (`ocp.refine.result.graded`); the caller keeps ``solution``.
 
     Moving knots:
     The control is constant within each mesh interval (`RadauConstantControl` of ``degree``)
@@ -199,6 +216,14 @@ def polish_switches(problem: Problem, solution: Solution, *, N: int | None = Non
         See above. ``'switch-times'`` raises ``ValueError`` when ``solution`` is not
         bang-bang. The switch-time NLP reads ``N`` (its number of RK8 segments, when at
         least 2 per arc), ``degree``, ``ipopt_options``, ``scale`` and ``constraint_tol``.
+    budget : float, optional
+        Wall-time budget [s] of the whole call (default: none). Each NLP is stopped at the
+        first IPOPT iteration past it (the switch-time NLP through its iteration callback,
+        the moving knots through IPOPT's ``max_wall_time``), no further NLP (a finer RK8
+        grid, a second structure, the moving knots) is started once it is spent, and a
+        polish cut short is ``success=False`` with ``status`` ``'Maximum_WallTime_Exceeded'``
+        (``info['budget_spent']``). The NLP builds count against it but are not
+        interrupted.
     **solve_kwargs
         Passed to `ocp.solve` (``ipopt_options`` is merged over the defaults
         ``{'tol': 1e-10, 'bound_relax_factor': 0, 'max_iter': 3000}``; ``scale`` may name the
@@ -222,8 +247,11 @@ def polish_switches(problem: Problem, solution: Solution, *, N: int | None = Non
         the keys of
         `optimize_switch_times`
         (``'durations'``, ``'arc_controls'``, ``'segments'``, ``'integration_error'``,
-        ``'nlp_iterations'``, ``'nlp_status'``).
-        ``success=False`` (never an exception) if IPOPT failed.
+        ``'nlp_iterations'``, ``'nlp_status'``); always ``'initial_cost'`` and ``'gain'``
+        (``solution.cost`` minus the returned cost, with the objective's sign: positive is
+        better), ``'budget'``.
+        ``success=False`` (never an exception) if IPOPT failed, the budget ran out, or the
+        result is worse than ``solution`` (above).
 
     Notes
     -----
@@ -257,6 +285,12 @@ def polish_switches(problem: Problem, solution: Solution, *, N: int | None = Non
         raise ValueError(f"`stretch` must satisfy 0 < lower < 1 < upper < inf, got {stretch!r}")
     if method not in METHODS:
         raise ValueError(f"`method` must be one of {METHODS}, got {method!r}")
+    if budget is not None:
+        if isinstance(budget, (bool, np.bool_)) or not isinstance(
+                budget, (int, float, np.integer, np.floating)) or not float(budget) > 0:
+            raise ValueError(f"`budget` must be a number > 0 [s] or None, got {budget!r}")
+        budget = float(budget)
+    verbose = stage_sink(verbose, "polish")
     degree = integer(degree, "degree", minimum=1)
     tr = RadauConstantControl(degree)
     kw = dict(solve_kwargs)
@@ -266,10 +300,20 @@ def polish_switches(problem: Problem, solution: Solution, *, N: int | None = Non
     user_ipopt = kw.pop("ipopt_options", None) or {}
     if not isinstance(user_ipopt, Mapping):
         raise ValueError(f"`ipopt_options` must be a mapping, got {type(user_ipopt).__name__}")
-    ipopt = {**_STRICT, **{k[len("ipopt."):] if k.startswith("ipopt.") else k: v
-                           for k, v in user_ipopt.items()}}
+    ipopt = {**_STRICT, **check_ipopt_options(user_ipopt)}
 
     t_start = time.perf_counter()
+
+    def left() -> float | None:  # seconds of the budget left (None: no budget)
+        return None if budget is None else budget - (time.perf_counter() - t_start)
+
+    def finish(out: RefinedSolution, info: dict, message: str) -> RefinedSolution:
+        info = {**info, "budget": budget, "wall_time": time.perf_counter() - t_start}
+        out = annotate(out, info, message=message)
+        if out.status == STATUS_BUDGET:
+            out = _out_of_budget(out, budget, "the NLP converged")
+        return graded(problem, solution, out)
+
     fallback = {}
     if method != "moving-knots":
         arcs, why = bang_arcs(solution)
@@ -283,16 +327,26 @@ def polish_switches(problem: Problem, solution: Solution, *, N: int | None = Non
                 st = optimize_switch_times(problem, solution, arcs=a, N=n_sw, degree=degree,
                                            verbose=verbose, ipopt_options=ipopt,
                                            scale=kw.get("scale"),
-                                           constraint_tol=1e-6 if ctol is None else ctol)
-                # an optimum far worse than the start: the structure read from it is suspect
+                                           constraint_tol=1e-6 if ctol is None else ctol,
+                                           max_wall_time=None if budget is None
+                                           else max(left(), 1e-9))
+                # an optimum worse than the start: the structure read from it is suspect
                 # (a missed arc); the moving knots may find the better one
-                worse = st.success and problem.better(
-                    solution.cost,
-                    st.cost - problem.objective_sign * 1e-3 * max(1.0, abs(solution.cost)))
+                worse = st.status == STATUS_WORSE  # `optimize_switch_times` graded it
                 return st, worse, (st.success and not worse) or method == "switch-times"
 
             st, worse, done = attempt(arcs)
             short, tried = False, [st.iterations]
+            spent = budget is not None and left() <= 0
+            if spent and not done:  # no time for a second structure or the moving knots
+                info = {"stretch_active": np.zeros(0, dtype=int), "free_mesh_solution": None,
+                        "short_arcs": False, "attempt_iterations": tried}
+                out = finish(st, info, "polish_switches: " + st.message)
+                if out.status == STATUS_BUDGET:
+                    return out
+                return annotate(out, {"budget_spent": True}, message=(
+                    f"{out.message}; the polish budget of {budget:.3g} s was spent before a "
+                    "second structure or the moving knots could be tried"))
             if not done and method == "auto":  # second guess: arcs too short to be detected
                 more, _ = bang_arcs(solution, short_arcs=True)
                 if more is not None and more.durations.size > arcs.durations.size:
@@ -302,9 +356,8 @@ def polish_switches(problem: Problem, solution: Solution, *, N: int | None = Non
                         st, worse, short = st2, worse2, True
             if done:
                 info = {"stretch_active": np.zeros(0, dtype=int), "free_mesh_solution": None,
-                        "short_arcs": short, "attempt_iterations": tried,
-                        "wall_time": time.perf_counter() - t_start}
-                return annotate(st, info, message="polish_switches: " + st.message)
+                        "short_arcs": short, "attempt_iterations": tried}
+                return finish(st, info, "polish_switches: " + st.message)
             why = (f"the switch-time optimum {st.cost:.10g} is worse than the start's "
                    f"{solution.cost:.10g} (the structure read from it is suspect)" if worse
                    else f"the switch-time NLP failed: {st.message}")
@@ -312,6 +365,12 @@ def polish_switches(problem: Problem, solution: Solution, *, N: int | None = Non
         else:
             fallback = {"fallback": f"not bang-bang: {why}"}
 
+    if budget is not None and left() <= 0:  # no time left for the moving knots
+        last = fallback.get("switch_time_solution", solution)
+        info = {"method": last.info.get("method") if last is not solution else None, **fallback}
+        return _out_of_budget(annotate(last, {**info, "budget": budget, "initial_cost": float(
+            solution.cost), "gain": 0.0, "wall_time": time.perf_counter() - t_start}),
+            budget, "the moving-knot re-solve")
     mesh, sw0 = _aligned_mesh(solution, N)
     T0 = float(solution.T)
     nx, nu, np_ = problem.model.nx, problem.model.nu, problem.model.np
@@ -331,8 +390,10 @@ def polish_switches(problem: Problem, solution: Solution, *, N: int | None = Non
         return um[:, int(np.clip(np.searchsorted(b, t, side="left") - 1, 0, mesh.N - 1))]
 
     guess = {"t": sig, "x": xg, "u": u_guess, "p": np.asarray(solution.p, dtype=float)}
+    wall = {} if budget is None else {"max_wall_time": min(
+        float(ipopt.get("max_wall_time", math.inf)), max(left(), 1e-3))}
     sa = solve(aug, transcription=tr, mesh=mesh, guess=guess, verbose=verbose,
-               ipopt_options=ipopt, **kw)
+               ipopt_options={**ipopt, **wall}, **kw)
 
     # ---- back to the original problem on the mesh of physical interval lengths
     d = degree
@@ -359,6 +420,6 @@ def polish_switches(problem: Problem, solution: Solution, *, N: int | None = Non
     active = np.flatnonzero((v <= lo_s * T0 * (1 + 1e-6)) | (v >= hi_s * T0 * (1 - 1e-6)))
     info = {"method": "moving-knots", "switch_times": find_switches(out),
             "initial_switch_times": sw0, "initial_T": T0, "N": mesh.N, "stretch_active": active,
-            "free_mesh_solution": sa, "wall_time": time.perf_counter() - t_start, **fallback}
+            "free_mesh_solution": sa, **fallback}
     prefix = "polish_switches (constant control and free length per interval): "
-    return annotate(out, info, message=prefix + sa.message)
+    return finish(out, info, prefix + sa.message)

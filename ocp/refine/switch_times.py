@@ -47,6 +47,7 @@ multipliers of the continuity defects propagated through the step's Jacobian.
 """
 from __future__ import annotations
 
+import contextlib
 import math
 import time
 from dataclasses import dataclass
@@ -61,13 +62,15 @@ from dynamics.validate import integer
 
 from ..attitude import attitude_error
 from ..cached import checkout
+from ..ipopt_options import check_ipopt_options
+from ..progress import IterationCallback, iteration_sink
 from ..mesh import Mesh
 from ..problem import Problem
 from ..solution import Solution
 from ..transcription import RadauConstantControl
 from .arc_nlp import arc_nlp, constraint_bounds
 from .arcs import BangArcs, bang_arcs
-from .result import RefinedSolution, annotate
+from .result import RefinedSolution, annotate, graded
 from .rk8_step import step_function, step_jacobian
 
 __all__ = ["BangArcs", "bang_arcs", "optimize_switch_times"]
@@ -115,7 +118,7 @@ def optimize_switch_times(problem: Problem, solution: Solution, *, arcs: BangArc
                           N: int | None = None, degree: int = 3, verbose=False,
                           ipopt_options: Mapping | None = None, scale: Mapping | None = None,
                           constraint_tol: float = 1e-6, integration_tol: float = 1e-10,
-                          ) -> RefinedSolution:
+                          max_wall_time: float | None = None) -> RefinedSolution:
     """Optimize the switch times of a bang-bang ``solution`` of ``problem`` (module
     docstring): the arc durations are the decision variables, the control on each arc is
     held at its bang value.
@@ -135,8 +138,9 @@ def optimize_switch_times(problem: Problem, solution: Solution, *, arcs: BangArc
     degree : int
         Radau degree of the result's transcription (`RadauConstantControl`): the number of
         state nodes per interval, each filled by an RK8 step.
-    verbose : bool
-        IPOPT's own output.
+    verbose : bool or callable
+        One line per IPOPT iteration to stderr (``True``; `ocp.progress.StagePrinter`), or
+        each `ocp.progress.Progress` to a callable. Never IPOPT's own output on stdout.
     ipopt_options : mapping, optional
         Merged over ``{'tol': 1e-10, 'bound_relax_factor': 0, 'max_iter': 3000}``.
     scale : mapping, optional
@@ -150,12 +154,20 @@ def optimize_switch_times(problem: Problem, solution: Solution, *, arcs: BangArc
         Target of the integration error estimate (sum over the segments of the step-doubling
         estimate of the RK8 local error, relative to the state scales); only steers the
         default ``N``.
+    max_wall_time : float, optional
+        Wall-time budget [s] of the whole call: IPOPT is stopped at the first iteration
+        past it (``status`` ``'Maximum_WallTime_Exceeded'``, not a success; through the
+        iteration callback, so that the pooled solver is reused whatever the budget), and
+        no finer NLP is started once it is spent (the last success is returned, its
+        ``integration_error`` saying how accurate it is). Default: none.
 
     Returns
     -------
     RefinedSolution
-        ``success`` when IPOPT returned ``Solve_Succeeded`` and the violation is at most
-        ``constraint_tol``. Transcription `RadauConstantControl` on the mesh of the RK8
+        ``success`` when IPOPT returned ``Solve_Succeeded``, the violation is at most
+        ``constraint_tol`` and the cost is not worse than that of ``solution`` by more than
+        `ocp.refine.result.WORSE_SLACK` relative (else ``status`` ``'Worse_Than_Start'``;
+        ``info['initial_cost']``, ``info['gain']``). Transcription `RadauConstantControl` on the mesh of the RK8
         segments (knots at the switches). ``iterations`` and ``solve_time`` sum over the NLPs
         solved. ``info``: ``'method'`` (``'switch-times'``), ``'switch_times'`` [s],
         ``'initial_switch_times'``, ``'durations'`` (arc lengths [s]), ``'arc_controls'``
@@ -201,15 +213,21 @@ def optimize_switch_times(problem: Problem, solution: Solution, *, arcs: BangArc
         N = integer(N, "N", minimum=1)
         if N < 2 * D.size:
             raise ValueError(f"`N` must be at least 2 per arc ({2 * D.size}), got {N}")
+    if max_wall_time is not None and not (isinstance(max_wall_time, (int, float, np.integer,
+                                                                        np.floating))
+                                          and float(max_wall_time) > 0):
+        raise ValueError(f"`max_wall_time` must be a number > 0 [s] or None, got {max_wall_time!r}")
     nseg = _segments(D, N)
     guess, runs = solution, []
     while True:
         run = _solve_arcs(problem, guess, arcs._replace_durations(D), nseg, degree=degree,
                           verbose=verbose, ipopt_options=ipopt_options, scale=scale,
-                          constraint_tol=constraint_tol)
+                          constraint_tol=constraint_tol,
+                          deadline=None if max_wall_time is None else t_start + max_wall_time)
         runs.append(run)
+        spent = max_wall_time is not None and time.perf_counter() - t_start >= max_wall_time
         if (N is not None or not run.solution.success or len(runs) == 4
-                or run.integration_error <= integration_tol):
+                or run.integration_error <= integration_tol or spent):
             break
         guess, D, nseg = run.solution, run.durations, 2 * nseg
     ok = [r for r in runs if r.solution.success]
@@ -218,13 +236,14 @@ def optimize_switch_times(problem: Problem, solution: Solution, *, arcs: BangArc
             "initial_T": float(solution.T),
             "nlp_iterations": [r.iterations for r in runs], "nlp_status": [r.status for r in runs],
             "wall_time": time.perf_counter() - t_start}
-    return annotate(out, info, iterations=sum(r.iterations for r in runs),
-                    solve_time=sum(r.solution.solve_time for r in runs),
-                    build_time=sum(r.solution.build_time for r in runs))
+    return graded(problem, solution, annotate(
+        out, info, iterations=sum(r.iterations for r in runs),
+        solve_time=sum(r.solution.solve_time for r in runs),
+        build_time=sum(r.solution.build_time for r in runs)))
 
 
 def _solve_arcs(problem: Problem, guess: Solution, arcs: BangArcs, nseg: np.ndarray, *, degree,
-                verbose, ipopt_options, scale, constraint_tol) -> _Result:
+                verbose, ipopt_options, scale, constraint_tol, deadline=None) -> _Result:
     """The switch-time NLP with ``nseg[k]`` RK8 segments on arc ``k``, from the states of
     ``guess`` and the durations of ``arcs``."""
     scale = dict(scale or {})
@@ -293,29 +312,51 @@ def _solve_arcs(problem: Problem, guess: Solution, arcs: BangArcs, nseg: np.ndar
     Xg0 = np.clip(Xg / sx[:, None], XL, XU)
     w0 = np.concatenate([D0 / sT, p0[free_p] / sp, Xg0.reshape(-1, order="F")])
 
-    user = {k[len("ipopt."):] if k.startswith("ipopt.") else k: v
-            for k, v in (ipopt_options or {}).items()}
-    ipopt = {**_STRICT, "print_level": 5 if verbose is True else 0, "sb": "yes", **user}
+    user = check_ipopt_options(ipopt_options)
+    ipopt = {**_STRICT, "print_level": 0, "sb": "yes", **user}
+    # verbose: IPOPT's iterations through a callback to the sink (stderr), never IPOPT's own
+    # printing on the C stdout
+    sink = iteration_sink(verbose, None)
     # inputs_check off: the bounds are built consistent here, and casadi's count of
     # equalities (fixed variables included) against variables would print a warning for the
     # structurally over-determined end conditions of a symmetric slew, which IPOPT solves
     # (a quiet library)
     nlp_opts = {"ipopt": ipopt, "print_time": False, "error_on_fail": False, "inputs_check": False}
-    with checkout("switch_times_nlpsol", (nlp.key, repr(sorted(ipopt.items()))),
-                  lambda: ca.nlpsol("switch_times", "ipopt", nlp.nlp, nlp_opts),
-                  keepalive=nlp) as solver:
+    if sink is None:  # pooled with its (data-less) callback, which carries the deadline
+        def build():
+            callback = IterationCallback(0, 0)
+            return ca.nlpsol("switch_times", "ipopt", nlp.nlp,
+                             {**nlp_opts, "iteration_callback": callback}), callback
+
+        lend = checkout("switch_times_nlpsol", (nlp.key, repr(sorted(ipopt.items()))), build,
+                        keepalive=nlp)
+    else:  # a solver of its own, with the callback of this sink
+        def violation(g):
+            return float(np.max(np.concatenate([[0.0], lbg - g, g - ubg])))
+
+        callback = IterationCallback(w0.size, lbg.size, violation, sink)
+        with construction_lock():
+            lend = contextlib.nullcontext((ca.nlpsol(
+                "switch_times", "ipopt", nlp.nlp, {**nlp_opts, "iteration_callback": callback}),
+                callback))
+    with lend as (solver, callback):
         build_time = time.perf_counter() - t_build
         check_interrupt()
         t_solve = time.perf_counter()
         error = None
+        callback.deadline = deadline
         try:
             res = solver(x0=w0, p=par, lbx=lbw, ubx=ubw, lbg=lbg, ubg=ubg)
         except RuntimeError as exc:  # an evaluation error inside CasADi: report it
             res, error = None, exc
+        finally:
+            callback.deadline = None
         solve_time = time.perf_counter() - t_solve
         stats = solver.stats()
     check_interrupt()
     status = str(stats.get("return_status", "Unknown"))
+    if status == "User_Requested_Stop" and deadline is not None and time.perf_counter() >= deadline:
+        status = "Maximum_WallTime_Exceeded"  # stopped by the callback at the deadline
     iterations = int(stats.get("iter_count", 0))
     if res is None:
         wopt, lam_g, gval = w0, np.full(lbg.size, np.nan), np.full(lbg.size, np.nan)

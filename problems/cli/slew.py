@@ -9,6 +9,7 @@ from __future__ import annotations
 import argparse
 import csv
 import sys
+import time
 
 import numpy as np
 
@@ -183,6 +184,7 @@ def run(args) -> int:
         u_max = 1.0 if args.time_optimal else None
     else:
         u_max = float(args.u_max[0]) if args.u_max.size == 1 else args.u_max
+    t_start = time.perf_counter()
     common = dict(u_max=u_max, norm_bound=args.norm_bound, verbose=not args.quiet,
                   **_slew_target(args))
     inertia = inertia_matrix(args.inertia)
@@ -215,6 +217,12 @@ def run(args) -> int:
             success = data["success"] = False
             data["message"] = why
             rows.append(("check", "FAILED: T below the lower bound"))
+    info = getattr(sol, "info", {}) or {}
+    if "polish" in info:  # time-optimal: whether the switch-time polish ran, what it gained
+        data["polish"] = info["polish"]
+        rows.append(("switch-time polish", slew.polish_text(info["polish"])))
+    data["wall_time"] = time.perf_counter() - t_start
+    rows.append(("wall time, total [s]", f"{data['wall_time']:.3f}"))
     text = slew.format_summary(data)
     if "pointing_error_arcsec" in data and "pointing" not in text:
         rows.append(("pointing error [arcsec]", f"{data['pointing_error_arcsec']:.3g}"))

@@ -49,7 +49,7 @@ wheels or CMGs, momentum exchanged inside the spacecraft), `report` (`switch_tim
 from __future__ import annotations
 
 from .devices import cmg_slew, wheel_slew
-from .maneuvers import min_effort, time_optimal, verify
+from .maneuvers import min_effort, polish_text, time_optimal, verify
 from .problem import attitude_guess, eigenaxis_time, slew_problem
 from .report import format_summary, plot_slew, summary, switch_times
 from .table import ManeuverTable, example_targets, maneuver_table
@@ -57,6 +57,6 @@ from .targets import (MIN_REFINE_TOL, POINTING_TOL, RATE_TOL, STATUS_POINTING, S
                       KeepOut)
 
 __all__ = ["KeepOut", "slew_problem", "time_optimal", "min_effort", "wheel_slew", "cmg_slew", "eigenaxis_time",
-           "switch_times", "attitude_guess", "verify", "summary", "format_summary", "plot_slew",
+           "switch_times", "attitude_guess", "verify", "polish_text", "summary", "format_summary", "plot_slew",
            "maneuver_table", "ManeuverTable", "example_targets",
            "POINTING_TOL", "RATE_TOL", "MIN_REFINE_TOL", "STATUS_POINTING", "STATUS_REFINE"]

@@ -2,22 +2,26 @@
 from __future__ import annotations
 
 import math
+import time
 import warnings
+from typing import Mapping
 
 import casadi as ca
 import numpy as np
 
-from ocp import (Solution, annotate, polish_switches, refine, rest_solution, solve,
+from ocp import (Solution, annotate, bang_arcs, polish_switches, refine, rest_solution, solve,
                  solve_multistart)
 from dynamics.validate import integer
 from dynamics.interrupts import interruptible
+from ocp.progress import stage_sink
 
 from .problem import (attitude_guess, inertia_of, is_rest_to_rest, rough_time, seeded_guesses,
                       slew_angle, slew_problem)
 from .targets import (ARCSEC, MIN_REFINE_TOL, POINTING_TOL, RATE_TOL, STATUS_POINTING,
                       STATUS_REFINE, check_tol)
 
-__all__ = ["time_optimal", "min_effort", "verify", "DEFAULT_STARTS_TIME", "DEFAULT_STARTS_EFFORT"]
+__all__ = ["time_optimal", "min_effort", "verify", "polish_text", "DEFAULT_STARTS_TIME",
+           "DEFAULT_STARTS_EFFORT", "POLISH_MIN_BUDGET"]
 
 DEFAULT_STARTS_TIME = 3  # seeded starts of time_optimal without a user guess
 DEFAULT_STARTS_EFFORT = 4  # seeded starts of min_effort with a keep-out cone
@@ -152,14 +156,23 @@ def time_optimal(inertia, *, angle=None, axis=None, q0=None, qf=None, u_max=1.0,
         Default True where it applies: not with ``norm_bound`` or ``keep_out`` (their
         optimal torques are not bang-bang per axis), where ``polish=True`` is ignored with a
         warning. Polish the switch times (`ocp.polish_switches`, IPOPT ``tol`` 1e-9 unless
-        ``ipopt_options`` says otherwise): when the first solution is bang-bang on every
-        axis, the arc durations are solved for directly (``info['method'] ==
-        'switch-times'``: a few IPOPT iterations, ``T`` exact to about 1e-12 s; 3 iterations
-        on Bilimoria-Wie), else the moving-knot re-solve (``'moving-knots'``, Radau degree 5)
-        runs. The polished result is returned only if it is verified and not slower than
-        the first (a switch-time result may be slower by 1e-4 relative: the first's fixed
-        mesh can put T below the exact optimum by its discretization error); otherwise the
-        first solution (``info['polish']`` says why). Should
+        ``ipopt_options`` says otherwise) when the first solution is bang-bang on every axis
+        (`ocp.bang_arcs`, read from a few samples before anything is built; an axis whose
+        torque is zero throughout, as off the axis of a principal-axis slew, is held at
+        zero): the arc durations are solved for directly (``'switch-times'``: a few IPOPT
+        iterations, ``T`` exact to about 1e-12 s; 3 iterations on Bilimoria-Wie; should that
+        fail, the moving-knot re-solve at Radau degree 5 within what is left of the budget).
+        The polish has a wall-time budget: the first solve's wall time (all starts), at
+        least `POLISH_MIN_BUDGET` = 0.5 s. A first solution that is not bang-bang (a
+        singular arc) is not polished (the moving-knot re-solve took 6-70 s there, 20-200
+        times the first solve, and was rarely kept). The polished result is returned only
+        if it is verified and not slower than the first (a switch-time result may be slower
+        by 1e-4 relative: the first's fixed mesh can put T below the exact optimum by its
+        discretization error); otherwise the first solution. ``info['polish']`` records
+        what happened: ``ran``, ``used``, ``why``, ``method``, ``wall_time`` and ``budget``
+        [s], ``T_before``, ``T_polished``, ``T_after`` [s] and ``gain`` (``T_before -
+        T_after`` [s] when used, else 0); the message ends with the same in words
+        (`polish_text`) and ``info['wall_time']`` is the wall time of the whole call. Should
         neither be verified (the first's fixed mesh can smear the switches beyond
         ``pointing_tol``), the first is mesh-refined (`ocp.refine`, tol 1e-6, at most 4
         rounds) and verified again; should that stall too (its error estimates do not
@@ -170,7 +183,8 @@ def time_optimal(inertia, *, angle=None, axis=None, q0=None, qf=None, u_max=1.0,
         refined warm from the first and returned if verified (``info['fallback']`` quotes
         its ``T`` and the unregularized one; ``cost`` is its ``T``).
     verbose : bool
-        IPOPT progress lines
+        IPOPT progress lines, to stderr, labelled by stage (``[slew: start 2/3]``,
+        ``[polish]``)
     ipopt_options : dict, optional
     pointing_tol : float [rad]
         Largest re-simulated final attitude error of a success
@@ -249,21 +263,89 @@ EIGENAXIS_START = {"hessian_approximation": "limited-memory", "max_iter": 20}
 _EXACT_SLACK = 1e-4
 
 
+#: Least wall-time budget [s] of the switch-time polish of `solve_time_optimal` (its budget
+#: is the wall time of the first solve, multi-start included, or this if more): building
+#: the switch-time NLP of a new structure takes 0.1-0.5 s the first time (measured).
+POLISH_MIN_BUDGET = 0.5
+
+
+def _labelled_starts(start_options, n: int, verbose):
+    """``start_options`` (one entry per start: a mapping or a list of attempts) with each
+    start's IPOPT lines labelled ``[slew: start i/n]`` when ``verbose`` is True."""
+    if verbose is not True:
+        return start_options
+    entries = [{}] * n if start_options is None else list(start_options)
+    out = []
+    for i, entry in enumerate(entries):
+        label = {"verbose": stage_sink(True, f"slew: start {i + 1}/{n}")}
+        out.append({**entry, **label} if isinstance(entry, Mapping) else
+                   [{**attempt, **label} for attempt in entry])
+    return out
+
+
+def _polish_record(ran: bool, why: str, *, wall_time=0.0, budget=None, method=None,
+                   T_before=None, T_polished=None, T_after=None, used=False) -> dict:
+    """``info['polish']`` of `solve_time_optimal`: whether the polish ran and was used,
+    why, its wall time and budget [s], ``T`` before, of the polished result and after
+    (the polished one when used, else the first's) [s], and the gain ``T_before - T_after``
+    [s] (0 when not used)."""
+    gain = float(T_before) - float(T_after) if used else 0.0
+    return {"ran": ran, "used": used, "why": why, "method": method, "wall_time": wall_time,
+            "budget": budget, "T_before": T_before, "T_polished": T_polished,
+            "T_after": T_after, "gain": gain}
+
+
+def polish_text(record: dict) -> str:
+    """One line for a message or summary from a `solve_time_optimal` ``info['polish']``
+    record.
+
+    Examples
+    --------
+    >>> from problems.slew.maneuvers import polish_text
+    >>> polish_text({"ran": False, "used": False, "why": "polish=False"})
+    'polish skipped: polish=False'
+    """
+    if not record.get("ran"):
+        return f"polish skipped: {record['why']}"
+    head = (f"polish ({record.get('method') or 'none'}, {record['wall_time']:.3g} s of a "
+            f"{record['budget']:.3g} s budget)")
+    if record.get("used"):
+        return (f"{head}: T {record['T_before']:.10g} -> {record['T_after']:.10g} s, gain "
+                f"{record['gain']:.3g} s")
+    return f"{head} not used: {record['why']}"
+
+
 def solve_time_optimal(problem, guess, guesses, opts, *, polish, pointing_tol, rate_tol,
                        ipopt_options, verbose, start_options=None):
     """The time-optimal pipeline shared by the rigid-body and the device slews: solve from
     ``guess`` (or the best of ``guesses``), verify by re-simulation, polish the switch
     times when ``polish`` (kept only if verified and not slower), else refine the mesh
-    (`_refined_fallback`). ``opts`` are `ocp.solve` keywords."""
+    (`_refined_fallback`). ``opts`` are `ocp.solve` keywords.
+
+    The polish runs only when the first solution is bang-bang (`ocp.refine.arcs.bang_arcs`,
+    a few samples: decided before anything is built), within a wall-time budget of the first
+    solve's wall time (at least `POLISH_MIN_BUDGET`). The result records it in
+    ``info['polish']`` (`_polish_record`: ran, used, why, method, wall_time, budget,
+    T_before, T_polished, T_after, gain) and in its message (`polish_text`);
+    ``info['wall_time']`` is the wall time of the whole pipeline [s]. With ``verbose`` the
+    IPOPT lines go to stderr labelled ``[slew: start i/n]`` and ``[polish]``."""
     ptol, rtol = pointing_tol, rate_tol
+    t_start = time.perf_counter()
     if guess is not None:
-        sol = solve(problem, guess=guess, **opts)
+        sol = solve(problem, guess=guess, **{**opts, "verbose": stage_sink(verbose, "slew")})
     else:
-        sol = solve_multistart(problem, guesses, start_options=start_options, **opts)
+        sol = solve_multistart(problem, guesses, start_options=_labelled_starts(
+            start_options, len(guesses), opts.get("verbose")), **opts)
+    t_main = time.perf_counter() - t_start
     first = sol
-    if not (polish and first.success):
-        return _refined_fallback(problem, first, verify(sol, pointing_tol=ptol, rate_tol=rtol),
-                                 ptol, rtol, ipopt_options, opts["scale"])
+    arcs, not_bang = (None, "") if not (polish and first.success) else bang_arcs(first)
+    if arcs is None:
+        why = ("polish=False (or not applicable)" if not polish else
+               "the first solve failed" if not first.success else f"not bang-bang: {not_bang}")
+        out = _refined_fallback(problem, first, verify(sol, pointing_tol=ptol, rate_tol=rtol),
+                                ptol, rtol, ipopt_options, opts["scale"])
+        return _finish(out, _polish_record(False, why, T_before=float(first.T),
+                                           T_after=float(first.T)), t_start)
     # a bang-bang first solution: switch-time optimization (arc durations only, RK8 shooting;
     # Bilimoria-Wie: 3 IPOPT iterations, T = 3.2430832775, re-simulated pointing error 8e-10
     # rad). Otherwise the moving-knot fallback, at degree 5: at degree 3 the ~4 intervals per
@@ -273,9 +355,14 @@ def solve_time_optimal(problem, guess, guesses, opts, *, polish, pointing_tol, r
     polish_opts = {"tol": 1e-9, **(ipopt_options or {})}
     pscale = None if opts["scale"] is None else {"objective": opts["scale"]["objective"],
                                                  "t_clock": opts["scale"]["T"]}
+    budget = max(t_main, POLISH_MIN_BUDGET)
+    t_polish = time.perf_counter()
     polished = polish_switches(problem, sol, degree=5, verbose=verbose, ipopt_options=polish_opts,
-                               scale=pscale)
+                               scale=pscale, budget=budget)
     polished = verify(polished, pointing_tol=ptol, rate_tol=rtol)
+    ran = dict(wall_time=time.perf_counter() - t_polish, budget=budget,
+               method=polished.info.get("method"), T_before=float(sol.T),
+               T_polished=float(polished.T))
     # switch times are integrated to ~1e-13 while a fixed-mesh T can sit below the exact
     # optimum by its discretization error (J = diag(1, 2, 3), 1 rad: 2.2075331 against
     # 2.2075385, 2.4e-6 relative), so an exact polish may come out a hair slower and is kept
@@ -285,11 +372,22 @@ def solve_time_optimal(problem, guess, guesses, opts, *, polish, pointing_tol, r
         sol = verify(sol, pointing_tol=ptol, rate_tol=rtol)
     if polished.success and (polished.T <= sol.T + slack or not sol.success):
         first = {k: v for k, v in getattr(sol, "info", {}).items() if k in ("starts", "best")}
-        return annotate(polished, first) if first else polished
-    why = (f"polish not used: {polished.message}" if not polished.success else
-           f"polish not used: its T = {polished.T:.10g} s is not below {sol.T:.10g} s")
-    return _refined_fallback(problem, first, annotate(sol, {"polish": why}), ptol, rtol,
-                             ipopt_options, opts["scale"])
+        why = "verified, not slower" if sol.success else "verified where the first is not"
+        record = _polish_record(True, why, used=True, T_after=float(polished.T), **ran)
+        return _finish(annotate(polished, first), record, t_start)
+    why = (polished.message if not polished.success else
+           f"its T = {polished.T:.10g} s is not below {sol.T:.10g} s (the first kept)")
+    record = _polish_record(True, why, T_after=float(sol.T), **ran)
+    out = _refined_fallback(problem, first, annotate(sol, {"polish": record}), ptol, rtol,
+                            ipopt_options, opts["scale"])
+    return _finish(out, record, t_start)
+
+
+def _finish(solution, record: dict, t_start: float):
+    """``solution`` with ``info['polish'] = record``, its line appended to the message, and
+    ``info['wall_time']`` since ``t_start``."""
+    return annotate(solution, {"polish": record, "wall_time": time.perf_counter() - t_start},
+                    message=f"{solution.message}; {polish_text(record)}")
 
 
 def _refined_fallback(problem, first, verified, ptol, rtol, ipopt_options, scale):

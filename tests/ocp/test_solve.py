@@ -44,11 +44,12 @@ def test_verbose_false_prints_nothing(capfd):
     assert out == "" and err == ""
 
 
-def test_verbose_true_prints_one_line_per_iteration(capfd):
+def test_verbose_true_prints_one_line_per_iteration_to_stderr(capfd):
     problem, truth = brachistochrone()
     sol = solve(problem, N=8, verbose=True, guess=truth["guess"])
-    out, _ = capfd.readouterr()
-    lines = out.strip().splitlines()
+    out, err = capfd.readouterr()
+    assert out == ""  # progress goes to stderr: stdout stays the caller's
+    lines = err.strip().splitlines()
     assert "objective" in lines[0] and "inf_pr" in lines[0]
     assert len(lines) == 1 + sol.iterations + 1  # header, iterations 0..n
     last = lines[-1].split()

@@ -80,11 +80,17 @@ def test_time_optimal_uses_the_switch_time_polish():
     assert sol.success and sol.status == "Solve_Succeeded", sol.message
     assert sol.info["method"] == "switch-times" and sol.info["nlp_iterations"][-1] < 30
     assert abs(sol.T - BW_T) < 1e-6 and sol.info["pointing_error"] < 1e-8
-    # the eigenaxis start alone ends at the eigenaxis local optimum: x and y torques inside
-    # their bounds, not bang-bang, so the moving-knot polish is tried (and not kept)
+    # the eigenaxis start alone ends at the eigenaxis local optimum: x and y torques idle
+    # (zero throughout), z bang-bang: the switch-time polish holds x and y at zero and gives
+    # the eigenaxis time 2 sqrt(pi) exactly (it was refused as not bang-bang, the moving
+    # knots tried and not kept)
     eig = slew.time_optimal(np.eye(3), angle=np.pi, axis=[0, 0, 1], u_max=1.0, starts=1)
-    assert eig.success and eig.T == pytest.approx(2 * math.sqrt(math.pi), rel=1e-6)
-    assert bang_arcs(eig)[0] is None
+    assert eig.success and eig.T == pytest.approx(2 * math.sqrt(math.pi), rel=1e-10)
+    arcs, _ = bang_arcs(slew.time_optimal(np.eye(3), angle=np.pi, axis=[0, 0, 1], u_max=1.0,
+                                          starts=1, polish=False))
+    np.testing.assert_array_equal(arcs.controls[:2], 0.0)
+    np.testing.assert_array_equal(arcs.controls[2], [1.0, -1.0])
+    assert eig.info["polish"]["method"] == "switch-times" and eig.info["polish"]["used"]
 
 
 def _singular():
@@ -249,3 +255,60 @@ def test_another_target_reuses_the_switch_time_nlp_and_matches_a_fresh_build():
     np.testing.assert_allclose(two.info["switch_times"], fresh.info["switch_times"], atol=1e-12)
     # the target is met (independently of the NLP): re-simulated pointing error
     assert two.pointing_error < 1e-8
+
+
+# ------------------------------------------------- never worse, a budget, quiet stdout
+def test_a_polish_worse_than_its_start_is_not_a_success():
+    """The brachistochrone's start is the cycloid to 1e-8 (closed form); a piecewise-constant
+    angle on 2 free intervals cannot get within 1e-3 of it: not a success, and it says so."""
+    from .reference import brachistochrone
+
+    problem, truth = brachistochrone()
+    start = solve(problem, N=20, guess=truth["guess"])
+    assert start.success and start.T == pytest.approx(truth["T"], rel=1e-7)
+    coarse = polish_switches(problem, start, N=2)
+    assert coarse.T > truth["T"] * (1 + 1e-3)  # worse than the exact optimum, by physics
+    assert not coarse.success and coarse.status == "Worse_Than_Start", coarse.message
+    assert "worse than the start" in coarse.message
+    assert coarse.info["gain"] == pytest.approx(start.T - coarse.T) and coarse.info["gain"] < 0
+    # as fine as the start: within the slack of the exact optimum, a success
+    fine = polish_switches(problem, start)
+    assert fine.success, fine.message
+    assert abs(fine.T - truth["T"]) <= 1e-3 * truth["T"]
+
+
+def test_budget_stops_the_polish_and_says_so():
+    problem, truth = bang_bang()
+    start = solve(problem, N=7)
+    free = polish_switches(problem, start)
+    assert free.success and free.info["budget"] is None
+    assert free.info["gain"] == pytest.approx(start.T - truth["T"], abs=1e-9)  # T exact
+    ample = polish_switches(problem, start, budget=60.0)
+    assert ample.success and ample.T == pytest.approx(free.T, abs=1e-12)
+    assert ample.info["wall_time"] <= 60.0
+    spent = polish_switches(problem, start, budget=1e-6)  # over before IPOPT's first iteration
+    assert not spent.success and spent.status == "Maximum_WallTime_Exceeded", spent.message
+    assert "budget" in spent.message
+    with pytest.raises(ValueError, match="`budget`"):
+        polish_switches(problem, start, budget=0.0)
+    # not bang-bang (the brachistochrone's angle is smooth): the moving knots, out of time
+    from .reference import brachistochrone
+
+    smooth, truth = brachistochrone()
+    first = solve(smooth, N=20, guess=truth["guess"])
+    cut = polish_switches(smooth, first, budget=1e-6)
+    assert not cut.success and cut.status == "Maximum_WallTime_Exceeded", cut.message
+    assert cut.info["budget_spent"] and "budget" in cut.message
+
+
+def test_verbose_polish_prints_labelled_lines_to_stderr_only(capfd):
+    problem, _ = bang_bang()
+    start = solve(problem, N=7)
+    capfd.readouterr()
+    sol = polish_switches(problem, start, verbose=True)
+    out, err = capfd.readouterr()
+    assert sol.success and sol.info["method"] == "switch-times"
+    assert out == ""  # no IPOPT output on stdout (it printed its own banner and table there)
+    lines = err.strip().splitlines()
+    assert lines and all(line.startswith("[polish] ") for line in lines)
+    assert len(lines) == 1 + sum(n + 1 for n in sol.info["nlp_iterations"])  # header + iterates

@@ -128,3 +128,25 @@ def test_bench_passes_quick_and_out_to_run(tmp_path, monkeypatch, capsys):
     with pytest.raises(SystemExit) as exc:
         main(["bench", "probe", "--out", str(seen)])  # a file, not a folder
     assert exc.value.code == 2
+
+
+def test_slew_verbose_keeps_stdout_to_the_summary(tmp_path, capfd):
+    """``appdyn slew ... --time-optimal`` (verbose: no --quiet): IPOPT's iterations go to
+    stderr labelled by stage, the summary says what the polish did and the total wall time."""
+    import re
+
+    out = tmp_path / "slew.json"
+    code = main(["slew", "--inertia", "1,1,1", "--u-max", "1", "--axis", "0,0,1", "--angle",
+                 "180", "--time-optimal", "--json", str(out)])
+    stdout, stderr = capfd.readouterr()
+    assert code == 0
+    iteration = re.compile(r"^\s*\d+\s+[-+]?\d\.\d+e[-+]\d+")
+    assert not any(iteration.match(line) for line in stdout.splitlines()), stdout
+    assert "This is Ipopt" not in stdout and "objective (scaled)" not in stdout
+    assert "[slew: start 1/3]" in stderr and "[slew: start 3/3]" in stderr
+    assert "[polish]" in stderr
+    assert "switch-time polish" in stdout and "wall time, total [s]" in stdout
+    data = json.loads(out.read_text())
+    assert data["polish"]["ran"] and data["polish"]["used"]
+    assert data["polish"]["gain"] == pytest.approx(data["polish"]["T_before"] - data["T"])
+    assert data["wall_time"] >= data["polish"]["wall_time"] + data["solve_time"]
