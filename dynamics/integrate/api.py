@@ -80,8 +80,15 @@ def simulate(model: Model, x0, t, *, u=None, p=None, hold: Hold = "linear", meth
           step counts, checked for 8th-order behaviour (`dynamics.integrate.auto`). A stiff problem (a decaying mode of the Jacobian at
           ``x0`` faster than ``1e6`` explicit steps over the horizon can follow) goes to
           cvodes, whose global error is then estimated from runs at tightened local
-          tolerances (``status`` 1). A tolerance that cannot be verified is ``success=False`` with
-          ``status`` 2 (round-off floor) or 3 (``max_steps``); never a silent fallback.
+          tolerances (``status`` 1). A non-smooth right-hand side (``fmin``, ``fmax``,
+          ``if_else``, ``fabs``, ... in the model's expression graph, found by
+          `dynamics.integrate.smoothness`, or a callable ``u``, which may jump) loses the
+          order those estimates assume at its kinks: it is integrated by DOP853 with step
+          rejection (its steps crowd at the kinks), the global error again estimated from
+          runs at local tolerances 100x apart (`dynamics.integrate.stepcontrol`; ``method``
+          ``'dop853'`` in the result). A tolerance that cannot be verified is
+          ``success=False`` with ``status`` 2 (round-off floor), 3 (``max_steps``) or 5
+          (non-smooth right-hand side: order loss at kinks); never a silent fallback.
     rtol : float, optional
         Relative tolerance, ``100 eps <= rtol < 1`` (used by ``auto`` and ``cvodes``).
     atol : float or array_like (nx,), optional
@@ -133,7 +140,10 @@ def simulate(model: Model, x0, t, *, u=None, p=None, hold: Hold = "linear", meth
     Notes
     -----
     A numerical failure (cvodes gives up, a fixed-step state becomes non-finite) returns
-    ``success=False`` with the reason; it never raises. An exception raised by a callable
+    ``success=False`` with the reason; it never raises. A fixed-step run whose invariants are
+    grossly violated at an output time (a quaternion norm off by more than 1e-3, a conserved
+    energy or momentum off by more than its size: `dynamics.integrate.sanity`) is
+    ``success=False`` with ``status`` 4: its step is too large for the motion. An exception raised by a callable
     ``u`` propagates.
 
     Examples

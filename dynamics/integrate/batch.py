@@ -30,8 +30,9 @@ from .estimates import jacobian_x, rho_sigma
 from .evaluate import map_eval
 from .inputs import HOLDS, Control, Problem
 from .loops import Progress
-from .result import (FAILED, OK, OK_STIFF, ROUNDOFF, UNVERIFIED, VIOLATED, Dense, Run,
-                     SimulationResult)
+from .result import (FAILED, NONSMOOTH, OK, OK_STIFF, ROUNDOFF, UNVERIFIED, VIOLATED, Dense,
+                     Run, SimulationResult)
+from .smoothness import nonsmooth_operations
 from .sanity import remedy, violations
 
 __all__ = ["Batch", "BatchResult", "check_batch", "simulate_batch", "BATCH_THREADS"]
@@ -125,6 +126,7 @@ class BatchTarget:
 
     def __init__(self, batch: Batch):
         self.batch, self.t, self.runs = batch, batch.t, batch.K
+        self.nonsmooth = nonsmooth_operations(batch.model.f)  # (as `Single.nonsmooth`)
         self.x0 = np.ascontiguousarray(batch.x0.T).reshape(-1)
 
     def _unstack(self, flat: np.ndarray) -> np.ndarray:
@@ -176,18 +178,24 @@ def simulate_batch(batch: Batch, method: str, steps: int, rtol: float, atol: np.
             "" if ok.all() else f"; {int((~ok).sum())} failed: {runs[int(np.argmin(ok))].message}")
     else:
         target = BatchTarget(batch)
-        run, value, st, reason, n_steps, _ = auto_runs(target, rtol, np.tile(atol, K), max_steps,
-                                                   jit, progress)
-        if run is None and reason.startswith("stiff"):  # as a single run: auto's cvodes, per run
+        if target.nonsmooth:  # each run with its own step control (`stepcontrol`)
+            run, st, reason = None, 0, "non-smooth"
+        else:
+            run, value, st, reason, n_steps, _ = auto_runs(target, rtol, np.tile(atol, K),
+                                                       max_steps, jit, progress)
+        if run is None and reason.startswith(("stiff", "non-smooth")):
+            # as single runs: auto's cvodes, or its step control, per run
             outs = [solve_auto(batch.problem(k), rtol, atol, max_steps, jit, cvodes_options,
                                progress) for k in range(K)]
             x = np.stack([o[0].x for o in outs], axis=2)
             ok = np.array([o[0].ok for o in outs])
             status = np.array([o[2] if o[0].ok else FAILED for o in outs])
             estimate[:] = [o[3] for o in outs]
-            used, compiled = "cvodes", False
+            used = ", ".join(sorted({o[1] for o in outs}))
+            compiled = all(o[0].compiled for o in outs)
             n_steps = max(o[0].n_steps for o in outs)
-            message = f"auto, run by run ({K} runs): {outs[int(np.argmax(status != OK_STIFF))][0].message}"
+            worst = int(np.argmax(~np.isin(status, (OK, OK_STIFF))))
+            message = f"auto, run by run ({K} runs): {outs[worst][0].message}"
         elif run is None:  # too many steps: no rk8 run was made
             x = np.full((nx, batch.t.size, K), np.nan)
             x[:, 0] = batch.x0
@@ -201,6 +209,10 @@ def simulate_batch(batch: Batch, method: str, steps: int, rtol: float, atol: np.
             used, compiled = "rk8", run.compiled
             verdict = {OK: f"estimated error {value:.2g} of tolerance (the largest over the runs)",
                        ROUNDOFF: "tolerance not verified: at the round-off floor of fixed-step runs",
+                       NONSMOOTH: "tolerance not verified: non-smooth right-hand side "
+                                  f"({', '.join(target.nonsmooth)}): order loss at kinks, "
+                                  "not round-off (run the runs one by one: each is then "
+                                  "integrated with step rejection)",
                        UNVERIFIED: f"tolerance not verified: {reason}",
                        FAILED: "a run became non-finite"}.get(st, "")
             message = f"auto: {run.message}; {verdict}"
@@ -243,7 +255,8 @@ class BatchResult:
         the tolerance.
     status : ndarray of int, shape (K,)
         `SimulationResult`'s codes per run (0 ok, 1 ok with cvodes, 2 round-off floor,
-        3 not verified, 4 a fixed-step run whose invariants are grossly violated, -1 failed).
+        3 not verified, 4 a fixed-step run whose invariants are grossly violated,
+        5 not verified on a non-smooth right-hand side, -1 failed).
     message : str
     method : str
         The method used.

@@ -16,10 +16,10 @@ from ..serialize import text_table, to_json
 from .evaluate import map_eval
 
 __all__ = ["SimulationResult", "make_result", "new_result", "Dense", "Run", "OK", "OK_STIFF", "ROUNDOFF",
-           "UNVERIFIED", "VIOLATED", "FAILED"]
+           "UNVERIFIED", "VIOLATED", "NONSMOOTH", "FAILED"]
 
 # status codes of SimulationResult (documented in its docstring)
-OK, OK_STIFF, ROUNDOFF, UNVERIFIED, VIOLATED, FAILED = 0, 1, 2, 3, 4, -1
+OK, OK_STIFF, ROUNDOFF, UNVERIFIED, VIOLATED, NONSMOOTH, FAILED = 0, 1, 2, 3, 4, 5, -1
 
 
 class Dense:
@@ -126,13 +126,17 @@ class SimulationResult:
         quaternion's norm off 1 by more than 1e-3, or an invariant the flow conserves along
         the run (energy or momentum of a torque-free body) changed by more than its own size
         (`dynamics.integrate.sanity`): the step is too large for the motion, ``x`` is not a
-        solution (remedy: more ``steps`` or ``method='auto'``); ``-1`` failure (integrator
-        error, or a non-finite state). With 2 and 3 ``x`` is the finest run made and
+        solution (remedy: more ``steps`` or ``method='auto'``); ``5`` not verified: the
+        right-hand side is non-smooth (kinks or jumps: ``fmin``/``fmax``/``if_else`` in the
+        model, or a callable control) and the runs lost their order there, so the
+        tolerance could not be verified (not a round-off floor; the message gives the
+        remedy); ``-1`` failure (integrator error, or a non-finite state). With 2 and 3 ``x`` is the finest run made and
         ``error_estimate`` says how far off it is thought to be.
     message : str
         What happened, in words.
     method : str
-        The method that produced ``x`` (``auto`` reports ``rk8`` or ``cvodes``).
+        The method that produced ``x`` (``auto`` reports ``rk8``, ``cvodes``, or
+        ``dop853`` for DOP853 with step rejection on a non-smooth right-hand side).
     wall_time : float [s]
         Time spent in `simulate`, validation and any compilation included.
     n_steps, n_rhs : int
