@@ -250,7 +250,7 @@ def _sane(model: Model, t: np.ndarray, run: Run, control, p: np.ndarray, method:
     """``(run, status)`` of a finished fixed-step run: ``VIOLATED`` with the reason and the
     remedy in its message when its invariants are grossly off (`sanity.violation`)."""
     bad = violation(model, t, run.x, lambda: _zero_grid(t, model.nu) if control is None
-                    else control.grid(t), p)
+                    else control.grid(t), p, method)
     if not bad:
         return run, OK
     return (Run.new(run.x, run.n_steps, run.n_rhs, run.substeps, run.compiled, True,
