@@ -231,7 +231,7 @@ def _sane(batch: Batch, x: np.ndarray, ok: np.ndarray, status: np.ndarray, messa
     if good.size == 0:
         return status, message
     U = lambda: np.concatenate([batch.ua[good], batch.ub[good, -1:]], axis=1).transpose(2, 1, 0)
-    found = violations(batch.model, batch.t, x[:, :, good], U, batch.p[:, good])
+    found = violations(batch.model, batch.t, x[:, :, good], U, batch.p[:, good], method)
     bad = [(int(k), why) for k, why in zip(good, found) if why]
     if not bad:
         return status, message

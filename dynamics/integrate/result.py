@@ -125,8 +125,8 @@ class SimulationResult:
         ``lie``) whose invariants are grossly violated at an output time: the attitude
         quaternion's norm off 1 by more than 1e-3, or an invariant the flow conserves along
         the run (energy or momentum of a torque-free body) changed by more than its own size
-        (`dynamics.integrate.sanity`; a single ``rk4``/``rk8`` run of a model with an
-        attitude is checked by the quaternion's norm, which those methods do not keep): the step is too large for the motion, ``x`` is not a
+        (`dynamics.integrate.sanity`; an ``rk4``/``rk8`` run of a model with an attitude
+        is checked by the quaternion's norm, which those methods do not keep): the step is too large for the motion, ``x`` is not a
         solution (remedy: more ``steps`` or ``method='auto'``); ``5`` not verified: the
         right-hand side is non-smooth (kinks or jumps: ``fmin``/``fmax``/``if_else`` in the
         model, or a callable control) and the runs lost their order there, so the
