@@ -415,7 +415,7 @@ def _auto_stepped(problem: Problem, rtol, atol, max_steps, jit, progress, causes
     if verdict == "met":
         message = (f"{head}: DOP853 with step rejection, its steps crowded at the kinks "
                    f"({run.message}); estimated error {estimate:.2g} of tolerance, from a "
-                   "run at a 100x looser local tolerance")
+                   "run at a 100x looser local tolerance and steps at least twice as long")
         status = OK
     elif verdict == "tightest":
         message = (f"auto: tolerance not verified: {_nonsmooth_remedy(causes)} (DOP853 with "

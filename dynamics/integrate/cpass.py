@@ -223,21 +223,25 @@ int rk8_pass_ws(casadi_real* ws, const long long* off, int done, int k, casadi_r
 # intervals, every interval ending exactly on its output time (kinks of a non-smooth
 # right-hand side shrink the steps that straddle them, as they should).
 _STEPPER = r"""
-/* Steps of x (in/out) over `nint` output intervals of lengths H; controls ua + tau ud on
-   interval k (stride `ustride`); `hio` (in/out) the proposed step; outputs in X (nx, ldx)
-   from column 0. `count` (in/out): accepted steps, rejected steps, flag (1: a non-finite
-   state, 2: step-size underflow, 3: more than max_steps steps), smallest accepted step.
-   Returns the intervals done (fewer when the flag is set). Hairer's DOP853 controller:
-   safety 0.9, the step changed by a factor in [1/3, 6] (no growth right after a reject). */
+/* Steps of x (in/out) over `nint` output intervals of lengths H, no step of interval k
+   longer than hmax[k]; controls ua + tau ud on interval k (stride `ustride`); `hio`
+   (in/out) the controller's proposed step; outputs in X (nx, ldx) from column 0 and the
+   longest accepted step of each interval in `hbig`. `count` (in/out): accepted steps, rejected
+   steps, flag (1: a non-finite state, 2: step-size underflow, 3: more than max_steps
+   steps), smallest accepted step. Returns the intervals done (fewer when the flag is set).
+   Hairer's DOP853 controller (`stepcontrol.next_step`): safety 0.9, the step changed by a
+   factor in [1/3, 6], no growth right after a rejection; a step cut short (by the output
+   time or hmax) says nothing against the proposal. */
 int rk8_adaptive(casadi_real* x, casadi_real* hio, int nint, const casadi_real* H,
-                 const casadi_real* ua, const casadi_real* ud, int ustride,
-                 const casadi_real* p, casadi_real rtol, const casadi_real* atol,
-                 casadi_real max_steps, casadi_real* X, int ldx, casadi_real* count) {
+                 const casadi_real* hmax, const casadi_real* ua, const casadi_real* ud,
+                 int ustride, const casadi_real* p, casadi_real rtol, const casadi_real* atol,
+                 casadi_real max_steps, casadi_real* X, int ldx, casadi_real* hbig,
+                 casadi_real* count) {
   pass_ctx c;
   const casadi_real* arg[PASS_NARG + 7];
   casadi_real* res[PASS_NRES + 2];
-  casadi_real xn[PASS_NX], u[PASS_U], h = *hio, hs, tau, err, fac, Hk;
-  int k, i, j, last, rejected, finite;
+  casadi_real xn[PASS_NX], u[PASS_U], h = *hio, hp, hs, tau, err, fac, Hk;
+  int k, i, last, rejected, finite;
   c.p = p; c.atol = atol; c.rtol = rtol;
   arg[0] = x; arg[1] = &hs; arg[2] = u; arg[4] = p; arg[5] = &c.rtol; arg[6] = atol;
   res[0] = xn; res[1] = &err;
@@ -246,9 +250,11 @@ int rk8_adaptive(casadi_real* x, casadi_real* hio, int nint, const casadi_real* 
     arg[3] = ud + k * ustride;
     tau = 0;
     rejected = 0;
+    hbig[k] = 0;
     while (tau < Hk) {
-      last = tau + 1.01 * h >= Hk;
-      hs = last ? Hk - tau : h;
+      hp = fmin(h, hmax[k]);
+      last = tau + 1.01 * hp >= Hk;
+      hs = last ? Hk - tau : hp;
       for (i = 0; i < PASS_NU; ++i) u[i] = ua[k * ustride + i] + tau * ud[k * ustride + i];
       rk8_step_err(arg, res, c.iw, c.w, 0);
       finite = isfinite(err);
@@ -258,11 +264,11 @@ int rk8_adaptive(casadi_real* x, casadi_real* hio, int nint, const casadi_real* 
         for (i = 0; i < PASS_NX; ++i) x[i] = xn[i];
         tau = last ? Hk : tau + hs;
         count[0] += 1;
+        if (hs > hbig[k]) hbig[k] = hs;
         if (hs < count[3]) count[3] = hs;
         fac = fmax(1.0 / 6.0, fmin(3.0, fac));
         fac = rejected ? fmin(hs, hs / fac) : hs / fac;
-        h = last && fac < h ? h : fac;  /* (a step cut short at the output time says
-                                           nothing against the proposal) */
+        h = hs < h && fac < h ? h : fac;
         rejected = 0;
       } else {
         count[1] += 1;
@@ -313,7 +319,8 @@ def pass_library(model: Model) -> object | None:
         fun.library = lib  # (kept alive with the function)
         stepper = lib.rk8_adaptive
         f64 = ctypes.c_double
-        stepper.argtypes = [ptr, ptr, i32, ptr, ptr, ptr, i32, ptr, f64, ptr, f64, ptr, i32, ptr]
+        stepper.argtypes = [ptr, ptr, i32, ptr, ptr, ptr, ptr, i32, ptr, f64, ptr, f64, ptr,
+                            i32, ptr, ptr]
         stepper.restype = i32
         fun.stepper = stepper  # (`dynamics.integrate.stepcontrol`)
         return fun

@@ -52,11 +52,13 @@ _REASONS = ("", "a state became non-finite", "the step size underflowed",
 
 
 def run_stepped(problem: Problem, rtol: float, atol: np.ndarray, max_steps: int,
-                progress=None) -> Run | None:
+                progress=None, hmax: np.ndarray | None = None):
     """One DOP853 run with step rejection at the local tolerances ``rtol``, ``atol``
-    (linear control); None without the model's compiled library (`cpass.pass_library`).
-    ``substeps`` of the run: the most steps in one output interval are not counted; it is
-    0. The message gives the steps, rejections and the smallest step."""
+    (linear control), no step of output interval ``k`` longer than ``hmax[k]`` [s]
+    (default: the interval). Returns ``(run, longest)``, ``longest (nint,)`` [s] the longest
+    accepted step of each interval; None without the model's compiled library
+    (`cpass.pass_library`).
+    The run's message gives the steps, rejections and the smallest step."""
     lib = pass_library(problem.model)
     if lib is None or problem.control.mode != "linear":
         return None
@@ -65,39 +67,54 @@ def run_stepped(problem: Problem, rtol: float, atol: np.ndarray, max_steps: int,
     nx, nu, nint = model.nx, model.nu, problem.nint
     ctrl = problem.control
     H = np.ascontiguousarray(t[1:] - t[:-1])
+    hmax = H if hmax is None else np.ascontiguousarray(hmax, dtype=float)
     ua = np.ascontiguousarray(ctrl.ua, dtype=float).reshape(nint, nu)
     ud = np.ascontiguousarray((ctrl.ub - ctrl.ua) / H[:, None], dtype=float).reshape(nint, nu)
     x = np.array(problem.x0, dtype=float)
     p = np.ascontiguousarray(problem.p, dtype=float)
     at = np.ascontiguousarray(atol, dtype=float)
-    h0 = _initial_step(problem, rtol, atol, 8)[0]
-    h = np.array([h0 if h0 is not None and h0 > 0 else float(H[0]) / 100.0])
+    h = np.array([_first_step(problem, rtol, atol)])
     X = np.full((nx, nint + 1), np.nan)
     X[:, 0] = x
     out = X[:, 1:].copy()  # (nx, nint), row stride nint
+    longest = np.zeros(nint)
     count = np.array([0.0, 0.0, 0.0, math.inf])
     addr = lambda a, off=0: a.ctypes.data + 8 * off  # noqa: E731
+    progress = Progress(None) if progress is None else progress
     done = 0
     with deferred_interrupts() if nint > INTERVALS else contextlib.nullcontext():
         while done < nint and not count[2]:
             check_interrupt()
             k = min(INTERVALS, nint - done)
             before = count[0] + count[1]
-            got = stepper(addr(x), addr(h), k, addr(H, done), addr(ua, done * nu),
-                          addr(ud, done * nu), nu, addr(p), rtol, addr(at),
-                          float(max_steps), addr(out, done), nint, addr(count))
-            if progress is not None and progress.fun is not None:
-                new = int(count[0] + count[1] - before)
-                progress.start(new)
-                progress.advance(new)
-            done += got
+            done += stepper(addr(x), addr(h), k, addr(H, done), addr(hmax, done),
+                            addr(ua, done * nu), addr(ud, done * nu), nu, addr(p), rtol,
+                            addr(at), float(max_steps), addr(out, done), nint,
+                            addr(longest, done), addr(count))
+            progress.start(int(count[0] + count[1] - before))
+            progress.advance(int(count[0] + count[1] - before))
     X[:, 1:done + 1] = out[:, :done]
+    return _stepped_run(X, t, count, done, rtol, True), longest
+
+
+def _first_step(problem: Problem, rtol: float, atol: np.ndarray) -> float:
+    """The first step proposed [s]: Hairer's heuristic (`estimates._initial_step`), or a
+    hundredth of the first interval where it is degenerate."""
+    h0 = _initial_step(problem, rtol, atol, 8)[0]
+    return h0 if h0 is not None and h0 > 0 else float(problem.t[1] - problem.t[0]) / 100.0
+
+
+def _stepped_run(X: np.ndarray, t: np.ndarray, count, done: int, rtol: float,
+                 compiled: bool) -> Run:
+    """The `Run` of a stepped run from its counters ``(accepted, rejected, flag, smallest
+    step)`` and the intervals ``done``."""
     steps, rejects = int(count[0]), int(count[1])
     n_rhs = DOP853.stages * (steps + rejects)
     if count[2]:
-        return Run.new(X, steps + rejects, n_rhs, 0, True, False,
-                       f"dop853: {_REASONS[int(count[2])]} before t = {t[min(done + 1, nint)]:.6g}")
-    return Run.new(X, steps + rejects, n_rhs, 0, True, True,
+        return Run.new(X, steps + rejects, n_rhs, 0, compiled, False,
+                       f"dop853: {_REASONS[int(count[2])]} before "
+                       f"t = {t[min(done + 1, t.size - 1)]:.6g}")
+    return Run.new(X, steps + rejects, n_rhs, 0, compiled, True,
                    f"dop853 with step rejection: {steps} steps, {rejects} rejected, smallest "
                    f"step {count[3]:.3g} s (local rtol {rtol:.3g})")
 
@@ -135,30 +152,32 @@ def _callable_step(model) -> ca.Function:
 
 
 def run_stepped_callable(problem: Problem, rtol: float, atol: np.ndarray, max_steps: int,
-                         progress=None) -> Run:
+                         progress=None, hmax: np.ndarray | None = None):
     """`run_stepped` for a callable control (``problem.control.mode == 'stages'``): the same
     controller (`next_step`) stepping from Python, the control called at each step's stage
     times (a jump of the control shrinks the steps that straddle it, as a kink does)."""
     model, t, fun = problem.model, problem.t, problem.control.fun
-    nx = model.nx
+    nx, nint = model.nx, problem.nint
+    H = t[1:] - t[:-1]
+    hmax = H if hmax is None else hmax
     nodes = np.array(unique_nodes("rk8"))
     step = _callable_step(model)
     X = np.full((nx, t.size), np.nan)
     X[:, 0] = problem.x0
     x = np.array(problem.x0, dtype=float)
-    h0 = _initial_step(problem, rtol, atol, 8)[0]
-    h = h0 if h0 is not None and h0 > 0 else float(t[1] - t[0]) / 100.0
-    steps = rejects = 0
-    smallest = math.inf
+    h = _first_step(problem, rtol, atol)
+    longest = np.zeros(nint)
+    count = [0, 0, 0, math.inf]  # as `cpass._STEPPER`'s
     rt = np.array([rtol])
     progress = Progress(None) if progress is None else progress
-    for k in range(problem.nint):
+    for k in range(nint):
         check_interrupt()
-        before = steps + rejects
-        tk, Hk, tau, rejected = float(t[k]), float(t[k + 1] - t[k]), 0.0, False
+        before = count[0] + count[1]
+        tk, Hk, tau, rejected = float(t[k]), float(H[k]), 0.0, False
         while tau < Hk:
-            last = tau + 1.01 * h >= Hk
-            hs = Hk - tau if last else h
+            hp = min(h, float(hmax[k]))
+            last = tau + 1.01 * hp >= Hk
+            hs = Hk - tau if last else hp
             us = np.concatenate([fun(tk + tau + c * hs) for c in nodes])
             out = call_buffered(step, [x, np.array([hs]), us, problem.p, rt, atol], (nx + 1,))
             err = float(out[nx]) if np.isfinite(out[:nx]).all() else math.nan
@@ -166,41 +185,47 @@ def run_stepped_callable(problem: Problem, rtol: float, atol: np.ndarray, max_st
             if ok:
                 x[:] = out[:nx]
                 tau = Hk if last else tau + hs
-                steps += 1
-                smallest = min(smallest, hs)
-                h = h if last and hn < h else hn
-                rejected = False
+                count[0] += 1
+                longest[k] = max(longest[k], hs)
+                count[3] = min(count[3], hs)
+                h = h if hs < h and hn < h else hn
             else:
-                rejects += 1
-                h, rejected = hn, True
-            if steps + rejects > max_steps or not h > 64 * _EPS * Hk:
-                why = ("more than max_steps steps" if steps + rejects > max_steps else
-                       "the step size underflowed" if math.isfinite(err) else
-                       "a state became non-finite")
-                return Run.new(X, steps + rejects, DOP853.stages * (steps + rejects), 0,
-                               False, False, f"dop853: {why} before t = {t[k + 1]:.6g}")
+                count[1] += 1
+                h = hn
+            rejected = not ok
+            if count[0] + count[1] > max_steps:
+                count[2] = 3
+            elif not h > 64 * _EPS * Hk:
+                count[2] = 2 if math.isfinite(err) else 1
+            if count[2]:
+                return _stepped_run(X, t, count, k, rtol, False), longest
         X[:, k + 1] = x
-        progress.start(steps + rejects - before)
-        progress.advance(steps + rejects - before)
-    return Run.new(X, steps + rejects, DOP853.stages * (steps + rejects), 0, False, True,
-                   f"dop853 with step rejection: {steps} steps, {rejects} rejected, smallest "
-                   f"step {smallest:.3g} s (local rtol {rtol:.3g})")
+        progress.start(count[0] + count[1] - before)
+        progress.advance(count[0] + count[1] - before)
+    return _stepped_run(X, t, count, nint, rtol, False), longest
 
 
 def solve_stepped(problem: Problem, rtol: float, atol: np.ndarray, max_steps: int,
                   progress=None):
     """Step-controlled runs at local tolerances ``rtol * _FIRST``, then ``_TIGHTEN`` times
     tighter each, until two successive runs differ by at most the tolerance
-    (`estimates.tightened`). Returns ``(run, verdict, estimate, n_steps, n_rhs)`` as that
+    (`estimates.tightened`). No step of a run is longer than half the longest step of the
+    one before in the same output interval: where the grid, not the tolerance, limits the
+    steps (a smooth stretch), a tighter tolerance alone would repeat the same steps and
+    their difference would tell nothing. Returns ``(run, verdict, estimate, n_steps, n_rhs)`` as `tightened`
     does (``verdict`` None: no compiled stepper for this model or control)."""
-    spent = [0]
-
     stepped = run_stepped_callable if problem.control.mode == "stages" else run_stepped
+    H = problem.t[1:] - problem.t[:-1]
+    state = {"spent": 0, "hmax": H}
 
     def run_at(local_rtol, local_atol):
-        run = stepped(problem, local_rtol, local_atol, max_steps - spent[0], progress)
-        if run is not None:
-            spent[0] += run.n_steps
+        got = stepped(problem, local_rtol, local_atol, max_steps - state["spent"], progress,
+                      state["hmax"])
+        if got is None:
+            return None
+        run, longest = got
+        state["spent"] += run.n_steps
+        state["hmax"] = np.where(longest > 0, longest, H) / 2.0
         return run
 
     return tightened(run_at, rtol, atol, _FIRST, _TIGHTEN, LOCAL_RTOL_MIN)
