@@ -389,11 +389,13 @@ def nonsmooth_causes(problem: Problem) -> tuple[str, ...]:
     return found + (("callable u",) if problem.control.mode == "stages" else ())
 
 
-def _nonsmooth_remedy(causes) -> str:
-    return (f"non-smooth right-hand side ({', '.join(causes)}): order loss at kinks, not "
-            "round-off; remedy: a looser tolerance, a smooth law (e.g. tanh instead of a "
-            "saturation), output times on the switching times, or a control given as "
-            "samples (hold='zoh')")
+def _nonsmooth_remedy(causes, cause: str = "") -> str:
+    """The words of status ``NONSMOOTH``: the causes found, ``cause`` (what else is known)
+    and the remedy."""
+    return (f"non-smooth right-hand side ({', '.join(causes)}): order loss at kinks"
+            f"{', ' + cause if cause else ''}; remedy: a looser tolerance, a smooth law (e.g. "
+            "tanh instead of a saturation), output times on the switching times, or a "
+            "control given as samples (hold='zoh')")
 
 
 def _auto_stepped(problem: Problem, rtol, atol, max_steps, jit, progress, causes):
@@ -422,11 +424,13 @@ def _auto_stepped(problem: Problem, rtol, atol, max_steps, jit, progress, causes
                    f"step rejection down to local rtol {LOCAL_RTOL_MIN:g}: runs still differ by "
                    f"{estimate:.2g} of tolerance; {run.message}); x is the best solution found")
         status = NONSMOOTH
+    elif "max_steps" in run.message:  # (x: NaN from the stop on, as auto's other paths)
+        message = (f"auto: tolerance not verified: {run.message} ({head}); raise max_steps "
+                   "or loosen the tolerance")
+        return (Run(run.x, n_steps, n_rhs, 0, run.compiled, True, message), "dop853",
+                UNVERIFIED, estimate)
     else:
-        failed = "max_steps" in run.message
-        message = (f"auto: tolerance not verified: {run.message} ({head})" if failed
-                   else f"{head}: {run.message}")
-        status = UNVERIFIED if failed else FAILED
+        message, status = f"{head}: {run.message}", FAILED
     return (Run(run.x, n_steps, n_rhs, 0, run.compiled, run.ok, message), "dop853", status,
             estimate)
 
@@ -474,7 +478,8 @@ def solve_auto(problem: Problem, rtol, atol, max_steps, jit, cvodes_options, pro
                    f"runs on this grid ({run.message}; estimated error incl. modelled round-off "
                    f"{estimate:.2g} of tolerance); x is the best solution found")
     elif status == NONSMOOTH:
-        message = (f"auto: tolerance not verified: {_nonsmooth_remedy(Single(problem).nonsmooth)}"
+        message = (f"auto: tolerance not verified: "
+                   f"{_nonsmooth_remedy(Single(problem).nonsmooth, 'not round-off')}"
                    f" (rk8 runs of different step counts do not converge at order 8"
                    f"{': ' + reason if reason else ''}; {run.message}; estimated error "
                    f"{estimate:.2g} of tolerance); x is the best solution found")

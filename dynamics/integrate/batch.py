@@ -30,7 +30,7 @@ from .estimates import jacobian_x, rho_sigma
 from .evaluate import map_eval
 from .inputs import HOLDS, Control, Problem
 from .loops import Progress
-from .result import (FAILED, NONSMOOTH, OK, OK_STIFF, ROUNDOFF, UNVERIFIED, VIOLATED, Dense,
+from .result import (FAILED, OK, OK_STIFF, ROUNDOFF, UNVERIFIED, VIOLATED, Dense,
                      Run, SimulationResult)
 from .smoothness import nonsmooth_operations
 from .sanity import remedy, violations
@@ -209,10 +209,6 @@ def simulate_batch(batch: Batch, method: str, steps: int, rtol: float, atol: np.
             used, compiled = "rk8", run.compiled
             verdict = {OK: f"estimated error {value:.2g} of tolerance (the largest over the runs)",
                        ROUNDOFF: "tolerance not verified: at the round-off floor of fixed-step runs",
-                       NONSMOOTH: "tolerance not verified: non-smooth right-hand side "
-                                  f"({', '.join(target.nonsmooth)}): order loss at kinks, "
-                                  "not round-off (run the runs one by one: each is then "
-                                  "integrated with step rejection)",
                        UNVERIFIED: f"tolerance not verified: {reason}",
                        FAILED: "a run became non-finite"}.get(st, "")
             message = f"auto: {run.message}; {verdict}"

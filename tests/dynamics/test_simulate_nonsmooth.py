@@ -145,3 +145,9 @@ def test_smooth_callable_torque_estimate_bounds_the_true_error(rtol):
                        np.outer(AXIS, 0.01 / SPHERE * (1 - np.cos(T)))])
     ratio = np.abs(res.x - truth) / (1e-10 + rtol * np.abs(truth))
     assert ratio.max() <= res.error_estimate <= 1.0, (ratio.max(), res.error_estimate)
+
+
+def test_step_budget_on_a_non_smooth_model_is_status_3_not_a_failure():
+    res = simulate(saturated_pd_wheel_loop(), X0, T, rtol=1e-6, max_steps=500)
+    assert not res.success and res.status == 3, res.message
+    assert "max_steps" in res.message and "non-smooth" in res.message
