@@ -82,7 +82,8 @@ def test_rigid_body_spun_up_by_a_held_torque_matches_the_closed_form():
     torque = np.zeros((3, T.size))
     torque[2] = 2.0 * U
     w, angle = held_spin(4.0, 0.1, T, torque[2])
-    for method, kw in (("rk8", {"steps": 8}), ("auto", {"rtol": 1e-10})):
+    for method, kw in (("rk8", {"steps": 8}), ("lie", {"steps": 8}),
+                       ("auto", {"rtol": 1e-10})):
         res = simulate(rigid_body(inertia), [0, 0, 0, 1, 0, 0, 0.1], T, u=torque, hold="zoh",
                        method=method, **kw)
         assert res.success, res.message
