@@ -145,7 +145,7 @@ class SimulationResult:
         (``auto`` makes several).
     substeps : int
         Fixed-step methods: steps per output interval of the returned solution (``auto``'s
-        one-pass path: the most in any interval); 0 for cvodes.
+        one-pass path: the most in any interval); 0 for cvodes and ``dop853``.
     error_estimate : float
         ``auto`` with a fixed-step result: estimated max over states and output times of
         ``|error| / (atol + rtol |x|)`` (1.0 is exactly the tolerance); NaN otherwise.
