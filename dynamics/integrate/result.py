@@ -147,8 +147,9 @@ class SimulationResult:
         Fixed-step methods: steps per output interval of the returned solution (``auto``'s
         one-pass path: the most in any interval); 0 for cvodes and ``dop853``.
     error_estimate : float
-        ``auto`` with a fixed-step result: estimated max over states and output times of
-        ``|error| / (atol + rtol |x|)`` (1.0 is exactly the tolerance); NaN otherwise.
+        ``auto``: estimated max over states and output times of ``|error| / (atol + rtol
+        |x|)`` (1.0 is exactly the tolerance), for every path (rk8, cvodes on a stiff
+        problem, dop853 on a non-smooth one); NaN for the other methods.
     compiled : bool
         Whether the loop that produced ``x`` ran as jit-compiled C.
     invariants : mapping of str to ndarray
