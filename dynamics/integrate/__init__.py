@@ -4,7 +4,6 @@ SUNDIALS CVODES, and an ``auto`` mode that meets a requested global tolerance.
 The public entry points are `dynamics.simulate`, `dynamics.SimulationResult`,
 `dynamics.BatchResult`, `dynamics.Event` and `dynamics.METHODS`; the modules of this package are its internals, one job each:
 
-==============  ===========================================================================
 ``api``         `simulate`: checks the inputs, runs the method, builds the result
 ``inputs``      normalisation and checks of ``t``, ``x0``, ``u``, tolerances -> `Problem`
 ``tableaux``    Butcher tableaux (data only) and stage nodes
@@ -19,6 +18,25 @@ The public entry points are `dynamics.simulate`, `dynamics.SimulationResult`,
 ``batch``       K runs at once (``x0`` of shape (nx, K)): the chunk loop mapped over the
                 runs on threads, ``auto``'s error control over the batch; `BatchResult`
 ==============  ===========================================================================
+=======
+===============  ===========================================================================
+``api``          `simulate`: checks the inputs, runs the method, builds the result
+``inputs``       normalisation and checks of ``t``, ``x0``, ``u``, tolerances -> `Problem`
+``tableaux``     Butcher tableaux (data only) and stage nodes
+``kernels``      one step of a method as a CasADi Function (explicit RK, Lie group CF4)
+``loops``        the chunk Function (``mapaccum`` of steps, jit) and the fixed-step runner
+``cvodes``       SUNDIALS CVODES through ``casadi.integrator``
+``auto``         Richardson global-error estimates, round-off floor, stiffness test
+``result``       `SimulationResult` and its dense output; `Run`, one run's outcome
+``evaluate``     buffered numeric evaluation of Functions (no per-element conversion)
+``events``       event functions (``events=``): zero crossings located on the solution,
+                 `Event`; a terminal event truncates the result
+``batch``        K runs at once (``x0`` of shape (nx, K)): the chunk loop mapped over the
+                 runs on threads, ``auto``'s error control over the batch; `BatchResult`
+``sanity``       fixed-step runs checked against the model's invariants (status 4)
+``smoothness``   the non-smooth operations (kinks, jumps) of a model's expression graph
+``stepcontrol``  DOP853 with step rejection for non-smooth right-hand sides (``auto``)
+===============  ===========================================================================
 
 Every fixed-step integration (``rk4``, ``rk8``, ``lie`` and the runs ``auto`` makes) calls
 ONE CasADi Function per (model, method, control mode): a ``mapaccum`` of 512 steps, each
@@ -43,7 +61,8 @@ Controls
 ``u`` is ``None`` (zero), a constant ``(nu,)`` vector, samples ``(nu, n)`` on the grid ``t``
 (linear between samples: within interval ``k`` the control is
 ``u_k + (tau - t_k) (u_{k+1} - u_k) / (t_{k+1} - t_k)``, evaluated at every Runge-Kutta stage
-time; the kinks sit on the grid, where steps start and end, so no order is lost), or a
+time; or, with ``hold='zoh'``, ``u_k`` on the whole interval; the kinks and jumps sit on the
+grid, where steps start and end, so no order is lost), or a
 callable ``u(t) -> (nu,)`` evaluated at every stage time (fixed-step methods; the calls are
 made from Python before the compiled loop runs) or at every right-hand-side evaluation
 (``cvodes``, through a ``casadi.Callback``).

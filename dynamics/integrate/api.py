@@ -19,16 +19,18 @@ from .inputs import (Problem, check_cvodes_options, check_invariants, check_t, c
                      check_u, check_x0, fast_x0)
 from .kernels import check_lie_model
 from .loops import Progress, run_fixed, run_short
-from .result import FAILED, OK, OK_STIFF, Dense, SimulationResult, new_result
+from .result import FAILED, OK, OK_STIFF, VIOLATED, Dense, Run, SimulationResult, new_result
+from .sanity import remedy, violation
 
-__all__ = ["simulate", "METHODS", "Method"]
+__all__ = ["simulate", "METHODS", "Method", "Hold"]
 
 Method = Literal["auto", "cvodes", "rk4", "rk8", "lie"]
+Hold = Literal["linear", "zoh"]
 METHODS = ("auto", "cvodes", "rk4", "rk8", "lie")
 _FIXED_STEP = ("rk4", "rk8", "lie")
 
 
-def simulate(model: Model, x0, t, *, u=None, p=None, method: Method = "auto",
+def simulate(model: Model, x0, t, *, u=None, p=None, hold: Hold = "linear", method: Method = "auto",
              rtol: float = 1e-8, atol=1e-10, invariants=False, steps: int | None = None,
              jit: bool | None = None, max_steps: int = 100_000_000,
              cvodes_options: Mapping | None = None,
@@ -51,11 +53,19 @@ def simulate(model: Model, x0, t, *, u=None, p=None, method: Method = "auto",
         Output times, strictly increasing, ``n >= 2``. Fixed-step methods step exactly onto
         every output time.
     u : None, array_like (nu,) or (nu, n), or callable, optional
-        Control [model units]: ``None`` is zero; a constant; samples on ``t``, linear in time
-        between samples; or ``u(t) -> (nu,)`` for a float ``t`` [s], called at every stage
-        time (fixed step) or right-hand-side evaluation (cvodes).
+        Control [model units]: ``None`` is zero; a constant; samples on ``t``, between
+        samples as ``hold`` says; or ``u(t) -> (nu,)`` for a float ``t`` [s], called at every
+        stage time (fixed step) or right-hand-side evaluation (cvodes).
     p : array_like, shape (np,) or, for a batch, (np, K), optional
         Parameters; the model's defaults when omitted.
+    hold : {'linear', 'zoh'}, optional
+        How samples ``u`` of shape ``(nu, n)`` (or ``(nu, n, K)``) act between the output
+        times: ``'linear'`` (default) interpolates; ``'zoh'`` (zero-order hold, a digital
+        controller's output) applies ``u[:, k]`` on ``[t_k, t_{k+1})`` (``u[:, -1]`` acts
+        after the grid: it only enters ``xdot`` and ``sample`` at ``t[-1]``). The jumps sit
+        on the grid, where every method's steps start and end, so every method integrates
+        each interval with its constant control and loses no order. A constant or ``None``
+        ``u`` is the same under both; a callable ``u`` takes only ``'linear'``.
     method : {'auto', 'cvodes', 'rk4', 'rk8', 'lie'}
         * ``'rk4'``, ``'rk8'`` (DOP853's 8th-order weights), ``'lie'`` (CF4 on the quaternion,
           RK4 on the other states; needs ``model.attitude``): fixed step, ``steps`` steps per
@@ -72,8 +82,15 @@ def simulate(model: Model, x0, t, *, u=None, p=None, method: Method = "auto",
           step counts, checked for 8th-order behaviour (`dynamics.integrate.auto`). A stiff problem (a decaying mode of the Jacobian at
           ``x0`` faster than ``1e6`` explicit steps over the horizon can follow) goes to
           cvodes, whose global error is then estimated from runs at tightened local
-          tolerances (``status`` 1). A tolerance that cannot be verified is ``success=False`` with
-          ``status`` 2 (round-off floor) or 3 (``max_steps``); never a silent fallback.
+          tolerances (``status`` 1). A non-smooth right-hand side (``fmin``, ``fmax``,
+          ``if_else``, ``fabs``, ... in the model's expression graph, found by
+          `dynamics.integrate.smoothness`, or a callable ``u``, which may jump) loses the
+          order those estimates assume at its kinks: it is integrated by DOP853 with step
+          rejection (its steps crowd at the kinks), the global error again estimated from
+          runs at local tolerances 100x apart (`dynamics.integrate.stepcontrol`; ``method``
+          ``'dop853'`` in the result). A tolerance that cannot be verified is
+          ``success=False`` with ``status`` 2 (round-off floor), 3 (``max_steps``) or 5
+          (non-smooth right-hand side: order loss at kinks); never a silent fallback.
     rtol : float, optional
         Relative tolerance, ``100 eps <= rtol < 1`` (used by ``auto`` and ``cvodes``).
     atol : float or array_like (nx,), optional
@@ -123,7 +140,8 @@ def simulate(model: Model, x0, t, *, u=None, p=None, method: Method = "auto",
         Naming the argument: non-finite or wrongly shaped ``x0``, ``t`` not strictly
         increasing or shorter than 2, ``u`` or ``p`` of the wrong shape (also a callable
         ``u`` returning the wrong shape), an unknown ``method``, bad ``rtol``/``atol``,
-        ``steps`` with a method that does not take it, ``'lie'`` on a model without an
+        ``steps`` with a method that does not take it, an unknown ``hold`` or ``'zoh'``
+        with a callable ``u``, ``'lie'`` on a model without an
         attitude, unknown ``invariants``, an attitude quaternion in ``x0`` whose norm is
         not 1 to 1e-6, an unknown or ill-typed ``cvodes_options`` entry, ``events`` with a
         batch, an event Function of the wrong inputs or outputs, an event function whose
@@ -133,7 +151,10 @@ def simulate(model: Model, x0, t, *, u=None, p=None, method: Method = "auto",
     Notes
     -----
     A numerical failure (cvodes gives up, a fixed-step state becomes non-finite) returns
-    ``success=False`` with the reason; it never raises. An exception raised by a callable
+    ``success=False`` with the reason; it never raises. A fixed-step run whose invariants are
+    grossly violated at an output time (a quaternion norm off by more than 1e-3, a conserved
+    energy or momentum off by more than its size: `dynamics.integrate.sanity`) is
+    ``success=False`` with ``status`` 4: its step is too large for the motion. An exception raised by a callable
     ``u`` or an event function propagates.
 
     Examples
@@ -160,14 +181,15 @@ def simulate(model: Model, x0, t, *, u=None, p=None, method: Method = "auto",
                 raise ValueError("`events` are located for single runs only; simulate the "
                                  "runs of a batch (`x0` of shape (nx, K)) one by one")
             return _simulate_batch(model, x0, t, u, p, method, rtol, atol, invariants, steps,
-                                   jit, max_steps, cvodes_options, progress, start)
+                                   jit, max_steps, cvodes_options, progress, start, hold)
         x = check_x0(x0, model)
     x0 = x
     if CLOCK_STATE in model.states:  # a time-dependent model: its clock starts at t[0]
         check_clock_start(model, x0, t[0])
     p = model.resolve_p(p)
     rtol, atol = check_tolerances(rtol, atol, model.nx)
-    control = None if u is None else check_u(u, model.nu, t)  # None: zero, made if needed
+    control = None if u is None and hold == "linear" else check_u(u, model.nu, t, hold)
+    # (None: zero, made if needed)
     names = check_invariants(invariants, model)
     specs = None if events is None else check_events(events, model, t, x0, control, p)
     max_steps, steps, cvodes_options, counter = _check_options(method, max_steps, jit, steps,
@@ -190,6 +212,8 @@ def simulate(model: Model, x0, t, *, u=None, p=None, method: Method = "auto",
         else:
             run, used, status, estimate = solve_auto(problem, rtol, atol, max_steps, jit,
                                                      cvodes_options, counter)
+    if method in _FIXED_STEP and run.ok:
+        run, status = _sane(model, t, run, control, p, method)
     x = run.x
     x.setflags(write=False)
     values = _invariants(model, x, p, names) if names else {}
@@ -199,7 +223,7 @@ def simulate(model: Model, x0, t, *, u=None, p=None, method: Method = "auto",
         time.perf_counter() - start, run.n_steps, run.n_rhs, run.substeps,  # error_estimate,
         estimate, run.compiled, MappingProxyType(values),  # compiled, invariants, _dense)
         Dense(model, p, lambda: _zero_grid(t, model.nu) if control is None
-              else control.grid(t)))
+              else control.grid(t), None if control is None else control.left_grid(t)))
     if specs is None:
         return result
     problem = Problem.new(model, x0, t, check_u(None, model.nu, t) if control is None
@@ -209,7 +233,7 @@ def simulate(model: Model, x0, t, *, u=None, p=None, method: Method = "auto",
 
 
 def _simulate_batch(model, x0, t, u, p, method, rtol, atol, invariants, steps, jit, max_steps,
-                    cvodes_options, progress, start) -> BatchResult:
+                    cvodes_options, progress, start, hold) -> BatchResult:
     """`simulate` for ``x0`` of shape ``(nx, K)`` (`dynamics.integrate.batch`)."""
     if clock_index(model) is not None:
         raise ValueError("`x0` of shape (nx, K) (a batch) is not supported for a model with a "
@@ -217,7 +241,7 @@ def _simulate_batch(model, x0, t, u, p, method, rtol, atol, invariants, steps, j
     if invariants not in (False, None, ()):
         raise ValueError("`invariants` are evaluated per run for a batch: use "
                          "`result.run(k).sample` or `model.invariant` on `result.x[:, :, k]`")
-    batch = check_batch(model, x0, t, u, p)
+    batch = check_batch(model, x0, t, u, p, hold)
     rtol, atol = check_tolerances(rtol, atol, model.nx)
     max_steps, steps, cvodes_options, counter = _check_options(method, max_steps, jit, steps,
                                                                cvodes_options, progress)
@@ -241,6 +265,17 @@ def _check_options(method, max_steps, jit, steps, cvodes_options, progress):
         raise TypeError(f"`progress` must be None or a callable (done, total), "
                         f"got {type(progress).__name__}")
     return max_steps, steps, cvodes_options, Progress(progress)
+
+
+def _sane(model: Model, t: np.ndarray, run: Run, control, p: np.ndarray, method: str):
+    """``(run, status)`` of a finished fixed-step run: ``VIOLATED`` with the reason and the
+    remedy in its message when its invariants are grossly off (`sanity.violation`)."""
+    bad = violation(model, t, run.x, lambda: _zero_grid(t, model.nu) if control is None
+                    else control.grid(t), p, method)
+    if not bad:
+        return run, OK
+    return (Run.new(run.x, run.n_steps, run.n_rhs, run.substeps, run.compiled, True,
+                    f"{run.message}; not a solution: {bad}; {remedy(method)}"), VIOLATED)
 
 
 def _zero_grid(t: np.ndarray, nu: int) -> np.ndarray:

@@ -13,11 +13,13 @@ from .adaptive import run_pass
 from .cpass import BMAX, CHECK_EVERY, NOISE
 from .cvodes import run_cvodes
 from .estimates import (_AUTO_ACCEPT, _EPS, _FLOOR_ULPS, _carried, _floor, _initial_step,
-                        _perturbed, _roundoff, _scaled_diff, _screen, _spectrum)
+                        _perturbed, _roundoff, _scaled_diff, _screen, _spectrum, tightened)
 from .evaluate import map_eval
 from .inputs import Problem
 from .loops import Progress, run_fixed
-from .result import FAILED, OK, OK_STIFF, ROUNDOFF, UNVERIFIED, Run
+from .result import FAILED, NONSMOOTH, OK, OK_STIFF, ROUNDOFF, UNVERIFIED, Run
+from .smoothness import nonsmooth_operations
+from .stepcontrol import LOCAL_RTOL_MIN, solve_stepped
 from .tableaux import DOP853
 
 __all__ = ["solve_auto"]
@@ -33,6 +35,7 @@ _PASS_THETA = 1.0      # the check run's embedded estimates over the horizon, in
 _PASS_TRIES = 3        # passes (each aimed tighter) before the multi-run search
 _PASS_ULPS = 10 ** 4   # the one-pass path needs the tolerance this many ulps above the state
 _PASS_MEASURED = 10 ** 6  # and below this many it measures the model's rounding (`_floor`)
+_ORDER_LOSS = 100.0    # differences this many times the modelled round-off: not round-off
 
 
 @dataclass(frozen=True)
@@ -43,6 +46,7 @@ class _Estimate:
     accept: bool       # the tolerance is met
     next_m: int        # substeps per interval to try next (0: stop, round-off floor)
     trusted: bool = False  # the runs were seen in the asymptotic range
+    order_lost: bool = False  # stopped with differences far above the modelled round-off
 
 
 def _estimate(runs: dict, rtol, atol, asymptotic: bool) -> _Estimate:
@@ -125,7 +129,9 @@ def _estimate(runs: dict, rtol, atol, asymptotic: bool) -> _Estimate:
         # asymptotic range, not a round-off floor)
         # more steps no longer shrink the differences (truncation alone would shrink them
         # (c/b)^8 >= 6x): the measured round-off floor; stop
-        return _Estimate(d_bc + e_c, False, 0, trusted)
+        # (far above the modelled round-off, which is pessimistic, it is the order that
+        # is lost: a kink or a jump of the right-hand side, see `auto_runs`)
+        return _Estimate(d_bc + e_c, False, 0, trusted, d_bc > _ORDER_LOSS * rho)
     if len(finite) >= 3 and max(d_ab, d_bc) <= 4 * rho and 2 * max(d_ab, d_bc) + rho <= \
             _AUTO_ACCEPT:
         # three step counts agree to the modelled round-off: the truncation error of the
@@ -151,6 +157,8 @@ class Single:
 
     def __init__(self, problem: Problem):
         self.problem, self.t, self.x0 = problem, problem.t, problem.x0
+        #: why the right-hand side may be non-smooth (`nonsmooth_causes`); () if smooth
+        self.nonsmooth = nonsmooth_causes(problem)
 
     def run(self, x0: np.ndarray, m: int, jit: bool, progress) -> Run:
         """``m`` rk8 steps per output interval from ``x0``."""
@@ -177,8 +185,11 @@ def auto_runs(target, rtol, atol, max_steps, jit_pref, progress: Progress):
 
     Returns ``(run or None, estimate, status, reason, total_steps, total_rhs)``: ``None`` and
     reason ``"stiff"`` hand the problem to `_auto_cvodes`. ``status`` is ``OK``,
-    ``ROUNDOFF`` (the tolerance lies below the round-off floor) or ``UNVERIFIED`` (not
-    within ``max_steps`` or the run budget); the best run found is returned with them.
+    ``ROUNDOFF`` (the tolerance lies below the round-off floor), ``NONSMOOTH`` (a
+    right-hand side that may be non-smooth, ``target.nonsmooth``, whose runs stopped
+    converging far above the modelled round-off, or did not settle: the order is lost at
+    kinks) or ``UNVERIFIED`` (not within ``max_steps`` or the run budget); the best run
+    found is returned with them.
     """
     t = target.t
     nint = t.size - 1
@@ -234,12 +245,14 @@ def auto_runs(target, rtol, atol, max_steps, jit_pref, progress: Progress):
                 return best, est.value + floor, ROUNDOFF, "", *total
             return best, est.value, OK, "", *total
         if est.next_m == 0:
-            return (runs[max(k for k, r in runs.items() if r.ok)], est.value, ROUNDOFF, "",
-                    *total)
+            lost = est.order_lost and target.nonsmooth
+            return (runs[max(k for k, r in runs.items() if r.ok)], est.value,
+                    NONSMOOTH if lost else ROUNDOFF, "", *total)
         m = est.next_m
     finite = [k for k, r in runs.items() if r.ok]
     best = runs[max(finite)] if finite else (runs[max(runs)] if runs else None)
-    return best, est.value, UNVERIFIED, reason, *total
+    settled = not (target.nonsmooth and reason.startswith("the error estimates did not"))
+    return best, est.value, UNVERIFIED if settled else NONSMOOTH, reason, *total
 
 
 def _first_bad(x: np.ndarray) -> int:
@@ -255,28 +268,15 @@ def _auto_jit(jit_pref) -> bool:
 
 
 def _auto_cvodes(problem: Problem, rtol, atol, extra):
-    """cvodes for a stiff problem, with its global error estimated: runs at local tolerances
-    ``tol / 10, tol / 1000, ...`` until two successive runs agree within the tolerance; the
-    tighter run is returned with their scaled difference as its (conservative) error
-    estimate. Returns ``(run, estimate, status, n_steps, n_rhs)``."""
-    total = [0, 0]
-    prev, estimate = None, math.inf
-    factor = 0.1
-    while True:
-        r, a = rtol * factor, atol * factor
-        run = run_cvodes(problem, max(r, _CVODES_RTOL_MIN), a, extra)
-        total[0] += run.n_steps
-        total[1] += run.n_rhs
-        if not run.ok:
-            return run, math.nan, FAILED, *total
-        if prev is not None:
-            scale = atol[:, None] + rtol * np.abs(run.x[:, 1:])
-            estimate = _scaled_diff(prev.x[:, 1:], run.x[:, 1:], scale)
-            if estimate <= 1.0:
-                return run, estimate, OK_STIFF, *total
-        if r <= _CVODES_RTOL_MIN:
-            return run, estimate, UNVERIFIED, *total
-        prev, factor = run, factor * 1e-2
+    """cvodes for a stiff problem, with its global error estimated (`estimates.tightened`):
+    runs at local tolerances ``tol / 10, tol / 1000, ...`` until two successive runs agree
+    within the tolerance; the tighter run is returned with their scaled difference as its
+    (conservative) error estimate. Returns ``(run, estimate, status, n_steps, n_rhs)``."""
+    run, verdict, estimate, n_steps, n_rhs = tightened(
+        lambda r, a: run_cvodes(problem, r, a, extra), rtol, atol, 0.1, 1e-2,
+        _CVODES_RTOL_MIN)
+    status = {"met": OK_STIFF, "tightest": UNVERIFIED, "failed": FAILED}[verdict]
+    return run, estimate, status, n_steps, n_rhs
 
 
 def one_pass(problem: Problem, rtol, atol, max_steps, jit_pref, progress):
@@ -381,11 +381,76 @@ def _size_over_tolerance(problem: Problem, rtol: float, atol: np.ndarray) -> flo
                default=0.0)
 
 
+def nonsmooth_causes(problem: Problem) -> tuple[str, ...]:
+    """Why ``problem``'s right-hand side may be non-smooth: the non-smooth operations of
+    the model (`smoothness.nonsmooth_operations`), and ``"callable u"`` for a control
+    that is a Python callable (it may jump); ``()`` when it is smooth."""
+    found = nonsmooth_operations(problem.model.f)
+    return found + (("callable u",) if problem.control.mode == "stages" else ())
+
+
+def _nonsmooth_remedy(causes, cause: str = "") -> str:
+    """The words of status ``NONSMOOTH``: the causes found, ``cause`` (what else is known)
+    and the remedy."""
+    return (f"non-smooth right-hand side ({', '.join(causes)}): order loss at kinks"
+            f"{', ' + cause if cause else ''}; remedy: a looser tolerance, a smooth law (e.g. "
+            "tanh instead of a saturation), output times on the switching times, or a "
+            "control given as samples (hold='zoh')")
+
+
+def _auto_stepped(problem: Problem, rtol, atol, max_steps, jit, progress, causes):
+    """``auto`` for a non-smooth right-hand side (`stepcontrol`): ``(run, method, status,
+    estimate)``, or None to leave it to the general path (no compiled stepper for a
+    sampled control, or a stiff problem, which goes to cvodes). A callable control steps
+    from Python (`stepcontrol.run_stepped_callable`)."""
+    if problem.control.mode == "linear" and not _auto_jit(jit):
+        return None
+    lipschitz, sigma = Single(problem).spectrum(rtol, atol)
+    horizon = float(problem.t[-1] - problem.t[0])
+    if horizon * sigma / _RK8_STABILITY > _STIFF_STEPS:
+        return None
+    run, verdict, estimate, n_steps, n_rhs = solve_stepped(problem, rtol, atol, max_steps,
+                                                           progress)
+    if verdict is None:
+        return None
+    head = f"auto: non-smooth right-hand side ({', '.join(causes)})"
+    if verdict == "met":
+        message = (f"{head}: DOP853 with step rejection, its steps crowded at the kinks "
+                   f"({run.message}); estimated error {estimate:.2g} of tolerance, from a "
+                   "run at a 100x looser local tolerance and steps at least twice as long")
+        status = OK
+    elif verdict == "tightest":
+        message = (f"auto: tolerance not verified: {_nonsmooth_remedy(causes)} (DOP853 with "
+                   f"step rejection down to local rtol {LOCAL_RTOL_MIN:g}: runs still differ by "
+                   f"{estimate:.2g} of tolerance; {run.message}); x is the best solution found")
+        status = NONSMOOTH
+    elif "max_steps" in run.message:  # (x: NaN from the stop on, as auto's other paths)
+        message = (f"auto: tolerance not verified: {run.message} ({head}); raise max_steps "
+                   "or loosen the tolerance")
+        return (Run(run.x, n_steps, n_rhs, 0, run.compiled, True, message), "dop853",
+                UNVERIFIED, estimate)
+    else:
+        message, status = f"{head}: {run.message}", FAILED
+    return (Run(run.x, n_steps, n_rhs, 0, run.compiled, run.ok, message), "dop853", status,
+            estimate)
+
+
 def solve_auto(problem: Problem, rtol, atol, max_steps, jit, cvodes_options, progress):
-    """``auto``: -> (run, method used, status, error estimate); counters cover every run."""
-    run, estimate, spent = one_pass(problem, rtol, atol, max_steps, jit, progress)
-    if run is not None:
-        return run, "rk8", OK, estimate
+    """``auto``: -> (run, method used, status, error estimate); counters cover every run.
+
+    A right-hand side with kinks (`nonsmooth_causes`) goes to DOP853 with step rejection
+    (`_auto_stepped`), which does not assume the method's order; a smooth one to the
+    one-pass path, then the multi-run Richardson search (`auto_runs`)."""
+    causes = nonsmooth_causes(problem)
+    spent = 0
+    if causes:
+        got = _auto_stepped(problem, rtol, atol, max_steps, jit, progress, causes)
+        if got is not None:
+            return got
+    else:
+        run, estimate, spent = one_pass(problem, rtol, atol, max_steps, jit, progress)
+        if run is not None:
+            return run, "rk8", OK, estimate
     run, estimate, status, reason, n_steps, n_rhs = auto_runs(Single(problem), rtol, atol,
                                                           max_steps - spent, jit, progress)
     n_steps, n_rhs = n_steps + spent, n_rhs + DOP853.stages * spent
@@ -411,6 +476,12 @@ def solve_auto(problem: Problem, rtol, atol, max_steps, jit, cvodes_options, pro
     if status == ROUNDOFF:
         message = ("auto: tolerance not verified: it lies at the round-off floor of fixed-step "
                    f"runs on this grid ({run.message}; estimated error incl. modelled round-off "
+                   f"{estimate:.2g} of tolerance); x is the best solution found")
+    elif status == NONSMOOTH:
+        message = (f"auto: tolerance not verified: "
+                   f"{_nonsmooth_remedy(Single(problem).nonsmooth, 'not round-off')}"
+                   f" (rk8 runs of different step counts do not converge at order 8"
+                   f"{': ' + reason if reason else ''}; {run.message}; estimated error "
                    f"{estimate:.2g} of tolerance); x is the best solution found")
     elif status == UNVERIFIED:
         message = (f"auto: tolerance not verified: {reason} ({run.message}; estimated error "

@@ -28,9 +28,12 @@ from .batch_fixed import BATCH_THREADS, fixed_batch, fixed_message, run_fixed_ba
 from .cvodes import run_cvodes
 from .estimates import jacobian_x, rho_sigma
 from .evaluate import map_eval
-from .inputs import Control, Problem
+from .inputs import HOLDS, Control, Problem
 from .loops import Progress
-from .result import FAILED, OK, OK_STIFF, ROUNDOFF, UNVERIFIED, Dense, Run, SimulationResult
+from .result import (FAILED, OK, OK_STIFF, ROUNDOFF, UNVERIFIED, VIOLATED, Dense,
+                     Run, SimulationResult)
+from .smoothness import nonsmooth_operations
+from .sanity import remedy, violations
 
 __all__ = ["Batch", "BatchResult", "check_batch", "simulate_batch", "BATCH_THREADS"]
 
@@ -39,7 +42,8 @@ class Batch:
     """K runs on one grid: ``x0 (nx, K)``, ``p (np, K)``, controls ``ua, ub (K, nint, nu)``
     (the values at the start and end of each output interval, linear in between);
     ``constant`` when each run's control is known to be one value throughout (``False``
-    leaves it to be found from the values)."""
+    leaves it to be found from the values); ``tail (K, nu)`` the samples at ``t[-1]`` of a
+    zero-order hold (``ub = ua``), else None."""
 
     model: Model
     x0: np.ndarray
@@ -48,6 +52,7 @@ class Batch:
     ua: np.ndarray
     ub: np.ndarray
     constant: bool = False
+    tail: np.ndarray | None = None  # (K, nu): the samples at t[-1] of a zero-order hold
 
     @property
     def K(self) -> int:
@@ -60,12 +65,17 @@ class Batch:
     def problem(self, k: int) -> Problem:
         """Run ``k`` as a single-run `Problem`."""
         return Problem(self.model, self.x0[:, k].copy(), self.t,
-                       Control("linear", self.ua[k], self.ub[k]), self.p[:, k].copy())
+                       Control("linear", self.ua[k], self.ub[k],
+                               tail=None if self.tail is None else self.tail[k]),
+                       self.p[:, k].copy())
 
 
-def check_batch(model: Model, x0, t: np.ndarray, u, p) -> Batch:
+def check_batch(model: Model, x0, t: np.ndarray, u, p, hold: str = "linear") -> Batch:
     """The batch of ``x0 (nx, K)`` with ``p`` ``(np,)`` or ``(np, K)`` and ``u`` None,
-    ``(nu,)``, ``(nu, n)`` (shared) or ``(nu, n, K)`` (per run); raises naming the argument."""
+    ``(nu,)``, ``(nu, n)`` (shared) or ``(nu, n, K)`` (per run), samples held as ``hold``
+    says (`dynamics.integrate.inputs.HOLDS`); raises naming the argument."""
+    if hold not in HOLDS:
+        raise ValueError(f"`hold` must be one of {HOLDS}, got {hold!r}")
     nx, nu, n = model.nx, model.nu, t.size
     X0 = np.array(finite_array(x0, "x0"), dtype=float)
     if X0.ndim != 2 or X0.shape[0] != nx or X0.shape[1] < 1:
@@ -104,8 +114,10 @@ def check_batch(model: Model, x0, t: np.ndarray, u, p) -> Batch:
     else:
         raise ValueError(f"`u` must be None, ({nu},), ({nu}, {n}) or ({nu}, {n}, {K}) for "
                          f"a batch of {K} runs, got {a.shape}")
-    return Batch(model, X0, t, P, np.ascontiguousarray(U[:, :-1]), np.ascontiguousarray(U[:, 1:]),
-                 a.shape == (nu,))
+    ua = np.ascontiguousarray(U[:, :-1])
+    if hold == "zoh" and a.shape != (nu,):
+        return Batch(model, X0, t, P, ua, ua, False, np.array(U[:, -1]))
+    return Batch(model, X0, t, P, ua, np.ascontiguousarray(U[:, 1:]), a.shape == (nu,))
 
 
 class BatchTarget:
@@ -114,6 +126,7 @@ class BatchTarget:
 
     def __init__(self, batch: Batch):
         self.batch, self.t, self.runs = batch, batch.t, batch.K
+        self.nonsmooth = nonsmooth_operations(batch.model.f)  # (as `Single.nonsmooth`)
         self.x0 = np.ascontiguousarray(batch.x0.T).reshape(-1)
 
     def _unstack(self, flat: np.ndarray) -> np.ndarray:
@@ -154,6 +167,7 @@ def simulate_batch(batch: Batch, method: str, steps: int, rtol: float, atol: np.
                                                progress=progress)
         status = np.where(ok, OK, FAILED)
         used, message = method, fixed_message(method, steps, n_steps, ok)
+        status, message = _sane(batch, x, ok, status, message, method)
     elif method == "cvodes":
         runs = [run_cvodes(batch.problem(k), rtol, atol, cvodes_options) for k in range(K)]
         x = np.stack([r.x for r in runs], axis=2)
@@ -164,18 +178,24 @@ def simulate_batch(batch: Batch, method: str, steps: int, rtol: float, atol: np.
             "" if ok.all() else f"; {int((~ok).sum())} failed: {runs[int(np.argmin(ok))].message}")
     else:
         target = BatchTarget(batch)
-        run, value, st, reason, n_steps, _ = auto_runs(target, rtol, np.tile(atol, K), max_steps,
-                                                   jit, progress)
-        if run is None and reason.startswith("stiff"):  # as a single run: auto's cvodes, per run
+        if target.nonsmooth:  # each run with its own step control (`stepcontrol`)
+            run, st, reason = None, 0, "non-smooth"
+        else:
+            run, value, st, reason, n_steps, _ = auto_runs(target, rtol, np.tile(atol, K),
+                                                       max_steps, jit, progress)
+        if run is None and reason.startswith(("stiff", "non-smooth")):
+            # as single runs: auto's cvodes, or its step control, per run
             outs = [solve_auto(batch.problem(k), rtol, atol, max_steps, jit, cvodes_options,
                                progress) for k in range(K)]
             x = np.stack([o[0].x for o in outs], axis=2)
             ok = np.array([o[0].ok for o in outs])
             status = np.array([o[2] if o[0].ok else FAILED for o in outs])
             estimate[:] = [o[3] for o in outs]
-            used, compiled = "cvodes", False
+            used = ", ".join(sorted({o[1] for o in outs}))
+            compiled = all(o[0].compiled for o in outs)
             n_steps = max(o[0].n_steps for o in outs)
-            message = f"auto, run by run ({K} runs): {outs[int(np.argmax(status != OK_STIFF))][0].message}"
+            worst = int(np.argmax(~np.isin(status, (OK, OK_STIFF))))
+            message = f"auto, run by run ({K} runs): {outs[worst][0].message}"
         elif run is None:  # too many steps: no rk8 run was made
             x = np.full((nx, batch.t.size, K), np.nan)
             x[:, 0] = batch.x0
@@ -199,6 +219,24 @@ def simulate_batch(batch: Batch, method: str, steps: int, rtol: float, atol: np.
                        error_estimate=estimate, compiled=bool(compiled), _batch=batch)
 
 
+def _sane(batch: Batch, x: np.ndarray, ok: np.ndarray, status: np.ndarray, message: str,
+          method: str):
+    """``(status, message)`` of a fixed-step batch with its finished runs checked by
+    `sanity.violations`: ``VIOLATED`` for runs whose invariants are grossly off."""
+    good = np.flatnonzero(ok)
+    if good.size == 0:
+        return status, message
+    U = lambda: np.concatenate([batch.ua[good], batch.ub[good, -1:]], axis=1).transpose(2, 1, 0)
+    found = violations(batch.model, batch.t, x[:, :, good], U, batch.p[:, good], method)
+    bad = [(int(k), why) for k, why in zip(good, found) if why]
+    if not bad:
+        return status, message
+    status = status.copy()
+    status[[k for k, _ in bad]] = VIOLATED
+    return status, (f"{message}; {len(bad)} run(s) not a solution (run {bad[0][0]}: "
+                    f"{bad[0][1]}); {remedy(method)}")
+
+
 @dataclass(frozen=True)
 class BatchResult:
     """What `simulate` returns for a batch of K runs (``x0`` of shape ``(nx, K)``).
@@ -213,7 +251,8 @@ class BatchResult:
         the tolerance.
     status : ndarray of int, shape (K,)
         `SimulationResult`'s codes per run (0 ok, 1 ok with cvodes, 2 round-off floor,
-        3 not verified, -1 failed).
+        3 not verified, 4 a fixed-step run whose invariants are grossly violated,
+        5 not verified on a non-smooth right-hand side, -1 failed).
     message : str
     method : str
         The method used.
@@ -260,4 +299,5 @@ class BatchResult:
             message=self.message, method=self.method, wall_time=self.wall_time,
             n_steps=self.n_steps, n_rhs=0, substeps=0, error_estimate=float(self.error_estimate[k]),
             compiled=self.compiled, invariants=MappingProxyType({}),
-            _dense=Dense(b.model, problem.p, lambda: problem.control.grid(problem.t)))
+            _dense=Dense(b.model, problem.p, lambda: problem.control.grid(problem.t),
+                         problem.control.left_grid(problem.t)))

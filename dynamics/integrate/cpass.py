@@ -1,6 +1,8 @@
 """The compiled pass of `dynamics.integrate.adaptive`: its C source (`_DRIVER`, a plain loop
-around the casadi-generated rk8 steps and right-hand side of a model) and its build
-(`pass_library`: compiled once per model for this machine, loaded with ``ctypes``)."""
+around the casadi-generated rk8 steps and right-hand side of a model), the step-controlled
+DOP853 of `dynamics.integrate.stepcontrol` (`_STEPPER`, in the same library) and their
+build (`pass_library`: compiled once per model for this machine, loaded with ``ctypes``;
+the stepper is the attribute ``stepper`` of the returned function)."""
 from __future__ import annotations
 
 import ctypes
@@ -216,6 +218,75 @@ int rk8_pass_ws(casadi_real* ws, const long long* off, int done, int k, casadi_r
 """
 
 
+# The stepper of `dynamics.integrate.stepcontrol`: DOP853 (the same generated step with its
+# embedded estimate) with classical step-size control and step rejection over the output
+# intervals, every interval ending exactly on its output time (kinks of a non-smooth
+# right-hand side shrink the steps that straddle them, as they should).
+_STEPPER = r"""
+/* Steps of x (in/out) over `nint` output intervals of lengths H, no step of interval k
+   longer than hmax[k]; controls ua + tau ud on interval k (stride `ustride`); `hio`
+   (in/out) the controller's proposed step; outputs in X (nx, ldx) from column 0 and the
+   longest accepted step of each interval in `hbig`. `count` (in/out): accepted steps, rejected
+   steps, flag (1: a non-finite state, 2: step-size underflow, 3: more than max_steps
+   steps), smallest accepted step. Returns the intervals done (fewer when the flag is set).
+   Hairer's DOP853 controller (`stepcontrol.next_step`): safety 0.9, the step changed by a
+   factor in [1/3, 6], no growth right after a rejection; a step cut short (by the output
+   time or hmax) says nothing against the proposal. */
+int rk8_adaptive(casadi_real* x, casadi_real* hio, int nint, const casadi_real* H,
+                 const casadi_real* hmax, const casadi_real* ua, const casadi_real* ud,
+                 int ustride, const casadi_real* p, casadi_real rtol, const casadi_real* atol,
+                 casadi_real max_steps, casadi_real* X, int ldx, casadi_real* hbig,
+                 casadi_real* count) {
+  pass_ctx c;
+  const casadi_real* arg[PASS_NARG + 7];
+  casadi_real* res[PASS_NRES + 2];
+  casadi_real xn[PASS_NX], u[PASS_U], h = *hio, hp, hs, tau, err, fac, Hk;
+  int k, i, last, rejected, finite;
+  c.p = p; c.atol = atol; c.rtol = rtol;
+  arg[0] = x; arg[1] = &hs; arg[2] = u; arg[4] = p; arg[5] = &c.rtol; arg[6] = atol;
+  res[0] = xn; res[1] = &err;
+  for (k = 0; k < nint; ++k) {
+    Hk = H[k];
+    arg[3] = ud + k * ustride;
+    tau = 0;
+    rejected = 0;
+    hbig[k] = 0;
+    while (tau < Hk) {
+      hp = fmin(h, hmax[k]);
+      last = tau + 1.01 * hp >= Hk;
+      hs = last ? Hk - tau : hp;
+      for (i = 0; i < PASS_NU; ++i) u[i] = ua[k * ustride + i] + tau * ud[k * ustride + i];
+      rk8_step_err(arg, res, c.iw, c.w, 0);
+      finite = isfinite(err);
+      for (i = 0; i < PASS_NX && finite; ++i) finite = isfinite(xn[i]);
+      fac = finite ? pow(err, 0.125) / 0.9 : 3.0;
+      if (finite && err <= 1.0) {
+        for (i = 0; i < PASS_NX; ++i) x[i] = xn[i];
+        tau = last ? Hk : tau + hs;
+        count[0] += 1;
+        if (hs > hbig[k]) hbig[k] = hs;
+        if (hs < count[3]) count[3] = hs;
+        fac = fmax(1.0 / 6.0, fmin(3.0, fac));
+        fac = rejected ? fmin(hs, hs / fac) : hs / fac;
+        h = hs < h && fac < h ? h : fac;
+        rejected = 0;
+      } else {
+        count[1] += 1;
+        h = hs / fmin(3.0, fac);
+        rejected = 1;
+      }
+      if (count[0] + count[1] > max_steps) { count[2] = 3; break; }
+      if (!(h > 64 * DBL_EPSILON * Hk)) { count[2] = finite ? 2 : 1; break; }
+    }
+    if (count[2]) break;
+    for (i = 0; i < PASS_NX; ++i) X[i * ldx + k] = x[i];
+  }
+  *hio = h;
+  return k;
+}
+"""
+
+
 def pass_library(model: Model) -> object | None:
     """The compiled pass of ``model`` (a ``ctypes`` function, cached); None without a C
     compiler or when the model cannot be code-generated (the pass is worth it only as C)."""
@@ -229,13 +300,14 @@ def pass_library(model: Model) -> object | None:
         # auto's multi-run search (the fallback) runs the rk8 chunk loop: compiled now, at
         # the same time (a later call with this model then compiles nothing)
         chunk = chunk_compile_job(model, "rk8", "linear")
-        jobs = [(steps, _DRIVER % sizes, _OPTS[0], ctypes.CDLL)] + ([chunk[0]] if chunk else [])
+        source = _DRIVER % sizes + _STEPPER
+        jobs = [(steps, source, _OPTS[0], ctypes.CDLL)] + ([chunk[0]] if chunk else [])
         lib, *rest = cache.compile_parallel(jobs)
         if chunk:
             chunk[1](rest[0])
         if isinstance(lib, RuntimeError):  # (e.g. a compiler without -march=native)
             try:
-                lib = cache.compile_c(steps, _DRIVER % sizes, _OPTS[1], ctypes.CDLL)
+                lib = cache.compile_c(steps, source, _OPTS[1], ctypes.CDLL)
             except RuntimeError:
                 return None
         if lib is None:
@@ -245,6 +317,12 @@ def pass_library(model: Model) -> object | None:
         fun.argtypes = [ptr, ptr, i32, i32, ptr, ptr]
         fun.restype = i32
         fun.library = lib  # (kept alive with the function)
+        stepper = lib.rk8_adaptive
+        f64 = ctypes.c_double
+        stepper.argtypes = [ptr, ptr, i32, ptr, ptr, ptr, ptr, i32, ptr, f64, ptr, f64, ptr,
+                            i32, ptr, ptr]
+        stepper.restype = i32
+        fun.stepper = stepper  # (`dynamics.integrate.stepcontrol`)
         return fun
 
     return cache.get(("rk8_pass", cache.function_key(model.f)), build, keepalive=model.f)

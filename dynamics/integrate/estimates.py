@@ -15,7 +15,7 @@ from .evaluate import call_buffered
 from .inputs import Problem
 from .result import Run
 
-__all__ = ["jacobian_x", "rho_sigma"]
+__all__ = ["jacobian_x", "rho_sigma", "tightened"]
 
 _EPS = np.finfo(float).eps
 _AUTO_ACCEPT = 0.5     # accept a trusted estimate (truncation + round-off) below this
@@ -29,6 +29,41 @@ def _scaled_diff(xa: np.ndarray, xb: np.ndarray, scale: np.ndarray) -> float:
     diff = np.abs(xa - xb)
     ratio = np.divide(diff, scale, out=np.where(diff == 0, 0.0, np.inf), where=scale > 0)
     return float(ratio.max())
+
+
+def tightened(run_at, rtol: float, atol: np.ndarray, first: float, ratio: float,
+              tightest: float):
+    """A global error estimate for a method with *local* error control (cvodes, DOP853 with
+    step rejection): runs ``run_at(local_rtol, local_atol) -> Run`` at the local tolerances
+    ``(rtol, atol) * f`` for ``f = first, first * ratio, ...`` (``local_rtol`` at least
+    ``tightest``) until two successive runs differ by at most the tolerance ``atol + rtol
+    |x|`` at the output times (scaled max). The tighter run is taken with that difference
+    as its error estimate: conservative whenever it is at least twice as accurate as the
+    other (a ``1 / ratio``-fold tighter local tolerance).
+
+    Returns ``(run, verdict, estimate, n_steps, n_rhs)``: ``verdict`` ``"met"``;
+    ``"tightest"`` (not met at ``tightest``: the last run); ``"failed"`` (a run failed:
+    it is returned); ``None`` when ``run_at`` returned None (no such run can be made).
+    """
+    total = [0, 0]
+    prev, estimate, factor = None, math.inf, first
+    while True:
+        local = rtol * factor
+        run = run_at(max(local, tightest), atol * factor)
+        if run is None:
+            return None, None, math.nan, *total
+        total[0] += run.n_steps
+        total[1] += run.n_rhs
+        if not run.ok:
+            return run, "failed", math.nan, *total
+        if prev is not None:
+            scale = atol[:, None] + rtol * np.abs(run.x[:, 1:])
+            estimate = _scaled_diff(prev.x[:, 1:], run.x[:, 1:], scale)
+            if estimate <= 1.0:
+                return run, "met", estimate, *total
+        if local <= tightest:
+            return run, "tightest", estimate, *total
+        prev, factor = run, factor * ratio
 
 
 def _roundoff(x: np.ndarray, n_steps: int, scale: np.ndarray) -> float:

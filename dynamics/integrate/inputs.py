@@ -18,7 +18,7 @@ from .. import cache
 from ..model import Model
 from ..validate import QUAT_NORM_TOL, check_unit_quaternion, finite_array, finite_scalar
 
-__all__ = ["Control", "Problem", "check_t", "check_x0", "check_tolerances",
+__all__ = ["HOLDS", "Control", "Problem", "check_t", "check_x0", "check_tolerances",
            "check_u", "check_invariants", "check_cvodes_options"]
 
 _EPS = np.finfo(float).eps
@@ -183,9 +183,11 @@ class Control:
     """The control input, normalized.
 
     ``mode == "linear"``: ``ua[k], ub[k]`` (shape (nint, nu)) are the values at the start and
-    end of interval ``k``; ``constant`` when known to be one value throughout (``False``
-    leaves it to be found from the values). ``mode == "stages"``: ``fun(t) -> (nu,)`` is
-    called at stage times.
+    end of interval ``k``, linear in between (a zero-order hold has ``ub = ua``);
+    ``constant`` when known to be one value throughout (``False`` leaves it to be found from
+    the values); ``tail (nu,)`` the sample at ``t[-1]`` when it is not ``ub[-1]`` (a
+    zero-order hold: the value held after the grid). ``mode == "stages"``: ``fun(t) ->
+    (nu,)`` is called at stage times.
     """
 
     mode: str
@@ -193,6 +195,7 @@ class Control:
     ub: np.ndarray | None = None
     fun: Callable | None = None
     constant: bool = False
+    tail: np.ndarray | None = None
 
     def at(self, t: float, k: int, tk: float, H: float) -> np.ndarray:
         if self.mode == "stages":
@@ -200,16 +203,29 @@ class Control:
         return self.ua[k] + (t - tk) / H * (self.ub[k] - self.ua[k])
 
     def grid(self, t: np.ndarray) -> np.ndarray:
-        """Control on the output grid, shape (nu, n)."""
+        """Control on the output grid, shape (nu, n) (at a jump of a zero-order hold: the
+        value from the grid time on)."""
         if self.mode == "stages":
             return np.stack([self.fun(ti) for ti in t], axis=1)
-        return np.concatenate([self.ua, self.ub[-1:]], axis=0).T
+        last = self.ub[-1:] if self.tail is None else self.tail[None, :]
+        return np.concatenate([self.ua, last], axis=0).T
+
+    def left_grid(self, t: np.ndarray) -> np.ndarray | None:
+        """The control's left limits on the output grid, shape (nu, n) (the first column:
+        the value at ``t[0]``), where they differ from `grid` (a zero-order hold); else
+        None."""
+        if self.tail is None:
+            return None
+        return np.concatenate([self.ua[:1], self.ub], axis=0).T
 
     def head(self, nint: int) -> "Control":
         """The control of the first ``nint`` intervals."""
         if self.mode == "stages":
             return self
-        return Control("linear", self.ua[:nint], self.ub[:nint], constant=self.constant)
+        tail = None if self.tail is None else (
+            self.ua[nint] if nint < self.ua.shape[0] else self.tail)
+        return Control("linear", self.ua[:nint], self.ub[:nint], constant=self.constant,
+                       tail=tail)
 
     def cvodes_input(self, t: np.ndarray) -> np.ndarray:
         """Piecewise-constant integrator input ``[u_k, slope_k, t_k]``, shape (nint, 2 nu + 1)."""
@@ -219,12 +235,24 @@ class Control:
         return np.concatenate([self.ua, slope, t[:-1, None]], axis=1)
 
 
-def check_u(u, nu: int, t: np.ndarray) -> Control:
+#: How sampled controls are interpolated between samples: linearly, or held (zero order).
+HOLDS = ("linear", "zoh")
+
+
+def check_u(u, nu: int, t: np.ndarray, hold: str = "linear") -> Control:
+    """``u`` (see `dynamics.simulate`) as a `Control` on the grid ``t``; ``hold`` how
+    samples ``(nu, n)`` are interpolated: ``"linear"``, or ``"zoh"`` (``u[:, k]`` on
+    ``[t_k, t_{k+1})``). Raises naming ``u`` or ``hold``."""
+    if hold not in HOLDS:
+        raise ValueError(f"`hold` must be one of {HOLDS}, got {hold!r}")
     n = t.size
     if u is None:
         z = np.zeros((n - 1, nu))
-        return _new(Control, mode="linear", ua=z, ub=z, fun=None, constant=True)
+        return _new(Control, mode="linear", ua=z, ub=z, fun=None, constant=True, tail=None)
     if callable(u):
+        if hold != "linear":
+            raise ValueError(f"`hold={hold!r}` applies to samples `u` of shape ({nu}, {n}); "
+                             "a callable `u` is evaluated where the integrator needs it")
         fun = _checked_callable(u, nu)
         fun(float(t[0]))  # raises ValueError naming `u` on a wrong shape
         if nu == 0:
@@ -245,8 +273,10 @@ def check_u(u, nu: int, t: np.ndarray) -> Control:
     if a.shape == (nu, n):
         if not np.all(np.isfinite(a)):
             raise ValueError("`u` must be finite")
-        return Control("linear", np.ascontiguousarray(a[:, :-1].T),
-                       np.ascontiguousarray(a[:, 1:].T))
+        ua = np.ascontiguousarray(a[:, :-1].T)
+        if hold == "zoh":
+            return Control("linear", ua, ua, tail=a[:, -1].copy())
+        return Control("linear", ua, np.ascontiguousarray(a[:, 1:].T))
     raise ValueError(
         f"`u` must be None, a constant of shape ({nu},), samples of shape ({nu}, {n}) on `t`, "
         f"or a callable of t returning shape ({nu},); got shape {a.shape}"
@@ -262,7 +292,8 @@ def _checked_callable(fun, nu: int):
                 f"got {value.shape} at t = {t}"
             )
         value = value.reshape(nu)
-        if not np.all(np.isfinite(value)):
+        # (a finite sum: every value is finite, the common case at a third of the cost)
+        if not math.isfinite(value.sum()) and not np.all(np.isfinite(value)):
             raise ValueError(f"`u` returned a non-finite value {value.tolist()} at t = {t}")
         return value
 

@@ -16,27 +16,31 @@ from ..serialize import text_table, to_json
 from .evaluate import map_eval
 
 __all__ = ["SimulationResult", "make_result", "new_result", "Dense", "Run", "OK", "OK_STIFF", "ROUNDOFF",
-           "UNVERIFIED", "FAILED", "TERMINAL_EVENT"]
+           "UNVERIFIED", "VIOLATED", "NONSMOOTH", "FAILED", "TERMINAL_EVENT"]
 
 # status codes of SimulationResult (documented in its docstring)
-OK, OK_STIFF, ROUNDOFF, UNVERIFIED, FAILED = 0, 1, 2, 3, -1
-TERMINAL_EVENT = 4  # a terminal event stopped the solution (`simulate(events=...)`)
+OK, OK_STIFF, ROUNDOFF, UNVERIFIED, VIOLATED, NONSMOOTH, FAILED = 0, 1, 2, 3, 4, 5, -1
+TERMINAL_EVENT = 6  # a terminal event stopped the solution (`simulate(events=...)`)
 
 
 class Dense:
     """What `SimulationResult.sample` needs: the model, ``p`` and ``u`` on the grid; caches xdot.
 
     ``u_grid`` is the control on the output grid, shape (nu, n), or a callable returning it
-    (evaluated on first use). Pickling stores the evaluated array, never the callable, and
+    (evaluated on first use); ``u_left`` its left limits there, shape (nu, n), when they
+    differ (a zero-order hold jumps at the grid times): the dense output then takes the
+    derivative at an interval's end from them. Pickling stores the evaluated array, never the callable, and
     leaves the lock out (a new one is made on load).
     """
 
     def __init__(self, model: Model, p: np.ndarray,
-                 u_grid: Callable[[], np.ndarray] | np.ndarray):
+                 u_grid: Callable[[], np.ndarray] | np.ndarray, u_left: np.ndarray | None = None):
         self._model, self._p = model, p
         self._u_grid = u_grid if callable(u_grid) else None
         self._u = None if callable(u_grid) else np.asarray(u_grid, dtype=float)
+        self._u_left = u_left  # (nu, n) left limits of a control that jumps on the grid
         self._xdot = None
+        self._xdot_left = None
         self._drift = None
         self._lock = threading.Lock()
 
@@ -65,15 +69,28 @@ class Dense:
                 self._xdot = xdot
             return self._xdot
 
+    def xdot_left(self, x: np.ndarray) -> np.ndarray:
+        """The state derivative's left limits at the grid times (`xdot` where the control
+        does not jump)."""
+        if self._u_left is None:
+            return self.xdot(x)
+        with self._lock:
+            if self._xdot_left is None:
+                xdot = map_eval(self._model.f, [x, self._u_left, self._p])
+                xdot.setflags(write=False)
+                self._xdot_left = xdot
+            return self._xdot_left
+
     def __getstate__(self) -> dict:
         with self._lock:
             return {"model": self._model, "p": self._p, "u": self._controls(),
-                    "xdot": self._xdot,
+                    "u_left": self._u_left, "xdot": self._xdot,
                     "drift": None if self._drift is None else dict(self._drift)}
 
     def __setstate__(self, state: dict) -> None:
         self._model, self._p = state["model"], state["p"]
         self._u_grid, self._u = None, state["u"]
+        self._u_left, self._xdot_left = state.get("u_left"), None
         self._xdot = state["xdot"]
         if self._xdot is not None:
             self._xdot.setflags(write=False)
@@ -95,23 +112,34 @@ class SimulationResult:
         did not reach are NaN.
     success : bool
         True only when the answer was verified against what was asked: ``auto`` met the
-        tolerance by its global error estimate (status 0 or 1); a fixed-step method or
-        ``cvodes`` reached ``t[-1]`` with finite states (they take no global tolerance; see
-        ``invariant_drift`` for a check of a fixed-step run).
+        tolerance by its global error estimate (status 0 or 1); a fixed-step method reached
+        ``t[-1]`` with finite states that keep the model's invariants sane (status 4
+        otherwise), ``cvodes`` with finite states (they take no global tolerance; see
+        ``invariant_drift`` for a measure of a fixed-step run's accuracy).
     status : int
         ``0`` success (``auto``: the estimated global error of the rk8 run is within
         tolerance); ``1`` success of ``auto`` on a stiff problem through cvodes, its global
         error estimated from runs at tightened local tolerances; ``2`` not verified: the
         tolerance lies below the round-off floor of fixed-step runs on this grid (more steps
         no longer reduce the differences between runs); ``3`` not verified: ``max_steps``
-        or the run budget was reached first; ``-1`` failure (integrator error, or a
-        non-finite state); ``4`` success, stopped by a terminal event (``events``): ``t``
-        ends at the event time. With 2 and 3 ``x`` is the finest run made and
+        or the run budget was reached first; ``4`` a fixed-step run (``rk4``, ``rk8``,
+        ``lie``) whose invariants are grossly violated at an output time: the attitude
+        quaternion's norm off 1 by more than 1e-3, or an invariant the flow conserves along
+        the run (energy or momentum of a torque-free body) changed by more than its own size
+        (`dynamics.integrate.sanity`; an ``rk4``/``rk8`` run of a model with an attitude
+        is checked by the quaternion's norm, which those methods do not keep): the step is too large for the motion, ``x`` is not a
+        solution (remedy: more ``steps`` or ``method='auto'``); ``5`` not verified: the
+        right-hand side is non-smooth (kinks or jumps: ``fmin``/``fmax``/``if_else`` in the
+        model, or a callable control) and the runs lost their order there, so the
+        tolerance could not be verified (not a round-off floor; the message gives the
+        remedy); ``6`` success, stopped by a terminal event (``events``): ``t`` ends at
+        the event time; ``-1`` failure (integrator error, or a non-finite state). With 2 and 3 ``x`` is the finest run made and
         ``error_estimate`` says how far off it is thought to be.
     message : str
         What happened, in words.
     method : str
-        The method that produced ``x`` (``auto`` reports ``rk8`` or ``cvodes``).
+        The method that produced ``x`` (``auto`` reports ``rk8``, ``cvodes``, or
+        ``dop853`` for DOP853 with step rejection on a non-smooth right-hand side).
     wall_time : float [s]
         Time spent in `simulate`, validation and any compilation included.
     n_steps, n_rhs : int
@@ -119,10 +147,11 @@ class SimulationResult:
         (``auto`` makes several).
     substeps : int
         Fixed-step methods: steps per output interval of the returned solution (``auto``'s
-        one-pass path: the most in any interval); 0 for cvodes.
+        one-pass path: the most in any interval); 0 for cvodes and ``dop853``.
     error_estimate : float
-        ``auto`` with a fixed-step result: estimated max over states and output times of
-        ``|error| / (atol + rtol |x|)`` (1.0 is exactly the tolerance); NaN otherwise.
+        ``auto``: estimated max over states and output times of ``|error| / (atol + rtol
+        |x|)`` (1.0 is exactly the tolerance), for every path (rk8, cvodes on a stiff
+        problem, dop853 on a non-smooth one); NaN for the other methods.
     compiled : bool
         Whether the loop that produced ``x`` ran as jit-compiled C.
     invariants : mapping of str to ndarray
@@ -308,7 +337,8 @@ class SimulationResult:
                 f"`t` must lie within the simulated interval [{self.t[0]}, {self.t[-1]}], "
                 f"got [{tq.min()}, {tq.max()}]"
             )
-        out = _hermite(self.t, self.x, self.xdot, tq)
+        left = self.xdot if self._dense is None else self._dense.xdot_left(self.x)
+        out = _hermite(self.t, self.x, self.xdot, left, tq)
         return out[:, 0] if scalar else out
 
 
@@ -340,14 +370,16 @@ def new_result(t, x, success, status, message, method, wall_time, n_steps, n_rhs
     return result
 
 
-def _hermite(t, x, xdot, tq):
+def _hermite(t, x, xdot, xdot_left, tq):
+    """Cubic Hermite interpolation at ``tq``: on interval ``i`` from ``x``, ``xdot`` at its
+    start and ``x``, ``xdot_left`` at its end."""
     i = np.clip(np.searchsorted(t, tq, side="right") - 1, 0, t.size - 2)
     dt = t[i + 1] - t[i]
     s = (tq - t[i]) / dt
     s2, s3 = s * s, s * s * s
     h00, h10, h01, h11 = 2 * s3 - 3 * s2 + 1, s3 - 2 * s2 + s, 3 * s2 - 2 * s3, s3 - s2
     return (h00 * x[:, i] + h10 * dt * xdot[:, i] + h01 * x[:, i + 1]
-            + h11 * dt * xdot[:, i + 1])
+            + h11 * dt * xdot_left[:, i + 1])
 
 
 @dataclass(frozen=True)

@@ -157,6 +157,63 @@ def test_fixed_step_instability_shows_as_invariant_drift():
     assert good.success
 
 
+# ------------------------------------- issue 27 item 3: a fixed-step blow-up is no success
+def test_fixed_step_blow_up_is_not_a_success():
+    """rk4, one step of 500 s on a tumbling body: the quaternion's norm reaches ~1e38
+    (it must be 1); the run is status 4 with the remedy, and a resolved run of the same
+    method stays a success that matches the Jacobi-elliptic solution."""
+    model = rigid_body([1.0, 2.0, 3.0])
+    x0 = np.array([0.0, 0.0, 0.0, 1.0, 1.0, 2.0, 3.0])
+    bad = simulate(model, x0, [0.0, 500.0], method="rk4", steps=1)
+    assert abs(np.linalg.norm(bad.x[:4, -1]) - 1.0) > 1.0  # (the premise: a gross violation)
+    assert not bad.success and bad.status == 4, bad.message
+    assert "quaternion" in bad.message and "`steps`" in bad.message and "auto" in bad.message
+    t = np.linspace(0.0, 20.0, 201)
+    good = simulate(model, x0, t, method="rk4", steps=20)
+    assert good.success and good.status == 0, good.message
+    assert np.max(np.abs(good.x[4:] - torque_free_omega([1.0, 2.0, 3.0], x0[4:], t))) < 1e-4
+
+
+def test_lie_blow_up_is_caught_by_the_conserved_energy():
+    """The Lie-group step keeps |q| = 1 exactly, so only the energy (conserved by the
+    torque-free flow) shows one step of 500 s to be no solution."""
+    model = rigid_body([1.0, 2.0, 3.0])
+    bad = simulate(model, [0.0, 0.0, 0.0, 1.0, 1.0, 2.0, 3.0], [0.0, 500.0], method="lie")
+    assert abs(np.linalg.norm(bad.x[:4, -1]) - 1.0) < 1e-12
+    assert bad.invariant_drift["energy"] > 1.0  # (the premise)
+    assert not bad.success and bad.status == 4 and "'energy'" in bad.message, bad.message
+
+
+def _oscillator():
+    """``y'' = -y + u`` with its energy ``(y^2 + v^2) / 2`` (conserved only for u = 0)."""
+    y, v, u = ca.SX.sym("y"), ca.SX.sym("v"), ca.SX.sym("u")
+    return Model.from_expressions([("y", y), ("v", v)], [v, -y + u], [("u", u)],
+                                  invariants={"energy": 0.5 * (y * y + v * v)})
+
+
+def test_fixed_step_energy_check_only_where_the_flow_conserves_it():
+    """rk4 with h = 3 on y'' = -y (|amplification| > 1 for h > 2.83): energy grows ~1e10
+    over 20 steps, status 4; with a control u the energy is not conserved and not checked
+    (a driven oscillator may gain energy), so the same run is no violation."""
+    model = _oscillator()
+    t = np.linspace(0.0, 60.0, 21)
+    bad = simulate(model, [1.0, 0.0], t, method="rk4")
+    assert bad.invariant_drift["energy"] > 1e3  # (the premise: closed form keeps it at 0.5)
+    assert not bad.success and bad.status == 4 and "'energy'" in bad.message, bad.message
+    driven = simulate(model, [1.0, 0.0], t, u=[0.5], method="rk4")
+    assert driven.success and driven.status == 0, driven.message
+    good = simulate(model, [1.0, 0.0], t, method="rk4", steps=100)
+    assert good.success and np.max(np.abs(good.x[0] - np.cos(t))) < 1e-6
+
+
+def test_fixed_step_batch_flags_only_the_runs_that_blew_up():
+    model = rigid_body([1.0, 2.0, 3.0])
+    x0 = np.array([[0.0, 0.0, 0.0, 1.0, 1.0, 2.0, 3.0], [0.0, 0.0, 0.0, 1.0, 1e-5, 2e-5, 3e-5]]).T
+    res = simulate(model, x0, [0.0, 500.0], method="rk4")
+    assert list(res.success) == [False, True] and list(res.status) == [4, 0], res.message
+    assert "run 0" in res.message and "quaternion" in res.message
+
+
 def test_non_finite_fixed_step_run_is_a_failure():
     res = simulate(rigid_body([1.0, 2.0, 3.0]), X0, np.linspace(0.0, 1e4, 3), method="rk8")
     assert not res.success and res.status == -1 and "non-finite" in res.message

@@ -249,13 +249,16 @@ def test_sweep_unknown_parameter_lists_the_valid_ones(case, args, valid, capsys)
 
 # ------------------------------------------------------- 7. torque-free truth check
 def test_diverged_fixed_step_run_fails_the_truth_check(capsys):
+    """One rk4 step of 1000 s: simulate itself says the run is not a solution (status 4:
+    the quaternion's norm ~1e34), the truth check fails as well."""
     code = main([*TF, "--w0", "1,0.1,0.8", "--method", "rk4", "--t-final", "1000",
                  "--points", "2"])
     assert code == 1
     captured = capsys.readouterr()
     assert "truth check FAILED" in captured.out and "success                        False" \
         in captured.out
-    assert captured.err.count("\n") == 1 and "truth check FAILED" in captured.err
+    assert captured.err.count("\n") == 1 and "not a solution" in captured.err
+    assert "quaternion" in captured.err and "`steps`" in captured.err
 
 
 def test_fixed_step_passes_with_enough_steps(capsys):

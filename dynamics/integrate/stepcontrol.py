@@ -1,0 +1,240 @@
+"""``auto`` for a non-smooth right-hand side: DOP853 with local error control and step
+rejection, its global error estimated from runs at tightened local tolerances.
+
+A kink of the right-hand side (``fmin``/``fmax`` of a saturation, an ``if_else``; found by
+`dynamics.integrate.smoothness`) costs an 8th-order method its order on the step that
+straddles it, so the Richardson estimates of `dynamics.integrate.auto` (which assume order
+8 on every interval) neither converge nor mean anything there. A step-size controller needs
+no order: the embedded estimate of a step across a kink is large, the step is rejected and
+shrunk until its local error meets the tolerance, so the steps crowd at each kink and stay
+long elsewhere (the kinks are localized to the precision the tolerance asks for).
+
+The *global* error at the output times is then estimated as for auto's stiff path: runs at
+local tolerances ``tol * f``, ``tol * f / 100``, ... (`_TIGHTEN`) until two successive runs
+differ by at most the tolerance; the tighter run is returned with that difference as its
+error estimate. Each run also takes no step longer than half the longest step of the run
+before in the same output interval: where the output grid, not the tolerance, limits the
+steps, the tighter tolerance alone would repeat the same steps. The estimate is
+conservative: a run at a 100x tighter local tolerance with steps at most half as long is
+many times more accurate (error proportional to the local tolerance to the power 7/8 for
+DOP853 on a smooth stretch, 2^8-fold smaller for halved steps, at least proportional where
+a kink limits the step), so the difference bounds the tighter run's error with a wide
+margin. The runs are plain compiled C (`cpass._STEPPER`, in the model's compiled pass
+library, no extra compile); a callable control steps from Python with the same controller
+(`next_step`).
+
+Measured: a reaction-wheel slew under a saturated PD law (60 s, 121 outputs, rtol 1e-6)
+verifies in 7357 steps, about 16 ms; error 2e-3 of the tolerance against scipy's DOP853 at
+rtol 1e-13. A bang-bang callable torque: 4725 steps, about 0.7 s.
+"""
+from __future__ import annotations
+
+import contextlib
+import math
+
+import casadi as ca
+import numpy as np
+
+from .. import cache
+from ..interrupts import check_interrupt, deferred_interrupts
+from .adaptive import INTERVALS
+from .cpass import pass_library
+from .estimates import _initial_step, tightened
+from .evaluate import call_buffered
+from .inputs import Problem
+from .kernels import kernel
+from .loops import Progress
+from .result import Run
+from .tableaux import DOP853, unique_nodes
+
+__all__ = ["LOCAL_RTOL_MIN", "next_step", "run_stepped", "run_stepped_callable",
+           "solve_stepped"]
+
+_EPS = float(np.finfo(float).eps)
+
+_FIRST = 0.1      # the first run's local tolerance, relative to the requested one
+_TIGHTEN = 1e-2   # the local tolerance of each further run, relative to the one before
+#: Tightest local rtol of a run (below it the runs meet the states' rounding).
+LOCAL_RTOL_MIN = 1e-14
+_REASONS = ("", "a state became non-finite", "the step size underflowed",
+            "more than max_steps steps")
+
+
+def run_stepped(problem: Problem, rtol: float, atol: np.ndarray, max_steps: int,
+                progress=None, hmax: np.ndarray | None = None):
+    """One DOP853 run with step rejection at the local tolerances ``rtol``, ``atol``
+    (linear control), no step of output interval ``k`` longer than ``hmax[k]`` [s]
+    (default: the interval). Returns ``(run, longest)``, ``longest (nint,)`` [s] the longest
+    accepted step of each interval; None without the model's compiled library
+    (`cpass.pass_library`).
+    The run's message gives the steps, rejections and the smallest step."""
+    lib = pass_library(problem.model)
+    if lib is None or problem.control.mode != "linear":
+        return None
+    stepper = lib.stepper
+    model, t = problem.model, problem.t
+    nx, nu, nint = model.nx, model.nu, problem.nint
+    ctrl = problem.control
+    H = np.ascontiguousarray(t[1:] - t[:-1])
+    hmax = H if hmax is None else np.ascontiguousarray(hmax, dtype=float)
+    ua = np.ascontiguousarray(ctrl.ua, dtype=float).reshape(nint, nu)
+    ud = np.ascontiguousarray((ctrl.ub - ctrl.ua) / H[:, None], dtype=float).reshape(nint, nu)
+    x = np.array(problem.x0, dtype=float)
+    p = np.ascontiguousarray(problem.p, dtype=float)
+    at = np.ascontiguousarray(atol, dtype=float)
+    h = np.array([_first_step(problem, rtol, atol)])
+    X = np.full((nx, nint + 1), np.nan)
+    X[:, 0] = x
+    out = X[:, 1:].copy()  # (nx, nint), row stride nint
+    longest = np.zeros(nint)
+    count = np.array([0.0, 0.0, 0.0, math.inf])
+    addr = lambda a, off=0: a.ctypes.data + 8 * off  # noqa: E731
+    progress = Progress(None) if progress is None else progress
+    done = 0
+    with deferred_interrupts() if nint > INTERVALS else contextlib.nullcontext():
+        while done < nint and not count[2]:
+            check_interrupt()
+            k = min(INTERVALS, nint - done)
+            before = count[0] + count[1]
+            done += stepper(addr(x), addr(h), k, addr(H, done), addr(hmax, done),
+                            addr(ua, done * nu), addr(ud, done * nu), nu, addr(p), rtol,
+                            addr(at), float(max_steps), addr(out, done), nint,
+                            addr(longest, done), addr(count))
+            progress.start(int(count[0] + count[1] - before))
+            progress.advance(int(count[0] + count[1] - before))
+    X[:, 1:done + 1] = out[:, :done]
+    return _stepped_run(X, t, count, done, rtol, True), longest
+
+
+def _first_step(problem: Problem, rtol: float, atol: np.ndarray) -> float:
+    """The first step proposed [s]: Hairer's heuristic (`estimates._initial_step`), or a
+    hundredth of the first interval where it is degenerate."""
+    h0 = _initial_step(problem, rtol, atol, 8)[0]
+    return h0 if h0 is not None and h0 > 0 else float(problem.t[1] - problem.t[0]) / 100.0
+
+
+def _stepped_run(X: np.ndarray, t: np.ndarray, count, done: int, rtol: float,
+                 compiled: bool) -> Run:
+    """The `Run` of a stepped run from its counters ``(accepted, rejected, flag, smallest
+    step)`` and the intervals ``done``."""
+    steps, rejects = int(count[0]), int(count[1])
+    n_rhs = DOP853.stages * (steps + rejects)
+    if count[2]:
+        return Run.new(X, steps + rejects, n_rhs, 0, compiled, False,
+                       f"dop853: {_REASONS[int(count[2])]} before "
+                       f"t = {t[min(done + 1, t.size - 1)]:.6g}")
+    return Run.new(X, steps + rejects, n_rhs, 0, compiled, True,
+                   f"dop853 with step rejection: {steps} steps, {rejects} rejected, smallest "
+                   f"step {count[3]:.3g} s (local rtol {rtol:.3g})")
+
+
+#: The step-size controller of `cpass._STEPPER` (Hairer's DOP853): safety, and the least
+#: and most factor of a step change.
+_SAFETY, _SHRINK, _GROW = 0.9, 1.0 / 3.0, 6.0
+
+
+def next_step(h: float, err: float, rejected: bool) -> tuple[bool, float]:
+    """The controller of `cpass._STEPPER` in Python: whether a step ``h`` with embedded
+    estimate ``err`` (tolerance units) is accepted, and the next step (no growth right after
+    a rejection; a non-finite ``err`` is a rejection by the largest factor)."""
+    if not math.isfinite(err):
+        return False, h * _SHRINK
+    fac = err ** 0.125 / _SAFETY
+    if err <= 1.0:
+        new = h / max(1.0 / _GROW, min(1.0 / _SHRINK, fac))
+        return True, min(h, new) if rejected else new
+    return False, h / min(1.0 / _SHRINK, fac)
+
+
+def _callable_step(model) -> ca.Function:
+    """``(x, h, us, p, rtol, atol) -> [x_next; err]``: one rk8 step with DOP853's estimate,
+    the control given at the distinct stage nodes (cached per model)."""
+    def build():
+        step = kernel(model, "rk8", "stages", error=True)
+        sym = ca.SX if step.is_a("SXFunction") else ca.MX
+        ins = [sym.sym(step.name_in(i), step.sparsity_in(i)) for i in range(step.n_in())]
+        x_next, err = step.call(ins)
+        return ca.Function("rk8_step_err_stages", ins, [ca.vertcat(x_next, err)])
+
+    return cache.get(("rk8_step_err_stages", cache.function_key(model.f)), build,
+                     keepalive=model.f)
+
+
+def run_stepped_callable(problem: Problem, rtol: float, atol: np.ndarray, max_steps: int,
+                         progress=None, hmax: np.ndarray | None = None):
+    """`run_stepped` for a callable control (``problem.control.mode == 'stages'``): the same
+    controller (`next_step`) stepping from Python, the control called at each step's stage
+    times (a jump of the control shrinks the steps that straddle it, as a kink does)."""
+    model, t, fun = problem.model, problem.t, problem.control.fun
+    nx, nint = model.nx, problem.nint
+    H = t[1:] - t[:-1]
+    hmax = H if hmax is None else hmax
+    nodes = np.array(unique_nodes("rk8"))
+    step = _callable_step(model)
+    X = np.full((nx, t.size), np.nan)
+    X[:, 0] = problem.x0
+    x = np.array(problem.x0, dtype=float)
+    h = _first_step(problem, rtol, atol)
+    longest = np.zeros(nint)
+    count = [0, 0, 0, math.inf]  # as `cpass._STEPPER`'s
+    rt = np.array([rtol])
+    progress = Progress(None) if progress is None else progress
+    for k in range(nint):
+        check_interrupt()
+        before = count[0] + count[1]
+        tk, Hk, tau, rejected = float(t[k]), float(H[k]), 0.0, False
+        while tau < Hk:
+            hp = min(h, float(hmax[k]))
+            last = tau + 1.01 * hp >= Hk
+            hs = Hk - tau if last else hp
+            us = np.concatenate([fun(tk + tau + c * hs) for c in nodes])
+            out = call_buffered(step, [x, np.array([hs]), us, problem.p, rt, atol], (nx + 1,))
+            err = float(out[nx]) if np.isfinite(out[:nx]).all() else math.nan
+            ok, hn = next_step(hs, err, rejected)
+            if ok:
+                x[:] = out[:nx]
+                tau = Hk if last else tau + hs
+                count[0] += 1
+                longest[k] = max(longest[k], hs)
+                count[3] = min(count[3], hs)
+                h = h if hs < h and hn < h else hn
+            else:
+                count[1] += 1
+                h = hn
+            rejected = not ok
+            if count[0] + count[1] > max_steps:
+                count[2] = 3
+            elif not h > 64 * _EPS * Hk:
+                count[2] = 2 if math.isfinite(err) else 1
+            if count[2]:
+                return _stepped_run(X, t, count, k, rtol, False), longest
+        X[:, k + 1] = x
+        progress.start(count[0] + count[1] - before)
+        progress.advance(count[0] + count[1] - before)
+    return _stepped_run(X, t, count, nint, rtol, False), longest
+
+
+def solve_stepped(problem: Problem, rtol: float, atol: np.ndarray, max_steps: int,
+                  progress=None):
+    """Step-controlled runs at local tolerances ``rtol * _FIRST``, then ``_TIGHTEN`` times
+    tighter each, until two successive runs differ by at most the tolerance
+    (`estimates.tightened`). No step of a run is longer than half the longest step of the
+    one before in the same output interval: where the grid, not the tolerance, limits the
+    steps (a smooth stretch), a tighter tolerance alone would repeat the same steps and
+    their difference would tell nothing. Returns ``(run, verdict, estimate, n_steps, n_rhs)`` as `tightened`
+    does (``verdict`` None: no compiled stepper for this model or control)."""
+    stepped = run_stepped_callable if problem.control.mode == "stages" else run_stepped
+    H = problem.t[1:] - problem.t[:-1]
+    state = {"spent": 0, "hmax": H}
+
+    def run_at(local_rtol, local_atol):
+        got = stepped(problem, local_rtol, local_atol, max_steps - state["spent"], progress,
+                      state["hmax"])
+        if got is None:
+            return None
+        run, longest = got
+        state["spent"] += run.n_steps
+        state["hmax"] = np.where(longest > 0, longest, H) / 2.0
+        return run
+
+    return tightened(run_at, rtol, atol, _FIRST, _TIGHTEN, LOCAL_RTOL_MIN)
