@@ -123,7 +123,7 @@ def simulate(model: Model, x0, t, *, u=None, p=None, hold: Hold = "linear", meth
         detected on which steps), with scipy's attributes ``terminal`` (bool or number of
         occurrences) and ``direction``; `dynamics.Event` gives them to a Function. Results
         in ``t_events`` and ``x_events``; a terminal event ends ``t`` at the event (status
-        4). Single runs only (not with ``x0`` of shape (nx, K)).
+        6). Single runs only (not with ``x0`` of shape (nx, K)).
 
     Returns
     -------
