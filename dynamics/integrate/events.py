@@ -66,6 +66,7 @@ from .evaluate import call_buffered, map_eval
 from .inputs import Control, Problem
 from .loops import run_fixed
 from .result import FAILED, OK, OK_STIFF, TERMINAL_EVENT, Dense, SimulationResult, make_result
+from .stepcontrol import LOCAL_RTOL_MIN, run_stepped, run_stepped_callable
 from .tableaux import TABLEAUX
 
 __all__ = ["Event", "EventSpec", "SUBGRID", "scan_times", "check_events", "controls_at",
@@ -74,6 +75,13 @@ __all__ = ["Event", "EventSpec", "SUBGRID", "scan_times", "check_events", "contr
 #: Most scan points per output interval of ``auto`` and ``cvodes`` (fixed-step methods are
 #: scanned at every step).
 SUBGRID = 64
+
+#: Local tolerances of the event scan of ``auto``'s step-controlled runs (non-smooth
+#: right-hand sides), relative to the asked ones: those of its second run (`stepcontrol`:
+#: ``_FIRST * _TIGHTEN``), the tighter of the two that verify the least-refined answers.
+_STEPPED_TIGHTEN = 1e-3
+#: Most steps of one such run (a hop or a block of the scan).
+_STEPPED_MAX = 10_000_000
 
 #: Internal points per block of the scan (bounds the memory of a long run's scan; a
 #: terminal event ends the scan at its block).
@@ -259,14 +267,17 @@ def _values(spec: EventSpec, ts: np.ndarray, X: np.ndarray, U: np.ndarray,
     return np.array([_value(spec, float(ts[j]), X[:, j], U[:, j], p) for j in range(ts.size)])
 
 
-def controls_at(control: Control | None, t: np.ndarray, ts: np.ndarray, nu: int) -> np.ndarray:
+def controls_at(control: Control | None, t: np.ndarray, ts: np.ndarray, nu: int,
+                side: str = "right") -> np.ndarray:
     """The control of `simulate` (``None``: zero) at the times ``ts (N,)`` within the grid
-    ``t``: shape (nu, N), linear between samples or the callable's values."""
+    ``t``: shape (nu, N), linear between samples (or held: ``hold='zoh'``) or the callable's
+    values. At a grid time, ``side='right'`` gives the value from that time on, ``'left'``
+    the limit from before (they differ where a held control jumps)."""
     if control is None:
         return np.zeros((nu, ts.size))
     if control.mode == "stages":
         return np.stack([control.fun(float(tj)) for tj in ts], axis=1).reshape(nu, ts.size)
-    k = np.clip(np.searchsorted(t, ts, side="right") - 1, 0, t.size - 2)
+    k = np.clip(np.searchsorted(t, ts, side=side) - 1, 0, t.size - 2)
     w = ((ts - t[k]) / (t[k + 1] - t[k]))[:, None]
     return (control.ua[k] + w * (control.ub[k] - control.ua[k])).T
 
@@ -318,10 +329,10 @@ class _FixedSteps:
 def on_grid(problem: Problem, ts: np.ndarray, x0: np.ndarray) -> Problem:
     """``problem`` from ``x0`` on the grid ``ts`` (increasing, within ``problem.t``), with
     the same control (samples: the same piecewise-linear function, sampled on ``ts``)."""
-    ctrl = problem.control
-    if ctrl.mode == "linear":
-        U = controls_at(ctrl, problem.t, ts, problem.model.nu).T
-        ctrl = Control("linear", U[:-1], U[1:], constant=ctrl.constant)
+    ctrl, t, nu = problem.control, problem.t, problem.model.nu
+    if ctrl.mode == "linear":  # each piece from the value at its start to the limit at its end
+        ctrl = Control("linear", controls_at(ctrl, t, ts[:-1], nu).T,
+                       controls_at(ctrl, t, ts[1:], nu, side="left").T, constant=ctrl.constant)
     return Problem.new(problem.model, x0, ts, ctrl, problem.p)
 
 
@@ -406,6 +417,39 @@ class _CvodesSteps:
         return out
 
 
+class _SteppedSteps:
+    """The solution of ``auto``'s step-controlled DOP853 (a non-smooth right-hand side,
+    `dynamics.integrate.stepcontrol`) between the output points: ``sub`` scan points per
+    output interval (one DOP853 run with step rejection over a block of them from the answer
+    at its start), and from any point such a run to any later time, both at the local
+    tolerances ``rtol``, ``atol`` (tighter than those of the answer's runs)."""
+
+    def __init__(self, problem: Problem, rtol, atol, sub: int):
+        self.problem, self.sub, self.per_interval = problem, sub, sub
+        self.rtol, self.atol = rtol, atol
+        self.n_steps = self.n_rhs = 0
+        self.stepped = run_stepped_callable if problem.control.mode == "stages" else run_stepped
+
+    def _run(self, problem: Problem) -> np.ndarray:
+        got = self.stepped(problem, self.rtol, self.atol, _STEPPED_MAX)
+        run = got[0]
+        self.n_steps += run.n_steps
+        self.n_rhs += run.n_rhs
+        return run.x  # NaN from a failure on
+
+    def points(self, i0: int, i1: int, x: np.ndarray, carry: np.ndarray):
+        """As `_FixedSteps.points`, for ``i0`` an output point."""
+        ts, outputs = scan_times(self.problem.t, self.sub, i0, i1)
+        if self.sub == 1:
+            return ts, x[:, i0:i1 + 1]
+        X = self._run(on_grid(self.problem, ts, x[:, i0 // self.sub]))
+        return ts, _with_outputs(X, x, i0, self.sub, outputs)
+
+    def hop(self, xa: np.ndarray, ta: float, tb: float) -> np.ndarray:
+        """The state at ``tb`` from ``(ta, xa)`` (NaN when the run fails)."""
+        return self._run(on_grid(self.problem, np.array([ta, tb]), xa))[:, 1]
+
+
 def _scaled_integrator(model: Model, opts: dict, callback=None):
     """cvodes on ``dx/ds = h f(x, u(ta + s h), p)`` from ``s = 0`` to 1; its ``p`` is
     ``[p, ta, h]`` and, for a linear control, the control at the interval's start ``ua``,
@@ -435,6 +479,11 @@ def _stepper(result: SimulationResult, problem: Problem, method: str, rtol, atol
             rtol, atol = max(rtol * _AUTO_CVODES_TIGHTEN, 100 * _EPS), atol * _AUTO_CVODES_TIGHTEN
         sub = min(SUBGRID, max(1, math.ceil(result.n_steps / nint)))
         return _CvodesSteps(problem, rtol, atol, extra, sub)
+    if result.method == "dop853":  # auto on a non-smooth right-hand side
+        steps_per = math.ceil(result.n_steps / nint)
+        return _SteppedSteps(problem, max(rtol * _STEPPED_TIGHTEN, LOCAL_RTOL_MIN),
+                             atol * _STEPPED_TIGHTEN,
+                             min(SUBGRID, max(1, steps_per)))
     m = max(1, result.substeps)
     if method != "auto":
         return _FixedSteps(problem, result.method, m, 1, jit)  # every step

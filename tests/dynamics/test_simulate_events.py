@@ -335,3 +335,29 @@ def test_bad_events_are_refused_naming_the_argument():
         Event(height, direction="up")
     with pytest.raises(ValueError, match="`events` are located for single runs only"):
         simulate(oscillator(), np.ones((2, 3)), [0.0, 1.0], events=height)
+
+
+@pytest.mark.parametrize("method, kwargs", [("auto", {}), ("rk8", {"steps": 4}),
+                                            ("cvodes", {"rtol": 1e-12, "atol": 1e-12})])
+def test_event_under_a_held_control(method, kwargs):
+    # y'' = u held (zoh) at 1, -1, 1 on [0, 1), [1, 2), [2, 3): y = 1/2 + s - s^2 / 2 on
+    # [1, 2] (s = t - 1) reaches 0.995 at s = 0.9, in the last scan piece before the jump at
+    # t = 2 (a piece that must hold -1 to its end, not ramp to the next sample)
+    t = np.array([0.0, 1.0, 2.0, 3.0])
+    u = np.array([[1.0, -1.0, 1.0, 0.0]])
+    near_top = Event(lambda t, x, u, p: x[0] - 0.995, terminal=True)
+    res = simulate(driven(), [0.0, 0.0], t, u=u, hold="zoh", method=method, events=near_top,
+                   **kwargs)
+    tol = 1e-9 if method == "cvodes" else TOL
+    assert res.status == TERMINAL_EVENT and abs(res.t[-1] - 1.9) < tol
+
+
+def test_event_on_a_non_smooth_right_hand_side():
+    # y'' = -sat(4 y, 1) from y = 2: |4y| >= 1 for y >= 1/4, so y = 2 - t^2 / 2 until y = 1/4
+    # at t = sqrt(7/2); auto integrates the kink (fmin/fmax) by DOP853 with step rejection
+    y = X_SYM[0]
+    model = _model("saturated", ca.vertcat(X_SYM[1], -ca.fmin(ca.fmax(4 * y, -1), 1)))
+    quarter = Event(lambda t, x, u, p: x[0] - 0.25, terminal=True, direction=-1)
+    res = simulate(model, [2.0, 0.0], np.linspace(0.0, 4.0, 3), events=quarter)
+    assert res.method == "dop853"
+    assert res.status == TERMINAL_EVENT and abs(res.t[-1] - np.sqrt(3.5)) < TOL
