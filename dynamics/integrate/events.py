@@ -124,7 +124,7 @@ class Event:
     >>> ground = Event(ca.Function("ground", [t, x, u, p], [x[0]]), terminal=True, direction=-1)
     >>> res = simulate(fall, [10.0, 0.0], np.linspace(0.0, 5.0, 6), events=ground)
     >>> res.status, bool(abs(res.t[-1] - np.sqrt(2 * 10.0 / 9.81)) < 1e-12)
-    (4, True)
+    (6, True)
     """
 
     def __init__(self, fun, terminal: bool | int = False, direction: float = 0.0,
