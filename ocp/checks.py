@@ -36,7 +36,8 @@ import numpy as np
 
 from .propagation import SCALE_FLOOR
 
-__all__ = ["BoundViolation", "bound_grid", "bound_scale", "bound_violation", "periodic_jumps",
+__all__ = ["BoundViolation", "bound_grid", "bound_scale", "bound_violation",
+           "interval_bound_violation", "periodic_jumps",
            "resimulation_mismatch", "BOUND_SAMPLES", "DEFAULT_VERIFY_TOL",
            "DEFAULT_VERIFY_TOL_LOW_ORDER", "default_verify_tol",
            "STATUS_BOUND_VIOLATION", "STATUS_RESIMULATION", "check_verify_tol"]
@@ -121,8 +122,13 @@ class BoundViolation:
             return "within bounds"
         kind = "control" if self.name in controls else "state"
         text = (f"the dense {kind} `{self.name}` leaves its bounds [{self.lower:g}, {self.upper:g}] "
-                f"at t = {self.time:.6g} s: {self.value:.6g} ({self.max:.3g} in units of its "
+                f"at t = {self.time:.6g} s: {self.value:.10g} ({self.max:.3g} in units of its "
                 f"scale {self.scale:g})")
+        if kind == "control" and self.max < 1e-3:
+            return text + ("; a small overshoot of the interpolant through nodes that IPOPT's "
+                           "interior point keeps a hair inside the bound next to a switch: "
+                           "tighten IPOPT's tol (ipopt_options={'tol': 1e-10}) or solve with "
+                           "transcription='radau' and control='constant' or 'linear'")
         if kind == "control":
             return text + ("; the control interpolant overshoots between the nodes (bang-bang or "
                            "singular arc): solve with transcription='radau' and control='linear' or "
@@ -159,15 +165,12 @@ def bound_scale(bounds: np.ndarray, nodes: np.ndarray) -> np.ndarray:
     return np.maximum(np.maximum(b, np.where(np.isfinite(v), v, 0.0)), SCALE_FLOOR)
 
 
-def bound_violation(dense, problem, x_nodes: np.ndarray, u_nodes: np.ndarray) -> BoundViolation:
-    """The `BoundViolation` of the dense output ``dense`` of a solution of ``problem`` on
-    `bound_grid` (``x_nodes``, ``u_nodes``: the solution's ``x`` and ``u``, for the scales)."""
-    model = problem.model
-    names = tuple(model.states) + tuple(model.controls)
+def _excess(dense, problem, x_nodes, u_nodes):
+    """``(bounds (2, n), scale (n,), k, s, values (n, M), excess (n, M))`` of the states and
+    controls on `bound_grid`, or ``None`` without finite bounds."""
     bounds = np.concatenate([problem.x_bounds, problem.u_bounds], axis=1)
-    finite = np.any(np.isfinite(bounds), axis=0)
-    if not np.any(finite) or dense.N == 0:
-        return BoundViolation()
+    if not np.any(np.isfinite(bounds)) or dense.N == 0:
+        return None
     k, s = bound_grid(dense)
     x, u = dense.eval(k, s)
     values = np.concatenate([x, u], axis=0)
@@ -175,6 +178,33 @@ def bound_violation(dense, problem, x_nodes: np.ndarray, u_nodes: np.ndarray) ->
     lo, hi = bounds[0][:, None], bounds[1][:, None]
     excess = np.maximum(np.maximum(lo - values, values - hi), 0.0) / scale[:, None]
     excess[~np.isfinite(values)] = np.inf
+    return bounds, scale, k, s, values, excess
+
+
+def interval_bound_violation(solution) -> np.ndarray:
+    """Largest scaled bound violation of ``solution``'s dense output in each mesh interval
+    (`bound_violation` per interval), shape (N,) [-]: where `ocp.refine` splits a mesh
+    whose dense output leaves a bound."""
+    d = solution.dense
+    out = _excess(d, solution.problem, solution.x, solution.u)
+    if out is None:
+        return np.zeros(d.N)
+    k, excess = out[2], out[5]
+    per = np.zeros(d.N)
+    np.maximum.at(per, k, np.max(excess, axis=0))
+    return per
+
+
+def bound_violation(dense, problem, x_nodes: np.ndarray, u_nodes: np.ndarray) -> BoundViolation:
+    """The `BoundViolation` of the dense output ``dense`` of a solution of ``problem`` on
+    `bound_grid` (``x_nodes``, ``u_nodes``: the solution's ``x`` and ``u``, for the scales)."""
+    model = problem.model
+    names = tuple(model.states) + tuple(model.controls)
+    out = _excess(dense, problem, x_nodes, u_nodes)
+    if out is None:
+        return BoundViolation()
+    bounds, scale, k, s, values, excess = out
+    finite = np.any(np.isfinite(bounds), axis=0)
     worst = np.max(excess, axis=1)
     by_name = {n: float(worst[i]) for i, n in enumerate(names) if finite[i]}
     i = int(np.argmax(worst))

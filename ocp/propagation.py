@@ -173,12 +173,16 @@ def _propagator(sol: Solution, rtol: float, atol: float) -> ca.Function:
     L = sol.problem.lagrange
 
     def build():
-        integ = interval_integrator(sol, tr.node_sigma, rtol, atol, lagrange=L)
+        # the states by an integrator of their own: with the running cost under CVODES' error
+        # control too, its steps (and so the states) would change with L
+        integ = interval_integrator(sol, tr.node_sigma, rtol, atol)
         x0 = ca.MX.sym("x0", f.numel_in(0))
         dat = ca.MX.sym("data", integ.numel_in("p"))
-        out = integ(x0=x0, p=dat)
-        xs = out["xf"]
-        q = out["qf"][:, -1] if L is not None else ca.MX(1, 1)
+        xs = integ(x0=x0, p=dat)["xf"]
+        q = ca.MX(1, 1)
+        if L is not None:
+            cost = interval_integrator(sol, (1.0,), rtol, atol, lagrange=L)
+            q = cost(x0=x0, p=dat)["qf"][:, -1]
         return ca.Function("step", [x0, dat], [xs[:, -1], xs, q]).mapaccum("propagate", N)
 
     lkey = None if L is None else function_key(L)

@@ -172,6 +172,7 @@ class Solution:
                 ("cost (re-simulated)", f"{sim:.10g} (re-simulated - collocated: "
                                         f"{sim - self.cost:.3g})"),
                 ("propagation error (scaled)", _worst_state(errs)),
+                ("bound violation (scaled)", _worst_bound(self.bound_violation)),
                 ("T [s]", f"{self.T:.10g}"),
                 ("mesh", f"{self.transcription.name}, N = {self.mesh.N}"),
                 ("constraint violation", f"{self.constraint_violation:.3g}"),
@@ -225,7 +226,9 @@ class Solution:
 
         Besides the fields, ``'simulated_cost'`` (`simulated_cost`) and
         ``'propagation_errors'`` (`propagation_errors`: ``{state: {'absolute': ...,
-        'scaled': ...}}``) from the re-simulation, which is run (once, `propagation`) for it.
+        'scaled': ...}}``) from the re-simulation, which is run (once, `propagation`) for it,
+        and ``'bound_violation'`` (`bound_violation`: ``{'max': ..., 'by_name': {...},
+        'name': ..., 'time': ...}``).
         """
         model = self.problem.model
         errs = self.propagation_errors
@@ -233,6 +236,10 @@ class Solution:
             "success": bool(self.success), "status": self.status, "message": self.message,
             "cost": self.cost, "simulated_cost": self.simulated_cost,
             "propagation_errors": {k: {"absolute": a, "scaled": r} for k, (a, r) in errs.items()},
+            "bound_violation": {"max": self.bound_violation.max,
+                                "by_name": dict(self.bound_violation.by_name),
+                                "name": self.bound_violation.name,
+                                "time": self.bound_violation.time},
             "T": self.T, "t0": self.t0,
             "constraint_violation": self.constraint_violation,
             "transcription": self.transcription.name, "N": int(self.mesh.N),
@@ -561,6 +568,13 @@ class Solution:
         """
         prop = self.propagation
         return float(prop.cost) if prop.success else float("nan")
+
+
+def _worst_bound(bv: BoundViolation) -> str:
+    """``'0.93 (u1 at t = 3.21 s)'`` or ``'0 (within bounds)'``."""
+    if bv.name is None:
+        return "0 (within bounds)" if bv.by_name else "none (no bounds)"
+    return f"{bv.max:.3g} ({bv.name} at t = {bv.time:.6g} s)"
 
 
 def _worst_state(errs: Mapping[str, tuple]) -> str:

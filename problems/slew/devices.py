@@ -267,7 +267,7 @@ def cmg_slew(inertia, geometry, *, objective="time", T=None, angle=None, axis=No
     >>> from dynamics.momentum import pyramid
     >>> from problems import slew
     >>> geo = pyramid(np.deg2rad(54.74), h=1.0)
-    >>> sol = slew.cmg_slew(10 * np.eye(3), geo, objective="effort", T=2.0, angle=0.1,
+    >>> sol = slew.cmg_slew(10 * np.eye(3), geo, objective="effort", T=3.0, angle=0.1,
     ...                     axis=[1, 0, 0], min_measure=0.5, N=15)
     >>> sol.success, sol.info["min_measure"] >= 0.5 - 1e-6
     (True, True)

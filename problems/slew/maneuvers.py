@@ -7,8 +7,9 @@ import warnings
 import casadi as ca
 import numpy as np
 
-from ocp import (CONTROLS, DEFAULT_CONSTRAINT_TOL, STATUS_BOUND_VIOLATION, Solution, annotate,
-                 polish_switches, refine, rest_solution, solve, solve_multistart)
+from ocp import (CONTROLS, DEFAULT_CONSTRAINT_TOL, STATUS_BOUND_VIOLATION, STATUS_RESIMULATION,
+                 Solution, annotate, polish_switches, refine, rest_solution, solve,
+                 solve_multistart)
 from ocp.solve import verified
 from dynamics.validate import integer
 from dynamics.interrupts import interruptible
@@ -520,11 +521,23 @@ def refine_and_verify(problem, first, *, tol, scale, pointing_tol, rate_tol, ipo
                       verbose):
     """The minimum-effort pipeline after the first solve (shared with the device slews):
     refine the mesh to ``tol`` (`ocp.refine`; not meeting it is `STATUS_REFINE`) and verify
-    by re-simulation."""
-    if not first.success:
+    by re-simulation. A first solve that converged but fails `ocp.solve`'s checks of its
+    dense output is refined too (the remedy); a result whose control polynomial still
+    leaves a bound the optimum rides (a torque or gimbal-rate limit: a kink the polynomial
+    overshoots however fine the mesh) is refined again with a piecewise-linear control
+    (``control='linear'``) -- unless the problem has path constraints (a keep-out cone, a
+    singularity measure), which `ocp.RadauLinearControl` imposes at the mesh points only:
+    then the failure stands."""
+    if not (first.success or first.status in (STATUS_BOUND_VIOLATION, STATUS_RESIMULATION)):
         return verify(first, pointing_tol=pointing_tol, rate_tol=rate_tol)
-    sol = refine(problem, first, tol=tol, verbose=verbose, ipopt_options=ipopt_options, scale=scale)
-    if sol.success and not sol.info.get("converged", False):
+    kw = dict(tol=tol, verbose=verbose, ipopt_options=ipopt_options, scale=scale)
+    sol = refine(problem, first, transcription=first.transcription, **kw)
+    bv = sol.bound_violation
+    if (not sol.success and bv.name in problem.model.controls and bv.max > DEFAULT_CONSTRAINT_TOL
+            and not problem.path):  # (a linear control has its path rows at the mesh points only)
+        sol = refine(problem, sol, control="linear", **kw)
+    checks = (STATUS_BOUND_VIOLATION, STATUS_RESIMULATION)
+    if (sol.success or sol.status in checks) and not sol.info.get("converged", False):
         sol = annotate(sol, {}, success=False, status=STATUS_REFINE,
                        message=f"{sol.message}; the requested refinement tol {tol:g} was not met")
     return verify(sol, pointing_tol=pointing_tol, rate_tol=rate_tol)
