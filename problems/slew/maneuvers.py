@@ -279,16 +279,17 @@ def bounded(problem, sol, *, control="constant", pointing_tol=POINTING_TOL, rate
     kw = dict(ipopt_options=ipopt_options, scale=scale)
     again = solve(problem, transcription="radau", control=control, mesh=sol.mesh, guess=sol, **kw)
     again = verify(again, pointing_tol=pointing_tol, rate_tol=rate_tol)
-    if not again.success and again.status not in (STATUS_BOUND_VIOLATION,) and np.isfinite(again.T):
+    if not again.success and again.status != STATUS_BOUND_VIOLATION and np.isfinite(again.T):
         finer = refine(problem, again, tol=1e-6, max_rounds=4, transcription=again.transcription,
                        **kw)
         finer = verify(finer, pointing_tol=pointing_tol, rate_tol=rate_tol)
         again = finer if finer.success else again
     keep = {k: v for k, v in getattr(sol, "info", {}).items()
             if k in ("starts", "best", "polish", "fallback")}
-    why = (f"the {sol.transcription.name} solution (T = {sol.T:.10g} s) leaves the torque "
-           f"bounds between its nodes (max {sol.bound_violation.max:.3g} of u_max, "
-           f"`{sol.bound_violation.name}`): re-solved with control={control!r}")
+    bv = sol.bound_violation
+    why = (f"the {sol.transcription.name} solution (T = {sol.T:.10g} s) leaves the bounds "
+           f"between its nodes (`{bv.name}` by {bv.max:.3g} of its scale at t = {bv.time:.6g} "
+           f"s): re-solved with control={control!r}")
     if again.success:
         return annotate(again, {**keep, "bounded": why})
     return annotate(failed, {"bounded": f"{why}, which failed: {again.message[:300]}"},
