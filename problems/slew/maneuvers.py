@@ -8,7 +8,7 @@ import casadi as ca
 import numpy as np
 
 from ocp import (CONTROLS, DEFAULT_CONSTRAINT_TOL, STATUS_BOUND_VIOLATION, STATUS_RESIMULATION,
-                 Solution, annotate, polish_switches, refine, rest_solution, solve,
+                 Problem, Solution, annotate, polish_switches, refine, rest_solution, solve,
                  solve_multistart)
 from ocp.solve import verified
 from dynamics.validate import integer
@@ -262,15 +262,44 @@ def time_optimal(inertia, *, angle=None, axis=None, q0=None, qf=None, u_max=1.0,
 SEED_OPTIONS = {"bound_tol": math.inf, "verify": False}
 
 
-def bounded(problem, sol, *, control="constant", pointing_tol=POINTING_TOL, rate_tol=RATE_TOL,
-            ipopt_options=None, scale=None):
-    """``sol`` if its dense control keeps the bounds (`ocp.Solution.bound_violation` within
-    `ocp.DEFAULT_CONSTRAINT_TOL`) or it is no success; else re-solved with ``control``
+def bounded(problem, solution, *, control="constant", pointing_tol=POINTING_TOL,
+            rate_tol=RATE_TOL, ipopt_options=None, scale=None):
+    """``solution`` if its dense output keeps the bounds (`ocp.Solution.bound_violation`
+    within `ocp.DEFAULT_CONSTRAINT_TOL`) or it is no success; else re-solved with ``control``
     (``'constant'`` or ``'linear'``) on its mesh, warm from it, and graded (`verify`; a
-    miss is mesh-refined once more, `ocp.refine` tol 1e-6, 4 rounds). Returns the bounded
-    solution if graded a success, else ``sol`` as a ``'Bound_Violation'`` failure whose
-    message names the variable, the time and what the bounded re-solve gave. With
-    ``control='polynomial'`` no re-solve: the failure at once."""
+    miss is mesh-refined once more, `ocp.refine` tol 1e-6, 4 rounds).
+
+    Parameters
+    ----------
+    problem : ocp.Problem
+        The slew ``solution`` solves.
+    solution : ocp.Solution
+    control : {'constant', 'linear', 'polynomial'}
+        ``'polynomial'``: no re-solve, the failure at once.
+    pointing_tol, rate_tol, ipopt_options, scale
+        As in `time_optimal` (``scale``: `ocp.solve` scale overrides).
+
+    Returns
+    -------
+    ocp.Solution
+        The bounded solution if graded a success, else ``solution`` as a
+        ``'Bound_Violation'`` failure whose message names the variable, the time and what
+        the bounded re-solve gave.
+
+    Raises
+    ------
+    TypeError
+        If ``problem`` is not an `ocp.Problem` or ``solution`` not an `ocp.Solution`.
+    ValueError
+        If ``control`` is not one of `ocp.CONTROLS`.
+    """
+    if not isinstance(problem, Problem):
+        raise TypeError(f"`problem` must be an ocp.Problem, got {type(problem).__name__}")
+    if not isinstance(solution, Solution):
+        raise TypeError(f"`solution` must be an ocp.Solution, got {type(solution).__name__}")
+    if control not in CONTROLS:
+        raise ValueError(f"`control` must be one of {CONTROLS}, got {control!r}")
+    sol = solution
     if not sol.success or sol.bound_violation.max <= DEFAULT_CONSTRAINT_TOL:
         return sol
     failed = verified(sol, DEFAULT_CONSTRAINT_TOL, None)
