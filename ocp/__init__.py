@@ -37,9 +37,11 @@ from .progress import LOGGER
 from .propagation import SCALE_FLOOR, state_scale
 from .solution import Propagation, Solution
 from .rest import STATUS_REST, rest_solution
+from .checks import (DEFAULT_VERIFY_TOL, STATUS_BOUND_VIOLATION, STATUS_RESIMULATION,
+                     BoundViolation)
 from .solve import DEFAULT_CONSTRAINT_TOL, STATUS_CONSTRAINT_TOL, STATUS_EXCEPTION, Progress, solve
-from .transcription import (TRANSCRIPTIONS, HermiteSimpson, Radau, RadauConstantControl,
-                            Transcription, Trapezoid, get_transcription)
+from .transcription import (CONTROLS, TRANSCRIPTIONS, HermiteSimpson, Radau, RadauConstantControl,
+                            RadauLinearControl, Transcription, Trapezoid, get_transcription)
 
 __all__ = [
     "Problem",
@@ -77,6 +79,12 @@ __all__ = [
     "RefinedSolution",
     "RefinementRound",
     "RadauConstantControl",
+    "RadauLinearControl",
+    "CONTROLS",
+    "BoundViolation",
+    "STATUS_BOUND_VIOLATION",
+    "STATUS_RESIMULATION",
+    "DEFAULT_VERIFY_TOL",
     "IntervalErrors",
     "interval_errors",
     "find_switches",

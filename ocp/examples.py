@@ -158,7 +158,9 @@ def goddard_rocket(regularization: float = 0.0) -> Problem:
     The optimal thrust has a singular arc (module docstring): without regularization
     `ocp.refine` stalls (status ``'Refinement_Stalled'``) and the re-simulated cost
     `Solution.simulated_cost` is the number to trust; a small ``regularization`` (1e-4:
-    the re-simulated altitude 7.7e-7 below the optimum) lets refinement converge.
+    the re-simulated altitude 7.7e-7 below the optimum) lets refinement converge. The
+    ``'radau'`` thrust polynomial overshoots its bounds on this arc (a ``'Bound_Violation'``
+    failure of `ocp.solve`); solve with ``control='linear'``.
 
     Parameters
     ----------
@@ -183,9 +185,12 @@ def goddard_rocket(regularization: float = 0.0) -> Problem:
     --------
     >>> import ocp
     >>> from ocp.examples import goddard_rocket, GODDARD_OPTIMUM
-    >>> sol = ocp.solve(goddard_rocket(), N=20)
-    >>> sol.success, round(sol.cost, 5), round(sol.simulated_cost, 5), GODDARD_OPTIMUM["h_f"]
-    (True, 1.01286, 1.01282, 1.0128369183)
+    >>> sol = ocp.solve(goddard_rocket(), N=20)  # the Radau thrust polynomial overshoots [0, 3.5]
+    >>> sol.status, round(sol.cost, 5), round(sol.simulated_cost, 5), GODDARD_OPTIMUM["h_f"]
+    ('Bound_Violation', 1.01286, 1.01282, 1.0128369183)
+    >>> linear = ocp.solve(goddard_rocket(), N=20, control="linear")  # stays within the bounds
+    >>> linear.success, round(linear.cost, 5), round(linear.simulated_cost, 5)
+    (True, 1.01283, 1.01283)
     """
     if isinstance(regularization, bool) or not isinstance(regularization, numbers.Real):
         raise TypeError(f"`regularization` must be a real number, got {type(regularization).__name__}")

@@ -380,7 +380,7 @@ def guess_from_simulation(problem, u, *, T=None, n=201, method="auto", rtol=1e-8
     >>> guess = ocp.guess_from_simulation(fastest, lambda t: 1.0 if t < 1 else -1.0, T=2.0, n=21)
     >>> guess["x"].shape, guess["u"].shape, guess["T"]
     ((2, 21), (1, 21), 2.0)
-    >>> sol = ocp.solve(fastest, N=10, guess=guess)
+    >>> sol = ocp.solve(fastest, N=10, guess=guess, control="constant")  # bang-bang
     >>> sol.success, round(sol.T, 6)
     (True, 2.0)
     """

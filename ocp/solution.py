@@ -11,12 +11,32 @@ from dynamics.attitude import quat_conj, quat_mul
 from dynamics.figures import finish_figure, new_figure
 from dynamics.serialize import text_table, to_json
 
+from .checks import BoundViolation, bound_violation
 from .dense import DenseOutput
 from .propagation import (SCALE_FLOOR, Propagation, interval_integrator, propagate,
                           stack_interval_controls, state_scale)
 
-__all__ = ["Solution", "Propagation", "DenseOutput", "interval_integrator", "stack_interval_controls",
-           "state_scale", "SCALE_FLOOR"]
+__all__ = ["Solution", "Propagation", "DenseOutput", "BoundViolation", "interval_integrator",
+           "stack_interval_controls", "state_scale", "SCALE_FLOOR", "draw_bounds"]
+
+
+def draw_bounds(ax, lines, bounds) -> None:
+    """Dashed horizontal lines at the finite bounds of plotted variables, each in the colour
+    of its curve.
+
+    Parameters
+    ----------
+    ax : matplotlib.axes.Axes
+    lines : sequence of matplotlib.lines.Line2D
+        The curves, one per variable (as returned by ``ax.plot``).
+    bounds : array_like, shape (2, n)
+        Lower and upper bounds of the ``n`` variables (``-inf``/``inf`` for none).
+    """
+    lo, hi = np.asarray(bounds, dtype=float)
+    for line, a, b in zip(lines, lo, hi):
+        for v in (a, b):
+            if np.isfinite(v):
+                ax.axhline(v, color=line.get_color(), linestyle="--", linewidth=0.8, alpha=0.7)
 
 
 @dataclass(eq=False)
@@ -39,15 +59,17 @@ class Solution:
     ----------
     success : bool
         Verified: IPOPT returned ``Solve_Succeeded`` (its ``tol`` met; an acceptable-level
-        stop counts only if a warm re-solve then succeeds) *and* ``constraint_violation``
-        is at most the ``constraint_tol`` of `ocp.solve` (default 1e-6). A failure still
-        carries IPOPT's last iterate.
+        stop counts only if a warm re-solve then succeeds), ``constraint_violation`` is at
+        most the ``constraint_tol`` of `ocp.solve` (default 1e-6), so is the dense output's
+        `bound_violation`, and the re-simulation agrees with the collocation to
+        ``verify_tol`` (unless ``verify=False``; `ocp.checks`). A failure still carries
+        IPOPT's last iterate.
     status : str
         IPOPT's return status (``'Solve_Succeeded'``, ``'Solved_To_Acceptable_Level'``,
         ``'Infeasible_Problem_Detected'``, ``'Maximum_Iterations_Exceeded'``, ...) or one of
-        `ocp.solve`'s own: ``'Constraint_Tol_Not_Met'``, ``'Exception'``,
-        ``'Rest_Solution'``; drivers on top add theirs (see `ocp.refine`,
-        `problems.slew`).
+        `ocp.solve`'s own: ``'Constraint_Tol_Not_Met'``, ``'Bound_Violation'``,
+        ``'Resimulation_Mismatch'``, ``'Exception'``, ``'Rest_Solution'``; drivers on top
+        add theirs (see `ocp.refine`, `problems.slew`).
     message : str
         What happened, in words.
     T : float [s]
@@ -150,6 +172,7 @@ class Solution:
                 ("cost (re-simulated)", f"{sim:.10g} (re-simulated - collocated: "
                                         f"{sim - self.cost:.3g})"),
                 ("propagation error (scaled)", _worst_state(errs)),
+                ("bound violation (scaled)", _worst_bound(self.bound_violation)),
                 ("T [s]", f"{self.T:.10g}"),
                 ("mesh", f"{self.transcription.name}, N = {self.mesh.N}"),
                 ("constraint violation", f"{self.constraint_violation:.3g}"),
@@ -203,7 +226,9 @@ class Solution:
 
         Besides the fields, ``'simulated_cost'`` (`simulated_cost`) and
         ``'propagation_errors'`` (`propagation_errors`: ``{state: {'absolute': ...,
-        'scaled': ...}}``) from the re-simulation, which is run (once, `propagation`) for it.
+        'scaled': ...}}``) from the re-simulation, which is run (once, `propagation`) for it,
+        and ``'bound_violation'`` (`bound_violation`: ``{'max': ..., 'by_name': {...},
+        'name': ..., 'time': ...}``).
         """
         model = self.problem.model
         errs = self.propagation_errors
@@ -211,6 +236,10 @@ class Solution:
             "success": bool(self.success), "status": self.status, "message": self.message,
             "cost": self.cost, "simulated_cost": self.simulated_cost,
             "propagation_errors": {k: {"absolute": a, "scaled": r} for k, (a, r) in errs.items()},
+            "bound_violation": {"max": self.bound_violation.max,
+                                "by_name": dict(self.bound_violation.by_name),
+                                "name": self.bound_violation.name,
+                                "time": self.bound_violation.time},
             "T": self.T, "t0": self.t0,
             "constraint_violation": self.constraint_violation,
             "transcription": self.transcription.name, "N": int(self.mesh.N),
@@ -225,7 +254,8 @@ class Solution:
         return to_json(self.to_dict())
 
     def plot(self, path=None, *, fig=None, n=400):
-        """States (top) and controls (bottom) against time, from the dense output.
+        """States (top) and controls (bottom) against time, from the dense output; the
+        controls' finite bounds as dashed lines in their colours.
 
         Parameters
         ----------
@@ -247,8 +277,9 @@ class Solution:
         xs, us = self.sample(ts)
         for name, row in zip(model.states, np.atleast_2d(xs)):
             top.plot(ts, row, label=name)
-        for name, row in zip(model.controls, np.atleast_2d(us)):
-            bottom.plot(ts, row, label=name)
+        curves = [bottom.plot(ts, row, label=name)[0]
+                  for name, row in zip(model.controls, np.atleast_2d(us))]
+        draw_bounds(bottom, curves, self.problem.u_bounds)
         top.set(ylabel="states", title=f"{self.transcription.name}, N = {self.mesh.N}: "
                 f"cost {self.cost:.6g}, success {self.success}")
         bottom.set(xlabel="t [s]", ylabel="controls")
@@ -374,6 +405,28 @@ class Solution:
         return (x[:, 0], u[:, 0]) if scalar else (x, u)
 
     # ----------------------------------------------------------- diagnostics
+    @cached_property
+    def bound_violation(self) -> BoundViolation:
+        """Largest violation of the state and control bounds by the dense output, per
+        variable in units of its scale, and where it is worst (`ocp.checks.BoundViolation`).
+
+        Evaluated on `ocp.checks.bound_grid`: in every mesh interval 17 equally spaced points
+        (``sigma = 0, 1/16, ..., 1``; both one-sided limits at a mesh point) and the
+        transcription's nodes -- the interpolant `sample` returns and `propagate` replays.
+        The scale of a variable is ``max(|finite bounds|, max_n |v(t_n)|, 1e-6)``. `ocp.solve`
+        requires ``bound_violation.max <= constraint_tol`` for a success. Computed on first
+        use and cached.
+
+        Examples
+        --------
+        >>> import ocp
+        >>> from ocp.examples import min_time
+        >>> sol = ocp.solve(min_time(), N=10, control="linear")  # |u| <= 1: bang-bang
+        >>> sol.bound_violation.max, sorted(sol.bound_violation.by_name)
+        (0.0, ['u'])
+        """
+        return bound_violation(self.dense, self.problem, self.x, self.u)
+
     @property
     def quaternion_norm_error(self) -> float | None:
         """``max | |q| - 1 |`` over the nodes (attitude models), else ``None``."""
@@ -515,6 +568,13 @@ class Solution:
         """
         prop = self.propagation
         return float(prop.cost) if prop.success else float("nan")
+
+
+def _worst_bound(bv: BoundViolation) -> str:
+    """``'0.93 (u1 at t = 3.21 s)'`` or ``'0 (within bounds)'``."""
+    if bv.name is None:
+        return "0 (within bounds)" if bv.by_name else "none (no bounds)"
+    return f"{bv.max:.3g} ({bv.name} at t = {bv.time:.6g} s)"
 
 
 def _worst_state(errs: Mapping[str, tuple]) -> str:

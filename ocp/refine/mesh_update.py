@@ -3,6 +3,7 @@ it applies each round (split inaccurate intervals, bracket switches, merge very 
 neighbours)."""
 from __future__ import annotations
 
+import dataclasses
 import math
 import sys
 import time
@@ -12,6 +13,8 @@ import numpy as np
 
 from dynamics.validate import integer, positive
 from dynamics.interrupts import interruptible
+from ..checks import (STATUS_BOUND_VIOLATION, STATUS_RESIMULATION, interval_bound_violation,
+                      periodic_jumps)
 from ..mesh import Mesh
 from ..problem import Problem
 from ..progress import LOGGER
@@ -114,6 +117,40 @@ def _stalled(history: list, q: int, max_intervals: int, window: int) -> bool:
     return bool(grew and errors[-1] > errors[0] / 2.0 ** q)
 
 
+def _refinable(sol: Solution) -> bool:
+    """Whether a failed round is one refinement is the remedy for: the NLP converged but the
+    dense output leaves a bound between the nodes or its re-simulation disagrees
+    (`ocp.checks`), and no unbounded angle control jumps by ``2 pi k`` (finer meshes would
+    only pile intervals on those jumps)."""
+    return (sol.status in (STATUS_BOUND_VIOLATION, STATUS_RESIMULATION)
+            and not periodic_jumps(sol))
+
+
+def _sim(sol: Solution) -> float:
+    """The objective ``sol`` achieves re-simulated (`Solution.simulated_cost`; the collocated
+    one where the re-simulation failed)."""
+    v = sol.simulated_cost
+    return v if np.isfinite(v) else sol.cost
+
+
+def _better_round(problem: Problem, best, current, tol: float):
+    """The round to return if later rounds get worse: ``current`` ``(round, solution,
+    errors)`` unless ``best`` (an earlier successful round) achieves a re-simulated objective
+    better by more than ``max(tol, its own largest scaled re-simulation error)`` relative to
+    ``max(|J|, 1)`` (a coarse round's re-simulated trajectory may miss the constraints by that
+    much, and gain objective from it); only successful (verified) rounds count."""
+    if not current[1].success:
+        return best
+    if best is None:
+        return current
+    a, b = _sim(best[1]), _sim(current[1])
+    rel = best[1].propagation.relative_error
+    slack = max(tol, float(np.max(rel)) if rel.size and np.all(np.isfinite(rel)) else 0.0)
+    if problem.better(a, b) and abs(a - b) > slack * max(abs(a), 1.0):
+        return best
+    return current
+
+
 def _stall_message(history: list, q: int, window: int, sol: Solution) -> str:
     errors = ", ".join(f"{r.max_error:.2e}" for r in history[-(window + 1):])
     sizes = ", ".join(str(r.n_intervals) for r in history[-(window + 1):])
@@ -171,7 +208,14 @@ def refine(problem: Problem, solution: Solution | None = None, *, tol: float = 1
     and the problem is solved again on the new mesh, warm-started from the last solution.
     It stops when the largest estimated error is ``<= tol``, when the estimate stalls (below),
     after ``max_rounds`` rounds, when the mesh would exceed ``max_intervals`` intervals, or
-    when an NLP fails.
+    when a solve fails. A round that converged but fails `ocp.solve`'s checks of the dense
+    output (``'Bound_Violation'``, ``'Resimulation_Mismatch'``) is refined further (a finer
+    mesh is their remedy) and the last round's status stands -- except when an unbounded
+    angle control jumps by ``2 pi k`` between nodes (`ocp.checks.periodic_jumps`): no mesh
+    resolves those, and refinement stops at once with that round's message naming the
+    control. Note that a switch inside an interval makes the ``'radau'`` control polynomial
+    overshoot however small the interval: refine bang-bang problems with
+    ``control='linear'`` or ``'constant'``.
 
     *Stall.* Every interval above ``tol`` is cut into at least two pieces each round, which
     gains a factor ``2**q`` in its error where the solution is smooth (a switch bracket gains
@@ -194,7 +238,9 @@ def refine(problem: Problem, solution: Solution | None = None, *, tol: float = 1
     ``h(tf) = 1.0128369``): unregularized, ``refine(tol=1e-6)`` stalls after 2 rounds (errors
     4.2e-2, 9.1e-3, 7.7e-3 on 20, 39, 70 intervals; collocated cost 1.0128424, re-simulated
     1.0128361); with ``eps = 1e-4`` it converges in 3 rounds (62 intervals) to a re-simulated
-    altitude 1.0128361, 7.7e-7 below the singular optimum; ``eps = 1e-3`` costs 1.4e-5 of
+    altitude 1.0128361, 7.7e-7 below the singular optimum -- a ``'Bound_Violation'``
+    though: the Radau thrust polynomial overshoots ``[0, 3.5]`` at the arc junctions;
+    with ``control='linear'`` it converges within the bounds on 33 intervals; ``eps = 1e-3`` costs 1.4e-5 of
     altitude. Smaller ``eps`` sharpens the junctions and needs more rounds (``1e-5``: 8
     rounds, with ``stall_rounds=None, max_rounds=8``). The exact alternative imposes the arc
     structure (phases with the singular control law).
@@ -235,7 +281,11 @@ def refine(problem: Problem, solution: Solution | None = None, *, tol: float = 1
     Returns
     -------
     RefinedSolution
-        The last solution, with ``info['refinement']`` (also ``.refinement``): one
+        The last solution -- unless its re-simulated objective (`Solution.simulated_cost`)
+        is worse than that of an earlier verified round by more than ``max(tol, that
+        round's scaled re-simulation error)`` relative: then that round, with
+        ``info['returned_round']`` and a message quoting both objectives (refinement never
+        returns a worse objective than its input as a success) -- with ``info['refinement']`` (also ``.refinement``): one
         `RefinementRound` ``(n_intervals, max_error, cost, iterations, time)`` per NLP
         solved, and ``info['converged']``, ``info['errors']``, ``info['meshes']``,
         ``info['stop']``. ``success`` is that of the last NLP (its message says so); not
@@ -268,7 +318,7 @@ def refine(problem: Problem, solution: Solution | None = None, *, tol: float = 1
     >>> rocket = ocp.refine(goddard_rocket(), tol=1e-6)
     >>> rocket.status, rocket.info["stop"], len(rocket.refinement) - 1
     ('Refinement_Stalled', 'stalled', 2)
-    >>> smooth = ocp.refine(goddard_rocket(regularization=1e-4), tol=1e-6)
+    >>> smooth = ocp.refine(goddard_rocket(regularization=1e-4), tol=1e-6, control="linear")
     >>> smooth.success, smooth.info["converged"], round(float(smooth.propagation.x[0, -1]), 6)
     (True, True, 1.012836)
     """
@@ -286,6 +336,7 @@ def refine(problem: Problem, solution: Solution | None = None, *, tol: float = 1
     kw = dict(solve_kwargs)
     guess0 = kw.pop("guess", None)
     mesh0 = kw.pop("mesh", None)
+    control = kw.pop("control", None)
     if degree is not None and transcription != "radau":
         warnings.warn(f"`degree` is ignored: it applies to transcription 'radau' given by "
                       f"name, not {transcription!r}", UserWarning, stacklevel=2)
@@ -294,7 +345,8 @@ def refine(problem: Problem, solution: Solution | None = None, *, tol: float = 1
                       f"{'`solution`' if solution is not None else '`mesh`'}", UserWarning,
                       stacklevel=2)
     N = 20 if N is None else N
-    tr = _transcription(transcription, 3 if degree is None else degree)
+    tr = get_transcription(_transcription(transcription, 3 if degree is None else degree),
+                           None, control)
     q = _local_order(tr)
 
     t_round = time.perf_counter()
@@ -307,25 +359,30 @@ def refine(problem: Problem, solution: Solution | None = None, *, tol: float = 1
         sol = solve(problem, transcription=tr, N=None if mesh0 is not None else N, mesh=mesh0,
                     guess=guess0, verbose=verbose, **kw)
     history, meshes = [], []
-    stop, est = "", None
+    stop, est, best = "", None, None
     for rnd in range(max_rounds + 1):
         meshes.append(sol.mesh)
-        if not sol.success:
+        if not (sol.success or _refinable(sol)):
             history.append(RefinementRound(sol.mesh.N, float("nan"), sol.cost, sol.iterations,
                                            time.perf_counter() - t_round))
-            stop = f"the NLP of round {rnd} failed"
+            stop = f"the solve of round {rnd} failed ({sol.status})"
             break
         itol = float(np.clip(1e-4 * tol, 1e-13, 1e-10))  # CVODES fails below ~1e-14
         est = interval_errors(sol, rtol=itol, atol=itol)
         history.append(RefinementRound(sol.mesh.N, est.max_error, sol.cost, sol.iterations,
                                        time.perf_counter() - t_round))
         _report(rnd, history[-1], verbose, progress)
-        if est.max_error <= tol:
+        best = _better_round(problem, best, (rnd, sol, est), tol)
+        outside = sol.status == STATUS_BOUND_VIOLATION
+        if est.max_error <= tol and not outside:
             stop = "tolerance reached"
             break
         if stall_rounds is not None and _stalled(history, q, max_intervals, stall_rounds):
             stop = "stalled"
             break
+        if outside:  # the intervals whose dense output leaves a bound are split too
+            est = dataclasses.replace(est, error=np.where(
+                interval_bound_violation(sol) > 0, np.maximum(est.error, 4.0 * tol), est.error))
         if rnd == max_rounds:
             stop = f"max_rounds = {max_rounds} reached"
             break
@@ -346,7 +403,19 @@ def refine(problem: Problem, solution: Solution | None = None, *, tol: float = 1
                    f"{sol.mesh.N} intervals; {sol.message}")
     info = {"refinement": history, "converged": bool(converged), "errors": est, "meshes": meshes,
             "tol": tol, "stop": stop}
-    if stop == "stalled" and sol.success:
-        return annotate(sol, info, success=False, status=STATUS_STALLED,
-                        message=_stall_message(history, q, stall_rounds, sol))
+    if best is not None and best[1] is not sol and sol.success:
+        # never a worse objective than an earlier verified round: that round is returned
+        rnd, earlier, est_b = best
+        note = (f"refine: the last round's re-simulated objective {_sim(sol):.10g} is worse "
+                f"than round {rnd}'s {_sim(earlier):.10g} (by more than tol {tol:g} relative"
+                f"{'' if sol.success else '; the last round failed: ' + sol.message[:300]}); "
+                f"returned round {rnd} ({earlier.mesh.N} intervals, estimated error "
+                f"{est_b.max_error:.2e}); {earlier.message}")
+        info.update(converged=bool(est_b.max_error <= tol), errors=est_b, returned_round=rnd)
+        return annotate(earlier, info, message=note)
+    if stop == "stalled" and (sol.success or _refinable(sol)):
+        message = _stall_message(history, q, stall_rounds, sol)
+        if not sol.success:  # the last round also failed a check of its dense output
+            message += f" The last round also failed ({sol.status}): {sol.message}"
+        return annotate(sol, info, success=False, status=STATUS_STALLED, message=message)
     return annotate(sol, info, message=message)

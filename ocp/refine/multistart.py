@@ -91,7 +91,7 @@ def solve_multistart(problem: Problem, guesses: Sequence, *, start_options: Sequ
     >>> import ocp
     >>> from ocp.examples import min_time
     >>> fastest = min_time()  # x'' = u, |u| <= 1, from rest at 0 to rest at 1
-    >>> sol = ocp.solve_multistart(fastest, [None, {"T": 5.0}], N=10)
+    >>> sol = ocp.solve_multistart(fastest, [None, {"T": 5.0}], N=10, control="constant")
     >>> sol.success, round(sol.T, 6), len(sol.info["starts"])
     (True, 2.0, 2)
 
@@ -99,7 +99,8 @@ def solve_multistart(problem: Problem, guesses: Sequence, *, start_options: Sequ
 
     >>> from concurrent.futures import ThreadPoolExecutor
     >>> with ThreadPoolExecutor(max_workers=2) as pool:
-    ...     again = ocp.solve_multistart(fastest, [None, {"T": 5.0}], N=10, executor=pool)
+    ...     again = ocp.solve_multistart(fastest, [None, {"T": 5.0}], N=10, executor=pool,
+    ...                                 control="constant")
     >>> again.T == sol.T, again.info["best"] == sol.info["best"]
     (True, True)
     """

@@ -42,14 +42,14 @@ Modules
 -------
 `targets` (input checks, the target attitude, `KeepOut`, defaults and statuses),
 `problem` (`slew_problem`, `eigenaxis_time`, guesses), `maneuvers` (`time_optimal`,
-`min_effort`, `verify`), `table` (`maneuver_table`: the slew to every target of a
+`min_effort`, `verify`, `bounded`), `table` (`maneuver_table`: the slew to every target of a
 catalogue, on any executor, as a `ManeuverTable`), `devices` (`wheel_slew`, `cmg_slew`: the same slews by reaction
 wheels or CMGs, momentum exchanged inside the spacecraft), `report` (`switch_times`, `summary`, `format_summary`, `plot_slew`).
 """
 from __future__ import annotations
 
 from .devices import cmg_slew, wheel_slew
-from .maneuvers import min_effort, polish_text, time_optimal, verify
+from .maneuvers import bounded, min_effort, polish_text, time_optimal, verify
 from .problem import attitude_guess, eigenaxis_time, slew_problem
 from .report import format_summary, plot_slew, summary, switch_times
 from .table import ManeuverTable, example_targets, maneuver_table
@@ -57,6 +57,6 @@ from .targets import (MIN_REFINE_TOL, POINTING_TOL, RATE_TOL, STATUS_POINTING, S
                       KeepOut)
 
 __all__ = ["KeepOut", "slew_problem", "time_optimal", "min_effort", "wheel_slew", "cmg_slew", "eigenaxis_time",
-           "switch_times", "attitude_guess", "verify", "polish_text", "summary", "format_summary", "plot_slew",
+           "switch_times", "attitude_guess", "verify", "bounded", "polish_text", "summary", "format_summary", "plot_slew",
            "maneuver_table", "ManeuverTable", "example_targets",
            "POINTING_TOL", "RATE_TOL", "MIN_REFINE_TOL", "STATUS_POINTING", "STATUS_REFINE"]

@@ -32,7 +32,7 @@ from dynamics.validate import (check_inertia, finite_array, integer, one_of, pos
                                positive_each, unit_axes)
 from ocp import Constraint, Problem, annotate, solve
 
-from .maneuvers import refine_and_verify, solve_time_optimal
+from .maneuvers import SEED_OPTIONS, bounded, refine_and_verify, solve_time_optimal
 from .problem import attitude_guess, rough_time, seeded_guesses, slew_problem
 from .targets import POINTING_TOL, RATE_TOL, check_tol, targets
 
@@ -101,9 +101,11 @@ def _pipeline(problem, rb_problem, convert, objective, *, starts, seed, N, tol, 
     opts = dict(N=N, verbose=verbose, ipopt_options=ipopt_options, scale=None)
     if objective == "time":
         guesses = [convert(g) for g in seeded_guesses(rb_problem, starts, seed)]
-        sol = solve_time_optimal(problem, None, guesses, dict(opts, transcription="radau"),
+        first = dict(opts, transcription="radau", **SEED_OPTIONS)  # as time_optimal
+        sol = solve_time_optimal(problem, None, guesses, first,
                                  polish=polish, pointing_tol=ptol, rate_tol=rtol,
                                  ipopt_options=ipopt_options, verbose=verbose)
+        sol = bounded(problem, sol, pointing_tol=ptol, rate_tol=rtol, ipopt_options=ipopt_options)
     else:
         first = solve(problem, guess=convert(attitude_guess(rb_problem)), **opts)
         sol = refine_and_verify(problem, first, tol=tol, scale=None, pointing_tol=ptol,
@@ -265,7 +267,7 @@ def cmg_slew(inertia, geometry, *, objective="time", T=None, angle=None, axis=No
     >>> from dynamics.momentum import pyramid
     >>> from problems import slew
     >>> geo = pyramid(np.deg2rad(54.74), h=1.0)
-    >>> sol = slew.cmg_slew(10 * np.eye(3), geo, objective="effort", T=2.0, angle=0.1,
+    >>> sol = slew.cmg_slew(10 * np.eye(3), geo, objective="effort", T=3.0, angle=0.1,
     ...                     axis=[1, 0, 0], min_measure=0.5, N=15)
     >>> sol.success, sol.info["min_measure"] >= 0.5 - 1e-6
     (True, True)

@@ -8,6 +8,7 @@ import numpy as np
 
 from dynamics.attitude import dcm_from_quat
 from ocp import Solution, control_switches
+from ocp.solution import draw_bounds
 
 from .targets import ARCSEC
 
@@ -185,7 +186,8 @@ def format_summary(data: dict) -> str:
 
 
 def plot_slew(solution: Solution, path=None, *, fig=None, dpi: int = 110):
-    """Quaternion, rates, torques and the rotation path (body axes on the unit sphere).
+    """Quaternion, rates, torques (with the torque bounds ``+-u_max`` dashed) and the
+    rotation path (body axes on the unit sphere).
 
     Builds a `matplotlib.figure.Figure` (no pyplot, no backend change) and returns it; the
     caller shows or saves it. With ``path`` it is also saved there (``Figure.savefig``).
@@ -224,8 +226,9 @@ def plot_slew(solution: Solution, path=None, *, fig=None, dpi: int = 110):
               (u, "torque [N m]", ["u1", "u2", "u3"])]
     for k, (data, label, names) in enumerate(panels):
         ax = fig.add_subplot(2, 2, k + 1)
-        for row, name in zip(data, names):
-            ax.plot(t, row, label=name)
+        curves = [ax.plot(t, row, label=name)[0] for row, name in zip(data, names)]
+        if label.startswith("torque"):
+            draw_bounds(ax, curves, solution.problem.u_bounds)
         ax.set(xlabel="t [s]", ylabel=label)
         ax.legend(loc="best", fontsize=8)
         ax.grid(alpha=0.3)

@@ -124,3 +124,54 @@ def rigid_slew(theta_f=1.0, T=2.0, axis=2, sign=1.0, inertia=1.0):
 
 def observed_order(e_coarse: float, e_fine: float, refinement: float = 2.0) -> float:
     return math.log(e_coarse / e_fine) / math.log(refinement)
+
+
+def orbit_raising(angle_bounds=None):
+    """Bryson & Ho (1975), Applied Optimal Control, sec. 2.5: maximum final radius of a
+    low-thrust transfer in a fixed time, normalized units (mu = 1, r0 = 1, thrust 0.1405,
+    mass rate 0.0749, tf = 3.32). States r, radial and tangential velocity u, v, mass m;
+    control the thrust angle phi from the local horizontal:
+
+        r' = u,  u' = v^2/r - 1/r^2 + thrust sin(phi)/m,  v' = -u v/r + thrust cos(phi)/m,
+        m' = -0.0749,
+
+    from r = 1, u = 0, v = 1, m = 1 to a circular orbit (u = 0, v = 1/sqrt(r)). Optimum
+    r(tf) = 1.5253 (Bryson & Ho's figure 2.5.1 and the later literature, e.g. Betts 2010,
+    Practical Methods for Optimal Control, 2nd ed., example 'orbit raising': 1.52526).
+    ``angle_bounds``: ``None`` leaves phi unbounded (a periodic control: 2 pi k jumps cost
+    the collocation nothing), else ``(lower, upper)``."""
+    thrust, mdot = 0.1405, 0.0749
+    x, phi, p = ca.SX.sym("x", 4), ca.SX.sym("phi"), ca.SX.sym("p", 0)
+    r, u, v, m = x[0], x[1], x[2], x[3]
+    rhs = ca.vertcat(u, v ** 2 / r - 1 / r ** 2 + thrust * ca.sin(phi) / m,
+                     -u * v / r + thrust * ca.cos(phi) / m, -mdot)
+    model = Model(ca.Function("orbit_raising", [x, phi, p], [rhs], ["x", "u", "p"], ["xdot"]),
+                  ("r", "u", "v", "m"), ("phi",), name="orbit_raising")
+    kw = {} if angle_bounds is None else {"u_bounds": {"phi": tuple(angle_bounds)}}
+    pr = Problem(model, T=3.32, x_initial=[1.0, 0.0, 1.0, 1.0], x_final={"u": 0.0},
+                 x_bounds={"r": (0.5, 5.0), "m": (0.1, 1.0)},
+                 boundary=lambda r_f, v_f: v_f - 1 / ca.sqrt(r_f),
+                 mayer=lambda r_f: r_f, maximize=True, **kw)
+    return pr, {"r_f": 1.5253}
+
+
+def free_flying_robot():
+    """Sakawa (1999), "Trajectory planning of a free-flying robot by using the optimal
+    control", Optimal Control Applications and Methods 20; as in Betts (2010) and PSOPT's
+    example: x' = vx, y' = vy, theta' = omega, vx' = (F1 + F2) cos(theta), vy' = (F1 + F2)
+    sin(theta), omega' = 0.2 F1 - 0.2 F2 with F1 = u1 - u2, F2 = u3 - u4, 0 <= u_i <= 1,
+    u1 + u2 <= 1, u3 + u4 <= 1, from (-10, -10, pi/2, 0, 0, 0) to rest at the origin in
+    T = 12, min integral (u1 + u2 + u3 + u4) dt. Optimum J = 7.9101 (Betts: 7.910154646;
+    PSOPT: 7.9101471): bang-bang thrusts with singular pieces."""
+    x, u, p = ca.SX.sym("x", 6), ca.SX.sym("u", 4), ca.SX.sym("p", 0)
+    F1, F2 = u[0] - u[1], u[2] - u[3]
+    rhs = ca.vertcat(x[3], x[4], x[5], (F1 + F2) * ca.cos(x[2]), (F1 + F2) * ca.sin(x[2]),
+                     0.2 * F1 - 0.2 * F2)
+    model = Model(ca.Function("free_flying_robot", [x, u, p], [rhs], ["x", "u", "p"], ["xdot"]),
+                  ("x", "y", "theta", "vx", "vy", "omega"), ("u1", "u2", "u3", "u4"),
+                  name="free_flying_robot")
+    pr = Problem(model, T=12.0, x_initial=[-10.0, -10.0, math.pi / 2, 0.0, 0.0, 0.0],
+                 x_final=[0.0] * 6, u_bounds=([0.0] * 4, [1.0] * 4),
+                 path=lambda x, u, p: ca.vertcat(u[0] + u[1] - 1, u[2] + u[3] - 1),
+                 lagrange=lambda x, u, p: ca.sum1(u))
+    return pr, {"J": 7.9101}

@@ -35,17 +35,18 @@ def test_per_model_functions_are_built_once_and_cleared():
 def test_second_solve_with_another_guess_reuses_the_solver():
     clear_caches()
     problem, truth = bang_bang()
-    first = ocp.solve(problem, N=12)
+    # bang-bang: a piecewise-constant control (the Radau polynomial overshoots |u| <= 1)
+    first = ocp.solve(problem, N=12, control="constant")
     hits = cache.info().hits
-    again = ocp.solve(problem, N=12, guess={"T": 4.5})  # another start, the same scaling
+    again = ocp.solve(problem, N=12, guess={"T": 4.5}, control="constant")  # another start
     assert first.success and again.success
     assert _ocp_kinds()["ocp.nlpsol"] == 1 and cache.info().hits > hits
     assert abs(again.T - truth["T"]) < 1e-6 and abs(first.T - again.T) < 1e-7
     # another mesh, options or a progress listener build their own
     seen = []
-    other = ocp.solve(problem, N=12, progress=seen.append)
+    other = ocp.solve(problem, N=12, progress=seen.append, control="constant")
     assert other.success and seen
-    assert ocp.solve(problem, N=12, ipopt_options={"tol": 1e-9}).success
+    assert ocp.solve(problem, N=12, ipopt_options={"tol": 1e-9}, control="constant").success
     assert _ocp_kinds()["ocp.nlpsol"] == 2
 
 

@@ -94,7 +94,7 @@ def test_default_guess_hint_on_failure():
     user = ocp.solve(fastest, N=10, guess={"T": 3.0}, ipopt_options={"max_iter": 1})
     assert not user.success
     assert "default initial guess" not in user.message
-    ok = ocp.solve(fastest, N=10)
+    ok = ocp.solve(fastest, N=10, control="constant")  # bang-bang
     assert ok.success and "default initial guess" not in ok.message
 
 
@@ -108,7 +108,7 @@ def test_polish_keeps_the_sign():
     base = min_time()  # maximize -T is minimum time: T = 2
     prob = ocp.Problem(base.model, T=base.T, x_initial=base.x_initial, x_final=base.x_final,
                        u_bounds=base.u_bounds, mayer=lambda xf, p, T: -T, maximize=True)
-    sol = ocp.solve(prob, N=10)
+    sol = ocp.solve(prob, N=10, control="constant")  # bang-bang
     assert sol.success and sol.cost == pytest.approx(-2.0, abs=1e-6)
     pol = ocp.polish_switches(prob, sol)
     assert pol.success and pol.cost == pytest.approx(-2.0, abs=1e-8)

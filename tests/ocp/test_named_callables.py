@@ -49,7 +49,7 @@ def test_named_mayer_minimum_time_is_bang_bang():
     for mayer in (lambda T: T, lambda T, x_f: T + 0.0 * x_f):
         prob = base.replace(mayer=mayer)
         _same(prob.mayer, base.mayer)
-        sol = solve(prob, N=20)
+        sol = solve(prob, N=20, control="constant")  # bang-bang
         assert sol.success and sol.T == pytest.approx(truth["T"], abs=1e-6)
 
 
@@ -111,7 +111,7 @@ def test_a_named_path_list_is_stacked_into_rows():
 def test_constant_running_cost_is_minimum_time():
     base, truth = bang_bang()
     prob = base.replace(mayer=None, lagrange=lambda: 1.0)
-    sol = solve(prob, N=20)
+    sol = solve(prob, N=20, control="constant")  # bang-bang
     assert sol.success and sol.T == pytest.approx(truth["T"], abs=1e-6)
 
 

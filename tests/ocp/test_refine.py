@@ -55,7 +55,9 @@ TILTED = (0.3, -0.4, 1.0)
 def test_refine_bang_bang_reduces_T_error_and_concentrates_at_the_switch():
     problem, truth = bang_bang()
     T_star = truth["T"]
-    sol = refine(problem, N=7, tol=1e-6, ipopt_options=STRICT)  # odd N: switch inside an interval
+    # odd N: switch inside an interval. A linear control: the Radau polynomial overshoots
+    # the bound around a switch inside an interval however small (a Bound_Violation)
+    sol = refine(problem, N=7, tol=1e-6, ipopt_options=STRICT, control="linear")
     assert isinstance(sol, RefinedSolution) and isinstance(sol, Solution)
     assert sol.success and sol.info["converged"], sol.message
     hist = sol.refinement
@@ -194,7 +196,9 @@ def test_polish_switches_bilimoria_wie_from_a_tilted_start():
     t = time.perf_counter()
     problem = bilimoria_wie()
     start = solve(problem, N=20, guess=axis_guess(TILTED), verbose=False)
-    assert start.success and 3.2428 < start.T < 3.2440
+    # its Radau control polynomials overshoot |u| <= 1 between the nodes (a Bound_Violation,
+    # which also lets its T sit below the polished one); a start for the polish all the same
+    assert start.status == "Bound_Violation" and 3.2428 < start.T < 3.2440
     sol = polish_switches(problem, start)
     elapsed = time.perf_counter() - t
     assert sol.success, sol.message
@@ -231,12 +235,15 @@ def test_constant_control_transcription_on_a_fixed_mesh():
 # ========================================================================= multistart
 def test_multistart_picks_the_better_local_optimum():
     problem = bilimoria_wie()
-    sol = solve_multistart(problem, [None, axis_guess(TILTED)], N=20)  # None: eigenaxis SLERP
+    # None: eigenaxis SLERP. A piecewise-constant control (bang-bang; the Radau polynomial
+    # overshoots the bounds): feasible, so T stays above the optimum 3.2430833 (switch-time
+    # polish) by its O(h) discretization error (measured 3.24623)
+    sol = solve_multistart(problem, [None, axis_guess(TILTED)], N=20, control="constant")
     assert isinstance(sol, RefinedSolution) and sol.success
     starts = sol.starts
     assert [s["index"] for s in starts] == [0, 1] and all(s["success"] for s in starts)
     assert abs(starts[0]["cost"] - 2 * math.sqrt(math.pi)) < 1e-3  # eigenaxis local optimum
-    assert 3.2428 < starts[1]["cost"] < 3.2440
+    assert 3.24308 < starts[1]["cost"] < 3.2470
     assert sol.info["best"] == 1 and sol.T == pytest.approx(starts[1]["T"])
     assert all(s["time"] > 0 and s["iterations"] > 0 for s in starts)
 

@@ -13,8 +13,10 @@ from .reference import STRICT, bang_bang
 @pytest.mark.parametrize("N", [7, 8])  # odd: switch inside an interval; even: on a knot
 def test_detectors_agree_on_a_bang_bang_solution(N):
     problem, truth = bang_bang()
-    sol = solve(problem, N=N, ipopt_options=STRICT)
-    assert sol.success, sol.message
+    # the Radau control polynomial through the switch overshoots |u| <= 1 (N = 7): the
+    # detectors read the collocated solution all the same
+    sol = solve(problem, N=N, ipopt_options=STRICT, verify=False)
+    assert sol.success if N == 8 else sol.status == "Bound_Violation", sol.message
     per = control_switches(sol)
     merged = find_switches(sol)
     assert len(per) == 1

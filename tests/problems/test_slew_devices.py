@@ -51,7 +51,12 @@ def test_cmg_min_effort_keeps_the_singularity_measure_above_its_bound():
     bound = 0.5 * (free.info["min_measure"] + float(singularity_measure(geo, np.zeros(4))))
     kept = slew.cmg_slew(10 * np.eye(3), geo, objective="effort", T=2.0, angle=0.1,
                          axis=[1, 0, 0], N=15, min_measure=bound)
-    assert free.success and kept.success, kept.message
+    assert free.success, free.message
+    # held above the bound, the gimbal rates ride their limits and the Radau rate polynomials
+    # overshoot them between the nodes (8 % at N = 15; before the dense output was checked
+    # this was a success). The piecewise-linear remedy imposes the measure at the mesh
+    # points only (it dipped 2.3e-5 below between them), so it is not taken: an honest failure
+    assert not kept.success and "leaves its bounds" in kept.message, kept.message
     assert free.info["min_measure"] < bound  # unconstrained, the path dips below
     assert kept.info["min_measure"] >= bound * (1 - 1e-6)
     assert kept.cost >= free.cost
@@ -91,5 +96,8 @@ def test_cmg_time_optimal_singular_arc_general_inertia_is_verified():
     fixed[:4] = False
     assert np.max(sol.terminal_error[fixed]) <= slew.RATE_TOL  # rates and fixed gimbals
     assert sol.cost == sol.T  # graded as a minimum-time solution, not by the penalty
-    assert abs(sol.T - 2.6895796) < 1e-5  # 1.1e-5 relative above the stalled 2.6895489
+    # the regularized fallback's Radau gimbal rates left their bounds between the nodes (T
+    # 2.6895796, 1.1e-5 relative above the stalled 2.6895489): re-solved with a constant rate
+    # per interval on its mesh (`slew.bounded`), measured T = 2.6895478
+    assert "bounded" in sol.info and abs(sol.T - 2.6895478) < 1e-6
     assert sol.info["momentum_drift"] < 1e-5

@@ -143,7 +143,12 @@ def test_general_inertia_near_miss_is_verified_on_a_finer_mesh():
     assert "uniform mesh of 60 intervals" in sol.info["fallback"]
     xf = resimulate(sol, inertia, [0, 0, 0, 1.0], np.zeros(3))
     assert angle_between(xf[:4], target(1.0, [0, 0, 1])) <= slew.POINTING_TOL
-    assert np.max(np.abs(sol.u)) <= 1.0 + 1e-9 and sol.T == pytest.approx(2.51199, abs=1e-4)
+    # the fallback's Radau torque polynomials left |u| <= 1 between the nodes (T 2.51199);
+    # re-solved with a constant torque per interval on its mesh (`slew.bounded`), measured
+    # 2.5121083: 1.2e-4 slower, within the bounds everywhere
+    _, u = sol.sample(np.linspace(sol.t0, sol.t0 + sol.T, 4001))
+    assert np.max(np.abs(u)) <= 1.0 + 1e-9 and "bounded" in sol.info
+    assert sol.T == pytest.approx(2.5121083, abs=1e-6)
 
 
 def test_refinement_tol_is_required(monkeypatch):

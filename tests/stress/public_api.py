@@ -416,6 +416,8 @@ OVERRIDES = {
     "ocp.optimize_switch_times": {"problem": lambda: _slew_optimal()[0],
                                   "solution": lambda: _slew_optimal()[1]},
     "problems.slew.verify": {"solution": lambda: _slew_optimal()[1]},
+    "problems.slew.bounded": {"problem": lambda: _slew_optimal()[0],
+                              "solution": lambda: _slew_optimal()[1]},
 }
 
 # optional keywords that make the all-valid call valid (a target, a spin rate, ...)
