@@ -336,7 +336,8 @@ def bounded(problem, solution, *, control="constant", pointing_tol=POINTING_TOL,
            f"between its nodes (`{bv.name}` by {bv.max:.3g} of its scale at t = {bv.time:.6g} "
            f"s): re-solved with control={control!r}")
     if again.success:
-        return annotate(again, {**keep, "bounded": why})
+        said = f"; {polish_text(keep['polish'])}" if "polish" in keep else ""
+        return annotate(again, {**keep, "bounded": why}, message=f"{again.message}; {why}{said}")
     return annotate(failed, {"bounded": f"{why}, which failed: {again.message[:300]}"},
                     message=f"{failed.message}; {why}, which failed: {again.message[:300]}")
 

@@ -60,14 +60,11 @@ USER_SLEW = dict(angle=np.pi / 2, axis=np.array([0.0, 1.0, 1.0]) / np.sqrt(2),
 def test_polish_skipped_on_a_first_solution_that_is_not_bang_bang():
     """Its first solution has a singular arc (component 0 off its bounds on a stretch): the
     switch-time polish does not apply, and the moving-knot re-solve it fell back to took
-    6.5 s (20x the solve) to be discarded. Now skipped, saying so: the same T, in about the
-    time of the solve without it."""
+    6.5 s (20x the solve) to be discarded. Now skipped before anything is built, saying so:
+    the same T (the times are measured by bench/trust.py, not asserted here)."""
     import time
 
-    plain = slew.time_optimal(USER_INERTIA, **USER_SLEW, polish=False)  # warm: builds cached
-    t = time.perf_counter()
     plain = slew.time_optimal(USER_INERTIA, **USER_SLEW, polish=False)
-    t_plain = time.perf_counter() - t
     t = time.perf_counter()
     sol = slew.time_optimal(USER_INERTIA, **USER_SLEW)
     t_polish = time.perf_counter() - t
@@ -77,8 +74,7 @@ def test_polish_skipped_on_a_first_solution_that_is_not_bang_bang():
     record = sol.info["polish"]
     assert record["ran"] is False and record["used"] is False and "not bang-bang" in record["why"]
     assert "polish skipped: not bang-bang" in sol.message
-    assert sol.T == plain.T and record["gain"] == 0.0
-    assert t_polish <= 2.0 * t_plain + 0.5, (t_polish, t_plain)
+    assert sol.T == plain.T and record["gain"] == 0.0 and record["wall_time"] == 0.0
     assert sol.info["wall_time"] <= t_polish
 
 
