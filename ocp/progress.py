@@ -19,7 +19,7 @@ from typing import Callable
 import casadi as ca
 import numpy as np
 
-from dynamics.interrupts import interrupt_pending
+from appdyn.dynamics.interrupts import interrupt_pending
 
 __all__ = ["LOGGER", "Progress", "IterationCallback", "printer", "iteration_sink"]
 

@@ -10,8 +10,8 @@ import warnings
 
 import numpy as np
 
-from dynamics.validate import integer, positive
-from dynamics.interrupts import interruptible
+from appdyn.dynamics.validate import integer, positive
+from appdyn.dynamics.interrupts import interruptible
 from ..mesh import Mesh
 from ..problem import Problem
 from ..progress import LOGGER
@@ -254,8 +254,8 @@ def refine(problem: Problem, solution: Solution | None = None, *, tol: float = 1
 
     Examples
     --------
-    >>> import ocp
-    >>> from ocp.examples import min_energy
+    >>> from appdyn import ocp
+    >>> from appdyn.ocp.examples import min_energy
     >>> energy = min_energy()  # x'' = u from rest at 0 to rest at 1 in T = 1 s
     >>> first = ocp.solve(energy, N=10, transcription="trapezoid")
     >>> sol = ocp.refine(energy, first, tol=1e-8)
@@ -264,7 +264,7 @@ def refine(problem: Problem, solution: Solution | None = None, *, tol: float = 1
 
     A singular arc stalls; a small regularization converges:
 
-    >>> from ocp.examples import goddard_rocket
+    >>> from appdyn.ocp.examples import goddard_rocket
     >>> rocket = ocp.refine(goddard_rocket(), tol=1e-6)
     >>> rocket.status, rocket.info["stop"], len(rocket.refinement) - 1
     ('Refinement_Stalled', 'stalled', 2)
