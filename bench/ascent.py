@@ -29,9 +29,9 @@ from pathlib import Path
 
 import numpy as np
 
-from dynamics import clear_caches
-from problems.ascent import delta3_ascent
-from problems.ascent.delta3 import FINAL_MASS_BETTS
+from appdyn.dynamics import clear_caches
+from appdyn.problems.ascent import delta3_ascent
+from appdyn.problems.ascent.delta3 import FINAL_MASS_BETTS
 
 from _common import Row, script_main, write_csv
 

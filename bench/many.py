@@ -30,11 +30,11 @@ from pathlib import Path
 
 import numpy as np
 
-from dynamics import clear_caches
-from ocp import solve_multistart
-from problems import slew
-from problems import stability as st
-from problems.dispersion import nutation_spread
+from appdyn.dynamics import clear_caches
+from appdyn.ocp import solve_multistart
+from appdyn.problems import slew
+from appdyn.problems import stability as st
+from appdyn.problems.dispersion import nutation_spread
 
 from _common import Row, script_main, write_csv
 

@@ -77,11 +77,11 @@ import numpy as np
 from scipy.optimize import brentq
 
 from _common import Row, save_figure, script_main, write_csv  # bench/ on sys.path (runner, script)
-from dynamics import wheel_spacecraft
-from dynamics.model import Model
-from ocp import Problem, solve
-from ocp.examples import GODDARD_OPTIMUM, goddard_rocket, min_energy, min_time
-from problems import slew
+from appdyn.dynamics import wheel_spacecraft
+from appdyn.dynamics.model import Model
+from appdyn.ocp import Problem, solve
+from appdyn.ocp.examples import GODDARD_OPTIMUM, goddard_rocket, min_energy, min_time
+from appdyn.problems import slew
 
 NAME = "ocp_precision"
 BW_T = 3.2430832775  # Bilimoria & Wie (1993), best known

@@ -23,9 +23,9 @@ from pathlib import Path
 
 import numpy as np
 
-from dynamics import rigid_body, simulate
-from dynamics.integrate import adaptive, evaluate
-from dynamics.integrate.loops import CHUNK, _chunk_shapes, chunk_function
+from appdyn.dynamics import rigid_body, simulate
+from appdyn.dynamics.integrate import adaptive, evaluate
+from appdyn.dynamics.integrate.loops import CHUNK, _chunk_shapes, chunk_function
 
 from _common import Row, script_main, write_csv
 

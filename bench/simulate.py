@@ -47,8 +47,8 @@ from pathlib import Path
 import numpy as np
 from scipy.integrate import solve_ivp
 
-from dynamics import rigid_body, simulate
-from dynamics.truth import torque_free_omega
+from appdyn.dynamics import rigid_body, simulate
+from appdyn.dynamics.truth import torque_free_omega
 
 from _common import Row, machine, save_figure, script_main, timed, write_csv
 

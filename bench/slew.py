@@ -32,8 +32,8 @@ from pathlib import Path
 
 import numpy as np
 
-from ocp import solve
-from problems import slew
+from appdyn.ocp import solve
+from appdyn.problems import slew
 
 from _common import Row, script_main, write_csv
 

@@ -31,8 +31,8 @@ from pathlib import Path
 
 import numpy as np
 
-from dynamics import hinged_bodies, rigid_body, simulate
-from dynamics.truth import torque_free_omega
+from appdyn.dynamics import hinged_bodies, rigid_body, simulate
+from appdyn.dynamics.truth import torque_free_omega
 
 from _common import Row, script_main, write_csv
 
@@ -93,7 +93,7 @@ def torque_free(quick: bool):
 
 def spherical(quick: bool):
     try:
-        from dynamics.mechanisms import spherical_mass_matrix, spherical_pendulum
+        from appdyn.dynamics.mechanisms import spherical_mass_matrix, spherical_pendulum
     except ImportError as exc:  # pragma: no cover - the models live in dynamics.mechanisms
         return [{"case": "spherical pendulum", "setting": "skipped", "message": str(exc)}], []
     # point mass (I = 0): the same physics in both; almost planar, passing ~7e-4 rad from the
@@ -182,7 +182,7 @@ def hinged(quick: bool):
 # --------------------------------------------------------------------------------------------
 
 def cmg(quick: bool):
-    from dynamics.momentum import pyramid, steer
+    from appdyn.dynamics.momentum import pyramid, steer
 
     geo = pyramid(np.deg2rad(54.74))
     T = 20.0

@@ -114,8 +114,8 @@ def _finite_or_inf(fun):
 
 
 def case_torque_free():
-    from dynamics import rigid_body
-    from dynamics.truth import torque_free_omega
+    from appdyn.dynamics import rigid_body
+    from appdyn.dynamics.truth import torque_free_omega
 
     inertia, w0 = np.array([1.0, 2.0, 3.0]), np.array([1.0, 0.1, 0.8])
     t = np.linspace(0.0, 100.0, 101)
@@ -126,8 +126,8 @@ def case_torque_free():
 
 
 def case_axisymmetric():
-    from dynamics import rigid_body
-    from dynamics.truth import axisymmetric
+    from appdyn.dynamics import rigid_body
+    from appdyn.dynamics.truth import axisymmetric
 
     inertia, w0 = np.array([1.0, 1.0, 1.6]), np.array([0.3, -0.1, 1.0])
     q0 = np.array([0.1, -0.2, 0.3, 0.9])
@@ -145,7 +145,7 @@ def case_axisymmetric():
 
 
 def case_wheels():
-    from dynamics import wheel_spacecraft
+    from appdyn.dynamics import wheel_spacecraft
 
     hub = np.array([[10.0, 0.2, -0.1], [0.2, 12.0, 0.3], [-0.1, 0.3, 8.0]])
     axes = np.c_[np.eye(3), np.ones(3) / np.sqrt(3.0)]
@@ -164,8 +164,8 @@ def case_wheels():
 
 
 def case_cmg():
-    from dynamics import cmg_spacecraft
-    from dynamics.momentum.cluster import pyramid
+    from appdyn.dynamics import cmg_spacecraft
+    from appdyn.dynamics.momentum.cluster import pyramid
 
     geo = pyramid(np.arccos(1.0 / np.sqrt(3.0)), h=1.0)
     model = cmg_spacecraft([20.0, 25.0, 18.0], geo.gimbal_axes, geo.spin_axes0, geo.h)
@@ -183,8 +183,8 @@ def case_cmg():
 
 
 def case_hinged():
-    from dynamics import hinged_bodies
-    from dynamics.attitude import quat_from_axis_angle
+    from appdyn.dynamics import hinged_bodies
+    from appdyn.dynamics.attitude import quat_from_axis_angle
 
     model = hinged_bodies(10.0, [1.0, 2.0, 2.5], 2.0, [0.2, 0.3, 0.4], [0.4, 0.0, 0.0],
                           [-0.3, 0.0, 0.0], kind="ball", stabilization=None)
@@ -211,7 +211,7 @@ def case_launch_vehicle():
     import casadi as ca
     from scipy.linalg import expm
 
-    from dynamics import launch_vehicle
+    from appdyn.dynamics import launch_vehicle
 
     model = launch_vehicle(thrust=2.0e6, inertia=4.0e7, arm=20.0, mass=1.0e5, k_psi=2.0,
                            k_psidot=0.5)
@@ -315,7 +315,7 @@ def _row(case, solver, setting, first, times, x, success, n_steps):
 
 
 def _appdyn_runs(case, cfg, budget_end):
-    from dynamics import simulate
+    from appdyn.dynamics import simulate
 
     rows = []
     atol = np.broadcast_to(np.asarray(case.scale, dtype=float), (case.model.nx,)) \

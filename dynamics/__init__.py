@@ -42,7 +42,7 @@ def clear_caches() -> None:
 
     Examples
     --------
-    >>> from dynamics import clear_caches, rigid_body
+    >>> from appdyn.dynamics import clear_caches, rigid_body
     >>> model = rigid_body([1.0, 2.0, 3.0])
     >>> rigid_body([1.0, 2.0, 3.0]) is model  # built once, cached by inertia
     True
@@ -55,5 +55,5 @@ def clear_caches() -> None:
 
 def __getattr__(name):
     if name == "truth":
-        return importlib.import_module("dynamics.truth")
-    raise AttributeError(f"module 'dynamics' has no attribute {name!r}")
+        return importlib.import_module("appdyn.dynamics.truth")
+    raise AttributeError(f"module 'appdyn.dynamics' has no attribute {name!r}")

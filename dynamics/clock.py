@@ -31,8 +31,8 @@ A mass on a spring whose anchor is driven by ``a sin(t)``; the clock is the thir
 
 >>> import casadi as ca
 >>> import numpy as np
->>> from dynamics import Model, simulate
->>> from dynamics.clock import CLOCK_STATE, check_clock_start, clock_index
+>>> from appdyn.dynamics import Model, simulate
+>>> from appdyn.dynamics.clock import CLOCK_STATE, check_clock_start, clock_index
 >>> x, u, p = ca.SX.sym("x", 3), ca.SX.sym("u", 0), ca.SX.sym("p", 1)
 >>> y, ydot, t = x[0], x[1], x[2]
 >>> xdot = ca.vertcat(ydot, -(y - p[0] * ca.sin(t)), 1)      # clock: t' = 1
@@ -87,9 +87,9 @@ def clock_index(model) -> int | None:
 
     Examples
     --------
-    >>> from dynamics import rigid_body
-    >>> from dynamics.clock import clock_index
-    >>> from dynamics.mechanisms import shaken_pendulum
+    >>> from appdyn.dynamics import rigid_body
+    >>> from appdyn.dynamics.clock import clock_index
+    >>> from appdyn.dynamics.mechanisms import shaken_pendulum
     >>> clock_index(shaken_pendulum()), clock_index(rigid_body([1.0, 2.0, 3.0])) is None
     (2, True)
     """
@@ -125,8 +125,8 @@ def check_clock_start(model, x0, t0) -> np.ndarray:
 
     Examples
     --------
-    >>> from dynamics.clock import check_clock_start
-    >>> from dynamics.mechanisms import shaken_pendulum
+    >>> from appdyn.dynamics.clock import check_clock_start
+    >>> from appdyn.dynamics.mechanisms import shaken_pendulum
     >>> check_clock_start(shaken_pendulum(), [0.1, 0.0, 5.0], 5.0)
     array([0.1, 0. , 5. ])
     """

@@ -112,8 +112,8 @@ def closed_loop(model: Model, controller: ca.Function, *,
     --------
     >>> import casadi as ca
     >>> import numpy as np
-    >>> from dynamics import rigid_body, simulate
-    >>> from dynamics import closed_loop
+    >>> from appdyn.dynamics import rigid_body, simulate
+    >>> from appdyn.dynamics import closed_loop
     >>> x = ca.SX.sym("x", 7)
     >>> damper = ca.Function("rate_damper", [x], [-2.0 * x[4:7]], ["x"], ["u"])  # L = -2 w
     >>> loop = closed_loop(rigid_body([1.0, 1.0, 1.0]), damper)

@@ -16,7 +16,7 @@ def new_figure(figsize=(8.0, 5.0)):
 
     Examples
     --------
-    >>> from dynamics.figures import new_figure
+    >>> from appdyn.dynamics.figures import new_figure
     >>> type(new_figure()).__name__
     'Figure'
     """

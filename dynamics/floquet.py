@@ -84,8 +84,8 @@ def variational_model(model: Model) -> Model:
 
     Examples
     --------
-    >>> from dynamics.floquet import variational_model
-    >>> from dynamics.mechanisms import shaken_pendulum
+    >>> from appdyn.dynamics.floquet import variational_model
+    >>> from appdyn.dynamics.mechanisms import shaken_pendulum
     >>> variational_model(shaken_pendulum()).states
     ('theta', 'theta_dot', 't', 'Phi_0_0', 'Phi_1_0', 'Phi_0_1', 'Phi_1_1')
     """
@@ -235,7 +235,7 @@ def classify_multipliers(multipliers, tol: float = TOL) -> tuple[str, str]:
 
     Examples
     --------
-    >>> from dynamics.floquet import classify_multipliers
+    >>> from appdyn.dynamics.floquet import classify_multipliers
     >>> classify_multipliers([0.5, -0.9j])[0], classify_multipliers([1j, -1j])[0]
     ('asymptotically stable', 'marginally stable')
     >>> classify_multipliers([2.0, 0.5])
@@ -325,8 +325,8 @@ def monodromy(model, x0, period, *, u=None, p=None, rtol=1e-10, atol=1e-10, step
     hanging at rest, ``det Phi = 1`` (no damping):
 
     >>> import numpy as np
-    >>> from dynamics.floquet import monodromy
-    >>> from dynamics.mechanisms import double_pendulum
+    >>> from appdyn.dynamics.floquet import monodromy
+    >>> from appdyn.dynamics.mechanisms import double_pendulum
     >>> phi = monodromy(double_pendulum(), np.zeros(4), 1.0, jit=False)
     >>> phi.shape, round(float(np.linalg.det(phi)), 9)
     ((4, 4), 1.0)
@@ -363,8 +363,8 @@ def floquet(model, x0, period, *, u=None, p=None, tol=TOL, rtol=1e-10, atol=1e-1
     Kapitza frequency of 128 rad/s), with a little hinge damping:
 
     >>> import math
-    >>> from dynamics.floquet import floquet
-    >>> from dynamics.mechanisms import shaken_pendulum
+    >>> from appdyn.dynamics.floquet import floquet
+    >>> from appdyn.dynamics.mechanisms import shaken_pendulum
     >>> model = shaken_pendulum(freq=200.0, damping=0.002)
     >>> res = floquet(model, [math.pi, 0.0, 0.0], 2 * math.pi / 200.0, jit=False)
     >>> res.verdict, res.success, res.multipliers.shape

@@ -175,8 +175,8 @@ class HingedBodies(Model):
         Examples
         --------
         >>> import numpy as np
-        >>> from dynamics import hinged_bodies
-        >>> from dynamics.attitude import dcm_from_quat, quat_from_axis_angle, quat_mul
+        >>> from appdyn.dynamics import hinged_bodies
+        >>> from appdyn.dynamics.attitude import dcm_from_quat, quat_from_axis_angle, quat_mul
         >>> axis = np.array([0.0, 0.0, 1.0])
         >>> model = hinged_bodies(10.0, [1, 2, 2.5], 2.0, [0.2, 0.2, 0.3], [0, 0, 0.5],
         ...                       [0, 0, -0.2], kind="revolute", axis=axis)
@@ -229,7 +229,7 @@ class HingedBodies(Model):
         Examples
         --------
         >>> import numpy as np
-        >>> from dynamics import hinged_bodies
+        >>> from appdyn.dynamics import hinged_bodies
         >>> model = hinged_bodies(3.0, [1, 1, 1], 1.0, [0.1, 0.1, 0.1], [0.5, 0, 0], [-0.2, 0, 0])
         >>> x = model.initial_state([0, 0, 0, 1], [0, 0, 1.0], [0, 0, 0], [0, 0, 0, 1], [0, 0, 1.0])
         >>> x[23] += 1e-3  # open the hinge by a millimetre
@@ -434,7 +434,7 @@ def hinged_bodies(m1, I1, m2, I2, r1, r2, *, kind: str = "ball", axis=None,
     Examples
     --------
     >>> import numpy as np
-    >>> from dynamics import hinged_bodies
+    >>> from appdyn.dynamics import hinged_bodies
     >>> model = hinged_bodies(10.0, [1.0, 2.0, 2.5], 2.0, [0.2, 0.3, 0.4],
     ...                       [0.4, 0.0, 0.0], [-0.3, 0.0, 0.0])
     >>> model.nx, model.states[13:17]

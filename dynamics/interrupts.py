@@ -38,7 +38,7 @@ def deferred_interrupts():
 
     Examples
     --------
-    >>> from dynamics.interrupts import check_interrupt, deferred_interrupts
+    >>> from appdyn.dynamics.interrupts import check_interrupt, deferred_interrupts
     >>> with deferred_interrupts():
     ...     for k in range(3):
     ...         check_interrupt()  # raises KeyboardInterrupt here after a Ctrl-C

@@ -531,7 +531,7 @@ def linearize(model: Model, x, u=None, p=None, *, frame: Frame = "spinning",
 
     Examples
     --------
-    >>> from dynamics import rigid_body
+    >>> from appdyn.dynamics import rigid_body
     >>> sys = linearize(rigid_body([1.0, 2.0, 3.0]), [0, 0, 0, 1, 10.0, 0, 0])
     >>> sys.state_labels
     ['dth1', 'dth2', 'dth3', 'w1', 'w2', 'w3']

@@ -69,7 +69,7 @@ class Model:
     Examples
     --------
     >>> import casadi as ca
-    >>> from dynamics import Model
+    >>> from appdyn.dynamics import Model
     >>> x, u, p = ca.SX.sym("x", 2), ca.SX.sym("u", 1), ca.SX.sym("p", 1)
     >>> f = ca.Function("oscillator", [x, u, p], [ca.vertcat(x[1], -p[0] * x[0] + u[0])],
     ...                 ["x", "u", "p"], ["xdot"])
@@ -147,7 +147,7 @@ class Model:
         Examples
         --------
         >>> import casadi as ca
-        >>> from dynamics import Model
+        >>> from appdyn.dynamics import Model
         >>> x, v, u = ca.SX.sym("x"), ca.SX.sym("v"), ca.SX.sym("u")
         >>> model = Model.from_expressions({"x": x, "v": v}, {"x": v, "v": u}, {"u": u})
         >>> model.states, model.controls, model.params
@@ -356,7 +356,7 @@ def model_from_expressions(states, xdot, controls=None, params=None, *, p_defaul
     A pendulum ``theta'' = -(g / l) sin(theta) + u``:
 
     >>> import casadi as ca
-    >>> from dynamics.model import model_from_expressions
+    >>> from appdyn.dynamics.model import model_from_expressions
     >>> th, om, u, g, l = (ca.SX.sym(n) for n in ("theta", "omega", "u", "g", "l"))
     >>> model = model_from_expressions(
     ...     [("theta", th), ("omega", om)], [om, -g / l * ca.sin(th) + u],

@@ -87,7 +87,7 @@ def rigid_body(inertia) -> Model:
 
     Examples
     --------
-    >>> from dynamics import rigid_body
+    >>> from appdyn.dynamics import rigid_body
     >>> model = rigid_body([1.0, 2.0, 3.0])
     >>> model.states, model.controls
     (('q1', 'q2', 'q3', 'q4', 'w1', 'w2', 'w3'), ('L1', 'L2', 'L3'))

@@ -23,7 +23,7 @@ def plain(v, *, strict: bool = False):
     Examples
     --------
     >>> import numpy as np
-    >>> from dynamics.serialize import plain
+    >>> from appdyn.dynamics.serialize import plain
     >>> plain({"x": np.array([1.0, np.inf]), "n": np.int64(3)})
     {'x': [1.0, inf], 'n': 3}
     """
@@ -62,7 +62,7 @@ def jsonable(v):
     Examples
     --------
     >>> import numpy as np
-    >>> from dynamics.serialize import jsonable
+    >>> from appdyn.dynamics.serialize import jsonable
     >>> jsonable({"x": np.array([1.0, np.nan]), "z": 1 + 2j, "n": np.int64(3)})
     {'x': [1.0, None], 'z': [1.0, 2.0], 'n': 3}
     """
@@ -74,7 +74,7 @@ def to_json(data) -> str:
 
     Examples
     --------
-    >>> from dynamics.serialize import to_json
+    >>> from appdyn.dynamics.serialize import to_json
     >>> print(to_json({"error": float("inf")}))
     {
       "error": null
@@ -88,7 +88,7 @@ def text_table(title: str, rows) -> str:
 
     Examples
     --------
-    >>> from dynamics.serialize import text_table
+    >>> from appdyn.dynamics.serialize import text_table
     >>> print(text_table("Result", [("success", True), ("cost", 6.0)]))
     Result
       success  True

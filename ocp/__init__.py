@@ -3,7 +3,7 @@
 State a `Problem` (dynamics, bounds, boundary conditions, constraints, cost), pick a
 transcription (`Trapezoid`, `HermiteSimpson`, `Radau`), and `solve` it::
 
-    from ocp import Problem, solve
+    from appdyn.ocp import Problem, solve
     sol = solve(Problem(model, T=1.0, x_initial=..., x_final=..., lagrange=...),
                 transcription="radau", N=20)
     sol.success, sol.cost, sol.sample(t)

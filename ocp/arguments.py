@@ -12,8 +12,8 @@ from typing import Mapping
 
 import numpy as np
 
-from dynamics.model import Model
-from dynamics.validate.base import real_array
+from appdyn.dynamics.model import Model
+from appdyn.dynamics.validate.base import real_array
 
 __all__ = ["as_vector", "index", "boundary_values", "bounds", "horizon", "parameters",
            "row_bounds"]

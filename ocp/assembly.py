@@ -42,9 +42,9 @@ import casadi as ca
 import numpy as np
 import scipy.sparse as sps
 
-from dynamics.attitude import quat_conj, quat_mul
+from appdyn.dynamics.attitude import quat_conj, quat_mul
 
-from dynamics.cache import compile_function, compiler
+from appdyn.dynamics.cache import compile_function, compiler
 
 from .cached import cached, function_key
 from .layout import Layout

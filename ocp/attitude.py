@@ -24,8 +24,8 @@ import math
 import casadi as ca
 import numpy as np
 
-from dynamics.attitude import quat_conj, quat_mul
-from dynamics.validate import QUAT_NORM_TOL, unit_quaternion
+from appdyn.dynamics.attitude import quat_conj, quat_mul
+from appdyn.dynamics.validate import QUAT_NORM_TOL, unit_quaternion
 
 __all__ = ["check_attitude", "needs_norm_at_t0", "attitude_error", "target_rows", "nlp_rows",
            "target_bounds", "slerp", "quaternion_path"]

@@ -8,7 +8,7 @@ polish (``rk8_step``, ``rk8_step_jacobian``), the NLP structures of `ocp.assembl
 the switch-time NLPs (``switch_times_nlp``, by content and arc count) and their solvers
 (``switch_times_nlpsol``, pooled) -- are built once per model right-hand side and
 defining arguments and reused by every solve, refinement round and `Solution` of that
-model. Keys are ``("ocp.<kind>", ...)`` tuples holding `dynamics.cache.function_key` of the
+model. Keys are ``("appdyn.ocp.<kind>", ...)`` tuples holding `dynamics.cache.function_key` of the
 model Functions (which are kept alive with the entry); `dynamics.clear_caches` empties
 them with everything else.
 
@@ -23,15 +23,15 @@ sides) is a pure Function, shared by all threads.
 Examples
 --------
 >>> import casadi as ca
->>> from dynamics import cache, clear_caches
->>> from ocp.cached import cached
+>>> from appdyn.dynamics import cache, clear_caches
+>>> from appdyn.ocp.cached import cached
 >>> x = ca.SX.sym("x")
 >>> f = ca.Function("f", [x], [2 * x])
 >>> g = cached("double", (cache.function_key(f),), lambda: f.map(3), keepalive=f)
 >>> g is cached("double", (cache.function_key(f),), lambda: f.map(3), keepalive=f)
 True
 >>> clear_caches()
->>> cache.contains(("ocp.double", cache.function_key(f)))
+>>> cache.contains(("appdyn.ocp.double", cache.function_key(f)))
 False
 """
 from __future__ import annotations
@@ -40,7 +40,7 @@ import contextlib
 import threading
 from typing import Callable, Hashable
 
-from dynamics import cache
+from appdyn.dynamics import cache
 
 __all__ = ["cached", "checkout", "function_key", "PER_THREAD"]
 
@@ -51,12 +51,12 @@ function_key = cache.function_key
 
 
 def cached(kind: str, parts: tuple, build: Callable[[], object], *, keepalive=None):
-    """``build()`` kept in `dynamics.cache` under ``("ocp." + kind, *parts)``.
+    """``build()`` kept in `dynamics.cache` under ``("appdyn.ocp." + kind, *parts)``.
 
     Parameters
     ----------
     kind : str
-        What is built (the key's first item is ``"ocp." + kind``).
+        What is built (the key's first item is ``"appdyn.ocp." + kind``).
     parts : tuple
         The defining arguments: `function_key` of every Function the entry is built from,
         transcriptions (frozen dataclasses), grids as tuples of floats, tolerances.
@@ -71,7 +71,7 @@ def cached(kind: str, parts: tuple, build: Callable[[], object], *, keepalive=No
         The cached entry, or a fresh ``build()`` when ``parts`` is not hashable (e.g. a
         user-defined transcription with mutable fields).
     """
-    key: Hashable = ("ocp." + kind,) + tuple(parts)
+    key: Hashable = ("appdyn.ocp." + kind,) + tuple(parts)
     if kind in PER_THREAD:
         key += (("thread", threading.get_ident()),)
     try:
@@ -87,7 +87,7 @@ def checkout(kind: str, parts: tuple, build: Callable[[], object], *, keepalive=
     """Like `cached`, for an entry that must not run in two threads at once (an IPOPT
     solver): a context manager lending an instance to this caller alone, from a pool kept in
     `dynamics.cache` (`dynamics.cache.checkout`); a fresh ``build()`` for unhashable parts."""
-    key: Hashable = ("ocp." + kind,) + tuple(parts)
+    key: Hashable = ("appdyn.ocp." + kind,) + tuple(parts)
     try:
         hash(key)
     except TypeError:

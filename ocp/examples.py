@@ -50,8 +50,8 @@ coast, the singular control law on the middle one), as the tests do to compute t
 
 Examples
 --------
->>> import ocp
->>> from ocp.examples import min_energy, min_time
+>>> from appdyn import ocp
+>>> from appdyn.ocp.examples import min_energy, min_time
 >>> round(ocp.solve(min_energy(), N=10).cost, 6)
 6.0
 >>> round(ocp.solve(min_time(distance=4.0), N=10).T, 6)
@@ -65,7 +65,7 @@ from types import MappingProxyType
 
 import casadi as ca
 
-from dynamics.model import Model
+from appdyn.dynamics.model import Model
 
 from .problem import Problem
 
@@ -183,8 +183,8 @@ def goddard_rocket(regularization: float = 0.0) -> Problem:
 
     Examples
     --------
-    >>> import ocp
-    >>> from ocp.examples import goddard_rocket, GODDARD_OPTIMUM
+    >>> from appdyn import ocp
+    >>> from appdyn.ocp.examples import goddard_rocket, GODDARD_OPTIMUM
     >>> sol = ocp.solve(goddard_rocket(), N=20)  # the Radau thrust polynomial overshoots [0, 3.5]
     >>> sol.status, round(sol.cost, 5), round(sol.simulated_cost, 5), GODDARD_OPTIMUM["h_f"]
     ('Bound_Violation', 1.01286, 1.01282, 1.0128369183)

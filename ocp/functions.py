@@ -35,7 +35,7 @@ from typing import Sequence
 import casadi as ca
 import numpy as np
 
-from dynamics.model import Model
+from appdyn.dynamics.model import Model
 
 __all__ = ["named_function", "canonical", "by_name", "vocabulary", "valid_names", "POSITIONAL"]
 
@@ -78,7 +78,7 @@ def named_function(fun, kind: str, model: Model, argname: str) -> ca.Function:
 
     Examples
     --------
-    >>> from ocp.examples import double_integrator
+    >>> from appdyn.ocp.examples import double_integrator
     >>> model = double_integrator()  # states ('x', 'v'), control 'u'
     >>> c = named_function(lambda x_f, v_0: [x_f - 1, v_0], "boundary", model, "boundary")
     >>> c.name_in(), c.name_out(), c.numel_out(0)

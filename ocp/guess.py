@@ -47,7 +47,7 @@ from typing import Callable, Mapping
 
 import numpy as np
 
-from dynamics.validate.base import real_array
+from appdyn.dynamics.validate.base import real_array
 
 from .attitude import quaternion_path, slerp  # slerp: re-exported (compatibility)
 from .horizon import default_T as _default_T, simulate_control as _simulate
@@ -374,8 +374,8 @@ def guess_from_simulation(problem, u, *, T=None, n=201, method="auto", rtol=1e-8
 
     Examples
     --------
-    >>> import ocp
-    >>> from ocp.examples import min_time
+    >>> from appdyn import ocp
+    >>> from appdyn.ocp.examples import min_time
     >>> fastest = min_time()  # x'' = u, |u| <= 1, from rest at 0 to rest at 1
     >>> guess = ocp.guess_from_simulation(fastest, lambda t: 1.0 if t < 1 else -1.0, T=2.0, n=21)
     >>> guess["x"].shape, guess["u"].shape, guess["T"]

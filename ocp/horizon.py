@@ -101,7 +101,7 @@ def simulate_control(problem, u: np.ndarray, t: np.ndarray, p, x0=None, **option
     u : ndarray, shape (nu, n)
         The controls used (clipped).
     """
-    from dynamics import simulate
+    from appdyn.dynamics import simulate
 
     lo, hi = problem.u_bounds
     u = np.clip(u, lo[:, None], hi[:, None])

@@ -252,7 +252,7 @@ def available_linear_solvers(options=None) -> tuple | None:
 
     Examples
     --------
-    >>> from ocp.ipopt_options import available_linear_solvers
+    >>> from appdyn.ocp.ipopt_options import available_linear_solvers
     >>> "mumps" in available_linear_solvers()
     True
     """

@@ -49,7 +49,7 @@ from typing import Callable, Union
 import casadi as ca
 import numpy as np
 
-from dynamics.model import Model
+from appdyn.dynamics.model import Model
 
 from .arguments import boundary_values, bounds, horizon, parameters, row_bounds
 from .attitude import attitude_error, check_attitude, needs_norm_at_t0
@@ -211,8 +211,8 @@ class Problem:
     rest to rest over a unit distance:
 
     >>> import casadi as ca
-    >>> from dynamics.model import Model
-    >>> import ocp
+    >>> from appdyn.dynamics.model import Model
+    >>> from appdyn import ocp
     >>> x, u, p = ca.SX.sym("x", 2), ca.SX.sym("u"), ca.SX.sym("p", 0)
     >>> f = ca.Function("f", [x, u, p], [ca.vertcat(x[1], u)], ["x", "u", "p"], ["xdot"])
     >>> model = Model(f, ("x", "v"), ("u",))  # the double integrator x'' = u

@@ -22,7 +22,7 @@ from typing import Callable
 import casadi as ca
 import numpy as np
 
-from dynamics.interrupts import interrupt_pending
+from appdyn.dynamics.interrupts import interrupt_pending
 
 __all__ = ["LOGGER", "Progress", "IterationCallback", "printer", "iteration_sink",
            "StagePrinter", "stage_sink"]
@@ -146,7 +146,7 @@ def stage_sink(verbose, label: str):
 
     Examples
     --------
-    >>> from ocp.progress import stage_sink
+    >>> from appdyn.ocp.progress import stage_sink
     >>> stage_sink(True, "polish").label, stage_sink(False, "polish")
     ('polish', False)
     """

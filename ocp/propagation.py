@@ -8,7 +8,7 @@ from typing import TYPE_CHECKING
 import casadi as ca
 import numpy as np
 
-from dynamics.validate.base import real_array
+from appdyn.dynamics.validate.base import real_array
 
 from .cached import cached, function_key
 

@@ -63,8 +63,8 @@ def rest_solution(problem: Problem, *, T: float | None = None, transcription="ra
     --------
     Holding the state is the exact answer when the target is the initial state:
 
-    >>> import ocp
-    >>> from ocp.examples import double_integrator
+    >>> from appdyn import ocp
+    >>> from appdyn.ocp.examples import double_integrator
     >>> model = double_integrator()  # x'' = u
     >>> stay = ocp.Problem(model, T=1.0, x_initial=[0, 0], x_final=[0, 0],
     ...                    lagrange=lambda x, u, p: 0.5 * u**2)

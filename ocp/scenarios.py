@@ -21,8 +21,8 @@ Two initial conditions of ``x' = -k x``, with the gain ``k`` free: minimizing
 (``A = 0, B = 1, Q = R = 1``) for any set of initial conditions:
 
 >>> import casadi as ca
->>> import ocp
->>> from dynamics import Model
+>>> from appdyn import ocp
+>>> from appdyn.dynamics import Model
 >>> x, k = ca.SX.sym("x"), ca.SX.sym("k")
 >>> loop = Model.from_expressions({"x": x}, {"x": -k * x}, params={"k": k}, p_default=[0.5])
 >>> pr = ocp.scenario_problem(loop, [[1.0, -2.0]], T=20.0, p_bounds={"k": (0.01, 10.0)},
@@ -38,9 +38,9 @@ from typing import Mapping, Sequence
 import casadi as ca
 import numpy as np
 
-from dynamics.model import Model
-from dynamics.validate import integer
-from dynamics.validate.base import real_array
+from appdyn.dynamics.model import Model
+from appdyn.dynamics.validate import integer
+from appdyn.dynamics.validate.base import real_array
 
 from .arguments import bounds, row_bounds
 from .functions import named_function

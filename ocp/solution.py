@@ -7,9 +7,9 @@ from typing import Mapping
 
 import numpy as np
 
-from dynamics.attitude import quat_conj, quat_mul
-from dynamics.figures import finish_figure, new_figure
-from dynamics.serialize import text_table, to_json
+from appdyn.dynamics.attitude import quat_conj, quat_mul
+from appdyn.dynamics.figures import finish_figure, new_figure
+from appdyn.dynamics.serialize import text_table, to_json
 
 from .checks import BoundViolation, bound_violation
 from .dense import DenseOutput
@@ -205,8 +205,8 @@ class Solution:
 
         Examples
         --------
-        >>> import ocp
-        >>> from ocp.examples import min_energy
+        >>> from appdyn import ocp
+        >>> from appdyn.ocp.examples import min_energy
         >>> sol = ocp.solve(min_energy(), N=10)  # x'' = u, rest to rest: u = 6 - 12 t
         >>> sol["v"].shape == sol.t.shape, round(float(sol["u"][0]), 6), round(float(sol["x"][-1]), 6)
         (True, 6.0, 1.0)
@@ -381,8 +381,8 @@ class Solution:
 
         Examples
         --------
-        >>> import ocp
-        >>> from ocp.examples import min_energy
+        >>> from appdyn import ocp
+        >>> from appdyn.ocp.examples import min_energy
         >>> energy = min_energy()  # x'' = u from rest at 0 to rest at 1 in T = 1 s
         >>> sol = ocp.solve(energy, N=10)
         >>> t = [0.0, 0.5, 1.0]
@@ -419,8 +419,8 @@ class Solution:
 
         Examples
         --------
-        >>> import ocp
-        >>> from ocp.examples import min_time
+        >>> from appdyn import ocp
+        >>> from appdyn.ocp.examples import min_time
         >>> sol = ocp.solve(min_time(), N=10, control="linear")  # |u| <= 1: bang-bang
         >>> sol.bound_violation.max, sorted(sol.bound_violation.by_name)
         (0.0, ['u'])
@@ -470,8 +470,8 @@ class Solution:
 
         Examples
         --------
-        >>> import ocp
-        >>> from ocp.examples import min_energy
+        >>> from appdyn import ocp
+        >>> from appdyn.ocp.examples import min_energy
         >>> sol = ocp.solve(min_energy(), N=4)  # Bryson & Ho: J = 6
         >>> prop = sol.propagate()
         >>> prop.success, round(prop.cost, 8), bool(prop.relative_error.max() < 1e-9)

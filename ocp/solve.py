@@ -82,8 +82,8 @@ from typing import Mapping
 
 import numpy as np
 
-from dynamics.cache import construction_lock
-from dynamics.interrupts import check_interrupt, interruptible
+from appdyn.dynamics.cache import construction_lock
+from appdyn.dynamics.interrupts import check_interrupt, interruptible
 
 from .cached import checkout
 from .checks import (STATUS_BOUND_VIOLATION, STATUS_RESIMULATION, check_verify_tol,
@@ -274,8 +274,8 @@ def solve(problem: Problem, *, transcription="radau", N: int | None = None, degr
     Minimum energy of the double integrator over a unit distance in T = 1 s (Bryson & Ho:
     u = 6 - 12 t, J = 6):
 
-    >>> import ocp
-    >>> from ocp.examples import min_energy
+    >>> from appdyn import ocp
+    >>> from appdyn.ocp.examples import min_energy
     >>> energy = min_energy()  # x'' = u from rest at 0 to rest at 1 in T = 1 s
     >>> sol = ocp.solve(energy, N=10)
     >>> sol.success, sol.status, round(sol.cost, 6)

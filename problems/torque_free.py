@@ -17,11 +17,11 @@ from dataclasses import asdict, dataclass, field
 
 import numpy as np
 
-from dynamics import rigid_body
-from dynamics.attitude import principal_axes
-from dynamics.rigid_body import check_inertia
-from dynamics import simulate
-from dynamics.truth import torque_free_omega
+from appdyn.dynamics import rigid_body
+from appdyn.dynamics.attitude import principal_axes
+from appdyn.dynamics.rigid_body import check_inertia
+from appdyn.dynamics import simulate
+from appdyn.dynamics.truth import torque_free_omega
 
 __all__ = ["TorqueFreeReport", "torque_free", "CHECK_FACTOR", "ROUNDOFF_FACTOR",
            "STATUS_VERIFIED", "STATUS_CHECK_FAILED", "STATUS_INTEGRATOR_FAILED"]

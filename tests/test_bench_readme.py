@@ -12,8 +12,8 @@ from pathlib import Path
 
 import pytest
 
-from problems.cli import bench as bench_cli
-from problems.cli import main
+from appdyn.problems.cli import bench as bench_cli
+from appdyn.problems.cli import main
 
 ROOT = Path(__file__).resolve().parents[1]
 README = ROOT / "README.md"

@@ -12,7 +12,7 @@ from pathlib import Path
 
 import pytest
 
-from problems.cli import main
+from appdyn.problems.cli import main
 
 README = Path(__file__).resolve().parents[1] / "README.md"
 BLOCK = re.compile(r"^```(\w+)([^\n]*)\n(.*?)^```", re.S | re.M)

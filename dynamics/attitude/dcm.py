@@ -44,7 +44,7 @@ def dcm_from_quat(q):
     Examples
     --------
     >>> import numpy as np
-    >>> from dynamics.attitude import dcm_from_quat
+    >>> from appdyn.dynamics.attitude import dcm_from_quat
     >>> A = dcm_from_quat([0.0, 0.0, np.sin(np.pi / 4), np.cos(np.pi / 4)])  # 90 deg about z
     >>> np.round(A @ [1.0, 0.0, 0.0], 6)  # inertial x seen in the rotated body frame
     array([ 0., -1.,  0.])
@@ -98,7 +98,7 @@ def quat_from_dcm(A):
     Examples
     --------
     >>> import numpy as np
-    >>> from dynamics.attitude import quat_from_dcm
+    >>> from appdyn.dynamics.attitude import quat_from_dcm
     >>> A = np.array([[0.0, 1.0, 0.0], [-1.0, 0.0, 0.0], [0.0, 0.0, 1.0]])  # 90 deg about z
     >>> np.round(quat_from_dcm(A), 6)
     array([0.      , 0.      , 0.707107, 0.707107])
@@ -154,7 +154,7 @@ def dcm_from_axis_angle(axis, angle):
     Examples
     --------
     >>> import numpy as np
-    >>> from dynamics.attitude import dcm_from_axis_angle
+    >>> from appdyn.dynamics.attitude import dcm_from_axis_angle
     >>> np.round(dcm_from_axis_angle([0, 0, 2], np.pi / 2), 6)  # the axis is normalized
     array([[ 0.,  1.,  0.],
            [-1.,  0.,  0.],
@@ -198,7 +198,7 @@ def quat_from_axis_angle(axis, angle):
     Examples
     --------
     >>> import numpy as np
-    >>> from dynamics.attitude import quat_from_axis_angle
+    >>> from appdyn.dynamics.attitude import quat_from_axis_angle
     >>> np.round(quat_from_axis_angle([1, 0, 0], np.pi), 6)
     array([1., 0., 0., 0.])
     """
@@ -233,7 +233,7 @@ def axis_angle_from_quat(q):
     Examples
     --------
     >>> import numpy as np
-    >>> from dynamics.attitude import axis_angle_from_quat
+    >>> from appdyn.dynamics.attitude import axis_angle_from_quat
     >>> axis, angle = axis_angle_from_quat([0.0, 0.6, 0.0, 0.8])
     >>> axis, round(float(np.degrees(angle)), 6)
     (array([0., 1., 0.]), 73.739795)

@@ -45,7 +45,7 @@ def dcm_axis(component=None, angle=None, *, axis=None):
     Examples
     --------
     >>> import numpy as np
-    >>> from dynamics.attitude import dcm_axis
+    >>> from appdyn.dynamics.attitude import dcm_axis
     >>> np.round(dcm_axis(3, np.pi / 2), 6)  # A3: frame rotation about the third axis
     array([[ 0.,  1.,  0.],
            [-1.,  0.,  0.],
@@ -99,7 +99,7 @@ def dcm_from_euler313(angles):
     Examples
     --------
     >>> import numpy as np
-    >>> from dynamics.attitude import dcm_axis, dcm_from_euler313
+    >>> from appdyn.dynamics.attitude import dcm_axis, dcm_from_euler313
     >>> psi, theta, phi = 0.3, 0.2, 0.1
     >>> A = dcm_from_euler313([psi, theta, phi])
     >>> bool(np.allclose(A, dcm_axis(3, phi) @ dcm_axis(1, theta) @ dcm_axis(3, psi)))
@@ -145,7 +145,7 @@ def euler313_from_dcm(A):
     Examples
     --------
     >>> import numpy as np
-    >>> from dynamics.attitude import dcm_from_euler313, euler313_from_dcm
+    >>> from appdyn.dynamics.attitude import dcm_from_euler313, euler313_from_dcm
     >>> np.round(euler313_from_dcm(dcm_from_euler313([0.3, 0.2, 0.1])), 6)
     array([0.3, 0.2, 0.1])
     """
@@ -187,7 +187,7 @@ def quat_from_euler313(angles):
     Examples
     --------
     >>> import numpy as np
-    >>> from dynamics.attitude import quat_from_euler313
+    >>> from appdyn.dynamics.attitude import quat_from_euler313
     >>> np.round(quat_from_euler313([np.pi / 2, 0.0, 0.0]), 6)  # psi = 90 deg about z
     array([0.      , 0.      , 0.707107, 0.707107])
     """
@@ -221,7 +221,7 @@ def euler313_from_quat(q):
     Examples
     --------
     >>> import numpy as np
-    >>> from dynamics.attitude import euler313_from_quat, quat_from_euler313
+    >>> from appdyn.dynamics.attitude import euler313_from_quat, quat_from_euler313
     >>> np.round(euler313_from_quat(quat_from_euler313([0.3, 0.2, 0.1])), 6)
     array([0.3, 0.2, 0.1])
     """
@@ -249,7 +249,7 @@ def dcm_from_euler321(angles):
     Examples
     --------
     >>> import numpy as np
-    >>> from dynamics.attitude import dcm_axis, dcm_from_euler321
+    >>> from appdyn.dynamics.attitude import dcm_axis, dcm_from_euler321
     >>> yaw, pitch, roll = 0.3, 0.2, 0.1
     >>> A = dcm_from_euler321([yaw, pitch, roll])
     >>> bool(np.allclose(A, dcm_axis(1, roll) @ dcm_axis(2, pitch) @ dcm_axis(3, yaw)))
@@ -294,7 +294,7 @@ def euler321_from_dcm(A):
     Examples
     --------
     >>> import numpy as np
-    >>> from dynamics.attitude import dcm_from_euler321, euler321_from_dcm
+    >>> from appdyn.dynamics.attitude import dcm_from_euler321, euler321_from_dcm
     >>> np.round(euler321_from_dcm(dcm_from_euler321([0.3, -0.2, 0.1])), 6)
     array([ 0.3, -0.2,  0.1])
     """
@@ -332,7 +332,7 @@ def quat_from_euler321(angles):
     Examples
     --------
     >>> import numpy as np
-    >>> from dynamics.attitude import quat_from_euler321
+    >>> from appdyn.dynamics.attitude import quat_from_euler321
     >>> np.round(quat_from_euler321([0.0, 0.0, np.pi / 2]), 6)  # roll 90 deg about x
     array([0.707107, 0.      , 0.      , 0.707107])
     """
@@ -374,7 +374,7 @@ def euler321_from_quat(q):
     Examples
     --------
     >>> import numpy as np
-    >>> from dynamics.attitude import euler321_from_quat, quat_from_euler321
+    >>> from appdyn.dynamics.attitude import euler321_from_quat, quat_from_euler321
     >>> np.round(np.degrees(euler321_from_quat(quat_from_euler321(np.radians([30, 20, 10])))), 6)
     array([30., 20., 10.])
     """

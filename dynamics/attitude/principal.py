@@ -50,7 +50,7 @@ def principal_axes(inertia, *, order="nearest"):
     Examples
     --------
     >>> import numpy as np
-    >>> from dynamics.attitude import principal_axes
+    >>> from appdyn.dynamics.attitude import principal_axes
     >>> inertia = [[4560.7, 31.2, -43.4], [31.2, 4545.0, -270.7], [-43.4, -270.7, 1567.4]]
     >>> moments, A = principal_axes(inertia)  # Gemini (Sec. 4.4)
     >>> np.round(moments, 3)

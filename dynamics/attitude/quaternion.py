@@ -39,7 +39,7 @@ def skew(v):
 
     Examples
     --------
-    >>> from dynamics.attitude import skew
+    >>> from appdyn.dynamics.attitude import skew
     >>> skew([1.0, 2.0, 3.0]) @ [0.0, 0.0, 1.0]  # [1, 2, 3] x e3
     array([ 2., -1.,  0.])
     """
@@ -75,7 +75,7 @@ def quat_mul(q, p):
     Examples
     --------
     >>> import numpy as np
-    >>> from dynamics.attitude import dcm_from_quat, quat_from_axis_angle, quat_mul
+    >>> from appdyn.dynamics.attitude import dcm_from_quat, quat_from_axis_angle, quat_mul
     >>> q = quat_from_axis_angle([0, 0, 1], np.pi / 2)
     >>> p = quat_from_axis_angle([1, 0, 0], np.pi / 2)
     >>> np.round(quat_mul(q, p), 6)
@@ -118,7 +118,7 @@ def quat_conj(q):
 
     Examples
     --------
-    >>> from dynamics.attitude import quat_conj, quat_mul
+    >>> from appdyn.dynamics.attitude import quat_conj, quat_mul
     >>> q = [0.5, 0.5, 0.5, 0.5]
     >>> quat_conj(q)
     array([-0.5, -0.5, -0.5,  0.5])
@@ -150,7 +150,7 @@ def quat_normalize(q):
 
     Examples
     --------
-    >>> from dynamics.attitude import quat_normalize
+    >>> from appdyn.dynamics.attitude import quat_normalize
     >>> quat_normalize([0.0, 0.0, 3.0, 4.0])
     array([0. , 0. , 0.6, 0.8])
     """
@@ -184,7 +184,7 @@ def quat_kinematics_matrix(w):
     Examples
     --------
     >>> import numpy as np
-    >>> from dynamics.attitude import quat_kinematics_matrix
+    >>> from appdyn.dynamics.attitude import quat_kinematics_matrix
     >>> W = quat_kinematics_matrix([1.0, 2.0, 2.0])
     >>> W.shape, bool(np.allclose(W @ W, -9 * np.eye(4)))  # Wbar^2 = -|w|^2 E
     ((4, 4), True)
@@ -225,7 +225,7 @@ def quat_rate(q, w):
     Examples
     --------
     >>> import casadi as ca
-    >>> from dynamics.attitude import quat_rate
+    >>> from appdyn.dynamics.attitude import quat_rate
     >>> quat_rate([0.0, 0.0, 0.0, 1.0], [0.2, 0.0, 0.0])  # spin about body x at 0.2 rad/s
     array([ 0.1,  0. ,  0. , -0. ])
     >>> q, w = ca.SX.sym("q", 4), ca.SX.sym("w", 3)  # symbolic, for a CasADi model
@@ -271,7 +271,7 @@ def rotation_angle(q):
     Examples
     --------
     >>> import numpy as np
-    >>> from dynamics.attitude import quat_from_axis_angle, rotation_angle
+    >>> from appdyn.dynamics.attitude import quat_from_axis_angle, rotation_angle
     >>> round(float(np.degrees(rotation_angle(quat_from_axis_angle([1, 1, 0], np.radians(120))))), 6)
     120.0
     """
@@ -317,7 +317,7 @@ def propagate_quat(q, w, h):
     Examples
     --------
     >>> import numpy as np
-    >>> from dynamics.attitude import propagate_quat
+    >>> from appdyn.dynamics.attitude import propagate_quat
     >>> q = propagate_quat([0.0, 0.0, 0.0, 1.0], [0.0, 0.0, np.pi], 0.5)  # 90 deg about z
     >>> np.round(q, 6)
     array([0.      , 0.      , 0.707107, 0.707107])

@@ -73,7 +73,7 @@ def baumgarte(c, residual, position=None, *, time_constant=DEFAULT_TIME_CONSTANT
 
     Examples
     --------
-    >>> from dynamics.constrained import baumgarte
+    >>> from appdyn.dynamics.constrained import baumgarte
     >>> baumgarte([0.0, 0.0], [1.0, 1.0], [0.5], time_constant=0.5)
     array([6., 2.])
     """
@@ -121,7 +121,7 @@ def project_velocities(M, B, v, b=None):
 
     Examples
     --------
-    >>> from dynamics.constrained import project_velocities
+    >>> from appdyn.dynamics.constrained import project_velocities
     >>> project_velocities([[1.0, 0.0], [0.0, 3.0]], [[1.0, -1.0]], [4.0, 0.0])  # equal speeds
     array([1., 1.])
     """
@@ -169,7 +169,7 @@ def project_positions(residual: Callable, jacobian: Callable, x, *, retract: Cal
     Examples
     --------
     >>> import numpy as np
-    >>> from dynamics.constrained import project_positions
+    >>> from appdyn.dynamics.constrained import project_positions
     >>> res = project_positions(lambda x: [x @ x - 1.0], lambda x: [2 * x], np.array([3.0, 4.0]))
     >>> np.round(res.x, 12), res.success
     (array([0.6, 0.8]), True)

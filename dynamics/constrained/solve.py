@@ -118,7 +118,7 @@ def constrained_accelerations(M, Q, B, c) -> ConstrainedAccelerations:
     A particle (m = 2 kg) on a circle of radius 0.5 m at 3 m/s: tension ``m v^2 / r``.
 
     >>> import numpy as np
-    >>> from dynamics.constrained import constrained_accelerations
+    >>> from appdyn.dynamics.constrained import constrained_accelerations
     >>> x, v = np.array([0.5, 0.0]), np.array([0.0, 3.0])
     >>> res = constrained_accelerations(2.0 * np.eye(2), [0.0, 0.0], x, v @ v)
     >>> res.vdot, res.lam  # centripetal -v^2/r; lam = m v^2 / r^2 = 72
@@ -153,7 +153,7 @@ def reaction_forces(B, lam):
 
     Examples
     --------
-    >>> from dynamics.constrained import reaction_forces
+    >>> from appdyn.dynamics.constrained import reaction_forces
     >>> reaction_forces([[1.0, 0.5, 2.0]], [3.0])
     array([-3. , -1.5, -6. ])
     """

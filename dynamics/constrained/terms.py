@@ -63,7 +63,7 @@ def constraint_terms(q, qdot, v, *, position=None, velocity=None, t=None) -> Con
     A pendulum point ``(x, y)`` at distance ``l``, with ``v = (xdot, ydot)``:
 
     >>> import casadi as ca
-    >>> from dynamics.constrained import constraint_terms
+    >>> from appdyn.dynamics.constrained import constraint_terms
     >>> q, v, l = ca.SX.sym("q", 2), ca.SX.sym("v", 2), 1.5
     >>> terms = constraint_terms(q, v, v, position=(ca.sumsqr(q) - l**2) / 2)
     >>> terms.B
@@ -115,7 +115,7 @@ def residual_invariant(x, p, terms: ConstraintTerms) -> ca.Function:
     Examples
     --------
     >>> import casadi as ca
-    >>> from dynamics.constrained import constraint_terms, residual_invariant
+    >>> from appdyn.dynamics.constrained import constraint_terms, residual_invariant
     >>> x, p = ca.SX.sym("x", 4), ca.SX.sym("p", 0)
     >>> terms = constraint_terms(x[:2], x[2:], x[2:], position=(ca.sumsqr(x[:2]) - 1) / 2)
     >>> residual_invariant(x, p, terms)(ca.DM([2.0, 0.0, 1.0, 0.0]), [])

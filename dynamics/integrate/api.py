@@ -160,8 +160,8 @@ def simulate(model: Model, x0, t, *, u=None, p=None, hold: Hold = "linear", meth
     Examples
     --------
     >>> import numpy as np
-    >>> from dynamics import rigid_body, simulate
-    >>> from dynamics.truth import torque_free_omega
+    >>> from appdyn.dynamics import rigid_body, simulate
+    >>> from appdyn.dynamics.truth import torque_free_omega
     >>> inertia, w0, t = [1.0, 2.0, 3.0], [0.1, 0.2, 0.3], np.linspace(0.0, 10.0, 11)
     >>> res = simulate(rigid_body(inertia), [0, 0, 0, 1, *w0], t, method="rk8", steps=10, jit=False)
     >>> res.success, res.x.shape

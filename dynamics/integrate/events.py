@@ -117,7 +117,7 @@ class Event:
     --------
     >>> import casadi as ca
     >>> import numpy as np
-    >>> from dynamics import Event, Model, simulate
+    >>> from appdyn.dynamics import Event, Model, simulate
     >>> x, u, p, t = ca.SX.sym("x", 2), ca.SX.sym("u", 0), ca.SX.sym("p", 0), ca.SX.sym("t")
     >>> fall = Model(f=ca.Function("fall", [x, u, p], [ca.vertcat(x[1], -9.81)],
     ...                            ["x", "u", "p"], ["xdot"]), states=("h", "v"), controls=())

@@ -221,7 +221,7 @@ class SimulationResult:
         Examples
         --------
         >>> import numpy as np
-        >>> from dynamics import rigid_body, simulate
+        >>> from appdyn.dynamics import rigid_body, simulate
         >>> res = simulate(rigid_body([1.0, 2.0, 3.0]), [0, 0, 0, 1, 1.0, 0.0, 0.0],
         ...                np.linspace(0.0, 1.0, 3))
         >>> res["w1"]  # a pure spin about a principal axis stays put

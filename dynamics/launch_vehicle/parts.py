@@ -64,7 +64,7 @@ class Aero:
 
     Examples
     --------
-    >>> from dynamics.launch_vehicle import Aero
+    >>> from appdyn.dynamics.launch_vehicle import Aero
     >>> Aero(dynamic_pressure=3.0e4, area=10.0, normal_force_slope=3.0, cp_arm=5.0).wind
     'parameter'
     """
@@ -102,7 +102,7 @@ class MassFlow:
 
     Examples
     --------
-    >>> from dynamics.launch_vehicle import MassFlow
+    >>> from appdyn.dynamics.launch_vehicle import MassFlow
     >>> MassFlow(rate=250.0, flow_start=-2.0, burn_time=100.0).nozzle_exit is None
     True
     """
@@ -148,7 +148,7 @@ class Slosh:
 
     Examples
     --------
-    >>> from dynamics.launch_vehicle import Slosh
+    >>> from appdyn.dynamics.launch_vehicle import Slosh
     >>> Slosh(mass=2000.0, hinge=3.0, frequency=2.0).stiffness  # N/m
     8000.0
     """
@@ -202,7 +202,7 @@ class Bending:
 
     Examples
     --------
-    >>> from dynamics.launch_vehicle import Bending
+    >>> from appdyn.dynamics.launch_vehicle import Bending
     >>> Bending(frequency=12.0, generalized_mass=5000.0, slope_sensor=0.02).damping_ratio
     0.0
     """
@@ -239,7 +239,7 @@ class Actuator:
 
     Examples
     --------
-    >>> from dynamics.launch_vehicle import Actuator
+    >>> from appdyn.dynamics.launch_vehicle import Actuator
     >>> Actuator(0.05, deflection_limits=(-0.1, 0.1), rate_limit=0.5).deflection_limits
     (-0.1, 0.1)
     """

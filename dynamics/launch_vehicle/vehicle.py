@@ -162,8 +162,8 @@ def rigid_part(slosh: Slosh | None, m, I):
 
     Examples
     --------
-    >>> from dynamics.launch_vehicle import Slosh
-    >>> from dynamics.launch_vehicle.vehicle import rigid_part
+    >>> from appdyn.dynamics.launch_vehicle import Slosh
+    >>> from appdyn.dynamics.launch_vehicle.vehicle import rigid_part
     >>> rigid_part(Slosh(mass=1.0, hinge=2.0, length=1.0), 4.0, 10.0)  # 10 - 4 * 1 * 1 / 3
     (3.0, 0.75, 8.666666666666666)
     """
@@ -403,7 +403,7 @@ def launch_vehicle(*, thrust, inertia, arm, mass, k_psi=None, k_psidot=None, aer
     Examples
     --------
     >>> import numpy as np
-    >>> from dynamics import launch_vehicle, linearize
+    >>> from appdyn.dynamics import launch_vehicle, linearize
     >>> F, I, l = 2.0e6, 4.0e7, 20.0
     >>> model = launch_vehicle(thrust=F, inertia=I, arm=l, mass=1.0e5, k_psi=2.0, k_psidot=0.5)
     >>> model.states, model.controls

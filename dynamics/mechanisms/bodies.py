@@ -104,7 +104,7 @@ def rolling_coin(*, mass=1.0, radius=0.1, inertia_axial=None, inertia_transverse
     Examples
     --------
     >>> import numpy as np
-    >>> from dynamics.mechanisms import coin_state, rolling_coin
+    >>> from appdyn.dynamics.mechanisms import coin_state, rolling_coin
     >>> model = rolling_coin(gravity=9.81)
     >>> x0 = coin_state(np.pi / 2, 0.0, 10.0, radius=0.1)    # upright, rolling at 1 m/s
     >>> float(np.abs(model.rhs(x0)[6:]).max()) < 1e-12        # goes straight on
@@ -161,7 +161,7 @@ def coin_steady_rates(theta, path_radius, *, mass=1.0, radius=0.1, inertia_axial
     Examples
     --------
     >>> import numpy as np
-    >>> from dynamics.mechanisms import coin_steady_rates
+    >>> from appdyn.dynamics.mechanisms import coin_steady_rates
     >>> [round(r, 6) for r in coin_steady_rates(np.pi / 3, 0.5, gravity=9.81)]
     [2.725425, -14.989839]
     """
@@ -195,7 +195,7 @@ def coin_state(theta, psi_dot, phi_dot, *, radius=0.1, psi=0.0, phi=0.0, theta_d
 
     Examples
     --------
-    >>> from dynamics.mechanisms import coin_state
+    >>> from appdyn.dynamics.mechanisms import coin_state
     >>> (coin_state(1.5707963267948966, 0.0, 10.0)[6:9] + 0.0).round(6).tolist()
     [-1.0, 0.0, 0.0]
     """
@@ -298,7 +298,7 @@ def dumbbell_disk(*, mass=_DD_DEFAULTS["mass"], arm=_DD_DEFAULTS["arm"], inertia
 
     Examples
     --------
-    >>> from dynamics.mechanisms import dumbbell_disk, dumbbell_disk_state
+    >>> from appdyn.dynamics.mechanisms import dumbbell_disk, dumbbell_disk_state
     >>> model = dumbbell_disk()
     >>> x0 = dumbbell_disk_state(0.3, 0.0, [0.0, 0.0, 0.0])
     >>> round(float(model.invariant("alpha", x0)), 12), model.states[7:10]
@@ -324,7 +324,7 @@ def dumbbell_disk_state(alpha, alpha_dot, w, *, arm=_DD_DEFAULTS["arm"]) -> np.n
 
     Examples
     --------
-    >>> from dynamics.mechanisms import dumbbell_disk_state
+    >>> from appdyn.dynamics.mechanisms import dumbbell_disk_state
     >>> dumbbell_disk_state(0.0, 1.0, [0.0, 0.0, 0.0], arm=2.0)[4:].tolist()
     [0.0, 0.0, 2.0, 0.0, 0.0, 0.0, 2.0, 0.0, 0.0]
     """
@@ -351,7 +351,7 @@ def dumbbell_disk_frequency(*, mass=_DD_DEFAULTS["mass"], arm=_DD_DEFAULTS["arm"
 
     Examples
     --------
-    >>> from dynamics.mechanisms import dumbbell_disk_frequency
+    >>> from appdyn.dynamics.mechanisms import dumbbell_disk_frequency
     >>> round(dumbbell_disk_frequency(), 12)          # I0 = 0.5, B = 1.5: w^2 = 16/3
     2.309401076759
     """

@@ -68,7 +68,7 @@ def symbols(coords, params, *, clock: bool = False) -> Symbols:
 
     Examples
     --------
-    >>> from dynamics.mechanisms.common import symbols
+    >>> from appdyn.dynamics.mechanisms.common import symbols
     >>> s = symbols(("theta",), ("mass",), clock=True)
     >>> s.x.shape, s.t is not None, tuple(s.par)
     ((3, 1), True, ('mass',))
@@ -106,7 +106,7 @@ def assemble(sym: Symbols, qdd, *, name: str, param_units: Mapping[str, str],
     Examples
     --------
     >>> import casadi as ca
-    >>> from dynamics.mechanisms.common import assemble, symbols
+    >>> from appdyn.dynamics.mechanisms.common import assemble, symbols
     >>> s = symbols(("theta",), ("w0",))
     >>> m = assemble(s, [-s.par["w0"] ** 2 * ca.sin(s.q[0])], name="pendulum",
     ...              param_units={"w0": "rad/s"}, p_default=[2.0])
@@ -140,8 +140,8 @@ def with_parameters(model: Model, values: Mapping[str, float]) -> Model:
 
     Examples
     --------
-    >>> from dynamics.mechanisms import double_pendulum
-    >>> from dynamics.mechanisms.common import with_parameters
+    >>> from appdyn.dynamics.mechanisms import double_pendulum
+    >>> from appdyn.dynamics.mechanisms.common import with_parameters
     >>> with_parameters(double_pendulum(), {"mass2": 3.0}).p_default.tolist()
     [1.0, 3.0, 1.0, 1.0, 9.80665]
     """
@@ -156,7 +156,7 @@ def nonnegative(value, name: str) -> float:
 
     Examples
     --------
-    >>> from dynamics.mechanisms.common import nonnegative
+    >>> from appdyn.dynamics.mechanisms.common import nonnegative
     >>> nonnegative(0, "damping")
     0.0
     >>> nonnegative(-1.0, "damping")

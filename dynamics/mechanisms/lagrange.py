@@ -47,7 +47,7 @@ def lagrange_terms(T, V, q, v):
     Examples
     --------
     >>> import casadi as ca
-    >>> from dynamics.mechanisms import lagrange_terms
+    >>> from appdyn.dynamics.mechanisms import lagrange_terms
     >>> q, v = ca.SX.sym("q"), ca.SX.sym("v")
     >>> M, Q = lagrange_terms(0.5 * 2.0 * v ** 2, 0.5 * 8.0 * q ** 2, q, v)
     >>> float(M), ca.Function("Q", [q], [Q])(0.5)

@@ -102,7 +102,7 @@ def rod_pendulum(*, mass=1.0, length=1.0, gravity=GRAVITY,
     Examples
     --------
     >>> import numpy as np
-    >>> from dynamics.mechanisms import rod_pendulum, rod_reaction
+    >>> from appdyn.dynamics.mechanisms import rod_pendulum, rod_reaction
     >>> model = rod_pendulum(length=2.0, gravity=9.81)
     >>> x0 = [0.0, -2.0, 3.0, 0.0]           # hanging, moving at 3 m/s: th' = 1.5 rad/s
     >>> round(float(model.invariant("rod_force", x0)), 9), rod_reaction(0.0, 1.5, length=2.0,
@@ -137,7 +137,7 @@ def rod_reaction(theta, theta_dot, *, mass=1.0, length=1.0, gravity=GRAVITY):
 
     Examples
     --------
-    >>> from dynamics.mechanisms import rod_reaction
+    >>> from appdyn.dynamics.mechanisms import rod_reaction
     >>> rod_reaction(0.0, 0.0, gravity=9.81)
     -9.81
     """
@@ -209,7 +209,7 @@ def shaken_pendulum_multipliers(*, mass=SHAKEN_DEFAULTS["mass"],
 
     Examples
     --------
-    >>> from dynamics.mechanisms import (shaken_multiplier_state, shaken_pendulum,
+    >>> from appdyn.dynamics.mechanisms import (shaken_multiplier_state, shaken_pendulum,
     ...                                  shaken_pendulum_multipliers)
     >>> lagrange, euler = shaken_pendulum_multipliers(), shaken_pendulum()
     >>> x0 = shaken_multiplier_state(0.5, 1.0, 0.01)
@@ -236,7 +236,7 @@ def shaken_multiplier_state(theta, theta_dot, t=0.0, *, length=SHAKEN_DEFAULTS["
 
     Examples
     --------
-    >>> from dynamics.mechanisms import shaken_multiplier_state
+    >>> from appdyn.dynamics.mechanisms import shaken_multiplier_state
     >>> shaken_multiplier_state(0.0, 2.0, amp_y=0.0).round(6).tolist()
     [0.0, -0.25, 0.0, 0.5, 0.0, 2.0, 0.0]
     """
@@ -312,7 +312,7 @@ def sliding_bead(*, mass=1.0, rate=1.0, rate_amp=0.0, rate_freq=0.0,
 
     Examples
     --------
-    >>> from dynamics.mechanisms import bead_torque, sliding_bead
+    >>> from appdyn.dynamics.mechanisms import bead_torque, sliding_bead
     >>> model = sliding_bead(mass=2.0, rate=3.0)
     >>> x0 = [0.5, 0.0, 1.0, 3.0, 0.0]
     >>> round(float(model.invariant("torque", x0)), 12), bead_torque(0.5, 1.0, 3.0, 0.0, mass=2.0)
@@ -346,7 +346,7 @@ def bead_torque(r, r_dot, rate, rate_dot, *, mass=1.0):
 
     Examples
     --------
-    >>> from dynamics.mechanisms import bead_torque
+    >>> from appdyn.dynamics.mechanisms import bead_torque
     >>> bead_torque(1.0, 0.0, 2.0, 0.5)
     0.5
     """
@@ -382,7 +382,7 @@ def bead_motion(t, r0, r0_dot, rate):
 
     Examples
     --------
-    >>> from dynamics.mechanisms import bead_motion
+    >>> from appdyn.dynamics.mechanisms import bead_motion
     >>> [round(float(a), 6) for a in bead_motion(1.0, 1.0, 0.0, 1.0)]
     [1.543081, 1.175201]
     """

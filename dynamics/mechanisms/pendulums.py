@@ -95,7 +95,7 @@ def double_pendulum(*, mass1=1.0, mass2=1.0, length1=1.0, length2=1.0,
 
     Examples
     --------
-    >>> from dynamics.mechanisms import double_pendulum
+    >>> from appdyn.dynamics.mechanisms import double_pendulum
     >>> model = double_pendulum(mass2=2.0)
     >>> model.states
     ('theta1', 'theta2', 'theta1_dot', 'theta2_dot')
@@ -131,7 +131,7 @@ def double_pendulum_modes(*, mass1=1.0, mass2=1.0, length1=1.0, length2=1.0,
 
     Examples
     --------
-    >>> from dynamics.mechanisms import double_pendulum_modes
+    >>> from appdyn.dynamics.mechanisms import double_pendulum_modes
     >>> double_pendulum_modes(gravity=1.0).round(6)   # sqrt(2 -+ sqrt 2)
     array([0.765367, 1.847759])
     """
@@ -213,7 +213,7 @@ def variable_length_pendulum(*, mass=1.0, gravity=GRAVITY, length=1.0, length_ra
 
     Examples
     --------
-    >>> from dynamics.mechanisms import variable_length_pendulum
+    >>> from appdyn.dynamics.mechanisms import variable_length_pendulum
     >>> model = variable_length_pendulum(length=2.0, length_rate=-0.1)
     >>> model.states
     ('theta', 'theta_dot', 't')
@@ -264,7 +264,7 @@ def pendulum_swing(t, theta0, *, length=1.0, gravity=GRAVITY) -> np.ndarray:
     Examples
     --------
     >>> import numpy as np
-    >>> from dynamics.mechanisms import pendulum_period, pendulum_swing
+    >>> from appdyn.dynamics.mechanisms import pendulum_period, pendulum_swing
     >>> T = pendulum_period(2.0, length=1.0, gravity=9.81)
     >>> np.round(pendulum_swing([0.0, T / 4, T / 2], 2.0, length=1.0, gravity=9.81), 12) + 0.0
     array([ 2.,  0., -2.])
@@ -285,7 +285,7 @@ def pendulum_period(theta0, *, length=1.0, gravity=GRAVITY) -> float:
     Examples
     --------
     >>> import math
-    >>> from dynamics.mechanisms import pendulum_period
+    >>> from appdyn.dynamics.mechanisms import pendulum_period
     >>> round(pendulum_period(1e-8, length=1.0, gravity=1.0) / (2 * math.pi), 12)
     1.0
     """

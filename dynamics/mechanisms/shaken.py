@@ -113,7 +113,7 @@ def shaken_pendulum(*, mass=_D["mass"], inertia=_D["inertia"], length=_D["length
 
     Examples
     --------
-    >>> from dynamics.mechanisms import shaken_pendulum
+    >>> from appdyn.dynamics.mechanisms import shaken_pendulum
     >>> model = shaken_pendulum(amp_y=0.0)
     >>> model.states, model.params[:4]
     (('theta', 'theta_dot', 't'), ('mass', 'inertia', 'length', 'gravity'))
@@ -153,7 +153,7 @@ def natural_frequency(*, mass=_D["mass"], inertia=_D["inertia"], length=_D["leng
 
     Examples
     --------
-    >>> from dynamics.mechanisms import natural_frequency
+    >>> from appdyn.dynamics.mechanisms import natural_frequency
     >>> round(natural_frequency(gravity=3.0), 12)    # l_eff = 1/3 m
     3.0
     """
@@ -166,7 +166,7 @@ def equivalent_length(*, mass=_D["mass"], inertia=_D["inertia"], length=_D["leng
 
     Examples
     --------
-    >>> from dynamics.mechanisms import equivalent_length
+    >>> from appdyn.dynamics.mechanisms import equivalent_length
     >>> round(equivalent_length(), 12)               # a rod hinged at its end: 2/3 of 0.5 m
     0.333333333333
     """
@@ -207,7 +207,7 @@ def kapitza_frequency(amp_y, *, mass=_D["mass"], inertia=_D["inertia"], length=_
 
     Examples
     --------
-    >>> from dynamics.mechanisms import kapitza_frequency
+    >>> from appdyn.dynamics.mechanisms import kapitza_frequency
     >>> round(kapitza_frequency(0.02, exact=False), 3), round(kapitza_frequency(0.02), 3)
     (127.845, 127.946)
     """
@@ -244,7 +244,7 @@ def resonance_tongue(amp_y, *, mass=_D["mass"], inertia=_D["inertia"], length=_D
 
     Examples
     --------
-    >>> from dynamics.mechanisms import natural_frequency, resonance_tongue
+    >>> from appdyn.dynamics.mechanisms import natural_frequency, resonance_tongue
     >>> low, high = resonance_tongue(0.02)
     >>> bool(low < 2 * natural_frequency() < high), round(low, 4), round(high, 4)
     (True, 10.2588, 11.5757)

@@ -131,7 +131,7 @@ def spherical_pendulum(sequence: str, *, mass=1.0, length=1.0, inertia=0.01,
 
     Examples
     --------
-    >>> from dynamics.mechanisms import spherical_pendulum
+    >>> from appdyn.dynamics.mechanisms import spherical_pendulum
     >>> model = spherical_pendulum("3-2-1", inertia=0.0, gravity=9.81)
     >>> model.states
     ('theta', 'phi', 'theta_dot', 'phi_dot')
@@ -177,7 +177,7 @@ def conical_rate(cone_angle, *, length=1.0, gravity=GRAVITY) -> float:
     Examples
     --------
     >>> import math
-    >>> from dynamics.mechanisms import conical_rate
+    >>> from appdyn.dynamics.mechanisms import conical_rate
     >>> round(conical_rate(math.pi / 3, length=2.0, gravity=9.81), 6)   # sqrt(9.81)
     3.132092
     """
@@ -210,7 +210,7 @@ def spherical_mass_matrix(sequence: str, q, *, mass=1.0, length=1.0, inertia=0.0
     Examples
     --------
     >>> import numpy as np
-    >>> from dynamics.mechanisms import spherical_mass_matrix
+    >>> from appdyn.dynamics.mechanisms import spherical_mass_matrix
     >>> [float(np.linalg.cond(spherical_mass_matrix(s, [0.0, 0.0], inertia=1e-4)))
     ...  for s in ("3-1-3", "3-2-1")]
     [10001.0, 1.0]

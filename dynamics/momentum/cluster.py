@@ -69,7 +69,7 @@ class ClusterGeometry:
 
     Examples
     --------
-    >>> from dynamics.momentum import ClusterGeometry
+    >>> from appdyn.dynamics.momentum import ClusterGeometry
     >>> geo = ClusterGeometry([[0.0], [0.0], [1.0]], [[1.0], [0.0], [0.0]], h=2.0)
     >>> geo.n, geo.h, geo.transverse_axes0.ravel()  # one unit about e_z, spin e_x
     (1, array([2.]), array([0., 1., 0.]))
@@ -140,7 +140,7 @@ def pyramid(beta, h=1.0) -> ClusterGeometry:
     Examples
     --------
     >>> import numpy as np
-    >>> from dynamics.momentum import pyramid, cluster_momentum
+    >>> from appdyn.dynamics.momentum import pyramid, cluster_momentum
     >>> geo = pyramid(np.arccos(1 / np.sqrt(3)))
     >>> np.round(cluster_momentum(geo, np.deg2rad([90, 90, 90, 90])), 4)  # 4 sin(beta) e_z
     array([0.    , 0.    , 3.266])
@@ -184,7 +184,7 @@ def cluster_momentum(geometry: ClusterGeometry, delta):
     --------
     >>> import casadi as ca
     >>> import numpy as np
-    >>> from dynamics.momentum import pyramid, cluster_momentum
+    >>> from appdyn.dynamics.momentum import pyramid, cluster_momentum
     >>> geo = pyramid(np.deg2rad(54.74))
     >>> np.round(cluster_momentum(geo, np.deg2rad([-90, 0, 90, 0])), 3)  # elliptic singular state
     array([1.155, 0.   , 0.   ])
@@ -214,7 +214,7 @@ def cluster_jacobian(geometry: ClusterGeometry, delta):
     Examples
     --------
     >>> import numpy as np
-    >>> from dynamics.momentum import pyramid, cluster_jacobian
+    >>> from appdyn.dynamics.momentum import pyramid, cluster_jacobian
     >>> np.round(cluster_jacobian(pyramid(np.pi / 2), np.zeros(4)), 12) + 0.0  # all along e_z
     array([[0., 0., 0., 0.],
            [0., 0., 0., 0.],
@@ -244,7 +244,7 @@ def gram_determinant(C):
     Examples
     --------
     >>> import numpy as np
-    >>> from dynamics.momentum import gram_determinant
+    >>> from appdyn.dynamics.momentum import gram_determinant
     >>> float(gram_determinant(np.diag([1.0, 2.0, 3.0])))
     36.0
     """
@@ -278,7 +278,7 @@ def singularity_measure(geometry: ClusterGeometry, delta):
     Examples
     --------
     >>> import numpy as np
-    >>> from dynamics.momentum import pyramid, singularity_measure
+    >>> from appdyn.dynamics.momentum import pyramid, singularity_measure
     >>> geo = pyramid(np.arccos(1 / np.sqrt(3)))
     >>> round(float(singularity_measure(geo, np.zeros(4)) ** 2 * 27), 12)  # det = 32/27
     32.0
@@ -325,7 +325,7 @@ def singular_direction(geometry: ClusterGeometry, delta, *, tol=SINGULAR_TOL) ->
     Examples
     --------
     >>> import numpy as np
-    >>> from dynamics.momentum import pyramid, singular_direction
+    >>> from appdyn.dynamics.momentum import pyramid, singular_direction
     >>> geo = pyramid(np.deg2rad(54.74))
     >>> np.round(singular_direction(geo, np.deg2rad([-90, 0, 90, 0])), 12) + 0.0
     array([1., 0., 0.])
@@ -368,7 +368,7 @@ def classify_singularity(geometry: ClusterGeometry, delta, *, tol=SINGULAR_TOL
     Examples
     --------
     >>> import numpy as np
-    >>> from dynamics.momentum import pyramid, classify_singularity
+    >>> from appdyn.dynamics.momentum import pyramid, classify_singularity
     >>> geo = pyramid(np.deg2rad(54.74))
     >>> classify_singularity(geo, np.deg2rad([-90, 0, 90, 0]))
     'elliptic'

@@ -183,7 +183,7 @@ def cmg_spacecraft(inertia, gimbal_axes, spin_axes0, h, *,
     Examples
     --------
     >>> import numpy as np
-    >>> from dynamics.momentum.cmg import cmg_spacecraft
+    >>> from appdyn.dynamics.momentum.cmg import cmg_spacecraft
     >>> g, s0 = [[0.0], [0.0], [1.0]], [[1.0], [0.0], [0.0]]  # one CMG, gimbal about z
     >>> model = cmg_spacecraft([10.0, 10.0, 10.0], g, s0, h=2.0)
     >>> model.states[7:], model.controls

@@ -64,7 +64,7 @@ def fibonacci_directions(count: int) -> np.ndarray:
     Examples
     --------
     >>> import numpy as np
-    >>> from dynamics.momentum import fibonacci_directions
+    >>> from appdyn.dynamics.momentum import fibonacci_directions
     >>> u = fibonacci_directions(500)
     >>> u.shape, bool(np.allclose(np.linalg.norm(u, axis=0), 1.0)), bool(abs(u[2].mean()) < 1e-12)
     ((3, 500), True, True)
@@ -125,7 +125,7 @@ def singular_surface(geometry: ClusterGeometry, directions, signs) -> SurfacePoi
     Examples
     --------
     >>> import numpy as np
-    >>> from dynamics.momentum import pyramid, singular_surface
+    >>> from appdyn.dynamics.momentum import pyramid, singular_surface
     >>> geo = pyramid(np.arccos(1 / np.sqrt(3)))
     >>> pts = singular_surface(geo, [1.0, 0.0, 0.0], [1, 1, 1, 1])  # saturation along x
     >>> np.round(pts.H[:, 0], 6) + 0.0, np.round(np.degrees(pts.delta[:, 0]), 6) + 0.0
@@ -165,7 +165,7 @@ def classify_singularities(geometry: ClusterGeometry, delta, *, tol=SINGULAR_TOL
     Examples
     --------
     >>> import numpy as np
-    >>> from dynamics.momentum import pyramid, classify_singularities
+    >>> from appdyn.dynamics.momentum import pyramid, classify_singularities
     >>> geo = pyramid(np.deg2rad(54.74))
     >>> states = np.deg2rad([[-90, 0, 90, 0], [90, -90, 90, -90], [0, 0, 0, 0]]).T
     >>> classify_singularities(geo, states).tolist()
@@ -219,7 +219,7 @@ def momentum_envelope(geometry: ClusterGeometry, *, directions: int = 2000) -> "
     Examples
     --------
     >>> import numpy as np
-    >>> from dynamics.momentum import pyramid, momentum_envelope
+    >>> from appdyn.dynamics.momentum import pyramid, momentum_envelope
     >>> env = momentum_envelope(pyramid(np.arccos(1 / np.sqrt(3))), directions=500)
     >>> round(env.max_momentum([1, 0, 0]), 9), round(float(2 * (1 + 1 / np.sqrt(3))), 9)
     (3.154700538, 3.154700538)
@@ -307,7 +307,7 @@ class MomentumEnvelope:
         Examples
         --------
         >>> import numpy as np
-        >>> from dynamics.momentum import pyramid, momentum_envelope
+        >>> from appdyn.dynamics.momentum import pyramid, momentum_envelope
         >>> env = momentum_envelope(pyramid(np.deg2rad(54.74)), directions=200)
         >>> bool(abs(env.max_momentum([0, 0, 1]) - 4 * np.sin(np.deg2rad(54.74))) < 1e-12)
         True

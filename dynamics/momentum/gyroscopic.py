@@ -82,7 +82,7 @@ def wheel_torque(wheel_inertia, wheel_accel):
 
     Examples
     --------
-    >>> from dynamics.momentum import wheel_torque
+    >>> from appdyn.dynamics.momentum import wheel_torque
     >>> wheel_torque(0.05, [2.0, -2.0, 2.0])  # spin-up about (1, -1, 1) pushes the body back
     array([-0.1,  0.1, -0.1])
     """
@@ -118,7 +118,7 @@ def cmg_torque(gimbal_rate_vector, rotor_momentum):
 
     Examples
     --------
-    >>> from dynamics.momentum import cmg_torque
+    >>> from appdyn.dynamics.momentum import cmg_torque
     >>> cmg_torque([0.0, 0.0, 0.5], [10.0, 0.0, 0.0])  # -(0.5 e_z) x (10 e_x)
     array([ 0., -5.,  0.])
     """
@@ -153,7 +153,7 @@ def coriolis_torque(Omega, omega, inertia):
 
     Examples
     --------
-    >>> from dynamics.momentum import coriolis_torque
+    >>> from appdyn.dynamics.momentum import coriolis_torque
     >>> coriolis_torque([0.0, 0.0, 1.0], [10.0, 0.0, 0.0], [2.0, 1.0, 1.0])  # -Omega x I1 omega
     array([  0., -20.,   0.])
     """
@@ -211,7 +211,7 @@ def propeller_torque(yaw_rate, spin_rate, inertia, t, *, blades=2, phase=0.0):
     Examples
     --------
     >>> import numpy as np
-    >>> from dynamics.momentum import propeller_torque
+    >>> from appdyn.dynamics.momentum import propeller_torque
     >>> np.round(propeller_torque(0.1, 100.0, 2.0, [0.0, np.pi / 400]), 12) + 0.0
     array([[  0.,   0.],
            [-40., -20.],
@@ -254,7 +254,7 @@ def gyroscope_reaction_torque(Omega, H):
 
     Examples
     --------
-    >>> from dynamics.momentum import gyroscope_reaction_torque
+    >>> from appdyn.dynamics.momentum import gyroscope_reaction_torque
     >>> gyroscope_reaction_torque([0.0, 0.0, 1.0], [5.0, 0.0, 0.0])
     array([ 0., -5.,  0.])
     """

@@ -113,7 +113,7 @@ def pseudo_inverse_steering(C, torque):
     Examples
     --------
     >>> import numpy as np
-    >>> from dynamics.momentum import pyramid, cluster_jacobian, pseudo_inverse_steering
+    >>> from appdyn.dynamics.momentum import pyramid, cluster_jacobian, pseudo_inverse_steering
     >>> C = cluster_jacobian(pyramid(np.deg2rad(54.74)), np.zeros(4))
     >>> rate = pseudo_inverse_steering(C, [0.1, 0.0, 0.0])
     >>> np.round(-C @ rate, 12) + 0.0  # the body torque
@@ -152,7 +152,7 @@ def sr_inverse_steering(C, torque, lam0=SR_LAM0, mu=SR_MU):
     Examples
     --------
     >>> import numpy as np
-    >>> from dynamics.momentum import pyramid, cluster_jacobian, sr_inverse_steering
+    >>> from appdyn.dynamics.momentum import pyramid, cluster_jacobian, sr_inverse_steering
     >>> geo = pyramid(np.deg2rad(54.74))
     >>> C = cluster_jacobian(geo, np.deg2rad([-90, 0, 90, 0]))  # singular along x
     >>> np.round(sr_inverse_steering(C, [0.1, 0.0, 0.0]), 12) + 0.0  # bounded (here locked)
@@ -192,7 +192,7 @@ def gsr_inverse_steering(C, torque, t=None, lam0=SR_LAM0, mu=SR_MU, eps0=GSR_EPS
     Examples
     --------
     >>> import numpy as np
-    >>> from dynamics.momentum import pyramid, cluster_jacobian, gsr_inverse_steering
+    >>> from appdyn.dynamics.momentum import pyramid, cluster_jacobian, gsr_inverse_steering
     >>> C = cluster_jacobian(pyramid(np.deg2rad(54.74)), np.deg2rad([-90, 0, 90, 0]))
     >>> rate = gsr_inverse_steering(C, [1.0, 0.0, 0.0], t=0.5)  # torque along the singular x
     >>> round(float(np.linalg.norm(rate)), 4)  # the dither moves the gimbals (SR: exactly 0)
@@ -230,7 +230,7 @@ def null_motion(C, gradient):
     Examples
     --------
     >>> import numpy as np
-    >>> from dynamics.momentum import pyramid, cluster_jacobian, null_motion
+    >>> from appdyn.dynamics.momentum import pyramid, cluster_jacobian, null_motion
     >>> C = cluster_jacobian(pyramid(np.deg2rad(54.74)), np.zeros(4))
     >>> rate = null_motion(C, [1.0, 0.0, 0.0, 0.0])
     >>> np.round(C @ rate, 12) + 0.0, bool(np.linalg.norm(rate) > 0)

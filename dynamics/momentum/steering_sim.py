@@ -135,7 +135,7 @@ def steering_model(geometry: ClusterGeometry, law="sr", *, momentum_states: bool
     Examples
     --------
     >>> import numpy as np
-    >>> from dynamics.momentum import pyramid, steering_model
+    >>> from appdyn.dynamics.momentum import pyramid, steering_model
     >>> model = steering_model(pyramid(np.deg2rad(54.74)), "gsr", eps0=0.02)
     >>> model.states, model.controls
     (('d1', 'd2', 'd3', 'd4', 't'), ('T1', 'T2', 'T3'))
@@ -232,7 +232,7 @@ def steer(geometry: ClusterGeometry, torque, t, *, law="sr", delta0=None, steps:
     Examples
     --------
     >>> import numpy as np
-    >>> from dynamics.momentum import pyramid, steer
+    >>> from appdyn.dynamics.momentum import pyramid, steer
     >>> geo, t = pyramid(np.deg2rad(54.74)), np.linspace(0, 5, 51)
     >>> res = steer(geo, [0.0, 0.0, -0.2], t, law="pinv")
     >>> res.success, np.round(res.H[:, -1], 9) + 0.0  # H(t) = H(0) - torque t

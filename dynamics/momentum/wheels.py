@@ -92,7 +92,7 @@ def rotor_dynamics(inertia, axes, w, h, torque=None, *, wheel_inertia=None, moto
     Examples
     --------
     >>> import casadi as ca
-    >>> from dynamics.momentum.wheels import rotor_dynamics
+    >>> from appdyn.dynamics.momentum.wheels import rotor_dynamics
     >>> H, wdot, hdot = rotor_dynamics([[1, 0, 0], [0, 2, 0], [0, 0, 3]], [[1.0], [0.0], [0.0]],
     ...                                ca.DM([0.0, 0.0, 1.0]), [2.0])  # held wheel, h = 2
     >>> H.T, wdot.T  # w x H = (0, 2, 0), I_L wdot = -w x H
@@ -146,7 +146,7 @@ def attitude_invariants(x, p, H, energy, **more) -> dict:
     Examples
     --------
     >>> import casadi as ca
-    >>> from dynamics.momentum.wheels import attitude_invariants
+    >>> from appdyn.dynamics.momentum.wheels import attitude_invariants
     >>> x, p = ca.SX.sym("x", 7), ca.SX.sym("p", 0)
     >>> sorted(attitude_invariants(x, p, x[4:7], 0.5 * ca.sumsqr(x[4:7])))
     ['energy', 'momentum_inertial', 'quat_norm']
@@ -231,7 +231,7 @@ def wheel_spacecraft(inertia, axes, wheel_inertia, *, external_torque: bool = Fa
     Examples
     --------
     >>> import numpy as np
-    >>> from dynamics.momentum.wheels import wheel_spacecraft
+    >>> from appdyn.dynamics.momentum.wheels import wheel_spacecraft
     >>> model = wheel_spacecraft([10.0, 12.0, 8.0], np.eye(3), 0.05)
     >>> model.states[7:], model.controls
     (('W1', 'W2', 'W3'), ('tau1', 'tau2', 'tau3'))

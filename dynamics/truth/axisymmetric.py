@@ -91,7 +91,7 @@ def axisymmetric(inertia_diag, w0, q0, t, *, axis_index=None, axis=None):
     Examples
     --------
     >>> import numpy as np
-    >>> from dynamics.truth import axisymmetric
+    >>> from appdyn.dynamics.truth import axisymmetric
     >>> w, q = axisymmetric([1.0, 1.0, 2.0], [0.1, 0.0, 0.5], [0, 0, 0, 1], [0.0, np.pi])
     >>> np.round(w, 6)  # the transverse rate turns at lam = (2 - 1) / 1 * 0.5 rad/s
     array([[0.1, 0. ],
@@ -155,7 +155,7 @@ def constant_rate_quat(q0, w, t):
     Examples
     --------
     >>> import numpy as np
-    >>> from dynamics.truth import constant_rate_quat
+    >>> from appdyn.dynamics.truth import constant_rate_quat
     >>> np.round(constant_rate_quat([0, 0, 0, 1], [0.0, 0.0, np.pi], 0.5)[:, 0], 6)  # 90 deg
     array([0.      , 0.      , 0.707107, 0.707107])
     """
@@ -221,7 +221,7 @@ def symmetric_precession(inertia_diag, w0, *, axis_index=None, axis=None):
 
     Examples
     --------
-    >>> from dynamics.truth import symmetric_precession
+    >>> from appdyn.dynamics.truth import symmetric_precession
     >>> prec = symmetric_precession([1.0, 1.0, 2.0], [0.1, 0.0, 0.5])
     >>> round(float(prec.omega_p), 6), round(float(prec.lam), 6), prec.axis_index
     (1.004988, 0.5, 2)

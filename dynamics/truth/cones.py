@@ -72,7 +72,7 @@ def cone_angles(inertia_diag, w0):
     Examples
     --------
     >>> import numpy as np
-    >>> from dynamics.truth import cone_angles
+    >>> from appdyn.dynamics.truth import cone_angles
     >>> cones = cone_angles([1.0, 2.0, 3.0], [0.1, 0.2, 0.3])
     >>> np.round(np.degrees([cones.theta_min, cones.theta_max]), 6), cones.axis_index
     (array([13.054453, 26.856271]), 2)
@@ -151,7 +151,7 @@ def small_asymmetry_rates(inertia_diag, rate=None, *, axis_index=None, axis=None
 
     Examples
     --------
-    >>> from dynamics.truth import small_asymmetry_rates
+    >>> from appdyn.dynamics.truth import small_asymmetry_rates
     >>> lam1, lam2 = small_asymmetry_rates([1.0, 2.0, 3.0], 2.0, axis_index=2)  # major axis
     >>> float(lam1), float(lam2)  # (3 - 2) / 1 * 2, (3 - 1) / 2 * 2
     (2.0, 2.0)
@@ -189,7 +189,7 @@ def small_asymmetry_frequency(inertia_diag, rate=None, *, axis_index=None, axis=
 
     Examples
     --------
-    >>> from dynamics.truth import small_asymmetry_frequency
+    >>> from appdyn.dynamics.truth import small_asymmetry_frequency
     >>> small_asymmetry_frequency([1.0, 2.0, 3.0], 2.0, axis_index=2)
     2.0
     """

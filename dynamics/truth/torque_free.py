@@ -37,7 +37,7 @@ def energy(inertia_diag, w):
 
     Examples
     --------
-    >>> from dynamics.truth import energy
+    >>> from appdyn.dynamics.truth import energy
     >>> round(float(energy([1.0, 2.0, 3.0], [1.0, 1.0, 1.0])), 6)  # (1 + 2 + 3) / 2
     3.0
     """
@@ -63,7 +63,7 @@ def momentum_magnitude(inertia_diag, w):
 
     Examples
     --------
-    >>> from dynamics.truth import momentum_magnitude
+    >>> from appdyn.dynamics.truth import momentum_magnitude
     >>> round(float(momentum_magnitude([1.0, 2.0, 3.0], [1.0, 1.0, 1.0])), 6)  # sqrt(14)
     3.741657
     """
@@ -354,7 +354,7 @@ def torque_free_parameters(inertia_diag, w0):
 
     Examples
     --------
-    >>> from dynamics.truth import torque_free_parameters
+    >>> from appdyn.dynamics.truth import torque_free_parameters
     >>> prm = torque_free_parameters([1.0, 2.0, 3.0], [0.1, 0.2, 0.3])
     >>> prm.branch, prm.axis_index, prm.functions
     ('major', 2, ('cn', 'sn', 'dn'))
@@ -426,7 +426,7 @@ def torque_free_omega(inertia_diag, w0, t):
     Examples
     --------
     >>> import numpy as np
-    >>> from dynamics.truth import torque_free_omega, torque_free_parameters
+    >>> from appdyn.dynamics.truth import torque_free_omega, torque_free_parameters
     >>> inertia, w0 = [1.0, 2.0, 3.0], [0.1, 0.2, 0.3]
     >>> np.round(torque_free_omega(inertia, w0, [0.0, 10.0]), 6)
     array([[ 0.1     , -0.112273],

@@ -34,7 +34,7 @@ def is_symbolic(x) -> bool:
     Examples
     --------
     >>> import casadi as ca
-    >>> from dynamics.validate import is_symbolic
+    >>> from appdyn.dynamics.validate import is_symbolic
     >>> is_symbolic(ca.SX.sym("x")), is_symbolic(ca.DM(1.0)), is_symbolic([1.0])
     (True, False, False)
     """

@@ -35,7 +35,7 @@ def check_inertia(inertia, *, name="inertia", triangle=True):
 
     Examples
     --------
-    >>> from dynamics.validate import check_inertia
+    >>> from appdyn.dynamics.validate import check_inertia
     >>> check_inertia([1.0, 2.0, 3.0])  # principal moments become a diagonal matrix
     array([[1., 0., 0.],
            [0., 2., 0.],

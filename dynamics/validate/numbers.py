@@ -39,7 +39,7 @@ def finite_array(x, name: str, shape: tuple | None = None, *, batch: bool = Fals
 
     Examples
     --------
-    >>> from dynamics.validate import finite_array
+    >>> from appdyn.dynamics.validate import finite_array
     >>> finite_array([1, 2, 3], "w0", (3,))
     array([1., 2., 3.])
     >>> finite_array([1.0, float("nan"), 3.0], "w0", (3,))
@@ -76,13 +76,13 @@ def finite_scalar(x, name: str) -> float:
 
     Examples
     --------
-    >>> from dynamics.validate import finite_scalar
+    >>> from appdyn.dynamics.validate import finite_scalar
     >>> finite_scalar(2, "rate")
     2.0
     >>> finite_scalar("fast", "rate")
     Traceback (most recent call last):
         ...
-    dynamics.validate.ArgumentTypeError: `rate` must be real numbers, got a string: 'fast'
+    appdyn.dynamics.validate.ArgumentTypeError: `rate` must be real numbers, got a string: 'fast'
     """
     if type(x) is float and math.isfinite(x):  # fast path: the common case
         return x
@@ -121,7 +121,7 @@ def one_of(value, name: str, choices: tuple):
 
     Examples
     --------
-    >>> from dynamics.validate import one_of
+    >>> from appdyn.dynamics.validate import one_of
     >>> one_of("rk4", "method", ("rk4", "rk8"))
     'rk4'
     >>> one_of("rk5", "method", ("rk4", "rk8"))
@@ -173,7 +173,7 @@ def integer(value, name: str, *, minimum: int | None = None) -> int:
     Examples
     --------
     >>> import numpy as np
-    >>> from dynamics.validate import integer
+    >>> from appdyn.dynamics.validate import integer
     >>> integer(np.int64(3), "steps", minimum=1)
     3
     >>> integer(0, "steps", minimum=1)
@@ -217,7 +217,7 @@ def positive(value, name: str) -> float:
 
     Examples
     --------
-    >>> from dynamics.validate import positive
+    >>> from appdyn.dynamics.validate import positive
     >>> positive(2, "u_max")
     2.0
     >>> positive(0.0, "u_max")
@@ -243,7 +243,7 @@ def nonnegative(value, name: str) -> float:
 
     Examples
     --------
-    >>> from dynamics.validate import nonnegative
+    >>> from appdyn.dynamics.validate import nonnegative
     >>> nonnegative(0, "effort_weight")
     0.0
     """
@@ -278,7 +278,7 @@ def positive_each(value, name: str, n: int) -> np.ndarray:
 
     Examples
     --------
-    >>> from dynamics.validate import positive_each
+    >>> from appdyn.dynamics.validate import positive_each
     >>> positive_each(0.5, "wheel_inertia", 3)
     array([0.5, 0.5, 0.5])
     >>> positive_each([1.0, -1.0], "wheel_inertia", 2)

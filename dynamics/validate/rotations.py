@@ -54,7 +54,7 @@ def unit_vector(v, name: str, *, size: int = 3, batch: bool = False) -> np.ndarr
 
     Examples
     --------
-    >>> from dynamics.validate import unit_vector
+    >>> from appdyn.dynamics.validate import unit_vector
     >>> unit_vector([0, 3, 4], "axis")
     array([0. , 0.6, 0.8])
     """
@@ -97,7 +97,7 @@ def unit_quaternion(q, name: str, *, tol: float = QUAT_NORM_TOL) -> np.ndarray:
 
     Examples
     --------
-    >>> from dynamics.validate import unit_quaternion
+    >>> from appdyn.dynamics.validate import unit_quaternion
     >>> unit_quaternion([0.0, 0.6, 0.0, 0.8], "q0")
     array([0. , 0.6, 0. , 0.8])
     >>> unit_quaternion([0.0, 0.0, 0.0, 2.0], "q0")
@@ -126,7 +126,7 @@ def check_unit_quaternion(q, name: str, *, tol: float = QUAT_NORM_TOL) -> None:
 
     Examples
     --------
-    >>> from dynamics.validate import check_unit_quaternion
+    >>> from appdyn.dynamics.validate import check_unit_quaternion
     >>> check_unit_quaternion([0.0, 0.6, 0.0, 0.8], "q0")
     >>> check_unit_quaternion([0.0, 0.0, 0.0, 2.0], "q0")
     Traceback (most recent call last):
@@ -170,7 +170,7 @@ def unit_quaternions(q, name: str, *, tol: float = QUAT_NORM_TOL,
 
     Examples
     --------
-    >>> from dynamics.validate import unit_quaternions
+    >>> from appdyn.dynamics.validate import unit_quaternions
     >>> unit_quaternions([[0.0, 0.0], [0.0, 0.6], [0.0, 0.0], [1.0, 0.8]], "q")  # (4, n)
     array([[0. , 0. ],
            [0. , 0.6],
@@ -229,7 +229,7 @@ def rotation_matrix(A, name: str, *, tol: float = DCM_ORTHO_TOL, batch: bool = F
     Examples
     --------
     >>> import numpy as np
-    >>> from dynamics.validate import rotation_matrix
+    >>> from appdyn.dynamics.validate import rotation_matrix
     >>> rotation_matrix(2 * np.eye(3), "A")
     Traceback (most recent call last):
         ...
@@ -300,7 +300,7 @@ def unit_axes(axes, name: str, *, n: int | None = None, tol: float = AXIS_NORM_T
 
     Examples
     --------
-    >>> from dynamics.validate import unit_axes
+    >>> from appdyn.dynamics.validate import unit_axes
     >>> unit_axes([[1.0, 0.0], [0.0, 0.6], [0.0, 0.8]], "axes")
     array([[1. , 0. ],
            [0. , 0.6],

@@ -14,8 +14,8 @@ from typing import Mapping, Sequence
 
 import numpy as np
 
-from dynamics.cache import construction_lock
-from dynamics.interrupts import check_interrupt, interruptible
+from appdyn.dynamics.cache import construction_lock
+from appdyn.dynamics.interrupts import check_interrupt, interruptible
 
 from ..cached import checkout
 from ..guess import initial_guess
@@ -114,8 +114,8 @@ def solve_phases(problem: MultiPhaseProblem, *, guess=None, objective_scale: flo
     Rest at 0 to rest at 1 in 2 s with minimum ``integral u^2 / 2``, split at t = 1 s (the
     merged problem's optimum is ``6 d^2 / T^3 = 0.75``):
 
-    >>> import ocp
-    >>> from ocp.examples import double_integrator
+    >>> from appdyn import ocp
+    >>> from appdyn.ocp.examples import double_integrator
     >>> di, energy = double_integrator(), (lambda u: 0.5 * u**2)
     >>> first = ocp.Problem(di, T=1.0, x_initial=[0, 0], lagrange=energy)
     >>> second = ocp.Problem(di, T=1.0, x_final=[1, 0], lagrange=energy)

@@ -91,9 +91,9 @@ def bang_arcs(solution: Solution, *, samples: int = 9,
 
     Examples
     --------
-    >>> import ocp
-    >>> from ocp.examples import min_time
-    >>> from ocp.refine.switch_times import bang_arcs
+    >>> from appdyn import ocp
+    >>> from appdyn.ocp.examples import min_time
+    >>> from appdyn.ocp.refine.switch_times import bang_arcs
     >>> arcs, why = bang_arcs(ocp.solve(min_time(), N=10))  # x'' = u, |u| <= 1
     >>> arcs.switch_times.round(6), arcs.controls
     (array([1.]), array([[ 1., -1.]]))

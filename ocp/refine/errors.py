@@ -9,7 +9,7 @@ import casadi as ca
 import numpy as np
 
 from ..cached import cached, function_key
-from dynamics.validate import integer
+from appdyn.dynamics.validate import integer
 from ..solution import Solution, interval_integrator, stack_interval_controls
 from ..transcription import Transcription
 from .switches import control_switches

@@ -11,8 +11,8 @@ import warnings
 
 import numpy as np
 
-from dynamics.validate import integer, positive
-from dynamics.interrupts import interruptible
+from appdyn.dynamics.validate import integer, positive
+from appdyn.dynamics.interrupts import interruptible
 from ..checks import (STATUS_BOUND_VIOLATION, STATUS_RESIMULATION, interval_bound_violation,
                       periodic_jumps)
 from ..mesh import Mesh
@@ -304,8 +304,8 @@ def refine(problem: Problem, solution: Solution | None = None, *, tol: float = 1
 
     Examples
     --------
-    >>> import ocp
-    >>> from ocp.examples import min_energy
+    >>> from appdyn import ocp
+    >>> from appdyn.ocp.examples import min_energy
     >>> energy = min_energy()  # x'' = u from rest at 0 to rest at 1 in T = 1 s
     >>> first = ocp.solve(energy, N=10, transcription="trapezoid")
     >>> sol = ocp.refine(energy, first, tol=1e-8)
@@ -314,7 +314,7 @@ def refine(problem: Problem, solution: Solution | None = None, *, tol: float = 1
 
     A singular arc stalls; a small regularization converges:
 
-    >>> from ocp.examples import goddard_rocket
+    >>> from appdyn.ocp.examples import goddard_rocket
     >>> rocket = ocp.refine(goddard_rocket(), tol=1e-6)
     >>> rocket.status, rocket.info["stop"], len(rocket.refinement) - 1
     ('Refinement_Stalled', 'stalled', 2)

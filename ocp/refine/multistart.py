@@ -11,8 +11,8 @@ from typing import Mapping, Sequence
 
 import numpy as np
 
-from dynamics.executors import check_executor, gather
-from dynamics.interrupts import interruptible
+from appdyn.dynamics.executors import check_executor, gather
+from appdyn.dynamics.interrupts import interruptible
 from ..problem import Problem
 from ..progress import LOGGER
 from ..solution import Solution
@@ -88,8 +88,8 @@ def solve_multistart(problem: Problem, guesses: Sequence, *, start_options: Sequ
 
     Examples
     --------
-    >>> import ocp
-    >>> from ocp.examples import min_time
+    >>> from appdyn import ocp
+    >>> from appdyn.ocp.examples import min_time
     >>> fastest = min_time()  # x'' = u, |u| <= 1, from rest at 0 to rest at 1
     >>> sol = ocp.solve_multistart(fastest, [None, {"T": 5.0}], N=10, control="constant")
     >>> sol.success, round(sol.T, 6), len(sol.info["starts"])

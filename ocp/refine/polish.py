@@ -34,13 +34,13 @@ from typing import Mapping
 import casadi as ca
 import numpy as np
 
-from dynamics.model import Model
-from dynamics.interrupts import interruptible
+from appdyn.dynamics.model import Model
+from appdyn.dynamics.interrupts import interruptible
 
 from ..cached import cached, function_key
 from ..ipopt_options import check_ipopt_options
 from ..progress import stage_sink
-from dynamics.validate import integer
+from appdyn.dynamics.validate import integer
 from ..mesh import Mesh
 from ..problem import Constraint, Problem
 from ..solution import Solution
@@ -262,8 +262,8 @@ def polish_switches(problem: Problem, solution: Solution, *, N: int | None = Non
     --------
     The bang-bang double integrator: the switch moves onto its exact time T/2 = 1 s.
 
-    >>> import ocp
-    >>> from ocp.examples import min_time
+    >>> from appdyn import ocp
+    >>> from appdyn.ocp.examples import min_time
     >>> fastest = min_time()  # x'' = u, |u| <= 1, from rest at 0 to rest at 1
     >>> sol = ocp.polish_switches(fastest, ocp.solve(fastest, N=10))
     >>> sol.success, round(sol.T, 8), ocp.find_switches(sol).round(8), sol.info["method"]

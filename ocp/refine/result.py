@@ -127,8 +127,8 @@ def worse_than(problem, cost: float, start: float, slack: float = WORSE_SLACK) -
 
     Examples
     --------
-    >>> from ocp.examples import min_time
-    >>> from ocp.refine.result import worse_than
+    >>> from appdyn.ocp.examples import min_time
+    >>> from appdyn.ocp.refine.result import worse_than
     >>> worse_than(min_time(), 2.01, 2.0), worse_than(min_time(), 2.001, 2.0)
     (True, False)
     """

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import casadi as ca
 
-from dynamics.integrate.tableaux import DOP853
+from appdyn.dynamics.integrate.tableaux import DOP853
 
 from ..cached import cached, function_key
 from ..transcription import sx_compatible

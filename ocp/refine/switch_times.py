@@ -56,9 +56,9 @@ from typing import Mapping
 import casadi as ca
 import numpy as np
 
-from dynamics.cache import construction_lock
-from dynamics.interrupts import check_interrupt
-from dynamics.validate import integer
+from appdyn.dynamics.cache import construction_lock
+from appdyn.dynamics.interrupts import check_interrupt
+from appdyn.dynamics.validate import integer
 
 from ..attitude import attitude_error
 from ..cached import checkout
@@ -185,9 +185,9 @@ def optimize_switch_times(problem: Problem, solution: Solution, *, arcs: BangArc
 
     Examples
     --------
-    >>> import ocp
-    >>> from ocp.examples import min_time
-    >>> from ocp.refine.switch_times import optimize_switch_times
+    >>> from appdyn import ocp
+    >>> from appdyn.ocp.examples import min_time
+    >>> from appdyn.ocp.refine.switch_times import optimize_switch_times
     >>> fastest = min_time()  # x'' = u, |u| <= 1, from rest at 0 to rest at 1
     >>> sol = optimize_switch_times(fastest, ocp.solve(fastest, N=9))
     >>> sol.success, round(sol.T, 12), sol.info["switch_times"].round(12)

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from dynamics.validate import integer
+from appdyn.dynamics.validate import integer
 from ..solution import Solution
 
 __all__ = ["control_switches", "find_switches"]
@@ -83,8 +83,8 @@ def control_switches(solution: Solution, *, samples: int = 9) -> list[np.ndarray
 
     Examples
     --------
-    >>> import ocp
-    >>> from ocp.examples import min_time
+    >>> from appdyn import ocp
+    >>> from appdyn.ocp.examples import min_time
     >>> fastest = min_time()  # x'' = u, |u| <= 1, from rest at 0 to rest at 1
     >>> sol = ocp.solve(fastest, N=10)
     >>> [s.round(6) for s in ocp.control_switches(sol)]  # u = +1, then -1 from t = T/2
@@ -126,7 +126,7 @@ def find_switches(solution: Solution, *, samples: int = 9) -> np.ndarray:
 
     Examples
     --------
-    >>> from ocp import examples, find_switches, solve
+    >>> from appdyn.ocp import examples, find_switches, solve
     >>> find_switches(solve(examples.min_time(), N=10)).round(6)  # x'' = u, |u| <= 1
     array([1.])
     """

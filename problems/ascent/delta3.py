@@ -89,9 +89,9 @@ from typing import NamedTuple
 import casadi as ca
 import numpy as np
 
-from dynamics import cache
-from dynamics.model import Model, model_from_expressions
-from dynamics.validate import finite_array, finite_scalar, integer, is_symbolic, positive
+from appdyn.dynamics import cache
+from appdyn.dynamics.model import Model, model_from_expressions
+from appdyn.dynamics.validate import finite_array, finite_scalar, integer, is_symbolic, positive
 
 __all__ = [
     "CD", "CONTROLS", "FINAL_MASS_BETTS", "FINAL_MASS_YAPSS", "FINAL_TIME_BETTS", "G0",
@@ -308,7 +308,7 @@ def delta3_model(phase: int) -> Model:
 
     Examples
     --------
-    >>> from problems.ascent.delta3 import delta3_model, initial_state, PHASES
+    >>> from appdyn.problems.ascent.delta3 import delta3_model, initial_state, PHASES
     >>> model = delta3_model(0)
     >>> model.states, model.controls
     (('rx', 'ry', 'rz', 'vx', 'vy', 'vz', 'm'), ('ux', 'uy', 'uz'))

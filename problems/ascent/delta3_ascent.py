@@ -20,8 +20,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-import ocp
-from dynamics.validate import finite_array
+from appdyn import ocp
+from appdyn.dynamics.validate import finite_array
 
 from .delta3 import (FINAL_MASS_BETTS, H_SCALE, OMEGA_E, PHASES, RE, RHO0,
                      TARGET_ORBIT, delta3_model, guess, initial_state, orbit_residuals,
@@ -201,7 +201,7 @@ class AscentResult:
         """Altitude, inertial speed, mass, thrust direction and dynamic pressure against time,
         the phase boundaries marked; returns a `matplotlib.figure.Figure` (library habit:
         no pyplot)."""
-        from dynamics.figures import cleared_figure
+        from appdyn.dynamics.figures import cleared_figure
 
         fig = cleared_figure(fig, (10.0, 8.0))
         axes = fig.subplots(3, 2, sharex=True).ravel()

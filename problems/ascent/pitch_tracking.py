@@ -10,10 +10,10 @@ from typing import Mapping
 
 import numpy as np
 
-from dynamics import simulate
-from dynamics.figures import finish_figure, new_figure
-from dynamics.serialize import text_table, to_json
-from dynamics.validate import finite_scalar, positive
+from appdyn.dynamics import simulate
+from appdyn.dynamics.figures import finish_figure, new_figure
+from appdyn.dynamics.serialize import text_table, to_json
+from appdyn.dynamics.validate import finite_scalar, positive
 
 from .planar import PlanarAscent
 from .planar_model import SCALE_HEIGHT, STATES, TRACKING_STATES, AscentVehicle, _vehicle, pitch_model

@@ -11,10 +11,10 @@ from typing import Literal, Mapping
 import casadi as ca
 import numpy as np
 
-import ocp
-from dynamics.figures import finish_figure, new_figure
-from dynamics.serialize import text_table, to_json
-from dynamics.validate import finite_scalar, integer, one_of, positive
+from appdyn import ocp
+from appdyn.dynamics.figures import finish_figure, new_figure
+from appdyn.dynamics.serialize import text_table, to_json
+from appdyn.dynamics.validate import finite_scalar, integer, one_of, positive
 
 from .planar_model import (RHO0, SCALE_HEIGHT, STATES, AscentVehicle, _vehicle, planar_model,
                            vertical_rise)

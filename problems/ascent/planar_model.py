@@ -82,8 +82,8 @@ from functools import lru_cache
 
 import casadi as ca
 
-from dynamics.model import Model, model_from_expressions
-from dynamics.validate import finite_scalar, positive
+from appdyn.dynamics.model import Model, model_from_expressions
+from appdyn.dynamics.validate import finite_scalar, positive
 
 # the atmosphere, gravity and Earth of the Delta III benchmark (one place for them)
 from .delta3 import G0, H_SCALE as SCALE_HEIGHT, RE as EARTH_RADIUS, RHO0
@@ -180,7 +180,7 @@ class AscentVehicle:
 
 @lru_cache(maxsize=1)
 def _default_vehicle() -> AscentVehicle:
-    from problems.gains import EXAMPLE_CONFIG, load_config
+    from appdyn.problems.gains import EXAMPLE_CONFIG, load_config
 
     cfg = load_config(EXAMPLE_CONFIG)
     v = cfg.vehicle

@@ -40,9 +40,11 @@ import os
 import re
 import sys
 
-from problems.cli import ascent, bench, cmg, demo, dispersion, gains, simulate, slew, stability
-from problems.cli.common import attach_negative_values
-from problems.cli.slew import rest_to_rest_bound
+import appdyn
+
+from appdyn.problems.cli import ascent, bench, cmg, demo, dispersion, gains, simulate, slew, stability
+from appdyn.problems.cli.common import attach_negative_values
+from appdyn.problems.cli.slew import rest_to_rest_bound
 
 __all__ = ["main", "build_parser", "COMMANDS", "rest_to_rest_bound"]
 
@@ -58,6 +60,7 @@ def build_parser() -> argparse.ArgumentParser:
         prog="appdyn", description="Aerospace vehicle dynamics and optimal control on CasADi.",
         epilog="exit status: 0 done (and verified), 1 numerical failure or failed check, "
                "2 bad input")
+    parser.add_argument("--version", action="version", version=f"appdyn {appdyn.__version__}")
     sub = parser.add_subparsers(dest="command", required=True)
     for module in COMMANDS.values():
         module.add_parser(sub)

@@ -1,6 +1,6 @@
-"""``python -m problems.cli ...`` runs the ``appdyn`` command line."""
+"""``python -m appdyn.problems.cli ...`` runs the ``appdyn`` command line."""
 import sys
 
-from problems.cli import main
+from appdyn.problems.cli import main
 
 sys.exit(main())

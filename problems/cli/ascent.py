@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import argparse
 
-from problems.cli.common import PLOT_SUFFIXES, finish, integer, output_file, positive, same_file
+from appdyn.problems.cli.common import PLOT_SUFFIXES, finish, integer, output_file, positive, same_file
 
 __all__ = ["add_parser", "check", "run"]
 
@@ -51,7 +51,7 @@ def check(parser, args) -> None:
 
 def run(args) -> int:
     """Solve, print the phase table, write ``--plot``/``--json``; 0 when verified."""
-    from problems.ascent import delta3_ascent
+    from appdyn.problems.ascent import delta3_ascent
 
     result = delta3_ascent(N=args.N, degree=args.degree,
                            refine_tol=None if args.no_refine else args.refine_tol)

@@ -19,12 +19,12 @@ import sys
 
 import numpy as np
 
-from problems.cli.common import PLOT_SUFFIXES, finish, same_file, save_figure, write_json
-from problems.cli.common import integer as _integer
-from problems.cli.common import number as _number
-from problems.cli.common import output_file as _output_file
-from problems.cli.common import positive as _positive
-from problems.cli.common import vector as _vector
+from appdyn.problems.cli.common import PLOT_SUFFIXES, finish, same_file, save_figure, write_json
+from appdyn.problems.cli.common import integer as _integer
+from appdyn.problems.cli.common import number as _number
+from appdyn.problems.cli.common import output_file as _output_file
+from appdyn.problems.cli.common import positive as _positive
+from appdyn.problems.cli.common import vector as _vector
 
 __all__ = ["add_parser", "check", "run", "pyramid_extent", "CHECK_TOL"]
 
@@ -53,7 +53,7 @@ def pyramid_extent(beta, h) -> dict:
     Examples
     --------
     >>> import numpy as np
-    >>> from problems.cli.cmg import pyramid_extent
+    >>> from appdyn.problems.cli.cmg import pyramid_extent
     >>> {k: round(v, 4) for k, v in pyramid_extent(np.deg2rad(54.74), 1.0).items()}
     {'x': 3.1546, 'y': 3.1546, 'z': 3.2662}
     """
@@ -125,13 +125,13 @@ def check(parser, args) -> None:
 
 
 def _geometry(args):
-    from dynamics.momentum import pyramid
+    from appdyn.dynamics.momentum import pyramid
 
     return pyramid(np.radians(args.beta), args.h if args.h.size == 4 else float(args.h[0]))
 
 
 def _envelope(args) -> int:
-    from dynamics.momentum import momentum_envelope
+    from appdyn.dynamics.momentum import momentum_envelope
 
     env = momentum_envelope(_geometry(args), directions=args.directions)
     computed, closed = env.extent, pyramid_extent(np.radians(args.beta), args.h)
@@ -163,7 +163,7 @@ def _envelope(args) -> int:
 
 
 def _steer(args) -> int:
-    from dynamics.momentum import steer
+    from appdyn.dynamics.momentum import steer
 
     t = np.linspace(0.0, args.t_final, args.points)
     res = steer(_geometry(args), args.torque, t, law=args.law,

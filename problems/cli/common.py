@@ -20,7 +20,7 @@ from pathlib import Path
 
 import numpy as np
 
-from dynamics.serialize import jsonable, to_json
+from appdyn.dynamics.serialize import jsonable, to_json
 
 __all__ = ["vector", "number", "positive", "integer", "output_file", "attach_negative_values",
            "strict_jsonable", "strict_json", "Progress", "progress_enabled", "write_outputs",

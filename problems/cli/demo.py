@@ -19,13 +19,13 @@ def check(parser, args) -> None:
 
 def run(args) -> int:
     """Run the tour; 0 when the simulation and the slew are verified, else 1."""
-    from problems.torque_free import torque_free
+    from appdyn.problems.torque_free import torque_free
 
     print("== 1. Torque-free asymmetric body, 100 s, checked against the exact solution ==")
     report = torque_free([1.0, 2.0, 3.0], [1.0, 0.1, 0.8], t_final=100.0, rtol=1e-12, atol=1e-12)
     print(report)
 
-    from problems import slew
+    from appdyn.problems import slew
 
     print("\n== 2. Time-optimal 180 deg slew, J = E, |u_i| <= 1 (Bilimoria & Wie 1993) ==")
     sol = slew.time_optimal(np.eye(3), angle=np.pi, axis=[0, 0, 1], u_max=1.0)
@@ -33,7 +33,7 @@ def run(args) -> int:
     print(slew.format_summary(slew.summary(sol, eigenaxis=eig)))
     print("  (best known T = 3.2430; the eigenaxis maneuver is a local optimum)")
 
-    from problems import stability
+    from appdyn.problems import stability
 
     print("\n== 3. Stability: Explorer I's lesson (Kelvin-Tait-Chetaev; Rheinfurth & Wilson, "
           "NASA RP-1262, Sec. 4.5 NOTE) ==")

@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import argparse
 
-from problems.cli.common import (Progress, add_executor_options, executor_from, finish,
+from appdyn.problems.cli.common import (Progress, add_executor_options, executor_from, finish,
                                  integer, output_file, positive, progress_enabled, same_file,
                                  PLOT_SUFFIXES)
 
@@ -59,7 +59,7 @@ def check(parser, args) -> None:
 def run(args) -> int:
     """Run the dispersion, print its statistics, write ``--plot``/``--json``; 0 when every
     sample succeeded."""
-    from problems.dispersion import nutation_spread
+    from appdyn.problems.dispersion import nutation_spread
 
     progress = Progress(f"dispersion spin ({args.samples} samples)", enabled=progress_enabled(args))
     try:

@@ -16,8 +16,8 @@ import argparse
 import math
 from pathlib import Path
 
-from problems.cli.common import PLOT_SUFFIXES, finish, same_file
-from problems.cli.common import output_file as _output_file
+from appdyn.problems.cli.common import PLOT_SUFFIXES, finish, same_file
+from appdyn.problems.cli.common import output_file as _output_file
 
 __all__ = ["add_parser", "check", "run", "DesignPrintout"]
 
@@ -32,7 +32,7 @@ def _config_file(text):
 
 def _example() -> str:
     """Path of the example configuration installed with the package."""
-    from problems.gains.config import EXAMPLE_CONFIG
+    from appdyn.problems.gains.config import EXAMPLE_CONFIG
 
     return str(EXAMPLE_CONFIG)
 
@@ -72,7 +72,7 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
 def check(parser, args) -> None:
     """Read and check the configuration before any computation (argparse error, exit 2,
     naming the field), and the output files."""
-    from problems.gains.config import load_config
+    from appdyn.problems.gains.config import load_config
 
     if same_file(args.plot, args.json):
         parser.error("argument --json: the same file as --plot")
@@ -137,7 +137,7 @@ class DesignPrintout:
 
     def plot(self):
         """`problems.gains.launch_vehicle.plot_design`."""
-        from problems.gains.launch_vehicle import plot_design
+        from appdyn.problems.gains.launch_vehicle import plot_design
 
         return plot_design(self.design)
 
@@ -146,7 +146,7 @@ def run(args) -> int:
     """Design, print, write ``--plot``/``--json``; 0 when verified, else 1."""
     config = getattr(args, "_config", None)
     if config is None:  # run() called without check()
-        from problems.gains.config import load_config
+        from appdyn.problems.gains.config import load_config
 
         config = load_config(args.config)
     design = config.design()

@@ -8,15 +8,15 @@ from __future__ import annotations
 import re
 import sys
 
-from problems.cli.common import PLOT_SUFFIXES, Progress, inertia_matrix, progress_enabled
-from problems.cli.common import integer as _integer
-from problems.cli.common import number as _number
-from problems.cli.common import output_file as _output_file
-from problems.cli.common import positive as _positive
-from problems.cli.common import same_file, save_figure
-from problems.cli.common import vector as _vector
-from problems.cli.common import finish, write_json, write_outputs
-from problems.cli.stability import (add_launch_vehicle_options, call_naming_parts, check_flight,
+from appdyn.problems.cli.common import PLOT_SUFFIXES, Progress, inertia_matrix, progress_enabled
+from appdyn.problems.cli.common import integer as _integer
+from appdyn.problems.cli.common import number as _number
+from appdyn.problems.cli.common import output_file as _output_file
+from appdyn.problems.cli.common import positive as _positive
+from appdyn.problems.cli.common import same_file, save_figure
+from appdyn.problems.cli.common import vector as _vector
+from appdyn.problems.cli.common import finish, write_json, write_outputs
+from appdyn.problems.cli.stability import (add_launch_vehicle_options, call_naming_parts, check_flight,
                                    launch_vehicle_kwargs)
 
 __all__ = ["add_parser", "check", "run", "FIXED_STEP", "HINGED_TOL", "HINGED_CONSERVED"]
@@ -132,7 +132,7 @@ def _run_launch_vehicle(args) -> int:
     import math
     from dataclasses import replace
 
-    from problems.stability import launch_vehicle_response
+    from appdyn.problems.stability import launch_vehicle_response
 
     kwargs = launch_vehicle_kwargs(args)
     if args.deflection_limit or args.rate_limit:  # degrees on the command line
@@ -155,7 +155,7 @@ def _run_launch_vehicle(args) -> int:
 
 def run(args) -> int:
     """Simulate, print the report, write ``--plot``/``--json``; 0 when verified, else 1."""
-    from problems.torque_free import torque_free
+    from appdyn.problems.torque_free import torque_free
 
     if args.case == "launch-vehicle":
         return _run_launch_vehicle(args)
@@ -243,7 +243,7 @@ def _hinged_run(args, stabilized, progress=None):
     """``(model, SimulationResult)`` of the hinged bodies with or without drift control."""
     import numpy as np
 
-    from dynamics import hinged_bodies, simulate
+    from appdyn.dynamics import hinged_bodies, simulate
 
     kwargs = {} if stabilized else {"stabilization": None}
     try:
@@ -348,7 +348,7 @@ def _hinged_figure(args, runs):
     """Rates, hinge reaction, and drift/residual of ``runs`` = {stabilized: result}."""
     import numpy as np
 
-    from dynamics.figures import finish_figure, new_figure
+    from appdyn.dynamics.figures import finish_figure, new_figure
 
     main_run = runs[not args.no_stabilization]
     fig = new_figure((11.0, 8.0))

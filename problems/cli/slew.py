@@ -13,15 +13,15 @@ import time
 
 import numpy as np
 
-from problems.cli.common import PLOT_SUFFIXES, inertia_matrix
-from problems.cli.common import integer as _integer
-from problems.cli.common import number as _number
-from problems.cli.common import output_file as _output_file
-from problems.cli.common import positive as _positive
-from problems.cli.common import same_file
-from problems.cli.common import vector as _vector
-from problems.cli.common import write_json
-from problems.cli.common import (Progress, add_executor_options, executor_from, finish,
+from appdyn.problems.cli.common import PLOT_SUFFIXES, inertia_matrix
+from appdyn.problems.cli.common import integer as _integer
+from appdyn.problems.cli.common import number as _number
+from appdyn.problems.cli.common import output_file as _output_file
+from appdyn.problems.cli.common import positive as _positive
+from appdyn.problems.cli.common import same_file
+from appdyn.problems.cli.common import vector as _vector
+from appdyn.problems.cli.common import write_json
+from appdyn.problems.cli.common import (Progress, add_executor_options, executor_from, finish,
                                  progress_enabled)
 
 __all__ = ["add_parser", "check", "run", "run_table", "read_targets", "rest_to_rest_bound",
@@ -97,7 +97,7 @@ def check(parser, args) -> None:
     """Checks across options, as argparse errors on ``parser`` (exit status 2)."""
     p = parser
     if args.targets is not None or args.example_targets:
-        from problems.slew.table import check_targets, example_targets
+        from appdyn.problems.slew.table import check_targets, example_targets
 
         flag = "--targets" if args.targets is not None else "--example-targets"
         for other, value in (("--axis", args.axis), ("--angle", args.angle), ("--qf", args.qf),
@@ -176,7 +176,7 @@ def rest_to_rest_bound(inertia, theta, u_norm) -> float:
 
 def run(args) -> int:
     """Solve, print the summary, write ``--plot``/``--json``; 0 when verified, else 1."""
-    from problems import slew
+    from appdyn.problems import slew
 
     if getattr(args, "_targets", None) is not None:
         return run_table(args)
@@ -251,7 +251,7 @@ def run(args) -> int:
 def run_table(args) -> int:
     """``--targets``/``--example-targets``: solve the maneuver table, print it, write
     ``--json``; 0 when every slew is verified, else 1."""
-    from problems.slew import maneuver_table
+    from appdyn.problems.slew import maneuver_table
 
     if args.u_max is None:
         u_max = 1.0 if args.time_optimal else None

@@ -36,7 +36,7 @@ the report shows the library's radians.
 `add_parser` adds the ``stability`` command to an argparse sub-parser group (its cases land
 in ``args.case``); `check` checks across options; `run` executes parsed arguments; `main` is
 a standalone entry taking the arguments after ``stability`` (from a shell:
-``python -m problems.cli stability spin ...``). Case names are mapped to
+``python -m appdyn.problems.cli stability spin ...``). Case names are mapped to
 the library's functions by `problems.stability.resolve_case` (its one alias table). This
 module prints; the library does not.
 """
@@ -48,14 +48,14 @@ import sys
 
 import numpy as np
 
-from problems.cli.common import Progress, attach_negative_values, inertia_matrix
-from problems.cli.common import number as _number
-from problems.cli.common import output_file as _output_file
-from problems.cli.common import positive as _positive
-from problems.cli.common import (add_executor_options, executor_from, progress_enabled, same_file,
+from appdyn.problems.cli.common import Progress, attach_negative_values, inertia_matrix
+from appdyn.problems.cli.common import number as _number
+from appdyn.problems.cli.common import output_file as _output_file
+from appdyn.problems.cli.common import positive as _positive
+from appdyn.problems.cli.common import (add_executor_options, executor_from, progress_enabled, same_file,
                                  save_figure)
-from problems.cli.common import vector as _floats
-from problems.cli.common import finish
+from appdyn.problems.cli.common import vector as _floats
+from appdyn.problems.cli.common import finish
 
 __all__ = ["add_parser", "check", "run", "main", "parse_damper", "sweep_parameters",
            "add_launch_vehicle_options", "launch_vehicle_kwargs", "check_flight",
@@ -89,7 +89,7 @@ def parse_damper(tokens):
             raise ValueError(f"`--damper` {key} must be numbers, got {value!r}") from None
         kwargs[key] = tuple(nums) if key in ("position", "direction") else (
             nums[0] if len(nums) == 1 else value)
-    from dynamics.spinning import PointMassDamper, SphericalDamper
+    from appdyn.dynamics.spinning import PointMassDamper, SphericalDamper
 
     try:
         return PointMassDamper(**kwargs) if kind == "point" else SphericalDamper(**kwargs)
@@ -121,7 +121,7 @@ def _items(fields):
 
 
 def _launch_vehicle_parts():
-    from dynamics.launch_vehicle import Actuator, Aero, Bending, Slosh
+    from appdyn.dynamics.launch_vehicle import Actuator, Aero, Bending, Slosh
 
     slosh = _items(("mass", "hinge", "length", "frequency", "damping_ratio"))
     bending = _items(("frequency", "generalized_mass", "damping_ratio", "slope_sensor",
@@ -435,7 +435,7 @@ def run(args) -> int:
     (``problems.cli.main`` does). ``ValueError`` from bad input propagates
     (``problems.cli.main`` turns it into exit status 2).
     """
-    from problems import stability as st  # imported on use: building the parser stays light
+    from appdyn.problems import stability as st  # imported on use: building the parser stays light
 
     if args.case == "sweep":
         case = args.sweep_case

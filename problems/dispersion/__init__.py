@@ -23,7 +23,7 @@ constant, ``theta = atan(I_t |w_t| / (I_a w3))``: each sample matches it, and th
 of theta over the samples is the spread of that closed form over the draws.
 
 >>> import numpy as np
->>> from problems.dispersion import Normal, dispersion, nutation_history, spinner
+>>> from appdyn.problems.dispersion import Normal, dispersion, nutation_history, spinner
 >>> res = dispersion(
 ...     spinner, [0, 0, 0, 1, 0.0, 0.0, 1.0], np.linspace(0.0, 30.0, 31),
 ...     samples=20, seed=0,

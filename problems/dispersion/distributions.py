@@ -20,8 +20,8 @@ from typing import Mapping
 
 import numpy as np
 
-from dynamics import validate
-from dynamics.validate import ArgumentTypeError
+from appdyn.dynamics import validate
+from appdyn.dynamics.validate import ArgumentTypeError
 
 __all__ = ["Distribution", "Normal", "Uniform", "SmallRotation", "RandomRotation",
            "check_spec", "draw", "generators", "draw_samples", "describe"]
@@ -69,7 +69,7 @@ class Normal(Distribution):
     Examples
     --------
     >>> import numpy as np
-    >>> from problems.dispersion import Normal
+    >>> from appdyn.problems.dispersion import Normal
     >>> x = Normal(1.0, 0.1).draw(np.random.default_rng(0))
     >>> round(x, 6)
     1.012573
@@ -103,7 +103,7 @@ class Uniform(Distribution):
     Examples
     --------
     >>> import numpy as np
-    >>> from problems.dispersion import Uniform
+    >>> from appdyn.problems.dispersion import Uniform
     >>> round(Uniform(-1.0, 1.0).draw(np.random.default_rng(0)), 6)
     0.273923
     """
@@ -150,7 +150,7 @@ class SmallRotation(Distribution):
     Examples
     --------
     >>> import numpy as np
-    >>> from problems.dispersion import SmallRotation
+    >>> from appdyn.problems.dispersion import SmallRotation
     >>> dq = SmallRotation(0.01).draw(np.random.default_rng(0))
     >>> dq.shape, bool(abs(np.linalg.norm(dq) - 1) < 1e-15), bool(dq[3] > 0.9999)
     ((4,), True, True)
@@ -177,7 +177,7 @@ class RandomRotation(Distribution):
     Examples
     --------
     >>> import numpy as np
-    >>> from problems.dispersion import RandomRotation
+    >>> from appdyn.problems.dispersion import RandomRotation
     >>> q = RandomRotation().draw(np.random.default_rng(0))
     >>> bool(abs(np.linalg.norm(q) - 1) < 1e-15), bool(q[3] >= 0)
     (True, True)
@@ -251,7 +251,7 @@ def draw_samples(params: Mapping, seed: int, samples: int) -> list[dict]:
 
     Examples
     --------
-    >>> from problems.dispersion import Normal, Uniform, draw_samples
+    >>> from appdyn.problems.dispersion import Normal, Uniform, draw_samples
     >>> specs = {"a": Normal(0.0, 1.0), "b": Uniform(0.0, 1.0), "c": 3.0}
     >>> draws = draw_samples(specs, 7, 2)
     >>> [sorted(d) for d in draws], draws[0]["c"]

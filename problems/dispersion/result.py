@@ -5,9 +5,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from dynamics.figures import cleared_figure, finish_figure
-from dynamics.serialize import jsonable, text_table, to_json
-from dynamics.validate.base import real_array
+from appdyn.dynamics.figures import cleared_figure, finish_figure
+from appdyn.dynamics.serialize import jsonable, text_table, to_json
+from appdyn.dynamics.validate.base import real_array
 
 from .distributions import describe
 
@@ -63,7 +63,7 @@ def statistics(values, percentiles=(1.0, 50.0, 99.0)) -> Statistics:
 
     Examples
     --------
-    >>> from problems.dispersion import statistics
+    >>> from appdyn.problems.dispersion import statistics
     >>> s = statistics([1.0, 2.0, 3.0, 4.0], percentiles=(50,))
     >>> s.count, s.mean, round(s.std, 6), s.min, s.max, s.percentiles
     (4, 2.5, 1.290994, 1.0, 4.0, {50.0: 2.5})

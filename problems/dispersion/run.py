@@ -20,12 +20,12 @@ from typing import Callable, Mapping
 
 import numpy as np
 
-from dynamics import simulate, validate
-from dynamics.integrate import METHODS
-from dynamics.integrate.inputs import check_t
-from dynamics.executors import check_executor, gather
-from dynamics.interrupts import check_interrupt, interruptible
-from dynamics.model import Model, check_model
+from appdyn.dynamics import simulate, validate
+from appdyn.dynamics.integrate import METHODS
+from appdyn.dynamics.integrate.inputs import check_t
+from appdyn.dynamics.executors import check_executor, gather
+from appdyn.dynamics.interrupts import check_interrupt, interruptible
+from appdyn.dynamics.model import Model, check_model
 
 from .distributions import check_spec, draw_samples
 from .result import DispersionResult, assemble
@@ -212,8 +212,8 @@ def dispersion(model, x0, t, *, samples: int, seed: int | None, outputs: Mapping
 
     >>> import casadi as ca
     >>> import numpy as np
-    >>> from dynamics.model import model_from_expressions
-    >>> from problems.dispersion import Uniform, dispersion
+    >>> from appdyn.dynamics.model import model_from_expressions
+    >>> from appdyn.problems.dispersion import Uniform, dispersion
     >>> y, k = ca.SX.sym("y"), ca.SX.sym("k")
     >>> decay = model_from_expressions({"y": y}, {"y": -k * y}, params={"k": k}, p_default=[1.0])
     >>> res = dispersion(decay, [1.0], [0.0, 1.0], samples=50, seed=0,

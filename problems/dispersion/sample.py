@@ -19,9 +19,9 @@ from typing import Callable
 
 import numpy as np
 
-from dynamics import simulate, validate
-from dynamics.attitude import quat_mul
-from dynamics.model import Model, check_model
+from appdyn.dynamics import simulate, validate
+from appdyn.dynamics.attitude import quat_mul
+from appdyn.dynamics.model import Model, check_model
 
 __all__ = ["SampleTask", "SampleOutcome", "run_sample", "run_samples", "accepted", "picked", "check_callable",
            "ATTITUDE", "NOT_SIMULATED"]

@@ -16,8 +16,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from dynamics import rigid_body, validate
-from dynamics.attitude import dcm_from_quat
+from appdyn.dynamics import rigid_body, validate
+from appdyn.dynamics.attitude import dcm_from_quat
 
 from .distributions import Normal
 from .run import dispersion
@@ -63,7 +63,7 @@ def spinner(transverse_inertia, axial_inertia, transverse_asymmetry=0.0):
 
     Examples
     --------
-    >>> from problems.dispersion import spinner
+    >>> from appdyn.problems.dispersion import spinner
     >>> spinner(1000.0, 1500.0).states
     ('q1', 'q2', 'q3', 'q4', 'w1', 'w2', 'w3')
     """
@@ -98,8 +98,8 @@ def nutation_history(res, transverse_inertia, axial_inertia, transverse_asymmetr
     Examples
     --------
     >>> import numpy as np
-    >>> from dynamics import simulate
-    >>> from problems.dispersion import nutation_closed_form, nutation_history, spinner
+    >>> from appdyn.dynamics import simulate
+    >>> from appdyn.problems.dispersion import nutation_closed_form, nutation_history, spinner
     >>> res = simulate(spinner(1000.0, 1500.0), [0, 0, 0, 1, 0.02, 0, 1.0],
     ...                np.linspace(0, 10, 11), jit=False)
     >>> theta = nutation_history(res, 1000.0, 1500.0)
@@ -138,7 +138,7 @@ def nutation_closed_form(transverse_inertia, axial_inertia, w0) -> float:
     Examples
     --------
     >>> import numpy as np
-    >>> from problems.dispersion import nutation_closed_form
+    >>> from appdyn.problems.dispersion import nutation_closed_form
     >>> round(float(np.degrees(nutation_closed_form(1000.0, 1500.0, [0.02, 0.0, 1.0]))), 6)
     0.763898
     """
@@ -189,7 +189,7 @@ def nutation_spread(samples: int = 200, seed: int | None = 0, *,
     Examples
     --------
     >>> import numpy as np
-    >>> from problems.dispersion import nutation_spread
+    >>> from appdyn.problems.dispersion import nutation_spread
     >>> res = nutation_spread(samples=8, seed=1, points=21)
     >>> res.success, res.outputs["nutation"].shape
     (True, (8, 21))

@@ -10,10 +10,10 @@ from typing import Mapping, Sequence
 import casadi as ca
 import numpy as np
 
-from dynamics import simulate
-from dynamics.model import Model
-from dynamics.rigid_body import RIGID_BODY_STATES, rigid_body
-from dynamics.validate import finite_array, nonnegative
+from appdyn.dynamics import simulate
+from appdyn.dynamics.model import Model
+from appdyn.dynamics.rigid_body import RIGID_BODY_STATES, rigid_body
+from appdyn.dynamics.validate import finite_array, nonnegative
 
 __all__ = ["attitude_loop", "initial_state", "settle_time", "error_angle", "check_scenarios",
            "gain_names", "pd_law", "loop_torque", "linearized_loop", "bang_bang_time",

@@ -62,7 +62,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Mapping
 
-from dynamics.launch_vehicle import Actuator, Aero
+from appdyn.dynamics.launch_vehicle import Actuator, Aero
 
 from .launch_vehicle import LaunchScenario, LaunchVehicle
 

@@ -75,8 +75,8 @@ from typing import Mapping
 
 import numpy as np
 
-import ocp
-from dynamics.validate import finite_scalar, positive
+from appdyn import ocp
+from appdyn.dynamics.validate import finite_scalar, positive
 
 from .result import STATUS_LIMITS, STATUS_UNSTABLE, GainDesign
 from .lv_data import (GAIN_UNITS, LaunchScenario, LaunchVehicle, WEIGHT_KEYS, check_gain_bounds,
@@ -174,7 +174,7 @@ def launch_vehicle_gains(vehicle, scenarios, *, delta_max, delta_rate_max, weigh
     Examples
     --------
     >>> import math
-    >>> from dynamics.launch_vehicle import Aero
+    >>> from appdyn.dynamics.launch_vehicle import Aero
     >>> v = LaunchVehicle(2e6, 4e7, 20.0, 1e5, aero=Aero(3e4, 10.0, 3.0, 5.0), velocity=300.0)
     >>> d = launch_vehicle_gains(v, [LaunchScenario(psi0=0.02), LaunchScenario(gust_alpha=0.03)],
     ...                          delta_max=math.radians(6), delta_rate_max=math.radians(25),
@@ -293,7 +293,7 @@ def plot_design(design: GainDesign, path=None):
     matplotlib.figure.Figure
         Three panels [deg, deg, deg/s] against time [s], the limits dashed.
     """
-    from dynamics.figures import finish_figure, new_figure
+    from appdyn.dynamics.figures import finish_figure, new_figure
 
     if not isinstance(design, GainDesign):
         raise TypeError(f"`design` must be a GainDesign, got {type(design).__name__}")

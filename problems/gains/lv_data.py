@@ -8,8 +8,8 @@ from typing import Mapping, Sequence
 
 import numpy as np
 
-from dynamics.launch_vehicle import Actuator, Aero
-from dynamics.validate import finite_scalar, positive
+from appdyn.dynamics.launch_vehicle import Actuator, Aero
+from appdyn.dynamics.validate import finite_scalar, positive
 
 __all__ = ["WEIGHT_KEYS", "DEFAULT_WEIGHTS", "GM_INF", "GAIN_UNITS", "LaunchVehicle",
            "LaunchScenario", "check_weights", "check_gain_bounds", "check_scenarios",
@@ -60,7 +60,7 @@ class LaunchVehicle:
 
     Examples
     --------
-    >>> from dynamics.launch_vehicle import Aero
+    >>> from appdyn.dynamics.launch_vehicle import Aero
     >>> v = LaunchVehicle(2e6, 4e7, 20.0, 1e5, aero=Aero(3e4, 10.0, 3.0, 5.0), velocity=300.0)
     >>> round(v.aero_gain_bound, 4)  # q S C_N_alpha l_cp / (F l)
     0.1125

@@ -8,10 +8,10 @@ import math
 import casadi as ca
 import numpy as np
 
-from dynamics.launch_vehicle import Actuator
-from dynamics.launch_vehicle import launch_vehicle as vehicle_model
-from dynamics.model import Model
-from dynamics.validate import positive
+from appdyn.dynamics.launch_vehicle import Actuator
+from appdyn.dynamics.launch_vehicle import launch_vehicle as vehicle_model
+from appdyn.dynamics.model import Model
+from appdyn.dynamics.validate import positive
 
 from .lv_data import GAIN_UNITS, LaunchVehicle
 

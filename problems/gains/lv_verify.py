@@ -8,8 +8,8 @@ import math
 import casadi as ca
 import numpy as np
 
-import ocp
-from dynamics.launch_vehicle import launch_vehicle as vehicle_model
+from appdyn import ocp
+from appdyn.dynamics.launch_vehicle import launch_vehicle as vehicle_model
 
 from .result import STATUS_LIMITS, STATUS_UNSTABLE, GainDesign
 from .lv_data import GM_INF, LaunchVehicle
@@ -68,8 +68,8 @@ def stability_check(veh: LaunchVehicle, gains, filter_tau=None) -> tuple[dict, o
     ``A = A_cl + B K C``) under the compensator, through `problems.stability.loop`."""
     import control
 
-    from problems.stability import launch_vehicle as stability_report
-    from problems.stability import loop, loop_transfer
+    from appdyn.problems.stability import launch_vehicle as stability_report
+    from appdyn.problems.stability import loop, loop_transfer
 
     rep = stability_report(k_psi=gains[0], k_psidot=gains[1], **veh.stability_kwargs())
     L = loop_transfer(rep)
@@ -99,7 +99,7 @@ def resimulate(veh: LaunchVehicle, gains, scenarios, horizon, points, *,
     """Every scenario re-simulated on a fine grid: on the library's closed-loop vehicle
     (`dynamics.launch_vehicle` with the gains given) for the PD law; for the integral/filter
     law on `closed_loop_model` with the user's actuator (clamps included)."""
-    from dynamics import simulate
+    from appdyn.dynamics import simulate
 
     gains = np.asarray(gains, dtype=float)
     V = veh.velocity or 0.0

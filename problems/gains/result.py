@@ -6,7 +6,7 @@ from typing import Mapping
 
 import numpy as np
 
-from dynamics.serialize import jsonable, text_table, to_json
+from appdyn.dynamics.serialize import jsonable, text_table, to_json
 
 __all__ = ["GainDesign", "STATUS_UNSTABLE", "STATUS_LIMITS"]
 

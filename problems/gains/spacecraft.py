@@ -47,8 +47,8 @@ from typing import Mapping
 import casadi as ca
 import numpy as np
 
-import ocp
-from dynamics.validate import check_inertia, finite_array, nonnegative, positive, positive_each
+from appdyn import ocp
+from appdyn.dynamics.validate import check_inertia, finite_array, nonnegative, positive, positive_each
 
 from .attitude_loop import (attitude_loop, check_scenarios, error_angle, gain_names, initial_state,
                             linearized_loop, loop_torque, pd_law, settle_time, simulate_loop,
@@ -167,7 +167,7 @@ def attitude_gains(inertia, scenarios, *, u_max, horizon=None, per_axis: bool = 
     A 30 deg slew about the third principal axis, ``J3 = 3 kg m^2``, ``|u_i| <= 0.5 N m``:
 
     >>> import numpy as np
-    >>> from problems.gains.spacecraft import attitude_gains
+    >>> from appdyn.problems.gains.spacecraft import attitude_gains
     >>> res = attitude_gains([1.0, 2.0, 3.0], [{"angle": np.radians(30), "axis": [0, 0, 1]}],
     ...                      u_max=0.5, time_optimal_reference=False)
     >>> res.success, res.verification["limits_met"], res.verification["stable"]
@@ -299,7 +299,7 @@ def attitude_gains(inertia, scenarios, *, u_max, horizon=None, per_axis: bool = 
 
     T_opt, to_ok, to_msg = float("nan"), False, "not computed"
     if time_optimal_reference and a_max > 0:
-        from problems.slew import time_optimal
+        from appdyn.problems.slew import time_optimal
         kw = {"starts": 1, "N": 30, **dict(time_optimal_options or {})}
         try:
             ts_sol = time_optimal(I, angle=a_max, axis=info[ref]["axis"], u_max=umax, **kw)

@@ -29,9 +29,9 @@ import numpy as np
 from scipy.linalg import expm
 from scipy.signal import place_poles
 
-import ocp
-from dynamics.model import Model
-from dynamics.validate import finite_array, positive
+from appdyn import ocp
+from appdyn.dynamics.model import Model
+from appdyn.dynamics.validate import finite_array, positive
 
 from .result import STATUS_UNSTABLE, GainDesign
 
@@ -276,7 +276,7 @@ def state_feedback_gains(A, B, Q, R, initial_states, horizon, *, N: int = _DEFAU
     The double integrator with ``Q = I``, ``R = 1`` (LQR gain ``[1, sqrt(3)]``):
 
     >>> import numpy as np
-    >>> from problems.gains.state_feedback import state_feedback_gains
+    >>> from appdyn.problems.gains.state_feedback import state_feedback_gains
     >>> A, B = np.array([[0.0, 1.0], [0.0, 0.0]]), np.array([[0.0], [1.0]])
     >>> K, res = state_feedback_gains(A, B, np.eye(2), np.eye(1), np.eye(2), 20.0)
     >>> res.success, np.round(K, 4), res.verification["lqr_relative_difference"] < 1e-4

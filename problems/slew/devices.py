@@ -23,14 +23,14 @@ from __future__ import annotations
 import casadi as ca
 import numpy as np
 
-from dynamics import cmg_spacecraft, wheel_spacecraft
-from dynamics.attitude import dcm_from_quat
-from dynamics.interrupts import interruptible
-from dynamics.momentum import (ClusterGeometry, cluster_jacobian, cluster_momentum,
+from appdyn.dynamics import cmg_spacecraft, wheel_spacecraft
+from appdyn.dynamics.attitude import dcm_from_quat
+from appdyn.dynamics.interrupts import interruptible
+from appdyn.dynamics.momentum import (ClusterGeometry, cluster_jacobian, cluster_momentum,
                                gram_determinant)
-from dynamics.validate import (check_inertia, finite_array, integer, one_of, positive,
+from appdyn.dynamics.validate import (check_inertia, finite_array, integer, one_of, positive,
                                positive_each, unit_axes)
-from ocp import Constraint, Problem, annotate, solve
+from appdyn.ocp import Constraint, Problem, annotate, solve
 
 from .maneuvers import SEED_OPTIONS, bounded, refine_and_verify, solve_time_optimal
 from .problem import attitude_guess, rough_time, seeded_guesses, slew_problem
@@ -171,7 +171,7 @@ def wheel_slew(inertia, axes, wheel_inertia, *, objective="time", T=None, angle=
     bang-bang ``T = 2 sqrt(0.2)``:
 
     >>> import numpy as np
-    >>> from problems import slew
+    >>> from appdyn.problems import slew
     >>> sol = slew.wheel_slew(np.eye(3), np.eye(3), 0.01, angle=0.2, axis=[0, 0, 1], N=10,
     ...                       starts=1)
     >>> sol.success, round(sol.T, 6), round(2 * 0.2 ** 0.5, 6)
@@ -264,8 +264,8 @@ def cmg_slew(inertia, geometry, *, objective="time", T=None, angle=None, axis=No
     Examples
     --------
     >>> import numpy as np
-    >>> from dynamics.momentum import pyramid
-    >>> from problems import slew
+    >>> from appdyn.dynamics.momentum import pyramid
+    >>> from appdyn.problems import slew
     >>> geo = pyramid(np.deg2rad(54.74), h=1.0)
     >>> sol = slew.cmg_slew(10 * np.eye(3), geo, objective="effort", T=3.0, angle=0.1,
     ...                     axis=[1, 0, 0], min_measure=0.5, N=15)

@@ -9,13 +9,13 @@ from typing import Mapping
 import casadi as ca
 import numpy as np
 
-from ocp import (CONTROLS, DEFAULT_CONSTRAINT_TOL, STATUS_BOUND_VIOLATION, STATUS_RESIMULATION,
+from appdyn.ocp import (CONTROLS, DEFAULT_CONSTRAINT_TOL, STATUS_BOUND_VIOLATION, STATUS_RESIMULATION,
                  Problem, Solution, annotate, bang_arcs, polish_switches, refine, rest_solution, solve,
                  solve_multistart)
-from ocp.solve import verified
-from dynamics.validate import integer
-from dynamics.interrupts import interruptible
-from ocp.progress import stage_sink
+from appdyn.ocp.solve import verified
+from appdyn.dynamics.validate import integer
+from appdyn.dynamics.interrupts import interruptible
+from appdyn.ocp.progress import stage_sink
 
 from .problem import (attitude_guess, inertia_of, is_rest_to_rest, rough_time, seeded_guesses,
                       slew_angle, slew_problem)
@@ -61,7 +61,7 @@ def verify(solution: Solution, *, pointing_tol: float = POINTING_TOL, rate_tol: 
     Examples
     --------
     >>> import numpy as np
-    >>> from problems import slew
+    >>> from appdyn.problems import slew
     >>> sol = slew.min_effort(np.eye(3), 2.0, angle=0.1, axis=[1, 0, 0], N=10)
     >>> strict = slew.verify(sol, pointing_tol=1e-15)  # re-simulated, graded again
     >>> strict.success, strict.status
@@ -222,7 +222,7 @@ def time_optimal(inertia, *, angle=None, axis=None, q0=None, qf=None, u_max=1.0,
     bang-bang, ``T = 2 sqrt(0.1)`` (small N and one start to keep it quick):
 
     >>> import numpy as np
-    >>> from problems import slew
+    >>> from appdyn.problems import slew
     >>> sol = slew.time_optimal(np.eye(3), angle=0.1, axis=[0, 0, 1], N=10, starts=1)
     >>> sol.success, round(sol.T, 6), round(slew.eigenaxis_time(np.eye(3), 0.1, [0, 0, 1]), 6)
     (True, 0.632456, 0.632456)
@@ -397,7 +397,7 @@ def polish_text(record: dict) -> str:
 
     Examples
     --------
-    >>> from problems.slew.maneuvers import polish_text
+    >>> from appdyn.problems.slew.maneuvers import polish_text
     >>> polish_text({"ran": False, "used": False, "why": "polish=False"})
     'polish skipped: polish=False'
     """
@@ -607,7 +607,7 @@ def min_effort(inertia, T, *, angle=None, axis=None, q0=None, qf=None, u_max=Non
     ``6 J^2 theta^2 / T^3 = 0.0075``:
 
     >>> import numpy as np
-    >>> from problems import slew
+    >>> from appdyn.problems import slew
     >>> sol = slew.min_effort(np.eye(3), 2.0, angle=0.1, axis=[1, 0, 0], N=10)
     >>> sol.success, round(sol.cost, 8)
     (True, 0.0075)

@@ -7,12 +7,12 @@ import warnings
 import casadi as ca
 import numpy as np
 
-from dynamics import rigid_body
-from dynamics.attitude import quat_conj, quat_from_axis_angle, quat_mul, quat_normalize, rotation_angle
-from dynamics.rigid_body import check_inertia
-from dynamics.validate import positive, unit_vector
-from ocp import Problem
-from ocp.attitude import slerp
+from appdyn.dynamics import rigid_body
+from appdyn.dynamics.attitude import quat_conj, quat_from_axis_angle, quat_mul, quat_normalize, rotation_angle
+from appdyn.dynamics.rigid_body import check_inertia
+from appdyn.dynamics.validate import positive, unit_vector
+from appdyn.ocp import Problem
+from appdyn.ocp.attitude import slerp
 
 from .targets import KeepOut, check_angle, check_u_max, targets, vector3
 
@@ -51,7 +51,7 @@ def slew_problem(inertia, *, objective, T=None, angle=None, axis=None, q0=None, 
     Examples
     --------
     >>> import numpy as np
-    >>> from problems import slew
+    >>> from appdyn.problems import slew
     >>> pb = slew.slew_problem(np.eye(3), objective="effort", T=2.0, angle=0.1, axis=[1, 0, 0])
     >>> pb.model.nx, pb.model.nu, pb.T, pb.name
     (7, 3, 2.0, 'slew (effort)')
@@ -147,7 +147,7 @@ def eigenaxis_time(inertia, angle, axis, u_max=1.0) -> float:
     Examples
     --------
     >>> import numpy as np
-    >>> from problems import slew
+    >>> from appdyn.problems import slew
     >>> round(slew.eigenaxis_time(np.eye(3), np.pi, [0, 0, 1]), 6)  # 2 sqrt(pi)
     3.544908
     >>> J = np.diag([2.0, 3.0, 4.0])  # alpha = 2 / 4 about the third axis
@@ -208,7 +208,7 @@ def attitude_guess(problem: Problem, *, tilt_axis=None, tilt=0.0, T=None, n=201)
     Examples
     --------
     >>> import numpy as np
-    >>> from problems import slew
+    >>> from appdyn.problems import slew
     >>> pb = slew.slew_problem(np.eye(3), objective="effort", T=2.0, angle=0.1, axis=[1, 0, 0])
     >>> guess = slew.attitude_guess(pb, n=11)
     >>> guess["x"].shape, guess["u"].shape, guess["T"]

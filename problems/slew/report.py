@@ -6,9 +6,9 @@ from collections.abc import Mapping
 
 import numpy as np
 
-from dynamics.attitude import dcm_from_quat
-from ocp import Solution, control_switches
-from ocp.solution import draw_bounds
+from appdyn.dynamics.attitude import dcm_from_quat
+from appdyn.ocp import Solution, control_switches
+from appdyn.ocp.solution import draw_bounds
 
 from .targets import ARCSEC
 
@@ -46,7 +46,7 @@ def switch_times(solution: Solution, *, component=None, axis=None) -> list:
     A 0.1 rad rest-to-rest slew about the third body axis switches once, at half time:
 
     >>> import numpy as np
-    >>> from problems import slew
+    >>> from appdyn.problems import slew
     >>> sol = slew.time_optimal(np.eye(3), angle=0.1, axis=[0, 0, 1], N=10, starts=1)
     >>> t_s = slew.switch_times(sol, component=2)
     >>> t_s.round(4), round(sol.T / 2, 4)
@@ -91,7 +91,7 @@ def summary(solution: Solution, *, eigenaxis=None) -> dict:
     Examples
     --------
     >>> import numpy as np
-    >>> from problems import slew
+    >>> from appdyn.problems import slew
     >>> sol = slew.time_optimal(np.eye(3), angle=0.1, axis=[0, 0, 1], N=10, starts=1)
     >>> data = slew.summary(sol, eigenaxis=slew.eigenaxis_time(np.eye(3), 0.1, [0, 0, 1]))
     >>> data["success"], data["status"], round(data["T"], 6), round(data["eigenaxis_T"], 6)
@@ -146,7 +146,7 @@ def format_summary(data: dict) -> str:
     Examples
     --------
     >>> import numpy as np
-    >>> from problems import slew
+    >>> from appdyn.problems import slew
     >>> sol = slew.time_optimal(np.eye(3), angle=0.1, axis=[0, 0, 1], N=10, starts=1)
     >>> print(slew.format_summary(slew.summary(sol)))  # doctest: +ELLIPSIS
     Optimal slew

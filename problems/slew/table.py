@@ -21,12 +21,12 @@ from typing import Callable
 
 import numpy as np
 
-from dynamics.attitude import axis_angle_from_quat, quat_conj, quat_mul
-from dynamics.executors import check_executor, gather
-from dynamics.interrupts import check_interrupt, interruptible
-from dynamics.serialize import jsonable, text_table, to_json
-from dynamics.validate import check_inertia, finite_array, one_of, positive, unit_quaternion
-from problems.dispersion.result import ALL_FAILED, ALL_OK, SOME_FAILED
+from appdyn.dynamics.attitude import axis_angle_from_quat, quat_conj, quat_mul
+from appdyn.dynamics.executors import check_executor, gather
+from appdyn.dynamics.interrupts import check_interrupt, interruptible
+from appdyn.dynamics.serialize import jsonable, text_table, to_json
+from appdyn.dynamics.validate import check_inertia, finite_array, one_of, positive, unit_quaternion
+from appdyn.problems.dispersion.result import ALL_FAILED, ALL_OK, SOME_FAILED
 
 from .maneuvers import min_effort, time_optimal
 from .targets import check_u_max
@@ -129,7 +129,7 @@ def example_targets() -> list:
 
     Examples
     --------
-    >>> from problems.slew import example_targets
+    >>> from appdyn.problems.slew import example_targets
     >>> [t["name"] for t in example_targets()][:3]
     ['x 30', 'y 60', 'z 90']
     """
@@ -396,7 +396,7 @@ def maneuver_table(inertia, targets, *, objective: str = "time", T=None, u_max=1
     Two small slews of a unit-inertia body (bang-bang: ``T = 2 sqrt(theta)``):
 
     >>> import numpy as np
-    >>> from problems.slew import maneuver_table
+    >>> from appdyn.problems.slew import maneuver_table
     >>> table = maneuver_table(np.eye(3), [{"name": "roll", "angle": 0.1, "axis": [1, 0, 0]},
     ...                                    {"name": "yaw", "angle": 0.2, "axis": [0, 0, 1]}],
     ...                        N=10, starts=1)

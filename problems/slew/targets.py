@@ -12,9 +12,9 @@ from dataclasses import dataclass
 import casadi as ca
 import numpy as np
 
-from dynamics.attitude import dcm_from_quat, quat_from_axis_angle, quat_mul, quat_normalize
-from dynamics.validate import finite_array, finite_scalar, unit_quaternion, unit_vector
-from dynamics.validate import positive
+from appdyn.dynamics.attitude import dcm_from_quat, quat_from_axis_angle, quat_mul, quat_normalize
+from appdyn.dynamics.validate import finite_array, finite_scalar, unit_quaternion, unit_vector
+from appdyn.dynamics.validate import positive
 
 __all__ = ["KeepOut", "POINTING_TOL", "RATE_TOL", "MIN_REFINE_TOL", "STATUS_POINTING",
            "STATUS_REFINE", "ARCSEC", "vector3", "targets", "check_u_max", "check_angle",
@@ -46,7 +46,7 @@ class KeepOut:
     Keep the body x axis 30 deg away from the inertial y axis (e.g. the Sun):
 
     >>> import numpy as np
-    >>> from problems import slew
+    >>> from appdyn.problems import slew
     >>> cone = slew.KeepOut(boresight=[2, 0, 0], direction=[0, 1, 0], half_angle=np.radians(30))
     >>> cone.boresight, round(cone.half_angle, 6)
     ((1.0, 0.0, 0.0), 0.523599)

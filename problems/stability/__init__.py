@@ -43,11 +43,11 @@ family with eigenvalue 0) are factored out by `Linearization.quotient` and
 
 Examples
 --------
->>> from problems import stability
+>>> from appdyn.problems import stability
 >>> stability.spin([2.0, 3.0, 4.5], axis=[0, 0, 1], rate=5.0).verdict
 'marginally stable'
 """
-from dynamics.spinning import PointMassDamper, SphericalDamper
+from appdyn.dynamics.spinning import PointMassDamper, SphericalDamper
 
 from .cases import CASE_ALIASES, CASES, resolve_case
 from .common import STANDARD_GRAVITY

@@ -6,8 +6,8 @@ import math
 
 import numpy as np
 
-from dynamics.figures import axes_or_new_figure, finish_figure
-from dynamics.serialize import jsonable, plain
+from appdyn.dynamics.figures import axes_or_new_figure, finish_figure
+from appdyn.dynamics.serialize import jsonable, plain
 
 __all__ = ["STANDARD_GRAVITY", "check_number", "plain", "jsonable", "format_complex",
            "format_number", "param_text", "axes_or_new_figure", "finish_figure"]

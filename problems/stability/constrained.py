@@ -34,10 +34,10 @@ import math
 import casadi as ca
 import numpy as np
 
-from dynamics import cache
-from dynamics.linearize import linearization
-from dynamics.mechanisms import SEQUENCES, conical_rate, spherical_pendulum
-from dynamics.model import Model
+from appdyn.dynamics import cache
+from appdyn.dynamics.linearize import linearization
+from appdyn.dynamics.mechanisms import SEQUENCES, conical_rate, spherical_pendulum
+from appdyn.dynamics.model import Model
 
 from .common import STANDARD_GRAVITY, check_number
 from .report import Quantity, StabilityReport, build_report
@@ -91,7 +91,7 @@ def conical_nutation_frequency(cone_angle, *, mass=1.0, length=1.0, inertia=0.0,
     Examples
     --------
     >>> import math
-    >>> from problems.stability.constrained import conical_nutation_frequency
+    >>> from appdyn.problems.stability.constrained import conical_nutation_frequency
     >>> round(conical_nutation_frequency(math.pi / 3, length=9.80665), 12)   # sqrt(2 * 7/4)
     1.870828693387
     """
@@ -153,7 +153,7 @@ def conical_pendulum(*, mass, length, cone_angle, inertia=0.0, gravity=STANDARD_
     Examples
     --------
     >>> import math
-    >>> from problems import stability
+    >>> from appdyn.problems import stability
     >>> rep = stability.conical_pendulum(mass=1.0, length=1.0, cone_angle=math.pi / 3)
     >>> rep.verdict, rep.status, rep.ss.state_labels
     ('marginally stable', 0, ['theta', 'theta_dot'])

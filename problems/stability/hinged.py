@@ -13,9 +13,9 @@ import math
 import casadi as ca
 import numpy as np
 
-from dynamics import cache
-from dynamics.linearize import linearization
-from dynamics.model import Model
+from appdyn.dynamics import cache
+from appdyn.dynamics.linearize import linearization
+from appdyn.dynamics.model import Model
 
 from .closed_forms import axis_kind, principal_moments, rigid_spin_lambda2
 from .common import check_number
@@ -33,8 +33,8 @@ def _hinged_relative(m1, inertia1, m2, inertia2, r1, r2, kind):
     origin, in the states ``(q1, w1, q_rel, w2)`` (``q2 = q_rel (x) q1``, ``w2`` body-2
     axes), ``assemble(y)`` the full 26-state ``x`` and ``full`` the `hinged_bodies` model
     (no Baumgarte term: the constraints are then exact first integrals)."""
-    from dynamics.attitude import dcm_from_quat, quat_conj, quat_mul
-    from dynamics.hinged import hinged_bodies
+    from appdyn.dynamics.attitude import dcm_from_quat, quat_conj, quat_mul
+    from appdyn.dynamics.hinged import hinged_bodies
 
     axis = [0.0, 0.0, 1.0] if kind == "revolute" else None
     full = hinged_bodies(m1, np.reshape(inertia1, (3, 3)), m2, np.reshape(inertia2, (3, 3)),
@@ -65,7 +65,7 @@ def _hinged_relative(m1, inertia1, m2, inertia2, r1, r2, kind):
 def _error_functions(assemble, full, kind):
     """``(xr) -> conserved / constraint functions`` in the linearization's 13 coordinates
     (``dth`` for body 1's attitude about the reference ``q_ref = [0, 0, 0, 1]``)."""
-    from dynamics.attitude import quat_mul
+    from appdyn.dynamics.attitude import quat_mul
 
     xr = ca.SX.sym("xr", 13)
     dth = xr[0:3]
@@ -115,7 +115,7 @@ def _restrict_subspace(lin, L, eliminate, reason):
 
 
 def _hinged_check(m1, inertia1, m2, inertia2, r1, r2, rate, kind, axis):
-    from dynamics.validate import check_inertia
+    from appdyn.dynamics.validate import check_inertia
 
     m1 = check_number(m1, "m1", positive=True)
     m2 = check_number(m2, "m2", positive=True)
@@ -233,7 +233,7 @@ def hinged_spin(*, m1, inertia1, m2, inertia2, r1, r2, rate, kind="revolute",
 
     Examples
     --------
-    >>> from problems import stability
+    >>> from appdyn.problems import stability
     >>> rep = stability.hinged_spin(m1=10.0, inertia1=[2.0, 2.0, 3.0], m2=2.0,
     ...                             inertia2=[0.2, 0.2, 0.3], r1=[0, 0, 0.5],
     ...                             r2=[0, 0, -0.2], rate=5.0)

@@ -60,8 +60,8 @@ import casadi as ca
 import numpy as np
 from numpy.polynomial import Polynomial
 
-from dynamics.launch_vehicle import launch_vehicle as vehicle_model
-from dynamics.linearize import linearization
+from appdyn.dynamics.launch_vehicle import launch_vehicle as vehicle_model
+from appdyn.dynamics.linearize import linearization
 
 from .common import check_number
 from .loop import loop
@@ -297,7 +297,7 @@ def launch_vehicle(*, thrust, inertia, arm, mass, k_psi, k_psidot, aero=None, ve
     Examples
     --------
     >>> import math
-    >>> from problems import stability
+    >>> from appdyn.problems import stability
     >>> F, I, l = 2.0e6, 4.0e7, 20.0
     >>> rep = stability.launch_vehicle(thrust=F, inertia=I, arm=l, mass=1.0e5, k_psi=2.0,
     ...                                k_psidot=2.0)

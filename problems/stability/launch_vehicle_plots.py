@@ -7,7 +7,7 @@ import math
 
 import numpy as np
 
-from dynamics.figures import axes_or_new_figure, cleared_figure, finish_figure
+from appdyn.dynamics.figures import axes_or_new_figure, cleared_figure, finish_figure
 
 from .report import StabilityReport
 
@@ -37,7 +37,7 @@ def loop_transfer(report: StabilityReport):
     Examples
     --------
     >>> import control
-    >>> from problems import stability
+    >>> from appdyn.problems import stability
     >>> rep = stability.launch_vehicle(thrust=2e6, inertia=4e7, arm=20, mass=1e5, k_psi=2,
     ...                                k_psidot=2)
     >>> round(float(control.stability_margins(stability.loop_transfer(rep))[1]), 4)
@@ -123,7 +123,7 @@ def bode_plot(report: StabilityReport, path=None, *, fig=None, omega=None,
 
     Examples
     --------
-    >>> from problems import stability
+    >>> from appdyn.problems import stability
     >>> rep = stability.launch_vehicle(thrust=2e6, inertia=4e7, arm=20, mass=1e5, k_psi=2,
     ...                                k_psidot=2)
     >>> fig = stability.bode_plot(rep, pole_map=True)
@@ -182,7 +182,7 @@ def nichols_plot(report: StabilityReport, path=None, *, ax=None, omega=None):
 
     Examples
     --------
-    >>> from problems import stability
+    >>> from appdyn.problems import stability
     >>> rep = stability.launch_vehicle(thrust=2e6, inertia=4e7, arm=20, mass=1e5, k_psi=2,
     ...                                k_psidot=2)
     >>> [t.get_text() for t in stability.nichols_plot(rep).axes[0].get_legend().get_texts()]

@@ -18,10 +18,10 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from dynamics.figures import cleared_figure, finish_figure
-from dynamics.integrate import SimulationResult, simulate
-from dynamics.launch_vehicle import launch_vehicle as vehicle_model
-from dynamics.serialize import jsonable, plain, text_table
+from appdyn.dynamics.figures import cleared_figure, finish_figure
+from appdyn.dynamics.integrate import SimulationResult, simulate
+from appdyn.dynamics.launch_vehicle import launch_vehicle as vehicle_model
+from appdyn.dynamics.serialize import jsonable, plain, text_table
 
 from .common import check_number
 from .launch_vehicle import flight_speed, frozen_state
@@ -34,7 +34,7 @@ def gust(t, speed, start, duration):
 
     Examples
     --------
-    >>> from problems.stability.launch_vehicle_response import gust
+    >>> from appdyn.problems.stability.launch_vehicle_response import gust
     >>> gust([0.0, 1.5, 2.0, 3.0], speed=10.0, start=1.0, duration=1.0).tolist()
     [0.0, 10.0, 0.0, 0.0]
     """
@@ -211,7 +211,7 @@ def launch_vehicle_response(*, thrust, inertia, arm, mass, k_psi, k_psidot, aero
     Examples
     --------
     >>> import math
-    >>> from problems.stability import launch_vehicle_response
+    >>> from appdyn.problems.stability import launch_vehicle_response
     >>> res = launch_vehicle_response(thrust=2e6, inertia=4e7, arm=20.0, mass=1e5, k_psi=2.0,
     ...                               k_psidot=2.0, psi0=0.05, t_final=10.0, points=201)
     >>> res.success, float(res.series["psi"][0])

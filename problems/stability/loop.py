@@ -42,7 +42,7 @@ def loop(plant, controller, *, title: str = "Feedback loop", closed_form=None) -
     ``delta = -(k_psi psi + k_psidot psi')`` (RP-1262, Ch. 5, Eqs. 5.53-5.54):
 
     >>> import control, numpy as np
-    >>> from problems import stability
+    >>> from appdyn.problems import stability
     >>> plant = control.ss([[0, 1], [0, 0]], [[0], [200.0]], np.eye(2), np.zeros((2, 1)))
     >>> rep = stability.loop(plant, [[0.8, 0.3]])
     >>> rep.verdict

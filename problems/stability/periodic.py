@@ -33,10 +33,10 @@ from dataclasses import asdict, dataclass, field
 import numpy as np
 from scipy.special import mathieu_a, mathieu_b
 
-from dynamics.floquet import TOL, classify_multipliers, floquet, variational_model
-from dynamics.integrate import simulate
-from dynamics.mechanisms import kapitza_frequency, resonance_tongue
-from dynamics.mechanisms import shaken_pendulum as shaken_model
+from appdyn.dynamics.floquet import TOL, classify_multipliers, floquet, variational_model
+from appdyn.dynamics.integrate import simulate
+from appdyn.dynamics.mechanisms import kapitza_frequency, resonance_tongue
+from appdyn.dynamics.mechanisms import shaken_pendulum as shaken_model
 
 from .common import (STANDARD_GRAVITY, check_number, finish_figure, format_number, jsonable,
                      param_text, plain)
@@ -229,7 +229,7 @@ def mathieu_region(a: float, q: float):
 
     Examples
     --------
-    >>> from problems.stability.periodic import mathieu_region
+    >>> from appdyn.problems.stability.periodic import mathieu_region
     >>> mathieu_region(-0.5, 0.2)[0], mathieu_region(1.0, 0.2)[0], mathieu_region(2.0, 0.2)[0]
     (False, False, True)
     """
@@ -341,7 +341,7 @@ def shaken_pendulum(*, mass, inertia, length, amp_y, freq, amp_x=0.0, damping=0.
     A uniform rod 0.5 m long (``l_eff = 1/3`` m) shaken by 2 cm, whose Kapitza frequency is
     127.946 rad/s:
 
-    >>> from problems import stability
+    >>> from appdyn.problems import stability
     >>> rod = dict(mass=1.0, inertia=1 / 48, length=0.25, amp_y=0.02)
     >>> rep = stability.shaken_pendulum(**rod, freq=200.0, position="inverted")
     >>> rep.verdict, rep.status, round(rep.quantity("Kapitza frequency (M").closed_form, 3)

@@ -20,7 +20,7 @@ from typing import Mapping, Sequence
 
 import numpy as np
 
-from dynamics.linearize import Linearization
+from appdyn.dynamics.linearize import Linearization
 
 from .common import (axes_or_new_figure, finish_figure, format_number, jsonable, param_text,
                      plain)
@@ -178,7 +178,7 @@ class StabilityReport:
 
     Examples
     --------
-    >>> from problems import stability
+    >>> from appdyn.problems import stability
     >>> rep = stability.spin([2.0, 3.0, 4.5], axis=[1, 0, 0], rate=10.0)
     >>> rep.verdict, rep.success, rep.status
     ('marginally stable', True, 0)
@@ -517,8 +517,8 @@ def analyze(sys, *, title: str = "Linear system",
     --------
     A torque-free spin about the minor axis, linearized by `dynamics.linearize`:
 
-    >>> from dynamics import linearize, rigid_body
-    >>> from problems import stability
+    >>> from appdyn.dynamics import linearize, rigid_body
+    >>> from appdyn.problems import stability
     >>> sys = linearize(rigid_body([2.0, 3.0, 4.5]), [0, 0, 0, 1, 10.0, 0, 0])
     >>> rep = stability.analyze(sys, groups={"attitude": ["dth1", "dth2", "dth3"],
     ...                                      "rates": ["w1", "w2", "w3"]})

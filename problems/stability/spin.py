@@ -11,9 +11,9 @@ import math
 import casadi as ca
 import numpy as np
 
-from dynamics.linearize import Linearization, linearization
-from dynamics.rigid_body import check_inertia, rigid_body
-from dynamics.spinning import (PointMassDamper, SphericalDamper, gyrostat_model,
+from appdyn.dynamics.linearize import Linearization, linearization
+from appdyn.dynamics.rigid_body import check_inertia, rigid_body
+from appdyn.dynamics.spinning import (PointMassDamper, SphericalDamper, gyrostat_model,
                                steady_spin_state, unit_vector)
 
 from .closed_forms import (axis_kind, gyrostat_lambda2, principal_moments, rigid_spin_lambda2,
@@ -114,7 +114,7 @@ def spin(inertia, axis, rate, *, damper=None) -> StabilityReport:
 
     Examples
     --------
-    >>> from problems import stability
+    >>> from appdyn.problems import stability
     >>> rep = stability.spin([2.0, 3.0, 4.5], axis=[1, 0, 0], rate=10.0)
     >>> rep.verdict
     'marginally stable'
@@ -234,7 +234,7 @@ def gyrostat(inertia, axis, rate, wheel_momentum, *, wheel_inertia=None, damper=
 
     Examples
     --------
-    >>> from problems import stability
+    >>> from appdyn.problems import stability
     >>> rep = stability.gyrostat([3.0, 4.0, 5.0], [1, 0, 0], rate=2.0, wheel_momentum=3.0)
     >>> rep.verdict  # Ia + h/W = 4.5 lies between the transverse moments 4 and 5
     'unstable'

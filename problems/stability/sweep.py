@@ -5,8 +5,8 @@ import inspect
 
 import numpy as np
 
-from dynamics.executors import check_executor, gather
-from dynamics.interrupts import check_interrupt, interruptible
+from appdyn.dynamics.executors import check_executor, gather
+from appdyn.dynamics.interrupts import check_interrupt, interruptible
 
 from .cases import resolve_case
 from .common import plain
@@ -100,7 +100,7 @@ def sweep(case, parameter: str, values, *, rtol: float = 1e-8, progress=None, ex
     The sleeping top (RP-1262, Sec. 4.6, Eq. 4.128: ``w0 = (2 / I1) sqrt(m g l I2)``):
 
     >>> import numpy as np
-    >>> from problems import stability
+    >>> from appdyn.problems import stability
     >>> res = stability.sweep("heavy_top", "rate", np.linspace(0, 60, 7), axial_inertia=0.002,
     ...                       transverse_inertia=0.005, mass=0.3, length=0.04)
     >>> res.verdicts[0], res.verdicts[-1]

@@ -11,8 +11,8 @@ import math
 
 import numpy as np
 
-from dynamics.linearize import Linearization, linearization
-from dynamics.spinning import tilt_torque_body
+from appdyn.dynamics.linearize import Linearization, linearization
+from appdyn.dynamics.spinning import tilt_torque_body
 
 from .closed_forms import method3_roots, sleeping_rate, with_conjugates
 from .common import STANDARD_GRAVITY, check_number
@@ -97,7 +97,7 @@ def heavy_top(axial_inertia, transverse_inertia, mass, length, rate, *,
 
     Examples
     --------
-    >>> from problems import stability
+    >>> from appdyn.problems import stability
     >>> top = stability.heavy_top(0.002, 0.005, mass=0.3, length=0.04, rate=40.0)
     >>> top.verdict
     'marginally stable'
@@ -155,7 +155,7 @@ def spinning_projectile(axial_inertia, transverse_inertia, rate, *, dynamic_pres
 
     Examples
     --------
-    >>> from problems import stability
+    >>> from appdyn.problems import stability
     >>> rep = stability.spinning_projectile(0.002, 0.02, 2000.0, dynamic_pressure=2e5,
     ...                                     area=1e-3, cn_alpha=2.0, cp_offset=0.03)
     >>> rep.verdict, round(rep.quantity("gyroscopic stability factor").closed_form, 4)
@@ -209,7 +209,7 @@ def rotor(axial_inertia, transverse_inertia, stiffness, bearing_distance, rate, 
 
     Examples
     --------
-    >>> from problems import stability
+    >>> from appdyn.problems import stability
     >>> rep = stability.rotor(0.01, 0.05, stiffness=1e4, bearing_distance=0.1, rate=50.0,
     ...                       internal_damping=0.01)
     >>> rep.verdict

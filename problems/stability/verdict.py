@@ -18,7 +18,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from dynamics.validate.base import real_array
+from appdyn.dynamics.validate.base import real_array
 
 from .common import format_complex
 
@@ -76,7 +76,7 @@ def classify(A, *, rtol: float = ZERO_RTOL):
 
     Examples
     --------
-    >>> from problems.stability import classify
+    >>> from appdyn.problems.stability import classify
     >>> classify([[0.0, 1.0], [-1.0, 0.0]])[0]
     'marginally stable'
     >>> classify([[0.0, 1.0], [0.0, 0.0]])[0]  # a Jordan block at 0: grows like t

@@ -15,7 +15,7 @@ from hypothesis import strategies as st
 from scipy.linalg import expm
 from scipy.spatial.transform import Rotation
 
-from dynamics import attitude as at
+from appdyn.dynamics import attitude as at
 
 GEMINI = np.array([[4560.7, 31.2, -43.4], [31.2, 4545.0, -270.7], [-43.4, -270.7, 1567.4]])
 
@@ -337,7 +337,7 @@ def test_bad_input_raises(call, match):
 def test_propagate_quat_matches_simulation_of_a_spinning_sphere():
     """A torque-free sphere keeps a constant body rate, so the closed form is exact:
     compare it with simulate's integration of Eq. 4.70 (cvodes and compiled rk8)."""
-    from dynamics import rigid_body, simulate
+    from appdyn.dynamics import rigid_body, simulate
 
     q0 = unit_quat([0.3, -0.2, 0.5, 0.8])
     w = np.array([0.7, -1.1, 0.4])

@@ -6,8 +6,8 @@ import threading
 import numpy as np
 import pytest
 
-import dynamics
-from dynamics import cache, rigid_body, simulate
+from appdyn import dynamics
+from appdyn.dynamics import cache, rigid_body, simulate
 
 HAVE_CC = shutil.which("gcc") is not None or shutil.which("cc") is not None
 X0 = np.array([0.0, 0.0, 0.0, 1.0, 1.0, 0.1, 0.8])

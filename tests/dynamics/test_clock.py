@@ -4,10 +4,10 @@ import math
 import numpy as np
 import pytest
 
-from dynamics import rigid_body, simulate
-from dynamics.clock import CLOCK_RTOL, CLOCK_STATE, CLOCK_UNIT, check_clock_start, clock_index
-from dynamics.linearize import linearization
-from dynamics.mechanisms import shaken_pendulum, variable_length_pendulum
+from appdyn.dynamics import rigid_body, simulate
+from appdyn.dynamics.clock import CLOCK_RTOL, CLOCK_STATE, CLOCK_UNIT, check_clock_start, clock_index
+from appdyn.dynamics.linearize import linearization
+from appdyn.dynamics.mechanisms import shaken_pendulum, variable_length_pendulum
 
 
 def test_clock_state_name_unit_and_index():

@@ -8,11 +8,11 @@ import pytest
 from scipy.integrate import solve_ivp
 from scipy.linalg import expm
 
-import dynamics.feedback as closed_loop_module
-from dynamics import Model, rigid_body, simulate
-from dynamics.attitude import quat_conj, quat_mul, rotation_angle
-from dynamics import closed_loop
-from dynamics.momentum.wheels import wheel_spacecraft
+import appdyn.dynamics.feedback as closed_loop_module
+from appdyn.dynamics import Model, rigid_body, simulate
+from appdyn.dynamics.attitude import quat_conj, quat_mul, rotation_angle
+from appdyn.dynamics import closed_loop
+from appdyn.dynamics.momentum.wheels import wheel_spacecraft
 
 INERTIA = np.array([[12.0, 0.3, -0.2], [0.3, 10.0, 0.1], [-0.2, 0.1, 8.0]])
 TARGET = np.array([0.3, -0.4, 0.2, 0.0])

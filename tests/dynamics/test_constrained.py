@@ -9,8 +9,8 @@ import casadi as ca
 import numpy as np
 import pytest
 
-from dynamics import Model, simulate
-from dynamics.constrained import (DEFAULT_TIME_CONSTANT, baumgarte, constrained_accelerations,
+from appdyn.dynamics import Model, simulate
+from appdyn.dynamics.constrained import (DEFAULT_TIME_CONSTANT, baumgarte, constrained_accelerations,
                                   constraint_terms, project_positions, project_velocities,
                                   reaction_forces, residual_invariant)
 

@@ -11,13 +11,13 @@ import pkgutil
 
 import pytest
 
-import dynamics
-from dynamics import attitude, truth, validate
+from appdyn import dynamics
+from appdyn.dynamics import attitude, truth, validate
 
 OPTIONS = doctest.NORMALIZE_WHITESPACE | doctest.ELLIPSIS
 MODULES = sorted(
-    info.name for info in pkgutil.walk_packages(dynamics.__path__, prefix="dynamics.")
-) + ["dynamics"]
+    info.name for info in pkgutil.walk_packages(dynamics.__path__, prefix="appdyn.dynamics.")
+) + ["appdyn.dynamics"]
 
 
 def _tests(module_name):
@@ -37,7 +37,7 @@ def test_docstring_examples_run_as_written(module_name):
 
 
 def _public_entry_points():
-    names = [f"dynamics.{n}" for n in ("Model", "rigid_body", "simulate", "linearize", "clear_caches")]
+    names = [f"appdyn.dynamics.{n}" for n in ("Model", "rigid_body", "simulate", "linearize", "clear_caches")]
     for module in (attitude, truth, validate):
         names += [f"{module.__name__}.{n}" for n in module.__all__
                   if inspect.isfunction(getattr(module, n))]

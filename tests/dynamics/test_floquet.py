@@ -15,11 +15,11 @@ from scipy.integrate import solve_ivp
 from scipy.linalg import expm
 from scipy.optimize import brentq
 
-from dynamics import rigid_body
-from dynamics.floquet import (TOL, VERDICTS, FloquetResult, classify_multipliers, floquet,
+from appdyn.dynamics import rigid_body
+from appdyn.dynamics.floquet import (TOL, VERDICTS, FloquetResult, classify_multipliers, floquet,
                               monodromy, variational_model)
-from dynamics.linearize import linearization
-from dynamics.mechanisms import (double_pendulum, kapitza_frequency, natural_frequency,
+from appdyn.dynamics.linearize import linearization
+from appdyn.dynamics.mechanisms import (double_pendulum, kapitza_frequency, natural_frequency,
                                  resonance_tongue, shaken_pendulum)
 
 M, IC, L, G = 1.0, 1.0 / 48.0, 0.25, 9.81          # a 0.5 m uniform rod hinged at its end

@@ -14,10 +14,10 @@ import casadi as ca
 import numpy as np
 import pytest
 
-from dynamics import hinged_bodies, simulate, wheel_spacecraft
-from dynamics.attitude import dcm_from_quat, quat_from_axis_angle, quat_mul, quat_rate, skew
-from dynamics.constrained import constraint_terms
-from dynamics.hinged import HINGED_STATES, Hinge, hinge_terms
+from appdyn.dynamics import hinged_bodies, simulate, wheel_spacecraft
+from appdyn.dynamics.attitude import dcm_from_quat, quat_from_axis_angle, quat_mul, quat_rate, skew
+from appdyn.dynamics.constrained import constraint_terms
+from appdyn.dynamics.hinged import HINGED_STATES, Hinge, hinge_terms
 
 BODIES = dict(m1=10.0, I1=[[2.0, 0.1, 0.0], [0.1, 3.0, -0.2], [0.0, -0.2, 4.0]], m2=4.0,
               I2=[0.5, 0.6, 0.7], r1=[0.5, 0.1, -0.2], r2=[-0.3, 0.05, 0.1])
@@ -95,7 +95,7 @@ def _reduced_ball(m1, I1, m2, I2, r1, r2):
                      -ca.cross(w1, I1 @ w1), -ca.cross(w2, I2 @ w2))
     z = ca.solve(K, rhs)
     ydot = ca.vertcat(quat_rate(q1, w1), z[0:3], quat_rate(q2, w2), z[3:6])
-    from dynamics import Model
+    from appdyn.dynamics import Model
     f = ca.Function("reduced", [y, ca.SX.sym("u", 0), ca.SX.sym("p", 0)], [ydot],
                     ["x", "u", "p"], ["xdot"])
     return Model(f, tuple(f"y{i}" for i in range(14)), ())

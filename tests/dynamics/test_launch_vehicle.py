@@ -6,8 +6,8 @@ import pickle
 import numpy as np
 import pytest
 
-from dynamics import launch_vehicle, linearization, simulate
-from dynamics.launch_vehicle import Actuator, Aero, Bending, MassFlow, Slosh
+from appdyn.dynamics import launch_vehicle, linearization, simulate
+from appdyn.dynamics.launch_vehicle import Actuator, Aero, Bending, MassFlow, Slosh
 
 F, I, L, M = 2.0e6, 4.0e7, 20.0, 1.0e5  # thrust [N], inertia [kg m^2], arm [m], mass [kg]
 RIGID = dict(thrust=F, inertia=I, arm=L, mass=M)

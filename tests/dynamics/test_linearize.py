@@ -4,11 +4,11 @@ import numpy as np
 import pytest
 from scipy.linalg import expm
 
-from dynamics import Model, rigid_body, simulate
-from dynamics.attitude import (principal_axes, propagate_quat, quat_conj, quat_from_axis_angle,
+from appdyn.dynamics import Model, rigid_body, simulate
+from appdyn.dynamics.attitude import (principal_axes, propagate_quat, quat_conj, quat_from_axis_angle,
                                quat_mul, quat_rate, skew)
-from dynamics.linearize import ANGLE_STATES, error_dynamics, linearization, linearize
-from dynamics.spinning import PointMassDamper, gyrostat_model, tilt_torque_body
+from appdyn.dynamics.linearize import ANGLE_STATES, error_dynamics, linearization, linearize
+from appdyn.dynamics.spinning import PointMassDamper, gyrostat_model, tilt_torque_body
 
 GEMINI = np.array([[4560.7, 31.2, -43.4], [31.2, 4545.0, -270.7], [-43.4, -270.7, 1567.4]])
 
@@ -245,7 +245,7 @@ def test_reference_rate_is_the_deprecated_name_of_w_ref():
     """Vocabulary: a rate vector is ``w_*``; the old field name still reads, with a warning."""
     import warnings as _warnings
 
-    from dynamics import linearization, rigid_body
+    from appdyn.dynamics import linearization, rigid_body
 
     lin = linearization(rigid_body([2.0, 3.0, 4.5]), [0, 0, 0, 1, 10.0, 0, 0])
     np.testing.assert_allclose(lin.w_ref, [10.0, 0.0, 0.0])

@@ -12,10 +12,10 @@ import pytest
 from scipy.integrate import cumulative_simpson, solve_ivp
 from scipy.linalg import eigh
 
-from dynamics import simulate
-from dynamics.clock import clock_index
-from dynamics.linearize import linearization
-from dynamics.mechanisms import (GRAVITY, conical_rate, double_pendulum, double_pendulum_modes,
+from appdyn.dynamics import simulate
+from appdyn.dynamics.clock import clock_index
+from appdyn.dynamics.linearize import linearization
+from appdyn.dynamics.mechanisms import (GRAVITY, conical_rate, double_pendulum, double_pendulum_modes,
                                  equivalent_length, kapitza_frequency, natural_frequency,
                                  pendulum_period, pendulum_swing, resonance_tongue,
                                  shaken_pendulum, spherical_mass_matrix, spherical_pendulum,

@@ -6,8 +6,8 @@ import math
 import numpy as np
 import pytest
 
-from dynamics import simulate
-from dynamics.mechanisms import (bead_motion, bead_torque, coin_state, coin_steady_rates,
+from appdyn.dynamics import simulate
+from appdyn.dynamics.mechanisms import (bead_motion, bead_torque, coin_state, coin_steady_rates,
                                  dumbbell_disk, dumbbell_disk_frequency, dumbbell_disk_state,
                                  rod_pendulum, rod_reaction, rolling_coin,
                                  shaken_multiplier_state, shaken_pendulum,
@@ -184,7 +184,7 @@ def _alpha_acc(model, x):
     """``(a, a', a'')`` and ``w'`` from the state and the model's right-hand side:
     ``rho = A r``, ``rho' = -w x rho + A r'``, ``rho'' = -w' x rho - w x rho' - w x A r'
     + A r''``, ``a = atan2(rho1, rho3)``, ``a'' = (rho3 rho1'' - rho1 rho3'') / l^2``."""
-    from dynamics.attitude import dcm_from_quat
+    from appdyn.dynamics.attitude import dcm_from_quat
     xd = model.rhs(x)
     A = dcm_from_quat(x[:4])
     r, w, rd = x[4:7], x[7:10], x[10:13]

@@ -4,7 +4,7 @@ import json
 import numpy as np
 import pytest
 
-from dynamics import rigid_body, simulate
+from appdyn.dynamics import rigid_body, simulate
 
 
 def strict_loads(text):

@@ -4,8 +4,8 @@ import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
-from dynamics import Model, rigid_body
-from dynamics.attitude import dcm_from_quat, principal_axes
+from appdyn.dynamics import Model, rigid_body
+from appdyn.dynamics.attitude import dcm_from_quat, principal_axes
 
 GEMINI = np.array([[4560.7, 31.2, -43.4], [31.2, 4545.0, -270.7], [-43.4, -270.7, 1567.4]])
 

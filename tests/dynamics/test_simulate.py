@@ -10,9 +10,9 @@ import pytest
 from scipy.integrate import solve_ivp
 from scipy.linalg import expm
 
-from dynamics import METHODS, Model, SimulationResult, rigid_body, simulate
-from dynamics.attitude import dcm_from_quat, quat_kinematics_matrix, quat_rate
-from dynamics.truth import axisymmetric, torque_free_omega
+from appdyn.dynamics import METHODS, Model, SimulationResult, rigid_body, simulate
+from appdyn.dynamics.attitude import dcm_from_quat, quat_kinematics_matrix, quat_rate
+from appdyn.dynamics.truth import axisymmetric, torque_free_omega
 
 HAVE_CC = shutil.which("gcc") is not None or shutil.which("cc") is not None
 
@@ -206,7 +206,7 @@ def test_lie_is_at_least_fourth_order_with_attitude_dependent_torque():
 
 
 def test_dop853_weights_satisfy_quadrature_order_conditions():
-    from dynamics.integrate.tableaux import DOP853 as tab  # the copied coefficients, checked
+    from appdyn.dynamics.integrate.tableaux import DOP853 as tab  # the copied coefficients, checked
 
     b, c = np.array(tab.b), np.array(tab.c)
     for k in range(8):

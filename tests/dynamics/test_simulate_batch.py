@@ -6,9 +6,9 @@ import casadi as ca
 import numpy as np
 import pytest
 
-from dynamics import Model, rigid_body, simulate
-from dynamics.integrate.batch import BatchResult
-from dynamics.truth import torque_free_omega
+from appdyn.dynamics import Model, rigid_body, simulate
+from appdyn.dynamics.integrate.batch import BatchResult
+from appdyn.dynamics.truth import torque_free_omega
 
 INERTIA = [1.0, 2.0, 3.0]
 
@@ -139,8 +139,8 @@ def test_a_stiff_batch_goes_to_cvodes_run_by_run_as_single_runs_do():
 
 
 # ------------------------------------------------ parts of a batch spread over threads
-from dynamics import executors  # noqa: E402
-from dynamics.integrate import batch_fixed as batch_module  # noqa: E402
+from appdyn.dynamics import executors  # noqa: E402
+from appdyn.dynamics.integrate import batch_fixed as batch_module  # noqa: E402
 
 
 @pytest.fixture
@@ -330,7 +330,7 @@ def test_lanes_are_dropped_with_their_chunk_function():
     """A thread's lane does not hold the chunk Function; its table entry goes with it."""
     import gc
 
-    from dynamics.integrate import evaluate
+    from appdyn.dynamics.integrate import evaluate
 
     x, n = ca.SX.sym("x", 2), ca.SX.sym("n")
     f = ca.Function("chunkish", [x, n], [ca.repmat(x, 1, 4)])

@@ -11,10 +11,10 @@ import numpy as np
 import pytest
 from scipy.optimize import brentq
 
-from dynamics import Event, Model, rigid_body, simulate
-from dynamics.integrate.result import TERMINAL_EVENT
-from dynamics.truth import constant_rate_quat, torque_free_omega
-from dynamics.truth.common import quat_mul
+from appdyn.dynamics import Event, Model, rigid_body, simulate
+from appdyn.dynamics.integrate.result import TERMINAL_EVENT
+from appdyn.dynamics.truth import constant_rate_quat, torque_free_omega
+from appdyn.dynamics.truth.common import quat_mul
 
 G = 9.81
 H0 = 10.0

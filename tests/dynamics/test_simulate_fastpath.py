@@ -8,10 +8,10 @@ import casadi as ca
 import numpy as np
 import pytest
 
-import dynamics
-from dynamics import cache
-from dynamics.integrate import api, evaluate, inputs
-from dynamics.integrate.inputs import check_t
+from appdyn import dynamics
+from appdyn.dynamics import cache
+from appdyn.dynamics.integrate import api, evaluate, inputs
+from appdyn.dynamics.integrate.inputs import check_t
 
 INERTIA = [1.5, 2.0, 3.25]  # a body of its own: other tests count the chunks of theirs
 X0 = [0, 0, 0, 1, 1.0, 0.1, 0.8]

@@ -9,10 +9,10 @@ import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
 
-from dynamics import closed_loop, rigid_body, simulate
-from dynamics.attitude import quat_conj, quat_mul
-from dynamics.integrate.smoothness import nonsmooth_operations
-from dynamics.momentum.wheels import wheel_spacecraft
+from appdyn.dynamics import closed_loop, rigid_body, simulate
+from appdyn.dynamics.attitude import quat_conj, quat_mul
+from appdyn.dynamics.integrate.smoothness import nonsmooth_operations
+from appdyn.dynamics.momentum.wheels import wheel_spacecraft
 
 INERTIA = np.array([[12.0, 0.3, -0.2], [0.3, 10.0, 0.1], [-0.2, 0.1, 8.0]])
 TARGET = np.array([0.3, -0.4, 0.2, 0.0])

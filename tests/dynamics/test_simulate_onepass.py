@@ -8,13 +8,13 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from dynamics import cache, rigid_body, simulate
-from dynamics.integrate import adaptive
-from dynamics.integrate.auto import one_pass
-from dynamics.integrate.inputs import Problem, check_u
-from dynamics.integrate.loops import Progress
-from dynamics.integrate.result import FAILED
-from dynamics.truth import torque_free_omega, torque_free_parameters
+from appdyn.dynamics import cache, rigid_body, simulate
+from appdyn.dynamics.integrate import adaptive
+from appdyn.dynamics.integrate.auto import one_pass
+from appdyn.dynamics.integrate.inputs import Problem, check_u
+from appdyn.dynamics.integrate.loops import Progress
+from appdyn.dynamics.integrate.result import FAILED
+from appdyn.dynamics.truth import torque_free_omega, torque_free_parameters
 
 INERTIA = [1.0, 2.0, 3.0]
 X0 = np.array([0.0, 0.0, 0.0, 1.0, 1.0, 0.1, 0.8])
@@ -130,7 +130,7 @@ def test_a_blow_up_is_a_failure_not_a_pass():
     """A right-hand side that overflows: the pass stops at the non-finite state and auto's
     search reports the failure (status FAILED), as it did before the pass."""
     import casadi as ca
-    from dynamics import Model
+    from appdyn.dynamics import Model
     x = ca.SX.sym("x")
     model = Model(ca.Function("f", [x, ca.SX.sym("u", 0), ca.SX.sym("p", 0)], [x ** 2],
                               ["x", "u", "p"], ["xdot"]), ("x",), ())
@@ -170,7 +170,7 @@ def test_the_first_auto_call_also_compiles_the_fallback_loop():
     """No hidden compile later: the first ``auto`` call of a model compiles the pass and,
     at the same time, the rk8 chunk loop its multi-run search runs, so a later call that
     falls back (here a tolerance near round-off) finds both in the cache."""
-    from dynamics.integrate.loops import chunk_key
+    from appdyn.dynamics.integrate.loops import chunk_key
     model = rigid_body([1.0, 2.2, 3.0])
     t = np.linspace(0.0, 10.0, 11)
     simulate(model, X0, t, rtol=1e-4)

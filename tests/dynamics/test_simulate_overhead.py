@@ -10,11 +10,11 @@ import casadi as ca
 import numpy as np
 import pytest
 
-import dynamics
-from dynamics.integrate.evaluate import call_buffered
-from dynamics.integrate.kernels import kernel
-from dynamics.integrate.result import SimulationResult, make_result
-from dynamics.validate import QUAT_NORM_TOL, check_unit_quaternion, unit_quaternion
+from appdyn import dynamics
+from appdyn.dynamics.integrate.evaluate import call_buffered
+from appdyn.dynamics.integrate.kernels import kernel
+from appdyn.dynamics.integrate.result import SimulationResult, make_result
+from appdyn.dynamics.validate import QUAT_NORM_TOL, check_unit_quaternion, unit_quaternion
 
 INERTIA = [1.0, 2.0, 3.0]
 X0 = np.array([0.0, 0.0, 0.0, 1.0, 1.0, 0.1, 0.8])
@@ -121,7 +121,7 @@ def test_threads_share_no_buffer(body):
 
 
 def test_buffer_dropped_with_its_function():
-    from dynamics.integrate import evaluate
+    from appdyn.dynamics.integrate import evaluate
     x = ca.SX.sym("x", 2)
     f = ca.Function("twice", [x], [2 * x])
     np.testing.assert_array_equal(call_buffered(f, [np.array([1.0, 2.0])], (2,)), [2.0, 4.0])

@@ -11,8 +11,8 @@ import pytest
 from hypothesis import HealthCheck, assume, given, settings
 from hypothesis import strategies as st
 
-from dynamics import Model, cache, rigid_body, simulate
-from dynamics.truth import (axisymmetric, constant_rate_quat, torque_free_omega,
+from appdyn.dynamics import Model, cache, rigid_body, simulate
+from appdyn.dynamics.truth import (axisymmetric, constant_rate_quat, torque_free_omega,
                             torque_free_parameters)
 
 X0 = np.array([0.0, 0.0, 0.0, 1.0, 1.0, 0.1, 0.8])

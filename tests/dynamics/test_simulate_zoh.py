@@ -6,7 +6,7 @@ import casadi as ca
 import numpy as np
 import pytest
 
-from dynamics import Model, rigid_body, simulate
+from appdyn.dynamics import Model, rigid_body, simulate
 
 RNG = np.random.default_rng(27)
 T = np.cumsum(np.r_[0.0, RNG.uniform(0.2, 0.7, 30)])  # a non-uniform grid

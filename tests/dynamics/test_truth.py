@@ -16,7 +16,7 @@ from scipy.integrate import solve_ivp
 from scipy.linalg import expm
 from scipy.optimize import minimize_scalar
 
-from dynamics import truth
+from appdyn.dynamics import truth
 
 INTEGRATOR = dict(method="DOP853", rtol=1e-13, atol=1e-13)
 TOL = 1e-9  # closed form vs. integration, relative to |w0| (or absolute for quaternions)

@@ -12,7 +12,7 @@ from hypothesis import given
 from hypothesis import strategies as st
 from scipy.spatial.transform import Rotation
 
-from dynamics import validate as v
+from appdyn.dynamics import validate as v
 
 pytestmark = pytest.mark.filterwarnings("error")  # the checks never warn
 
@@ -252,7 +252,7 @@ def test_integer():
 
 # ---------------------------------------------------------------------- check_inertia
 def test_check_inertia_lives_here_and_in_rigid_body():
-    from dynamics.rigid_body import check_inertia
+    from appdyn.dynamics.rigid_body import check_inertia
 
     assert check_inertia is v.check_inertia
     np.testing.assert_array_equal(v.check_inertia([1.0, 2.0, 2.5]), np.diag([1.0, 2.0, 2.5]))

@@ -12,9 +12,9 @@ import casadi as ca
 import numpy as np
 from scipy.optimize import brentq
 
-from dynamics.model import Model
-from dynamics.rigid_body import rigid_body
-from ocp import Problem
+from appdyn.dynamics.model import Model
+from appdyn.dynamics.rigid_body import rigid_body
+from appdyn.ocp import Problem
 
 TRANSCRIPTION_NAMES = ("trapezoid", "hermite-simpson", "hermite-simpson-compressed", "radau")
 # Nominal convergence orders for smooth problems: trapezoid 2, Hermite-Simpson 4 (both

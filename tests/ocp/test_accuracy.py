@@ -22,12 +22,12 @@ import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
 
-import ocp
-from ocp import Problem, refine, solve
-from ocp.examples import GODDARD_OPTIMUM, double_integrator, goddard_rocket, min_energy, min_time
-from ocp.mesh import Mesh
-from ocp.refine.mesh_update import STATUS_STALLED
-from ocp.solution import SCALE_FLOOR
+from appdyn import ocp
+from appdyn.ocp import Problem, refine, solve
+from appdyn.ocp.examples import GODDARD_OPTIMUM, double_integrator, goddard_rocket, min_energy, min_time
+from appdyn.ocp.mesh import Mesh
+from appdyn.ocp.refine.mesh_update import STATUS_STALLED
+from appdyn.ocp.solution import SCALE_FLOOR
 
 
 # ------------------------------------------------------------------ independent truth

@@ -4,13 +4,13 @@ import casadi as ca
 import numpy as np
 import pytest
 
-import ocp
-from ocp import Constraint, Mesh, Problem, solve
-from ocp.assembly import content_key
-from ocp.guess import initial_guess
-from ocp.nlp import Discretization
-from ocp.scaling import auto_scaling
-from ocp.transcription import get_transcription
+from appdyn import ocp
+from appdyn.ocp import Constraint, Mesh, Problem, solve
+from appdyn.ocp.assembly import content_key
+from appdyn.ocp.guess import initial_guess
+from appdyn.ocp.nlp import Discretization
+from appdyn.ocp.scaling import auto_scaling
+from appdyn.ocp.transcription import get_transcription
 
 from .reference import bang_bang, bryson_denham, rigid_slew, static_parameter
 
@@ -128,7 +128,7 @@ def test_warm_start_with_multipliers_converges_at_once():
 def test_warm_start_of_another_problem_uses_primal_values_only():
     """The dual warm start is kept for the same NLP; a Solution of another problem of the
     same structure (other target) starts IPOPT from its primal values, as before."""
-    from ocp.solve import _warm_point
+    from appdyn.ocp.solve import _warm_point
 
     a, _ = rigid_slew(theta_f=1.0)
     b, tb = rigid_slew(theta_f=1.1)
@@ -142,7 +142,7 @@ def test_warm_start_of_another_problem_uses_primal_values_only():
 def test_code_generation_gives_the_same_solution():
     """``codegen=True`` compiles the interval derivatives to C: the same iterates, the
     same optimum (Bryson-Denham, J = 4 / (9 l)) as the SX Functions."""
-    from dynamics.cache import compiler
+    from appdyn.dynamics.cache import compiler
 
     problem, truth = bryson_denham()
     plain = solve(problem, N=12)

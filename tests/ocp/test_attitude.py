@@ -4,10 +4,10 @@ import math
 import numpy as np
 import pytest
 
-from dynamics import rigid_body
-from dynamics.attitude import quat_from_axis_angle
-from ocp import Problem
-from ocp.attitude import attitude_error, quaternion_path, slerp, target_bounds, target_rows
+from appdyn.dynamics import rigid_body
+from appdyn.dynamics.attitude import quat_from_axis_angle
+from appdyn.ocp import Problem
+from appdyn.ocp.attitude import attitude_error, quaternion_path, slerp, target_bounds, target_rows
 
 
 def test_slerp_is_the_constant_rate_rotation():

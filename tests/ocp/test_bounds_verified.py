@@ -15,8 +15,8 @@ import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
 
-import ocp
-from ocp import refine, solve
+from appdyn import ocp
+from appdyn.ocp import refine, solve
 
 from .reference import STRICT, bang_bang, free_flying_robot, min_energy, orbit_raising
 
@@ -128,7 +128,7 @@ def test_refine_never_returns_a_worse_objective_than_an_earlier_round(monkeypatc
     first = solve(problem, N=80, control="linear")
     coarse = solve(problem, N=10, control="linear")
     assert first.success and coarse.success and coarse.simulated_cost > first.simulated_cost + 1e-2
-    mesh_update = importlib.import_module("ocp.refine.mesh_update")
+    mesh_update = importlib.import_module("appdyn.ocp.refine.mesh_update")
     monkeypatch.setattr(mesh_update, "solve", lambda *a, **k: coarse)
     sol = refine(problem, first, tol=1e-9, max_rounds=1, control="linear")
     assert sol.simulated_cost == pytest.approx(first.simulated_cost, abs=1e-12)

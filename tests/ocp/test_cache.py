@@ -3,13 +3,13 @@ from __future__ import annotations
 
 import numpy as np
 
-import ocp
-from dynamics import cache, clear_caches
+from appdyn import ocp
+from appdyn.dynamics import cache, clear_caches
 from tests.ocp.reference import bang_bang, min_energy
 
 
 def _ocp_kinds():
-    return {k: n for k, n in cache.info().kinds.items() if k.startswith("ocp.")}
+    return {k: n for k, n in cache.info().kinds.items() if k.startswith("appdyn.ocp.")}
 
 
 def test_per_model_functions_are_built_once_and_cleared():
@@ -23,11 +23,11 @@ def test_per_model_functions_are_built_once_and_cleared():
     sol = ocp.solve(problem, N=8)
     assert sol.propagation.success
     kinds = _ocp_kinds()
-    for kind in ("ocp.kernel", "ocp.interpolant", "ocp.interval_integrator", "ocp.propagator",
-                 "ocp.nlpsol"):
+    for kind in ("appdyn.ocp.kernel", "appdyn.ocp.interpolant", "appdyn.ocp.interval_integrator", "appdyn.ocp.propagator",
+                 "appdyn.ocp.nlpsol"):
         assert kinds.get(kind, 0) >= 1, kinds
     ocp.interval_errors(sol)
-    assert _ocp_kinds().get("ocp.interval_check", 0) == 1
+    assert _ocp_kinds().get("appdyn.ocp.interval_check", 0) == 1
     clear_caches()
     assert _ocp_kinds() == {}
 
@@ -40,14 +40,14 @@ def test_second_solve_with_another_guess_reuses_the_solver():
     hits = cache.info().hits
     again = ocp.solve(problem, N=12, guess={"T": 4.5}, control="constant")  # another start
     assert first.success and again.success
-    assert _ocp_kinds()["ocp.nlpsol"] == 1 and cache.info().hits > hits
+    assert _ocp_kinds()["appdyn.ocp.nlpsol"] == 1 and cache.info().hits > hits
     assert abs(again.T - truth["T"]) < 1e-6 and abs(first.T - again.T) < 1e-7
     # another mesh, options or a progress listener build their own
     seen = []
     other = ocp.solve(problem, N=12, progress=seen.append, control="constant")
     assert other.success and seen
     assert ocp.solve(problem, N=12, ipopt_options={"tol": 1e-9}, control="constant").success
-    assert _ocp_kinds()["ocp.nlpsol"] == 2
+    assert _ocp_kinds()["appdyn.ocp.nlpsol"] == 2
 
 
 def test_cached_solver_gives_the_same_answer_as_a_fresh_one():

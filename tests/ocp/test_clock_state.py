@@ -8,9 +8,9 @@ import math
 import casadi as ca
 import numpy as np
 
-import ocp
-from dynamics import Model
-from dynamics.clock import clock_index
+from appdyn import ocp
+from appdyn.dynamics import Model
+from appdyn.dynamics.clock import clock_index
 
 
 def test_forced_double_integrator_with_a_clock_state():

@@ -12,7 +12,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from ocp import Mesh, solve
+from appdyn.ocp import Mesh, solve
 
 from .reference import STRICT, min_energy
 

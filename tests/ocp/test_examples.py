@@ -8,8 +8,9 @@ import pkgutil
 import numpy as np
 import pytest
 
-import ocp
-import problems.slew
+from appdyn import ocp
+import appdyn.problems.slew  # noqa: F401
+from appdyn import problems
 
 FLAGS = doctest.NORMALIZE_WHITESPACE | doctest.ELLIPSIS
 
@@ -36,7 +37,7 @@ def test_docstring_examples(name):
 
 
 def test_every_public_entry_point_has_an_example():
-    from problems import slew
+    from appdyn.problems import slew
 
     entries = [ocp.Problem, ocp.solve, ocp.rest_solution, ocp.refine, ocp.solve_multistart,
                ocp.polish_switches, ocp.guess_from_simulation, ocp.Solution.sample,

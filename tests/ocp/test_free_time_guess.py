@@ -8,10 +8,10 @@ import casadi as ca
 import numpy as np
 import pytest
 
-from dynamics import Model, rigid_body
-from dynamics.truth.torque_free import torque_free_omega
-from ocp import Mesh, Problem, Radau, solve
-from ocp.guess import initial_guess
+from appdyn.dynamics import Model, rigid_body
+from appdyn.dynamics.truth.torque_free import torque_free_omega
+from appdyn.ocp import Mesh, Problem, Radau, solve
+from appdyn.ocp.guess import initial_guess
 
 from .reference import bang_bang, double_integrator
 

@@ -5,10 +5,10 @@ import casadi as ca
 import numpy as np
 import pytest
 
-import ocp
-from dynamics import Model, rigid_body, simulate
-from dynamics.model import model_from_expressions
-from ocp.examples import double_integrator, min_energy
+from appdyn import ocp
+from appdyn.dynamics import Model, rigid_body, simulate
+from appdyn.dynamics.model import model_from_expressions
+from appdyn.ocp.examples import double_integrator, min_energy
 
 RNG = np.random.default_rng(7)
 
@@ -140,7 +140,7 @@ def test_solution_reads_states_and_controls_by_name():
 
 # ------------------------------------------------------------------ guesses by name
 def _nodes(problem, guess):
-    from ocp.guess import initial_guess
+    from appdyn.ocp.guess import initial_guess
     tr, mesh = ocp.Radau(3), ocp.Mesh.uniform(5)
     return initial_guess(problem, tr, mesh, guess), tr.state_tau(mesh), tr.control_tau(mesh)
 

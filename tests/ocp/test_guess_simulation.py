@@ -2,7 +2,7 @@
 import numpy as np
 import pytest
 
-from ocp import guess_from_simulation, solve
+from appdyn.ocp import guess_from_simulation, solve
 
 from .reference import min_energy
 

@@ -6,8 +6,8 @@ import sys
 
 import pytest
 
-from ocp import check_ipopt_options, polish_switches, solve
-from ocp.ipopt_options import available_linear_solvers
+from appdyn.ocp import check_ipopt_options, polish_switches, solve
+from appdyn.ocp.ipopt_options import available_linear_solvers
 
 from .reference import bang_bang, min_energy
 

@@ -5,7 +5,7 @@ import casadi as ca
 import numpy as np
 import pytest
 
-from ocp.layout import Layout
+from appdyn.ocp.layout import Layout
 
 
 def test_split_join_round_trip_numeric_and_symbolic():

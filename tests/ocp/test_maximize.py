@@ -2,8 +2,8 @@
 import numpy as np
 import pytest
 
-import ocp
-from ocp.examples import min_energy, min_time
+from appdyn import ocp
+from appdyn.ocp.examples import min_energy, min_time
 
 
 def _max_energy():
@@ -60,7 +60,7 @@ def test_multistart_ranks_by_sign(monkeypatch):
     """The ranking itself, with stub solves of known costs."""
     import importlib
 
-    ms = importlib.import_module("ocp.refine.multistart")
+    ms = importlib.import_module("appdyn.ocp.refine.multistart")
 
     prob = _max_energy()
     real = ocp.solve(prob, N=5)

@@ -13,8 +13,8 @@ import time
 import numpy as np
 import pytest
 
-import ocp
-from ocp.examples import min_time
+from appdyn import ocp
+from appdyn.ocp.examples import min_time
 
 GUESSES = [None, {"T": 5.0}, {"T": 1.0}, {"T": 3.0}]
 # start 0 is capped before it converges; start 2 tries a capped attempt first
@@ -101,7 +101,7 @@ def test_interrupt_cancels_the_pending_starts(problem):
 
 
 def test_problem_is_unpickled_once_per_worker(problem):
-    from ocp.refine.multistart import _Shipped
+    from appdyn.ocp.refine.multistart import _Shipped
 
     a, b = _Shipped(problem), _Shipped(problem)
     assert a.digest == b.digest and a.get() is b.get() and a.get() is not problem

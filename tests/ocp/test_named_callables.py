@@ -9,8 +9,8 @@ import casadi as ca
 import numpy as np
 import pytest
 
-from dynamics.model import Model
-from ocp import Constraint, Problem, solve
+from appdyn.dynamics.model import Model
+from appdyn.ocp import Constraint, Problem, solve
 
 from .reference import STRICT, bang_bang, bryson_denham, double_integrator, static_parameter
 

@@ -12,9 +12,9 @@ import numpy as np
 import pytest
 from scipy.optimize import brentq
 
-import ocp
-from dynamics.model import model_from_expressions
-from ocp.examples import double_integrator
+from appdyn import ocp
+from appdyn.dynamics.model import model_from_expressions
+from appdyn.ocp.examples import double_integrator
 
 ENERGY = lambda x, u, p: 0.5 * u**2  # noqa: E731
 

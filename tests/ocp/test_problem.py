@@ -8,8 +8,8 @@ import casadi as ca
 import numpy as np
 import pytest
 
-from dynamics.rigid_body import rigid_body
-from ocp import Constraint, Problem, solve
+from appdyn.dynamics.rigid_body import rigid_body
+from appdyn.ocp import Constraint, Problem, solve
 
 from .reference import double_integrator, min_energy
 
@@ -46,7 +46,7 @@ def test_array_boundary_values_with_none_and_nan_mark_free_components():
 
 def test_parameters_fixed_unless_bounded():
     x, u, p = ca.SX.sym("x", 2), ca.SX.sym("u"), ca.SX.sym("p", 2)
-    from dynamics.model import Model
+    from appdyn.dynamics.model import Model
     m = Model(ca.Function("f", [x, u, p], [ca.vertcat(x[1], p[0] * u + p[1])], ["x", "u", "p"], ["xdot"]),
               ("x", "v"), ("u",), ("k", "g"), p_default=[1.0, 0.0])
     pr = Problem(m, T=1.0, p={"g": -0.5}, p_bounds={"k": (0.5, 2.0)})
@@ -173,8 +173,8 @@ def test_several_path_constraints_are_accepted():
     """A sequence of constraints gets per-item labels; they must be valid Function names."""
     import casadi as ca
 
-    from dynamics import rigid_body
-    from ocp import Problem
+    from appdyn.dynamics import rigid_body
+    from appdyn.ocp import Problem
 
     x, u, p = ca.SX.sym("x", 7), ca.SX.sym("u", 3), ca.SX.sym("p", 0)
     g1 = ca.Function("g1", [x, u, p], [ca.sumsqr(u) - 1])

@@ -4,7 +4,7 @@ import logging
 import numpy as np
 import pytest
 
-from ocp import (LOGGER, Progress, RadauConstantControl, RefinementRound, Solution, get_transcription,
+from appdyn.ocp import (LOGGER, Progress, RadauConstantControl, RefinementRound, Solution, get_transcription,
                  refine, solve, solve_multistart)
 
 from .reference import STRICT, bang_bang, min_energy

@@ -24,7 +24,7 @@ import math
 import numpy as np
 import pytest
 
-from ocp import solve
+from appdyn.ocp import solve
 
 from .reference import (ORDER, STRICT, TRANSCRIPTION_NAMES, bang_bang, brachistochrone,
                         bryson_denham, min_energy, observed_order, rigid_slew, static_parameter)

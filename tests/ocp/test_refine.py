@@ -17,9 +17,9 @@ import time
 import numpy as np
 import pytest
 
-from dynamics import rigid_body
-from dynamics.attitude import quat_from_axis_angle
-from ocp import (Problem, RadauConstantControl, RefinedSolution, RefinementRound, Solution,
+from appdyn.dynamics import rigid_body
+from appdyn.dynamics.attitude import quat_from_axis_angle
+from appdyn.ocp import (Problem, RadauConstantControl, RefinedSolution, RefinementRound, Solution,
                  find_switches, interval_errors, polish_switches, refine, solve, solve_multistart)
 
 from .reference import STRICT, bang_bang, brachistochrone, double_integrator, min_energy, rigid_slew

@@ -3,8 +3,8 @@ import json
 
 import numpy as np
 
-import ocp
-from ocp.examples import min_energy
+from appdyn import ocp
+from appdyn.ocp.examples import min_energy
 
 
 def test_solution_serializes_and_plots(tmp_path):

@@ -4,8 +4,8 @@ import control
 import numpy as np
 import pytest
 
-import ocp
-from dynamics import Model
+from appdyn import ocp
+from appdyn.dynamics import Model
 
 from .reference import double_integrator
 

@@ -7,7 +7,7 @@ import casadi as ca
 import numpy as np
 import pytest
 
-from ocp import (Constraint, HermiteSimpson, Mesh, Problem, Progress, Radau, Solution, Trapezoid,
+from appdyn.ocp import (Constraint, HermiteSimpson, Mesh, Problem, Progress, Radau, Solution, Trapezoid,
                  solve)
 
 from .reference import (STRICT, TRANSCRIPTION_NAMES, brachistochrone, double_integrator,
@@ -100,7 +100,7 @@ def test_guess_from_arrays_and_callables():
 
 def test_default_attitude_guess_is_slerp():
     problem, truth = rigid_slew(theta_f=2.5, T=3.0, axis=0, sign=-1.0)
-    from ocp.guess import initial_guess
+    from appdyn.ocp.guess import initial_guess
     g = initial_guess(problem, Radau(3), Mesh.uniform(4))
     q = g.X[0:4]
     assert np.allclose(np.linalg.norm(q, axis=0), 1.0, atol=1e-15)
@@ -197,7 +197,7 @@ def test_boundary_function_and_mayer_replace_fixed_values():
 
 def test_free_initial_quaternion_gets_unit_norm():
     q = np.array([0.0, 0.0, math.sin(0.5), math.cos(0.5)])
-    from dynamics.rigid_body import rigid_body
+    from appdyn.dynamics.rigid_body import rigid_body
     problem = Problem(rigid_body(np.eye(3)), T=2.0, x_initial={"w1": 0, "w2": 0, "w3": 0.1},
                       x_final={"w1": 0, "w2": 0, "w3": 0}, q_final=q,
                       lagrange=lambda x, u, p: 0.5 * ca.sumsqr(u))
@@ -255,8 +255,8 @@ def test_solution_attributes():
 def test_automatic_scales_are_powers_of_two_so_boundary_values_are_exact():
     """Scaling by powers of two is exact in floating point: fixed boundary values reach
     IPOPT (as fixed variables) and come back bit for bit."""
-    from ocp.guess import initial_guess
-    from ocp.scaling import auto_scaling
+    from appdyn.ocp.guess import initial_guess
+    from appdyn.ocp.scaling import auto_scaling
     problem = Problem(double_integrator(), T=1.0, x_initial=[0.1, 1 / 3], x_final=[2.9, -0.7],
                       u_bounds={"u": (-30.3, 30.3)}, lagrange=lambda x, u, p: 0.5 * u ** 2)
     g = initial_guess(problem, Radau(3), Mesh.uniform(3))

@@ -7,10 +7,10 @@ import casadi as ca
 import numpy as np
 import pytest
 
-from dynamics.model import Model
-from ocp import Problem, RadauConstantControl, find_switches, polish_switches, solve
-from ocp.refine.switch_times import bang_arcs, optimize_switch_times
-from problems import slew
+from appdyn.dynamics.model import Model
+from appdyn.ocp import Problem, RadauConstantControl, find_switches, polish_switches, solve
+from appdyn.ocp.refine.switch_times import bang_arcs, optimize_switch_times
+from appdyn.problems import slew
 
 from .reference import STRICT, bang_bang, double_integrator, min_energy
 
@@ -235,7 +235,7 @@ def test_another_target_reuses_the_switch_time_nlp_and_matches_a_fresh_build():
     """The switch-time NLP is built once per switching structure, the target and scales
     as parameters: a slew to another target with the same arcs builds nothing, and gives
     the same answer as an NLP built afresh for it (cache emptied)."""
-    from dynamics import cache, clear_caches
+    from appdyn.dynamics import cache, clear_caches
 
     def first_and_problem(axis):
         start = slew.time_optimal(np.eye(3), angle=2.0, axis=axis, u_max=1.0, polish=False,
@@ -249,9 +249,9 @@ def test_another_target_reuses_the_switch_time_nlp_and_matches_a_fresh_build():
     assert a1.durations.size == a2.durations.size
     np.testing.assert_array_equal(a1.controls, a2.controls)
     one = optimize_switch_times(p1, s1, N=30)
-    entries = cache.info().kinds.get("ocp.switch_times_nlp", 0)
+    entries = cache.info().kinds.get("appdyn.ocp.switch_times_nlp", 0)
     two = optimize_switch_times(p2, s2, N=30)
-    assert cache.info().kinds.get("ocp.switch_times_nlp", 0) == entries  # nothing new built
+    assert cache.info().kinds.get("appdyn.ocp.switch_times_nlp", 0) == entries  # nothing new built
     assert two.build_time < 0.25 * one.build_time
     clear_caches()
     fresh = optimize_switch_times(p2, s2, N=30)

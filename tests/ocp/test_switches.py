@@ -4,8 +4,8 @@ at T*/2)."""
 import numpy as np
 import pytest
 
-from ocp import control_switches, find_switches, interval_errors, solve
-from ocp.refine.switch_times import bang_arcs
+from appdyn.ocp import control_switches, find_switches, interval_errors, solve
+from appdyn.ocp.refine.switch_times import bang_arcs
 
 from .reference import STRICT, bang_bang
 

@@ -7,12 +7,12 @@ import math
 import numpy as np
 import pytest
 
-from dynamics import rigid_body
-from dynamics.attitude import quat_from_axis_angle
-from ocp import (DEFAULT_CONSTRAINT_TOL, Problem, RadauConstantControl, check_ipopt_options,
+from appdyn.dynamics import rigid_body
+from appdyn.dynamics.attitude import quat_from_axis_angle
+from appdyn.ocp import (DEFAULT_CONSTRAINT_TOL, Problem, RadauConstantControl, check_ipopt_options,
                  ipopt_option_table, rest_solution, solve)
-from ocp.rest import STATUS_REST
-from ocp.solve import STATUS_CONSTRAINT_TOL
+from appdyn.ocp.rest import STATUS_REST
+from appdyn.ocp.solve import STATUS_CONSTRAINT_TOL
 
 from .reference import bang_bang, min_energy
 
@@ -143,7 +143,7 @@ def test_tiny_single_axis_time_optimal_slew_is_bang_bang(angle):
 
 def test_kept_common_options_match_the_installed_ipopt():
     """The options checked without the captured documentation agree with it."""
-    from ocp.ipopt_options import _COMMON
+    from appdyn.ocp.ipopt_options import _COMMON
     table = ipopt_option_table()
     for name, opt in _COMMON.items():
         if name != "sb":  # CasADi's, not documented by IPOPT

@@ -4,8 +4,8 @@ import json
 import numpy as np
 import pytest
 
-from problems.cli import main
-from problems.torque_free import torque_free
+from appdyn.problems.cli import main
+from appdyn.problems.torque_free import torque_free
 
 
 def test_torque_free_summary_and_json(tmp_path, capsys):
@@ -84,7 +84,7 @@ def test_slew_bad_input(args, message, capsys):
 def test_torque_free_report_status_plot_and_deprecated_worst_axis():
     from matplotlib.figure import Figure
 
-    from problems.torque_free import STATUS_CHECK_FAILED, STATUS_VERIFIED
+    from appdyn.problems.torque_free import STATUS_CHECK_FAILED, STATUS_VERIFIED
 
     rep = torque_free([1.0, 2.0, 3.0], [0.2, 1.0, 0.1], t_final=5.0, n_points=51)
     assert rep.status == STATUS_VERIFIED and rep.to_dict()["status"] == STATUS_VERIFIED
@@ -97,7 +97,7 @@ def test_torque_free_report_status_plot_and_deprecated_worst_axis():
 
 
 def test_umax_is_a_hidden_alias_of_u_max(capsys):
-    from problems.cli import build_parser
+    from appdyn.problems.cli import build_parser
 
     parser = build_parser()
     base = ["slew", "--inertia", "1,1,1", "--axis", "0,0,1", "--angle", "90", "--time-optimal"]
@@ -112,7 +112,7 @@ def test_umax_is_a_hidden_alias_of_u_max(capsys):
 
 def test_bench_passes_quick_and_out_to_run(tmp_path, monkeypatch, capsys):
     """`appdyn bench NAME --quick --out DIR` calls bench/NAME.py's run(True, DIR)."""
-    from problems.cli import bench
+    from appdyn.problems.cli import bench
 
     seen = tmp_path / "seen.txt"
     (tmp_path / "probe.py").write_text(

@@ -9,8 +9,8 @@ import doctest
 import numpy as np
 import pytest
 
-from problems.cli import COMMANDS, main
-from problems.cli import cmg as cmg_cli
+from appdyn.problems.cli import COMMANDS, main
+from appdyn.problems.cli import cmg as cmg_cli
 from tests.problems.test_cli_trust import exit_code, strict_loads
 
 BETA = 54.74

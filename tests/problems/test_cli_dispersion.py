@@ -4,8 +4,8 @@ import json
 
 import pytest
 
-from problems.cli import main
-from problems.dispersion import nutation_spread
+from appdyn.problems.cli import main
+from appdyn.problems.dispersion import nutation_spread
 
 
 def test_dispersion_spin_reports_the_closed_form_statistics(tmp_path, capsys):

@@ -6,8 +6,8 @@ import math
 
 import pytest
 
-from problems.cli import COMMANDS, main
-from problems.gains.config import EXAMPLE_CONFIG
+from appdyn.problems.cli import COMMANDS, main
+from appdyn.problems.gains.config import EXAMPLE_CONFIG
 
 
 def strict_json(path):

@@ -8,7 +8,7 @@ import re
 
 import pytest
 
-from problems.cli import main
+from appdyn.problems.cli import main
 
 BALL = ["simulate", "hinged", "--m1", "10", "--inertia1", "1,2,2.5", "--m2", "2",
         "--inertia2", "0.2,0.3,0.4", "--r1", "0.4,0,0", "--r2", "-0.3,0,0",

@@ -6,7 +6,7 @@ import math
 
 import pytest
 
-from problems.cli import main
+from appdyn.problems.cli import main
 
 VEHICLE = ["--thrust", "2e6", "--inertia", "4e7", "--arm", "20", "--mass", "1e5"]
 PARTS = ["--aero", "3e4,10,3,5", "--velocity", "500",

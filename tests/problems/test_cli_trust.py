@@ -13,12 +13,12 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 
-from dynamics.truth import torque_free_omega
-from problems import slew
-from problems import stability
-from problems.cli import main, rest_to_rest_bound
-from problems.cli.common import attach_negative_values, strict_json
-from problems.torque_free import CHECK_FACTOR, torque_free
+from appdyn.dynamics.truth import torque_free_omega
+from appdyn.problems import slew
+from appdyn.problems import stability
+from appdyn.problems.cli import main, rest_to_rest_bound
+from appdyn.problems.cli.common import attach_negative_values, strict_json
+from appdyn.problems.torque_free import CHECK_FACTOR, torque_free
 
 TF = ["simulate", "torque-free", "--inertia", "1,2,3"]
 SPIN = ["stability", "sweep", "spin", "--inertia", "1,2,3", "--axis", "1,0,0"]
@@ -106,7 +106,7 @@ def test_negative_scalars_and_ranges_in_stability(capsys):
 
 
 def test_attach_negative_values_only_for_value_options():
-    from problems.cli import build_parser
+    from appdyn.problems.cli import build_parser
 
     p = build_parser()
     assert attach_negative_values(p, ["--w0", "-1,2", "--angle", "-1e-3", "--values",
@@ -158,7 +158,7 @@ def test_other_conflicting_options(argv, names, capsys):
 ])
 def test_output_paths_are_checked_before_computing(option, name, message, tmp_path,
                                                    monkeypatch, capsys):
-    import problems.torque_free as tfmod
+    import appdyn.problems.torque_free as tfmod
 
     monkeypatch.setattr(tfmod, "torque_free", lambda *a, **k: pytest.fail("computed"))
     path = str(tmp_path / name) if name != "." else str(tmp_path)
@@ -298,7 +298,7 @@ def test_library_value_error_is_one_line_exit_2(capsys):
 
 
 def test_unexpected_failure_is_one_line_exit_1(monkeypatch, capsys):
-    import problems.torque_free as tfmod
+    import appdyn.problems.torque_free as tfmod
 
     def boom(*a, **k):
         raise RuntimeError("CVODES failed\n  at t = 3.2")

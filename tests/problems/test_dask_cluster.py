@@ -7,8 +7,8 @@ import pytest
 
 distributed = pytest.importorskip("distributed")
 
-from problems import stability as st  # noqa: E402
-from problems.dispersion import Normal, dispersion, nutation_history, spinner  # noqa: E402
+from appdyn.problems import stability as st  # noqa: E402
+from appdyn.problems.dispersion import Normal, dispersion, nutation_history, spinner  # noqa: E402
 
 X0 = [0, 0, 0, 1, 0.0, 0.0, 1.0]
 T = np.linspace(0.0, 10.0, 11)

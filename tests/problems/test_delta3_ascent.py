@@ -10,9 +10,9 @@ import math
 import numpy as np
 import pytest
 
-from problems.ascent import PHASES, TARGET_ORBIT, delta3_ascent, delta3_problem
-from problems.ascent.delta3 import FINAL_MASS_BETTS, FINAL_TIME_BETTS, MU
-from problems.cli import main
+from appdyn.problems.ascent import PHASES, TARGET_ORBIT, delta3_ascent, delta3_problem
+from appdyn.problems.ascent.delta3 import FINAL_MASS_BETTS, FINAL_TIME_BETTS, MU
+from appdyn.problems.cli import main
 
 
 @pytest.fixture(scope="module")

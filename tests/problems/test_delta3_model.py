@@ -7,7 +7,7 @@ import casadi as ca
 import numpy as np
 import pytest
 
-from problems.ascent import delta3 as d3
+from appdyn.problems.ascent import delta3 as d3
 
 MU = 3.986012e14
 OMEGA = 7.29211585e-5

@@ -19,16 +19,16 @@ import casadi as ca
 import numpy as np
 import pytest
 
-from dynamics import rigid_body
-from dynamics.model import model_from_expressions
-from dynamics.truth import symmetric_precession
-from problems import dispersion as dp
-from problems.dispersion import (Normal, SmallRotation, Uniform, dispersion, nutation_history,
+from appdyn.dynamics import rigid_body
+from appdyn.dynamics.model import model_from_expressions
+from appdyn.dynamics.truth import symmetric_precession
+from appdyn.problems import dispersion as dp
+from appdyn.problems.dispersion import (Normal, SmallRotation, Uniform, dispersion, nutation_history,
                                  nutation_spread, spinner)
 
-MODULES = ["problems.dispersion", "problems.dispersion.distributions",
-           "problems.dispersion.result", "problems.dispersion.run", "problems.dispersion.sample",
-           "problems.dispersion.spin"]
+MODULES = ["appdyn.problems.dispersion", "appdyn.problems.dispersion.distributions",
+           "appdyn.problems.dispersion.result", "appdyn.problems.dispersion.run", "appdyn.problems.dispersion.sample",
+           "appdyn.problems.dispersion.spin"]
 T = np.linspace(0.0, 20.0, 21)
 X0 = [0.0, 0.0, 0.0, 1.0, 0.02, 0.0, 1.0]
 SPIN = {"transverse_inertia": Normal(1000.0, 20.0), "axial_inertia": Normal(1500.0, 30.0),

@@ -11,12 +11,12 @@ import control
 import numpy as np
 import pytest
 
-from dynamics import simulate
-from dynamics.launch_vehicle import Actuator, Aero
-from dynamics.launch_vehicle import launch_vehicle as vehicle_model
-from problems.gains import STATUS_LIMITS, GainDesign
-from problems.gains.config import EXAMPLE_CONFIG, load_config, parse_config
-from problems.gains.launch_vehicle import (LaunchScenario, LaunchVehicle, design_model,
+from appdyn.dynamics import simulate
+from appdyn.dynamics.launch_vehicle import Actuator, Aero
+from appdyn.dynamics.launch_vehicle import launch_vehicle as vehicle_model
+from appdyn.problems.gains import STATUS_LIMITS, GainDesign
+from appdyn.problems.gains.config import EXAMPLE_CONFIG, load_config, parse_config
+from appdyn.problems.gains.launch_vehicle import (LaunchScenario, LaunchVehicle, design_model,
                                            launch_vehicle_gains)
 
 F, I, L, M, V = 2.0e6, 4.0e7, 20.0, 1.0e5, 300.0
@@ -241,8 +241,8 @@ def test_bad_arguments_name_the_argument(kwargs, error, match):
         launch_vehicle_gains(args.pop("vehicle"), args.pop("scenarios"), **args)
 
 
-@pytest.mark.parametrize("module_name", ["problems.gains.launch_vehicle", "problems.gains.config",
-                                         "problems.cli.gains"])
+@pytest.mark.parametrize("module_name", ["appdyn.problems.gains.launch_vehicle", "appdyn.problems.gains.config",
+                                         "appdyn.problems.cli.gains"])
 def test_docstring_examples_run_as_written(module_name):
     module = importlib.import_module(module_name)
     runner = doctest.DocTestRunner(optionflags=doctest.NORMALIZE_WHITESPACE | doctest.ELLIPSIS)

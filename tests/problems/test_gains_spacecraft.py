@@ -4,9 +4,9 @@ import math
 import numpy as np
 import pytest
 
-from dynamics import simulate
-from problems.gains.result import STATUS_LIMITS, GainDesign
-from problems.gains.spacecraft import (attitude_gains, attitude_loop, error_angle, initial_state,
+from appdyn.dynamics import simulate
+from appdyn.problems.gains.result import STATUS_LIMITS, GainDesign
+from appdyn.problems.gains.spacecraft import (attitude_gains, attitude_loop, error_angle, initial_state,
                                        settle_time)
 
 J_DIAG = np.diag([1.0, 2.0, 3.0])
@@ -126,7 +126,7 @@ def test_a_failed_re_simulation_is_reported_as_such(monkeypatch):
     """Found by the random valid-input sweep (an axis with components of 1e-175 made CVODES
     give up): the failed run's NaN peaks were reported as 'exceeds the torque limit by nan %'.
     A failed re-simulation now says so, with the simulator's message."""
-    import problems.gains.spacecraft as spacecraft
+    import appdyn.problems.gains.spacecraft as spacecraft
 
     def failing(loop, x0, gains, t):
         return _Failed(loop.nx, t.size)

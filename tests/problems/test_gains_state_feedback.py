@@ -3,8 +3,8 @@ import control
 import numpy as np
 import pytest
 
-from problems.gains.result import STATUS_UNSTABLE, GainDesign
-from problems.gains.state_feedback import (HORIZON_RATIO_MIN, STATUS_NOT_SPANNING,
+from appdyn.problems.gains.result import STATUS_UNSTABLE, GainDesign
+from appdyn.problems.gains.state_feedback import (HORIZON_RATIO_MIN, STATUS_NOT_SPANNING,
                                            STATUS_SHORT_HORIZON, state_feedback_gains)
 
 A_DI, B_DI = np.array([[0.0, 1.0], [0.0, 0.0]]), np.array([[0.0], [1.0]])

@@ -8,8 +8,8 @@ import math
 import numpy as np
 import pytest
 
-from dynamics import simulate
-from problems.ascent import (G0, AscentVehicle, fly_pitch_program,
+from appdyn.dynamics import simulate
+from appdyn.problems.ascent import (G0, AscentVehicle, fly_pitch_program,
                                     planar_ascent, planar_model, vertical_rise)
 
 TARGET = dict(target_altitude=65e3, target_gamma=math.radians(40.0))

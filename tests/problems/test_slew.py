@@ -4,8 +4,8 @@ import math
 import numpy as np
 import pytest
 
-from dynamics.attitude import quat_from_axis_angle, quat_mul, rotation_angle, quat_conj
-from problems import slew
+from appdyn.dynamics.attitude import quat_from_axis_angle, quat_mul, rotation_angle, quat_conj
+from appdyn.problems import slew
 
 
 def test_min_effort_single_axis_closed_form():

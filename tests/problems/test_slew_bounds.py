@@ -8,9 +8,9 @@ import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
 
-from dynamics.attitude import quat_conj, quat_mul
-from problems import slew
-from problems.slew.targets import POINTING_TOL
+from appdyn.dynamics.attitude import quat_conj, quat_mul
+from appdyn.problems import slew
+from appdyn.problems.slew.targets import POINTING_TOL
 
 INERTIA = np.array([[10.0, 1.2, -0.8], [1.2, 8.0, 0.5], [-0.8, 0.5, 6.0]])
 U_MAX = np.array([0.5, 0.5, 0.3])

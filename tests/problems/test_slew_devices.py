@@ -4,8 +4,8 @@ momentum, and the singularity-measure path bound."""
 import numpy as np
 import pytest
 
-from dynamics.momentum import pyramid, singularity_measure
-from problems import slew
+from appdyn.dynamics.momentum import pyramid, singularity_measure
+from appdyn.problems import slew
 
 BETA = np.deg2rad(54.74)
 

@@ -3,7 +3,7 @@ type, ValueError for a wrong value, naming the argument; a warning for an ignore
 import numpy as np
 import pytest
 
-from problems import slew
+from appdyn.problems import slew
 
 
 def test_ignored_horizon_of_a_time_optimal_slew_warns():

@@ -3,8 +3,8 @@ import numpy as np
 import pytest
 from matplotlib.figure import Figure
 
-import ocp
-from problems import slew
+from appdyn import ocp
+from appdyn.problems import slew
 
 
 @pytest.fixture(scope="module")

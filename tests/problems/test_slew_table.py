@@ -9,9 +9,9 @@ from concurrent.futures import ProcessPoolExecutor, ThreadPoolExecutor
 import numpy as np
 import pytest
 
-import problems.slew.table as table_module
-from problems import slew
-from problems.slew import maneuver_table
+import appdyn.problems.slew.table as table_module
+from appdyn.problems import slew
+from appdyn.problems.slew import maneuver_table
 
 FAST = dict(N=10, starts=1)
 AXES = ([1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0])
@@ -145,7 +145,7 @@ def test_docstring_examples_run_as_written():
 def test_cli_table_is_the_library_table(tmp_path, capsys):
     import json
 
-    from problems.cli import main
+    from appdyn.problems.cli import main
 
     src = tmp_path / "t.csv"
     src.write_text("name,angle,axis1,axis2,axis3,q1,q2,q3,q4\n"
@@ -171,7 +171,7 @@ def test_cli_table_is_the_library_table(tmp_path, capsys):
     ["--axis", "1,0,0", "--angle", "10", "--workers", "2"],
 ])
 def test_cli_table_bad_options_exit_2(argv):
-    from problems.cli import main
+    from appdyn.problems.cli import main
 
     with pytest.raises(SystemExit) as exc:
         main(["slew", "--inertia", "1,1,1", "--time-optimal", *argv])

@@ -12,8 +12,8 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 from scipy.integrate import solve_ivp
 
-from problems import slew
-from problems.slew import maneuvers
+from appdyn.problems import slew
+from appdyn.problems.slew import maneuvers
 
 E = np.eye(3)
 
@@ -155,7 +155,7 @@ def test_refinement_tol_is_required(monkeypatch):
     with pytest.raises(ValueError, match="`tol`"):
         slew.min_effort(E, 2.0, angle=1.0, axis=[1, 0, 0], tol=1e-16)
     # a refinement stopped above tol (here: no refinement round allowed) is not a success
-    import ocp
+    from appdyn import ocp
     monkeypatch.setattr(maneuvers, "refine", lambda *a, **k: ocp.refine(*a, **{**k, "max_rounds": 0}))
     sol = slew.min_effort([2.0, 3.0, 4.0], 2.0, angle=1.0, axis=[1, 1, 0], N=4, tol=1e-12)
     assert sol.success is False and sol.status == slew.STATUS_REFINE

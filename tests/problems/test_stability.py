@@ -15,15 +15,15 @@ from hypothesis import strategies as hs
 from numpy.polynomial import Polynomial as Poly
 from scipy.optimize import linear_sum_assignment
 
-from dynamics import simulate
-from dynamics.attitude import dcm_from_quat, principal_axes
-from dynamics.spinning import tilt_torque_body
-from problems import stability as st
-from problems.stability import (PointMassDamper, SphericalDamper, classify, gyrostat,
+from appdyn.dynamics import simulate
+from appdyn.dynamics.attitude import dcm_from_quat, principal_axes
+from appdyn.dynamics.spinning import tilt_torque_body
+from appdyn.problems import stability as st
+from appdyn.problems.stability import (PointMassDamper, SphericalDamper, classify, gyrostat,
                                 heavy_top, loop, rotor, spin, spinning_projectile, sweep)
-from problems.cli.stability import add_parser as add_stability_parser
-from problems.cli.stability import main as cli_main
-from problems.cli.stability import run as cli_run
+from appdyn.problems.cli.stability import add_parser as add_stability_parser
+from appdyn.problems.cli.stability import main as cli_main
+from appdyn.problems.cli.stability import run as cli_run
 
 TOL = 1e-9  # eigenvalues vs closed forms, relative to the spectral radius
 G0 = 9.80665
@@ -589,7 +589,9 @@ def test_plots_return_figures_without_pyplot(reports):
     assert len(res.plot().axes) == 2
     import pathlib
 
-    import problems.torque_free
+    import appdyn.problems.torque_free  # noqa: F401
+
+    from appdyn import problems
 
     for path in [*pathlib.Path(st.__file__).parent.glob("*.py"),
                  pathlib.Path(problems.torque_free.__file__)]:
@@ -598,7 +600,7 @@ def test_plots_return_figures_without_pyplot(reports):
 
 
 def test_one_case_table_serves_library_and_cli():
-    from problems.cli.stability import _OPTIONS
+    from appdyn.problems.cli.stability import _OPTIONS
 
     for cli_name in _OPTIONS:
         name, fun = st.resolve_case(cli_name)
@@ -612,7 +614,7 @@ def test_docstring_examples_run(module):
     import doctest
     import importlib
 
-    mod = importlib.import_module("problems.stability" + ("" if module == "__init__"
+    mod = importlib.import_module("appdyn.problems.stability" + ("" if module == "__init__"
                                                          else f".{module}"))
     result = doctest.testmod(mod, optionflags=doctest.NORMALIZE_WHITESPACE)
     assert result.failed == 0

@@ -14,8 +14,8 @@ import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
 
-from problems import stability as st
-from problems.stability import constrained
+from appdyn.problems import stability as st
+from appdyn.problems.stability import constrained
 
 G0 = 9.80665
 

@@ -6,7 +6,7 @@ import math
 import numpy as np
 import pytest
 
-from problems import stability as st
+from appdyn.problems import stability as st
 
 BASE = dict(m1=10.0, inertia1=[2.0, 2.0, 3.0], m2=2.0, inertia2=[0.2, 0.2, 0.3],
             r1=[0.0, 0.0, 0.5], r2=[0.0, 0.0, -0.2], rate=5.0)

@@ -14,11 +14,11 @@ import numpy as np
 import pytest
 from scipy.optimize import brentq, linear_sum_assignment
 
-from dynamics import launch_vehicle as vehicle_model
-from dynamics import linearize
-from dynamics.launch_vehicle import Actuator, Aero, Bending, MassFlow, Slosh
-from problems import stability as st
-from problems.stability import (bode_plot, classify, launch_vehicle, launch_vehicle_response,
+from appdyn.dynamics import launch_vehicle as vehicle_model
+from appdyn.dynamics import linearize
+from appdyn.dynamics.launch_vehicle import Actuator, Aero, Bending, MassFlow, Slosh
+from appdyn.problems import stability as st
+from appdyn.problems.stability import (bode_plot, classify, launch_vehicle, launch_vehicle_response,
                                 loop_transfer, nichols_plot, sweep)
 
 F, I, L, M = 2.0e6, 4.0e7, 20.0, 1.0e5  # N, kg m^2, m, kg
@@ -378,6 +378,6 @@ def test_response_bad_input_names_the_argument(kwargs, name):
 @pytest.mark.parametrize("module", ["launch_vehicle", "launch_vehicle_plots",
                                     "launch_vehicle_response"])
 def test_docstring_examples_run(module):
-    mod = importlib.import_module(f"problems.stability.{module}")
+    mod = importlib.import_module(f"appdyn.problems.stability.{module}")
     result = doctest.testmod(mod, optionflags=doctest.NORMALIZE_WHITESPACE)
     assert result.failed == 0 and result.attempted > 0

@@ -15,9 +15,9 @@ import pytest
 from scipy.integrate import solve_ivp
 from scipy.special import mathieu_a, mathieu_b
 
-from dynamics.mechanisms import kapitza_frequency, resonance_tongue
-from problems import stability as st
-from problems.stability import periodic
+from appdyn.dynamics.mechanisms import kapitza_frequency, resonance_tongue
+from appdyn.problems import stability as st
+from appdyn.problems.stability import periodic
 
 ROD = dict(mass=1.0, inertia=1.0 / 48.0, length=0.25)   # uniform rod 0.5 m, l_eff = 1/3 m
 G0 = 9.80665

@@ -13,8 +13,8 @@ import signal
 import numpy as np
 import pytest
 
-from problems import stability as st
-from problems.stability import SphericalDamper
+from appdyn.problems import stability as st
+from appdyn.problems.stability import SphericalDamper
 
 GYRO = dict(inertia=[3.0, 4.0, 5.0], axis=[1, 0, 0], rate=2.0)  # two boundaries
 DAMPED = dict(inertia=[3.0, 4.0, 4.0], axis=[1, 0, 0], rate=2.0,

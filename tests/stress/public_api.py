@@ -15,10 +15,10 @@ import casadi as ca
 import numpy as np
 
 MODULES = (
-    "dynamics", "dynamics.attitude", "dynamics.truth", "dynamics.momentum",
-    "dynamics.constrained", "dynamics.launch_vehicle", "dynamics.mechanisms", "ocp",
-    "problems.slew", "problems.stability", "problems.gains", "problems.dispersion",
-    "problems.ascent",
+    "appdyn.dynamics", "appdyn.dynamics.attitude", "appdyn.dynamics.truth", "appdyn.dynamics.momentum",
+    "appdyn.dynamics.constrained", "appdyn.dynamics.launch_vehicle", "appdyn.dynamics.mechanisms", "appdyn.ocp",
+    "appdyn.problems.slew", "appdyn.problems.stability", "appdyn.problems.gains", "appdyn.problems.dispersion",
+    "appdyn.problems.ascent",
 )
 
 
@@ -49,50 +49,50 @@ def _required(fn):
 
 @functools.cache
 def _rigid():
-    import dynamics
+    from appdyn import dynamics
     return dynamics.rigid_body(np.diag([1.0, 2.0, 3.0]))
 
 
 @functools.cache
 def _min_energy():
-    from ocp import examples
+    from appdyn.ocp import examples
     return examples.min_energy()
 
 
 @functools.cache
 def _solution():
-    import ocp
+    from appdyn import ocp
     return ocp.solve(_min_energy(), N=5)
 
 
 @functools.cache
 def _slew_problem():
-    from problems import slew
+    from appdyn.problems import slew
     return slew.slew_problem(np.diag([1.0, 2.0, 3.0]), objective="time", angle=1.0,
                              axis=[0.0, 0.0, 1.0])
 
 
 @functools.cache
 def _slew_solution():
-    import ocp
+    from appdyn import ocp
     return ocp.rest_solution(_slew_problem())
 
 
 @functools.cache
 def _pyramid():
-    from dynamics import momentum
+    from appdyn.dynamics import momentum
     return momentum.pyramid(0.9553)
 
 
 def _jacobian():
-    from dynamics import momentum
+    from appdyn.dynamics import momentum
     return momentum.cluster_jacobian(_pyramid(), np.full(4, 0.3))
 
 
 @functools.cache
 def _spinner_run():
-    import dynamics
-    from problems import dispersion
+    from appdyn import dynamics
+    from appdyn.problems import dispersion
     m = dispersion.spinner(1000.0, 1500.0)
     return dynamics.simulate(m, [0, 0, 0, 1, 0.02, 0.0, 1.0], np.linspace(0, 1, 3))
 
@@ -100,7 +100,7 @@ def _spinner_run():
 @functools.cache
 def _constrained_symbols():
     """``(x, p, terms)`` of a point on a line: ``x = (q, v)``, ``q' = v``, ``q1 = 1``."""
-    from dynamics import constrained
+    from appdyn.dynamics import constrained
     q, v = ca.SX.sym("q", 2), ca.SX.sym("v", 2)
     return ca.vertcat(q, v), ca.SX.sym("p", 0), constrained.constraint_terms(
         q, v, v, position=q[0] - 1)
@@ -121,33 +121,34 @@ def _lv_kwargs():
 
 @functools.cache
 def _lv_report():
-    from problems import stability
+    from appdyn.problems import stability
     return stability.launch_vehicle(**_lv_kwargs(), k_psi=2.0, k_psidot=0.5)
 
 
 @functools.cache
 def _slew_optimal():
     """A solved time-optimal slew (bang-bang torques): ``(problem, solution)``."""
-    from problems import slew
+    from appdyn.problems import slew
     res = slew.time_optimal(np.diag([1.0, 2.0, 3.0]), angle=1.0, axis=[0.0, 0.0, 1.0], N=20)
     return _slew_problem(), res
 
 
 @functools.cache
 def _planar_ascent():
-    from problems import ascent
+    from appdyn.problems import ascent
     return ascent.planar_ascent(target_altitude=65e3, target_gamma=np.radians(40.0),
                                 q_max=45e3, qalpha_max=2000.0, N=30)
 
 
 @functools.cache
 def _gain_design():
-    from problems import gains
+    from appdyn.problems import gains
     return gains.launch_vehicle_gains(_lv_kwargs(), [{"psi0": 0.05}], delta_max=0.1, delta_rate_max=0.5)
 
 
 def _config_path():
-    import problems.gains
+    import appdyn.problems.gains  # noqa: F401
+    from appdyn import problems
     from pathlib import Path
     return Path(problems.gains.__file__).with_name("launch_vehicle.toml")
 
@@ -159,8 +160,8 @@ def _config_data():
 
 def _split_energy():
     """Rest at 0 to rest at 1 in 2 s, minimum integral u^2/2, as two 1 s phases."""
-    import ocp
-    from ocp.examples import double_integrator
+    from appdyn import ocp
+    from appdyn.ocp.examples import double_integrator
     energy = lambda x, u, p: 0.5 * u ** 2  # noqa: E731
     first = ocp.Problem(double_integrator(), T=1.0, x_initial=[0.0, 0.0], lagrange=energy)
     second = ocp.Problem(double_integrator(), T=1.0, x_final=[1.0, 0.0], lagrange=energy)
@@ -169,7 +170,7 @@ def _split_energy():
 
 
 def _sample_task():
-    from problems.dispersion.sample import SampleTask
+    from appdyn.problems.dispersion.sample import SampleTask
     return SampleTask(0, {}, _rigid(), np.array([0.0, 0.0, 0.0, 1.0, 0.1, 0.2, 0.3]),
                       np.linspace(0.0, 1.0, 3), {"w1": "w1"}, (), None, {})
 
@@ -322,115 +323,115 @@ _ASC_R = lambda: np.array([6.4e6, 0.0, 0.0])  # noqa: E731
 _ASC_V = lambda: np.array([0.0, 7.5e3, 0.0])  # noqa: E731
 
 OVERRIDES = {
-    "dynamics.launch_vehicle": {"inertia": lambda: 2.0e6, "mass": lambda: 5.0e4},
-    "dynamics.launch_vehicle.launch_vehicle": {"inertia": lambda: 2.0e6, "mass": lambda: 5.0e4},
-    "problems.stability.launch_vehicle": {"inertia": lambda: 2.0e6, "mass": lambda: 5.0e4},
-    "problems.stability.launch_vehicle_response": {"inertia": lambda: 2.0e6,
+    "appdyn.dynamics.launch_vehicle": {"inertia": lambda: 2.0e6, "mass": lambda: 5.0e4},
+    "appdyn.dynamics.launch_vehicle.launch_vehicle": {"inertia": lambda: 2.0e6, "mass": lambda: 5.0e4},
+    "appdyn.problems.stability.launch_vehicle": {"inertia": lambda: 2.0e6, "mass": lambda: 5.0e4},
+    "appdyn.problems.stability.launch_vehicle_response": {"inertia": lambda: 2.0e6,
                                                    "mass": lambda: 5.0e4},
-    "dynamics.cmg_spacecraft": {"h": lambda: 1.0},
-    "dynamics.momentum.cmg_spacecraft": {"h": lambda: 1.0},
-    "dynamics.momentum.rotor_dynamics": {"w": lambda: ca.DM([0.1, 0.2, 0.3]),
+    "appdyn.dynamics.cmg_spacecraft": {"h": lambda: 1.0},
+    "appdyn.dynamics.momentum.cmg_spacecraft": {"h": lambda: 1.0},
+    "appdyn.dynamics.momentum.rotor_dynamics": {"w": lambda: ca.DM([0.1, 0.2, 0.3]),
                                          "h": lambda: np.array([0.1, 0.1, 0.1])},
-    "dynamics.momentum.wheel_torque": {"wheel_inertia": lambda: 0.01},
-    "dynamics.momentum.propeller_torque": {"inertia": lambda: 0.5},
-    "dynamics.momentum.steer": {"torque": lambda: np.array([0.1, 0.0, 0.0])},
-    "dynamics.constrained.constraint_terms": {"q": lambda: ca.SX.sym("q", 2),
+    "appdyn.dynamics.momentum.wheel_torque": {"wheel_inertia": lambda: 0.01},
+    "appdyn.dynamics.momentum.propeller_torque": {"inertia": lambda: 0.5},
+    "appdyn.dynamics.momentum.steer": {"torque": lambda: np.array([0.1, 0.0, 0.0])},
+    "appdyn.dynamics.constrained.constraint_terms": {"q": lambda: ca.SX.sym("q", 2),
                                               "qdot": lambda: ca.SX.sym("v", 2),
                                               "v": lambda: ca.SX.sym("v", 2)},
-    "dynamics.constrained.project_velocities": {"v": lambda: np.array([1.0, 0.0])},
-    "dynamics.constrained.project_positions": {
+    "appdyn.dynamics.constrained.project_velocities": {"v": lambda: np.array([1.0, 0.0])},
+    "appdyn.dynamics.constrained.project_positions": {
         "residual": lambda: (lambda x: np.array([np.dot(x, x) - 1.0])),
         "x": lambda: np.array([1.1, 0.0])},
-    "dynamics.constrained.residual_invariant": {"x": lambda: _constrained_symbols()[0],
+    "appdyn.dynamics.constrained.residual_invariant": {"x": lambda: _constrained_symbols()[0],
                                                 "p": lambda: _constrained_symbols()[1]},
-    "dynamics.truth.axisymmetric": {"inertia_diag": lambda: np.array([1.0, 1.0, 2.0])},
-    "dynamics.truth.symmetric_precession": {"inertia_diag": lambda: np.array([1.0, 1.0, 2.0])},
-    "ocp.scenario_problem": {"T": lambda: 1.0, "x_initial": lambda: np.tile(
+    "appdyn.dynamics.truth.axisymmetric": {"inertia_diag": lambda: np.array([1.0, 1.0, 2.0])},
+    "appdyn.dynamics.truth.symmetric_precession": {"inertia_diag": lambda: np.array([1.0, 1.0, 2.0])},
+    "appdyn.ocp.scenario_problem": {"T": lambda: 1.0, "x_initial": lambda: np.tile(
         np.array([[0.0], [0.0], [0.0], [1.0], [0.0], [0.0], [0.0]]), (1, 2))},
-    "dynamics.mechanisms.bead_motion": {"t": lambda: np.linspace(0.0, 1.0, 3)},
-    "dynamics.mechanisms.dumbbell_disk_state": {"w": lambda: np.array([0.0, 0.0, 1.0])},
-    "dynamics.mechanisms.lagrange_terms": {
+    "appdyn.dynamics.mechanisms.bead_motion": {"t": lambda: np.linspace(0.0, 1.0, 3)},
+    "appdyn.dynamics.mechanisms.dumbbell_disk_state": {"w": lambda: np.array([0.0, 0.0, 1.0])},
+    "appdyn.dynamics.mechanisms.lagrange_terms": {
         "T": lambda: 0.5 * ca.SX.sym("v") ** 2, "V": lambda: ca.SX(0),
         "q": lambda: ca.SX.sym("q"), "v": lambda: ca.SX.sym("v")},
-    "dynamics.mechanisms.spherical_mass_matrix": {"q": lambda: np.array([0.1, 0.2])},
-    "ocp.unstack": {"x": lambda: np.zeros((4, 3))},
-    "ocp.state_scale": {"x": lambda: np.zeros((2, 5))},
-    "problems.slew.min_effort": {"T": lambda: 5.0},
-    "problems.slew.eigenaxis_time": {"angle": lambda: 1.0},
-    "problems.slew.attitude_guess": {"problem": _slew_problem},
-    "problems.slew.switch_times": {"solution": _slew_solution},
-    "problems.slew.verify": {"solution": _slew_solution},
-    "problems.slew.summary": {"solution": _slew_solution},
-    "problems.slew.plot_slew": {"solution": _slew_solution},
-    "problems.slew.format_summary": {
-        "data": lambda: __import__("problems.slew", fromlist=["summary"]).summary(
+    "appdyn.dynamics.mechanisms.spherical_mass_matrix": {"q": lambda: np.array([0.1, 0.2])},
+    "appdyn.ocp.unstack": {"x": lambda: np.zeros((4, 3))},
+    "appdyn.ocp.state_scale": {"x": lambda: np.zeros((2, 5))},
+    "appdyn.problems.slew.min_effort": {"T": lambda: 5.0},
+    "appdyn.problems.slew.eigenaxis_time": {"angle": lambda: 1.0},
+    "appdyn.problems.slew.attitude_guess": {"problem": _slew_problem},
+    "appdyn.problems.slew.switch_times": {"solution": _slew_solution},
+    "appdyn.problems.slew.verify": {"solution": _slew_solution},
+    "appdyn.problems.slew.summary": {"solution": _slew_solution},
+    "appdyn.problems.slew.plot_slew": {"solution": _slew_solution},
+    "appdyn.problems.slew.format_summary": {
+        "data": lambda: __import__("appdyn.problems.slew", fromlist=["summary"]).summary(
             _slew_solution())},
-    "problems.stability.classify": {"A": lambda: np.array([[0.0, 1.0], [-1.0, -0.1]])},
-    "problems.stability.spin": {"axis": lambda: np.array([0.0, 0.0, 1.0])},
-    "problems.stability.heavy_top": {"rate": lambda: 20.0},
-    "problems.stability.spinning_projectile": {"axial_inertia": lambda: 0.01,
+    "appdyn.problems.stability.classify": {"A": lambda: np.array([[0.0, 1.0], [-1.0, -0.1]])},
+    "appdyn.problems.stability.spin": {"axis": lambda: np.array([0.0, 0.0, 1.0])},
+    "appdyn.problems.stability.heavy_top": {"rate": lambda: 20.0},
+    "appdyn.problems.stability.spinning_projectile": {"axial_inertia": lambda: 0.01,
                                                "transverse_inertia": lambda: 0.1,
                                                "rate": lambda: 100.0},
-    "problems.stability.rotor": {"rate": lambda: 10.0},
-    "problems.stability.loop": {"plant": lambda: __import__("control").tf([1.0], [1.0, 0.0, 0.0]),
+    "appdyn.problems.stability.rotor": {"rate": lambda: 10.0},
+    "appdyn.problems.stability.loop": {"plant": lambda: __import__("control").tf([1.0], [1.0, 0.0, 0.0]),
                                 "controller": lambda: np.array([[1.0]])},
-    "problems.stability.shaken_pendulum": {"inertia": lambda: 0.0208, "length": lambda: 0.25},
-    "problems.stability.conical_pendulum": {"length": lambda: 1.0},
-    "problems.gains.state_feedback_gains": {
+    "appdyn.problems.stability.shaken_pendulum": {"inertia": lambda: 0.0208, "length": lambda: 0.25},
+    "appdyn.problems.stability.conical_pendulum": {"length": lambda: 1.0},
+    "appdyn.problems.gains.state_feedback_gains": {
         "A": lambda: np.array([[0.0, 1.0], [0.0, 0.0]]), "B": lambda: np.array([[0.0], [1.0]]),
         "Q": lambda: np.eye(2)},
-    "problems.gains.launch_vehicle_gains": {"scenarios": lambda: [{"psi0": 0.1}]},
-    "problems.dispersion.nutation_history": {"transverse_inertia": lambda: 1000.0,
+    "appdyn.problems.gains.launch_vehicle_gains": {"scenarios": lambda: [{"psi0": 0.1}]},
+    "appdyn.problems.dispersion.nutation_history": {"transverse_inertia": lambda: 1000.0,
                                              "axial_inertia": lambda: 1500.0},
-    "problems.dispersion.nutation_max": {"transverse_inertia": lambda: 1000.0,
+    "appdyn.problems.dispersion.nutation_max": {"transverse_inertia": lambda: 1000.0,
                                          "axial_inertia": lambda: 1500.0},
-    "problems.dispersion.spinner": {"transverse_inertia": lambda: 1000.0,
+    "appdyn.problems.dispersion.spinner": {"transverse_inertia": lambda: 1000.0,
                                     "axial_inertia": lambda: 1500.0},
-    "problems.dispersion.nutation_closed_form": {"transverse_inertia": lambda: 1000.0,
+    "appdyn.problems.dispersion.nutation_closed_form": {"transverse_inertia": lambda: 1000.0,
                                                  "axial_inertia": lambda: 1500.0,
                                                  "w0": lambda: np.array([0.02, 0.0, 1.0])},
-    "problems.dispersion.draw_samples": {
-        "params": lambda: {"a": __import__("problems.dispersion", fromlist=["Normal"]).Normal(0.0, 1.0)}},
-    "problems.dispersion.statistics": {"values": lambda: np.array([1.0, 2.0, 3.0])},
-    "problems.ascent.drag_force": {"r": _ASC_R, "v": _ASC_V},
-    "problems.ascent.dynamic_pressure": {"r": _ASC_R, "v": _ASC_V},
-    "problems.ascent.orbit_residuals": {"r": _ASC_R, "v": _ASC_V},
-    "problems.ascent.orbital_elements": {"r": _ASC_R, "v": _ASC_V},
-    "problems.ascent.vertical_rise": {"vehicle": lambda: None},
-    "problems.ascent.fly_pitch_program": {"ascent": _planar_ascent},
-    "problems.dispersion.run_sample": {"task": _sample_task},
-    "problems.gains.load_config": {"path": _config_path},
-    "problems.gains.parse_config": {"data": _config_data},
-    "problems.gains.plot_design": {"design": _gain_design},
-    "problems.stability.bode_plot": {"report": _lv_report},
-    "problems.stability.nichols_plot": {"report": _lv_report},
-    "problems.stability.loop_transfer": {"report": _lv_report},
-    "problems.stability.analyze": {"sys": lambda: __import__("dynamics").linearize(
+    "appdyn.problems.dispersion.draw_samples": {
+        "params": lambda: {"a": __import__("appdyn.problems.dispersion", fromlist=["Normal"]).Normal(0.0, 1.0)}},
+    "appdyn.problems.dispersion.statistics": {"values": lambda: np.array([1.0, 2.0, 3.0])},
+    "appdyn.problems.ascent.drag_force": {"r": _ASC_R, "v": _ASC_V},
+    "appdyn.problems.ascent.dynamic_pressure": {"r": _ASC_R, "v": _ASC_V},
+    "appdyn.problems.ascent.orbit_residuals": {"r": _ASC_R, "v": _ASC_V},
+    "appdyn.problems.ascent.orbital_elements": {"r": _ASC_R, "v": _ASC_V},
+    "appdyn.problems.ascent.vertical_rise": {"vehicle": lambda: None},
+    "appdyn.problems.ascent.fly_pitch_program": {"ascent": _planar_ascent},
+    "appdyn.problems.dispersion.run_sample": {"task": _sample_task},
+    "appdyn.problems.gains.load_config": {"path": _config_path},
+    "appdyn.problems.gains.parse_config": {"data": _config_data},
+    "appdyn.problems.gains.plot_design": {"design": _gain_design},
+    "appdyn.problems.stability.bode_plot": {"report": _lv_report},
+    "appdyn.problems.stability.nichols_plot": {"report": _lv_report},
+    "appdyn.problems.stability.loop_transfer": {"report": _lv_report},
+    "appdyn.problems.stability.analyze": {"sys": lambda: __import__("appdyn.dynamics", fromlist=["x"]).linearize(
         _rigid(), np.array([0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 1.0]))},
-    "ocp.solve_phases": {"problem": _split_energy},
-    "ocp.rest_solution": {"problem": lambda: __import__(
-        "problems.slew", fromlist=["slew_problem"]).slew_problem(
+    "appdyn.ocp.solve_phases": {"problem": _split_energy},
+    "appdyn.ocp.rest_solution": {"problem": lambda: __import__(
+        "appdyn.problems.slew", fromlist=["slew_problem"]).slew_problem(
             np.diag([1.0, 2.0, 3.0]), objective="effort", T=2.0, angle=0.0, axis=[0, 0, 1])},
-    "ocp.polish_switches": {"problem": lambda: _slew_optimal()[0],
+    "appdyn.ocp.polish_switches": {"problem": lambda: _slew_optimal()[0],
                             "solution": lambda: _slew_optimal()[1]},
-    "ocp.optimize_switch_times": {"problem": lambda: _slew_optimal()[0],
+    "appdyn.ocp.optimize_switch_times": {"problem": lambda: _slew_optimal()[0],
                                   "solution": lambda: _slew_optimal()[1]},
-    "problems.slew.verify": {"solution": lambda: _slew_optimal()[1]},
-    "problems.slew.bounded": {"problem": lambda: _slew_optimal()[0],
+    "appdyn.problems.slew.verify": {"solution": lambda: _slew_optimal()[1]},
+    "appdyn.problems.slew.bounded": {"problem": lambda: _slew_optimal()[0],
                               "solution": lambda: _slew_optimal()[1]},
 }
 
 # optional keywords that make the all-valid call valid (a target, a spin rate, ...)
 EXTRA = {
-    "dynamics.constrained.constraint_terms": lambda: {"position": ca.SX.sym("q", 2)[0]},
-    "dynamics.truth.small_asymmetry_rates": lambda: {"rate": 1.0},
-    "dynamics.truth.small_asymmetry_frequency": lambda: {"rate": 1.0},
-    "problems.slew.slew_problem": lambda: {"angle": 1.0, "axis": [0.0, 0.0, 1.0]},
-    "problems.slew.time_optimal": lambda: {"angle": 1.0, "axis": [0.0, 0.0, 1.0]},
-    "problems.slew.min_effort": lambda: {"angle": 1.0, "axis": [0.0, 0.0, 1.0]},
-    "problems.slew.wheel_slew": lambda: {"angle": 1.0, "axis": [0.0, 0.0, 1.0]},
-    "problems.slew.cmg_slew": lambda: {"angle": 1.0, "axis": [0.0, 0.0, 1.0]},
-    "problems.stability.sweep": lambda: {"inertia": np.diag([1.0, 2.0, 3.0]),
+    "appdyn.dynamics.constrained.constraint_terms": lambda: {"position": ca.SX.sym("q", 2)[0]},
+    "appdyn.dynamics.truth.small_asymmetry_rates": lambda: {"rate": 1.0},
+    "appdyn.dynamics.truth.small_asymmetry_frequency": lambda: {"rate": 1.0},
+    "appdyn.problems.slew.slew_problem": lambda: {"angle": 1.0, "axis": [0.0, 0.0, 1.0]},
+    "appdyn.problems.slew.time_optimal": lambda: {"angle": 1.0, "axis": [0.0, 0.0, 1.0]},
+    "appdyn.problems.slew.min_effort": lambda: {"angle": 1.0, "axis": [0.0, 0.0, 1.0]},
+    "appdyn.problems.slew.wheel_slew": lambda: {"angle": 1.0, "axis": [0.0, 0.0, 1.0]},
+    "appdyn.problems.slew.cmg_slew": lambda: {"angle": 1.0, "axis": [0.0, 0.0, 1.0]},
+    "appdyn.problems.stability.sweep": lambda: {"inertia": np.diag([1.0, 2.0, 3.0]),
                                          "axis": np.array([0.0, 0.0, 1.0])},
 }
 
@@ -448,11 +449,11 @@ def _valid(func, param):
 # Functions whose all-valid call solves an NLP or runs many simulations: not run by
 # ``test_valid_examples`` (their garbage cases are cheap refusals before any solve).
 EXPENSIVE = {
-    "ocp.solve", "ocp.solve_phases", "ocp.refine", "ocp.solve_multistart",
-    "ocp.polish_switches", "ocp.optimize_switch_times", "problems.slew.time_optimal",
-    "problems.slew.min_effort", "problems.slew.wheel_slew", "problems.slew.cmg_slew",
-    "problems.slew.maneuver_table", "problems.gains.state_feedback_gains",
-    "problems.gains.attitude_gains", "problems.gains.launch_vehicle_gains",
-    "problems.ascent.planar_ascent", "problems.dispersion.dispersion",
-    "problems.stability.sweep", "dynamics.momentum.momentum_envelope",
+    "appdyn.ocp.solve", "appdyn.ocp.solve_phases", "appdyn.ocp.refine", "appdyn.ocp.solve_multistart",
+    "appdyn.ocp.polish_switches", "appdyn.ocp.optimize_switch_times", "appdyn.problems.slew.time_optimal",
+    "appdyn.problems.slew.min_effort", "appdyn.problems.slew.wheel_slew", "appdyn.problems.slew.cmg_slew",
+    "appdyn.problems.slew.maneuver_table", "appdyn.problems.gains.state_feedback_gains",
+    "appdyn.problems.gains.attitude_gains", "appdyn.problems.gains.launch_vehicle_gains",
+    "appdyn.problems.ascent.planar_ascent", "appdyn.problems.dispersion.dispersion",
+    "appdyn.problems.stability.sweep", "appdyn.dynamics.momentum.momentum_envelope",
 }

@@ -12,10 +12,10 @@ import pytest
 from hypothesis import HealthCheck, assume, given, settings
 from hypothesis import strategies as st
 
-from dynamics import attitude as att
-from dynamics import linearize, rigid_body, simulate
-from dynamics.truth import torque_free_omega
-from problems import slew
+from appdyn.dynamics import attitude as att
+from appdyn.dynamics import linearize, rigid_body, simulate
+from appdyn.dynamics.truth import torque_free_omega
+from appdyn.problems import slew
 
 FUZZ = settings(max_examples=12, deadline=None, derandomize=True,
                 suppress_health_check=[HealthCheck.too_slow, HealthCheck.filter_too_much])

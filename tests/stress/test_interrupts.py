@@ -14,12 +14,12 @@ from pathlib import Path
 
 import pytest
 
-from dynamics.interrupts import check_interrupt, deferred_interrupts
+from appdyn.dynamics.interrupts import check_interrupt, deferred_interrupts
 
 ROOT = Path(__file__).resolve().parents[2]
 SWEEP = """
 import numpy as np
-from problems import stability
+from appdyn.problems import stability
 print("start", flush=True)
 stability.sweep("spin", "rate", np.linspace(0.1, 10.0, 200000), inertia=[2.0, 3.0, 4.5],
                 axis=[1, 0, 0])
@@ -29,7 +29,7 @@ print("finished", flush=True)
 
 SIMULATE = """
 import numpy as np
-from dynamics import rigid_body, simulate
+from appdyn.dynamics import rigid_body, simulate
 model = rigid_body([1.0, 2.0, 3.0])
 simulate(model, [0, 0, 0, 1, 1.0, 0.1, 0.8], [0.0, 1.0], method="rk4", steps=10)  # compile
 print("start", flush=True)
@@ -44,8 +44,8 @@ print("finished", flush=True)
 # start): the interrupt was lost every time.
 SOLVE = """
 import numpy as np
-import ocp
-from problems.slew import slew_problem
+from appdyn import ocp
+from appdyn.problems.slew import slew_problem
 problem = slew_problem(np.diag([1.0, 2, 3]), objective="time", angle=2.5, axis=[1, 1, 1])
 
 def progress(it):
@@ -60,7 +60,7 @@ print("finished", sol.status, flush=True)
 # or the switch polish, wherever the trial's delay puts it
 SLEW = """
 import numpy as np
-from problems import slew
+from appdyn.problems import slew
 slew.time_optimal(np.diag([1.0, 2, 3]), angle=2.5, axis=[1, 1, 1], N=40)
 print("start", flush=True)
 for k in range(100):
@@ -121,7 +121,7 @@ def test_deferral_raises_at_the_check_and_restores_the_handler():
 PARTIAL = """
 import json
 import numpy as np
-from problems import stability
+from appdyn.problems import stability
 values = np.linspace(0.1, 10.0, 200000)
 print("start", flush=True)
 try:

@@ -13,12 +13,12 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-import ocp
-from dynamics import attitude as att
-from dynamics import rigid_body, simulate
-from dynamics.truth import axisymmetric, constant_rate_quat, torque_free_omega
-from ocp.examples import double_integrator, min_energy, min_time
-from problems import slew
+from appdyn import ocp
+from appdyn.dynamics import attitude as att
+from appdyn.dynamics import rigid_body, simulate
+from appdyn.dynamics.truth import axisymmetric, constant_rate_quat, torque_free_omega
+from appdyn.ocp.examples import double_integrator, min_energy, min_time
+from appdyn.problems import slew
 
 # --------------------------------------------------------------------------------------------
 # helpers

@@ -14,8 +14,8 @@ import casadi as ca
 import numpy as np
 import pytest
 
-import dynamics
-from dynamics import Model, simulate
+from appdyn import dynamics
+from appdyn.dynamics import Model, simulate
 
 X0 = [0.0, 0.0, 0.0, 1.0, 0.1, 0.2, 0.3]
 T = np.linspace(0.0, 1.0, 6)
@@ -158,8 +158,8 @@ def _check_solution(a, b):
 
 
 def test_min_energy_solution_round_trips():
-    import ocp
-    from ocp.examples import min_energy
+    from appdyn import ocp
+    from appdyn.ocp.examples import min_energy
 
     a = ocp.solve(min_energy(), N=10)
     assert a.success
@@ -171,7 +171,7 @@ def test_min_energy_solution_round_trips():
 
 
 def test_slew_solution_round_trips():
-    from problems import slew
+    from appdyn.problems import slew
 
     a = slew.min_effort(np.eye(3), 2.0, angle=0.5, axis=[0, 0, 1])
     b = _round_trip(a)
@@ -182,7 +182,7 @@ def test_slew_solution_round_trips():
 
 # --------------------------------------------------------------------- stability
 def test_stability_report_round_trips():
-    from problems import stability
+    from appdyn.problems import stability
 
     a = stability.spin([2.0, 3.0, 4.5], axis=[1, 0, 0], rate=10.0)
     b = _round_trip(a)
@@ -197,7 +197,7 @@ def test_stability_report_round_trips():
 
 
 def test_sweep_result_round_trips():
-    from problems import stability
+    from appdyn.problems import stability
 
     a = stability.sweep("spin", "rate", [1.0, 5.0], inertia=[2.0, 3.0, 4.5], axis=[1, 0, 0])
     b = _round_trip(a)

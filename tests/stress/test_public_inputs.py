@@ -43,20 +43,20 @@ GARBAGE = {
 
 # (function, parameter) -> {garbage id: reason it is a legitimate input}
 ALLOWED_GARBAGE = {
-    ("dynamics.launch_vehicle.rigid_part", "slosh"): {"none": "documented `Slosh or None`"},
-    ("problems.ascent.vertical_rise", "vehicle"): {"none": "documented `AscentVehicle or None`"},
-    ("ocp.check_ipopt_options", "options"): {"none": "documented `mapping ... or None`"},
-    ("problems.dispersion.dispersion", "seed"): {"none": "documented `int or None` (fresh entropy)"},
-    ("problems.dispersion.statistics", "values"): {
+    ("appdyn.dynamics.launch_vehicle.rigid_part", "slosh"): {"none": "documented `Slosh or None`"},
+    ("appdyn.problems.ascent.vertical_rise", "vehicle"): {"none": "documented `AscentVehicle or None`"},
+    ("appdyn.ocp.check_ipopt_options", "options"): {"none": "documented `mapping ... or None`"},
+    ("appdyn.problems.dispersion.dispersion", "seed"): {"none": "documented `int or None` (fresh entropy)"},
+    ("appdyn.problems.dispersion.statistics", "values"): {
         "cube": "documented shape (m, ...): a (7, 7, 7) array is valid"},
-    ("problems.dispersion.draw_samples", "seed"): {
+    ("appdyn.problems.dispersion.draw_samples", "seed"): {
         "none": "fresh entropy, as `dispersion(seed=None)` documents"},
 }
 # elementwise closed forms with no documented shape: any array broadcasts
 for _func, _params in {
-    "dynamics.mechanisms.bead_motion": ("t", "r0", "r0_dot", "rate"),
-    "dynamics.mechanisms.bead_torque": ("r", "r_dot", "rate", "rate_dot"),
-    "dynamics.mechanisms.rod_reaction": ("theta", "theta_dot"),
+    "appdyn.dynamics.mechanisms.bead_motion": ("t", "r0", "r0_dot", "rate"),
+    "appdyn.dynamics.mechanisms.bead_torque": ("r", "r_dot", "rate", "rate_dot"),
+    "appdyn.dynamics.mechanisms.rod_reaction": ("theta", "theta_dot"),
 }.items():
     for _param in _params:
         ALLOWED_GARBAGE.setdefault((_func, _param), {})["cube"] = (
@@ -68,27 +68,27 @@ for _func, _params in {
 # --------------------------------------------------------------------------------------------
 
 SKIPPED = {
-    "dynamics.clear_caches": "no required parameter",
-    "dynamics.attitude.dcm_axis": "no required parameter",
-    "dynamics.mechanisms.double_pendulum": "no required parameter",
-    "dynamics.mechanisms.double_pendulum_modes": "no required parameter",
-    "dynamics.mechanisms.dumbbell_disk": "no required parameter",
-    "dynamics.mechanisms.dumbbell_disk_frequency": "no required parameter",
-    "dynamics.mechanisms.equivalent_length": "no required parameter",
-    "dynamics.mechanisms.natural_frequency": "no required parameter",
-    "dynamics.mechanisms.rod_pendulum": "no required parameter",
-    "dynamics.mechanisms.rolling_coin": "no required parameter",
-    "dynamics.mechanisms.shaken_pendulum": "no required parameter",
-    "dynamics.mechanisms.shaken_pendulum_multipliers": "no required parameter",
-    "dynamics.mechanisms.sliding_bead": "no required parameter",
-    "dynamics.mechanisms.variable_length_pendulum": "no required parameter",
-    "ocp.get_transcription": "no required parameter",
-    "problems.slew.example_targets": "no required parameter",
-    "problems.dispersion.nutation_spread": "no required parameter",
-    "problems.ascent.delta3_ascent": "no required parameter",
-    "problems.ascent.delta3_problem": "no required parameter",
-    "problems.ascent.initial_state": "no required parameter",
-    "problems.ascent.default_gains": "no required parameter",
+    "appdyn.dynamics.clear_caches": "no required parameter",
+    "appdyn.dynamics.attitude.dcm_axis": "no required parameter",
+    "appdyn.dynamics.mechanisms.double_pendulum": "no required parameter",
+    "appdyn.dynamics.mechanisms.double_pendulum_modes": "no required parameter",
+    "appdyn.dynamics.mechanisms.dumbbell_disk": "no required parameter",
+    "appdyn.dynamics.mechanisms.dumbbell_disk_frequency": "no required parameter",
+    "appdyn.dynamics.mechanisms.equivalent_length": "no required parameter",
+    "appdyn.dynamics.mechanisms.natural_frequency": "no required parameter",
+    "appdyn.dynamics.mechanisms.rod_pendulum": "no required parameter",
+    "appdyn.dynamics.mechanisms.rolling_coin": "no required parameter",
+    "appdyn.dynamics.mechanisms.shaken_pendulum": "no required parameter",
+    "appdyn.dynamics.mechanisms.shaken_pendulum_multipliers": "no required parameter",
+    "appdyn.dynamics.mechanisms.sliding_bead": "no required parameter",
+    "appdyn.dynamics.mechanisms.variable_length_pendulum": "no required parameter",
+    "appdyn.ocp.get_transcription": "no required parameter",
+    "appdyn.problems.slew.example_targets": "no required parameter",
+    "appdyn.problems.dispersion.nutation_spread": "no required parameter",
+    "appdyn.problems.ascent.delta3_ascent": "no required parameter",
+    "appdyn.problems.ascent.delta3_problem": "no required parameter",
+    "appdyn.problems.ascent.initial_state": "no required parameter",
+    "appdyn.problems.ascent.default_gains": "no required parameter",
 }
 
 # (function, parameter, garbage) -> reason: known library bugs, strict xfail

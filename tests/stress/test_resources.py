@@ -23,7 +23,7 @@ COMPILES = """
 import gc, json, os, resource, sys
 import casadi as ca
 import numpy as np
-from dynamics import Model, cache, simulate
+from appdyn.dynamics import Model, cache, simulate
 
 def open_fds():
     return len(os.listdir("/proc/self/fd"))

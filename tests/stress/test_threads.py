@@ -28,8 +28,8 @@ WORKLOAD = r'''
 import json, random, sys, threading
 import casadi as ca
 import numpy as np
-from dynamics import Model, linearize, rigid_body, simulate
-from problems import slew, stability
+from appdyn.dynamics import Model, linearize, rigid_body, simulate
+from appdyn.problems import slew, stability
 
 x, tt = ca.SX.sym("x"), ca.SX.sym("tt")
 u, p = ca.SX.sym("u", 0), ca.SX.sym("p", 0)
@@ -130,7 +130,7 @@ def test_threads_soak():
 def test_cache_checkout_lends_distinct_instances_and_reuses_them():
     import threading
 
-    from dynamics import cache
+    from appdyn.dynamics import cache
 
     built = []
 
@@ -165,7 +165,7 @@ def test_cache_checkout_lends_distinct_instances_and_reuses_them():
 def test_a_cache_hit_does_not_wait_for_another_threads_build():
     import threading
 
-    from dynamics import cache
+    from appdyn.dynamics import cache
 
     key_hit, key_slow = ("test.hit", id(cache)), ("test.slow", id(cache))
     cache.get(key_hit, lambda: "ready")

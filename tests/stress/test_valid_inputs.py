@@ -81,14 +81,14 @@ def distinct_moments(draw):
 @st.composite
 def inertia_matrices(draw):
     """``R diag(moments) R^T`` for a random rotation ``R`` [kg m^2]."""
-    from dynamics.attitude import dcm_from_quat
+    from appdyn.dynamics.attitude import dcm_from_quat
     R = dcm_from_quat(draw(unit_quats))
     return R @ np.diag(draw(moments())) @ R.T
 
 
 @st.composite
 def rotations(draw):
-    from dynamics.attitude import dcm_from_quat
+    from appdyn.dynamics.attitude import dcm_from_quat
     return dcm_from_quat(draw(unit_quats))
 
 
@@ -282,67 +282,67 @@ def _principal_spin(draw):
 
 
 def _nonsingular_delta(draw):
-    from dynamics.momentum import pyramid, singularity_measure
+    from appdyn.dynamics.momentum import pyramid, singularity_measure
     d = draw(vectors(4, -math.pi, math.pi))
     assume(singularity_measure(pyramid(0.9553), d) > 0.1)
     return d
 
 
 RANDOM_OVERRIDES = {
-    "dynamics.attitude.quat_normalize": {"q": vectors(4, -3.0, 3.0).filter(
+    "appdyn.dynamics.attitude.quat_normalize": {"q": vectors(4, -3.0, 3.0).filter(
         lambda q: np.linalg.norm(q) > 1e-3)},
-    "dynamics.launch_vehicle": {"inertia": log_floats(1e6, 1e7), "mass": log_floats(2e4, 1e5)},
-    "dynamics.launch_vehicle.launch_vehicle": {"inertia": log_floats(1e6, 1e7),
+    "appdyn.dynamics.launch_vehicle": {"inertia": log_floats(1e6, 1e7), "mass": log_floats(2e4, 1e5)},
+    "appdyn.dynamics.launch_vehicle.launch_vehicle": {"inertia": log_floats(1e6, 1e7),
                                                "mass": log_floats(2e4, 1e5)},
-    "problems.stability.launch_vehicle": {"inertia": log_floats(1e6, 1e7),
+    "appdyn.problems.stability.launch_vehicle": {"inertia": log_floats(1e6, 1e7),
                                           "mass": log_floats(2e4, 1e5)},
-    "problems.stability.launch_vehicle_response": {"inertia": log_floats(1e6, 1e7),
+    "appdyn.problems.stability.launch_vehicle_response": {"inertia": log_floats(1e6, 1e7),
                                                    "mass": log_floats(2e4, 1e5)},
-    "dynamics.cmg_spacecraft": {"h": log_floats(0.1, 10.0)},
-    "dynamics.momentum.cmg_spacecraft": {"h": log_floats(0.1, 10.0)},
-    "dynamics.momentum.rotor_dynamics": {"h": vectors(3, -1.0, 1.0), "axes": st.just(np.eye(3))},
-    "dynamics.momentum.wheel_torque": {"wheel_inertia": log_floats(1e-3, 0.1)},
-    "dynamics.momentum.propeller_torque": {"inertia": log_floats(0.01, 10.0)},
-    "dynamics.truth.cone_angles": {"inertia_diag": distinct_moments(), "w0": nonzero_vectors},
-    "dynamics.constrained.project_velocities": {"v": vectors(2)},
-    "dynamics.constrained.project_positions": {"x": unit_vectors(2).map(
+    "appdyn.dynamics.cmg_spacecraft": {"h": log_floats(0.1, 10.0)},
+    "appdyn.dynamics.momentum.cmg_spacecraft": {"h": log_floats(0.1, 10.0)},
+    "appdyn.dynamics.momentum.rotor_dynamics": {"h": vectors(3, -1.0, 1.0), "axes": st.just(np.eye(3))},
+    "appdyn.dynamics.momentum.wheel_torque": {"wheel_inertia": log_floats(1e-3, 0.1)},
+    "appdyn.dynamics.momentum.propeller_torque": {"inertia": log_floats(0.01, 10.0)},
+    "appdyn.dynamics.truth.cone_angles": {"inertia_diag": distinct_moments(), "w0": nonzero_vectors},
+    "appdyn.dynamics.constrained.project_velocities": {"v": vectors(2)},
+    "appdyn.dynamics.constrained.project_positions": {"x": unit_vectors(2).map(
         lambda u: u * 1.1)},
-    "dynamics.truth.axisymmetric": {"inertia_diag": _symmetric_moments()},
-    "dynamics.truth.symmetric_precession": {"inertia_diag": _symmetric_moments()},
-    "dynamics.truth.small_asymmetry_rates": {"inertia_diag": distinct_moments()},
-    "dynamics.mechanisms.bead_motion": {"t": time_grids()},
-    "dynamics.mechanisms.bead_torque": {"r": floats(-1.0, 1.0)},
-    "dynamics.mechanisms.dumbbell_disk_state": {"w": vectors(3)},
-    "dynamics.mechanisms.spherical_mass_matrix": {"q": vectors(2, 0.2, 1.3)},
-    "dynamics.mechanisms.pendulum_swing": {"t": time_grids()},
-    "dynamics.momentum.pseudo_inverse_steering": {},
-    "ocp.unstack": {},
-    "ocp.state_scale": {"x": st.integers(1, 4).flatmap(
+    "appdyn.dynamics.truth.axisymmetric": {"inertia_diag": _symmetric_moments()},
+    "appdyn.dynamics.truth.symmetric_precession": {"inertia_diag": _symmetric_moments()},
+    "appdyn.dynamics.truth.small_asymmetry_rates": {"inertia_diag": distinct_moments()},
+    "appdyn.dynamics.mechanisms.bead_motion": {"t": time_grids()},
+    "appdyn.dynamics.mechanisms.bead_torque": {"r": floats(-1.0, 1.0)},
+    "appdyn.dynamics.mechanisms.dumbbell_disk_state": {"w": vectors(3)},
+    "appdyn.dynamics.mechanisms.spherical_mass_matrix": {"q": vectors(2, 0.2, 1.3)},
+    "appdyn.dynamics.mechanisms.pendulum_swing": {"t": time_grids()},
+    "appdyn.dynamics.momentum.pseudo_inverse_steering": {},
+    "appdyn.ocp.unstack": {},
+    "appdyn.ocp.state_scale": {"x": st.integers(1, 4).flatmap(
         lambda n: st.lists(vectors(5, -1e3, 1e3), min_size=n, max_size=n)).map(np.array)},
-    "ocp.scenario_problem": {"T": log_floats(0.5, 5.0)},
-    "problems.slew.min_effort": {"T": log_floats(2.0, 20.0), "inertia": inertia_matrices()},
-    "problems.slew.eigenaxis_time": {"inertia": moments().map(np.diag),
+    "appdyn.ocp.scenario_problem": {"T": log_floats(0.5, 5.0)},
+    "appdyn.problems.slew.min_effort": {"T": log_floats(2.0, 20.0), "inertia": inertia_matrices()},
+    "appdyn.problems.slew.eigenaxis_time": {"inertia": moments().map(np.diag),
                                      "angle": floats(0.1, math.pi),
                                      "axis": st.integers(0, 2).map(lambda i: np.eye(3)[i])},
-    "problems.stability.classify": {"A": st.integers(1, 4).flatmap(
+    "appdyn.problems.stability.classify": {"A": st.integers(1, 4).flatmap(
         lambda n: st.lists(vectors(n, -2.0, 2.0), min_size=n, max_size=n)).map(np.array)},
-    "problems.stability.heavy_top": {"rate": floats(0.5, 200.0)},
-    "problems.stability.spinning_projectile": {"rate": floats(10.0, 3000.0)},
-    "problems.stability.rotor": {"rate": floats(1.0, 100.0)},
-    "problems.stability.shaken_pendulum": {"inertia": log_floats(1e-3, 0.05),
+    "appdyn.problems.stability.heavy_top": {"rate": floats(0.5, 200.0)},
+    "appdyn.problems.stability.spinning_projectile": {"rate": floats(10.0, 3000.0)},
+    "appdyn.problems.stability.rotor": {"rate": floats(1.0, 100.0)},
+    "appdyn.problems.stability.shaken_pendulum": {"inertia": log_floats(1e-3, 0.05),
                                            "length": floats(0.05, 0.5)},
-    "problems.stability.conical_pendulum": {"length": floats(0.2, 2.0)},
-    "problems.stability.hinged_spin": {"rate": floats(0.1, 5.0),
+    "appdyn.problems.stability.conical_pendulum": {"length": floats(0.2, 2.0)},
+    "appdyn.problems.stability.hinged_spin": {"rate": floats(0.1, 5.0),
                                        "inertia1": moments().map(np.diag),
                                        "inertia2": moments().map(np.diag)},
-    "problems.dispersion.nutation_closed_form": {"w0": vectors(3, 0.01, 2.0)},
-    "problems.dispersion.statistics": {"values": st.integers(2, 20).flatmap(
+    "appdyn.problems.dispersion.nutation_closed_form": {"w0": vectors(3, 0.01, 2.0)},
+    "appdyn.problems.dispersion.statistics": {"values": st.integers(2, 20).flatmap(
         lambda n: vectors(n, -1e3, 1e3))},
-    "problems.ascent.drag_force": {"r": floats(6.38e6, 6.5e6).map(lambda r: np.array([r, 0, 0])),
+    "appdyn.problems.ascent.drag_force": {"r": floats(6.38e6, 6.5e6).map(lambda r: np.array([r, 0, 0])),
                                    "v": vectors(3, -3e3, 3e3)},
-    "problems.ascent.dynamic_pressure": {"r": floats(6.38e6, 6.5e6).map(
+    "appdyn.problems.ascent.dynamic_pressure": {"r": floats(6.38e6, 6.5e6).map(
         lambda r: np.array([r, 0, 0])), "v": vectors(3, -3e3, 3e3)},
-    "problems.gains.state_feedback_gains": {
+    "appdyn.problems.gains.state_feedback_gains": {
         "A": st.tuples(floats(-1.0, 1.0), floats(-1.0, 1.0)).map(
             lambda a: np.array([[0.0, 1.0], [a[0], a[1]]])),
         "B": st.just(np.array([[0.0], [1.0]])),
@@ -350,20 +350,20 @@ RANDOM_OVERRIDES = {
         "R": log_floats(0.1, 10.0).map(lambda s: np.array([[s]])),
         "initial_states": st.just(np.eye(2)),
         "horizon": floats(5.0, 15.0)},
-    "problems.gains.attitude_gains": {"inertia": moments().map(np.diag),
+    "appdyn.problems.gains.attitude_gains": {"inertia": moments().map(np.diag),
                                       "scenarios": floats(0.2, 1.0).flatmap(
                                           lambda a: unit_vectors().map(
                                               lambda ax: [{"angle": a, "axis": ax}])),
                                       "u_max": floats(0.5, 2.0)},
-    "problems.gains.launch_vehicle_gains": {"vehicle": _lv_vehicle(),
+    "appdyn.problems.gains.launch_vehicle_gains": {"vehicle": _lv_vehicle(),
                                             "scenarios": floats(0.02, 0.1).map(
                                                 lambda p: [{"psi0": p}])},
-    "problems.ascent.vertical_rise": {"speed": floats(1.0, 200.0)},
+    "appdyn.problems.ascent.vertical_rise": {"speed": floats(1.0, 200.0)},
 }
-for _f in ("problems.ascent.orbit_residuals", "problems.ascent.orbital_elements"):
+for _f in ("appdyn.problems.ascent.orbit_residuals", "appdyn.problems.ascent.orbital_elements"):
     RANDOM_OVERRIDES[_f] = {}
-for _f in ("dynamics.momentum.sr_inverse_steering", "dynamics.momentum.gsr_inverse_steering",
-           "dynamics.momentum.null_motion", "dynamics.momentum.gram_determinant"):
+for _f in ("appdyn.dynamics.momentum.sr_inverse_steering", "appdyn.dynamics.momentum.gsr_inverse_steering",
+           "appdyn.dynamics.momentum.null_motion", "appdyn.dynamics.momentum.gram_determinant"):
     RANDOM_OVERRIDES.setdefault(_f, {})
 
 @st.composite
@@ -398,60 +398,60 @@ def _spin_axis_moments(draw):
 
 # drawn together where the parameters are coupled (keyword -> values)
 JOINT = {
-    "problems.ascent.state_from_elements": _elements_kwargs(),
-    "problems.ascent.orbit_residuals": ascent_states().map(lambda rv: {"r": rv[0], "v": rv[1]}),
-    "problems.ascent.orbital_elements": elements().map(lambda el: dict(zip(
-        ("r", "v"), __import__("problems.ascent", fromlist=["x"]).state_from_elements(*el)))),
-    "problems.stability.spin": _principal_spin().map(lambda ia: {"inertia": ia[0],
+    "appdyn.problems.ascent.state_from_elements": _elements_kwargs(),
+    "appdyn.problems.ascent.orbit_residuals": ascent_states().map(lambda rv: {"r": rv[0], "v": rv[1]}),
+    "appdyn.problems.ascent.orbital_elements": elements().map(lambda el: dict(zip(
+        ("r", "v"), __import__("appdyn.problems.ascent", fromlist=["x"]).state_from_elements(*el)))),
+    "appdyn.problems.stability.spin": _principal_spin().map(lambda ia: {"inertia": ia[0],
                                                                  "axis": ia[1]}),
-    "problems.stability.gyrostat": _principal_spin().map(lambda ia: {"inertia": ia[0],
+    "appdyn.problems.stability.gyrostat": _principal_spin().map(lambda ia: {"inertia": ia[0],
                                                                      "axis": ia[1]}),
-    "dynamics.momentum.pseudo_inverse_steering": st.composite(
-        lambda draw: {"C": __import__("dynamics.momentum", fromlist=["x"]).cluster_jacobian(
-            __import__("dynamics.momentum", fromlist=["x"]).pyramid(0.9553),
+    "appdyn.dynamics.momentum.pseudo_inverse_steering": st.composite(
+        lambda draw: {"C": __import__("appdyn.dynamics.momentum", fromlist=["x"]).cluster_jacobian(
+            __import__("appdyn.dynamics.momentum", fromlist=["x"]).pyramid(0.9553),
             _nonsingular_delta(draw))})(),
-    "ocp.unstack": st.tuples(st.integers(1, 4), st.integers(1, 3), st.integers(1, 5)).map(
+    "appdyn.ocp.unstack": st.tuples(st.integers(1, 4), st.integers(1, 3), st.integers(1, 5)).map(
         lambda kmn: {"x": np.arange(float(kmn[0] * kmn[1] * kmn[2])).reshape(
             kmn[0] * kmn[2], kmn[1]), "K": kmn[0]}),
-    "problems.stability.heavy_top": _axisymmetric_pair().map(lambda ta: {
+    "appdyn.problems.stability.heavy_top": _axisymmetric_pair().map(lambda ta: {
         "transverse_inertia": ta[0], "axial_inertia": ta[1]}),
-    "problems.stability.rotor": _axisymmetric_pair().map(lambda ta: {
+    "appdyn.problems.stability.rotor": _axisymmetric_pair().map(lambda ta: {
         "transverse_inertia": ta[0], "axial_inertia": ta[1]}),
-    "problems.stability.spinning_projectile": _axisymmetric_pair().map(lambda ta: {
+    "appdyn.problems.stability.spinning_projectile": _axisymmetric_pair().map(lambda ta: {
         "transverse_inertia": ta[0] * 0.05, "axial_inertia": ta[1] * 0.05}),
-    "dynamics.linearize": _spin_state().map(lambda x: {"x": x}),
-    "dynamics.linearization": _spin_state().map(lambda x: {"x": x}),
-    "dynamics.wheel_spacecraft": _wheels(),
-    "dynamics.momentum.wheel_spacecraft": _wheels(),
-    "problems.slew.wheel_slew": _wheels().filter(lambda w: np.linalg.matrix_rank(w["axes"]) == 3),
-    "dynamics.truth.small_asymmetry_frequency": _spin_axis_moments().map(lambda ma: {
+    "appdyn.dynamics.linearize": _spin_state().map(lambda x: {"x": x}),
+    "appdyn.dynamics.linearization": _spin_state().map(lambda x: {"x": x}),
+    "appdyn.dynamics.wheel_spacecraft": _wheels(),
+    "appdyn.dynamics.momentum.wheel_spacecraft": _wheels(),
+    "appdyn.problems.slew.wheel_slew": _wheels().filter(lambda w: np.linalg.matrix_rank(w["axes"]) == 3),
+    "appdyn.dynamics.truth.small_asymmetry_frequency": _spin_axis_moments().map(lambda ma: {
         "inertia_diag": ma[0], "axis_index": ma[1]}),
-    "ocp.get_transcription": st.sampled_from(("radau", "radau-constant-control")).flatmap(
+    "appdyn.ocp.get_transcription": st.sampled_from(("radau", "radau-constant-control")).flatmap(
         lambda name: st.integers(1, 6).map(lambda d: {"transcription": name, "degree": d})),
-    "problems.dispersion.spinner": _axisymmetric_pair().map(lambda ta: {
+    "appdyn.problems.dispersion.spinner": _axisymmetric_pair().map(lambda ta: {
         "transverse_inertia": 1e3 * ta[0], "axial_inertia": 1e3 * ta[1]}),
-    "problems.dispersion.nutation_history": _axisymmetric_pair().map(lambda ta: {
+    "appdyn.problems.dispersion.nutation_history": _axisymmetric_pair().map(lambda ta: {
         "transverse_inertia": 1e3 * ta[0], "axial_inertia": 1e3 * ta[1]}),
-    "problems.dispersion.nutation_max": _axisymmetric_pair().map(lambda ta: {
+    "appdyn.problems.dispersion.nutation_max": _axisymmetric_pair().map(lambda ta: {
         "transverse_inertia": 1e3 * ta[0], "axial_inertia": 1e3 * ta[1]}),
-    "problems.slew.slew_problem": st.sampled_from(("time", "effort")).flatmap(
+    "appdyn.problems.slew.slew_problem": st.sampled_from(("time", "effort")).flatmap(
         lambda obj: log_floats(1.0, 20.0).map(lambda T: {"objective": obj, "T": T}
                                                if obj == "effort" else {"objective": obj})),
-    "problems.stability.hinged_spin": st.tuples(floats(0.1, 2.0), floats(0.1, 2.0)).map(
+    "appdyn.problems.stability.hinged_spin": st.tuples(floats(0.1, 2.0), floats(0.1, 2.0)).map(
         lambda ll: {"r1": np.array([0.0, 0.0, ll[0]]), "r2": np.array([0.0, 0.0, -ll[1]])}),
     # a torque whose momentum over the run stays inside the pyramid's envelope (|H| <= 0.8 of
     # h = 1 per unit): larger demands saturate the cluster, which `steer` reports as failure
-    "dynamics.momentum.steer": st.tuples(time_grids(), unit_vectors(), floats(0.0, 0.8)).map(
+    "appdyn.dynamics.momentum.steer": st.tuples(time_grids(), unit_vectors(), floats(0.0, 0.8)).map(
         lambda tdm: {"t": tdm[0], "torque": tdm[1] * tdm[2] / tdm[0][-1]}),
-    "problems.stability.sweep": st.tuples(moments().map(np.diag), st.integers(0, 2)).map(
+    "appdyn.problems.stability.sweep": st.tuples(moments().map(np.diag), st.integers(0, 2)).map(
         lambda ia: {"inertia": ia[0], "axis": np.eye(3)[ia[1]], "case": "spin",
                     "parameter": "rate"}),
 }
-for _f in ("dynamics.momentum.sr_inverse_steering", "dynamics.momentum.gsr_inverse_steering",
-           "dynamics.momentum.null_motion", "dynamics.momentum.gram_determinant"):
+for _f in ("appdyn.dynamics.momentum.sr_inverse_steering", "appdyn.dynamics.momentum.gsr_inverse_steering",
+           "appdyn.dynamics.momentum.null_motion", "appdyn.dynamics.momentum.gram_determinant"):
     JOINT[_f] = vectors(4, -math.pi, math.pi).map(lambda d: {"C": __import__(
-        "dynamics.momentum", fromlist=["x"]).cluster_jacobian(__import__(
-            "dynamics.momentum", fromlist=["x"]).pyramid(0.9553), d)})
+        "appdyn.dynamics.momentum", fromlist=["x"]).cluster_jacobian(__import__(
+            "appdyn.dynamics.momentum", fromlist=["x"]).pyramid(0.9553), d)})
 
 # parameters kept at their fixed example: objects the library builds, whose random inputs
 # are drawn where they are built (rigid_body, slew_problem, ocp.solve ... are all swept)
@@ -486,57 +486,57 @@ FIXED = {
 
 # functions without required parameters: random keywords
 OPTIONAL = {
-    "dynamics.mechanisms.double_pendulum": {
+    "appdyn.dynamics.mechanisms.double_pendulum": {
         "mass1": log_floats(0.1, 10.0), "mass2": log_floats(0.1, 10.0),
         "length1": log_floats(0.1, 3.0), "length2": log_floats(0.1, 3.0)},
-    "dynamics.mechanisms.double_pendulum_modes": {
+    "appdyn.dynamics.mechanisms.double_pendulum_modes": {
         "mass1": log_floats(0.1, 10.0), "mass2": log_floats(0.1, 10.0),
         "length1": log_floats(0.1, 3.0), "length2": log_floats(0.1, 3.0)},
-    "dynamics.mechanisms.dumbbell_disk": {"mass": log_floats(0.1, 10.0), "arm": floats(0.1, 1.0),
+    "appdyn.dynamics.mechanisms.dumbbell_disk": {"mass": log_floats(0.1, 10.0), "arm": floats(0.1, 1.0),
                                           "inertia": moments(), "stiffness": log_floats(0.1, 10.0)},
-    "dynamics.mechanisms.dumbbell_disk_frequency": {
+    "appdyn.dynamics.mechanisms.dumbbell_disk_frequency": {
         "mass": log_floats(0.1, 10.0), "arm": floats(0.1, 1.0), "inertia2": log_floats(0.1, 10.0),
         "stiffness": log_floats(0.1, 10.0)},
-    "dynamics.mechanisms.equivalent_length": {"mass": log_floats(0.1, 10.0),
+    "appdyn.dynamics.mechanisms.equivalent_length": {"mass": log_floats(0.1, 10.0),
                                               "inertia": log_floats(1e-3, 1.0),
                                               "length": floats(0.05, 2.0)},
-    "dynamics.mechanisms.natural_frequency": {"mass": log_floats(0.1, 10.0),
+    "appdyn.dynamics.mechanisms.natural_frequency": {"mass": log_floats(0.1, 10.0),
                                               "inertia": log_floats(1e-3, 1.0),
                                               "length": floats(0.05, 2.0)},
-    "dynamics.mechanisms.rod_pendulum": {"mass": log_floats(0.1, 10.0),
+    "appdyn.dynamics.mechanisms.rod_pendulum": {"mass": log_floats(0.1, 10.0),
                                          "length": floats(0.1, 3.0)},
-    "dynamics.mechanisms.rolling_coin": {"mass": log_floats(0.01, 10.0),
+    "appdyn.dynamics.mechanisms.rolling_coin": {"mass": log_floats(0.01, 10.0),
                                          "radius": floats(0.01, 1.0)},
-    "dynamics.mechanisms.shaken_pendulum": {"mass": log_floats(0.1, 10.0),
+    "appdyn.dynamics.mechanisms.shaken_pendulum": {"mass": log_floats(0.1, 10.0),
                                             "inertia": log_floats(1e-3, 0.1),
                                             "length": floats(0.05, 0.5),
                                             "amp_y": floats(0.0, 0.05), "freq": floats(10, 500)},
-    "dynamics.mechanisms.shaken_pendulum_multipliers": {
+    "appdyn.dynamics.mechanisms.shaken_pendulum_multipliers": {
         "mass": log_floats(0.1, 10.0), "inertia": log_floats(1e-3, 0.1),
         "length": floats(0.05, 0.5), "amp_y": floats(0.0, 0.05), "freq": floats(10, 500)},
-    "dynamics.mechanisms.sliding_bead": {"mass": log_floats(0.1, 10.0), "rate": NONZERO_RATE,
+    "appdyn.dynamics.mechanisms.sliding_bead": {"mass": log_floats(0.1, 10.0), "rate": NONZERO_RATE,
                                          "rate_amp": floats(0.0, 0.5),
                                          "rate_freq": floats(0.0, 3.0)},
-    "dynamics.mechanisms.variable_length_pendulum": {
+    "appdyn.dynamics.mechanisms.variable_length_pendulum": {
         "mass": log_floats(0.1, 10.0), "length": floats(0.5, 3.0),
         "length_rate": floats(-0.1, 0.1), "length_amp": floats(0.0, 0.2),
         "length_freq": floats(0.0, 3.0)},
-    "dynamics.attitude.dcm_axis": {"component": st.integers(1, 3),
+    "appdyn.dynamics.attitude.dcm_axis": {"component": st.integers(1, 3),
                                    "angle": floats(-math.pi, math.pi)},
-    "ocp.get_transcription": {"transcription": st.sampled_from(
+    "appdyn.ocp.get_transcription": {"transcription": st.sampled_from(
         ("trapezoid", "hermite-simpson", "hermite-simpson-compressed", "radau",
          "radau-constant-control"))},
-    "problems.dispersion.nutation_spread": {"samples": st.integers(2, 5),
+    "appdyn.problems.dispersion.nutation_spread": {"samples": st.integers(2, 5),
                                             "seed": st.integers(0, 1000),
                                             "duration": floats(1.0, 10.0)},
-    "problems.ascent.default_gains": {"q": floats(1e4, 5e4)},
-    "problems.ascent.delta3_problem": {"N": st.integers(4, 10), "degree": st.integers(3, 5)},
+    "appdyn.problems.ascent.default_gains": {"q": floats(1e4, 5e4)},
+    "appdyn.problems.ascent.delta3_problem": {"N": st.integers(4, 10), "degree": st.integers(3, 5)},
 }
 NOTHING_TO_DRAW = {
-    "dynamics.clear_caches": "no parameters",
-    "problems.slew.example_targets": "no parameters",
-    "problems.ascent.initial_state": "no parameters",
-    "problems.ascent.delta3_ascent": "its only numbers are mesh sizes; one solve (about 2 s)",
+    "appdyn.dynamics.clear_caches": "no parameters",
+    "appdyn.problems.slew.example_targets": "no parameters",
+    "appdyn.problems.ascent.initial_state": "no parameters",
+    "appdyn.problems.ascent.delta3_ascent": "its only numbers are mesh sizes; one solve (about 2 s)",
 }
 
 # fields documented to be NaN where not applicable, by attribute name: a fixed-step run's
@@ -556,16 +556,16 @@ ECHOED = {"problem", "model"}
 # numerical drivers where a random valid input may honestly be unsolvable: success=False
 # with a message is accepted (reported as a warning, never an exception)
 MAY_FAIL = {
-    "problems.gains.attitude_gains": (
+    "appdyn.problems.gains.attitude_gains": (
         "KNOWN, not fixed: a slew axis with components of 1e-175 (a unit axis hypothesis "
         "draws) makes CVODES give up on the closed-loop re-simulation (CV_REPTD_RHSFUNC_ERR "
         "near t = 18.7 s); the design says success=False, 'the re-simulation ... failed'"),
 }
 # parameters that must be CasADi symbols or expressions: the fixed symbolic example
 SYMBOLIC = {
-    "dynamics.constrained.constraint_terms": ("q", "qdot", "v"),
-    "dynamics.constrained.residual_invariant": ("x", "p"),
-    "dynamics.mechanisms.lagrange_terms": ("T", "V", "q", "v"),
+    "appdyn.dynamics.constrained.constraint_terms": ("q", "qdot", "v"),
+    "appdyn.dynamics.constrained.residual_invariant": ("x", "p"),
+    "appdyn.dynamics.mechanisms.lagrange_terms": ("T", "V", "q", "v"),
 }
 
 
@@ -579,7 +579,7 @@ class ValidInputFailedWarning(UserWarning):
 
 
 def _att():
-    from dynamics import attitude
+    from appdyn.dynamics import attitude
     return attitude
 
 
@@ -622,7 +622,7 @@ def _inv_torque_free(kw, out):
 
 
 def _inv_cluster_jacobian(kw, out):
-    from dynamics.momentum import cluster_momentum
+    from appdyn.dynamics.momentum import cluster_momentum
     d, eps = np.asarray(kw["delta"], float), 1e-6
     fd = np.column_stack([(np.ravel(cluster_momentum(kw["geometry"], d + eps * e))
                            - np.ravel(cluster_momentum(kw["geometry"], d - eps * e))) / (2 * eps)
@@ -641,7 +641,7 @@ def _inv_robust_steering(kw, out):
 
 
 def _inv_elements(kw, out):
-    from problems.ascent import orbital_elements
+    from appdyn.problems.ascent import orbital_elements
     el = orbital_elements(*out)
     _close([el.a / kw["a"], el.e, el.i], [1.0, kw["e"], kw["i"]], 1e-9)
     for name in ("raan", "argp", "nu"):
@@ -703,94 +703,94 @@ def _inv_unstack(kw, out):
 
 
 INVARIANTS = {
-    "dynamics.attitude.axis_angle_from_quat": _inv_axis_angle,
-    "dynamics.attitude.dcm_from_axis_angle": lambda kw, A: (
+    "appdyn.dynamics.attitude.axis_angle_from_quat": _inv_axis_angle,
+    "appdyn.dynamics.attitude.dcm_from_axis_angle": lambda kw, A: (
         _rotation(A), _close(A @ kw["axis"], kw["axis"], 1e-12)),
-    "dynamics.attitude.dcm_from_euler313": lambda kw, A: _rotation(A),
-    "dynamics.attitude.dcm_from_euler321": lambda kw, A: _rotation(A),
-    "dynamics.attitude.dcm_from_quat": lambda kw, A: (
+    "appdyn.dynamics.attitude.dcm_from_euler313": lambda kw, A: _rotation(A),
+    "appdyn.dynamics.attitude.dcm_from_euler321": lambda kw, A: _rotation(A),
+    "appdyn.dynamics.attitude.dcm_from_quat": lambda kw, A: (
         _rotation(A), _same_rotation(_att().quat_from_dcm(A), kw["q"])),
-    "dynamics.attitude.dcm_axis": lambda kw, A: _rotation(A),
-    "dynamics.attitude.euler313_from_dcm": lambda kw, e: _close(
+    "appdyn.dynamics.attitude.dcm_axis": lambda kw, A: _rotation(A),
+    "appdyn.dynamics.attitude.euler313_from_dcm": lambda kw, e: _close(
         _att().dcm_from_euler313(e), kw["A"], 1e-9),
-    "dynamics.attitude.euler321_from_dcm": lambda kw, e: _close(
+    "appdyn.dynamics.attitude.euler321_from_dcm": lambda kw, e: _close(
         _att().dcm_from_euler321(e), kw["A"], 1e-9),
-    "dynamics.attitude.euler313_from_quat": lambda kw, e: _close(
+    "appdyn.dynamics.attitude.euler313_from_quat": lambda kw, e: _close(
         _att().dcm_from_euler313(e), _att().dcm_from_quat(kw["q"]), 1e-9),
-    "dynamics.attitude.euler321_from_quat": lambda kw, e: _close(
+    "appdyn.dynamics.attitude.euler321_from_quat": lambda kw, e: _close(
         _att().dcm_from_euler321(e), _att().dcm_from_quat(kw["q"]), 1e-9),
-    "dynamics.attitude.principal_axes": lambda kw, out: (
+    "appdyn.dynamics.attitude.principal_axes": lambda kw, out: (
         _close(out[1] @ kw["inertia"] @ out[1].T, np.diag(out[0]), 1e-9 * np.max(out[0])),
         _close(out[1] @ out[1].T, np.eye(3), 1e-12)),
-    "dynamics.attitude.propagate_quat": lambda kw, q: (
-        _unit(q), _same_rotation(q, __import__("dynamics.truth", fromlist=["x"]).constant_rate_quat(
+    "appdyn.dynamics.attitude.propagate_quat": lambda kw, q: (
+        _unit(q), _same_rotation(q, __import__("appdyn.dynamics.truth", fromlist=["x"]).constant_rate_quat(
             kw["q"], kw["w"], [0.0, kw["h"]])[:, -1], 1e-12)),
-    "dynamics.attitude.quat_conj": lambda kw, qc: _same_rotation(
+    "appdyn.dynamics.attitude.quat_conj": lambda kw, qc: _same_rotation(
         _att().quat_mul(kw["q"], qc), [0, 0, 0, 1]),
-    "dynamics.attitude.quat_from_axis_angle": lambda kw, q: (
+    "appdyn.dynamics.attitude.quat_from_axis_angle": lambda kw, q: (
         _unit(q), _close(_att().dcm_from_quat(q), _att().dcm_from_axis_angle(
             kw["axis"], kw["angle"]), 1e-12)),
-    "dynamics.attitude.quat_from_dcm": lambda kw, q: (
+    "appdyn.dynamics.attitude.quat_from_dcm": lambda kw, q: (
         _unit(q), _close(_att().dcm_from_quat(q), kw["A"], 1e-12)),
-    "dynamics.attitude.quat_from_euler313": lambda kw, q: _close(
+    "appdyn.dynamics.attitude.quat_from_euler313": lambda kw, q: _close(
         _att().dcm_from_quat(q), _att().dcm_from_euler313(kw["angles"]), 1e-12),
-    "dynamics.attitude.quat_from_euler321": lambda kw, q: _close(
+    "appdyn.dynamics.attitude.quat_from_euler321": lambda kw, q: _close(
         _att().dcm_from_quat(q), _att().dcm_from_euler321(kw["angles"]), 1e-12),
-    "dynamics.attitude.quat_kinematics_matrix": lambda kw, W: _close(W, -np.transpose(W), 0),
-    "dynamics.attitude.quat_mul": lambda kw, qp: _close(
+    "appdyn.dynamics.attitude.quat_kinematics_matrix": lambda kw, W: _close(W, -np.transpose(W), 0),
+    "appdyn.dynamics.attitude.quat_mul": lambda kw, qp: _close(
         _att().dcm_from_quat(qp), _att().dcm_from_quat(kw["q"]) @ _att().dcm_from_quat(kw["p"]),
         1e-12),
-    "dynamics.attitude.quat_normalize": lambda kw, q: (
+    "appdyn.dynamics.attitude.quat_normalize": lambda kw, q: (
         _unit(q), _close(np.ravel(q) * np.linalg.norm(kw["q"]), kw["q"], 1e-12)),
-    "dynamics.attitude.quat_rate": lambda kw, qd: abs(float(np.dot(np.ravel(qd), kw["q"]))) < 1e-12,
-    "dynamics.attitude.rotation_angle": lambda kw, a: _close(
+    "appdyn.dynamics.attitude.quat_rate": lambda kw, qd: abs(float(np.dot(np.ravel(qd), kw["q"]))) < 1e-12,
+    "appdyn.dynamics.attitude.rotation_angle": lambda kw, a: _close(
         a, _att().axis_angle_from_quat(kw["q"])[1], 1e-12),
-    "dynamics.attitude.skew": lambda kw, S: (_close(S, -S.T, 0), _close(S @ kw["v"], 0, 1e-15)),
-    "dynamics.truth.torque_free_omega": _inv_torque_free,
-    "dynamics.truth.energy": lambda kw, T: _close(T, 0.5 * np.sum(kw["inertia_diag"] * kw["w"] ** 2),
+    "appdyn.dynamics.attitude.skew": lambda kw, S: (_close(S, -S.T, 0), _close(S @ kw["v"], 0, 1e-15)),
+    "appdyn.dynamics.truth.torque_free_omega": _inv_torque_free,
+    "appdyn.dynamics.truth.energy": lambda kw, T: _close(T, 0.5 * np.sum(kw["inertia_diag"] * kw["w"] ** 2),
                                                    1e-12),
-    "dynamics.truth.momentum_magnitude": lambda kw, H: _close(
+    "appdyn.dynamics.truth.momentum_magnitude": lambda kw, H: _close(
         H, np.linalg.norm(kw["inertia_diag"] * kw["w"]), 1e-12),
-    "dynamics.truth.constant_rate_quat": lambda kw, q: (
+    "appdyn.dynamics.truth.constant_rate_quat": lambda kw, q: (
         _close(np.linalg.norm(q, axis=0), 1.0, 1e-12), _same_rotation(q[:, 0], kw["q0"])),
-    "dynamics.momentum.cluster_jacobian": _inv_cluster_jacobian,
-    "dynamics.momentum.pseudo_inverse_steering": _inv_steering,
-    "dynamics.momentum.sr_inverse_steering": _inv_robust_steering,
-    "dynamics.momentum.null_motion": lambda kw, n: _close(kw["C"] @ np.ravel(n), 0, 1e-9),
-    "dynamics.momentum.gram_determinant": lambda kw, g: _close(
+    "appdyn.dynamics.momentum.cluster_jacobian": _inv_cluster_jacobian,
+    "appdyn.dynamics.momentum.pseudo_inverse_steering": _inv_steering,
+    "appdyn.dynamics.momentum.sr_inverse_steering": _inv_robust_steering,
+    "appdyn.dynamics.momentum.null_motion": lambda kw, n: _close(kw["C"] @ np.ravel(n), 0, 1e-9),
+    "appdyn.dynamics.momentum.gram_determinant": lambda kw, g: _close(
         g, np.linalg.det(kw["C"] @ kw["C"].T), 1e-9),
-    "dynamics.momentum.singularity_measure": lambda kw, m: _close(
-        float(m) ** 2, np.linalg.det(np.asarray(__import__("dynamics.momentum", fromlist=["x"])
+    "appdyn.dynamics.momentum.singularity_measure": lambda kw, m: _close(
+        float(m) ** 2, np.linalg.det(np.asarray(__import__("appdyn.dynamics.momentum", fromlist=["x"])
                                                 .cluster_jacobian(kw["geometry"], kw["delta"]))
-                                     @ np.asarray(__import__("dynamics.momentum", fromlist=["x"])
+                                     @ np.asarray(__import__("appdyn.dynamics.momentum", fromlist=["x"])
                                                   .cluster_jacobian(kw["geometry"],
                                                                     kw["delta"])).T), 1e-9),
-    "dynamics.momentum.cmg_torque": lambda kw, L: _close(
+    "appdyn.dynamics.momentum.cmg_torque": lambda kw, L: _close(
         L, -np.cross(kw["gimbal_rate_vector"], kw["rotor_momentum"]), 1e-12),
-    "dynamics.momentum.gyroscope_reaction_torque": lambda kw, L: _close(
+    "appdyn.dynamics.momentum.gyroscope_reaction_torque": lambda kw, L: _close(
         L, -np.cross(kw["Omega"], kw["H"]), 1e-12),
-    "dynamics.momentum.fibonacci_directions": lambda kw, D: _close(
+    "appdyn.dynamics.momentum.fibonacci_directions": lambda kw, D: _close(
         np.linalg.norm(np.reshape(D, (-1, 3)) if np.shape(D)[-1] == 3 else np.asarray(D).T,
                        axis=1), 1.0, 1e-12),
-    "dynamics.momentum.classify_singularity": lambda kw, c: c in (
+    "appdyn.dynamics.momentum.classify_singularity": lambda kw, c: c in (
         "nonsingular", "elliptic", "hyperbolic", "degenerate"),
-    "dynamics.constrained.constrained_accelerations": _inv_constrained,
-    "dynamics.constrained.reaction_forces": lambda kw, R: _close(
+    "appdyn.dynamics.constrained.constrained_accelerations": _inv_constrained,
+    "appdyn.dynamics.constrained.reaction_forces": lambda kw, R: _close(
         R, -np.asarray(kw["B"]).T @ np.ravel(kw["lam"]), 1e-12),
-    "dynamics.constrained.project_velocities": lambda kw, v: _close(
+    "appdyn.dynamics.constrained.project_velocities": lambda kw, v: _close(
         np.asarray(kw["B"]) @ np.ravel(v), 0, 1e-12),
-    "dynamics.mechanisms.pendulum_swing": _inv_pendulum,
-    "dynamics.mechanisms.pendulum_period": lambda kw, P: P >= 2 * math.pi * math.sqrt(
+    "appdyn.dynamics.mechanisms.pendulum_swing": _inv_pendulum,
+    "appdyn.dynamics.mechanisms.pendulum_period": lambda kw, P: P >= 2 * math.pi * math.sqrt(
         1.0 / 9.80665) * (1 - 1e-12),
-    "problems.ascent.state_from_elements": _inv_elements,
-    "problems.ascent.orbital_elements": lambda kw, el: (0 <= el.i <= math.pi, el.e >= 0),
-    "problems.ascent.dynamic_pressure": lambda kw, q: np.all(np.asarray(q) >= 0),
-    "problems.stability.spin": _inv_spin_verdict,
-    "problems.stability.heavy_top": _inv_heavy_top,
-    "problems.stability.classify": _inv_classify,
-    "problems.dispersion.statistics": _inv_statistics,
-    "problems.dispersion.nutation_closed_form": lambda kw, a: 0.0 <= a <= math.pi / 2 + 1e-12,
-    "ocp.unstack": _inv_unstack,
+    "appdyn.problems.ascent.state_from_elements": _inv_elements,
+    "appdyn.problems.ascent.orbital_elements": lambda kw, el: (0 <= el.i <= math.pi, el.e >= 0),
+    "appdyn.problems.ascent.dynamic_pressure": lambda kw, q: np.all(np.asarray(q) >= 0),
+    "appdyn.problems.stability.spin": _inv_spin_verdict,
+    "appdyn.problems.stability.heavy_top": _inv_heavy_top,
+    "appdyn.problems.stability.classify": _inv_classify,
+    "appdyn.problems.dispersion.statistics": _inv_statistics,
+    "appdyn.problems.dispersion.nutation_closed_form": lambda kw, a: 0.0 <= a <= math.pi / 2 + 1e-12,
+    "appdyn.ocp.unstack": _inv_unstack,
 }
 
 # --------------------------------------------------------------------------------------------
@@ -841,7 +841,7 @@ def _fields(obj):
         return [(f"[{i}]", v) for i, v in enumerate(obj)]
     if dataclasses.is_dataclass(obj):
         return [(f.name, getattr(obj, f.name)) for f in dataclasses.fields(obj)]
-    if type(obj).__module__.split(".")[0] in ("dynamics", "ocp", "problems") and hasattr(
+    if type(obj).__module__.startswith(("appdyn.dynamics", "appdyn.ocp", "appdyn.problems")) and hasattr(
             obj, "__dict__"):
         return list(vars(obj).items())
     return []
@@ -877,15 +877,15 @@ def _finite(obj, where="result", field="", depth=0, seen=None):
 
 # states at which a built model is evaluated, where O(1) numbers are not a state of it
 MODEL_STATES = {
-    "problems.ascent.delta3_model": lambda: __import__(
-        "problems.ascent", fromlist=["initial_state"]).initial_state(),
+    "appdyn.problems.ascent.delta3_model": lambda: __import__(
+        "appdyn.problems.ascent", fromlist=["initial_state"]).initial_state(),
 }
 
 
 def _check_model(func, model):
     """A built model evaluates to finite derivatives at a state (``MODEL_STATES``, or
     uniform in [-0.5, 0.5] with a unit attitude quaternion)."""
-    from dynamics.model import Model
+    from appdyn.dynamics.model import Model
     if not isinstance(model, Model):
         return
     if func in MODEL_STATES:

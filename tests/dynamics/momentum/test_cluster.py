@@ -15,7 +15,7 @@ import numpy as np
 import pytest
 from scipy.optimize import minimize
 
-from dynamics.momentum import (ClusterGeometry, classify_singularity, cluster, cluster_jacobian,
+from appdyn.dynamics.momentum import (ClusterGeometry, classify_singularity, cluster, cluster_jacobian,
                                cluster_momentum, gram_determinant, pyramid, singular_direction,
                                singularity_measure)
 

@@ -7,12 +7,12 @@ import casadi as ca
 import numpy as np
 import pytest
 
-from dynamics import simulate
-from dynamics.attitude import dcm_from_quat
-from dynamics.momentum import cmg
-from dynamics.momentum.cluster import cluster_momentum, pyramid
-from dynamics.momentum.cmg import cmg_spacecraft
-from dynamics.spinning import gyrostat_model
+from appdyn.dynamics import simulate
+from appdyn.dynamics.attitude import dcm_from_quat
+from appdyn.dynamics.momentum import cmg
+from appdyn.dynamics.momentum.cluster import cluster_momentum, pyramid
+from appdyn.dynamics.momentum.cmg import cmg_spacecraft
+from appdyn.dynamics.spinning import gyrostat_model
 
 INERTIA = np.array([[12.0, 0.3, -0.2], [0.3, 10.0, 0.1], [-0.2, 0.1, 8.0]])
 GEO = pyramid(np.arccos(1 / np.sqrt(3)), 2.0)

@@ -16,7 +16,7 @@ import time
 import numpy as np
 import pytest
 
-from dynamics.momentum import (ClusterGeometry, MomentumEnvelope, classify_singularities,
+from appdyn.dynamics.momentum import (ClusterGeometry, MomentumEnvelope, classify_singularities,
                                classify_singularity, cluster_jacobian, cluster_momentum,
                                fibonacci_directions, momentum_envelope, pyramid, singular_surface,
                                singularity_measure)
@@ -185,6 +185,6 @@ def test_two_unit_cluster_is_always_singular():
 
 
 def test_docstring_examples():
-    module = importlib.import_module("dynamics.momentum.envelope")
+    module = importlib.import_module("appdyn.dynamics.momentum.envelope")
     result = doctest.testmod(module, optionflags=doctest.NORMALIZE_WHITESPACE | doctest.ELLIPSIS)
     assert result.attempted > 0 and result.failed == 0

@@ -17,7 +17,7 @@ import numpy as np
 import pytest
 from scipy.linalg import expm
 
-from dynamics.momentum import (cmg_torque, coriolis_torque, gyroscope_reaction_torque, gyroscopic,
+from appdyn.dynamics.momentum import (cmg_torque, coriolis_torque, gyroscope_reaction_torque, gyroscopic,
                                propeller_torque, wheel_torque)
 
 RNG = np.random.default_rng(1729)

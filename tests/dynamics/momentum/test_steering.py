@@ -13,7 +13,7 @@ import casadi as ca
 import numpy as np
 import pytest
 
-from dynamics.momentum import (cluster_jacobian, cluster_momentum, cmg_torque, gram_determinant,
+from appdyn.dynamics.momentum import (cluster_jacobian, cluster_momentum, cmg_torque, gram_determinant,
                                gsr_inverse_steering, null_motion, pseudo_inverse_steering, pyramid,
                                singular_direction, sr_inverse_steering, steering)
 

@@ -16,13 +16,13 @@ import casadi as ca
 import numpy as np
 import pytest
 
-from dynamics import Model
-from dynamics.momentum import (cluster_jacobian, gsr_inverse_steering, pseudo_inverse_steering,
+from appdyn.dynamics import Model
+from appdyn.dynamics.momentum import (cluster_jacobian, gsr_inverse_steering, pseudo_inverse_steering,
                                pyramid, sr_inverse_steering, steer, steering_model)
 
 BETA = np.deg2rad(54.74)
 GEO = pyramid(BETA)
-STEER = importlib.import_module("dynamics.momentum.steering_sim")
+STEER = importlib.import_module("appdyn.dynamics.momentum.steering_sim")
 
 
 def test_momentum_exchange_constant_torque():

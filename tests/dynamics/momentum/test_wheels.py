@@ -6,12 +6,12 @@ import casadi as ca
 import numpy as np
 import pytest
 
-from dynamics import Model, rigid_body, simulate
-from dynamics.attitude import dcm_from_quat
-from dynamics import closed_loop
-from dynamics.momentum import wheels
-from dynamics.momentum.wheels import rotor_dynamics, wheel_spacecraft
-from dynamics.spinning import gyrostat_model
+from appdyn.dynamics import Model, rigid_body, simulate
+from appdyn.dynamics.attitude import dcm_from_quat
+from appdyn.dynamics import closed_loop
+from appdyn.dynamics.momentum import wheels
+from appdyn.dynamics.momentum.wheels import rotor_dynamics, wheel_spacecraft
+from appdyn.dynamics.spinning import gyrostat_model
 
 HUB = np.array([[12.0, 0.3, -0.2], [0.3, 10.0, 0.1], [-0.2, 0.1, 8.0]])
 AXES = np.column_stack([np.eye(3), np.ones(3) / np.sqrt(3)])  # three orthogonal + one skew

@@ -1,0 +1,41 @@
+"""appdyn: CasADi-based aerospace vehicle dynamics, linearization and optimal control.
+
+The package has three floors, each a subpackage (every arrow points down):
+
+- `appdyn.dynamics`: models as named-I/O CasADi Functions, simulation, linearization and
+  closed-form truths;
+- `appdyn.ocp`: the direct-collocation engine (problem statement, transcriptions, solve,
+  refinement, phases);
+- `appdyn.problems`: ready-made jobs (slews, stability reports, gains, ascent, dispersions)
+  and the ``appdyn`` command line.
+
+The subpackages are imported on first use (``import appdyn`` alone is cheap):
+
+>>> import appdyn
+>>> from appdyn.dynamics import rigid_body
+>>> rigid_body([1.0, 2.0, 3.0]).nx
+7
+"""
+from __future__ import annotations
+
+import importlib
+from importlib.metadata import PackageNotFoundError, version as _version
+
+try:
+    __version__ = _version("appdyn")
+except PackageNotFoundError:  # a source tree that was not installed
+    __version__ = "0+unknown"
+
+__all__ = ["__version__", "dynamics", "ocp", "problems"]
+
+_SUBPACKAGES = ("dynamics", "ocp", "problems")
+
+
+def __getattr__(name: str):
+    if name in _SUBPACKAGES:
+        return importlib.import_module(f"appdyn.{name}")
+    raise AttributeError(f"module 'appdyn' has no attribute {name!r}")
+
+
+def __dir__():
+    return sorted(__all__)
