@@ -17,13 +17,14 @@ are not installed are skipped with a one-line notice (never an error).
 
 The runner
 ----------
-``appdyn bench [NAME ...] [--quick] [--out DIR] [--readme]`` (``problems/cli/bench.py``)
+``appdyn bench [NAME ...] [--quick] [--out DIR] [--docs]`` (``problems/cli/bench.py``)
 puts ``bench/`` on ``sys.path`` (so a script imports ``from _common import Row``), imports
 each named benchmark, calls ``run(quick, out)``, prints the rows, and writes
 ``OUT/summary.csv`` (all benchmarks' rows; a partial run replaces only its own) and
 ``OUT/machine.json`` (`machine`). A benchmark that raises is reported and the others still
-run. ``--readme`` (and ``make bench``) regenerate the README's "Performance" tables from
-``RESULTS`` with ``bench/_readme.py``; those numbers are never edited by hand.
+run. ``--docs`` (``--readme``, its former name, and ``make bench``) regenerate the tables of
+the performance page, ``docs/performance.md``, from ``RESULTS`` with ``bench/_readme.py``;
+those numbers are never edited by hand.
 """
 from __future__ import annotations
 

@@ -1,0 +1,97 @@
+"""The API reference pages, written from the packages' ``__all__`` at every docs build.
+
+`public_packages` lists ``appdyn.dynamics``, ``appdyn.ocp``, ``appdyn.problems`` and every
+public subpackage below them (no part of the name starting with ``_``); `write_api` writes
+one page per package, an autosummary table of every name in its ``__all__`` with a page
+generated for each, and an index page ``api/index.rst``. A name that a package re-exports
+from one of its public subpackages (the same object under the same name there), and a
+subpackage named in ``__all__``, is documented once, on the subpackage's page, and linked
+from the parent's (Sphinx refuses two descriptions of one object).
+"""
+from __future__ import annotations
+
+import importlib
+import inspect
+import pkgutil
+from pathlib import Path
+
+ROOTS = ("appdyn.dynamics", "appdyn.ocp", "appdyn.problems")
+
+
+def public_packages() -> list[str]:
+    """Dotted names of the public packages (not modules) under `ROOTS`, roots first."""
+    names = []
+    for root in ROOTS:
+        package = importlib.import_module(root)
+        names.append(root)
+        for info in pkgutil.walk_packages(package.__path__, prefix=f"{root}."):
+            if info.ispkg and not any(part.startswith("_") for part in info.name.split(".")):
+                names.append(info.name)
+    return names
+
+
+def public_names(package: str) -> list[str]:
+    """The names in ``package.__all__`` (empty when it has none)."""
+    return list(getattr(importlib.import_module(package), "__all__", ()))
+
+
+def home(package: str, name: str, packages: list[str]) -> str:
+    """Where ``package.name`` is documented: the dotted name of the public package below
+    ``package`` that exports the same object under the same name (or that is the object),
+    else ``package`` itself."""
+    obj = getattr(importlib.import_module(package), name)
+    if inspect.ismodule(obj) and obj.__name__ in packages:
+        return obj.__name__
+    for sub in packages:
+        if sub.startswith(f"{package}.") and name in public_names(sub) \
+                and getattr(importlib.import_module(sub), name) is obj:
+            return home(sub, name, packages)
+    return package
+
+
+def page(package: str, packages: list[str]) -> str:
+    """The reStructuredText of one package's reference page (``packages``: all the public
+    packages, for the names documented on another page)."""
+    title = f"``{package}``"
+    lines = [title, "=" * len(title), "", f".. automodule:: {package}", "   :no-members:", ""]
+    names = public_names(package)
+    homes = {name: home(package, name, packages) for name in names}
+    own = [name for name in names if homes[name] == package]
+    elsewhere = [name for name in names if homes[name] != package]
+    if names:
+        lines += [".. currentmodule:: " + package, "", "Public names", "------------", ""]
+    if own:
+        lines += [".. autosummary::", "   :toctree: generated/", "   :nosignatures:", ""]
+        lines += [f"   {name}" for name in own]
+        lines.append("")
+    if elsewhere:
+        lines += ["Also exported here, documented with their subpackage:", ""]
+        for name in elsewhere:
+            target = homes[name]
+            link = (f":doc:`{name} <{target}>`" if target.endswith(f".{name}")
+                    and target in packages else f":py:obj:`{name} <{target}.{name}>`")
+            lines.append(f"- {link} (``{target}``)")
+        lines.append("")
+    return "\n".join(lines)
+
+
+def write_api(folder) -> list[Path]:
+    """Write ``folder/index.rst`` and one page per public package; the paths written (files
+    whose text is unchanged are left alone, so Sphinx does not rebuild them)."""
+    folder = Path(folder)
+    folder.mkdir(parents=True, exist_ok=True)
+    packages = public_packages()
+    texts = {f"{name}.rst": page(name, packages) for name in packages}
+    texts["index.rst"] = "\n".join([
+        "API reference", "=============", "",
+        "Every public name of every package, from its docstring (numpydoc). The names are",
+        "those of each package's ``__all__``; a name re-exported by a parent package is",
+        "listed under both.", "",
+        ".. toctree::", "   :maxdepth: 1", ""] + [f"   {name}" for name in packages]) + "\n"
+    written = []
+    for name, text in texts.items():
+        path = folder / name
+        if not path.is_file() or path.read_text() != text:
+            path.write_text(text)
+        written.append(path)
+    return written
