@@ -43,7 +43,6 @@ default_role = "py:obj"
 write_api(HERE / "api")
 autosummary_generate = True
 autosummary_imported_members = True
-autodoc_default_options = {"members": False}
 autodoc_typehints = "none"        # numpydoc's Parameters section carries types and units
 add_module_names = False
 numpydoc_show_class_members = False

@@ -16,12 +16,12 @@ import sys
 import matplotlib.pyplot as plt
 import numpy as np
 
-from appdyn.problems.dispersion import (Normal, dispersion, nutation_history, nutation_max,
-                                        spinner)
+from appdyn.problems.dispersion import (Normal, dispersion, nutation_history,
+                                        nutation_max, spinner)
 
 
 class ProgressBar:
-    """``progress(done, total)``: a 40-character bar, redrawn every 10 % (on stdout)."""
+    """``progress(done, total)``: a text bar, redrawn every 10 % (on stdout)."""
 
     def __init__(self, width=40):
         self.width, self.shown = width, -1
@@ -31,7 +31,8 @@ class ProgressBar:
         if tenth > self.shown:
             self.shown = tenth
             filled = self.width * done // total
-            sys.stdout.write(f"[{'#' * filled}{'.' * (self.width - filled)}] {done}/{total}\n")
+            bar = "#" * filled + "." * (self.width - filled)
+            sys.stdout.write(f"[{bar}] {done}/{total}\n")
 
 
 # %%
@@ -46,8 +47,8 @@ res = dispersion(spinner, [0, 0, 0, 1, 0.0, 0.0, 1.0], t, samples=100, seed=0,
                  progress=ProgressBar())
 print(res.success, res.message)
 peak = res.statistics["peak"]
-print(f"peak nutation: mean {np.degrees(peak.mean):.3f} deg, std {np.degrees(peak.std):.3f} deg, "
-      f"99th percentile {np.degrees(peak.percentiles[99.0]):.3f} deg")
+mean, std, p99 = np.degrees([peak.mean, peak.std, peak.percentiles[99.0]])
+print(f"peak nutation: mean {mean:.3f} deg, std {std:.3f} deg, 99th percentile {p99:.3f} deg")
 
 # %%
 # Every sample against its closed form:

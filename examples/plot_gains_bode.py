@@ -20,8 +20,9 @@ import numpy as np
 from appdyn.problems.gains import attitude_gains
 
 inertia = [10.0, 12.0, 8.0]                  # principal moments [kg m^2]
-design = attitude_gains(inertia, [{"angle": np.radians(60), "axis": [0, 0, 1]},
-                                  {"angle": np.radians(30), "axis": [1, 0, 0]}], u_max=0.5)
+slews = [{"angle": np.radians(60), "axis": [0, 0, 1]},      # designed together
+         {"angle": np.radians(30), "axis": [1, 0, 0]}]
+design = attitude_gains(inertia, slews, u_max=0.5)         # |u_i| <= 0.5 N m
 print(design)
 kp, kd = design.gains["kp"], design.gains["kd"]
 assert design.success and design.verification["limits_met"]
@@ -35,10 +36,10 @@ for J, loop in zip(inertia, loops):
     gm, pm, wg, wp = control.margin(loop)
     print(f"J = {J:4.1f} kg m^2: phase margin {pm:.1f} deg at {wp:.3f} rad/s")
 print("closed-loop poles [1/s]:", np.round(poles, 5))
-print(f"largest difference from the design's poles: {np.max(np.abs(poles - designed)):.1e}")
+print(f"difference from the design's poles: {np.max(np.abs(poles - designed)):.1e}")
 assert np.allclose(poles, designed, rtol=1e-8, atol=1e-10)
 
 # %%
 # The Bode plot of the three axes' loops, margins marked.
 plt.figure(figsize=(8, 6))
-control.bode_plot(loops, display_margins=True, label=[f"axis {i + 1}" for i in range(3)])
+control.bode_plot(loops, display_margins=True, label=["axis 1", "axis 2", "axis 3"])

@@ -44,7 +44,7 @@ sol = solve(problem, transcription="radau", N=30, verbose=False,
 exact = np.pi / np.sqrt(g)
 print(sol.success, sol.status)
 print(f"T = {sol.T:.8f} s, cycloid {exact:.8f} s, difference {sol.T - exact:.1e} s")
-for name, (error, relative) in sol.propagation_errors.items():   # re-simulated control
+for name, (error, relative) in sol.propagation_errors.items():  # re-simulated control
     print(f"propagation error of {name}: {error:.1e} ({relative:.1e} relative)")
 assert sol.success and abs(sol.T - exact) < 1e-6
 

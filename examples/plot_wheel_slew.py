@@ -21,7 +21,7 @@ from appdyn.dynamics import attitude as at
 from appdyn.dynamics import closed_loop, simulate, wheel_spacecraft
 
 inertia = np.diag([10.0, 12.0, 8.0])         # hub [kg m^2]
-model = wheel_spacecraft(inertia, np.eye(3), 0.02)   # wheels on the body axes, J = 0.02 kg m^2
+model = wheel_spacecraft(inertia, np.eye(3), 0.02)   # body-axis wheels, 0.02 kg m^2
 tau_max, kp, kd = 0.05, 0.3, 3.0             # N m, N m/rad (per 2 q_v), N m s/rad
 
 # %%
@@ -53,8 +53,8 @@ print(f"largest change with twice the steps: {np.abs(finer.x - res.x).max():.1e}
 print(f"error angle: {angle[0]:.1f} deg -> {angle[-1]:.2e} deg after {t[-1]:.0f} s")
 print(f"largest motor torque {np.abs(torque).max():.4f} N m (limit {tau_max} N m)")
 print("momentum drift [N m s]:", res.invariant_drift["momentum_inertial"])
-assert res.success and np.abs(finer.x - res.x).max() < 1e-5       # converged in the steps
-assert angle[-1] < 0.01 and np.abs(torque).max() <= tau_max              # settled, within limits
+assert res.success and np.abs(finer.x - res.x).max() < 1e-5   # converged in the steps
+assert angle[-1] < 0.01 and np.abs(torque).max() <= tau_max     # settled, within limits
 assert np.all(np.abs(res.invariant_drift["momentum_inertial"]) < 1e-10)
 
 # %%
