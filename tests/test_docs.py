@@ -96,6 +96,25 @@ def test_api_reference_lists_every_public_name(tmp_path):
     assert len(documented) >= 250
 
 
+def test_guide_api_links_name_documented_objects():
+    """Each ``{py:obj}`` link of a guide page names the page an object is documented on
+    (its package's, not a re-export), so that Sphinx resolves it."""
+    import re
+
+    api = _api()
+    packages = api.public_packages()
+    targets = [(page.name, t) for page in GUIDE
+               for t in re.findall(r"\{py:obj\}`~?([\w.]+)`", page.read_text())]
+    assert len(targets) >= 40
+    wrong = []
+    for page, target in targets:
+        package, _, name = target.rpartition(".")
+        if package not in packages or name not in api.public_names(package) \
+                or api.home(package, name, packages) != package:
+            wrong.append((page, target))
+    assert not wrong, f"links to names not documented there: {wrong}"
+
+
 def test_gallery_has_the_examples_asked_for():
     assert GALLERY <= {path.stem for path in EXAMPLES}
 
