@@ -6,7 +6,10 @@ one page per package, an autosummary table of every name in its ``__all__`` with
 generated for each, and an index page ``api/index.rst``. A name that a package re-exports
 from one of its public subpackages (the same object under the same name there), and a
 subpackage named in ``__all__``, is documented once, on the subpackage's page, and linked
-from the parent's (Sphinx refuses two descriptions of one object).
+from the parent's (Sphinx refuses two descriptions of one object). Constants (names that
+are neither classes, callables nor modules) are described on the package's page with their
+value and the ``#:`` comment where they are defined (autosummary would show the docstring
+of their type: "Convert a string or number to a floating point number").
 """
 from __future__ import annotations
 
@@ -14,6 +17,8 @@ import importlib
 import inspect
 import pkgutil
 from pathlib import Path
+
+from sphinx.pycode import ModuleAnalyzer
 
 ROOTS = ("appdyn.dynamics", "appdyn.ocp", "appdyn.problems")
 
@@ -33,6 +38,27 @@ def public_packages() -> list[str]:
 def public_names(package: str) -> list[str]:
     """The names in ``package.__all__`` (empty when it has none)."""
     return list(getattr(importlib.import_module(package), "__all__", ()))
+
+
+def is_constant(obj) -> bool:
+    """Data rather than code: not a class, a callable or a module."""
+    return not (inspect.isclass(obj) or inspect.ismodule(obj) or callable(obj))
+
+
+def constant_doc(package: str, name: str) -> str:
+    """The ``#:`` comment (or the string after the assignment) of ``name`` in the module of
+    ``package`` that defines it; empty when there is none."""
+    root = importlib.import_module(package)
+    modules = [package] + [info.name for info in
+                           pkgutil.walk_packages(getattr(root, "__path__", []), f"{package}.")]
+    for module in modules:
+        try:
+            docs = ModuleAnalyzer.for_module(module).find_attr_docs()
+        except Exception:  # noqa: BLE001 - a module without source: no comment to find
+            continue
+        if ("", name) in docs:
+            return "\n".join(line for line in docs[("", name)]).strip()
+    return ""
 
 
 def home(package: str, name: str, packages: list[str]) -> str:
@@ -56,7 +82,11 @@ def page(package: str, packages: list[str]) -> str:
     lines = [title, "=" * len(title), "", f".. automodule:: {package}", "   :no-members:", ""]
     names = public_names(package)
     homes = {name: home(package, name, packages) for name in names}
-    own = [name for name in names if homes[name] == package]
+    module = importlib.import_module(package)
+    own = [name for name in names if homes[name] == package
+           and not is_constant(getattr(module, name))]
+    constants = [name for name in names if homes[name] == package
+                 and is_constant(getattr(module, name))]
     elsewhere = [name for name in names if homes[name] != package]
     if names:
         lines += [".. currentmodule:: " + package, "", "Public names", "------------", ""]
@@ -64,6 +94,14 @@ def page(package: str, packages: list[str]) -> str:
         lines += [".. autosummary::", "   :toctree: generated/", "   :nosignatures:", ""]
         lines += [f"   {name}" for name in own]
         lines.append("")
+    if constants:
+        lines += ["Constants", "---------", ""]
+        for name in constants:
+            value = " ".join(repr(getattr(module, name)).split())
+            lines += [f".. py:data:: {name}", f"   :value: {value}", ""]
+            doc = constant_doc(package, name)
+            if doc:
+                lines += ["   " + line if line else "" for line in doc.splitlines()] + [""]
     if elsewhere:
         lines += ["Also exported here, documented with their subpackage:", ""]
         for name in elsewhere:
@@ -82,6 +120,12 @@ def write_api(folder) -> list[Path]:
     folder.mkdir(parents=True, exist_ok=True)
     packages = public_packages()
     texts = {f"{name}.rst": page(name, packages) for name in packages}
+    stubs = {f"{package}.{name}" for package in packages for name in public_names(package)
+             if home(package, name, packages) == package
+             and not is_constant(getattr(importlib.import_module(package), name))}
+    for stale in (folder / "generated").glob("*.rst"):
+        if stale.stem not in stubs:  # a name that left __all__ or became a constant
+            stale.unlink()
     texts["index.rst"] = "\n".join([
         "API reference", "=============", "",
         "Every public name of every package, from its docstring (numpydoc). The names are",

@@ -8,6 +8,7 @@ of their console blocks must exit 0. The full build (``make docs``, warnings as 
 run by CI after the tests.
 """
 import importlib.util
+import re
 import runpy
 import shlex
 from pathlib import Path
@@ -64,8 +65,9 @@ def test_page_cli_examples_run(line, tmp_path, monkeypatch):
 
 def test_api_reference_lists_every_public_name(tmp_path):
     """Each name in the ``__all__`` of appdyn.dynamics, appdyn.ocp, appdyn.problems and their
-    public subpackages has an autosummary entry on one reference page, or a link from its
-    package's page to the subpackage page that documents it (same object, same name)."""
+    public subpackages has an autosummary entry (a constant: a ``py:data`` description) on
+    one reference page, or a link from its package's page to the subpackage page that
+    documents it (same object, same name)."""
     api = _api()
     packages = api.public_packages()
     for name in ("appdyn.dynamics", "appdyn.ocp", "appdyn.problems",
@@ -79,6 +81,8 @@ def test_api_reference_lists_every_public_name(tmp_path):
         entries = text.split(".. autosummary::")[1].split("\n\n", 2)[1] \
             if ".. autosummary::" in text else ""
         documented |= {f"{package}.{line.strip()}" for line in entries.splitlines()}
+        documented |= {f"{package}.{name}" for name in
+                       re.findall(r"^\.\. py:data:: (\w+)$", text, flags=re.M)}
     missing = []
     for package in packages:
         text = (tmp_path / f"{package}.rst").read_text()
@@ -99,8 +103,6 @@ def test_api_reference_lists_every_public_name(tmp_path):
 def test_guide_api_links_name_documented_objects():
     """Each ``{py:obj}`` link of a guide page names the page an object is documented on
     (its package's, not a re-export), so that Sphinx resolves it."""
-    import re
-
     api = _api()
     packages = api.public_packages()
     targets = [(page.name, t) for page in GUIDE
