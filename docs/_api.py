@@ -13,12 +13,12 @@ of their type: "Convert a string or number to a floating point number").
 """
 from __future__ import annotations
 
+import ast
 import importlib
+import importlib.util
 import inspect
 import pkgutil
 from pathlib import Path
-
-from sphinx.pycode import ModuleAnalyzer
 
 ROOTS = ("appdyn.dynamics", "appdyn.ocp", "appdyn.problems")
 
@@ -45,19 +45,47 @@ def is_constant(obj) -> bool:
     return not (inspect.isclass(obj) or inspect.ismodule(obj) or callable(obj))
 
 
+def comments_above(source: str) -> dict[str, str]:
+    """``{name: text}`` of the module-level assignments in ``source`` documented the ways
+    Sphinx reads: ``#:`` comment lines right above, a ``#:`` comment on the line, or a
+    string right after."""
+    lines = source.splitlines()
+    found = {}
+    body = ast.parse(source).body
+    for i, node in enumerate(body):
+        targets = node.targets if isinstance(node, ast.Assign) else \
+            [node.target] if isinstance(node, ast.AnnAssign) else []
+        comment, k = [], node.lineno - 2
+        while k >= 0 and lines[k].lstrip().startswith("#:"):
+            comment.insert(0, lines[k].lstrip()[2:].strip())
+            k -= 1
+        _, inline, after = lines[node.end_lineno - 1].partition("#:")
+        if inline and after.strip() and not comment:
+            comment = [after.strip()]  # ``NAME = value  #: text``
+        following = body[i + 1] if i + 1 < len(body) else None
+        if not comment and isinstance(following, ast.Expr) and isinstance(
+                getattr(following, "value", None), ast.Constant) and isinstance(
+                following.value.value, str):
+            comment = [" ".join(following.value.value.split())]  # a string after it
+        for target in targets:
+            if isinstance(target, ast.Name) and comment:
+                found[target.id] = " ".join(comment)
+    return found
+
+
 def constant_doc(package: str, name: str) -> str:
-    """The ``#:`` comment (or the string after the assignment) of ``name`` in the module of
-    ``package`` that defines it; empty when there is none."""
+    """The ``#:`` comment of ``name`` in the module of ``package`` that defines it; empty
+    when there is none."""
     root = importlib.import_module(package)
     modules = [package] + [info.name for info in
                            pkgutil.walk_packages(getattr(root, "__path__", []), f"{package}.")]
     for module in modules:
-        try:
-            docs = ModuleAnalyzer.for_module(module).find_attr_docs()
-        except Exception:  # noqa: BLE001 - a module without source: no comment to find
+        spec = importlib.util.find_spec(module)
+        if spec is None or not spec.origin or not spec.origin.endswith(".py"):
             continue
-        if ("", name) in docs:
-            return "\n".join(line for line in docs[("", name)]).strip()
+        text = comments_above(Path(spec.origin).read_text()).get(name)
+        if text:
+            return text
     return ""
 
 

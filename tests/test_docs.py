@@ -100,6 +100,20 @@ def test_api_reference_lists_every_public_name(tmp_path):
     assert len(documented) >= 250
 
 
+def test_constant_comments_are_found():
+    """``#:`` comment lines right above a module-level assignment, a ``#:`` comment on its
+    line or a string after it document it (Sphinx's conventions); a plain comment or a blank
+    line between does not."""
+    api = _api()
+    source = ("#: the first\n#: and second line\nA = 1\n# plain\nB = 2\n#: c\n\nC = 3\n"
+              "#: typed\nD: float = 4.0\nE, F = 5, 6\nG = 7  #: inline\n"
+              "H = 8\n\"\"\"after\n   it\"\"\"\n")
+    assert api.comments_above(source) == {"A": "the first and second line", "D": "typed",
+                                          "G": "inline", "H": "after it"}
+    assert api.constant_doc("appdyn.problems.stability", "ZERO_RTOL").startswith(
+        "eigenvalues with")
+
+
 def test_guide_api_links_name_documented_objects():
     """Each ``{py:obj}`` link of a guide page names the page an object is documented on
     (its package's, not a re-export), so that Sphinx resolves it."""
