@@ -9,7 +9,7 @@ benchmarks) with
 * ``run(quick: bool, out: pathlib.Path) -> list[Row]``: runs the benchmark, writes its own
   detail files into ``out`` (``NAME.csv`` always, ``NAME.png`` where it has a figure; more
   files are fine, each named ``NAME*``) and returns its *summary rows*: the few headline
-  numbers a reader wants (the README's "Performance" section is generated from them);
+  numbers a reader wants (the tables of ``docs/performance.md`` are generated from them);
 * ``main(argv=())``: ``python bench/NAME.py [--quick] [--out DIR]`` (`script_main`).
 
 ``--quick`` must finish in well under two minutes for all benchmarks together; peers that
@@ -17,13 +17,14 @@ are not installed are skipped with a one-line notice (never an error).
 
 The runner
 ----------
-``appdyn bench [NAME ...] [--quick] [--out DIR] [--readme]`` (``problems/cli/bench.py``)
+``appdyn bench [NAME ...] [--quick] [--out DIR] [--docs]`` (``problems/cli/bench.py``)
 puts ``bench/`` on ``sys.path`` (so a script imports ``from _common import Row``), imports
 each named benchmark, calls ``run(quick, out)``, prints the rows, and writes
 ``OUT/summary.csv`` (all benchmarks' rows; a partial run replaces only its own) and
 ``OUT/machine.json`` (`machine`). A benchmark that raises is reported and the others still
-run. ``--readme`` (and ``make bench``) regenerate the README's "Performance" tables from
-``RESULTS`` with ``bench/_readme.py``; those numbers are never edited by hand.
+run. ``--docs`` (``--readme``, its former name, and ``make bench``) regenerate the tables of
+the performance page, ``docs/performance.md``, from ``RESULTS`` with ``bench/_readme.py``;
+those numbers are never edited by hand.
 """
 from __future__ import annotations
 
@@ -40,8 +41,8 @@ from pathlib import Path
 __all__ = ["Row", "RESULTS", "machine", "write_csv", "write_rows", "save_figure", "timed",
            "script_main", "format_rows"]
 
-#: default output folder of ``appdyn bench`` / ``make bench`` (committed: the README's
-#: performance section is generated from ``summary.csv`` and ``machine.json`` in it)
+#: default output folder of ``appdyn bench`` / ``make bench`` (committed: the tables of
+#: docs/performance.md are generated from ``summary.csv`` and ``machine.json`` in it)
 RESULTS = Path(__file__).resolve().parent / "results"
 
 

@@ -1,11 +1,13 @@
-"""The README's "Performance" tables, generated from a results folder.
+"""The tables of the performance page (``docs/performance.md``), generated from a results
+folder.
 
 ``render(results_dir)`` turns ``summary.csv`` and ``machine.json`` (written by ``appdyn
 bench``) into markdown: one line naming the machine and versions, then one table per
-benchmark. ``update_readme(readme_path, results_dir)`` puts that text between the markers
-``<!-- bench:begin -->`` and ``<!-- bench:end -->`` of the README. The numbers in that part
-of the README are never edited by hand (``tests/test_bench_readme.py`` checks that they are
-exactly ``render(bench/results)``); ``make bench`` regenerates them.
+benchmark. ``update_page(page_path, results_dir)`` puts that text between the markers
+``<!-- bench:begin -->`` and ``<!-- bench:end -->`` of the page (``update_readme`` is its
+former name: the tables were in the README until they moved to the docs). The numbers in
+that part of the page are never edited by hand (``tests/test_bench_readme.py`` checks that
+they are exactly ``render(bench/results)``); ``make bench`` regenerates them.
 """
 from __future__ import annotations
 
@@ -14,7 +16,7 @@ import json
 import math
 from pathlib import Path
 
-__all__ = ["BEGIN", "END", "render", "update_readme", "current", "format_value"]
+__all__ = ["BEGIN", "END", "render", "update_page", "update_readme", "current", "format_value"]
 
 BEGIN = "<!-- bench:begin -->"
 END = "<!-- bench:end -->"
@@ -94,26 +96,35 @@ def render(results_dir) -> str:
     return "\n".join(lines) + "\n"
 
 
-def update_readme(readme_path, results_dir) -> bool:
-    """Replace the text between `BEGIN` and `END` in ``readme_path`` by
-    ``render(results_dir)``; True when the file changed. Raises ``ValueError`` when the
-    markers are missing."""
-    path = Path(readme_path)
-    text = path.read_text()
+def _marked(path: Path, text: str) -> tuple[int, int]:
+    """Where the generated part of ``text`` (read from ``path``) starts and ends."""
     i, j = text.find(BEGIN), text.find(END)
     if i < 0 or j < i:
-        raise ValueError(f"`readme_path` {path} has no {BEGIN} ... {END} markers")
-    new = text[:i + len(BEGIN)] + "\n" + render(results_dir) + text[j:]
+        raise ValueError(f"`page_path` {path} has no {BEGIN} ... {END} markers")
+    return i + len(BEGIN), j
+
+
+def update_page(page_path, results_dir) -> bool:
+    """Replace the text between `BEGIN` and `END` in ``page_path`` by
+    ``render(results_dir)``; True when the file changed. Raises ``ValueError`` when the
+    markers are missing."""
+    path = Path(page_path)
+    text = path.read_text()
+    i, j = _marked(path, text)
+    new = text[:i] + "\n" + render(results_dir) + text[j:]
     if new != text:
         path.write_text(new)
     return new != text
 
 
-def current(readme_path) -> str:
-    """The generated text now between the markers of ``readme_path`` (what `render` gave when
+#: the former name of `update_page` (the tables were in the README)
+update_readme = update_page
+
+
+def current(page_path) -> str:
+    """The generated text now between the markers of ``page_path`` (what `render` gave when
     it was last regenerated)."""
-    text = Path(readme_path).read_text()
-    i, j = text.find(BEGIN), text.find(END)
-    if i < 0 or j < i:
-        raise ValueError(f"`readme_path` {readme_path} has no {BEGIN} ... {END} markers")
-    return text[i + len(BEGIN):j].removeprefix("\n")
+    path = Path(page_path)
+    text = path.read_text()
+    i, j = _marked(path, text)
+    return text[i:j].removeprefix("\n")

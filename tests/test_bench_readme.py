@@ -1,4 +1,5 @@
-"""The README's Performance tables come from bench/results, and the bench runner's contract.
+"""The performance page's tables (docs/performance.md) come from bench/results, and the bench
+runner's contract.
 
 No timing is asserted: these tests check where the numbers come from and how ``appdyn
 bench`` handles its benchmarks (``bench/_common.py`` describes the protocol).
@@ -17,6 +18,7 @@ from appdyn.problems.cli import main
 
 ROOT = Path(__file__).resolve().parents[1]
 README = ROOT / "README.md"
+PAGE = ROOT / "docs" / "performance.md"
 RESULTS = ROOT / "bench" / "results"
 
 
@@ -31,10 +33,31 @@ def _module(name):
 readme = _module("_readme")
 
 
-def test_readme_numbers_are_the_latest_results():
-    """The text between the markers is exactly render(bench/results): regenerate with
-    `make bench` (or `appdyn bench --readme`), never edit those numbers by hand."""
-    assert readme.current(README) == readme.render(RESULTS)
+def test_performance_page_numbers_are_the_latest_results():
+    """The text between the markers of docs/performance.md is exactly render(bench/results):
+    regenerate with `make bench` (or `appdyn bench --docs`), never edit those numbers by
+    hand. The tables left the README for that page."""
+    assert readme.current(PAGE) == readme.render(RESULTS)
+    assert readme.BEGIN not in README.read_text() and readme.END not in README.read_text()
+
+
+@pytest.mark.parametrize("flag", ["--docs", "--readme"])
+def test_docs_flag_rewrites_the_performance_page(flag, tmp_path, monkeypatch):
+    """``--docs`` (and ``--readme``, its former name) rewrite the marked part of the
+    performance page, and only that, from the results just written."""
+    bench_dir, out = tmp_path / "bench", tmp_path / "results"
+    bench_dir.mkdir()
+    _fake(bench_dir, "one", 2.5)
+    page = tmp_path / "performance.md"
+    page.write_text(f"# Performance\n{readme.BEGIN}\nold\n{readme.END}\nprose\n")
+    monkeypatch.setattr(bench_cli, "BENCH_DIR", bench_dir)
+    monkeypatch.setattr(bench_cli, "PERFORMANCE_PAGE", page)
+    assert main(["bench", "--out", str(out), flag]) == 0
+    text = page.read_text()
+    assert text.startswith(f"# Performance\n{readme.BEGIN}\n") and text.endswith(
+        f"{readme.END}\nprose\n")
+    assert readme.current(page) == readme.render(out) and "| case | metric | 2.500 s | full |" \
+        in text
 
 
 MACHINE = {"date": "2026-01-02 03:04 UTC", "cpu": "Test CPU", "cores": 2, "casadi": "3.8.0",
@@ -80,19 +103,20 @@ def test_format_value(value, text):
     assert readme.format_value(value) == text
 
 
-def test_update_readme_replaces_only_the_marked_text(tmp_path):
+def test_update_page_replaces_only_the_marked_text(tmp_path):
     folder = _results(tmp_path / "r", [dict(benchmark="a", case="c", metric="m", value=1.5,
                                             unit="s", note="")])
-    path = tmp_path / "README.md"
+    path = tmp_path / "performance.md"
     path.write_text(f"intro\n{readme.BEGIN}\nold 42\n{readme.END}\nrest\n")
-    assert readme.update_readme(path, folder)
+    assert readme.update_readme is readme.update_page  # the former name still works
+    assert readme.update_page(path, folder)
     text = path.read_text()
     assert text.startswith(f"intro\n{readme.BEGIN}\n") and text.endswith(f"{readme.END}\nrest\n")
     assert "old 42" not in text and readme.current(path) == readme.render(folder)
-    assert not readme.update_readme(path, folder)  # nothing to change the second time
+    assert not readme.update_page(path, folder)  # nothing to change the second time
     path.write_text("no markers\n")
     with pytest.raises(ValueError, match="markers"):
-        readme.update_readme(path, folder)
+        readme.update_page(path, folder)
 
 
 FAKE = '''

@@ -64,12 +64,12 @@ def quat_from_dcm(A):
     """Quaternion from a rotation matrix by the largest-diagonal algorithm [1]_.
 
     Steps 1-5 of [1]_ (re-derived from Eqs. 4.79-4.80; the OCR of step 1 is garbled):
-    with ``T = tr A`` and ``p = 2 q`` the symmetric matrix ``P = p p^T`` is
+    with ``T = tr A`` and ``p = 2 q`` the symmetric matrix ``P = p p^T`` is::
 
-    ``P = [[1+2A11-T, A12+A21, A13+A31, A23-A32],
-           [A12+A21, 1+2A22-T, A23+A32, A31-A13],
-           [A13+A31, A23+A32, 1+2A33-T, A12-A21],
-           [A23-A32, A31-A13, A12-A21, 1+T]]``.
+        P = [[1+2A11-T, A12+A21, A13+A31, A23-A32],
+             [A12+A21, 1+2A22-T, A23+A32, A31-A13],
+             [A13+A31, A23+A32, 1+2A33-T, A12-A21],
+             [A23-A32, A31-A13, A12-A21, 1+T]]
 
     The row ``k`` of the largest diagonal element gives ``q = P[k] / (2 sqrt(P[k, k]))`` up to
     sign, chosen so that ``q4 >= 0``.

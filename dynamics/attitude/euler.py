@@ -163,10 +163,11 @@ def _euler313(A):
 
 
 def quat_from_euler313(angles):
-    """Quaternion from classical 3-1-3 angles (Sec. 4.3 d C).
+    """Quaternion from classical 3-1-3 angles (Sec. 4.3 d C)::
 
-    ``q = [sin(t/2) cos((psi-phi)/2), sin(t/2) sin((psi-phi)/2),
-           cos(t/2) sin((psi+phi)/2), cos(t/2) cos((psi+phi)/2)]``
+        q = [sin(t/2) cos((psi-phi)/2), sin(t/2) sin((psi-phi)/2),
+             cos(t/2) sin((psi+phi)/2), cos(t/2) cos((psi+phi)/2)]
+
     (not sign-normalized: ``q4`` may be negative).
 
     Parameters

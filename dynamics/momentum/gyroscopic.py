@@ -11,7 +11,7 @@ Moving a term to the right-hand side makes it a torque on the main body:
 
 * `wheel_torque` -- momentum (reaction) wheel, ``L = -I_m omegadot`` (Eq. 4.148);
 * `cmg_torque` -- control moment gyro, ``L = -w_c x H_m`` (Eq. 4.150);
-* `coriolis_torque` -- Coriolis reaction torque ``L_R = -2 Omega . C_m x omega`` (Eq. 4.151);
+* `coriolis_torque` -- Coriolis reaction torque ``L_R = -2 Omega·C_m x omega`` (Eq. 4.151);
 * `propeller_torque` -- the seed's Example 1, a propeller on a yawing airplane;
 * `gyroscope_reaction_torque` -- symmetric gyroscope, ``L_R = -Omega x H`` (Eq. 4.152).
 
@@ -62,7 +62,7 @@ def _matvec(M, v):
 
 
 def wheel_torque(wheel_inertia, wheel_accel):
-    """Momentum-wheel control torque on the body, ``L_c = -I_m . omegadot_c`` (Eq. 4.148).
+    """Momentum-wheel control torque on the body, ``L_c = -I_m·omegadot_c`` (Eq. 4.148).
 
     The wheel spins about a principal axis, so ``omega x I_m omega = 0``; the torque is the
     reaction to its relative angular acceleration. Vector form: with a scalar axial moment
@@ -127,7 +127,7 @@ def cmg_torque(gimbal_rate_vector, rotor_momentum):
 
 
 def coriolis_torque(Omega, omega, inertia):
-    """Coriolis reaction torque ``L_R = -2 Omega . C_m x omega`` (Eq. 4.151).
+    """Coriolis reaction torque ``L_R = -2 Omega·C_m x omega`` (Eq. 4.151).
 
     ``C_m = (1/2 tr I_m) E - I_m`` (Eq. 4.144). In the principal axes of the moving mass
     (moments ``I_1, I_2, I_3``) this is the seed's component form

@@ -247,7 +247,7 @@ def _drag(r, v, symbolic: bool) -> list:
 
 
 def drag_force(r, v):
-    """Aerodynamic drag on the vehicle, as the model applies it (``v' = ... - D / m``).
+    """Aerodynamic drag on the vehicle, as the model applies it (the term ``- D / m`` of ``v'``).
 
     ``D = 1/2 CD S_REF rho(h) sqrt(v_rel . v_rel + V_REL_EPS^2) v_rel`` with ``v_rel = v -
     omega_E x r`` and ``rho = RHO0 exp(-(|r| - RE) / H_SCALE)``.

@@ -1,4 +1,4 @@
-"""The ``appdyn`` command line.
+"""The ``appdyn`` command line::
 
     appdyn simulate torque-free --inertia 1,2,3 --w0 -1,0.1,0.8 --t-final 50 [--plot F.png]
     appdyn simulate launch-vehicle --thrust F --inertia I --arm L --mass M --k-psi K --k-psidot KD
@@ -16,7 +16,7 @@
     appdyn dispersion spin [--samples N] [--seed S] [--workers N | --scheduler ADDR] [--plot F.png]
     appdyn ascent delta3 [--N N] [--refine-tol TOL | --no-refine] [--plot F.png] [--json F]
     appdyn demo
-    appdyn bench [NAME ...] [--quick] [--out DIR] [--readme]
+    appdyn bench [NAME ...] [--quick] [--out DIR] [--docs]
 
 One module per command (`simulate`, `slew`, `stability`, `cmg`, `gains`, `dispersion`, `ascent`, `demo`,
 `bench`), each with

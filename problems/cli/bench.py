@@ -1,4 +1,4 @@
-"""``appdyn bench [NAME ...] [--quick] [--out DIR] [--readme]``: run the benchmarks of the
+"""``appdyn bench [NAME ...] [--quick] [--out DIR] [--docs]``: run the benchmarks of the
 source checkout's ``bench/`` folder.
 
 Each ``bench/NAME.py`` (names starting with ``_`` are helpers) follows the protocol of
@@ -6,8 +6,9 @@ Each ``bench/NAME.py`` (names starting with ``_`` are helpers) follows the proto
 benchmark, calls ``run``, prints its summary rows and, at the end, one table of all of them;
 it writes ``OUT/summary.csv`` (a partial run replaces only the rows of the benchmarks that
 ran and keeps the others) and ``OUT/machine.json``. A benchmark that raises is reported in
-one line on stderr and the others still run (exit status 1 then). ``--readme`` regenerates
-the README's "Performance" tables from ``OUT`` (``bench/_readme.py``).
+one line on stderr and the others still run (exit status 1 then). ``--docs`` regenerates
+the tables of the performance page, ``docs/performance.md``, from ``OUT``
+(``bench/_readme.py``); ``--readme`` is its former name, kept as an alias.
 
 Exit status: 0 all ran; 1 a benchmark raised (or returned no list of rows); 2 unknown names
 or no ``bench/`` folder.
@@ -24,12 +25,15 @@ import traceback
 from dataclasses import asdict, fields, is_dataclass
 from pathlib import Path
 
-__all__ = ["add_parser", "check", "run", "BENCH_DIR", "load", "read_summary", "merge_rows"]
+__all__ = ["add_parser", "check", "run", "BENCH_DIR", "PERFORMANCE_PAGE", "load", "read_summary",
+           "merge_rows"]
 
 #: the benchmark scripts, next to the packages in a source checkout
 BENCH_DIR = Path(__file__).resolve().parents[2] / "bench"
 #: where ``_common`` and ``_readme`` come from when BENCH_DIR has none (a test's fake folder)
 _HOME_BENCH = BENCH_DIR
+#: the page whose marked part ``--docs`` regenerates (the tables left the README for it)
+PERFORMANCE_PAGE = BENCH_DIR.parent / "docs" / "performance.md"
 
 
 def add_parser(subparsers):
@@ -37,7 +41,7 @@ def add_parser(subparsers):
     bench = subparsers.add_parser(
         "bench", help="run benchmarks from the bench/ folder",
         description="Run the benchmarks of bench/ (all by default); write OUT/summary.csv and "
-                    "OUT/machine.json; --readme regenerates the README's Performance tables.",
+                    "OUT/machine.json; --docs regenerates the tables of docs/performance.md.",
         epilog="exit status: 0 all ran, 1 a benchmark raised, 2 unknown names or no bench/ folder")
     bench.set_defaults(_parser=bench)
     bench.add_argument("names", nargs="*", help="benchmark names (default: all), e.g. simulate")
@@ -46,8 +50,10 @@ def add_parser(subparsers):
                             "in under two minutes)")
     bench.add_argument("--out", type=Path, default=None, metavar="DIR",
                        help="output folder (default: bench/results/)")
-    bench.add_argument("--readme", action="store_true",
-                       help="regenerate the README's Performance section from the results")
+    bench.add_argument("--docs", "--readme", dest="docs", action="store_true",
+                       help="regenerate the tables of the docs' performance page "
+                            "(docs/performance.md) from the results; --readme is its "
+                            "former name")
     return bench
 
 
@@ -169,8 +175,7 @@ def run(args) -> int:
         print(f"appdyn bench: {len(failed)} benchmark(s) failed: {', '.join(failed)}"
               + (f"; earlier rows of {', '.join(kept)} in summary.csv kept" if kept else ""),
               file=sys.stderr)
-    if args.readme:
-        readme = BENCH_DIR.parent / "README.md"
-        _helper("_readme").update_readme(readme, out)
-        print(f"updated the Performance section of {readme}")
+    if args.docs:
+        _helper("_readme").update_page(PERFORMANCE_PAGE, out)
+        print(f"updated the tables of {PERFORMANCE_PAGE}")
     return 1 if failed else 0

@@ -80,7 +80,7 @@ class KeepOut:
         return math.cos(self.half_angle) - cosang
 
     def function(self) -> ca.Function:
-        """Path constraint ``g(x, u, p) = b . A(q) s - cos(half_angle) <= 0``."""
+        """Path constraint ``g(x, u, p) = dot(b, A(q) s) - cos(half_angle) <= 0``."""
         x, u, p = ca.SX.sym("x", 7), ca.SX.sym("u", 3), ca.SX.sym("p", 0)
         g = ca.dot(ca.DM(self.boresight), ca.mtimes(dcm_from_quat(x[:4]), ca.DM(self.direction)))
         return ca.Function("keep_out", [x, u, p], [g - math.cos(self.half_angle)],

@@ -9,6 +9,7 @@ stability boundaries), gain/phase margins for feedback loops, and ``success`` / 
 
 Cases
 -----
+=====================  ======================================================================
 `spin`                 torque-free spin about a principal axis, optionally with an energy damper
 `heavy_top`            Method III, Example 1 (Eqs. 4.122-4.132)
 `spinning_projectile`  Example 2: aerodynamic overturning moment in place of ``m g l``
@@ -25,6 +26,7 @@ Cases
 `hinged_spin`          two hinged bodies spinning together about a common axis (ball or
                        revolute hinge), reduced to the independent tilt coordinates
 `analyze`              any ``StateSpace`` (e.g. from `dynamics.linearize.linearize`)
+=====================  ======================================================================
 
 `sweep` runs a case along one parameter and locates each verdict boundary by bisection.
 
