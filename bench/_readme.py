@@ -36,6 +36,8 @@ TITLES = {
     "overhead": "Per-call Python overhead of `simulate` on a 2-point grid, cached model "
                 "(`bench/overhead.py`)",
     "stress": "Stress cases (`bench/stress.py`)",
+    "trust": "A new user's first hour: slews and saturated-law simulations, each in a fresh "
+             "process (`bench/trust.py`)",
 }
 
 

@@ -391,9 +391,27 @@ def _polish_record(ran: bool, why: str, *, wall_time=0.0, budget=None, method=No
             "T_after": T_after, "gain": gain}
 
 
-def polish_text(record: dict) -> str:
+def polish_text(record: Mapping) -> str:
     """One line for a message or summary from a `solve_time_optimal` ``info['polish']``
     record.
+
+    Parameters
+    ----------
+    record : mapping
+        ``info['polish']`` of a time-optimal slew: ``ran``, ``why`` and, when it ran,
+        ``used``, ``method``, ``wall_time`` [s], ``budget`` [s], ``T_before``, ``T_after``
+        [s], ``gain`` [s].
+
+    Returns
+    -------
+    str
+
+    Raises
+    ------
+    TypeError
+        If ``record`` is not a mapping.
+    ValueError
+        If ``record`` lacks a key the line needs.
 
     Examples
     --------
@@ -401,7 +419,15 @@ def polish_text(record: dict) -> str:
     >>> polish_text({"ran": False, "used": False, "why": "polish=False"})
     'polish skipped: polish=False'
     """
-    if not record.get("ran"):
+    if not isinstance(record, Mapping):
+        raise TypeError(f"`record` must be a mapping (a slew's info['polish']), got "
+                        f"{type(record).__name__}")
+    need = ("ran", "why") + (("used", "wall_time", "budget") if record.get("ran") else ())
+    need += ("T_before", "T_after", "gain") if record.get("ran") and record.get("used") else ()
+    missing = [key for key in need if key not in record]
+    if missing:
+        raise ValueError(f"`record` lacks {missing}: pass a time-optimal slew's info['polish']")
+    if not record["ran"]:
         return f"polish skipped: {record['why']}"
     head = (f"polish ({record.get('method') or 'none'}, {record['wall_time']:.3g} s of a "
             f"{record['budget']:.3g} s budget)")

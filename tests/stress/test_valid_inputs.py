@@ -321,6 +321,12 @@ RANDOM_OVERRIDES = {
         lambda n: st.lists(vectors(5, -1e3, 1e3), min_size=n, max_size=n)).map(np.array)},
     "appdyn.ocp.scenario_problem": {"T": log_floats(0.5, 5.0)},
     "appdyn.problems.slew.min_effort": {"T": log_floats(2.0, 20.0), "inertia": inertia_matrices()},
+    "appdyn.problems.slew.polish_text": {"record": st.fixed_dictionaries({
+        "ran": st.booleans(), "used": st.booleans(), "why": st.text(max_size=20),
+        "method": st.sampled_from(("switch-times", "moving-knots", None)),
+        "wall_time": floats(0.0, 100.0), "budget": floats(0.5, 100.0),
+        "T_before": floats(0.1, 100.0), "T_after": floats(0.1, 100.0),
+        "gain": floats(-1.0, 1.0)})},
     "appdyn.problems.slew.eigenaxis_time": {"inertia": moments().map(np.diag),
                                      "angle": floats(0.1, math.pi),
                                      "axis": st.integers(0, 2).map(lambda i: np.eye(3)[i])},
