@@ -41,16 +41,19 @@ NAME = "trust"
 _CASES = textwrap.dedent('''
     import json, math, sys, time
     import numpy as np
-    try:
-        from appdyn.dynamics import closed_loop, rigid_body, simulate
-        from appdyn.dynamics.attitude import quat_conj, quat_mul
-        from appdyn.dynamics.momentum import wheel_spacecraft
-        from appdyn.problems import slew
-    except ImportError:  # an older checkout: top-level packages
-        from dynamics import closed_loop, rigid_body, simulate
-        from dynamics.attitude import quat_conj, quat_mul
-        from dynamics.momentum import wheel_spacecraft
-        from problems import slew
+    import importlib, os
+    # the baseline checkout first on sys.path: its own packages (older ones are top-level)
+    prefixes = ("", "appdyn.") if os.environ.get("APPDYN_BENCH_SIDE") == "before" else ("appdyn.", "")
+    for prefix in prefixes:
+        try:
+            dyn = importlib.import_module(prefix + "dynamics")
+            break
+        except ImportError:
+            continue
+    closed_loop, rigid_body, simulate = dyn.closed_loop, dyn.rigid_body, dyn.simulate
+    quat_conj, quat_mul = dyn.attitude.quat_conj, dyn.attitude.quat_mul
+    wheel_spacecraft = dyn.wheel_spacecraft
+    slew = importlib.import_module(prefix + "problems.slew")
     import casadi as ca
     from scipy.integrate import solve_ivp
 
@@ -81,7 +84,8 @@ _CASES = textwrap.dedent('''
             x0 = np.r_[0, 0, 0, 1.0, 0, 0, 0, 0, 0, 0]
             run = lambda: simulate(loop, x0, t, rtol=1e-6)
             f = loop.f
-            rhs = lambda s, y: np.asarray(f(y, np.zeros(loop.nu), loop.p_default), float).ravel()
+            p = loop.resolve_p(None)
+            rhs = lambda s, y: np.asarray(f(y, np.zeros(loop.nu), p), float).ravel()
         else:
             bang = lambda s: 0.1 * np.sign(np.sin(2 * np.pi * s / 7)) * np.array([1.0, -1.0, 0.5])
             model = rigid_body(inertia)
@@ -111,7 +115,7 @@ def _run_case(case: str, root: Path | None) -> dict:
     """One case in a fresh process (``root``: a checkout first on ``sys.path``)."""
     env = dict(os.environ)
     if root is not None:
-        env["PYTHONPATH"] = str(root)
+        env.update(PYTHONPATH=str(root), APPDYN_BENCH_SIDE="before")
     proc = subprocess.run([sys.executable, "-c", _CASES, case], capture_output=True, text=True,
                           env=env, cwd=root or Path.cwd(), timeout=1800)
     if proc.returncode != 0:

@@ -4,21 +4,6 @@ SUNDIALS CVODES, and an ``auto`` mode that meets a requested global tolerance.
 The public entry points are `dynamics.simulate`, `dynamics.SimulationResult`,
 `dynamics.BatchResult`, `dynamics.Event` and `dynamics.METHODS`; the modules of this package are its internals, one job each:
 
-``api``         `simulate`: checks the inputs, runs the method, builds the result
-``inputs``      normalisation and checks of ``t``, ``x0``, ``u``, tolerances -> `Problem`
-``tableaux``    Butcher tableaux (data only) and stage nodes
-``kernels``     one step of a method as a CasADi Function (explicit RK, Lie group CF4)
-``loops``       the chunk Function (``mapaccum`` of steps, jit) and the fixed-step runner
-``cvodes``      SUNDIALS CVODES through ``casadi.integrator``
-``auto``        Richardson global-error estimates, round-off floor, stiffness test
-``result``      `SimulationResult` and its dense output; `Run`, one run's outcome
-``evaluate``    buffered numeric evaluation of Functions (no per-element conversion)
-``events``      event functions (``events=``): zero crossings located on the solution,
-                `Event`; a terminal event truncates the result
-``batch``       K runs at once (``x0`` of shape (nx, K)): the chunk loop mapped over the
-                runs on threads, ``auto``'s error control over the batch; `BatchResult`
-==============  ===========================================================================
-=======
 ===============  ===========================================================================
 ``api``          `simulate`: checks the inputs, runs the method, builds the result
 ``inputs``       normalisation and checks of ``t``, ``x0``, ``u``, tolerances -> `Problem`
