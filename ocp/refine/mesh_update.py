@@ -17,7 +17,7 @@ from ..checks import (STATUS_BOUND_VIOLATION, STATUS_RESIMULATION, interval_boun
                       periodic_jumps)
 from ..mesh import Mesh
 from ..problem import Problem
-from ..progress import LOGGER
+from ..progress import LOGGER, stage_sink
 from ..solution import Solution
 from ..solve import solve
 from ..transcription import Radau, Transcription, get_transcription
@@ -181,7 +181,7 @@ def _report(rnd: int, r: RefinementRound, verbose, progress) -> None:
             f"cost {r.cost:.12g}, {r.iterations} iterations")
     LOGGER.info(line)
     if verbose is True:
-        print(line, file=sys.stderr, flush=True)
+        print(f"[refine] {line}", file=sys.stderr, flush=True)
     if progress is not None:
         progress(r)
 
@@ -354,10 +354,11 @@ def refine(problem: Problem, solution: Solution | None = None, *, tol: float = 1
         sol = solution
     elif solution is not None:
         sol = solve(problem, transcription=tr, mesh=solution.mesh,
-                    guess=solution if guess0 is None else guess0, verbose=verbose, **kw)
+                    guess=solution if guess0 is None else guess0,
+                    verbose=stage_sink(verbose, "refine round 0"), **kw)
     else:
         sol = solve(problem, transcription=tr, N=None if mesh0 is not None else N, mesh=mesh0,
-                    guess=guess0, verbose=verbose, **kw)
+                    guess=guess0, verbose=stage_sink(verbose, "refine round 0"), **kw)
     history, meshes = [], []
     stop, est, best = "", None, None
     for rnd in range(max_rounds + 1):
@@ -391,7 +392,8 @@ def refine(problem: Problem, solution: Solution | None = None, *, tol: float = 1
             stop = f"max_intervals = {max_intervals} reached"
             break
         t_round = time.perf_counter()
-        sol = solve(problem, transcription=tr, mesh=mesh, guess=sol, verbose=verbose, **kw)
+        sol = solve(problem, transcription=tr, mesh=mesh, guess=sol,
+                    verbose=stage_sink(verbose, f"refine round {rnd + 1}"), **kw)
     converged = est is not None and sol.success and est.max_error <= tol
     if not sol.success:
         message = f"refine: {stop}: {sol.message}"

@@ -659,7 +659,8 @@ def min_effort(inertia, T, *, angle=None, axis=None, q0=None, qf=None, u_max=Non
         J = float(np.max(np.linalg.eigvalsh(inertia_of(problem.model))))
         d = 6.0 * (J * slew_angle(problem)) ** 2 / problem.T ** 3
         scale = {"objective": float(2.0 ** round(math.log2(d)))}
-    opts = dict(N=N, verbose=verbose, ipopt_options=ipopt_options, scale=scale)
+    opts = dict(N=N, verbose=stage_sink(verbose, "slew"), ipopt_options=ipopt_options,
+                scale=scale)
     if guess is not None:
         first = solve(problem, guess=guess, **opts)
     elif keep_out is None:

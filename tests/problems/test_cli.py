@@ -150,3 +150,20 @@ def test_slew_verbose_keeps_stdout_to_the_summary(tmp_path, capfd):
     assert data["polish"]["ran"] and data["polish"]["used"]
     assert data["polish"]["gain"] == pytest.approx(data["polish"]["T_before"] - data["T"])
     assert data["wall_time"] >= data["polish"]["wall_time"] + data["solve_time"]
+
+
+def test_min_effort_verbose_labels_every_stage_on_stderr(tmp_path, capfd):
+    """A minimum-effort slew, verbose: the first solve's and each refinement round's IPOPT
+    lines go to stderr labelled ``[slew]``, ``[refine round k]`` and ``[refine]``; stdout
+    holds the summary only."""
+    import re
+
+    code = main(["slew", "--inertia", "1,2,3", "--min-effort", "4", "--axis", "0,0,1", "--angle", "60",
+                 "--json", str(tmp_path / "effort.json")])
+    stdout, stderr = capfd.readouterr()
+    assert code == 0
+    iteration = re.compile(r"^\s*\d+\s+[-+]?\d\.\d+e[-+]\d+")
+    assert not any(iteration.match(line) for line in stdout.splitlines()), stdout
+    assert "[slew]" in stderr and "[refine round 1]" in stderr and "[refine] refine round 0" in stderr
+    unlabelled = [line for line in stderr.splitlines() if line and not line.startswith("[")]
+    assert not unlabelled, unlabelled[:5]
