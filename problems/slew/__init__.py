@@ -49,9 +49,9 @@ wheels or CMGs, momentum exchanged inside the spacecraft), `report` (`switch_tim
 from __future__ import annotations
 
 from .devices import cmg_slew, wheel_slew
-from .maneuvers import bounded, min_effort, polish_text, time_optimal, verify
+from .maneuvers import bounded, min_effort, time_optimal, verify
 from .problem import attitude_guess, eigenaxis_time, slew_problem
-from .report import format_summary, plot_slew, summary, switch_times
+from .report import format_summary, plot_slew, polish_text, summary, switch_times
 from .table import ManeuverTable, example_targets, maneuver_table
 from .targets import (MIN_REFINE_TOL, POINTING_TOL, RATE_TOL, STATUS_POINTING, STATUS_REFINE,
                       KeepOut)

@@ -19,10 +19,11 @@ from appdyn.ocp.progress import stage_sink
 
 from .problem import (attitude_guess, inertia_of, is_rest_to_rest, rough_time, seeded_guesses,
                       slew_angle, slew_problem)
+from .report import polish_text
 from .targets import (ARCSEC, MIN_REFINE_TOL, POINTING_TOL, RATE_TOL, STATUS_POINTING,
                       STATUS_REFINE, check_tol)
 
-__all__ = ["time_optimal", "min_effort", "verify", "bounded", "polish_text", "DEFAULT_STARTS_TIME",
+__all__ = ["time_optimal", "min_effort", "verify", "bounded", "DEFAULT_STARTS_TIME",
            "DEFAULT_STARTS_EFFORT", "POLISH_MIN_BUDGET", "SEED_OPTIONS"]
 
 DEFAULT_STARTS_TIME = 3  # seeded starts of time_optimal without a user guess
@@ -389,52 +390,6 @@ def _polish_record(ran: bool, why: str, *, wall_time=0.0, budget=None, method=No
     return {"ran": ran, "used": used, "why": why, "method": method, "wall_time": wall_time,
             "budget": budget, "T_before": T_before, "T_polished": T_polished,
             "T_after": T_after, "gain": gain}
-
-
-def polish_text(record: Mapping) -> str:
-    """One line for a message or summary from a `solve_time_optimal` ``info['polish']``
-    record.
-
-    Parameters
-    ----------
-    record : mapping
-        ``info['polish']`` of a time-optimal slew: ``ran``, ``why`` and, when it ran,
-        ``used``, ``method``, ``wall_time`` [s], ``budget`` [s], ``T_before``, ``T_after``
-        [s], ``gain`` [s].
-
-    Returns
-    -------
-    str
-
-    Raises
-    ------
-    TypeError
-        If ``record`` is not a mapping.
-    ValueError
-        If ``record`` lacks a key the line needs.
-
-    Examples
-    --------
-    >>> from appdyn.problems.slew.maneuvers import polish_text
-    >>> polish_text({"ran": False, "used": False, "why": "polish=False"})
-    'polish skipped: polish=False'
-    """
-    if not isinstance(record, Mapping):
-        raise TypeError(f"`record` must be a mapping (a slew's info['polish']), got "
-                        f"{type(record).__name__}")
-    need = ("ran", "why") + (("used", "wall_time", "budget") if record.get("ran") else ())
-    need += ("T_before", "T_after", "gain") if record.get("ran") and record.get("used") else ()
-    missing = [key for key in need if key not in record]
-    if missing:
-        raise ValueError(f"`record` lacks {missing}: pass a time-optimal slew's info['polish']")
-    if not record["ran"]:
-        return f"polish skipped: {record['why']}"
-    head = (f"polish ({record.get('method') or 'none'}, {record['wall_time']:.3g} s of a "
-            f"{record['budget']:.3g} s budget)")
-    if record.get("used"):
-        return (f"{head}: T {record['T_before']:.10g} -> {record['T_after']:.10g} s, gain "
-                f"{record['gain']:.3g} s")
-    return f"{head} not used: {record['why']}"
 
 
 def solve_time_optimal(problem, guess, guesses, opts, *, polish, pointing_tol, rate_tol,

@@ -12,7 +12,7 @@ from appdyn.ocp.solution import draw_bounds
 
 from .targets import ARCSEC
 
-__all__ = ["switch_times", "summary", "format_summary", "plot_slew"]
+__all__ = ["switch_times", "polish_text", "summary", "format_summary", "plot_slew"]
 
 
 def switch_times(solution: Solution, *, component=None, axis=None) -> list:
@@ -73,6 +73,52 @@ def switch_times(solution: Solution, *, component=None, axis=None) -> list:
 
 
 # ----------------------------------------------------------------------- reporting
+def polish_text(record: Mapping) -> str:
+    """One line for a message or summary from a `solve_time_optimal` ``info['polish']``
+    record.
+
+    Parameters
+    ----------
+    record : mapping
+        ``info['polish']`` of a time-optimal slew: ``ran``, ``why`` and, when it ran,
+        ``used``, ``method``, ``wall_time`` [s], ``budget`` [s], ``T_before``, ``T_after``
+        [s], ``gain`` [s].
+
+    Returns
+    -------
+    str
+
+    Raises
+    ------
+    TypeError
+        If ``record`` is not a mapping.
+    ValueError
+        If ``record`` lacks a key the line needs.
+
+    Examples
+    --------
+    >>> from appdyn.problems.slew import polish_text
+    >>> polish_text({"ran": False, "used": False, "why": "polish=False"})
+    'polish skipped: polish=False'
+    """
+    if not isinstance(record, Mapping):
+        raise TypeError(f"`record` must be a mapping (a slew's info['polish']), got "
+                        f"{type(record).__name__}")
+    need = ("ran", "why") + (("used", "wall_time", "budget") if record.get("ran") else ())
+    need += ("T_before", "T_after", "gain") if record.get("ran") and record.get("used") else ()
+    missing = [key for key in need if key not in record]
+    if missing:
+        raise ValueError(f"`record` lacks {missing}: pass a time-optimal slew's info['polish']")
+    if not record["ran"]:
+        return f"polish skipped: {record['why']}"
+    head = (f"polish ({record.get('method') or 'none'}, {record['wall_time']:.3g} s of a "
+            f"{record['budget']:.3g} s budget)")
+    if record.get("used"):
+        return (f"{head}: T {record['T_before']:.10g} -> {record['T_after']:.10g} s, gain "
+                f"{record['gain']:.3g} s")
+    return f"{head} not used: {record['why']}"
+
+
 def summary(solution: Solution, *, eigenaxis=None) -> dict:
     """JSON-ready summary of a slew solution.
 
@@ -80,7 +126,9 @@ def summary(solution: Solution, *, eigenaxis=None) -> dict:
     iterations, solve_time [s], constraint_violation (NLP units, see `ocp.solve`),
     pointing_error_arcsec (final attitude error of the re-simulated control [arcsec]),
     final_rate_error [rad/s] (same re-simulation), propagation_error (largest deviation of
-    the re-integrated trajectory from the collocated states), quaternion_norm_error, and
+    the re-integrated trajectory from the collocated states), quaternion_norm_error;
+    ``polish`` (what the switch-time polish did, `polish_text`) and ``wall_time`` [s] (the
+    whole pipeline, multi-start, polish and checks included) of a time-optimal slew; and
     ``eigenaxis_T`` [s] when given. Re-simulation numbers are NaN when it failed.
 
     Raises
@@ -123,6 +171,10 @@ def summary(solution: Solution, *, eigenaxis=None) -> dict:
         propagation_error=float(solution.propagation_error),
         quaternion_norm_error=float(solution.quaternion_norm_error),
     )
+    if "polish" in info:  # time-optimal: whether the switch-time polish ran, what it gained
+        out["polish"] = dict(info["polish"])
+    if "wall_time" in info:
+        out["wall_time"] = float(info["wall_time"])
     if eigenaxis is not None:
         out["eigenaxis_T"] = float(eigenaxis)
     return out
@@ -181,6 +233,10 @@ def format_summary(data: dict) -> str:
         ("propagation error", f"{data['propagation_error']:.2e}"),
         ("|q| - 1 (max)", f"{data['quaternion_norm_error']:.2e}"),
     ]
+    if "polish" in data:
+        rows.append(("switch-time polish", polish_text(data["polish"])))
+    if "wall_time" in data:
+        rows.append(("wall time, total [s]", f"{data['wall_time']:.3f}"))
     width = max(len(k) for k, _ in rows)
     return "\n".join(["Optimal slew"] + [f"  {k:<{width}}  {v}" for k, v in rows])
 
