@@ -257,7 +257,13 @@ def attitude_gains(inertia, scenarios, *, u_max, horizon=None, per_axis: bool = 
         xg.append(sim.x if sim.success else np.repeat(X0[:, k:k + 1], t_guess.size, 1))
     guess = {"t": t_guess, "x": np.vstack(xg), "p": g0}
     opts = {"tol": 1e-9, **dict(ipopt_options or {})}
-    sol = ocp.solve(problem, transcription=transcription, N=N, ipopt_options=opts, guess=guess)
+    # verify=False: the design is judged on the true closed loop (every scenario re-simulated
+    # by `dynamics.simulate` under the designed gains, its peak torque against the limit,
+    # below), not by the collocation's agreement with its own re-integration: on the random
+    # valid inputs of the stress tests a scenario's rate on a coarse mesh re-simulated 0.4 %
+    # of its size off the collocated one (cost 5.6e-6) and failed the generic gate
+    sol = ocp.solve(problem, transcription=transcription, N=N, ipopt_options=opts, guess=guess,
+                    verify=False)
     gains = np.asarray(sol.p, dtype=float)
 
     # ---- verification: linearized loop, re-simulation, time-optimal reference
