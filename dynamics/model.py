@@ -25,12 +25,12 @@ def _function_from_text(text: str) -> ca.Function:
 
 
 def _rebuild_model(f: str, states, controls, params, p_default, units: dict,
-                   invariants: dict, name: str, attitude) -> "Model":
+                   invariants: dict, name: str, attitude, layout=None, bounds=None) -> "Model":
     """Inverse of `Model.__reduce__`: deserialize the Functions, re-check, re-freeze."""
     return Model(_function_from_text(f), states, controls, params, p_default=p_default,
                  units=units,
                  invariants={k: _function_from_text(v) for k, v in invariants.items()},
-                 name=name, attitude=attitude)
+                 name=name, attitude=attitude, layout=layout or {}, bounds=bounds or {})
 
 
 @dataclass(frozen=True)
@@ -58,6 +58,13 @@ class Model:
         and its body angular velocity ``x[iw:iw+3]`` [rad/s] start, for models that carry
         an attitude. Geometric integrators and attitude linearization use it; ``None``
         when the model has no attitude.
+    layout : mapping of str to PartLayout, optional
+        For a model assembled from parts (`dynamics.scene.Scene.model`): each part's name to
+        its slices of ``x`` and ``u`` (`dynamics.scene.PartLayout`). Read states and controls
+        through it (``x[model.layout["wheels"].states]``), never by literal index.
+    bounds : mapping of str to (float, float), optional
+        Bounds ``(lower, upper)`` of named states and controls that come with the model (a
+        part's ``u_max``, a wheel's ``speed_max``); names without bounds are unbounded.
 
     Raises
     ------
@@ -90,6 +97,8 @@ class Model:
     invariants: Mapping[str, ca.Function] = field(default_factory=dict)
     name: str = "model"
     attitude: tuple[int, int] | None = None
+    layout: Mapping[str, object] = field(default_factory=dict)
+    bounds: Mapping[str, tuple] = field(default_factory=dict)
 
     def __post_init__(self):
         if not isinstance(self.f, ca.Function):
@@ -102,6 +111,12 @@ class Model:
         object.__setattr__(self, "p_default", p_default)
         object.__setattr__(self, "units", _freeze(self.units))
         object.__setattr__(self, "invariants", _freeze(self.invariants))
+        object.__setattr__(self, "layout", _freeze(self.layout))
+        unknown = [k for k in self.bounds if k not in self.states and k not in self.controls]
+        if unknown:
+            raise ValueError(f"`bounds` names unknown state(s) or control(s) {unknown}")
+        object.__setattr__(self, "bounds", _freeze(
+            {k: (float(lo), float(hi)) for k, (lo, hi) in dict(self.bounds).items()}))
 
         if self.f.name_in() != ["x", "u", "p"] or self.f.name_out() != ["xdot"]:
             raise ValueError(
@@ -170,7 +185,7 @@ class Model:
             self.f.serialize(), self.states, self.controls, self.params,
             np.array(self.p_default), dict(self.units),
             {k: fun.serialize() for k, fun in self.invariants.items()},
-            self.name, self.attitude))
+            self.name, self.attitude, dict(self.layout), dict(self.bounds)))
 
     # ------------------------------------------------------------------ sizes
     @property
@@ -187,6 +202,31 @@ class Model:
     def np(self) -> int:
         """Number of parameters."""
         return len(self.params)
+
+    # ----------------------------------------------------------------- bounds
+    def limits(self, which: str = "controls") -> tuple[np.ndarray, np.ndarray]:
+        """The ``bounds`` of the controls or states as two arrays (``-inf``/``inf`` where none).
+
+        Parameters
+        ----------
+        which : {'controls', 'states'}
+
+        Returns
+        -------
+        lower, upper : numpy.ndarray, shape (nu,) or (nx,)
+
+        Examples
+        --------
+        >>> from appdyn.dynamics.scene import ExternalTorque, RigidHub, Scene
+        >>> Scene(RigidHub([1.0, 2.0, 3.0]), ExternalTorque(u_max=0.5)).model().limits()
+        (array([-0.5, -0.5, -0.5]), array([0.5, 0.5, 0.5]))
+        """
+        if which not in ("controls", "states"):
+            raise ValueError(f"`which` must be 'controls' or 'states', got {which!r}")
+        names = self.controls if which == "controls" else self.states
+        lo = np.array([self.bounds.get(k, (-np.inf, np.inf))[0] for k in names], dtype=float)
+        hi = np.array([self.bounds.get(k, (-np.inf, np.inf))[1] for k in names], dtype=float)
+        return lo, hi
 
     # ------------------------------------------------------------- evaluation
     def resolve_p(self, p=None) -> np.ndarray:

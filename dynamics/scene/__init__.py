@@ -1,0 +1,34 @@
+"""Build any vehicle from parts: ``Scene(hub, *parts).model()``.
+
+A `Scene` is a `RigidHub` carrying parts; it assembles into one `Model` (named states and
+controls, units, bounds, invariants, and ``layout``: each part's slices). The part contract
+-- what a part declares and contributes, and the rules for adding one -- is the docstring of
+`dynamics.scene.contract`; the assembly (Kane's method on the symbols, one block solve) is
+`dynamics.scene.assembly`.
+
+Parts
+-----
+=====================  =====================================================================
+`ReactionWheels`       wheels driven by motor torques (states ``W``, controls ``tau``)
+`HeldRotor`            a rotor at constant relative speed (the gyrostat's wheel)
+`ExternalTorque`       body torque controls ``L1..L3``
+`ExternalForce`        force controls ``F1..F3`` at a hub point
+=====================  =====================================================================
+
+Examples
+--------
+>>> from appdyn.dynamics.scene import ExternalTorque, RigidHub, Scene
+>>> model = Scene(RigidHub([1.0, 2.0, 3.0]), ExternalTorque(u_max=1.0)).model()
+>>> model.nx, model.controls
+(7, ('L1', 'L2', 'L3'))
+"""
+from .assembly import PartLayout
+from .contract import Body, Contribution, Frame, Load, Part, PartVariables, Variable
+from .hubs import RigidHub
+from .loads import ExternalForce, ExternalTorque
+from .scene import Scene
+from .wheels import HeldRotor, ReactionWheels
+
+__all__ = ["Scene", "RigidHub", "Part", "PartLayout", "Variable", "PartVariables", "Body", "Load",
+           "Contribution", "Frame", "ReactionWheels", "HeldRotor", "ExternalTorque",
+           "ExternalForce"]

@@ -1,0 +1,265 @@
+"""The part contract: what a part of a `Scene` declares and what it contributes.
+
+A scene is a hub (`RigidHub`) carrying parts. The assembly (`dynamics.scene.assembly`) writes
+Euler's law and the quaternion kinematics once, by Kane's method on the symbols: every part
+describes its bodies kinematically and the loads it applies, the assembly forms the
+generalized inertia forces, the mass matrix and the right-hand side, and solves the block
+system once (hub accelerations from the Schur complement, then each part's: Basilisk's
+back-substitution, done symbolically so the result has exact derivatives).
+
+Rules for adding a part
+-----------------------
+A part is a frozen (hashable) dataclass deriving from `Part` whose fields are numbers, strings
+or tuples (convert arrays to tuples in ``__post_init__``, after validating them with a message
+that names the field). It sets ``kind`` (the default name, ``"wheels"``), and implements:
+
+``variables(self) -> PartVariables``
+    Its *coordinates* (positions: an angle, a displacement, a gimbal angle; or the clock),
+    its *speeds* (generalized speeds whose derivatives the assembly solves for) and its
+    *controls*, each a `Variable` with a name, a unit, a rest value, bounds, and for states
+    whether the slew jobs hold it at rest at the end (``terminal="rest"``) or leave it free
+    (``"free"``: a wheel speed, a gimbal angle). ``u_max`` is the one word for a control
+    bound: pass it to `Variable` as ``bounds=(-u_max, u_max)``. Names are local (``"s"``,
+    ``"W1"``); the scene makes them unique (a second damper's states become ``s_2``, ...).
+``contribute(self, frame, own) -> Contribution``
+    Given the hub `Frame` (its angular velocity ``w``, the velocity ``v`` of its reference
+    point, the DCM, positions measured from the hub's mass centre by `Frame.point`) and the
+    part's own symbols ``own`` (`PartSymbols`: ``own.coords``, ``own.speeds``,
+    ``own.controls``, each a column and each entry also by local name ``own["s"]``):
+
+    * ``rates``: the derivatives of its coordinates (in its speeds, coordinates, controls),
+    * ``bodies``: each moving mass as a `Body` -- absolute velocity of its mass centre and
+      absolute angular velocity (hub axes), its linear momentum and its angular momentum about
+      its mass centre (hub axes). The partial velocities, the mass matrix and every
+      Coriolis and centrifugal term follow from these by differentiation; a body may carry
+      momentum that is not ``I w`` (a held rotor's ``h a``),
+    * ``loads``: forces and torques as `Load` (a vector and the velocity it does work on: a
+      force with its point's velocity, a torque with the angular velocity of the body it acts
+      on, a spring's force with its coordinate's rate). A torque between the part and the hub
+      acts on the *relative* angular velocity; its reaction on the hub is then implied,
+    * ``potential``: its potential energy (springs, fields), ``kinetic``: only when its
+      kinetic energy is not ``1/2 (p.v + h.w)`` summed over its bodies,
+    * ``invariants``: further monitored quantities of the state, by name.
+
+    Loads that depend on the mass distribution of the whole scene (gravity) implement
+    ``field_loads(self, frame, bodies) -> Contribution`` instead, which receives every other
+    part's bodies.
+``spin_speeds(self, frame, own) -> expression`` (optional)
+    The part's speeds when it is at rest relative to a hub spinning at ``frame.w`` (zero
+    unless its speeds are absolute rates, as a spherical damper's core rate); used by
+    `Scene.state` and the spin stability case.
+
+Constraints are not part of the contract yet: every part is written in minimal coordinates,
+so an assembled model never forms a multiplier system (`dynamics.constrained` holds that
+machinery for the hand-written constrained models).
+
+Conventions: hub axes throughout, SI units, the quaternion scalar-last (inertial -> body).
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import ClassVar, Literal
+
+import casadi as ca
+
+__all__ = ["Variable", "PartVariables", "PartSymbols", "Body", "Load", "Contribution", "Frame",
+           "Part", "bounds_from_u_max"]
+
+
+@dataclass(frozen=True)
+class Variable:
+    """One named scalar of a part: a coordinate, a speed or a control.
+
+    Parameters
+    ----------
+    name : str
+        Local name (made unique by the scene).
+    unit : str
+        SI unit as printed (``"rad/s"``).
+    rest : float, optional
+        Value at rest (`Scene.state` fills unspecified blocks with it).
+    bounds : (float, float), optional
+        Lower and upper bound (controls: from ``u_max``; states: a speed limit).
+    terminal : {'rest', 'free'}, optional
+        Whether a rest-to-rest slew holds it at ``rest`` at the end.
+    """
+
+    name: str
+    unit: str
+    rest: float = 0.0
+    bounds: tuple = (-math.inf, math.inf)
+    terminal: Literal["rest", "free"] = "rest"
+
+
+@dataclass(frozen=True)
+class PartVariables:
+    """A part's declared coordinates, speeds and controls (tuples of `Variable`)."""
+
+    coords: tuple = ()
+    speeds: tuple = ()
+    controls: tuple = ()
+
+
+class PartSymbols:
+    """The symbols of one part inside an assembly: ``coords``, ``speeds``, ``controls``
+    (SX columns), and each scalar by its local name (``own["W1"]``)."""
+
+    def __init__(self, coords: ca.SX, speeds: ca.SX, controls: ca.SX, names: dict):
+        self.coords, self.speeds, self.controls = coords, speeds, controls
+        self._names = names
+
+    def __getitem__(self, name: str) -> ca.SX:
+        return self._names[name]
+
+
+@dataclass
+class Body:
+    """A moving mass of a part, described in hub axes.
+
+    Parameters
+    ----------
+    velocity : SX, 3x1 [m/s]
+        Absolute velocity of its mass centre (``frame.velocity(rho, rho_dot)``).
+    angular_velocity : SX, 3x1 [rad/s]
+        Absolute angular velocity.
+    momentum : SX, 3x1 [N s]
+        Linear momentum (``m * velocity``; zero for a massless rotor).
+    angular_momentum : SX, 3x1 [N m s]
+        Angular momentum about its mass centre (``I * angular_velocity``, plus any stored
+        momentum such as a held rotor's).
+    position : SX, 3x1 [m]
+        Its mass centre from the hub's reference point (for momentum about the reference and
+        for fields).
+    mass : float [kg]
+    inertia : SX, 3x3 [kg m^2]
+        About its mass centre (for fields; may depend on the coordinates).
+    """
+
+    velocity: ca.SX
+    angular_velocity: ca.SX
+    momentum: ca.SX
+    angular_momentum: ca.SX
+    position: ca.SX
+    mass: float = 0.0
+    inertia: ca.SX | None = None
+
+    @classmethod
+    def rigid(cls, mass: float, inertia, position, velocity, angular_velocity,
+              stored=None) -> "Body":
+        """A rigid body: ``p = m v``, ``h = I w (+ stored)``."""
+        I = ca.SX(inertia)
+        h = ca.mtimes(I, angular_velocity)
+        if stored is not None:
+            h = h + stored
+        return cls(velocity=velocity, angular_velocity=angular_velocity,
+                   momentum=mass * velocity, angular_momentum=h, position=position,
+                   mass=float(mass), inertia=I)
+
+
+@dataclass
+class Load:
+    """A generalized load: ``vector`` does work on ``velocity`` (power ``vector . velocity``).
+
+    A force and the velocity of its point, a torque and the angular velocity of the body it
+    acts on (relative to the hub for an internal motor), or a scalar spring force and its
+    coordinate's rate. The assembly maps it to generalized forces by the partial velocities.
+    """
+
+    vector: ca.SX
+    velocity: ca.SX
+
+
+@dataclass
+class Contribution:
+    """What a part adds to the assembly (module docstring, rules for adding a part)."""
+
+    rates: ca.SX | None = None
+    bodies: list = field(default_factory=list)
+    loads: list = field(default_factory=list)
+    potential: ca.SX | float = 0.0
+    kinetic: ca.SX | None = None
+    invariants: dict = field(default_factory=dict)
+
+
+@dataclass
+class Frame:
+    """The hub as its parts see it (hub axes).
+
+    Attributes
+    ----------
+    q : SX, 4x1
+        Hub attitude quaternion (scalar-last, inertial -> hub).
+    dcm : SX, 3x3
+        ``A(q)``: inertial -> hub components.
+    w : SX, 3x1 [rad/s]
+        Hub angular velocity.
+    v : SX, 3x1 [m/s]
+        Velocity of the hub's reference point (zero for an attitude-only hub, whose
+        reference point is fixed).
+    r : SX, 3x1 [m] or None
+        Inertial position of the reference point (six-degree-of-freedom hub only).
+    reference : tuple of float, shape (3,) [m]
+        The reference point from the hub's mass centre.
+    mass : float or None [kg]
+        Hub mass (None: attitude-only hub).
+    """
+
+    q: ca.SX
+    dcm: ca.SX
+    w: ca.SX
+    v: ca.SX
+    r: ca.SX | None
+    reference: tuple
+    mass: float | None
+
+    def point(self, from_mass_centre) -> ca.SX:
+        """A hub point given from the hub's mass centre, as measured from the reference."""
+        return ca.SX(ca.DM(from_mass_centre)) - ca.DM(self.reference)
+
+    def velocity(self, position, relative=None) -> ca.SX:
+        """Absolute velocity of a point at ``position`` (from the reference) moving at
+        ``relative`` with respect to the hub: ``v + w x position + relative``."""
+        out = self.v + ca.cross(self.w, position)
+        return out if relative is None else out + relative
+
+
+def bounds_from_u_max(u_max, n: int, name: str = "u_max") -> tuple:
+    """``n`` symmetric bounds ``(-u_max_i, u_max_i)`` (unbounded for None).
+
+    Raises
+    ------
+    ValueError
+        If ``u_max`` is not positive, or not a scalar or ``n`` values.
+    """
+    from ..validate import positive_each
+    if u_max is None:
+        return tuple((-math.inf, math.inf) for _ in range(n))
+    vals = positive_each(u_max, name, n)
+    return tuple((-float(v), float(v)) for v in vals)
+
+
+class Part:
+    """Base class of the parts of a `Scene` (the contract is the module docstring).
+
+    Subclasses are frozen dataclasses with a ``name`` field (``None``: the scene names it
+    after ``kind``).
+    """
+
+    kind: ClassVar[str] = "part"
+
+    def variables(self) -> PartVariables:
+        """The part's coordinates, speeds and controls."""
+        return PartVariables()
+
+    def contribute(self, frame: Frame, own: PartSymbols) -> Contribution:
+        """The part's rates, bodies, loads, energy and invariants (module docstring)."""
+        return Contribution()
+
+    def field_loads(self, frame: Frame, bodies: list) -> Contribution:
+        """Loads that act on every body of the scene (gravity); none by default."""
+        return Contribution()
+
+    def spin_speeds(self, frame: Frame, own: PartSymbols):
+        """The part's speeds at rest relative to a hub turning at ``frame.w`` (zero)."""
+        return ca.DM.zeros(own.speeds.numel())
