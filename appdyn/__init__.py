@@ -19,6 +19,7 @@ The subpackages are imported on first use (``import appdyn`` alone is cheap):
 from __future__ import annotations
 
 import importlib
+import os as _os
 from importlib.metadata import PackageNotFoundError, version as _version
 
 try:
@@ -27,6 +28,14 @@ except PackageNotFoundError:  # a source tree that was not installed
     __version__ = "0+unknown"
 
 __all__ = ["__version__", "dynamics", "ocp", "problems"]
+
+# A source checkout run in place (cwd or PYTHONPATH at the repository root, nothing
+# installed from it): the subpackages live beside this folder, as setup.py maps them.
+_ROOT = _os.path.dirname(_os.path.dirname(_os.path.abspath(__file__)))
+if (_os.path.isfile(_os.path.join(_ROOT, "pyproject.toml"))
+        and _os.path.isdir(_os.path.join(_ROOT, "dynamics", "scene"))
+        and _ROOT not in __path__):
+    __path__.append(_ROOT)
 
 _SUBPACKAGES = ("dynamics", "ocp", "problems")
 
