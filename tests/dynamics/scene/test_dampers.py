@@ -319,3 +319,32 @@ def test_scene_parts_keep_the_stability_names_and_state_helpers():
                            damper=SphericalDamper(0.5, 0.1), damper_on="rotor", wheel_rate=7.0)
     np.testing.assert_array_equal(x[7:], [0.0, 0.0, 8.0])
     assert model.layout["damper"].speeds == slice(7, 10)
+
+
+# ------------------------------------------------------- slosh: a sympy Kane model
+def test_slosh_hub_equals_an_independent_sympy_kane_model():
+    """A free hub (reference point off its mass centre) with a damped pendulum hinged off
+    the mass centre, a damped spring-mass and a force at a third point: the scene's
+    accelerations equal sympy.mechanics' Kane equations (Euler angles, physical spring
+    force pair) to 1e-12 at random states."""
+    from .kane_slosh import slosh_hub_equations
+    pend = Slosh(2.0, length=0.4, hinge=(0.3, 0.1, -0.2), direction=(0.3, -1.0, 0.2),
+                 damping=0.3)
+    spring = Slosh(1.5, kind="spring", frequency=4.0, damping=0.7, position=(0.0, 0.5, 0.1),
+                   direction=(0.2, 0.3, 1.0))
+    ref, point = (0.1, -0.2, 0.3), (0.4, 0.0, -0.5)
+    scene = Scene(RigidHub(IH, mass=40.0, reference=ref), pend, spring, ExternalForce(point=point))
+    model = scene.model()
+    truth = slosh_hub_equations(IH, 40.0, ref, point, pend, spring)
+    rows = [model.states.index(n) for n in
+            ("w1", "w2", "w3", "v1", "v2", "v3", "theta1_dot", "theta2_dot", "s_dot")]
+    rng = np.random.default_rng(7)
+    for _ in range(5):
+        q = rng.normal(size=4)
+        x = scene.state(q=q / np.linalg.norm(q), w=rng.normal(size=3), r=rng.normal(size=3),
+                        v=rng.normal(size=3), pendulum=rng.normal(size=4),
+                        spring=rng.normal(size=2) * [0.2, 1.0])
+        F = rng.normal(size=3) * 10.0
+        want = truth(x[4:7], x[10:13], x[13:15], x[15:17], x[17], x[18], F)
+        got = model.rhs(x, F)[rows]
+        np.testing.assert_allclose(got, want, rtol=0, atol=1e-12 * np.abs(want).max())
