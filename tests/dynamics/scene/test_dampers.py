@@ -14,7 +14,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from appdyn.dynamics import simulate
-from appdyn.dynamics.scene import (ExternalForce, ExternalTorque, HeldRotor, PointMassDamper,
+from appdyn.dynamics.scene import (ExternalForce, HeldRotor, PointMassDamper,
                                    RigidHub, Scene, Slosh, SphericalDamper, TiltTorque)
 from appdyn.dynamics.spinning import gyrostat_model, tilt_torque_body
 
