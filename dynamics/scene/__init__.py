@@ -26,6 +26,7 @@ from .assembly import PartLayout
 from .contract import Body, Contribution, Frame, Load, Part, PartVariables, Variable
 from .hubs import RigidHub
 from .loads import ExternalForce, ExternalTorque
+from .panels import HingedPanel
 from .scene import Scene
 from .wheels import HeldRotor, ReactionWheels
 
