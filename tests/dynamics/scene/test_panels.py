@@ -96,3 +96,55 @@ def test_trajectory_equals_the_multiplier_model_over_20_s(kind):
     for key in ("energy", "momentum_linear", "momentum_inertial"):
         vals = np.array([model.invariant(key, a.x[:, k]) for k in range(t.size)])
         assert np.max(np.abs(vals - vals[0])) < 1e-9 * max(1.0, np.max(np.abs(vals)))
+
+
+
+def kane_pinned_hub_with_revolute_panel(I_hub, m, I_panel, hinge, offset, axis, k, c):
+    """sympy.mechanics (Kane): a hub turning about its fixed mass centre and a revolute panel
+    with a spring and damper; ``(w, theta, theta_dot) -> (w', theta_ddot)`` as numbers."""
+    sm = pytest.importorskip("sympy")
+    me = pytest.importorskip("sympy.physics.mechanics")
+    th, w1, w2, w3, thd = me.dynamicsymbols("th w1 w2 w3 thd")
+    N, B = me.ReferenceFrame("N"), me.ReferenceFrame("B")
+    B.set_ang_vel(N, w1 * B.x + w2 * B.y + w3 * B.z)  # the rates do not depend on the attitude
+    ax = axis[0] * B.x + axis[1] * B.y + axis[2] * B.z
+    P = B.orientnew("P", "Axis", (th, ax))
+    O = me.Point("O")
+    O.set_vel(N, 0)
+    H = O.locatenew("H", hinge[0] * B.x + hinge[1] * B.y + hinge[2] * B.z)
+    G = H.locatenew("G", offset[0] * P.x + offset[1] * P.y + offset[2] * P.z)
+    H.v2pt_theory(O, N, B)
+    G.v2pt_theory(H, N, P)
+
+    def dyadic(F, J):
+        return me.inertia(F, J[0, 0], J[1, 1], J[2, 2], J[0, 1], J[1, 2], J[2, 0])
+
+    hub = me.RigidBody("hub", O, B, 1.0, (dyadic(B, I_hub), O))
+    panel = me.RigidBody("panel", G, P, m, (dyadic(P, I_panel), G))
+    kd = [thd - th.diff()]
+    hinge_torque = (-k * th - c * thd) * ax
+    km = me.KanesMethod(N, q_ind=[th], u_ind=[w1, w2, w3, thd], kd_eqs=kd)
+    km.kanes_equations([hub, panel], [(P, hinge_torque), (B, -hinge_torque)])
+    args = [th, w1, w2, w3, thd]
+    mass = sm.lambdify(args, km.mass_matrix, "numpy")
+    force = sm.lambdify(args, km.forcing, "numpy")
+
+    def rhs(w, theta, theta_dot):
+        x = [theta, *w, theta_dot]
+        return np.linalg.solve(np.array(mass(*x), float), np.array(force(*x), float).ravel())
+
+    return rhs
+
+
+def test_revolute_panel_on_a_pinned_hub_equals_a_sympy_kane_model():
+    axis, k, c = AXIS, 3.0, 0.4
+    kane = kane_pinned_hub_with_revolute_panel(I1, M2, I2, R1, -R2, axis, k, c)
+    scene = Scene(RigidHub(I1), HingedPanel(M2, I2, R1, -R2, axis=axis, stiffness=k, damping=c))
+    model = scene.model()
+    rng = np.random.default_rng(3)
+    for _ in range(5):
+        w, theta, rate = rng.normal(scale=0.5, size=3), rng.uniform(-2.0, 2.0), rng.normal()
+        xdot = model.rhs(scene.state(w=w, theta=theta, theta_dot=rate))
+        ref = kane(w, theta, rate)
+        np.testing.assert_allclose(xdot[[4, 5, 6, 8]], ref, rtol=0,
+                                   atol=1e-12 * max(1.0, np.max(np.abs(ref))))
