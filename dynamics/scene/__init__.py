@@ -13,6 +13,8 @@ Parts
 `HeldRotor`            a rotor at constant relative speed (the gyrostat's wheel)
 `ExternalTorque`       body torque controls ``L1..L3``
 `ExternalForce`        force controls ``F1..F3`` at a hub point
+`HingedPanel`          a rigid panel on a revolute (``theta``) or ball (``p1..p4``) hinge
+`GravityGradient`      gravity on every body: forces and gravity-gradient torques
 =====================  =====================================================================
 
 Examples
@@ -26,10 +28,11 @@ from .assembly import PartLayout
 from .contract import Body, Contribution, Frame, Load, Part, PartVariables, Variable
 from .hubs import RigidHub
 from .loads import ExternalForce, ExternalTorque
+from .gravity import GravityGradient
 from .panels import HingedPanel
 from .scene import Scene
 from .wheels import HeldRotor, ReactionWheels
 
 __all__ = ["Scene", "RigidHub", "Part", "PartLayout", "Variable", "PartVariables", "Body", "Load",
            "Contribution", "Frame", "ReactionWheels", "HeldRotor", "ExternalTorque",
-           "ExternalForce"]
+           "ExternalForce", "HingedPanel", "GravityGradient"]
