@@ -26,9 +26,9 @@ Examples
 """
 from .assembly import PartLayout
 from .contract import Body, Contribution, Frame, Load, Part, PartVariables, Variable
+from .gravity import GravityGradient
 from .hubs import RigidHub
 from .loads import ExternalForce, ExternalTorque
-from .gravity import GravityGradient
 from .panels import HingedPanel
 from .scene import Scene
 from .wheels import HeldRotor, ReactionWheels

@@ -8,8 +8,8 @@ body's size)::
     V_b = -mu m_b / |R_b| + mu / (2 |R_b|^3) (3 o.I_b o - tr I_b),    o = -R_b / |R_b|,
     T_b = 3 mu / |R_b|^3  o x I_b o                               (gravity-gradient torque)
 
-(Wie, Space Vehicle Dynamics and Control, Sec. 6.3; seed Sec. 4.9). How ``R_b`` is known
-depends on the hub:
+(MacCullagh's formula; Hughes, Spacecraft Attitude Dynamics, on gravitational torques; not
+in the seeds). How ``R_b`` is known depends on the hub:
 
 Six-degree-of-freedom hub (``RigidHub(..., mass=...)``): ``R_b = A r + rho_b`` in hub axes,
 ``r`` the reference point's inertial position (the central body at the inertial origin) and
@@ -28,7 +28,10 @@ feels the tidal force and the torque above::
     F_b = mu m_b / R^3 (3 o (o.rho_b) - rho_b),    T_b = 3 mu / R^3  o x I_b o,
 
 of ``V_b = -mu m_b / (2 R^3) (3 (o.rho_b)^2 - |rho_b|^2) + mu / (2 R^3) (3 o.I_b o - tr I_b)``
-(part of ``energy``, which the turning field does not conserve). The local-vertical
+(part of ``energy``, which the turning field does not conserve; the Jacobi integral
+``energy - n momentum_inertial[2]`` it does). The hub's centre, not the scene's mass centre,
+follows the orbit: an attitude model, exact as the parts' mass moves with respect to the hub
+only to the order ``m_parts / m_hub`` of the tidal terms. The local-vertical
 local-horizontal frame (``x`` along track, ``z`` to nadir, ``y`` against the orbit normal)
 turns at ``-n`` about its ``y``; a hub with principal axes along it librates in pitch as
 ``I_y theta'' = -3/2 n^2 (I_x - I_z) sin 2 theta``, at ``n sqrt(3 (I_x - I_z) / I_y)`` for
