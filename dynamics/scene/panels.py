@@ -142,7 +142,21 @@ class HingedPanel(Part):
             speeds=tuple(Variable(f"u{i}", "rad/s") for i in range(1, 4)))
 
     def attitude(self, own):
-        """``(R, w_rel)``: panel -> hub rotation and the relative rate in hub axes."""
+        """The panel's attitude and rate relative to the hub, from its own symbols.
+
+        Parameters
+        ----------
+        own : PartSymbols
+            Its coordinates (``theta``, or ``p1..p4``) and speeds (``theta_dot``, or
+            ``u1..u3``).
+
+        Returns
+        -------
+        R : SX, 3x3
+            Panel -> hub components (module docstring).
+        w_rel : SX, 3x1 [rad/s]
+            The panel's angular velocity relative to the hub, hub axes.
+        """
         if self.revolute:
             a = ca.DM(self.axis)
             R = ca.SX(dcm_from_axis_angle(a, own.coords[0])).T
