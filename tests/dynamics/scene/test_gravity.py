@@ -206,3 +206,25 @@ def test_loads_on_a_body_are_the_sums_over_its_point_masses(six_dof):
     tol_force, tol_torque = (1e-13, 1e-8) if six_dof else (5e-6, 5e-6)
     np.testing.assert_allclose(generalized[:3], force, rtol=0, atol=tol_force * np.linalg.norm(force))
     np.testing.assert_allclose(generalized[3:], torque, rtol=0, atol=tol_torque * np.linalg.norm(torque))
+
+
+def test_gravity_gradient_sees_the_wheels_axial_inertia():
+    """Hub (inertia without the wheels' axial moments) and wheels at rest: the rate of the
+    total angular momentum is the torque on the whole inertia ``I_hub + sum J a a^T``."""
+    from appdyn.dynamics.scene import ReactionWheels
+    I_hub, J = np.diag([100.0, 80.0, 40.0]), np.array([2.0, 3.0, 4.0])
+    axes = np.array([[1.0, 0.0, 0.0], [0.0, 0.6, 0.8], [0.0, -0.8, 0.6]]).T
+    scene = Scene(RigidHub(I_hub), ReactionWheels(axes, J), GravityGradient(MU, RADIUS))
+    model = scene.model()
+    q = np.array([0.3, -0.5, 0.2, 0.0])
+    q[3] = np.sqrt(1 - q @ q)
+    t = 800.0
+    x = scene.state(q=q, t=t)
+    xs = ca.SX.sym("x", model.nx)
+    H = model.invariants["momentum_inertial"](xs, [])
+    rate = np.asarray(ca.Function("r", [xs], [ca.mtimes(ca.jacobian(H, xs), model.f(xs, [], []))])(x)).ravel()
+    A = dcm_from_quat(q)
+    o = A @ -np.array([np.cos(N * t), np.sin(N * t), 0.0])
+    whole = I_hub + sum(Ji * np.outer(a, a) for Ji, a in zip(J, axes.T))
+    expected = A.T @ (3 * N**2 * np.cross(o, whole @ o))
+    np.testing.assert_allclose(rate, expected, rtol=0, atol=1e-13 * np.linalg.norm(expected))
