@@ -75,7 +75,8 @@ class HingedPanel(Part):
     -----
     The potential energy (``1/2 k theta^2``, ``2 k (1 - p4^2)``) is part of the scene's
     ``energy``, which is conserved without damping and loads. A ball panel adds the
-    invariant ``panel_quat_norm`` (``|p|``, 1 up to the integration error). Coordinates are
+    invariant ``panel_quat_norm`` (``|p|``, 1 up to the integration error; with the suffix of
+    its state names, ``panel_quat_norm_2``, for a second one). Coordinates are
     held at rest (zero angle) by a slew's terminal condition only with a spring; without one
     any angle is an equilibrium and they are left free.
 
@@ -177,7 +178,8 @@ class HingedPanel(Part):
             return Contribution(bodies=[body], loads=[Load(-k * theta - c * rate, rate)],
                                 potential=0.5 * k * theta ** 2)
         p, u = own.coords, own.speeds
+        suffix = p[0].name()[len("p1"):]  # the scene's suffix of this panel's names ("_2")
         torque = -2.0 * k * p[3] * p[0:3] - c * u
         return Contribution(rates=quat_rate(p, u), bodies=[body], loads=[Load(torque, u)],
                             potential=2.0 * k * (1.0 - p[3] ** 2),
-                            invariants={"panel_quat_norm": ca.norm_2(p)})
+                            invariants={"panel_quat_norm" + suffix: ca.norm_2(p)})

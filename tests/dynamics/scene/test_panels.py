@@ -211,3 +211,14 @@ def test_bad_panel_arguments_are_refused_by_name():
         HingedPanel(1.0, I2, R1, R2, stiffness=-1.0)
     with pytest.raises(ValueError, match="inertia"):
         HingedPanel(1.0, [1.0, 1.0, 5.0], R1, R2)
+
+
+def test_two_ball_panels_keep_their_own_names_and_invariants():
+    scene = Scene(RigidHub(I1), HingedPanel(M2, I2, R1, -R2), HingedPanel(M2, I2, -R1, R2))
+    model = scene.model()
+    assert scene.part_names == ("panel", "panel_2")
+    assert model.states[7:] == ("p1", "p2", "p3", "p4", "u1", "u2", "u3",
+                                "p1_2", "p2_2", "p3_2", "p4_2", "u1_2", "u2_2", "u3_2")
+    x = scene.state(panel_2=[0.0, 0.0, 0.6, 0.8, 0.0, 0.0, 0.0], panel=[0.0, 0.0, 0.0, 2.0, 0, 0, 0])
+    assert float(model.invariant("panel_quat_norm", x)) == 2.0
+    assert float(model.invariant("panel_quat_norm_2", x)) == 1.0
