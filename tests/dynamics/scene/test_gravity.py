@@ -57,7 +57,8 @@ def test_pitch_libration_is_the_gravity_gradient_pendulum(six_dof):
     atol = np.full(model.nx, 1e-12)
     if six_dof:  # position to a millimetre, velocity to a micrometre per second (of 7 Mm, 7.5 km/s)
         atol[model.layout["hub"].states][7:] = [1e-3] * 3 + [1e-6] * 3
-    for theta0, reference, tol in ((0.5, pendulum.y[0], 1e-8), (1e-4, 1e-4 * np.cos(omega * t), 1e-11)):
+    cases = ((0.5, pendulum.y[0], 1e-8), (1e-4, 1e-4 * np.cos(omega * t), 1e-11))
+    for theta0, reference, tol in cases:
         res = simulate(model, pitch_start(scene, theta0), t, rtol=1e-10, atol=atol, jit=False)
         assert res.success
         clock = res.x[-1] if not six_dof else t
@@ -185,9 +186,11 @@ def test_loads_on_a_body_are_the_sums_over_its_point_masses(six_dof):
     if six_dof:
         gravity, r = GravityGradient(MU), np.array([3.0e6, -5.0e6, 4.0e6])
     else:
-        gravity, r = GravityGradient(MU, RADIUS), RADIUS * np.array([np.cos(N * t), np.sin(N * t), 0.0])
+        gravity = GravityGradient(MU, RADIUS)
+        r = RADIUS * np.array([np.cos(N * t), np.sin(N * t), 0.0])
     frame = Frame(q=ca.DM(q), dcm=ca.DM(A), w=ca.DM.zeros(3), v=ca.DM.zeros(3),
-                  r=ca.DM(r) if six_dof else None, reference=(0.0, 0.0, 0.0), mass=1.0 if six_dof else None)
+                  r=ca.DM(r) if six_dof else None, reference=(0.0, 0.0, 0.0),
+                  mass=1.0 if six_dof else None)
     speeds = ca.SX.sym("nu", 6)  # the body's velocity and angular velocity, to tell the loads apart
     body = Body.rigid(mass, I, ca.DM(rho), speeds[:3], speeds[3:])
 
@@ -204,8 +207,10 @@ def test_loads_on_a_body_are_the_sums_over_its_point_masses(six_dof):
     # tidal: the expansion's error |rho| / R = 1.4e-6 (measured 1.9e-6 and 1.4e-6); point
     # mass: exact force (5e-16), torque to the round-off of the cancelling sum (7e-10)
     tol_force, tol_torque = (1e-13, 1e-8) if six_dof else (5e-6, 5e-6)
-    np.testing.assert_allclose(generalized[:3], force, rtol=0, atol=tol_force * np.linalg.norm(force))
-    np.testing.assert_allclose(generalized[3:], torque, rtol=0, atol=tol_torque * np.linalg.norm(torque))
+    np.testing.assert_allclose(generalized[:3], force, rtol=0,
+                               atol=tol_force * np.linalg.norm(force))
+    np.testing.assert_allclose(generalized[3:], torque, rtol=0,
+                               atol=tol_torque * np.linalg.norm(torque))
 
 
 def test_gravity_gradient_sees_the_wheels_axial_inertia():
@@ -222,7 +227,8 @@ def test_gravity_gradient_sees_the_wheels_axial_inertia():
     x = scene.state(q=q, t=t)
     xs = ca.SX.sym("x", model.nx)
     H = model.invariants["momentum_inertial"](xs, [])
-    rate = np.asarray(ca.Function("r", [xs], [ca.mtimes(ca.jacobian(H, xs), model.f(xs, [], []))])(x)).ravel()
+    rate = ca.Function("r", [xs], [ca.mtimes(ca.jacobian(H, xs), model.f(xs, [], []))])
+    rate = np.asarray(rate(x)).ravel()
     A = dcm_from_quat(q)
     o = A @ -np.array([np.cos(N * t), np.sin(N * t), 0.0])
     whole = I_hub + sum(Ji * np.outer(a, a) for Ji, a in zip(J, axes.T))

@@ -6,7 +6,8 @@ import numpy as np
 import pytest
 
 from appdyn.dynamics import hinged_bodies, simulate
-from appdyn.dynamics.attitude import dcm_from_axis_angle, dcm_from_quat, quat_from_axis_angle, quat_mul
+from appdyn.dynamics.attitude import (dcm_from_axis_angle, dcm_from_quat, quat_from_axis_angle,
+                                      quat_mul)
 from appdyn.dynamics.scene import HingedPanel, RigidHub, Scene
 
 M1, I1 = 12.0, np.array([[4.0, 0.3, -0.2], [0.3, 5.0, 0.4], [-0.2, 0.4, 6.0]])
@@ -18,7 +19,8 @@ AXIS = np.array([1.0, 2.0, -0.5]) / np.linalg.norm([1.0, 2.0, -0.5])
 
 def scenes(kind):
     axis = AXIS if kind == "revolute" else None
-    scene = Scene(RigidHub(I1, mass=M1), HingedPanel(M2, I2, hinge_point=R1, cm_offset=-R2, axis=axis))
+    scene = Scene(RigidHub(I1, mass=M1),
+                  HingedPanel(M2, I2, hinge_point=R1, cm_offset=-R2, axis=axis))
     return scene, hinged_bodies(M1, I1, M2, I2, R1, R2, kind=kind, axis=axis)
 
 
@@ -63,7 +65,8 @@ def test_rhs_maps_onto_the_multiplier_model(kind):
     model = scene.model()
     xs = ca.SX.sym("x", model.nx)
     mapped = to_hinged(scene, xs)
-    rate = ca.Function("rate", [xs], [mapped, ca.mtimes(ca.jacobian(mapped, xs), model.f(xs, [], []))])
+    rate = ca.Function("rate", [xs],
+                       [mapped, ca.mtimes(ca.jacobian(mapped, xs), model.f(xs, [], []))])
     rng = np.random.default_rng(7)
     for _ in range(5):
         blocks = start(kind)
@@ -96,7 +99,6 @@ def test_trajectory_equals_the_multiplier_model_over_20_s(kind):
     for key in ("energy", "momentum_linear", "momentum_inertial"):
         vals = np.array([model.invariant(key, a.x[:, k]) for k in range(t.size)])
         assert np.max(np.abs(vals - vals[0])) < 1e-9 * max(1.0, np.max(np.abs(vals)))
-
 
 
 def kane_pinned_hub_with_revolute_panel(I_hub, m, I_panel, hinge, offset, axis, k, c):
@@ -161,7 +163,7 @@ def test_hinge_spring_on_an_immovable_hub_is_the_torsion_pendulum(kind):
     axis = AXIS if kind == "revolute" else None
     scene = Scene(RigidHub(1e12 * np.eye(3)), HingedPanel(M2, I2, R1, c, axis=axis, stiffness=k))
     model = scene.model()
-    e = AXIS if kind == "revolute" else np.array([0.2, -0.9, 0.4]) / np.linalg.norm([0.2, -0.9, 0.4])
+    e = AXIS if kind == "revolute" else np.array([0.2, -0.9, 0.4]) / np.sqrt(1.01)
     if kind == "revolute":
         xdot = model.rhs(scene.state(theta=phi))
         expected = -k * phi / (e @ I_H @ e)
@@ -170,7 +172,8 @@ def test_hinge_spring_on_an_immovable_hub_is_the_torsion_pendulum(kind):
         xdot = model.rhs(scene.state(panel=np.r_[quat_from_axis_angle(e, phi), 0.0, 0.0, 0.0]))
         # the panel's axes after the turn: I_H and e in them (e is unchanged by the turn)
         expected = np.linalg.solve(I_H, -k * np.sin(phi) * e)
-        np.testing.assert_allclose(xdot[11:14], expected, rtol=0, atol=1e-10 * np.max(np.abs(expected)))
+        np.testing.assert_allclose(xdot[11:14], expected, rtol=0,
+                                   atol=1e-10 * np.max(np.abs(expected)))
 
 
 @pytest.mark.parametrize("kind", ["revolute", "ball"])
@@ -219,6 +222,7 @@ def test_two_ball_panels_keep_their_own_names_and_invariants():
     assert scene.part_names == ("panel", "panel_2")
     assert model.states[7:] == ("p1", "p2", "p3", "p4", "u1", "u2", "u3",
                                 "p1_2", "p2_2", "p3_2", "p4_2", "u1_2", "u2_2", "u3_2")
-    x = scene.state(panel_2=[0.0, 0.0, 0.6, 0.8, 0.0, 0.0, 0.0], panel=[0.0, 0.0, 0.0, 2.0, 0, 0, 0])
+    x = scene.state(panel_2=[0.0, 0.0, 0.6, 0.8, 0.0, 0.0, 0.0],
+                    panel=[0.0, 0.0, 0.0, 2.0, 0.0, 0.0, 0.0])
     assert float(model.invariant("panel_quat_norm", x)) == 2.0
     assert float(model.invariant("panel_quat_norm_2", x)) == 1.0

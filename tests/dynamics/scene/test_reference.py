@@ -52,7 +52,8 @@ def test_rhs_about_a_reference_point_maps_onto_the_mass_centre_form(kind):
         f_ref(mapped, u, []), ca.mtimes(ca.jacobian(mapped, x), f_cm(x, u, []))])
     rng = np.random.default_rng(17)
     for _ in range(5):
-        lhs, rhs = (np.asarray(a).ravel() for a in check(random_state(at_cm, rng), rng.normal(size=6)))
+        out = check(random_state(at_cm, rng), rng.normal(size=6))
+        lhs, rhs = (np.asarray(a).ravel() for a in out)
         np.testing.assert_allclose(lhs, rhs, rtol=0, atol=1e-12 * max(1.0, np.max(np.abs(rhs))))
 
 
