@@ -178,7 +178,8 @@ class HingedPanel(Part):
             return Contribution(bodies=[body], loads=[Load(-k * theta - c * rate, rate)],
                                 potential=0.5 * k * theta ** 2)
         p, u = own.coords, own.speeds
-        suffix = p[0].name()[len("p1"):]  # the scene's suffix of this panel's names ("_2")
+        # the scene's suffix of this panel's names ("_2"), to keep two panels' invariants apart
+        suffix = p[0].name()[len("p1"):] if p[0].is_symbolic() else ""
         torque = -2.0 * k * p[3] * p[0:3] - c * u
         return Contribution(rates=quat_rate(p, u), bodies=[body], loads=[Load(torque, u)],
                             potential=2.0 * k * (1.0 - p[3] ** 2),
