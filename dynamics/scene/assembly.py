@@ -174,7 +174,7 @@ def assemble(scene) -> Model:
     if hub.mass is None:
         hub_body.momentum = ca.SX.zeros(3)
     bodies_by_part = {"hub": [hub_body]}
-    loads, potential, kinetic, extra = [], [], [], {}
+    loads, potential, kinetic, extra, momenta = [], [], [], {}, {}
     coord_syms = [q] + ([r] if r is not None else [])
     coord_rates = [quat_rate(q, w)] + ([ca.mtimes(A.T, v)] if r is not None else [])
     speed_syms = [w] + ([v] if hub.translates else [])
@@ -211,6 +211,8 @@ def assemble(scene) -> Model:
                                   + ca.dot(b.angular_momentum, b.angular_velocity))
                            for b in c.bodies)
         extra.update(c.invariants)
+        if c.momentum is not None:
+            momenta[pname] = ca.SX(c.momentum)
     all_bodies = [b for bs in bodies_by_part.values() for b in bs]
     for part, pname in zip(scene.parts, scene.part_names):
         c = part.field_loads(frame, all_bodies)
@@ -241,8 +243,10 @@ def assemble(scene) -> Model:
     f = ca.Function(label, [x, u, p], [xdot], ["x", "u", "p"], ["xdot"])
 
     # invariants
-    H = sum((b.angular_momentum + ca.cross(b.position, b.momentum) for b in all_bodies),
-            ca.SX.zeros(3))
+    H = sum((momenta[pname] if pname in momenta else
+             sum((b.angular_momentum + ca.cross(b.position, b.momentum) for b in bs),
+                 ca.SX.zeros(3))
+             for pname, bs in bodies_by_part.items()), ca.SX.zeros(3))
     P = sum((ca.SX(b.momentum) for b in all_bodies), ca.SX.zeros(3))
     H_in = ca.mtimes(A.T, H)
     exprs = {"energy": sum(kinetic) + sum(ca.SX(e) for e in potential)}
