@@ -130,9 +130,11 @@ class CMGCluster(Part):
     -----
     Invariants: ``cmg_momentum`` [N m s] (``sum_i h_i s_i``, hub axes) and the scene's
     ``energy`` with the meaning of the module docstring. With ``L = 0`` the scene's
-    ``momentum_inertial`` is conserved exactly: for any gimbal-rate history (rate drive, the
-    gimbal-rate momentum left out, so it is conserved exactly only without
-    ``gimbal_inertia`` or at constant rates) and any gimbal torques (torque drive, all of it).
+    ``momentum_inertial`` is conserved exactly for any gimbal torques (torque drive: it holds
+    all the momentum) and for any gimbal-rate history without ``gimbal_inertia`` (rate
+    drive). With it, the rate drive's invariant leaves out the control's share
+    ``A^T sum_i J_g,i d_i' g_i``; the total with that share is conserved while the rates are
+    constant (the neglected gimbal acceleration changes it otherwise).
 
     Raises
     ------
