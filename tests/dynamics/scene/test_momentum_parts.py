@@ -277,3 +277,13 @@ def test_cmg_cluster_bad_input_names_the_argument(kwargs, error, match):
     args.update(kwargs)
     with pytest.raises(error, match=match):
         CMGCluster(**args)
+
+
+def test_wrapped_builders_read_by_layout():
+    """The wrapped builders are scenes: their parts' slices are in ``layout``."""
+    assert rigid_body(I_HUB).layout["torque"].controls == slice(0, 3)
+    wheels = wheel_spacecraft(I_HUB, np.eye(3), 0.05, external_torque=True)
+    assert wheels.layout["wheels"].states == slice(7, 10)
+    assert wheels.layout["torque"].controls == slice(3, 6)
+    cmg = cmg_spacecraft(I_HUB, GEO.gimbal_axes, GEO.spin_axes0, H_ROTOR)
+    assert cmg.layout["cmgs"].coords == slice(7, 11) and cmg.layout["cmgs"].controls == slice(0, 4)
