@@ -11,6 +11,8 @@ Parts
 =====================  =====================================================================
 `ReactionWheels`       wheels driven by motor torques (states ``W``, controls ``tau``)
 `HeldRotor`            a rotor at constant relative speed (the gyrostat's wheel)
+`CMGCluster`           single-gimbal CMGs (states ``d``; controls gimbal rates ``d_dot``, or
+                       gimbal torques ``tg`` with the rates as states)
 `ExternalTorque`       body torque controls ``L1..L3``
 `ExternalForce`        force controls ``F1..F3`` at a hub point
 `PointMassDamper`      a mass on a spring and dashpot sliding along a hub line (``s, s_dot``)
@@ -29,6 +31,7 @@ Examples
 (7, ('L1', 'L2', 'L3'))
 """
 from .assembly import PartLayout
+from .cmgs import CMGCluster
 from .contract import Body, Contribution, Frame, Load, Part, PartVariables, Variable
 from .dampers import PointMassDamper, Slosh, SphericalDamper
 from .fields import TiltTorque
@@ -42,4 +45,4 @@ from .wheels import HeldRotor, ReactionWheels
 __all__ = ["Scene", "RigidHub", "Part", "PartLayout", "Variable", "PartVariables", "Body", "Load",
            "Contribution", "Frame", "ReactionWheels", "HeldRotor", "ExternalTorque",
            "ExternalForce", "PointMassDamper", "SphericalDamper", "Slosh", "TiltTorque",
-           "HingedPanel", "GravityGradient"]
+           "HingedPanel", "GravityGradient", "CMGCluster"]

@@ -38,7 +38,11 @@ that names the field). It sets ``kind`` (the default name, ``"wheels"``), and im
       on, a spring's force with its coordinate's rate). A torque between the part and the hub
       acts on the *relative* angular velocity; its reaction on the hub is then implied,
     * ``potential``: its potential energy (springs, fields), ``kinetic``: only when its
-      kinetic energy is not ``1/2 (p.v + h.w)`` summed over its bodies,
+      kinetic energy is not ``1/2 (p.v + h.w)`` summed over its bodies, ``momentum``: only
+      when the angular momentum it adds to the ``momentum_inertial`` invariant (about the
+      reference point, hub axes) is not its bodies' ``h + rho x p`` (a share carried by a
+      prescribed motion, i.e. by a control, must be left out: invariants are functions of
+      the state),
     * ``invariants``: further monitored quantities of the state, by name.
 
     Loads that depend on the mass distribution of the whole scene (gravity) implement
@@ -180,6 +184,7 @@ class Contribution:
     loads: list = field(default_factory=list)
     potential: ca.SX | float = 0.0
     kinetic: ca.SX | None = None
+    momentum: ca.SX | None = None
     invariants: dict = field(default_factory=dict)
 
 
