@@ -12,7 +12,9 @@ import casadi as ca
 import numpy as np
 
 from appdyn.dynamics.linearize import Linearization, linearization
-from appdyn.dynamics.rigid_body import check_inertia, rigid_body
+from appdyn.dynamics.rigid_body import check_inertia
+from appdyn.dynamics.scene import (ExternalForce, ExternalTorque, HeldRotor, ReactionWheels,
+                                   RigidHub, Scene)
 from appdyn.dynamics.spinning import (PointMassDamper, SphericalDamper, gyrostat_model,
                                steady_spin_state, unit_vector)
 
@@ -20,6 +22,7 @@ from .closed_forms import (axis_kind, gyrostat_lambda2, principal_moments, rigid
                            spherical_damper_roots)
 from .common import check_number, plain
 from .report import Quantity, StabilityReport, build_report
+from .spin_scene import spin_groups, spin_linearization
 
 __all__ = ["spin", "gyrostat", "reduce_free_spin"]
 
@@ -69,7 +72,17 @@ def _damper_dict(damper):
 
 
 def spin(inertia, axis, rate, *, damper=None) -> StabilityReport:
-    """Torque-free spin ``w = rate * axis`` about a principal axis, optionally with a damper.
+    """Spin ``w = rate * axis`` of a scene, or torque-free spin of a rigid body about a
+    principal axis, optionally with a damper.
+
+    Given a `dynamics.scene.Scene` (``spin(scene, axis, rate)``): the relative equilibrium
+    with every part at rest relative to the hub (`problems.stability.spin_scene`: part
+    speeds from `Part.spin_speeds`, part coordinates solved so that the part speeds stay
+    constant), linearized in body rates, reduced by the momentum and the parts' first
+    integrals, modes labelled by part (``'nutation'`` for the hub, else the part's name).
+    Closed forms where known: a hub with held rotors and reaction wheels (at rest relative
+    to the hub, axes along or normal to the spin) spins as a gyrostat of wheel momentum
+    ``h = sum(held momenta) + rate sum(J_i, wheels along the axis)``.
 
     The body-rate perturbations (Rheinfurth & Wilson, NASA RP-1262, Sec. 4.5 C,
     Eqs. 4.94-4.95) have the eigenvalues
@@ -85,14 +98,15 @@ def spin(inertia, axis, rate, *, damper=None) -> StabilityReport:
 
     Parameters
     ----------
-    inertia : array_like, shape (3, 3) or (3,) [kg m^2]
-        Of the rigid body about its mass center (without the damper mass / core inertia).
+    inertia : Scene, or array_like, shape (3, 3) or (3,) [kg m^2]
+        A scene with an attitude-only hub, or the inertia of the rigid body about its mass
+        center (without the damper mass / core inertia).
     axis : array_like, shape (3,)
-        Spin axis in body axes; must be a principal axis of ``inertia``.
+        Spin axis in body (hub) axes; must be a principal axis of the (loaded) body.
     rate : float [rad/s]
-        Spin rate, finite and non-zero.
+        Spin rate, finite and non-zero (a scene: finite).
     damper : PointMassDamper or SphericalDamper, optional
-        An energy damper on the body.
+        An energy damper on the body (not with a scene: mount it on the scene).
 
     Returns
     -------
@@ -126,7 +140,20 @@ def spin(inertia, axis, rate, *, damper=None) -> StabilityReport:
     ...                                    position=[0, 0.6, 0], direction=[1, 0, 0])
     >>> stability.spin([2.0, 3.0, 4.5], [1, 0, 0], 4.0, damper=damper).verdict  # minor axis
     'unstable'
+
+    A scene: a hub with a held rotor (a gyrostat, ``Ia + h/W = 4.5`` between 4 and 5):
+
+    >>> from appdyn.dynamics.scene import HeldRotor, RigidHub, Scene
+    >>> rep = stability.spin(Scene(RigidHub([3.0, 4.0, 5.0]), HeldRotor([1, 0, 0], 3.0)),
+    ...                      [1, 0, 0], 2.0)
+    >>> rep.verdict, rep.status, [m.label for m in rep.modes]
+    ('unstable', 0, ['nutation', 'nutation'])
     """
+    if isinstance(inertia, Scene):
+        if damper is not None:
+            raise ValueError("`damper` is for an inertia; mount the damper on the scene as a "
+                             "part")
+        return _scene_spin(inertia, axis, rate)
     I = check_inertia(inertia)
     a = unit_vector(axis, "axis")
     rate = check_number(rate, "rate", nonzero=True)
@@ -135,19 +162,20 @@ def spin(inertia, axis, rate, *, damper=None) -> StabilityReport:
         raise ValueError("`damper` must be None, a PointMassDamper or a SphericalDamper, got "
                          f"{type(damper).__name__}")
     params = {"inertia": I, "axis": a, "rate": rate, "damper": _damper_dict(damper)}
-    notes, quantities, cf = [], [], None
+    quantities, cf = [], None
     if damper is None:
-        model = rigid_body(I)
-        x = np.concatenate([[0.0, 0.0, 0.0, 1.0], rate * a])
+        lin, red, notes, groups = _scene_case(Scene(RigidHub(I)), a, rate)
         title = "Torque-free spin about a principal axis (RP-1262, Sec. 4.5)"
     else:
         model = gyrostat_model(I, wheel_axis=a, damper=damper)
         x = steady_spin_state(a, rate, damper=damper)
         title = (f"Spin about a principal axis with a {type(damper).__name__} "
                  "(RP-1262, Sec. 4.5 NOTE)")
-    lin = _case_linearization(model, x, "rates", damper)
-    red, more = reduce_free_spin(model, x, lin)
-    notes += list(red.notes) + more
+        lin = _case_linearization(model, x, "rates", damper)
+        red, more = reduce_free_spin(model, x, lin)
+        notes = list(red.notes) + more
+        rates = [s for s in red.states if s.startswith("w") and not s.startswith("wd")]
+        groups = {"nutation": rates, "damper": [s for s in red.states if s not in rates]}
     kind = axis_kind(Ia, Ib, Ic)
     lam2 = rigid_spin_lambda2(Ia, Ib, Ic, rate)
     if damper is None:
@@ -180,11 +208,61 @@ def spin(inertia, axis, rate, *, damper=None) -> StabilityReport:
                          f"{expected} (if the damper is excited by the nutation)")
     notes.insert(0, f"spin about the {kind} axis{' of the loaded body' if damper else ''}; "
                     f"rigid moments Ia = {Ia:.10g}, Ib = {Ib:.10g}, Ic = {Ic:.10g} kg m^2")
-    rates = [s for s in red.states if s.startswith("w") and not s.startswith("wd")]
-    others = [s for s in red.states if s not in rates]
-    return build_report("spin", title, params, red.ss, lin=lin, closed_form=cf,
-                        groups={"nutation": rates, "damper": others},
+    return build_report("spin", title, params, red.ss, lin=lin, closed_form=cf, groups=groups,
                         quantities=quantities, notes=notes)
+
+
+def _held_momentum(scene: Scene, a) -> float | None:
+    """Axial wheel momentum [N m s] per unit rate and held momentum of a scene whose parts
+    are held rotors along ``a``, reaction wheels along or normal to it, and loads; None
+    for any other part (no closed form)."""
+    per_rate, held = 0.0, 0.0
+    for part in scene.parts:
+        if isinstance(part, (ExternalTorque, ExternalForce)):
+            continue
+        if isinstance(part, HeldRotor) and abs(abs(np.dot(part.axis, a)) - 1) <= 1e-12:
+            held += part.momentum * float(np.dot(part.axis, a))
+        elif isinstance(part, ReactionWheels):
+            c = part.axes_matrix.T @ a
+            if np.any((np.abs(c) > 1e-12) & (np.abs(np.abs(c) - 1) > 1e-12)):
+                return None
+            per_rate += float(np.sum(np.asarray(part.inertia) * c ** 2))
+        else:
+            return None
+    return per_rate, held
+
+
+def _scene_spin(scene: Scene, axis, rate) -> StabilityReport:
+    """`spin` of a scene (its docstring)."""
+    a = unit_vector(axis, "axis")
+    W = check_number(rate, "rate")
+    lin, red, notes, groups = _scene_case(scene, a, W)
+    quantities, cf = [], None
+    rotors = _held_momentum(scene, a)
+    if rotors is not None:
+        Ia, Ib, Ic = principal_moments(scene.hub.inertia_matrix, a)
+        h = rotors[0] * W + rotors[1]
+        lam2 = gyrostat_lambda2(Ia, Ib, Ic, W, h)
+        root = np.sqrt(complex(lam2))
+        cf = np.array([root, -root])
+        quantities += [Quantity("axial wheel momentum h", None, h, "N m s"),
+                       Quantity("lambda^2 = -(Ia W + h - Ib W)(Ia W + h - Ic W) / (Ib Ic)",
+                                None, lam2, "1/s^2", "Eqs. 4.94-4.95 with a wheel")]
+        if W:
+            kind = axis_kind(Ia + h / W, Ib, Ic)
+            notes.insert(0, f"spin about the {kind} axis of the hub with its wheels: "
+                            f"Ia + h/W = {Ia + h / W:.10g}, Ib = {Ib:.10g}, Ic = {Ic:.10g} "
+                            "kg m^2")
+    title = f"Spin of {scene.name or 'a scene'} about a hub axis"
+    params = {"scene": repr(scene), "axis": a, "rate": W}
+    return build_report("spin", title, params, red.ss, lin=lin, closed_form=cf, groups=groups,
+                        quantities=quantities, notes=notes)
+
+
+def _scene_case(scene: Scene, a, rate) -> tuple:
+    """``(lin, reduced, notes, groups)`` of a scene's spin (`spin_linearization`)."""
+    sl = spin_linearization(scene, a, rate)
+    return sl.lin, sl.reduced, list(sl.reduced.notes) + list(sl.notes), sl.groups
 
 
 def _pair_frequency(ev) -> float | None:
@@ -260,12 +338,17 @@ def gyrostat(inertia, axis, rate, wheel_momentum, *, wheel_inertia=None, damper=
                          "turns at rate + wheel_momentum / wheel_inertia)")
     if W == 0 and h == 0:
         raise ValueError("`rate` and `wheel_momentum` are both zero: nothing spins")
-    model = gyrostat_model(I, wheel_axis=a, wheel_momentum=h, damper=damper,
-                           damper_on=damper_on, wheel_rate=Wr)
-    x = steady_spin_state(a, W, damper=damper, damper_on=damper_on, wheel_rate=Wr)
-    lin = _case_linearization(model, x, "rates", damper)
-    red, notes = reduce_free_spin(model, x, lin)
-    notes = list(red.notes) + notes
+    if damper is None:
+        lin, red, notes, groups = _scene_case(Scene(RigidHub(I), HeldRotor(a, h)), a, W)
+    else:
+        model = gyrostat_model(I, wheel_axis=a, wheel_momentum=h, damper=damper,
+                               damper_on=damper_on, wheel_rate=Wr)
+        x = steady_spin_state(a, W, damper=damper, damper_on=damper_on, wheel_rate=Wr)
+        lin = _case_linearization(model, x, "rates", damper)
+        red, notes = reduce_free_spin(model, x, lin)
+        notes = list(red.notes) + notes
+        rates = [s for s in red.states if s in ("w1", "w2", "w3")]
+        groups = {"nutation": rates, "damper": [s for s in red.states if s not in rates]}
     params = {"inertia": I, "axis": a, "rate": W, "wheel_momentum": h,
               "wheel_inertia": wheel_inertia, "damper": _damper_dict(damper),
               "damper_on": damper_on}
@@ -293,12 +376,9 @@ def gyrostat(inertia, axis, rate, wheel_momentum, *, wheel_inertia=None, damper=
             quantities.append(Quantity("boundary h = Jr (Ia - It) W / (It - Jr)", None,
                                        Jr * (Ia - It) * W / (It - Jr), "N m s",
                                        "housing at the nutation rate"))
-    rates = [s for s in red.states if s in ("w1", "w2", "w3")]
     title = "Gyrostat (dual spin)" + (f" with a {type(damper).__name__} on the {damper_on}"
                                       if damper else "")
-    others = [s for s in red.states if s not in rates]
     return build_report("gyrostat", title, params, red.ss, lin=lin, closed_form=cf,
-                        groups={"nutation": rates, "damper": others},
-                        quantities=quantities, notes=notes)
+                        groups=groups, quantities=quantities, notes=notes)
 
 
