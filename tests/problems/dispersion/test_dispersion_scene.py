@@ -60,3 +60,20 @@ def test_as_model_names_the_argument():
         as_model("a scene")
     with pytest.raises(TypeError, match="`model` must be a Model, a Scene"):
         dispersion(3.0, X0, T, samples=2, seed=0, outputs={"w1": "w1"})
+
+
+def test_nutation_history_reads_the_hub_states_by_name():
+    """A scene whose hub carries wheels (axial moments 1e-9 kg m^2: a hub of the spinner's
+    moments, to 1e-12) and wheel states after the hub's: the nutation output finds q and w by
+    name and keeps the closed form atan(I_t |w_t| / (I_a w3))."""
+    from appdyn.dynamics import simulate
+    hub = RigidHub([1000.0, 1000.0, 1500.0])
+    scene = Scene(hub, ReactionWheels(np.eye(3), 1e-9))
+    t = np.linspace(0.0, 10.0, 11)
+    res = simulate(scene.model(), scene.state(w=[0.02, 0.0, 1.0]), t, rtol=1e-11, atol=1e-13)
+    theta = nutation_history(res, 1000.0, 1500.0)
+    assert res.x.shape[0] == 10
+    assert np.max(np.abs(theta - np.arctan2(1000.0 * 0.02, 1500.0))) < 1e-8
+    fake = type("Run", (), {"x": np.zeros((3, 2)), "states": ("a", "b", "c")})()
+    with pytest.raises(ValueError, match="q1..q4, w1..w3"):
+        nutation_history(fake, 1000.0, 1500.0)
