@@ -33,7 +33,7 @@ from .model import Model
 from .validate import check_inertia
 
 __all__ = ["PointMassDamper", "SphericalDamper", "tilt_torque_body", "gyrostat_model",
-           "steady_spin_state", "point_mass_offset", "unit_vector"]
+           "gyrostat_scene", "steady_spin_state", "point_mass_offset", "unit_vector"]
 
 
 # -------------------------------------------------------------------- tilt torque
@@ -169,6 +169,23 @@ def gyrostat_model(inertia, *, wheel_axis=(1.0, 0.0, 0.0), wheel_momentum: float
     ValueError
         Naming the argument (inertia, axis, momentum, damper type or placement).
     """
+    return gyrostat_scene(inertia, wheel_axis=wheel_axis, wheel_momentum=wheel_momentum,
+                          damper=damper, damper_on=damper_on, wheel_rate=wheel_rate).model()
+
+
+def gyrostat_scene(inertia, *, wheel_axis=(1.0, 0.0, 0.0), wheel_momentum: float = 0.0,
+                   damper=None, damper_on: str = "platform", wheel_rate: float = 0.0) -> Scene:
+    """The `Scene` of `gyrostat_model` (same arguments and errors): ``Scene(RigidHub(I),
+    HeldRotor(a, h) if h != 0, damper (on the rotor: housing_rate = wheel_rate a),
+    ExternalTorque(), name="gyrostat")``.
+
+    Examples
+    --------
+    >>> from appdyn.dynamics.spinning import SphericalDamper, gyrostat_scene
+    >>> gyrostat_scene([3.0, 4.0, 4.0], wheel_momentum=1.0,
+    ...                damper=SphericalDamper(0.1, 0.05)).part_names
+    ('rotor', 'damper', 'torque')
+    """
     I = check_inertia(inertia)
     a = unit_vector(wheel_axis, "wheel_axis")
     h = _finite(wheel_momentum, "wheel_momentum")
@@ -179,7 +196,7 @@ def gyrostat_model(inertia, *, wheel_axis=(1.0, 0.0, 0.0), wheel_momentum: float
         damper = dataclasses.replace(damper, housing_rate=tuple((rate * a).tolist()))
     if damper is not None:
         parts.append(damper)
-    return Scene(RigidHub(I), *parts, ExternalTorque(), name="gyrostat").model()
+    return Scene(RigidHub(I), *parts, ExternalTorque(), name="gyrostat")
 
 
 def point_mass_offset(damper: PointMassDamper, axis, rate: float) -> float:
