@@ -1,70 +1,31 @@
-"""Free-spin cases: `spin` (rigid or with an energy damper) and `gyrostat` (dual spin).
+"""Free-spin cases: `spin` (any scene; a rigid body, optionally with an energy damper) and
+`gyrostat` (dual spin).
 
-Both are linearized in body rates (``frame='rates'``; the attitude does not enter
-torque-free dynamics) and restricted to a first integral (``|H|^2``, else the energy), which
-removes the eigenvalue 0 of the neighbouring steady spins; the notes say which state went.
+Every case builds its vehicle as a `dynamics.scene.Scene` and analyses its spin with
+`problems.stability.spin_scene`: linearized in body rates (``frame='rates'``; the attitude
+does not enter torque-free dynamics) and restricted to the first integrals (``|H|^2``, the
+parts' conserved invariants), which removes the eigenvalue 0 of the neighbouring steady
+spins; the notes say which state went. The closed forms stay per case.
 """
 from __future__ import annotations
 
 import math
 
-import casadi as ca
 import numpy as np
 
-from appdyn.dynamics.linearize import Linearization, linearization
 from appdyn.dynamics.rigid_body import check_inertia
 from appdyn.dynamics.scene import (ExternalForce, ExternalTorque, HeldRotor, ReactionWheels,
                                    RigidHub, Scene)
-from appdyn.dynamics.spinning import (PointMassDamper, SphericalDamper, gyrostat_model,
-                               steady_spin_state, unit_vector)
+from appdyn.dynamics.spinning import (PointMassDamper, SphericalDamper, gyrostat_scene,
+                                      unit_vector)
 
 from .closed_forms import (axis_kind, gyrostat_lambda2, principal_moments, rigid_spin_lambda2,
                            spherical_damper_roots)
 from .common import check_number, plain
 from .report import Quantity, StabilityReport, build_report
-from .spin_scene import spin_groups, spin_linearization
+from .spin_scene import spin_linearization
 
-__all__ = ["spin", "gyrostat", "reduce_free_spin"]
-
-
-def _case_linearization(model, x, frame, damper):
-    """Linearize a steady spin; a damper that spoils the relative equilibrium is named."""
-    try:
-        return linearization(model, x, frame=frame)
-    except ValueError as exc:
-        if damper is None:
-            raise
-        raise ValueError(f"`damper`: no steady spin about `axis` with this damper: {exc}") from None
-
-
-def _invariant_gradient(model, x, lin: Linearization, key: str) -> np.ndarray:
-    """Gradient of ``|invariant|^2`` at ``x``, in the (non-attitude) states of ``lin``."""
-    xs = ca.SX.sym("x", model.nx)
-    value = model.invariants[key](xs, ca.DM(model.resolve_p()))
-    grad = ca.Function("grad", [xs], [ca.gradient(ca.sumsqr(value), xs)])
-    g = np.asarray(grad(x), dtype=float).reshape(-1)
-    return np.array([g[model.states.index(s)] if s in model.states else 0.0 for s in lin.states])
-
-
-def reduce_free_spin(model, x, lin: Linearization) -> tuple[Linearization, list]:
-    """Remove the neutral spin-rate direction of a torque-free spin (rates frame).
-
-    ``|H|^2`` is a first integral; where ``H = 0`` its gradient vanishes and the energy (a
-    first integral, or decaying to second order at the steady spin) takes over."""
-    notes = []
-    for name, key in (("|H|^2", "momentum_inertial"), ("energy", "energy")):
-        c = _invariant_gradient(model, x, lin, key)
-        if np.max(np.abs(c)) == 0:
-            continue
-        try:
-            red = lin.restrict(c, reason=f"{name} is a first integral; the steady spins form a "
-                               "one-parameter family, whose eigenvalue 0 goes")
-        except ValueError:
-            continue
-        return red, notes
-    notes.append("no first integral with a non-zero gradient: the neutral eigenvalue 0 of the "
-                 "spin-rate family stays in the model")
-    return lin, notes
+__all__ = ["spin", "gyrostat"]
 
 
 def _damper_dict(damper):
@@ -162,54 +123,63 @@ def spin(inertia, axis, rate, *, damper=None) -> StabilityReport:
         raise ValueError("`damper` must be None, a PointMassDamper or a SphericalDamper, got "
                          f"{type(damper).__name__}")
     params = {"inertia": I, "axis": a, "rate": rate, "damper": _damper_dict(damper)}
-    quantities, cf = [], None
     if damper is None:
-        lin, red, notes, groups = _scene_case(Scene(RigidHub(I)), a, rate)
+        sl = _scene_case(Scene(RigidHub(I)), a, rate)
         title = "Torque-free spin about a principal axis (RP-1262, Sec. 4.5)"
-    else:
-        model = gyrostat_model(I, wheel_axis=a, damper=damper)
-        x = steady_spin_state(a, rate, damper=damper)
-        title = (f"Spin about a principal axis with a {type(damper).__name__} "
-                 "(RP-1262, Sec. 4.5 NOTE)")
-        lin = _case_linearization(model, x, "rates", damper)
-        red, more = reduce_free_spin(model, x, lin)
-        notes = list(red.notes) + more
-        rates = [s for s in red.states if s.startswith("w") and not s.startswith("wd")]
-        groups = {"nutation": rates, "damper": [s for s in red.states if s not in rates]}
-    kind = axis_kind(Ia, Ib, Ic)
-    lam2 = rigid_spin_lambda2(Ia, Ib, Ic, rate)
-    if damper is None:
+        kind = axis_kind(Ia, Ib, Ic)
+        lam2 = rigid_spin_lambda2(Ia, Ib, Ic, rate)
         root = np.sqrt(complex(lam2))
         cf = np.array([root, -root])
-        quantities.append(Quantity("lambda^2 = -rate^2 (Ia - Ib)(Ia - Ic) / (Ib Ic)", None, lam2,
-                                   "1/s^2", "Eqs. 4.94-4.95"))
+        quantities = [Quantity("lambda^2 = -rate^2 (Ia - Ib)(Ia - Ic) / (Ib Ic)", None, lam2,
+                               "1/s^2", "Eqs. 4.94-4.95")]
         if lam2 < 0:
             quantities.append(Quantity("nutation frequency (body rates)",
-                                       _pair_frequency(red.eigenvalues()), float(abs(root.imag)),
-                                       "rad/s", "Sec. 4.5 C: sqrt(lambda1 lambda2)"))
+                                       _pair_frequency(sl.reduced.eigenvalues()),
+                                       float(abs(root.imag)), "rad/s",
+                                       "Sec. 4.5 C: sqrt(lambda1 lambda2)"))
+        more = []
     else:
-        comp = I + (damper.inertia_at(float(x[7])) if isinstance(damper, PointMassDamper)
-                    else damper.inertia * np.eye(3))
-        Ja, Jb, Jc = principal_moments(comp, a)
-        kind = axis_kind(Ja, Jb, Jc)
-        quantities += [Quantity("loaded axial moment Ja", None, Ja, "kg m^2"),
-                       Quantity("loaded transverse moment Jb", None, Jb, "kg m^2"),
-                       Quantity("loaded transverse moment Jc", None, Jc, "kg m^2"),
-                       Quantity("locked-damper lambda^2 = -rate^2 (Ja-Jb)(Ja-Jc)/(Jb Jc)", None,
-                                rigid_spin_lambda2(Ja, Jb, Jc, rate), "1/s^2",
-                                "Eqs. 4.94-4.95, damper locked")]
-        if isinstance(damper, SphericalDamper) and abs(Ib - Ic) <= 1e-12 * Ib:
-            cf = spherical_damper_roots(Ib, damper.inertia, damper.damping, Ia * rate, rate,
-                                        rate, Ia)
-        expected = {"major": "asymptotically stable", "minor": "unstable",
-                    "intermediate": "unstable"}.get(kind)
-        if expected:
-            notes.append(f"Kelvin-Tait-Chetaev: energy dissipation makes a {kind}-axis spin "
-                         f"{expected} (if the damper is excited by the nutation)")
+        sl = _scene_case(gyrostat_scene(I, wheel_axis=a, damper=damper), a, rate, damper=True)
+        title = (f"Spin about a principal axis with a {type(damper).__name__} "
+                 "(RP-1262, Sec. 4.5 NOTE)")
+        kind, quantities, cf, more = _damper_terms(I, a, rate, damper, _damper_offset(sl))
+    notes = _notes(sl) + more
     notes.insert(0, f"spin about the {kind} axis{' of the loaded body' if damper else ''}; "
                     f"rigid moments Ia = {Ia:.10g}, Ib = {Ib:.10g}, Ic = {Ic:.10g} kg m^2")
-    return build_report("spin", title, params, red.ss, lin=lin, closed_form=cf, groups=groups,
-                        quantities=quantities, notes=notes)
+    return build_report("spin", title, params, sl.reduced.ss, lin=sl.lin, closed_form=cf,
+                        groups=sl.groups, quantities=quantities, notes=notes)
+
+
+def _damper_offset(sl) -> float:
+    """The point-mass damper's resting displacement ``s`` [m] at the spin point (0 else)."""
+    return float(sl.point.values[0]) if sl.point.values else 0.0
+
+
+def _damper_terms(I, a, rate, damper, s) -> tuple:
+    """``(kind, quantities, closed_form, notes)`` of a torque-free body carrying one energy
+    damper: its loaded moments, the locked-damper ``lambda^2``, the closed form of a
+    symmetric body with a spherical damper and the Kelvin-Tait-Chetaev note."""
+    Ia, Ib, Ic = principal_moments(I, a)
+    comp = I + (damper.inertia_at(s) if isinstance(damper, PointMassDamper)
+                else damper.inertia * np.eye(3))
+    Ja, Jb, Jc = principal_moments(comp, a)
+    kind = axis_kind(Ja, Jb, Jc)
+    quantities = [Quantity("loaded axial moment Ja", None, Ja, "kg m^2"),
+                  Quantity("loaded transverse moment Jb", None, Jb, "kg m^2"),
+                  Quantity("loaded transverse moment Jc", None, Jc, "kg m^2"),
+                  Quantity("locked-damper lambda^2 = -rate^2 (Ja-Jb)(Ja-Jc)/(Jb Jc)", None,
+                           rigid_spin_lambda2(Ja, Jb, Jc, rate), "1/s^2",
+                           "Eqs. 4.94-4.95, damper locked")]
+    cf, notes = None, []
+    if isinstance(damper, SphericalDamper) and abs(Ib - Ic) <= 1e-12 * Ib:
+        cf = spherical_damper_roots(Ib, damper.inertia, damper.damping, Ia * rate, rate, rate,
+                                    Ia)
+    expected = {"major": "asymptotically stable", "minor": "unstable",
+                "intermediate": "unstable"}.get(kind)
+    if expected:
+        notes.append(f"Kelvin-Tait-Chetaev: energy dissipation makes a {kind}-axis spin "
+                     f"{expected} (if the damper is excited by the nutation)")
+    return kind, quantities, cf, notes
 
 
 def _held_momentum(scene: Scene, a) -> float | None:
@@ -236,10 +206,15 @@ def _scene_spin(scene: Scene, axis, rate) -> StabilityReport:
     """`spin` of a scene (its docstring)."""
     a = unit_vector(axis, "axis")
     W = check_number(rate, "rate")
-    lin, red, notes, groups = _scene_case(scene, a, W)
-    quantities, cf = [], None
+    sl = _scene_case(scene, a, W)
+    notes, quantities, cf = _notes(sl), [], None
     rotors = _held_momentum(scene, a)
-    if rotors is not None:
+    damper = _lone_damper(scene)
+    if damper is not None:
+        kind, quantities, cf, more = _damper_terms(scene.hub.inertia_matrix, a, W, damper,
+                                                   _damper_offset(sl))
+        notes = [f"spin about the {kind} axis of the loaded body"] + notes + more
+    elif rotors is not None:
         Ia, Ib, Ic = principal_moments(scene.hub.inertia_matrix, a)
         h = rotors[0] * W + rotors[1]
         lam2 = gyrostat_lambda2(Ia, Ib, Ic, W, h)
@@ -255,14 +230,37 @@ def _scene_spin(scene: Scene, axis, rate) -> StabilityReport:
                             "kg m^2")
     title = f"Spin of {scene.name or 'a scene'} about a hub axis"
     params = {"scene": repr(scene), "axis": a, "rate": W}
-    return build_report("spin", title, params, red.ss, lin=lin, closed_form=cf, groups=groups,
-                        quantities=quantities, notes=notes)
+    return build_report("spin", title, params, sl.reduced.ss, lin=sl.lin, closed_form=cf,
+                        groups=sl.groups, quantities=quantities, notes=notes)
 
 
-def _scene_case(scene: Scene, a, rate) -> tuple:
-    """``(lin, reduced, notes, groups)`` of a scene's spin (`spin_linearization`)."""
-    sl = spin_linearization(scene, a, rate)
-    return sl.lin, sl.reduced, list(sl.reduced.notes) + list(sl.notes), sl.groups
+def _lone_damper(scene: Scene):
+    """The energy damper of a scene that is a hub, one damper on the hub and loads; None for
+    any other scene."""
+    loads = (ExternalTorque, ExternalForce)
+    dampers = [p for p in scene.parts if not isinstance(p, loads)]
+    if len(dampers) != 1 or not (
+            isinstance(dampers[0], PointMassDamper)
+            or isinstance(dampers[0], SphericalDamper) and not any(dampers[0].housing_rate)):
+        return None
+    return dampers[0]
+
+
+def _scene_case(scene: Scene, a, rate, *, damper: bool = False):
+    """`spin_linearization` of a case's scene; with a damper, a spin that is no relative
+    equilibrium is blamed on ``damper`` (the rigid body's axis was checked before)."""
+    try:
+        return spin_linearization(scene, a, rate)
+    except ValueError as exc:
+        if not damper:
+            raise
+        raise ValueError(f"`damper`: no steady spin about `axis` with this damper: {exc}") \
+            from None
+
+
+def _notes(sl) -> list:
+    """The reduction's notes of a `SpinLinearization`."""
+    return list(sl.reduced.notes) + list(sl.notes)
 
 
 def _pair_frequency(ev) -> float | None:
@@ -338,17 +336,10 @@ def gyrostat(inertia, axis, rate, wheel_momentum, *, wheel_inertia=None, damper=
                          "turns at rate + wheel_momentum / wheel_inertia)")
     if W == 0 and h == 0:
         raise ValueError("`rate` and `wheel_momentum` are both zero: nothing spins")
-    if damper is None:
-        lin, red, notes, groups = _scene_case(Scene(RigidHub(I), HeldRotor(a, h)), a, W)
-    else:
-        model = gyrostat_model(I, wheel_axis=a, wheel_momentum=h, damper=damper,
-                               damper_on=damper_on, wheel_rate=Wr)
-        x = steady_spin_state(a, W, damper=damper, damper_on=damper_on, wheel_rate=Wr)
-        lin = _case_linearization(model, x, "rates", damper)
-        red, notes = reduce_free_spin(model, x, lin)
-        notes = list(red.notes) + notes
-        rates = [s for s in red.states if s in ("w1", "w2", "w3")]
-        groups = {"nutation": rates, "damper": [s for s in red.states if s not in rates]}
+    scene = gyrostat_scene(I, wheel_axis=a, wheel_momentum=h, damper=damper,
+                           damper_on=damper_on, wheel_rate=Wr)
+    sl = _scene_case(scene, a, W, damper=damper is not None)
+    lin, red, notes, groups = sl.lin, sl.reduced, _notes(sl), sl.groups
     params = {"inertia": I, "axis": a, "rate": W, "wheel_momentum": h,
               "wheel_inertia": wheel_inertia, "damper": _damper_dict(damper),
               "damper_on": damper_on}

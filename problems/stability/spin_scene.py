@@ -10,7 +10,7 @@ is not principal for the loaded body).
 `spin_linearization` linearizes in body rates (``frame='rates'``; in the spinning frame, with
 the spin phase factored out by `Linearization.quotient`, when a load depends on the
 attitude), factors out cyclic part coordinates (nothing depends on them) and restricts to the level sets of the first integrals: ``|H|^2`` first (today's
-free-spin reduction, `reduce_free_spin`), then every further invariant of the scene that the
+free-spin reduction), then every further invariant of the scene that the
 flow conserves exactly (a reaction wheel's absolute axial momentum), each only where its
 gradient is independent of those already used. Modes are labelled by part, from the model's
 ``layout`` (``'nutation'`` for the hub's rates and angles, the part's name otherwise).
@@ -51,6 +51,8 @@ class SpinPoint:
     iterations : int
         Newton steps taken.
     converged : bool
+    values : tuple of float
+        The solved coordinates, in the order of ``coordinates``.
     """
 
     x: np.ndarray
@@ -58,6 +60,7 @@ class SpinPoint:
     residual: float
     iterations: int
     converged: bool
+    values: tuple = ()
 
 
 @dataclass(frozen=True)
@@ -143,7 +146,7 @@ def spin_point(scene: Scene, axis: np.ndarray, rate: float) -> SpinPoint:
             break
         cv = cv + np.linalg.lstsq(J, -gv, rcond=None)[0]
     x[ic] = cv
-    return SpinPoint(x, names, res, it, res <= NEWTON_RTOL * scale)
+    return SpinPoint(x, names, res, it, res <= NEWTON_RTOL * scale, tuple(cv.tolist()))
 
 
 def _conserved(model, key: str, x: np.ndarray) -> bool:

@@ -14,9 +14,12 @@ from hypothesis import given, settings
 from hypothesis import strategies as hs
 
 from appdyn.dynamics.attitude import dcm_from_quat
-from appdyn.dynamics.scene import (ExternalTorque, HeldRotor, ReactionWheels, RigidHub, Scene)
+from appdyn.dynamics.scene import (ExternalTorque, HeldRotor, PointMassDamper, ReactionWheels,
+                                   RigidHub, Scene, SphericalDamper)
+from appdyn.dynamics.spinning import point_mass_offset
 from appdyn.problems import stability as st
 from appdyn.problems.stability.spin_scene import spin_point
+from tests.problems.test_stability import point_mass_polynomial, spherical_closed_form
 
 
 def sorted_ev(z):
@@ -151,6 +154,95 @@ def test_spin_point_of_parts_without_coordinates_is_the_scene_state():
     pt = spin_point(scene, np.array([0.0, 0.0, 1.0]), 3.0)
     np.testing.assert_array_equal(pt.x, scene.state(w=[0.0, 0.0, 3.0]))
     assert pt.converged and pt.coordinates == ()
+
+
+# ------------------------------------------------------------------ energy dampers
+M, K, C, R, W = 0.5, 60.0, 0.8, 0.6, 4.0
+
+
+@pytest.mark.parametrize("I1, kind, verdict", [(5.0, "major", "asymptotically stable"),
+                                               (2.0, "minor", "unstable"),
+                                               (3.5, "intermediate", "unstable")])
+def test_kelvin_tait_chetaev_point_mass_damper(I1, kind, verdict):
+    """Hub (I1, 3, 4) spinning about e1, a mass at R e2 sliding along e1: loaded moments
+    (I1 + m R^2, 3, 4 + m R^2); the hand-linearized polynomial gives the eigenvalues. The
+    rigid hub alone is marginally stable about its major and minor axes."""
+    hub = RigidHub([I1, 3.0, 4.0])
+    scene = Scene(hub, PointMassDamper(M, K, C, position=(0, R, 0), direction=(1, 0, 0)))
+    rep = st.spin(scene, [1, 0, 0], W)
+    assert rep.verdict == verdict
+    assert_eigenvalues(rep, point_mass_polynomial(I1 + M * R * R, 3.0, 4.0 + M * R * R, M, R,
+                                                  K, C, W))
+    assert rep.ss.state_labels == ["w2", "w3", "s", "s_dot"]
+    assert {m.label for m in rep.modes} == {"nutation", "damper"}
+    assert any(f"{kind} axis of the loaded body" in n for n in rep.notes)
+    rigid = st.spin(Scene(hub), [1, 0, 0], W).verdict
+    assert rigid == ("unstable" if kind == "intermediate" else "marginally stable")
+
+
+@pytest.mark.parametrize("Ia, verdict", [(3.0, "asymptotically stable"), (1.5, "unstable")])
+def test_kelvin_tait_chetaev_spherical_damper(Ia, verdict):
+    It, Jd, c, W3 = 2.0, 0.05, 0.02, 10.0
+    rep = st.spin(Scene(RigidHub([It, It, Ia]), SphericalDamper(Jd, c)), [0, 0, 1], W3)
+    assert rep.verdict == verdict
+    assert_eigenvalues(rep, spherical_closed_form(It, Ia, Jd, c, W3))
+    assert rep.status == st.STATUS_VERIFIED  # the report's own closed form, checked
+    assert rep.ss.state_labels == ["w1", "w2", "wd1", "wd2", "wd3"]
+
+
+def test_point_mass_rests_at_its_centrifugal_offset():
+    """A radial damper (along e2 at R e2) is pushed out: k s = mu W^2 (R + s); Newton finds
+    the closed form `point_mass_offset`, and the spin stays a relative equilibrium."""
+    damper = PointMassDamper(M, K, C, position=(0, R, 0), direction=(0, 1, 0))
+    scene = Scene(RigidHub([5.0, 3.0, 4.0]), damper)
+    pt = spin_point(scene, np.array([1.0, 0.0, 0.0]), W)
+    s = point_mass_offset(damper, [1, 0, 0], W)
+    assert pt.converged and pt.coordinates == ("s",)
+    assert abs(pt.values[0] - s) <= 1e-14 * abs(s)
+    assert abs(s - M * W * W * R / (K - M * W * W)) < 1e-14
+    rep = st.spin(scene, [1, 0, 0], W)
+    assert rep.linearization.x0[scene.layout["damper"].coords][0] == pt.values[0]
+    # a radial damper in the spin plane is not excited by the nutation (decoupled to first
+    # order): the nutation is that of the locked body, undamped
+    r2 = M * (R + s) ** 2
+    lam = 1j * W * np.sqrt((5.0 + r2 - 3.0) * (5.0 + r2 - 4.0 - r2) / (3.0 * (4.0 + r2)))
+    nutation = [z for z in rep.eigenvalues if abs(z.real) <= 1e-12]
+    np.testing.assert_allclose(sorted_ev(nutation), sorted_ev([lam, -lam]), rtol=1e-9)
+    assert rep.verdict == "marginally stable"
+
+
+def test_spring_the_centrifugal_load_cancels_finds_no_rest():
+    damper = PointMassDamper(M, M * W * W, C, position=(0, R, 0), direction=(0, 1, 0))
+    with pytest.raises(ValueError, match="parts find no rest.*Stiffen"):
+        st.spin(Scene(RigidHub([5.0, 3.0, 4.0]), damper), [1, 0, 0], W)
+
+
+def test_two_dampers_label_their_modes_by_part():
+    """No closed form for two dampers: the status says unchecked, the verdict is still
+    Kelvin-Tait-Chetaev's (major axis, energy dissipated: asymptotically stable), and each
+    damper's modes carry its scene name."""
+    scene = Scene(RigidHub([5.0, 3.0, 4.0]),
+                  PointMassDamper(M, K, C, position=(0, R, 0), direction=(1, 0, 0)),
+                  PointMassDamper(M, 2 * K, C, position=(0, 0, R), direction=(1, 0, 0)))
+    rep = st.spin(scene, [1, 0, 0], W)
+    assert rep.status == st.STATUS_UNCHECKED
+    assert rep.verdict == "asymptotically stable"
+    assert rep.ss.state_labels == ["w2", "w3", "s", "s_dot", "s_2", "s_dot_2"]
+    assert {m.label for m in rep.modes} <= {"nutation", "damper", "damper_2"}
+    assert "damper_2" in {m.label for m in rep.modes}
+
+
+def test_damper_wrappers_equal_the_scene_spin():
+    """`spin(inertia, damper=...)` and `gyrostat(..., damper=...)` build these scenes."""
+    damper = PointMassDamper(M, K, C, position=(0, R, 0), direction=(1, 0, 0))
+    a = st.spin([5.0, 3.0, 4.0], [1, 0, 0], W, damper=damper)
+    b = st.spin(Scene(RigidHub([5.0, 3.0, 4.0]), damper), [1, 0, 0], W)
+    np.testing.assert_allclose(a.eigenvalues, b.eigenvalues, rtol=0, atol=1e-13)
+    sph = SphericalDamper(0.1, 0.05)
+    g = st.gyrostat([3.0, 4.0, 4.0], [1, 0, 0], 2.0, 1.0, damper=sph)
+    h = st.spin(Scene(RigidHub([3.0, 4.0, 4.0]), HeldRotor([1, 0, 0], 1.0), sph), [1, 0, 0], 2.0)
+    np.testing.assert_allclose(g.eigenvalues, h.eigenvalues, rtol=0, atol=1e-13)
+    assert g.closed_form_error < 1e-8
 
 
 # ------------------------------------------------------------------ bad input
