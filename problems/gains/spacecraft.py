@@ -68,7 +68,7 @@ _INFEASIBLE = ("Infeasible_Problem_Detected", "Restoration_Failed")
 _TORQUE = "torque limit |u_i| <= u_max_i"
 
 
-def attitude_gains(inertia, scenarios, *, u_max=None, horizon=None, per_axis: bool = False,
+def attitude_gains(inertia, scenarios, *, u_max, horizon=None, per_axis: bool = False,
                    effort_weight: float = 0.1, settle_angle: float = DEFAULT_SETTLE_ANGLE,
                    settle_by_horizon: bool = False, gains0=None, gain_bounds=None,
                    N: int = _DEFAULT_N, transcription="radau", ipopt_options: Mapping | None = None,
@@ -81,15 +81,15 @@ def attitude_gains(inertia, scenarios, *, u_max=None, horizon=None, per_axis: bo
     inertia : array_like, shape (3, 3) or (3,) [kg m^2], or Scene
         Inertia about the mass center, body axes (or principal moments); or the spacecraft
         as a `dynamics.scene.Scene`: an attitude-only hub with at most one `ExternalTorque`
-        (`problems.gains.attitude_loop.spacecraft_scene`), whose ``u_max`` is the default
-        torque limit.
+        (`problems.gains.attitude_loop.spacecraft_scene`); ``u_max=None`` takes its
+        torque's bound.
     scenarios : sequence of mappings
         Initial conditions, each ``{'angle': float [rad], 'axis': (3,), 'w0': (3,) [rad/s]}``
         (``w0`` optional, default rest): the body rotated by ``angle`` (``0 <= angle < pi``)
         about ``axis`` from the target. Their designs share one set of gains.
     u_max : float or array_like, shape (3,) [N m]
         Torque limit per body axis; a path constraint in every scenario (also at ``t = 0``).
-        Required, unless a scene's torque is bounded.
+        ``None`` (with a scene whose torque is bounded): that bound.
     horizon : float [s], optional
         The cost's horizon; default 5 times the eigenaxis rest-to-rest bang-bang time
         ``2 sqrt(angle / alpha)`` of the largest-angle scenario (``alpha = min_i u_max_i /

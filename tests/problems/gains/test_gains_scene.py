@@ -47,9 +47,9 @@ def test_layout_blocks_are_the_rigid_body_states():
 
 
 def test_attitude_gains_of_a_scene_equal_those_of_its_inertia():
-    """The scene's torque bound is the default ``u_max``; the design is the inertia's."""
+    """``u_max=None`` takes the scene's torque bound; the design is the inertia's."""
     ref = attitude_gains(J, SLEW, u_max=0.5, time_optimal_reference=False, N=20)
-    res = attitude_gains(Scene(RigidHub(J), ExternalTorque(u_max=0.5)), SLEW,
+    res = attitude_gains(Scene(RigidHub(J), ExternalTorque(u_max=0.5)), SLEW, u_max=None,
                          time_optimal_reference=False, N=20)
     assert ref.success and res.success
     for k in ("kp", "kd"):
@@ -60,8 +60,8 @@ def test_attitude_gains_of_a_scene_equal_those_of_its_inertia():
 @pytest.mark.parametrize("body, kwargs, match", [
     (Scene(RigidHub(J), ReactionWheels(np.eye(3), 0.1)), {"u_max": 0.5}, "`inertia`.*ReactionWheels"),
     (Scene(RigidHub(J, mass=10.0)), {"u_max": 0.5}, "`inertia`.*translating"),
-    (Scene(RigidHub(J), ExternalTorque()), {}, "`u_max`"),
-    (J, {}, "`u_max`"),
+    (Scene(RigidHub(J), ExternalTorque()), {"u_max": None}, "`u_max`"),
+    (J, {"u_max": None}, "`u_max`"),
 ])
 def test_bad_scene_names_the_argument(body, kwargs, match):
     with pytest.raises(ValueError, match=match):
