@@ -32,8 +32,9 @@ from .scene.dampers import unit_vector
 from .model import Model
 from .validate import check_inertia
 
-__all__ = ["PointMassDamper", "SphericalDamper", "tilt_torque_body", "gyrostat_model",
-           "gyrostat_scene", "steady_spin_state", "point_mass_offset", "unit_vector"]
+__all__ = ["PointMassDamper", "SphericalDamper", "tilt_torque_body", "tilt_torque_scene",
+           "gyrostat_model", "gyrostat_scene", "steady_spin_state", "point_mass_offset",
+           "unit_vector"]
 
 
 # -------------------------------------------------------------------- tilt torque
@@ -93,10 +94,24 @@ def tilt_torque_body(inertia, overturning, *, axis=(1.0, 0.0, 0.0), direction=(1
     ----------
     .. [1] Rheinfurth & Wilson, NASA RP-1262, Sec. 4.6, Method III and its Example 1.
     """
+    return tilt_torque_scene(inertia, overturning, axis=axis, direction=direction,
+                             internal_damping=internal_damping).model()
+
+
+def tilt_torque_scene(inertia, overturning, *, axis=(1.0, 0.0, 0.0), direction=(1.0, 0.0, 0.0),
+                      internal_damping: float = 0.0) -> Scene:
+    """The `Scene` of `tilt_torque_body` (same arguments and errors).
+
+    Examples
+    --------
+    >>> from appdyn.dynamics.spinning import tilt_torque_scene
+    >>> tilt_torque_scene([0.002, 0.005, 0.005], 0.1).part_names
+    ('tilt', 'torque')
+    """
     hub = RigidHub(check_inertia(inertia))
     tilt = TiltTorque(overturning, axis=axis, direction=direction,
                       internal_damping=internal_damping)
-    return Scene(hub, tilt, ExternalTorque(), name="tilt_torque_body").model()
+    return Scene(hub, tilt, ExternalTorque(), name="tilt_torque_body")
 
 
 # ------------------------------------------------------------------------ gyrostat
