@@ -15,12 +15,12 @@ import numpy as np
 
 from appdyn.dynamics.rigid_body import check_inertia
 from appdyn.dynamics.scene import (ExternalForce, ExternalTorque, HeldRotor, ReactionWheels,
-                                   RigidHub, Scene)
+                                   RigidHub, Scene, TiltTorque)
 from appdyn.dynamics.spinning import (PointMassDamper, SphericalDamper, gyrostat_scene,
                                       unit_vector)
 
-from .closed_forms import (axis_kind, gyrostat_lambda2, principal_moments, rigid_spin_lambda2,
-                           spherical_damper_roots)
+from .closed_forms import (axis_kind, gyrostat_lambda2, method3_roots, principal_moments,
+                           rigid_spin_lambda2, spherical_damper_roots, with_conjugates)
 from .common import check_number, plain
 from .report import Quantity, StabilityReport, build_report
 from .spin_scene import spin_linearization
@@ -209,8 +209,16 @@ def _scene_spin(scene: Scene, axis, rate) -> StabilityReport:
     sl = _scene_case(scene, a, W)
     notes, quantities, cf = _notes(sl), [], None
     rotors = _held_momentum(scene, a)
-    damper = _lone_damper(scene)
-    if damper is not None:
+    damper, tilt = _lone_damper(scene), _upright_tilt(scene, a, sl)
+    if tilt is not None:
+        Ia, Ib, _ = principal_moments(scene.hub.inertia_matrix, a)
+        (r1, r2), G, K = method3_roots(Ia, Ib, tilt.overturning, W, tilt.internal_damping)
+        cf = with_conjugates((r1, r2))
+        quantities += [Quantity("K = (I1 - I2) w0^2 - kappa", None, K, "N m/rad",
+                                "Eq. 4.122"),
+                       Quantity("G = 2 I2 - I1", None, G, "kg m^2", "Eq. 4.122")]
+        notes.append("eigenvalues in the frame spinning at w0 (Method III, Eq. 4.127)")
+    elif damper is not None:
         kind, quantities, cf, more = _damper_terms(scene.hub.inertia_matrix, a, W, damper,
                                                    _damper_offset(sl))
         notes = [f"spin about the {kind} axis of the loaded body"] + notes + more
@@ -232,6 +240,19 @@ def _scene_spin(scene: Scene, axis, rate) -> StabilityReport:
     params = {"scene": repr(scene), "axis": a, "rate": W}
     return build_report("spin", title, params, sl.reduced.ss, lin=sl.lin, closed_form=cf,
                         groups=sl.groups, quantities=quantities, notes=notes)
+
+
+def _upright_tilt(scene: Scene, a, sl):
+    """The `TiltTorque` of a scene that is a hub symmetric about ``a`` with a tilt torque
+    about ``a`` from the direction ``a`` (Method III upright) and loads, linearized in the
+    spinning frame; None for any other scene."""
+    parts = [p for p in scene.parts if not isinstance(p, (ExternalTorque, ExternalForce))]
+    if len(parts) != 1 or not isinstance(parts[0], TiltTorque) or sl.lin.frame != "spinning":
+        return None
+    tilt = parts[0]
+    _, Ib, Ic = principal_moments(scene.hub.inertia_matrix, a)
+    aligned = min(np.dot(tilt.axis, a), np.dot(tilt.direction, a)) >= 1 - 1e-12
+    return tilt if aligned and abs(Ib - Ic) <= 1e-12 * Ib else None
 
 
 def _lone_damper(scene: Scene):

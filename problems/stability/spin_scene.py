@@ -215,14 +215,16 @@ def _restrict_integrals(model, lin: Linearization, integrals, prefer) -> tuple:
         P[r, range(red.n - 1)] = 1.0
         P[k] = -c[r] / c[k]
         T, red, used = T @ P, nxt, used + 1
-    if not used:
-        notes.append("no first integral with a non-zero gradient: the neutral eigenvalue 0 of "
-                     "the spin-rate family stays in the model")
-    return red, notes
+    return red, notes, used
 
 
-def reduce_spin(scene: Scene, x, lin: Linearization) -> tuple:
+def reduce_spin(scene: Scene, x, lin: Linearization, axis) -> tuple:
     """Factor the cyclic coordinates out of ``lin`` and restrict it to the first integrals.
+
+    The integrals are those the uncontrolled flow conserves exactly: ``|H|^2``, then the
+    parts' invariants, the energy last. Where none applies (a dissipative torque that depends
+    on the attitude), the hub's rate about ``axis``, if constant to first order (no torque
+    about the axis), is restricted instead.
 
     Returns
     -------
@@ -237,11 +239,11 @@ def reduce_spin(scene: Scene, x, lin: Linearization) -> tuple:
         if name in red.states and np.max(np.abs(red.A[:, red.index(name)])) <= 1e-13 * scale:
             red = red.quotient(name, reason="a cyclic coordinate: nothing depends on it")
     integrals = []
-    keys = [k for k in model.invariants if k not in ("quat_norm", "momentum_inertial")]
-    if "momentum_inertial" in model.invariants:
+    if "momentum_inertial" in model.invariants and _conserved(model, "momentum_inertial", x):
         integrals += [("|H|^2", "|H|^2 is a first integral; the steady spins form a "
                        "one-parameter family, whose eigenvalue 0 goes", g)
                       for g in _gradients(model, x, "momentum_inertial", True)]
+    keys = [k for k in model.invariants if k not in ("quat_norm", "momentum_inertial")]
     for key in sorted(keys, key=lambda k: k == "energy"):  # the energy last
         if not _conserved(model, key, x):
             continue
@@ -249,7 +251,17 @@ def reduce_spin(scene: Scene, x, lin: Linearization) -> tuple:
             label = key if key == "energy" else f"{key}[{j}]"
             integrals.append((label, f"{label} is a first integral", g))
     parts = {model.states[i] for i in _indices(model, "coords") + _indices(model, "speeds")}
-    return _restrict_integrals(model, red, integrals, parts)
+    red, notes, used = _restrict_integrals(model, red, integrals, parts)
+    if used:
+        return red, notes
+    rates = model.states[model.layout["hub"].speeds]
+    c = np.array([axis[rates.index(s)] if s in rates else 0.0 for s in red.states])
+    try:
+        return red.restrict(c, reason="the spin rate about the axis is constant to first "
+                            "order: no torque about it"), notes
+    except ValueError:
+        return red, notes + ["no first integral with a non-zero gradient: the neutral "
+                             "eigenvalue 0 of the spin-rate family stays in the model"]
 
 
 def spin_groups(model, states) -> dict:
@@ -263,13 +275,15 @@ def spin_groups(model, states) -> dict:
     return {k: v for k, v in groups.items() if v}
 
 
-def _linearize(model, x) -> Linearization:
+def _linearize(model, x, frame) -> Linearization:
     """Body-rate linearization, or in the spinning frame when a load depends on the attitude
-    (either may be a non-equilibrium: the caller checks)."""
-    try:
-        return linearization(model, x, frame="rates", allow_non_equilibrium=True)
-    except ValueError:
-        return linearization(model, x, frame="spinning", allow_non_equilibrium=True)
+    or ``frame='spinning'`` (either may be a non-equilibrium: the caller checks)."""
+    if frame != "spinning":
+        try:
+            return linearization(model, x, frame="rates", allow_non_equilibrium=True)
+        except ValueError:
+            pass
+    return linearization(model, x, frame="spinning", allow_non_equilibrium=True)
 
 
 def _quotient_phase(lin: Linearization, axis) -> Linearization:
@@ -282,7 +296,8 @@ def _quotient_phase(lin: Linearization, axis) -> Linearization:
     return lin.quotient(n, reason="the spin phase about the axis is cyclic")
 
 
-def spin_linearization(scene: Scene, axis: np.ndarray, rate: float) -> SpinLinearization:
+def spin_linearization(scene: Scene, axis: np.ndarray, rate: float, *,
+                       frame: str | None = None) -> SpinLinearization:
     """Linearize and reduce the steady spin of ``scene`` (module docstring).
 
     Parameters
@@ -291,6 +306,9 @@ def spin_linearization(scene: Scene, axis: np.ndarray, rate: float) -> SpinLinea
     axis : ndarray, shape (3,)
         Unit spin axis, hub axes.
     rate : float [rad/s]
+    frame : {None, 'spinning'}, optional
+        ``'spinning'`` keeps the attitude (error angles in the frame spinning with the hub,
+        the spin phase factored out) even where the body rates alone would do.
 
     Returns
     -------
@@ -323,10 +341,12 @@ def spin_linearization(scene: Scene, axis: np.ndarray, rate: float) -> SpinLinea
             f"rest (max |{', '.join(point.coordinates)} speeds'| = {point.residual:.3e} after "
             f"{point.iterations} Newton steps; e.g. a spring the centrifugal load overcomes). "
             "Stiffen the part or lower the rate")
-    lin = _linearize(model, point.x)
+    if frame not in (None, "spinning"):
+        raise ValueError(f"`frame` must be None or 'spinning', got {frame!r}")
+    lin = _linearize(model, point.x, frame)
     if not lin.is_equilibrium:
         raise ValueError(
             f"the scene has no relative equilibrium spinning about {where} with its parts at "
             f"rest on the hub (is `axis` a principal axis of the loaded body?): {lin.notes[0]}")
-    red, notes = reduce_spin(scene, point.x, _quotient_phase(lin, axis))
+    red, notes = reduce_spin(scene, point.x, _quotient_phase(lin, axis), axis)
     return SpinLinearization(point, lin, red, tuple(notes), spin_groups(model, red.states))

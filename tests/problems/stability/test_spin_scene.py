@@ -15,7 +15,7 @@ from hypothesis import strategies as hs
 
 from appdyn.dynamics.attitude import dcm_from_quat
 from appdyn.dynamics.scene import (ExternalTorque, HeldRotor, PointMassDamper, ReactionWheels,
-                                   RigidHub, Scene, SphericalDamper)
+                                   RigidHub, Scene, SphericalDamper, TiltTorque)
 from appdyn.dynamics.spinning import point_mass_offset
 from appdyn.problems import stability as st
 from appdyn.problems.stability.spin_scene import spin_point
@@ -243,6 +243,43 @@ def test_damper_wrappers_equal_the_scene_spin():
     h = st.spin(Scene(RigidHub([3.0, 4.0, 4.0]), HeldRotor([1, 0, 0], 1.0), sph), [1, 0, 0], 2.0)
     np.testing.assert_allclose(g.eigenvalues, h.eigenvalues, rtol=0, atol=1e-13)
     assert g.closed_form_error < 1e-8
+
+
+# ------------------------------------------------------------------ tilt torque (Method III)
+I1_TOP, I2_TOP, MGL = 0.002, 0.005, 0.3 * 9.80665 * 0.04
+
+
+@pytest.mark.parametrize("factor", [1.5, 3.0, -2.0, 0.7, 0.0])
+def test_heavy_top_scene_eq_4_127(factor):
+    """Hub (I1, I2, I2) about the pivot with gravity's tilt torque kappa = m g l, spinning
+    upright at w0 = factor * the sleeping rate (Eq. 4.128): the roots of Eq. 4.127,
+    s = i [(2 I2 - I1) w0 / (2 I2) +/- sqrt((I1 w0 / (2 I2))^2 - m g l / I2)], and conjugates,
+    in the frame spinning at w0; the spin phase goes by quotient, the spin rate with the
+    energy (or, at w0 = 0, as the rate no torque changes)."""
+    w0 = factor * 2 / I1_TOP * np.sqrt(MGL * I2_TOP)
+    scene = Scene(RigidHub([I1_TOP, I2_TOP, I2_TOP]), TiltTorque(MGL))
+    rep = st.spin(scene, [1, 0, 0], w0)
+    a = I1_TOP * w0 / (2 * I2_TOP)
+    root = np.sqrt(complex(a * a - MGL / I2_TOP))
+    lam = [1j * ((2 * I2_TOP - I1_TOP) * w0 / (2 * I2_TOP) + sgn * root) for sgn in (1, -1)]
+    assert_eigenvalues(rep, lam + [np.conj(z) for z in lam], rtol=1e-8)
+    assert rep.verdict == ("marginally stable" if abs(factor) > 1 else "unstable")
+    assert rep.ss.state_labels == ["dth2", "dth3", "w2", "w3"]
+    assert rep.status == st.STATUS_VERIFIED and {m.label for m in rep.modes} == {"nutation"}
+
+
+@pytest.mark.parametrize("w0, verdict", [(50.0, "asymptotically stable"), (90.0, "unstable")])
+def test_rotor_internal_damping_scene(w0, verdict):
+    """Bearings kappa = -2 k l^2, internal damping D: unstable above
+    w0^2 = 2 k l^2 / (I2 - I1) = 5000 (Kelvin-Tait-Chetaev, RP-1262 NOTE); no first integral
+    is left, the axial rate goes as constant to first order."""
+    scene = Scene(RigidHub([0.01, 0.05, 0.05]), TiltTorque(-2e4 * 0.01, internal_damping=0.01))
+    rep = st.spin(scene, [1, 0, 0], w0)
+    assert rep.verdict == verdict
+    assert any("constant to first order" in n for n in rep.notes)
+    np.testing.assert_allclose(rep.eigenvalues, st.rotor(0.01, 0.05, 1e4, 0.1, w0,
+                                                         internal_damping=0.01).eigenvalues,
+                               rtol=0, atol=1e-12 * w0)
 
 
 # ------------------------------------------------------------------ bad input
