@@ -15,7 +15,7 @@ from hypothesis import strategies as hs
 
 from appdyn.dynamics.attitude import dcm_from_quat
 from appdyn.dynamics.scene import (ExternalTorque, HeldRotor, PointMassDamper, ReactionWheels,
-                                   RigidHub, Scene, SphericalDamper, TiltTorque)
+                                   RigidHub, Scene, Slosh, SphericalDamper, TiltTorque)
 from appdyn.dynamics.spinning import point_mass_offset
 from appdyn.problems import stability as st
 from appdyn.problems.stability.spin_scene import spin_point
@@ -209,6 +209,21 @@ def test_point_mass_rests_at_its_centrifugal_offset():
     nutation = [z for z in rep.eigenvalues if abs(z.real) <= 1e-12]
     np.testing.assert_allclose(sorted_ev(nutation), sorted_ev([lam, -lam]), rtol=1e-9)
     assert rep.verdict == "marginally stable"
+
+
+def test_slosh_pendulum_swings_out_radially():
+    """A pendulum hinged at e2 whose rest direction (0, 0.8, 0.6) leans out of the spin
+    plane: spinning about e1 it swings out along the radius e2 (an angle atan2(0.6, 0.8) from
+    its rest direction), a relative equilibrium; damped, about the major axis: asymptotically
+    stable, its modes labelled by the part."""
+    scene = Scene(RigidHub([50.0, 30.0, 40.0]),
+                  Slosh(1.0, length=0.5, hinge=(0, 1.0, 0), direction=(0, 0.8, 0.6),
+                        damping=0.01))
+    rep = st.spin(scene, [1, 0, 0], 2.0)
+    theta = rep.linearization.x0[scene.layout["pendulum"].coords]
+    assert abs(np.hypot(*theta) - np.arctan2(0.6, 0.8)) < 1e-12
+    assert rep.verdict == "asymptotically stable" and rep.status == st.STATUS_UNCHECKED
+    assert {m.label for m in rep.modes} == {"nutation", "pendulum"}
 
 
 def test_spring_the_centrifugal_load_cancels_finds_no_rest():
