@@ -97,14 +97,8 @@ def _indices(model, key: str) -> list:
 
 
 def spin_point(scene: Scene, axis: np.ndarray, rate: float) -> SpinPoint:
-    """The state of ``scene`` spinning at ``rate * axis`` with its parts at rest on the hub.
-
-    Parameters
-    ----------
-    scene : Scene
-    axis : ndarray, shape (3,)
-        Unit spin axis, hub axes.
-    rate : float [rad/s]
+    """The state of ``scene`` spinning at ``rate * axis`` with its parts at rest on the hub
+    (``axis``: unit, hub axes; ``rate`` [rad/s]).
 
     Returns
     -------
