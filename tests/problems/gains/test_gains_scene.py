@@ -8,6 +8,7 @@ from __future__ import annotations
 import doctest
 import importlib
 
+import casadi as ca
 import numpy as np
 import pytest
 from hypothesis import given, settings
@@ -18,24 +19,46 @@ from appdyn.dynamics.scene import ExternalTorque, ReactionWheels, RigidHub, Scen
 from appdyn.problems.gains.attitude_loop import (Q_SCALAR, Q_VECTOR, RATES, attitude_loop,
                                                  initial_state, spacecraft_scene)
 from appdyn.problems.gains.spacecraft import attitude_gains
+from tests.dynamics.scene import legacy_gains
 
 J = np.array([[2.0, 0.1, 0.0], [0.1, 3.0, -0.2], [0.0, -0.2, 4.0]])
 SLEW = [{"angle": np.radians(30), "axis": [0, 0, 1]}]
 
 
+def _derivatives(model, x, g):
+    """``(xdot, d xdot/dx, d xdot/dp)`` of a loop at ``x`` with gains ``g``."""
+    xs, ps = ca.SX.sym("x", model.nx), ca.SX.sym("p", model.np)
+    xdot = model.f(xs, ca.DM(0, 1), ps)
+    fun = ca.Function("d", [xs, ps], [xdot, ca.jacobian(xdot, xs), ca.jacobian(xdot, ps)])
+    return [np.asarray(v, dtype=float) for v in fun(x, g)]
+
+
+def _close(got, want):
+    """Equal to 1e-13 relative to the magnitude, absolute floor 1e-13."""
+    assert np.max(np.abs(got - want)) <= 1e-13 * max(1.0, np.max(np.abs(want)))
+
+
 @settings(max_examples=25, deadline=None)
 @given(x=hs.lists(hs.floats(-1.0, 1.0), min_size=7, max_size=7),
        gains=hs.lists(hs.floats(0.0, 5.0), min_size=6, max_size=6), per_axis=hs.booleans())
-def test_scene_loop_is_the_rigid_body_under_the_law(x, gains, per_axis):
+def test_scene_loop_is_the_legacy_loop(x, gains, per_axis):
+    """The loop built on the scene against the old hand-written one (rigid_body under the
+    law, tests/dynamics/scene/legacy_gains.py): rhs, d xdot/dx, d xdot/dp; and against
+    the law applied from numpy on the rigid body."""
     x = np.array(x)
     x[0:4] = x[0:4] / max(np.linalg.norm(x[0:4]), 1e-3)
     g = np.array(gains if per_axis else gains[:2])
     kp, kd = (g[0:3], g[3:6]) if per_axis else (g[0], g[1])
     u = -2 * kp * x[0:3] - kd * x[4:7]  # the law written out on the rigid body's states
-    want = rigid_body(J).rhs(x, u)
+    legacy = legacy_gains.attitude_loop(J, per_axis=per_axis)
+    want = _derivatives(legacy, x, g)
+    _close(want[0].ravel(), rigid_body(J).rhs(x, u))
     for body in (J, Scene(RigidHub(J)), Scene(RigidHub(J), ExternalTorque(u_max=1.0))):
-        got = attitude_loop(body, per_axis=per_axis).rhs(x, p=g)
-        np.testing.assert_allclose(got, want, rtol=1e-13, atol=1e-13 * max(1, np.max(abs(want))))
+        loop = attitude_loop(body, per_axis=per_axis)
+        assert (loop.states, loop.params, loop.controls) == (legacy.states, legacy.params, ())
+        assert dict(loop.units) == dict(legacy.units) and loop.attitude == legacy.attitude
+        for got, ref in zip(_derivatives(loop, x, g), want):
+            _close(got, ref)
 
 
 def test_layout_blocks_are_the_rigid_body_states():
