@@ -25,11 +25,10 @@ import dataclasses
 
 import numpy as np
 
+from .model import Model
 from .scene import (ExternalTorque, HeldRotor, PointMassDamper, RigidHub, Scene,
                     SphericalDamper, TiltTorque)
-from .scene.dampers import real_number as _finite
-from .scene.dampers import unit_vector
-from .model import Model
+from .scene.dampers import real_number, unit_vector
 from .validate import check_inertia
 
 __all__ = ["PointMassDamper", "SphericalDamper", "tilt_torque_body", "tilt_torque_scene",
@@ -150,7 +149,8 @@ def gyrostat_model(inertia, *, wheel_axis=(1.0, 0.0, 0.0), wheel_momentum: float
       ``1/2 w.Jw + mu s' g.w + 1/2 mu s'^2 + 1/2 k s^2`` decays at ``-c s'^2`` (u = 0).
     * `SphericalDamper`: ``H = I w + h a + J_d w_d``; the core obeys
       ``J_d (w_d' + w x w_d) = -c (w_d - w_h)`` with the housing rate ``w_h = w`` (platform)
-      or ``w + wheel_rate a`` (rotor: the damper's ``housing_rate``), hence ``I w' = u - w x (I w + h a) + c (w_d - w_h)``.
+      or ``w + wheel_rate a`` (rotor: the damper's ``housing_rate``), hence
+      ``I w' = u - w x (I w + h a) + c (w_d - w_h)``.
       The energy ``1/2 w.Iw + 1/2 J_d |w_d|^2`` decays at ``-c |w_d - w|^2`` when the damper
       is on the platform (u = 0).
 
@@ -203,8 +203,8 @@ def gyrostat_scene(inertia, *, wheel_axis=(1.0, 0.0, 0.0), wheel_momentum: float
     """
     I = check_inertia(inertia)
     a = unit_vector(wheel_axis, "wheel_axis")
-    h = _finite(wheel_momentum, "wheel_momentum")
-    rate = _finite(wheel_rate, "wheel_rate")
+    h = real_number(wheel_momentum, "wheel_momentum")
+    rate = real_number(wheel_rate, "wheel_rate")
     _check_damper(damper, damper_on)
     parts = [HeldRotor(a, h)] if h != 0.0 else []
     if isinstance(damper, SphericalDamper) and damper_on == "rotor":
@@ -249,7 +249,7 @@ def steady_spin_state(axis, rate: float, *, damper=None, damper_on: str = "platf
     ndarray, shape (7,), (9,) or (10,)
     """
     a = unit_vector(axis, "axis")
-    rate = _finite(rate, "rate")
+    rate = real_number(rate, "rate")
     _check_damper(damper, damper_on)
     x = [0.0, 0.0, 0.0, 1.0, *(rate * a)]
     if isinstance(damper, PointMassDamper):

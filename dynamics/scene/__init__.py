@@ -17,6 +17,8 @@ Parts
 `SphericalDamper`      a viscously coupled spherical core (core rate ``wd1..wd3``)
 `Slosh`                slosh as a pendulum (two angles) or a spring-mass (``s, s_dot``)
 `TiltTorque`           a torque from the tilt of a hub axis (heavy top, projectile, bearings)
+`HingedPanel`          a rigid panel on a revolute (``theta``) or ball (``p1..p4``) hinge
+`GravityGradient`      gravity on every body: forces and gravity-gradient torques
 =====================  =====================================================================
 
 Examples
@@ -30,11 +32,14 @@ from .assembly import PartLayout
 from .contract import Body, Contribution, Frame, Load, Part, PartVariables, Variable
 from .dampers import PointMassDamper, Slosh, SphericalDamper
 from .fields import TiltTorque
+from .gravity import GravityGradient
 from .hubs import RigidHub
 from .loads import ExternalForce, ExternalTorque
+from .panels import HingedPanel
 from .scene import Scene
 from .wheels import HeldRotor, ReactionWheels
 
 __all__ = ["Scene", "RigidHub", "Part", "PartLayout", "Variable", "PartVariables", "Body", "Load",
            "Contribution", "Frame", "ReactionWheels", "HeldRotor", "ExternalTorque",
-           "ExternalForce", "PointMassDamper", "SphericalDamper", "Slosh", "TiltTorque"]
+           "ExternalForce", "PointMassDamper", "SphericalDamper", "Slosh", "TiltTorque",
+           "HingedPanel", "GravityGradient"]

@@ -213,7 +213,7 @@ def assemble(scene) -> Model:
         extra.update(c.invariants)
     all_bodies = [b for bs in bodies_by_part.values() for b in bs]
     for part, pname in zip(scene.parts, scene.part_names):
-        c = part.field_loads(frame, all_bodies)
+        c = part.field_loads(frame, all_bodies, owns[pname])
         loads += list(c.loads)
         potential.append(c.potential)
         extra.update(c.invariants)

@@ -42,8 +42,9 @@ that names the field). It sets ``kind`` (the default name, ``"wheels"``), and im
     * ``invariants``: further monitored quantities of the state, by name.
 
     Loads that depend on the mass distribution of the whole scene (gravity) implement
-    ``field_loads(self, frame, bodies) -> Contribution`` instead, which receives every other
-    part's bodies.
+    ``field_loads(self, frame, bodies, own) -> Contribution`` instead, which receives every
+    body of the scene (the hub's first) and the part's own symbols (a field may turn with a
+    clock coordinate the part declares; its ``rates`` still come from ``contribute``).
 ``spin_speeds(self, frame, own) -> expression`` (optional)
     The part's speeds when it is at rest relative to a hub spinning at ``frame.w`` (zero
     unless its speeds are absolute rates, as a spherical damper's core rate); used by
@@ -256,7 +257,7 @@ class Part:
         """The part's rates, bodies, loads, energy and invariants (module docstring)."""
         return Contribution()
 
-    def field_loads(self, frame: Frame, bodies: list) -> Contribution:
+    def field_loads(self, frame: Frame, bodies: list, own: PartSymbols) -> Contribution:
         """Loads that act on every body of the scene (gravity); none by default."""
         return Contribution()
 
