@@ -43,7 +43,9 @@ def spin(inertia, axis, rate, *, damper=None) -> StabilityReport:
     integrals, modes labelled by part (``'nutation'`` for the hub, else the part's name).
     Closed forms where known: a hub with held rotors and reaction wheels (at rest relative
     to the hub, axes along or normal to the spin) spins as a gyrostat of wheel momentum
-    ``h = sum(held momenta) + rate sum(J_i, wheels along the axis)``.
+    ``h = sum(held momenta) + rate sum(J_i, wheels along the axis)``; a hub with one energy
+    damper as below; a hub symmetric about the axis under an upright `TiltTorque` by
+    Method III (Eq. 4.127, in the frame spinning with the hub).
 
     The body-rate perturbations (Rheinfurth & Wilson, NASA RP-1262, Sec. 4.5 C,
     Eqs. 4.94-4.95) have the eigenvalues
@@ -182,10 +184,10 @@ def _damper_terms(I, a, rate, damper, s) -> tuple:
     return kind, quantities, cf, notes
 
 
-def _held_momentum(scene: Scene, a) -> float | None:
-    """Axial wheel momentum [N m s] per unit rate and held momentum of a scene whose parts
-    are held rotors along ``a``, reaction wheels along or normal to it, and loads; None
-    for any other part (no closed form)."""
+def _held_momentum(scene: Scene, a) -> tuple | None:
+    """``(per_rate, held)``: the axial wheel momentum per unit rate [N m s^2] and the held
+    momentum [N m s] of a scene whose parts are held rotors along ``a``, reaction wheels
+    along or normal to it, and loads; None for any other part (no closed form)."""
     per_rate, held = 0.0, 0.0
     for part in scene.parts:
         if isinstance(part, (ExternalTorque, ExternalForce)):
