@@ -322,3 +322,12 @@ def test_rotor_off_the_spin_axis_is_not_a_relative_equilibrium():
 def test_bad_input_names_the_argument(call, match):
     with pytest.raises((ValueError, TypeError), match=match):
         call()
+
+
+def test_sweep_over_the_rate_of_a_scene():
+    """`sweep` runs spin(scene, ...) too: a held rotor h = 3 on a hub (3, 4, 5) is unstable
+    while Ia + h/W lies between 4 and 5, i.e. for h/(Ic - Ia) = 1.5 < W < h/(Ib - Ia) = 3."""
+    scene = Scene(RigidHub([3.0, 4.0, 5.0]), HeldRotor([1, 0, 0], 3.0))
+    res = st.sweep("spin", "rate", np.linspace(1.0, 4.0, 7), inertia=scene, axis=[1, 0, 0])
+    values = sorted(b.value for b in res.boundaries)
+    np.testing.assert_allclose(values, [1.5, 3.0], atol=1e-6)
