@@ -285,6 +285,11 @@ class Slosh(Part):
     dashpot ``damping`` (states ``s`` [m], ``s_dot`` [m/s]), as a `PointMassDamper` with
     an infinite ``body_mass``.
 
+    The two pendulum angles are singular where the rod is perpendicular to ``p1`` and
+    ``direction`` both (``theta2 = +-pi/2``, 90 degrees from rest): slosh under thrust or
+    spin stays far from it, but a pendulum free of any restoring field can swing there,
+    where ``theta1'`` grows without bound and the integrator's steps shrink.
+
     The mass is a point mass; on an attitude-only hub it moves about the fixed reference
     point, on a six-degree-of-freedom hub the hub's mass reacts to it.
 
