@@ -219,10 +219,10 @@ def wheel_slew(inertia, axes, wheel_inertia, *, objective="time", T=None, angle=
     smax = None if speed_max is None else positive_each(speed_max, "speed_max", n)
     if smax is not None and np.any(np.abs(W0) > smax):
         raise ValueError(f"`W0` {W0.tolist()} lies outside `speed_max` {smax.tolist()}")
-    body_max = (float(np.min(tmax)) * float(np.linalg.svd(A, compute_uv=False)[-1])
-                if tmax is not None else None)
-    if body_max is not None and body_max == 0:
+    sigma = np.linalg.svd(A, compute_uv=False)  # (fewer than 3 wheels: fewer than 3 values)
+    if sigma.size < 3 or sigma[-1] == 0:
         raise ValueError("`axes` must span the three body axes for a slew")
+    body_max = float(np.min(tmax)) * float(sigma[-1]) if tmax is not None else None
     T_ref = rough_time(I, q0, qf, np.full(3, body_max if body_max else 1.0))
     horizon = slew_horizon(objective, T, T_max, T_ref)
     lo = np.r_[np.full(7, -np.inf), -smax if smax is not None else np.full(n, -np.inf)]

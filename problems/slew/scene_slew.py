@@ -134,14 +134,19 @@ def slew(scene, *, objective="time", angle=None, axis=None, q_final=None, T=None
     if objective == "effort":
         _ignored(opts, T_max=None, polish=None, transcription="radau", control="constant",
                  why="for a minimum-effort slew")
+    single = scene.parts[0] if len(scene.parts) == 1 and not scene.hub.translates else None
+    if opts.norm_bound and not isinstance(single, ExternalTorque):
+        raise ValueError("`norm_bound` applies to a scene of a hub and one ExternalTorque only")
+    if opts.min_measure is not None and getattr(single, "kind", None) != "cmgs":
+        raise ValueError("`min_measure` applies to a scene of a hub and one CMG cluster only")
     for engine in (_rigid, _wheels, _cmgs):
         sol = engine(scene, objective, angle, axis, q_final, T, w0, wf, opts)
         if sol is not None:
             return sol
-    if opts.norm_bound:
-        raise ValueError("`norm_bound` applies to a scene of a hub and one ExternalTorque only")
     if opts.min_measure is not None:
-        raise ValueError("`min_measure` applies to a scene of a hub and one CMG cluster only")
+        raise ValueError("`min_measure` is taken by `cmg_slew` only: rest to rest, without "
+                         "`guess`, `keep_out`, `polish=True` and with the default "
+                         "`transcription` and `control`")
     problem, rb, convert = scene_problem(scene, objective=objective, angle=angle, axis=axis,
                                          q_final=q_final, T=T, w0=w0, wf=wf, options=opts)
     keep_out = opts.keep_out is not None
@@ -261,8 +266,6 @@ def _wheels(scene, objective, angle, axis, q_final, T, w0, wf, opts):
     if not (_device_ok(scene, w0, wf, opts) and isinstance(scene.parts[0], ReactionWheels)
             and opts.polish is not False):
         return None
-    if opts.min_measure is not None:
-        raise ValueError("`min_measure` applies to a scene of a hub and one CMG cluster only")
     part = scene.parts[0]
     kw, W0 = _device_kw(scene, objective, angle, axis, q_final, T, opts)
     sol = wheel_slew(scene.hub.inertia_matrix, part.axes_matrix, np.asarray(part.inertia),
