@@ -188,7 +188,7 @@ def with_fields(options, given: Mapping, *, name: str = "slew") -> SlewOptions:
     >>> with_fields(None, {"Nn": 40})
     Traceback (most recent call last):
         ...
-    TypeError: slew() got an unexpected keyword argument 'Nn'; the options are N, starts, seed, tol, pointing_tol, rate_tol, T_max, q0, keep_out, norm_bound, polish, transcription, control, verbose, ipopt_options, guess, state0, min_measure
+    TypeError: slew() got an unexpected keyword argument 'Nn'; the options are N, starts, seed, ...
     """
     if options is None:
         options = SlewOptions()

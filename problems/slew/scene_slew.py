@@ -34,7 +34,7 @@ from appdyn.dynamics.interrupts import interruptible
 from appdyn.dynamics.momentum import ClusterGeometry
 from appdyn.dynamics.scene import ExternalTorque, ReactionWheels, Scene
 from appdyn.dynamics.validate import one_of
-from appdyn.ocp import Constraint, Problem, Solution
+from appdyn.ocp import Constraint, Problem, Solution, annotate
 
 from .devices import DEVICE_STARTS, cmg_slew, slew_costs, slew_horizon, solve_converted, wheel_slew
 from .maneuvers import DEFAULT_STARTS_EFFORT, DEFAULT_STARTS_TIME, min_effort, time_optimal
@@ -204,7 +204,7 @@ def _dict(mapping):
 
 
 def _engine(sol, name):
-    from appdyn.ocp import annotate
+    """``sol`` with ``info['engine'] = name``."""
     return annotate(sol, {"engine": name})
 
 
@@ -407,8 +407,9 @@ def scene_problem(scene, *, objective, angle=None, axis=None, q_final=None, T=No
     problem = Problem(model, T=horizon, x_initial=x0, x_final=xf, u_bounds=(lo, hi),
                       x_bounds=model.limits("states"), q_final=qf, path=path,
                       name=f"{scene.name or 'scene'} slew ({objective})", **slew_costs(objective))
+    # (its checks: the keep-out cone clear at both ends)
     rigid = slew_problem(I, objective=objective, T=None if objective == "time" else horizon,
-                         q0=q0, qf=qf, u_max=body_max, w0=w0, wf=wf)
+                         q0=q0, qf=qf, u_max=body_max, w0=w0, wf=wf, keep_out=opts.keep_out)
     to_controls = np.linalg.pinv(torque)
     def convert(guess):
         t, xr = guess["t"], guess["x"]
