@@ -150,6 +150,8 @@ def slew(scene, *, objective="time", angle=None, axis=None, q_final=None, T=None
     problem, rb, convert = scene_problem(scene, objective=objective, angle=angle, axis=axis,
                                          q_final=q_final, T=T, w0=w0, wf=wf, options=opts)
     keep_out = opts.keep_out is not None
+    if keep_out and opts.polish:
+        _ignored(opts, polish=None, why="with `keep_out` (not bang-bang per axis)")
     starts = opts.starts if opts.starts is not None else (
         DEFAULT_STARTS_TIME if objective == "time" else DEFAULT_STARTS_EFFORT)
     sol = solve_converted(problem, rb, convert, objective, starts=starts, seed=opts.seed or 0,
