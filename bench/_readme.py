@@ -38,6 +38,8 @@ TITLES = {
     "stress": "Stress cases (`bench/stress.py`)",
     "trust": "A new user's first hour: slews and saturated-law simulations, each in a fresh "
              "process (`bench/trust.py`)",
+    "scene": "Scenes: a hub-only scene against `rigid_body`, the build time of scenes of 1 to "
+             "10 parts (`bench/scene.py`)",
 }
 
 

@@ -13,174 +13,30 @@ Secs. 4.5-4.6).
 
 All models have the state ``[q1, q2, q3, q4, w1, w2, w3, ...]`` (scalar-last quaternion,
 inertial -> body, and body rates [rad/s]), ``attitude = (0, 4)``, and external body torques
-``u = [L1, L2, L3]`` [N m]. Their equations are derived in the docstrings; the tests check
-them against conservation laws (energy, inertial angular momentum) and closed forms.
+``u = [L1, L2, L3]`` [N m]. Both are scenes (`dynamics.scene`): ``Scene(RigidHub(I),
+[HeldRotor], [damper], ExternalTorque())`` and ``Scene(RigidHub(I), TiltTorque, ExternalTorque())``,
+so they carry ``layout``; the dampers are the scene parts of `dynamics.scene.dampers`, re-exported
+here. Their equations are derived in the docstrings; the tests check them against the former
+hand-written models, conservation laws (energy, inertial angular momentum) and closed forms.
 """
 from __future__ import annotations
 
-import math
-from dataclasses import dataclass
+import dataclasses
 
-import casadi as ca
 import numpy as np
 
-from . import cache, validate
-from .attitude import dcm_from_quat, quat_rate
+from .scene import (ExternalTorque, HeldRotor, PointMassDamper, RigidHub, Scene,
+                    SphericalDamper, TiltTorque)
+from .scene.dampers import real_number as _finite
+from .scene.dampers import unit_vector
 from .model import Model
-from .momentum.wheels import rotor_dynamics
-from .rigid_body import RIGID_BODY_STATES
 from .validate import check_inertia
 
 __all__ = ["PointMassDamper", "SphericalDamper", "tilt_torque_body", "gyrostat_model",
            "steady_spin_state", "point_mass_offset", "unit_vector"]
 
-_TORQUES = ("L1", "L2", "L3")
-_BASE_UNITS = {**{k: "-" for k in RIGID_BODY_STATES[:4]},
-               **{k: "rad/s" for k in RIGID_BODY_STATES[4:]}, **{k: "N m" for k in _TORQUES}}
-
-
-def unit_vector(v, name: str) -> np.ndarray:
-    """`validate.unit_vector` of a 3-vector, with the one message the stability reports show:
-    "`name` must be a finite non-zero 3-vector" for a wrong shape, a non-finite or a zero
-    vector (a `validate.ArgumentTypeError` when ``v`` holds no numbers)."""
-    try:
-        return validate.unit_vector(v, name)
-    except ValueError as exc:
-        raise type(exc)(f"`{name}` must be a finite non-zero 3-vector, got {v!r}") from None
-
-
-def _finite(value, name, *, positive=False, nonnegative=False, allow_inf=False) -> float:
-    """A real number (`validate.finite_scalar`), optionally positive or non-negative;
-    ``allow_inf`` also accepts ``+inf`` (an infinitely heavy body)."""
-    if allow_inf and isinstance(value, (int, float, np.floating)) and value == math.inf:
-        return math.inf
-    v = validate.finite_scalar(value, name)
-    if positive and not v > 0:
-        raise ValueError(f"`{name}` must be positive, got {v}")
-    if nonnegative and v < 0:
-        raise ValueError(f"`{name}` must be non-negative, got {v}")
-    return v
-
-
-# ------------------------------------------------------------------------- dampers
-@dataclass(frozen=True)
-class PointMassDamper:
-    """A point mass on a spring and dashpot, sliding along a straight line fixed in the body.
-
-    Parameters
-    ----------
-    mass : float [kg]
-        The moving mass ``m > 0``
-    stiffness : float [N/m]
-        Spring ``k > 0`` (force ``-k s``)
-    damping : float [N s/m]
-        Dashpot ``c >= 0`` (force ``-c s'``)
-    position : array_like, shape (3,) [m]
-        Body-frame position of the mass at ``s = 0`` (spring relaxed) relative to the mass
-        center of the rigid body that carries it.
-    direction : array_like, shape (3,)
-        Direction ``d`` of travel in body axes (normalized here); ``rho = position + s d``.
-    body_mass : float [kg], optional
-        Mass ``M`` of the carrying body. The free system's mass center moves with the mass;
-        this enters only through the reduced mass ``mu = m M / (m + M)``. The default ``inf``
-        gives ``mu = m`` (the body's mass center stays at the system's).
-    """
-
-    mass: float
-    stiffness: float
-    damping: float
-    position: tuple = (0.0, 0.0, 0.0)
-    direction: tuple = (1.0, 0.0, 0.0)
-    body_mass: float = math.inf
-
-    def __post_init__(self):
-        object.__setattr__(self, "mass", _finite(self.mass, "damper.mass", positive=True))
-        object.__setattr__(self, "stiffness",
-                           _finite(self.stiffness, "damper.stiffness", positive=True))
-        object.__setattr__(self, "damping",
-                           _finite(self.damping, "damper.damping", nonnegative=True))
-        try:
-            pos = np.array(self.position, dtype=float).reshape(-1)
-        except (TypeError, ValueError):
-            raise ValueError(f"`damper.position` must be 3 numbers, "
-                             f"got {self.position!r}") from None
-        if pos.size != 3 or not np.all(np.isfinite(pos)):
-            raise ValueError(f"`damper.position` must be 3 finite numbers [m], got {pos.tolist()}")
-        object.__setattr__(self, "position", tuple(pos.tolist()))
-        object.__setattr__(self, "direction",
-                           tuple(unit_vector(self.direction, "damper.direction").tolist()))
-        object.__setattr__(self, "body_mass", _finite(self.body_mass, "damper.body_mass",
-                                                      positive=True, allow_inf=True))
-
-    @property
-    def reduced_mass(self) -> float:
-        """``mu = m M / (m + M)`` [kg] (``m`` for an infinite body mass)."""
-        if math.isinf(self.body_mass):
-            return self.mass
-        return self.mass * self.body_mass / (self.mass + self.body_mass)
-
-    def inertia_at(self, s: float = 0.0) -> np.ndarray:
-        """Inertia [kg m^2] the mass adds about the system mass center at displacement ``s``:
-        ``mu (|rho|^2 E - rho rho^T)``."""
-        rho = np.asarray(self.position) + s * np.asarray(self.direction)
-        return self.reduced_mass * (rho @ rho * np.eye(3) - np.outer(rho, rho))
-
-
-@dataclass(frozen=True)
-class SphericalDamper:
-    """A spherical core (e.g. fluid in a spherical cavity) coupled to its housing viscously.
-
-    The core has isotropic inertia ``J_d`` about its center, which lies on the spin axis at the
-    system mass center; it receives the torque ``-c (w_d - w_h)``, ``w_d`` its angular
-    velocity and ``w_h`` that of the housing.
-
-    Parameters
-    ----------
-    inertia : float [kg m^2]
-        ``J_d > 0``
-    damping : float [N m s]
-        ``c >= 0``
-    """
-
-    inertia: float
-    damping: float
-
-    def __post_init__(self):
-        object.__setattr__(self, "inertia", _finite(self.inertia, "damper.inertia", positive=True))
-        object.__setattr__(self, "damping",
-                           _finite(self.damping, "damper.damping", nonnegative=True))
-
 
 # -------------------------------------------------------------------- tilt torque
-@cache.memoize
-def _tilt_torque_body(inertia_key, axis_key, direction_key, overturning, damping) -> Model:
-    inertia = np.array(inertia_key).reshape(3, 3)
-    a = ca.DM(axis_key)
-    d_in = ca.DM(direction_key)
-    x = ca.SX.sym("x", 7)
-    u = ca.SX.sym("u", 3)
-    p = ca.SX.sym("p", 0)
-    q, w = x[0:4], x[4:7]
-    I = ca.DM(inertia)
-    n = ca.mtimes(dcm_from_quat(q), d_in)  # the fixed direction in body axes
-    M = ca.mtimes(n, a.T) - ca.dot(a, n) * ca.DM.eye(3)  # tau' = M w, tau = a x n
-    torque = u - overturning * ca.cross(a, n) - damping * ca.mtimes(M.T, ca.mtimes(M, w))
-    wdot = ca.solve(I, torque - ca.cross(w, ca.mtimes(I, w)))
-    f = ca.Function("tilt_torque_body", [x, u, p], [ca.vertcat(quat_rate(q, w), wdot)],
-                    ["x", "u", "p"], ["xdot"])
-    h = ca.mtimes(I, w)
-    invariants = {
-        "energy": ca.Function("energy", [x, p], [0.5 * ca.dot(w, h) + overturning * ca.dot(a, n)],
-                              ["x", "p"], ["energy"]),
-        "momentum_inertial": ca.Function("momentum_inertial", [x, p],
-                                         [ca.mtimes(dcm_from_quat(q).T, h)], ["x", "p"],
-                                         ["momentum_inertial"]),
-        "quat_norm": ca.Function("quat_norm", [x, p], [ca.norm_2(q)], ["x", "p"], ["quat_norm"]),
-    }
-    return Model(f=f, states=RIGID_BODY_STATES, controls=_TORQUES, units=_BASE_UNITS,
-                 invariants=invariants, name="tilt_torque_body", attitude=(0, 4))
-
-
 def tilt_torque_body(inertia, overturning, *, axis=(1.0, 0.0, 0.0), direction=(1.0, 0.0, 0.0),
                      internal_damping: float = 0.0) -> Model:
     """Rigid body about a fixed point with a tilt-dependent torque ([1]_, Method III).
@@ -223,7 +79,9 @@ def tilt_torque_body(inertia, overturning, *, axis=(1.0, 0.0, 0.0), direction=(1
     Model
         ``x = [q1..q4, w1..w3]``, ``u = [L1, L2, L3]`` [N m], invariants ``energy``
         (``1/2 w.Iw + kappa a.n`` [J], conserved for ``D = 0``, ``u = 0``),
-        ``momentum_inertial`` [N m s] and ``quat_norm``. Cached by its arguments.
+        ``momentum_inertial`` [N m s] and ``quat_norm``; ``layout`` (parts ``tilt``,
+        ``torque``). The model of ``Scene(RigidHub(I), TiltTorque(kappa, ...),
+        ExternalTorque(), name="tilt_torque_body")``, cached by value.
 
     Raises
     ------
@@ -235,74 +93,13 @@ def tilt_torque_body(inertia, overturning, *, axis=(1.0, 0.0, 0.0), direction=(1
     ----------
     .. [1] Rheinfurth & Wilson, NASA RP-1262, Sec. 4.6, Method III and its Example 1.
     """
-    I = check_inertia(inertia)
-    kappa = _finite(overturning, "overturning")
-    a = unit_vector(axis, "axis")
-    d = unit_vector(direction, "direction")
-    damping = _finite(internal_damping, "internal_damping", nonnegative=True)
-    return _tilt_torque_body(tuple(I.reshape(-1).tolist()), tuple(a.tolist()), tuple(d.tolist()),
-                             kappa, damping)
+    hub = RigidHub(check_inertia(inertia))
+    tilt = TiltTorque(overturning, axis=axis, direction=direction,
+                      internal_damping=internal_damping)
+    return Scene(hub, tilt, ExternalTorque(), name="tilt_torque_body").model()
 
 
 # ------------------------------------------------------------------------ gyrostat
-@cache.memoize
-def _gyrostat(inertia_key, wheel_axis, wheel_momentum, damper, damper_on, wheel_rate) -> Model:
-    I = ca.DM(np.array(inertia_key).reshape(3, 3))
-    aw = ca.DM(wheel_axis)
-    h = wheel_momentum
-    nd = {None: 0, PointMassDamper: 2, SphericalDamper: 3}[type(damper) if damper else None]
-    x = ca.SX.sym("x", 7 + nd)
-    u = ca.SX.sym("u", 3)
-    p = ca.SX.sym("p", 0)
-    q, w = x[0:4], x[4:7]
-    extra_states, extra_units = (), {}
-    if damper is None:  # a wheel spacecraft whose wheel is held at constant relative speed
-        H, wdot, _ = rotor_dynamics(I, aw, w, [h], u)
-        rest = []
-        energy = 0.5 * ca.dot(w, ca.mtimes(I, w))
-    elif isinstance(damper, PointMassDamper):
-        s, sd = x[7], x[8]
-        mu, k, c = damper.reduced_mass, damper.stiffness, damper.damping
-        b, d = ca.DM(damper.position), ca.DM(damper.direction)
-        rho = b + s * d
-        g = ca.cross(rho, d)
-        E3 = ca.DM.eye(3)
-        J = I + mu * (ca.dot(rho, rho) * E3 - ca.mtimes(rho, rho.T))
-        Jdot = mu * sd * (2 * ca.dot(rho, d) * E3 - ca.mtimes(d, rho.T) - ca.mtimes(rho, d.T))
-        H = ca.mtimes(J, w) + mu * sd * g + h * aw
-        mass = ca.vertcat(ca.horzcat(J, mu * g), ca.horzcat(mu * g.T, mu))
-        rhs = ca.vertcat(u - ca.mtimes(Jdot, w) - ca.cross(w, H),
-                         -k * s - c * sd - mu * ca.dot(d, ca.cross(w, ca.cross(w, rho))))
-        acc = ca.solve(mass, rhs)
-        wdot = acc[0:3]
-        rest = [sd, acc[3]]
-        energy = (0.5 * ca.dot(w, ca.mtimes(J, w)) + mu * sd * ca.dot(g, w) + 0.5 * mu * sd ** 2
-                  + 0.5 * k * s ** 2)
-        extra_states, extra_units = ("s", "s_dot"), {"s": "m", "s_dot": "m/s"}
-    else:
-        wd = x[7:10]
-        Jd, c = damper.inertia, damper.damping
-        wh = w + (wheel_rate * aw if damper_on == "rotor" else 0)
-        H = ca.mtimes(I, w) + h * aw + Jd * wd
-        wdot = ca.solve(I, u - ca.cross(w, ca.mtimes(I, w) + h * aw) + c * (wd - wh))
-        rest = [-(c / Jd) * (wd - wh) - ca.cross(w, wd)]
-        energy = 0.5 * ca.dot(w, ca.mtimes(I, w)) + 0.5 * Jd * ca.dot(wd, wd)
-        extra_states = ("wd1", "wd2", "wd3")
-        extra_units = {k: "rad/s" for k in extra_states}
-    xdot = ca.vertcat(quat_rate(q, w), wdot, *rest)
-    f = ca.Function("gyrostat", [x, u, p], [xdot], ["x", "u", "p"], ["xdot"])
-    invariants = {
-        "energy": ca.Function("energy", [x, p], [energy], ["x", "p"], ["energy"]),
-        "momentum_inertial": ca.Function("momentum_inertial", [x, p],
-                                         [ca.mtimes(dcm_from_quat(q).T, H)], ["x", "p"],
-                                         ["momentum_inertial"]),
-        "quat_norm": ca.Function("quat_norm", [x, p], [ca.norm_2(q)], ["x", "p"], ["quat_norm"]),
-    }
-    return Model(f=f, states=RIGID_BODY_STATES + extra_states, controls=_TORQUES,
-                 units={**_BASE_UNITS, **extra_units}, invariants=invariants, name="gyrostat",
-                 attitude=(0, 4))
-
-
 def _check_damper(damper, damper_on):
     if damper is not None and not isinstance(damper, (PointMassDamper, SphericalDamper)):
         raise ValueError("`damper` must be None, a PointMassDamper or a SphericalDamper, got "
@@ -324,7 +121,7 @@ def gyrostat_model(inertia, *, wheel_axis=(1.0, 0.0, 0.0), wheel_momentum: float
     ``H' + w x H = u`` in body axes, with
 
     * no damper: ``H = I w + h a``, ``I w' = u - w x H`` -- a wheel spacecraft whose wheel
-      is held at constant speed (`dynamics.momentum.wheels.rotor_dynamics`, shared).
+      is held at constant speed (`HeldRotor`; `dynamics.momentum.wheels.rotor_dynamics`).
     * `PointMassDamper` (on the platform): with ``rho = b + s d``, ``g = rho x d``,
       ``mu`` the reduced mass and ``J(s) = I + mu (|rho|^2 E - rho rho^T)``, the angular
       momentum about the system mass center is ``H = J(s) w + mu s' g + h a``; the mass
@@ -338,7 +135,7 @@ def gyrostat_model(inertia, *, wheel_axis=(1.0, 0.0, 0.0), wheel_momentum: float
       ``1/2 w.Jw + mu s' g.w + 1/2 mu s'^2 + 1/2 k s^2`` decays at ``-c s'^2`` (u = 0).
     * `SphericalDamper`: ``H = I w + h a + J_d w_d``; the core obeys
       ``J_d (w_d' + w x w_d) = -c (w_d - w_h)`` with the housing rate ``w_h = w`` (platform)
-      or ``w + wheel_rate a`` (rotor), hence ``I w' = u - w x (I w + h a) + c (w_d - w_h)``.
+      or ``w + wheel_rate a`` (rotor: the damper's ``housing_rate``), hence ``I w' = u - w x (I w + h a) + c (w_d - w_h)``.
       The energy ``1/2 w.Iw + 1/2 J_d |w_d|^2`` decays at ``-c |w_d - w|^2`` when the damper
       is on the platform (u = 0).
 
@@ -362,7 +159,10 @@ def gyrostat_model(inertia, *, wheel_axis=(1.0, 0.0, 0.0), wheel_momentum: float
     Model
         ``x = [q1..q4, w1..w3]`` plus ``[s, s_dot]`` [m, m/s] (point mass) or
         ``[wd1, wd2, wd3]`` [rad/s] (core rate, body axes); ``u = [L1, L2, L3]``;
-        invariants ``energy`` [J], ``momentum_inertial`` [N m s], ``quat_norm``. Cached.
+        invariants ``energy`` [J], ``momentum_inertial`` [N m s], ``quat_norm``; ``layout``
+        (parts ``rotor`` when ``h != 0``, ``damper``, ``torque``). The model of
+        ``Scene(RigidHub(I), HeldRotor(a, h), damper, ExternalTorque(), name="gyrostat")``,
+        cached by value.
 
     Raises
     ------
@@ -374,9 +174,12 @@ def gyrostat_model(inertia, *, wheel_axis=(1.0, 0.0, 0.0), wheel_momentum: float
     h = _finite(wheel_momentum, "wheel_momentum")
     rate = _finite(wheel_rate, "wheel_rate")
     _check_damper(damper, damper_on)
-    if not isinstance(damper, SphericalDamper) or damper_on != "rotor":
-        rate = 0.0  # only a rotor-mounted damper sees the wheel speed
-    return _gyrostat(tuple(I.reshape(-1).tolist()), tuple(a.tolist()), h, damper, damper_on, rate)
+    parts = [HeldRotor(a, h)] if h != 0.0 else []
+    if isinstance(damper, SphericalDamper) and damper_on == "rotor":
+        damper = dataclasses.replace(damper, housing_rate=tuple((rate * a).tolist()))
+    if damper is not None:
+        parts.append(damper)
+    return Scene(RigidHub(I), *parts, ExternalTorque(), name="gyrostat").model()
 
 
 def point_mass_offset(damper: PointMassDamper, axis, rate: float) -> float:

@@ -11,7 +11,7 @@ Modules (every name in ``__all__`` is importable from ``dynamics.momentum``):
 * `gyroscopic` -- the torques of Eqs. 4.148-4.152 (wheel, CMG, Coriolis, propeller,
   symmetric gyroscope);
 * `wheels` -- `wheel_spacecraft` and `rotor_dynamics`, the one body-plus-rotor derivation
-  (shared with `dynamics.spinning.gyrostat_model`, a wheel held at constant speed);
+  (`dynamics.spinning.gyrostat_model` is its scene twin, a wheel held at constant speed);
 * `cmg` -- `cmg_spacecraft` (exact and torque-model fidelity);
 * `envelope` -- singular surfaces and the momentum envelope (`momentum_envelope`,
   `MomentumEnvelope`, `singular_surface`, `classify_singularities`);

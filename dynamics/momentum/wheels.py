@@ -1,6 +1,6 @@
 """Reaction wheels: a rigid hub carrying wheels that spin about body-fixed axes
 (Rheinfurth & Wilson, NASA RP-1262, Sec. 4.7, Eqs. 4.147-4.148), and the body-plus-rotor
-derivation that `dynamics.spinning.gyrostat_model` shares.
+derivation (`dynamics.spinning.gyrostat_model`, a scene, holds the wheel's speed).
 
 Derivation
 ----------

@@ -13,6 +13,10 @@ Parts
 `HeldRotor`            a rotor at constant relative speed (the gyrostat's wheel)
 `ExternalTorque`       body torque controls ``L1..L3``
 `ExternalForce`        force controls ``F1..F3`` at a hub point
+`PointMassDamper`      a mass on a spring and dashpot sliding along a hub line (``s, s_dot``)
+`SphericalDamper`      a viscously coupled spherical core (core rate ``wd1..wd3``)
+`Slosh`                slosh as a pendulum (two angles) or a spring-mass (``s, s_dot``)
+`TiltTorque`           a torque from the tilt of a hub axis (heavy top, projectile, bearings)
 =====================  =====================================================================
 
 Examples
@@ -24,6 +28,8 @@ Examples
 """
 from .assembly import PartLayout
 from .contract import Body, Contribution, Frame, Load, Part, PartVariables, Variable
+from .dampers import PointMassDamper, Slosh, SphericalDamper
+from .fields import TiltTorque
 from .hubs import RigidHub
 from .loads import ExternalForce, ExternalTorque
 from .scene import Scene
@@ -31,4 +37,4 @@ from .wheels import HeldRotor, ReactionWheels
 
 __all__ = ["Scene", "RigidHub", "Part", "PartLayout", "Variable", "PartVariables", "Body", "Load",
            "Contribution", "Frame", "ReactionWheels", "HeldRotor", "ExternalTorque",
-           "ExternalForce"]
+           "ExternalForce", "PointMassDamper", "SphericalDamper", "Slosh", "TiltTorque"]

@@ -8,7 +8,19 @@ import casadi as ca
 from ..validate import finite_array, one_of
 from .contract import Contribution, Load, Part, PartVariables, Variable, bounds_from_u_max
 
-__all__ = ["ExternalTorque", "ExternalForce"]
+__all__ = ["ExternalTorque", "ExternalForce", "vector_controls", "u_max_tuple"]
+
+
+def u_max_tuple(u_max, n: int, name: str = "u_max"):
+    """``u_max`` checked and stored as ``n`` positive floats (None stays None)."""
+    return None if u_max is None else tuple(b[1] for b in bounds_from_u_max(u_max, n, name))
+
+
+def vector_controls(prefix: str, unit: str, u_max) -> PartVariables:
+    """Three controls ``prefix1..prefix3`` [unit] bounded by ``u_max``."""
+    bounds = bounds_from_u_max(u_max, 3)
+    return PartVariables(controls=tuple(Variable(f"{prefix}{i + 1}", unit, bounds=bounds[i])
+                                        for i in range(3)))
 
 
 @dataclass(frozen=True)
@@ -36,13 +48,10 @@ class ExternalTorque(Part):
     kind = "torque"
 
     def __post_init__(self):
-        object.__setattr__(self, "u_max", None if self.u_max is None else tuple(
-            b[1] for b in bounds_from_u_max(self.u_max, 3)))
+        object.__setattr__(self, "u_max", u_max_tuple(self.u_max, 3))
 
     def variables(self) -> PartVariables:
-        bounds = bounds_from_u_max(self.u_max, 3)
-        return PartVariables(controls=tuple(Variable(f"L{i + 1}", "N m", bounds=bounds[i])
-                                            for i in range(3)))
+        return vector_controls("L", "N m", self.u_max)
 
     def contribute(self, frame, own) -> Contribution:
         return Contribution(loads=[Load(own.controls, frame.w)])
@@ -85,13 +94,10 @@ class ExternalForce(Part):
     def __post_init__(self):
         object.__setattr__(self, "point", tuple(finite_array(self.point, "point", (3,)).tolist()))
         object.__setattr__(self, "frame", one_of(self.frame, "frame", ("body", "inertial")))
-        object.__setattr__(self, "u_max", None if self.u_max is None else tuple(
-            b[1] for b in bounds_from_u_max(self.u_max, 3)))
+        object.__setattr__(self, "u_max", u_max_tuple(self.u_max, 3))
 
     def variables(self) -> PartVariables:
-        bounds = bounds_from_u_max(self.u_max, 3)
-        return PartVariables(controls=tuple(Variable(f"F{i + 1}", "N", bounds=bounds[i])
-                                            for i in range(3)))
+        return vector_controls("F", "N", self.u_max)
 
     def contribute(self, frame, own) -> Contribution:
         F = own.controls if self.frame == "body" else ca.mtimes(frame.dcm, own.controls)

@@ -93,6 +93,9 @@ class Scene:
     def __hash__(self):
         return hash((Scene, self.hub, self.parts, self.name))
 
+    def __reduce__(self):
+        return (_rebuild_scene, (self.hub, self.parts, self.name))
+
     def __repr__(self):
         inner = ", ".join([repr(self.hub)] + [repr(p) for p in self.parts])
         return f"Scene({inner}{'' if self.name is None else f', name={self.name!r}'})"
@@ -254,6 +257,11 @@ class Scene:
         for key, val in singles.items():
             x[index[key]] = val
         return x
+
+
+def _rebuild_scene(hub, parts, name) -> Scene:
+    """Inverse of `Scene.__reduce__` (pickling, process pools)."""
+    return Scene(hub, *parts, name=name)
 
 
 class _NumericOwn:

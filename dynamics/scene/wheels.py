@@ -16,6 +16,7 @@ import numpy as np
 
 from ..validate import finite_scalar, positive_each, unit_axes, unit_vector
 from .contract import Body, Contribution, Load, Part, PartVariables, Variable, bounds_from_u_max
+from .loads import u_max_tuple
 
 __all__ = ["ReactionWheels", "HeldRotor"]
 
@@ -64,9 +65,7 @@ class ReactionWheels(Part):
         object.__setattr__(self, "axes", tuple(map(tuple, A.tolist())))
         object.__setattr__(self, "inertia", tuple(positive_each(self.inertia, "inertia", n).tolist()))
         for key in ("u_max", "speed_max"):
-            val = getattr(self, key)
-            if val is not None:
-                object.__setattr__(self, key, tuple(b[1] for b in bounds_from_u_max(val, n, key)))
+            object.__setattr__(self, key, u_max_tuple(getattr(self, key), n, key))
 
     @property
     def axes_matrix(self) -> np.ndarray:

@@ -75,3 +75,13 @@ def test_six_dof_hub_momentum_about_the_origin_and_the_force_law():
     for key in ("momentum_linear", "momentum_inertial"):
         rate = (model.invariant(key, x + eps * xdot) - model.invariant(key, x - eps * xdot)) / (2 * eps)
         np.testing.assert_allclose(rate, 0.0, atol=1e-8)
+
+
+def test_a_scene_pickles_to_an_equal_scene():
+    import pickle
+    scene = Scene(RigidHub(I), ReactionWheels(np.eye(3), 0.05, u_max=0.1), name="craft")
+    back = pickle.loads(pickle.dumps(scene))
+    assert back == scene and back.model() is scene.model()
+    model = pickle.loads(pickle.dumps(scene.model()))
+    assert model.layout["wheels"] == scene.layout["wheels"]
+    assert model.bounds == scene.model().bounds
