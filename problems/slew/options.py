@@ -31,8 +31,9 @@ class SlewOptions:
     Parameters
     ----------
     N : int, optional
-        Collocation intervals of the first solve (default: 30; 20 for a minimum-effort slew
-        of a hub with an `ExternalTorque`, the default of `min_effort`).
+        Collocation intervals of the first solve (default: 30 time-optimal, 20 minimum
+        effort, 30 by the device engines; on the generic path more where a part oscillates:
+        `scene_slew.scene_intervals`).
     starts : int, optional
         Seeded starts (the eigenaxis SLERP and tilted SLERPs) of a time-optimal slew without
         a ``guess`` (default 3), or of a minimum-effort slew with a ``keep_out`` cone

@@ -39,14 +39,24 @@ from appdyn.ocp import Constraint, Problem, Solution, annotate
 from .devices import DEVICE_STARTS, cmg_slew, slew_costs, slew_horizon, solve_converted, wheel_slew
 from .maneuvers import DEFAULT_STARTS_EFFORT, DEFAULT_STARTS_TIME, min_effort, time_optimal
 from .options import SlewOptions, with_fields
-from .problem import rough_time, slew_problem
+from .problem import attitude_guess, rough_time, slew_problem
 from .targets import targets, vector3
 
-__all__ = ["slew", "scene_problem", "torque_map", "DEFAULT_N"]
+__all__ = ["slew", "scene_problem", "torque_map", "scene_intervals", "DEFAULT_N",
+           "INTERVALS_PER_PERIOD", "MAX_AUTO_N"]
 
 #: Collocation intervals of the first solve when `SlewOptions.N` is None, by objective (the
 #: defaults of `time_optimal` and `min_effort`; the device engines use 30 for both).
 DEFAULT_N = {"time": 30, "effort": 20}
+
+#: Least intervals per period of the fastest oscillation of a scene (`scene_intervals`): a
+#: damper on a 60 N/m spring with 0.5 kg (11.0 rad/s on its hub), 30 s of minimum effort: 20
+#: intervals stall the refinement (``Refinement_Stalled``); 4 per period ask for 211, capped
+#: at `MAX_AUTO_N`, verified after refinement to 232 (10.9 s; measured).
+INTERVALS_PER_PERIOD = 4
+
+#: Most intervals `scene_intervals` asks for (the refinement adds more where needed).
+MAX_AUTO_N = 200
 
 _GENERIC_ONLY = ("guess", "keep_out")  # settings the device engines do not take
 
@@ -154,8 +164,9 @@ def slew(scene, *, objective="time", angle=None, axis=None, q_final=None, T=None
         _ignored(opts, polish=None, why="with `keep_out` (not bang-bang per axis)")
     starts = opts.starts if opts.starts is not None else (
         DEFAULT_STARTS_TIME if objective == "time" else DEFAULT_STARTS_EFFORT)
+    N = opts.N or scene_intervals(problem, DEFAULT_N[objective], attitude_guess(rb, n=3)["T"])
     sol = solve_converted(problem, rb, convert, objective, starts=starts, seed=opts.seed or 0,
-                          N=opts.N or DEFAULT_N[objective], tol=opts.tol, verbose=opts.verbose,
+                          N=N, tol=opts.tol, verbose=opts.verbose,
                           ipopt_options=_dict(opts.ipopt_options), ptol=opts.pointing_tol,
                           rtol=opts.rate_tol, polish=opts.polish is not False and not keep_out,
                           guess=opts.guess, transcription=opts.transcription,
@@ -328,6 +339,47 @@ def torque_map(model, x) -> np.ndarray:
     p = ca.DM(model.resolve_p())
     jac = ca.Function("B", [xs, us], [ca.jacobian(model.f(xs, us, p)[4:7], us)])
     return np.array(jac(np.asarray(x, float), np.zeros(model.nu)))
+
+
+def scene_intervals(problem, least: int, horizon: float) -> int:
+    """Collocation intervals for a scene's slew ``problem``: at least ``least``, and at least
+    `INTERVALS_PER_PERIOD` per period of the fastest oscillation of the model linearized at
+    the initial state (a spring-mass damper, a slosh pendulum) over ``horizon``, at most
+    `MAX_AUTO_N` (or ``least`` if more).
+
+    Parameters
+    ----------
+    problem : ocp.Problem
+    least : int
+    horizon : float [s]
+        The expected slew time (the fixed ``T``, or the rough bang-bang time of a free one).
+
+    Returns
+    -------
+    int
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from appdyn.dynamics.scene import ExternalTorque, PointMassDamper, RigidHub, Scene
+    >>> from appdyn.problems.slew.scene_slew import scene_intervals, scene_problem
+    >>> stiff = Scene(RigidHub([10.0, 12.0, 8.0]), ExternalTorque(),
+    ...               PointMassDamper(0.5, 60.0, 0.8, position=[0.5, 0, 0], direction=[0, 1, 0]))
+    >>> pb = scene_problem(stiff, objective="effort", T=10.0, angle=0.3, axis=[0, 0, 1])[0]
+    >>> scene_intervals(pb, 20, 10.0)  # 10 s of an 11.0 rad/s mode: 17.5 periods
+    71
+    >>> scene_intervals(scene_problem(Scene(RigidHub([10.0, 12.0, 8.0]), ExternalTorque()),
+    ...     objective="effort", T=10.0, angle=0.3, axis=[0, 0, 1])[0], 20, 10.0)  # no mode
+    20
+    """
+    model = problem.model
+    xs, us = ca.SX.sym("x", model.nx), ca.SX.sym("u", model.nu)
+    f = model.f(xs, us, ca.DM(model.resolve_p()))
+    A = np.array(ca.Function("A", [xs, us], [ca.jacobian(f, xs)])(problem.x_initial,
+                                                                   np.zeros(model.nu)))
+    omega = float(np.max(np.abs(np.linalg.eigvals(A).imag), initial=0.0))
+    n = int(np.ceil(INTERVALS_PER_PERIOD * omega * horizon / (2 * np.pi)))
+    return max(least, min(n, MAX_AUTO_N))
 
 
 def scene_problem(scene, *, objective, angle=None, axis=None, q_final=None, T=None, w0=None,
