@@ -8,8 +8,8 @@ that is exactly one of the proven pipelines goes to it:
 ==============================================  ================================
 hub + `ExternalTorque`                          `time_optimal` / `min_effort`
 hub + `ReactionWheels` (rest to rest)           `wheel_slew`
-hub + CMG cluster (kind ``'cmgs'``, rest to     `cmg_slew`
-rest, no rotor or gimbal inertia)
+hub + `CMGCluster` (rest to rest; rate drive,   `cmg_slew`
+exact fidelity, no rotor or gimbal inertia)
 ==============================================  ================================
 
 Any other scene -- wheels with a damper, a hinged panel, a held rotor, a translating hub, or
@@ -17,7 +17,8 @@ one of the above with a setting its engine does not take -- is solved by the gen
 (`scene_problem`): an `ocp.Problem` on ``scene.model()`` from the model, its layout and bounds
 alone (never a part's class), with guesses converted from the rigid-body ones of the hub
 (`attitude_guess`: the SLERP with a smooth-step profile, tilted for the further starts) with
-the parts at rest and the controls that best produce the hub's torque, and the pipelines of
+the parts at rest and the controls that best produce the hub's torque, on enough intervals
+for the fastest oscillation of the model (`scene_intervals`), and the pipelines of
 `time_optimal` and `min_effort` (`solve_converted`). Every result says ``success=True`` only
 when verified by re-simulation (pointing, rates and every fixed final part state within the
 tolerances; `verify`).
@@ -289,11 +290,14 @@ def _wheels(scene, objective, angle, axis, q_final, T, w0, wf, opts):
 
 
 def _cmgs(scene, objective, angle, axis, q_final, T, w0, wf, opts):
-    """A hub with one CMG cluster (kind ``'cmgs'``) without rotor or gimbal inertia, rest to
-    rest: `cmg_slew` (or None)."""
+    """A hub with one CMG cluster (kind ``'cmgs'``: gimbal-rate drive, exact fidelity, no
+    rotor or gimbal inertia -- `dynamics.cmg_spacecraft`'s model), rest to rest: `cmg_slew`
+    (or None)."""
     part = scene.parts[0] if len(scene.parts) == 1 else None
     if not (part is not None and getattr(part, "kind", None) == "cmgs"
             and _device_ok(scene, w0, wf, opts) and opts.polish is not True
+            and getattr(part, "drive", "rate") == "rate"
+            and getattr(part, "fidelity", "exact") == "exact"
             and not getattr(part, "rotor_inertia", None)
             and not getattr(part, "gimbal_inertia", None)):
         return None
