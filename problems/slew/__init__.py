@@ -1,7 +1,23 @@
-"""Optimal attitude slews of a rigid body: time-optimal and minimum-effort.
+"""Optimal attitude slews: time-optimal and minimum-effort, of any scene.
 
-Both build an `ocp.Problem` on `dynamics.rigid_body` (state ``[q1..q4, w1..w3]``, control
-body torque) and return an `ocp.Solution`:
+The entry point is `slew`: ``slew(scene, objective="time" | "effort", angle=..., axis=...,
+q_final=..., T=..., w0=..., wf=..., **options)`` for any `dynamics.scene.Scene` -- bounds
+from its parts, settings in one `SlewOptions` (or as keywords). A scene that is exactly a
+proven pipeline goes to it (a hub with an `ExternalTorque`: `time_optimal` / `min_effort`;
+with reaction wheels: `wheel_slew`; with a CMG cluster: `cmg_slew`); any other scene is
+solved by the generic path on its assembled model (`scene_slew`). The four engines below keep
+their signatures; prefer ``slew(scene)``.
+
+>>> import numpy as np
+>>> from appdyn.dynamics.scene import ExternalTorque, RigidHub, Scene
+>>> from appdyn.problems.slew import slew
+>>> sol = slew(Scene(RigidHub(np.eye(3)), ExternalTorque(u_max=1.0)), angle=0.1,
+...            axis=[0, 0, 1], N=10, starts=1)
+>>> sol.success, round(sol.T, 6)  # the eigenaxis bang-bang 2 sqrt(0.1)
+(True, 0.632456)
+
+The rigid-body engines build an `ocp.Problem` on `dynamics.rigid_body` (state ``[q1..q4,
+w1..w3]``, control body torque) and return an `ocp.Solution`:
 
 * `time_optimal` minimizes the final time under per-axis torque bounds ``|u_i| <= u_max_i``
   or a norm bound ``|u| <= u_max``. Time-optimal slews have local optima (the eigenaxis
@@ -40,6 +56,7 @@ target rows by the initial attitude error (`ocp.scaling`).
 
 Modules
 -------
+`scene_slew` (`slew`, `scene_problem`: the generic path), `options` (`SlewOptions`),
 `targets` (input checks, the target attitude, `KeepOut`, defaults and statuses),
 `problem` (`slew_problem`, `eigenaxis_time`, guesses), `maneuvers` (`time_optimal`,
 `min_effort`, `verify`, `bounded`), `table` (`maneuver_table`: the slew to every target of a
@@ -50,13 +67,15 @@ from __future__ import annotations
 
 from .devices import cmg_slew, wheel_slew
 from .maneuvers import bounded, min_effort, time_optimal, verify
+from .options import SlewOptions
+from .scene_slew import scene_problem, slew
 from .problem import attitude_guess, eigenaxis_time, slew_problem
 from .report import format_summary, plot_slew, polish_text, summary, switch_times
 from .table import ManeuverTable, example_targets, maneuver_table
 from .targets import (MIN_REFINE_TOL, POINTING_TOL, RATE_TOL, STATUS_POINTING, STATUS_REFINE,
                       KeepOut)
 
-__all__ = ["KeepOut", "slew_problem", "time_optimal", "min_effort", "wheel_slew", "cmg_slew", "eigenaxis_time",
+__all__ = ["slew", "SlewOptions", "scene_problem", "KeepOut", "slew_problem", "time_optimal", "min_effort", "wheel_slew", "cmg_slew", "eigenaxis_time",
            "switch_times", "attitude_guess", "verify", "bounded", "polish_text", "summary", "format_summary", "plot_slew",
            "maneuver_table", "ManeuverTable", "example_targets",
            "POINTING_TOL", "RATE_TOL", "MIN_REFINE_TOL", "STATUS_POINTING", "STATUS_REFINE"]

@@ -30,15 +30,16 @@ from appdyn.dynamics.momentum import (ClusterGeometry, cluster_jacobian, cluster
                                gram_determinant)
 from appdyn.dynamics.validate import (check_inertia, finite_array, integer, one_of, positive,
                                positive_each, unit_axes)
-from appdyn.ocp import Constraint, Problem, annotate, solve
+from appdyn.ocp import Constraint, Problem, annotate, solve, solve_multistart
 
 from .maneuvers import SEED_OPTIONS, bounded, refine_and_verify, solve_time_optimal
 from .problem import attitude_guess, rough_time, seeded_guesses, slew_problem
 from .targets import POINTING_TOL, RATE_TOL, check_tol, targets
 
-__all__ = ["wheel_slew", "cmg_slew"]
+__all__ = ["wheel_slew", "cmg_slew", "solve_converted", "slew_horizon", "slew_costs",
+           "DEVICE_STARTS"]
 
-_STARTS = 3  # seeded starts of a time-optimal device slew
+DEVICE_STARTS = 3  # seeded starts of a time-optimal device slew
 
 
 def _vector(value, name, n, default) -> np.ndarray:
@@ -52,7 +53,9 @@ def _vector(value, name, n, default) -> np.ndarray:
     return v
 
 
-def _horizon(objective, T, T_max, T_ref):
+def slew_horizon(objective, T, T_max, T_ref):
+    """The ``T`` of an `ocp.Problem` of a slew: ``(0, T_max)`` for ``'time'`` (default 20
+    times the rough time ``T_ref`` [s]), the fixed positive ``T`` for ``'effort'``."""
     if objective == "time":
         return (0.0, float(T_max) if T_max is not None else 20.0 * T_ref)
     if T is None:
@@ -60,7 +63,9 @@ def _horizon(objective, T, T_max, T_ref):
     return positive(T, "T")
 
 
-def _costs(objective):
+def slew_costs(objective):
+    """The objective keywords of `ocp.Problem`: ``mayer = T`` (``'time'``) or ``lagrange =
+    1/2 |u|^2`` (``'effort'``)."""
     if objective == "time":
         return dict(mayer=lambda xf, p, T: T)
     return dict(lagrange=lambda x, u, p: 0.5 * ca.sumsqr(u))
@@ -76,7 +81,7 @@ def _problems(model, I, objective, horizon, q0, qf, dev0, devf, u_max, body_max,
         model, T=horizon, x_initial=np.r_[q0, 0.0, 0.0, 0.0, dev0],
         x_final=np.r_[np.full(4, np.nan), 0.0, 0.0, 0.0, free if devf is None else devf],
         u_bounds=None if u_max is None else (-u_max, u_max), x_bounds=x_bounds, q_final=qf,
-        path=path, name=f"{device} slew ({objective})", **_costs(objective))
+        path=path, name=f"{device} slew ({objective})", **slew_costs(objective))
     rb = slew_problem(I, objective=objective, T=None if objective == "time" else horizon,
                       q0=q0, qf=qf, u_max=body_max)
     return problem, rb
@@ -95,29 +100,48 @@ def _body_momentum(x_rb, H_inertial):
     return np.einsum("ijk,j->ik", dcm_from_quat(x_rb[:4]), H_inertial)
 
 
-def _pipeline(problem, rb_problem, convert, objective, *, starts, seed, N, tol, verbose,
-              ipopt_options, ptol, rtol, scale, polish):
-    """Solve ``problem`` from the converted rigid-body guesses of ``rb_problem``."""
+def solve_converted(problem, rb_problem, convert, objective, *, starts, seed, N, tol, verbose,
+                    ipopt_options, ptol, rtol, polish, scale=None, guess=None,
+                    transcription="radau", control="constant", eigenaxis=True):
+    """Solve the slew ``problem`` from the rigid-body guesses of ``rb_problem`` converted by
+    ``convert`` (a guess dict of the hub -> one of ``problem``), by the pipelines of
+    `time_optimal` (``'time'``: the best of ``starts`` seeded starts, polished when
+    ``polish``, kept within its bounds with ``control``) and `min_effort` (``'effort'``:
+    the eigenaxis start, or with ``eigenaxis=False`` -- a keep-out cone -- the best of the
+    seeded tilted starts; refined to ``tol``), verified by re-simulation.
+
+    ``guess`` (a solution or mapping of ``problem``) replaces the starts. With ``scale``
+    [N m s] the result's ``info['momentum_drift']`` is the largest change of the total
+    inertial momentum along the collocated trajectory over ``scale`` (momentum-exchange
+    slews, where it is conserved)."""
     opts = dict(N=N, verbose=verbose, ipopt_options=ipopt_options, scale=None)
     if objective == "time":
-        guesses = [convert(g) for g in seeded_guesses(rb_problem, starts, seed)]
-        first = dict(opts, transcription="radau", **SEED_OPTIONS)  # as time_optimal
-        sol = solve_time_optimal(problem, None, guesses, first,
+        guesses = None if guess is not None else [
+            convert(g) for g in seeded_guesses(rb_problem, starts, seed, eigenaxis=eigenaxis)]
+        first = dict(opts, transcription=transcription, **SEED_OPTIONS)  # as time_optimal
+        sol = solve_time_optimal(problem, guess, guesses, first,
                                  polish=polish, pointing_tol=ptol, rate_tol=rtol,
                                  ipopt_options=ipopt_options, verbose=verbose)
-        sol = bounded(problem, sol, pointing_tol=ptol, rate_tol=rtol, ipopt_options=ipopt_options)
+        sol = bounded(problem, sol, control=control, pointing_tol=ptol, rate_tol=rtol,
+                      ipopt_options=ipopt_options)
     else:
-        first = solve(problem, guess=convert(attitude_guess(rb_problem)), **opts)
+        if guess is not None:
+            first = solve(problem, guess=guess, **opts)
+        elif eigenaxis:
+            first = solve(problem, guess=convert(attitude_guess(rb_problem)), **opts)
+        else:
+            first = solve_multistart(problem, [convert(g) for g in seeded_guesses(
+                rb_problem, starts, seed, eigenaxis=False)], **opts)
         sol = refine_and_verify(problem, first, tol=tol, scale=None, pointing_tol=ptol,
                                 rate_tol=rtol, ipopt_options=ipopt_options, verbose=verbose)
-    return annotate(sol, _momentum_info(sol, scale))
+    return sol if scale is None else annotate(sol, _momentum_info(sol, scale))
 
 
 def _common(objective, tol, pointing_tol, rate_tol, starts):
     objective = one_of(objective, "objective", ("time", "effort"))
     return (objective, check_tol("tol", tol, 1e-7), check_tol("pointing_tol", pointing_tol, POINTING_TOL),
             check_tol("rate_tol", rate_tol, RATE_TOL),
-            integer(_STARTS if starts is None else starts, "starts", minimum=1))
+            integer(DEVICE_STARTS if starts is None else starts, "starts", minimum=1))
 
 
 @interruptible
@@ -126,6 +150,9 @@ def wheel_slew(inertia, axes, wheel_inertia, *, objective="time", T=None, angle=
                N=30, starts=None, seed=0, tol=1e-7, verbose=False, ipopt_options=None,
                pointing_tol=POINTING_TOL, rate_tol=RATE_TOL):
     """Time-optimal or minimum-effort rest-to-rest slew by reaction wheels.
+
+    The engine of `slew` for this scene; prefer ``slew(Scene(RigidHub(inertia),
+    ReactionWheels(axes, wheel_inertia, u_max=torque_max, speed_max=speed_max)), ...)``.
 
     Parameters
     ----------
@@ -192,12 +219,12 @@ def wheel_slew(inertia, axes, wheel_inertia, *, objective="time", T=None, angle=
     smax = None if speed_max is None else positive_each(speed_max, "speed_max", n)
     if smax is not None and np.any(np.abs(W0) > smax):
         raise ValueError(f"`W0` {W0.tolist()} lies outside `speed_max` {smax.tolist()}")
-    body_max = (float(np.min(tmax)) * float(np.linalg.svd(A, compute_uv=False)[-1])
-                if tmax is not None else None)
-    if body_max is not None and body_max == 0:
+    sigma = np.linalg.svd(A, compute_uv=False)  # (fewer than 3 wheels: fewer than 3 values)
+    if sigma.size < 3 or sigma[-1] == 0:
         raise ValueError("`axes` must span the three body axes for a slew")
+    body_max = float(np.min(tmax)) * float(sigma[-1]) if tmax is not None else None
     T_ref = rough_time(I, q0, qf, np.full(3, body_max if body_max else 1.0))
-    horizon = _horizon(objective, T, T_max, T_ref)
+    horizon = slew_horizon(objective, T, T_max, T_ref)
     lo = np.r_[np.full(7, -np.inf), -smax if smax is not None else np.full(n, -np.inf)]
     problem, rb = _problems(model, I, objective, horizon, q0, qf, W0, Wf, tmax,
                             body_max if body_max else None, "wheel", x_bounds=(lo, -lo))
@@ -217,9 +244,9 @@ def wheel_slew(inertia, axes, wheel_inertia, *, objective="time", T=None, angle=
         return dict(t=t, x=np.vstack([x, W]), u=tau, T=g["T"])
 
     scale = max(float(np.max(J * np.abs(W0))), float(np.max(J)) * 1.0, 1e-300)
-    return _pipeline(problem, rb, convert, objective, starts=starts, seed=seed, N=N, tol=tol,
-                     verbose=verbose, ipopt_options=ipopt_options, ptol=ptol, rtol=rtol,
-                     scale=scale, polish=True)
+    return solve_converted(problem, rb, convert, objective, starts=starts, seed=seed, N=N,
+                           tol=tol, verbose=verbose, ipopt_options=ipopt_options, ptol=ptol,
+                           rtol=rtol, scale=scale, polish=True)
 
 
 @interruptible
@@ -228,6 +255,9 @@ def cmg_slew(inertia, geometry, *, objective="time", T=None, angle=None, axis=No
              N=30, starts=None, seed=0, tol=1e-7, verbose=False, ipopt_options=None,
              pointing_tol=POINTING_TOL, rate_tol=RATE_TOL):
     """Time-optimal or minimum-effort rest-to-rest slew by a cluster of single-gimbal CMGs.
+
+    The engine of `slew` for this scene; prefer
+    ``slew(Scene(RigidHub(inertia), <CMG cluster>), ...)``.
 
     Parameters
     ----------
@@ -294,7 +324,7 @@ def cmg_slew(inertia, geometry, *, objective="time", T=None, angle=None, axis=No
                            lower=m_min ** 2, upper=np.inf, name="singularity"),)
     body_max = float(np.min(geometry.h)) * (float(np.min(rmax)) if rmax is not None else 1.0)
     T_ref = rough_time(I, q0, qf, np.full(3, body_max))
-    horizon = _horizon(objective, T, T_max, T_ref)
+    horizon = slew_horizon(objective, T, T_max, T_ref)
     problem, rb = _problems(model, I, objective, horizon, q0, qf, d0, df, rmax, body_max, "cmg",
                             path=path)
     H_in = dcm_from_quat(q0).T @ cluster_momentum(geometry, d0)
@@ -316,8 +346,8 @@ def cmg_slew(inertia, geometry, *, objective="time", T=None, angle=None, axis=No
             rates = np.clip(rates, -rmax[:, None], rmax[:, None])
         return dict(t=t, x=np.vstack([x, d]), u=rates, T=g["T"])
 
-    sol = _pipeline(problem, rb, convert, objective, starts=starts, seed=seed, N=N, tol=tol,
-                    verbose=verbose, ipopt_options=ipopt_options, ptol=ptol, rtol=rtol,
-                    scale=float(np.sum(geometry.h)), polish=False)
+    sol = solve_converted(problem, rb, convert, objective, starts=starts, seed=seed, N=N,
+                          tol=tol, verbose=verbose, ipopt_options=ipopt_options, ptol=ptol,
+                          rtol=rtol, scale=float(np.sum(geometry.h)), polish=False)
     measure = np.sqrt(np.maximum(gram_determinant(cluster_jacobian(geometry, sol.x[7:])), 0.0))
     return annotate(sol, {"min_measure": float(np.min(measure))})

@@ -125,6 +125,9 @@ def time_optimal(inertia, *, angle=None, axis=None, q0=None, qf=None, u_max=1.0,
                  rate_tol=RATE_TOL, control="constant") -> Solution:
     """Minimum-time rigid-body slew under torque bounds.
 
+    The engine of `slew` for this scene; prefer
+    ``slew(Scene(RigidHub(inertia), ExternalTorque(u_max=u_max)), objective="time", ...)``.
+
     Parameters
     ----------
     inertia : array_like, shape (3, 3) or (3,) [kg m^2]
@@ -542,6 +545,9 @@ def min_effort(inertia, T, *, angle=None, axis=None, q0=None, qf=None, u_max=Non
                tol=1e-7, starts=None, seed=None, verbose=False, ipopt_options=None,
                pointing_tol=POINTING_TOL, rate_tol=RATE_TOL) -> Solution:
     """Minimum-effort (``1/2 integral |u|^2 dt``) rigid-body slew over a fixed time ``T``.
+
+    The engine of `slew` for this scene; prefer
+    ``slew(Scene(RigidHub(inertia), ExternalTorque(u_max=u_max)), objective="effort", T=T, ...)``.
 
     Parameters
     ----------

@@ -93,14 +93,17 @@ def vector3(v, name, default):
     return np.array(default, dtype=float) if v is None else finite_array(v, name, (3,))
 
 
-def targets(q0, qf, angle, axis):
+def targets(q0, qf, angle, axis, *, qf_name="qf"):
+    """``(q0, qf)``: ``q0`` (default identity) and the target ``qf``, or ``q0`` turned by
+    ``angle`` [rad] about the body ``axis``; ``qf_name`` is ``qf``'s name in messages."""
     q0 = np.array([0.0, 0.0, 0.0, 1.0]) if q0 is None else unit_quaternion(q0, "q0")
     if qf is not None:
         if angle is not None or axis is not None:
-            raise ValueError("give either `qf` or `angle` and `axis`, not both")
-        return q0, unit_quaternion(qf, "qf")
+            raise ValueError(f"give either `{qf_name}` or `angle` and `axis`, not both")
+        return q0, unit_quaternion(qf, qf_name)
     if angle is None or axis is None:
-        raise ValueError("the target needs `qf`, or both `angle` [rad] and `axis` (body frame)")
+        raise ValueError(f"the target needs `{qf_name}`, or both `angle` [rad] and `axis` "
+                         f"(body frame)")
     angle = check_angle(angle)
     e = unit_vector(axis, "axis")
     return q0, quat_mul(quat_from_axis_angle(e, angle), q0)

@@ -43,6 +43,7 @@ def test_every_public_entry_point_has_an_example():
                ocp.polish_switches, ocp.guess_from_simulation, ocp.Solution.sample,
                ocp.control_switches, ocp.find_switches, slew.time_optimal, slew.min_effort,
                slew.eigenaxis_time, slew.switch_times, slew.summary, slew.format_summary,
-               slew.KeepOut, slew.verify, slew.slew_problem, slew.attitude_guess, ocp.solve_phases]
+               slew.KeepOut, slew.verify, slew.slew_problem, slew.attitude_guess, ocp.solve_phases,
+               slew.slew, slew.SlewOptions, slew.scene_problem]
     missing = [e.__qualname__ for e in entries if ">>>" not in (e.__doc__ or "")]
     assert not missing, f"no Examples in {missing}"
