@@ -1,6 +1,9 @@
 """Basilisk peer of the reaction-wheel detumble: writes ``tests/data/basilisk_rw_scenario.csv``.
 
-Runs in its own venv (``python3 -m venv /work/venv-bsk && /work/venv-bsk/bin/pip install bsk``)::
+Runs in its own venv, with pytest (bsk's ``unitTestSupport``, which ``simIncludeRW`` imports,
+imports it)::
+
+    python3 -m venv /work/venv-bsk && /work/venv-bsk/bin/pip install bsk pytest
 
     /work/venv-bsk/bin/python bench/peers/basilisk_rw.py [OUT.csv]
 
@@ -150,9 +153,10 @@ def run():
     sim.ConfigureStopTime(t_end)
     sim.ExecuteSimulation()
 
-    n = 3
-    cols = {"t": logs["state"].times() * macros.NANO2SEC}
-    blocks = {"sigma": np.array(logs["state"].sigma_BN), "omega": np.array(logs["state"].omega_BN_B),
+    n = len(WHEELS)  # the speed and torque messages hold arrays of a fixed maximal length
+    state = logs["state"]
+    cols = {"t": state.times() * macros.NANO2SEC}
+    blocks = {"sigma": np.array(state.sigma_BN), "omega": np.array(state.omega_BN_B),
               "Omega": np.array(logs["speeds"].wheelSpeeds)[:, :n],
               "us": np.array(logs["us"].motorTorque)[:, :n],
               "u": np.column_stack([np.array(rec.u_current) for rec in rw_logs]),
