@@ -25,15 +25,15 @@ import dataclasses
 
 import numpy as np
 
+from .model import Model
 from .scene import (ExternalTorque, HeldRotor, PointMassDamper, RigidHub, Scene,
                     SphericalDamper, TiltTorque)
-from .scene.dampers import real_number as _finite
-from .scene.dampers import unit_vector
-from .model import Model
+from .scene.dampers import real_number, unit_vector
 from .validate import check_inertia
 
-__all__ = ["PointMassDamper", "SphericalDamper", "tilt_torque_body", "gyrostat_model",
-           "steady_spin_state", "point_mass_offset", "unit_vector"]
+__all__ = ["PointMassDamper", "SphericalDamper", "tilt_torque_body", "tilt_torque_scene",
+           "gyrostat_model", "gyrostat_scene", "steady_spin_state", "point_mass_offset",
+           "unit_vector"]
 
 
 # -------------------------------------------------------------------- tilt torque
@@ -93,10 +93,24 @@ def tilt_torque_body(inertia, overturning, *, axis=(1.0, 0.0, 0.0), direction=(1
     ----------
     .. [1] Rheinfurth & Wilson, NASA RP-1262, Sec. 4.6, Method III and its Example 1.
     """
+    return tilt_torque_scene(inertia, overturning, axis=axis, direction=direction,
+                             internal_damping=internal_damping).model()
+
+
+def tilt_torque_scene(inertia, overturning, *, axis=(1.0, 0.0, 0.0), direction=(1.0, 0.0, 0.0),
+                      internal_damping: float = 0.0) -> Scene:
+    """The `Scene` of `tilt_torque_body` (same arguments and errors).
+
+    Examples
+    --------
+    >>> from appdyn.dynamics.spinning import tilt_torque_scene
+    >>> tilt_torque_scene([0.002, 0.005, 0.005], 0.1).part_names
+    ('tilt', 'torque')
+    """
     hub = RigidHub(check_inertia(inertia))
     tilt = TiltTorque(overturning, axis=axis, direction=direction,
                       internal_damping=internal_damping)
-    return Scene(hub, tilt, ExternalTorque(), name="tilt_torque_body").model()
+    return Scene(hub, tilt, ExternalTorque(), name="tilt_torque_body")
 
 
 # ------------------------------------------------------------------------ gyrostat
@@ -135,7 +149,8 @@ def gyrostat_model(inertia, *, wheel_axis=(1.0, 0.0, 0.0), wheel_momentum: float
       ``1/2 w.Jw + mu s' g.w + 1/2 mu s'^2 + 1/2 k s^2`` decays at ``-c s'^2`` (u = 0).
     * `SphericalDamper`: ``H = I w + h a + J_d w_d``; the core obeys
       ``J_d (w_d' + w x w_d) = -c (w_d - w_h)`` with the housing rate ``w_h = w`` (platform)
-      or ``w + wheel_rate a`` (rotor: the damper's ``housing_rate``), hence ``I w' = u - w x (I w + h a) + c (w_d - w_h)``.
+      or ``w + wheel_rate a`` (rotor: the damper's ``housing_rate``), hence
+      ``I w' = u - w x (I w + h a) + c (w_d - w_h)``.
       The energy ``1/2 w.Iw + 1/2 J_d |w_d|^2`` decays at ``-c |w_d - w|^2`` when the damper
       is on the platform (u = 0).
 
@@ -169,17 +184,34 @@ def gyrostat_model(inertia, *, wheel_axis=(1.0, 0.0, 0.0), wheel_momentum: float
     ValueError
         Naming the argument (inertia, axis, momentum, damper type or placement).
     """
+    return gyrostat_scene(inertia, wheel_axis=wheel_axis, wheel_momentum=wheel_momentum,
+                          damper=damper, damper_on=damper_on, wheel_rate=wheel_rate).model()
+
+
+def gyrostat_scene(inertia, *, wheel_axis=(1.0, 0.0, 0.0), wheel_momentum: float = 0.0,
+                   damper=None, damper_on: str = "platform", wheel_rate: float = 0.0) -> Scene:
+    """The `Scene` of `gyrostat_model` (same arguments and errors): ``Scene(RigidHub(I),
+    HeldRotor(a, h) if h != 0, damper (on the rotor: housing_rate = wheel_rate a),
+    ExternalTorque(), name="gyrostat")``.
+
+    Examples
+    --------
+    >>> from appdyn.dynamics.spinning import SphericalDamper, gyrostat_scene
+    >>> gyrostat_scene([3.0, 4.0, 4.0], wheel_momentum=1.0,
+    ...                damper=SphericalDamper(0.1, 0.05)).part_names
+    ('rotor', 'damper', 'torque')
+    """
     I = check_inertia(inertia)
     a = unit_vector(wheel_axis, "wheel_axis")
-    h = _finite(wheel_momentum, "wheel_momentum")
-    rate = _finite(wheel_rate, "wheel_rate")
+    h = real_number(wheel_momentum, "wheel_momentum")
+    rate = real_number(wheel_rate, "wheel_rate")
     _check_damper(damper, damper_on)
     parts = [HeldRotor(a, h)] if h != 0.0 else []
     if isinstance(damper, SphericalDamper) and damper_on == "rotor":
         damper = dataclasses.replace(damper, housing_rate=tuple((rate * a).tolist()))
     if damper is not None:
         parts.append(damper)
-    return Scene(RigidHub(I), *parts, ExternalTorque(), name="gyrostat").model()
+    return Scene(RigidHub(I), *parts, ExternalTorque(), name="gyrostat")
 
 
 def point_mass_offset(damper: PointMassDamper, axis, rate: float) -> float:
@@ -217,7 +249,7 @@ def steady_spin_state(axis, rate: float, *, damper=None, damper_on: str = "platf
     ndarray, shape (7,), (9,) or (10,)
     """
     a = unit_vector(axis, "axis")
-    rate = _finite(rate, "rate")
+    rate = real_number(rate, "rate")
     _check_damper(damper, damper_on)
     x = [0.0, 0.0, 0.0, 1.0, *(rate * a)]
     if isinstance(damper, PointMassDamper):

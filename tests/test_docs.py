@@ -26,7 +26,7 @@ PAGES = [DOCS / "quickstart.md", DOCS / "conventions.md"] + GUIDE
 #: pages that are prose only (no runnable example)
 PROSE = {"index.md", "architecture.md", "cli.md", "parallel.md"}
 #: user-guide pages the issue asks for (one per capability)
-CAPABILITIES = {"models", "attitude", "stability", "optimal_control", "slews", "trajectories",
+CAPABILITIES = {"scene", "models", "attitude", "stability", "optimal_control", "slews", "trajectories",
                 "gains", "dispersion", "wheels", "launch_vehicle", "cli", "parallel"}
 
 

@@ -26,7 +26,9 @@ also turns at ``delta_i' g_i`` relative to the body, which adds ``J_g,i delta_i'
     ``I(delta)' w = sum_i J_i delta_i' (t_i (s_i.w) + s_i (t_i.w))``.
 
 Not modelled: the gimbal acceleration torque ``-J_g,i delta_i'' g_i`` (the rates are
-prescribed, their derivatives are not model inputs) and the rotor spin-up (``h_i`` constant).
+prescribed, their derivatives are not model inputs; `dynamics.scene.CMGCluster` with
+``drive="torque"`` drives the gimbals by torques and has it) and the rotor spin-up (``h_i``
+constant).
 ``momentum_inertial`` is ``A(q)^T (I(delta) w + sum_i h_i s_i)``: exactly conserved (with
 ``L = 0``) for any gimbal-rate history when ``gimbal_inertia`` is None; with it the total
 ``A^T (H + sum_i J_g,i delta_i' g_i)`` changes by the neglected ``A^T sum_i J_g,i
@@ -50,77 +52,13 @@ from __future__ import annotations
 
 from typing import Literal
 
-import casadi as ca
 import numpy as np
 
-from .. import cache
-from ..attitude import quat_rate
 from ..model import Model
-from ..rigid_body import RIGID_BODY_STATES
-from ..validate import check_inertia, one_of, positive_each
-from .cluster import ClusterGeometry
-from .gyroscopic import cmg_torque
-from .wheels import ATTITUDE_UNITS, attitude_invariants
+from ..scene import CMGCluster, ExternalTorque, RigidHub, Scene
+from ..scene.cmgs import FIDELITIES
 
 __all__ = ["FIDELITIES", "cmg_spacecraft"]
-
-#: The levels of `cmg_spacecraft`.
-FIDELITIES = ("exact", "torque")
-
-
-def _spin_transverse(geometry: ClusterGeometry, delta):
-    """Lists of the columns ``s_i`` and ``t_i = ds_i/d(delta_i)`` (CasADi 3x1)."""
-    S0, T0 = geometry.spin_axes0, geometry.transverse_axes0
-    c, s = ca.cos(delta), ca.sin(delta)
-    spins = [ca.DM(S0[:, i]) * c[i] + ca.DM(T0[:, i]) * s[i] for i in range(geometry.n)]
-    transverse = [ca.DM(T0[:, i]) * c[i] - ca.DM(S0[:, i]) * s[i] for i in range(geometry.n)]
-    return spins, transverse
-
-
-@cache.memoize
-def _cmg_spacecraft(inertia_key: tuple, gimbal_key: tuple, spin_key: tuple, h_key: tuple,
-                    fidelity: str, rotor_key: tuple, gimbal_inertia_key: tuple,
-                    external_torque: bool) -> Model:
-    n = len(h_key)
-    geometry = ClusterGeometry(np.array(gimbal_key).reshape(3, n),
-                               np.array(spin_key).reshape(3, n), np.array(h_key))
-    G, h = geometry.gimbal_axes, geometry.h
-    x = ca.SX.sym("x", 7 + n)
-    u = ca.SX.sym("u", n + (3 if external_torque else 0))
-    p = ca.SX.sym("p", 0)
-    q, w, delta, rate = x[0:4], x[4:7], x[7:], u[0:n]
-    L = u[n:n + 3] if external_torque else ca.DM.zeros(3)
-    spins, transverse = _spin_transverse(geometry, delta)
-    rotors = [h[i] * spins[i] for i in range(n)]
-    inertia = ca.DM(np.array(inertia_key).reshape(3, 3))
-    if fidelity == "torque":
-        H = ca.mtimes(inertia, w) + sum(rotors)
-        torque = sum(cmg_torque(rate[i] * ca.DM(G[:, i]), rotors[i]) - ca.cross(w, rotors[i])
-                     for i in range(n))
-        wdot = ca.solve(inertia, L + torque - ca.cross(w, ca.mtimes(inertia, w)))
-    else:
-        for i, J in enumerate(rotor_key):
-            inertia = inertia + J * ca.mtimes(spins[i], spins[i].T)
-        H = ca.mtimes(inertia, w) + sum(rotors)
-        gimbal_momentum = sum(Jg * rate[i] * ca.DM(G[:, i]) for i, Jg in enumerate(gimbal_inertia_key))
-        rhs = L - ca.cross(w, H + gimbal_momentum)
-        for i in range(n):
-            s_i, t_i = spins[i], transverse[i]
-            turning = rotor_key[i] * (t_i * ca.dot(s_i, w) + s_i * ca.dot(t_i, w)) if rotor_key else 0
-            rhs = rhs - rate[i] * (h[i] * t_i + turning)
-        wdot = ca.solve(inertia, rhs)
-    f = ca.Function("cmg_spacecraft", [x, u, p], [ca.vertcat(quat_rate(q, w), wdot, rate)],
-                    ["x", "u", "p"], ["xdot"])
-    angles = tuple(f"d{i + 1}" for i in range(n))
-    rates = tuple(f"d{i + 1}_dot" for i in range(n))
-    controls = rates + (("L1", "L2", "L3") if external_torque else ())
-    units = {**{k: v for k, v in ATTITUDE_UNITS.items() if k in RIGID_BODY_STATES + controls},
-             **{k: "rad" for k in angles}, **{k: "rad/s" for k in rates}}
-    energy = 0.5 * ca.dot(w, ca.mtimes(inertia, w))
-    return Model(f=f, states=RIGID_BODY_STATES + angles, controls=controls, units=units,
-                 invariants=attitude_invariants(x, p, H, energy, cmg_momentum=sum(rotors)),
-                 name="cmg_spacecraft" if fidelity == "exact" else "cmg_spacecraft_torque",
-                 attitude=(0, 4))
 
 
 def cmg_spacecraft(inertia, gimbal_axes, spin_axes0, h, *,
@@ -164,7 +102,9 @@ def cmg_spacecraft(inertia, gimbal_axes, spin_axes0, h, *,
         with the gimbals and rotors locked, as for `dynamics.spinning.gyrostat_model`;
         conserved while the gimbals stand still, changed at the rate ``-sum_i delta_i'
         (h_i t_i.w + J_i (s_i.w)(t_i.w))`` when they turn), ``quat_norm`` and
-        ``cmg_momentum`` [N m s] (``sum_i h_i s_i``, body axes). Cached by the arguments.
+        ``cmg_momentum`` [N m s] (``sum_i h_i s_i``, body axes). It is the scene
+        ``Scene(RigidHub(inertia), CMGCluster(gimbal_axes, spin_axes0, h, ...)[,
+        ExternalTorque()], name=...)`` (`dynamics.scene`), cached by value.
 
     Raises
     ------
@@ -192,22 +132,11 @@ def cmg_spacecraft(inertia, gimbal_axes, spin_axes0, h, *,
     >>> np.round(xdot[4:7], 12) + 0.0  # I w' = -h delta' t, t = g x s = e_y
     array([ 0. , -0.1,  0. ])
     """
-    I = check_inertia(inertia)
-    geometry = ClusterGeometry(gimbal_axes, spin_axes0, h)
-    fidelity = one_of(fidelity, "fidelity", FIDELITIES)
+    hub = RigidHub(inertia)
+    cmgs = CMGCluster(gimbal_axes, spin_axes0, h, rotor_inertia=rotor_inertia,
+                      gimbal_inertia=gimbal_inertia, fidelity=fidelity)
     if not isinstance(external_torque, (bool, np.bool_)):
         raise TypeError(f"`external_torque` must be True or False, got {external_torque!r}")
-    extra = {}
-    for name, value in (("rotor_inertia", rotor_inertia), ("gimbal_inertia", gimbal_inertia)):
-        if value is None:
-            extra[name] = ()
-        elif fidelity == "torque":
-            raise ValueError(f"`{name}` is not used by fidelity='torque' (the torque model "
-                             "neglects rotor and gimbal inertia); use fidelity='exact'")
-        else:
-            extra[name] = tuple(positive_each(value, name, geometry.n).tolist())
-    return _cmg_spacecraft(tuple(I.reshape(-1).tolist()),
-                           tuple(geometry.gimbal_axes.reshape(-1).tolist()),
-                           tuple(geometry.spin_axes0.reshape(-1).tolist()),
-                           tuple(geometry.h.tolist()), fidelity, extra["rotor_inertia"],
-                           extra["gimbal_inertia"], bool(external_torque))
+    torque = (ExternalTorque(),) if external_torque else ()
+    name = "cmg_spacecraft" if cmgs.fidelity == "exact" else "cmg_spacecraft_torque"
+    return Scene(hub, cmgs, *torque, name=name).model()

@@ -23,28 +23,20 @@ axial moment ``J_i`` and turns at ``W_i`` relative to the hub. With the *locked*
 * kinetic energy ``E = 1/2 w.I w + 1/2 sum_i J_i (a_i.w + W_i)^2``, and
   ``E' = L.w + sum_i tau_i W_i`` exactly (the work of the external torque and the motors).
 
-`rotor_dynamics` is that derivation, written once; `wheel_spacecraft` builds the model.
+`rotor_dynamics` is that derivation, written once (the gyrostat's); `wheel_spacecraft` is the
+scene of a `dynamics.scene.RigidHub` carrying `dynamics.scene.ReactionWheels`, whose assembly
+derives the same equations by Kane's method.
 """
 from __future__ import annotations
 
 import casadi as ca
 import numpy as np
 
-from .. import cache
-from ..attitude import dcm_from_quat, quat_rate
 from ..model import Model
-from ..rigid_body import RIGID_BODY_STATES
-from ..validate import (check_inertia, finite_array, is_symbolic, positive, positive_each,
-                        unit_axes)
+from ..scene import ExternalTorque, ReactionWheels, RigidHub, Scene
+from ..validate import check_inertia, finite_array, is_symbolic, positive_each, unit_axes
 
-__all__ = ["ATTITUDE_UNITS", "rotor_dynamics",
-           "attitude_invariants", "wheel_spacecraft"]
-
-
-#: Units of the attitude states and of an external torque ``L1..L3``.
-ATTITUDE_UNITS = {**{k: "-" for k in RIGID_BODY_STATES[:4]},
-                  **{k: "rad/s" for k in RIGID_BODY_STATES[4:]},
-                  "L1": "N m", "L2": "N m", "L3": "N m"}
+__all__ = ["rotor_dynamics", "wheel_spacecraft"]
 
 
 def rotor_dynamics(inertia, axes, w, h, torque=None, *, wheel_inertia=None, motor=None):
@@ -124,69 +116,6 @@ def rotor_dynamics(inertia, axes, w, h, torque=None, *, wheel_inertia=None, moto
     return H, wdot, tau - ca.DM(J) * ca.mtimes(A.T, wdot)
 
 
-def attitude_invariants(x, p, H, energy, **more) -> dict:
-    """The invariants of an attitude model as Functions of ``(x, p)``.
-
-    Parameters
-    ----------
-    x, p : casadi SX
-        The model's state (quaternion in ``x[0:4]``) and parameter symbols.
-    H : casadi SX, 3x1 [N m s]
-        Total angular momentum in body axes.
-    energy : casadi SX [J]
-    **more : casadi SX
-        Further monitored quantities, by name.
-
-    Returns
-    -------
-    dict of str to casadi.Function
-        ``energy``, ``momentum_inertial`` (``A(q)^T H``), ``quat_norm`` and ``more``; each
-        has inputs ``('x', 'p')`` and one output named like its key.
-
-    Examples
-    --------
-    >>> import casadi as ca
-    >>> from appdyn.dynamics.momentum.wheels import attitude_invariants
-    >>> x, p = ca.SX.sym("x", 7), ca.SX.sym("p", 0)
-    >>> sorted(attitude_invariants(x, p, x[4:7], 0.5 * ca.sumsqr(x[4:7])))
-    ['energy', 'momentum_inertial', 'quat_norm']
-    """
-    q = x[0:4]
-    exprs = {"energy": energy, "momentum_inertial": ca.mtimes(dcm_from_quat(q).T, H),
-             "quat_norm": ca.norm_2(q), **more}
-    return {key: ca.Function(key, [x, p], [value], ["x", "p"], [key])
-            for key, value in exprs.items()}
-
-
-@cache.memoize
-def _wheel_spacecraft(inertia_key: tuple, axes_key: tuple, wheel_key: tuple,
-                      external_torque: bool) -> Model:
-    hub = np.array(inertia_key).reshape(3, 3)
-    A = np.array(axes_key).reshape(3, -1)
-    J = np.array(wheel_key)
-    n = J.size
-    x = ca.SX.sym("x", 7 + n)
-    u = ca.SX.sym("u", n + (3 if external_torque else 0))
-    p = ca.SX.sym("p", 0)
-    q, w, W = x[0:4], x[4:7], x[7:]
-    tau = u[0:n]
-    L = u[n:n + 3] if external_torque else None
-    locked = hub + A @ np.diag(J) @ A.T
-    H, wdot, hdot = rotor_dynamics(locked, A, w, ca.DM(J) * W, L, wheel_inertia=J, motor=tau)
-    f = ca.Function("wheel_spacecraft", [x, u, p], [ca.vertcat(quat_rate(q, w), wdot, hdot / J)],
-                    ["x", "u", "p"], ["xdot"])
-    wheel_momentum = ca.DM(J) * (ca.mtimes(ca.DM(A).T, w) + W)  # absolute, about a_i
-    energy = 0.5 * ca.dot(w, ca.mtimes(ca.DM(hub), w)) + 0.5 * ca.dot(wheel_momentum, wheel_momentum / J)
-    speeds = tuple(f"W{i + 1}" for i in range(n))
-    torques = tuple(f"tau{i + 1}" for i in range(n))
-    controls = torques + (("L1", "L2", "L3") if external_torque else ())
-    units = {**ATTITUDE_UNITS, **{k: "rad/s" for k in speeds}, **{k: "N m" for k in torques}}
-    return Model(f=f, states=RIGID_BODY_STATES + speeds, controls=controls,
-                 units={k: v for k, v in units.items() if k in RIGID_BODY_STATES + speeds + controls},
-                 invariants=attitude_invariants(x, p, H, energy, wheel_momentum=wheel_momentum),
-                 name="wheel_spacecraft", attitude=(0, 4))
-
-
 def wheel_spacecraft(inertia, axes, wheel_inertia, *, external_torque: bool = False) -> Model:
     """Rigid hub with ``n`` reaction wheels driven by motor torques (module docstring).
 
@@ -213,7 +142,9 @@ def wheel_spacecraft(inertia, axes, wheel_inertia, *, external_torque: bool = Fa
         (``A(q)^T H``, hub and wheels; conserved for ``L = 0`` whatever the motor torques),
         ``energy`` [J] (``1/2 w.I w + 1/2 sum_i J_i (a_i.w + W_i)^2``; its rate is
         ``sum_i tau_i W_i + L.w``), ``quat_norm`` and ``wheel_momentum`` [N m s] (shape n:
-        each wheel's absolute axial momentum ``J_i (a_i.w + W_i)``). Cached by the arguments.
+        each wheel's absolute axial momentum ``J_i (a_i.w + W_i)``). It is the scene
+        ``Scene(RigidHub(inertia), ReactionWheels(axes, wheel_inertia)[, ExternalTorque()],
+        name="wheel_spacecraft")`` (`dynamics.scene`), cached by value.
 
     Raises
     ------
@@ -239,10 +170,10 @@ def wheel_spacecraft(inertia, axes, wheel_inertia, *, external_torque: bool = Fa
     >>> np.round(xdot[[4, 7]], 12)  # hub: -tau/I1; wheel: tau/J - wdot1
     array([-0.001,  0.201])
     """
-    hub = check_inertia(inertia)
+    hub = RigidHub(inertia)
     A = unit_axes(axes, "axes")
     J = positive_each(wheel_inertia, "wheel_inertia", A.shape[1])
     if not isinstance(external_torque, (bool, np.bool_)):
         raise TypeError(f"`external_torque` must be True or False, got {external_torque!r}")
-    return _wheel_spacecraft(tuple(hub.reshape(-1).tolist()), tuple(A.reshape(-1).tolist()),
-                             tuple(J.tolist()), bool(external_torque))
+    torque = (ExternalTorque(),) if external_torque else ()
+    return Scene(hub, ReactionWheels(A, J), *torque, name="wheel_spacecraft").model()

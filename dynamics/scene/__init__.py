@@ -11,12 +11,16 @@ Parts
 =====================  =====================================================================
 `ReactionWheels`       wheels driven by motor torques (states ``W``, controls ``tau``)
 `HeldRotor`            a rotor at constant relative speed (the gyrostat's wheel)
+`CMGCluster`           single-gimbal CMGs (states ``d``; controls gimbal rates ``d_dot``, or
+                       gimbal torques ``tg`` with the rates as states)
 `ExternalTorque`       body torque controls ``L1..L3``
 `ExternalForce`        force controls ``F1..F3`` at a hub point
 `PointMassDamper`      a mass on a spring and dashpot sliding along a hub line (``s, s_dot``)
 `SphericalDamper`      a viscously coupled spherical core (core rate ``wd1..wd3``)
 `Slosh`                slosh as a pendulum (two angles) or a spring-mass (``s, s_dot``)
 `TiltTorque`           a torque from the tilt of a hub axis (heavy top, projectile, bearings)
+`HingedPanel`          a rigid panel on a revolute (``theta``) or ball (``p1..p4``) hinge
+`GravityGradient`      gravity on every body: forces and gravity-gradient torques
 =====================  =====================================================================
 
 Examples
@@ -27,14 +31,18 @@ Examples
 (7, ('L1', 'L2', 'L3'))
 """
 from .assembly import PartLayout
+from .cmgs import CMGCluster
 from .contract import Body, Contribution, Frame, Load, Part, PartVariables, Variable
 from .dampers import PointMassDamper, Slosh, SphericalDamper
 from .fields import TiltTorque
+from .gravity import GravityGradient
 from .hubs import RigidHub
 from .loads import ExternalForce, ExternalTorque
+from .panels import HingedPanel
 from .scene import Scene
 from .wheels import HeldRotor, ReactionWheels
 
 __all__ = ["Scene", "RigidHub", "Part", "PartLayout", "Variable", "PartVariables", "Body", "Load",
            "Contribution", "Frame", "ReactionWheels", "HeldRotor", "ExternalTorque",
-           "ExternalForce", "PointMassDamper", "SphericalDamper", "Slosh", "TiltTorque"]
+           "ExternalForce", "PointMassDamper", "SphericalDamper", "Slosh", "TiltTorque",
+           "HingedPanel", "GravityGradient", "CMGCluster"]

@@ -38,12 +38,17 @@ that names the field). It sets ``kind`` (the default name, ``"wheels"``), and im
       on, a spring's force with its coordinate's rate). A torque between the part and the hub
       acts on the *relative* angular velocity; its reaction on the hub is then implied,
     * ``potential``: its potential energy (springs, fields), ``kinetic``: only when its
-      kinetic energy is not ``1/2 (p.v + h.w)`` summed over its bodies,
+      kinetic energy is not ``1/2 (p.v + h.w)`` summed over its bodies, ``momentum``: only
+      when the angular momentum it adds to the ``momentum_inertial`` invariant (about the
+      reference point, hub axes) is not its bodies' ``h + rho x p`` (a share carried by a
+      prescribed motion, i.e. by a control, must be left out: invariants are functions of
+      the state),
     * ``invariants``: further monitored quantities of the state, by name.
 
     Loads that depend on the mass distribution of the whole scene (gravity) implement
-    ``field_loads(self, frame, bodies) -> Contribution`` instead, which receives every other
-    part's bodies.
+    ``field_loads(self, frame, bodies, own) -> Contribution`` instead, which receives every
+    body of the scene (the hub's first) and the part's own symbols (a field may turn with a
+    clock coordinate the part declares; its ``rates`` still come from ``contribute``).
 ``spin_speeds(self, frame, own) -> expression`` (optional)
     The part's speeds when it is at rest relative to a hub spinning at ``frame.w`` (zero
     unless its speeds are absolute rates, as a spherical damper's core rate); used by
@@ -179,6 +184,7 @@ class Contribution:
     loads: list = field(default_factory=list)
     potential: ca.SX | float = 0.0
     kinetic: ca.SX | None = None
+    momentum: ca.SX | None = None
     invariants: dict = field(default_factory=dict)
 
 
@@ -256,7 +262,7 @@ class Part:
         """The part's rates, bodies, loads, energy and invariants (module docstring)."""
         return Contribution()
 
-    def field_loads(self, frame: Frame, bodies: list) -> Contribution:
+    def field_loads(self, frame: Frame, bodies: list, own: PartSymbols) -> Contribution:
         """Loads that act on every body of the scene (gravity); none by default."""
         return Contribution()
 

@@ -207,6 +207,8 @@ class SphericalDamper(Part):
     center (its mass belongs to the hub's); it receives the torque ``-c (w_d - w_h)``,
     ``w_d`` its angular velocity and ``w_h = w + housing_rate`` that of the housing, and the
     hub the reaction. Speeds ``wd1..wd3`` [rad/s]: the core's absolute rate, hub axes.
+    The energy changes at ``-c (w_d - w_h).(w_d - w)``: a loss when the housing is the hub;
+    a turning housing's motor supplies the difference.
     At rest relative to its housing, ``w_d = w + housing_rate`` (`Scene.state`).
 
     Parameters
@@ -259,7 +261,9 @@ class SphericalDamper(Part):
         pos = frame.point((0.0, 0.0, 0.0))
         core = Body(velocity=frame.velocity(pos), angular_velocity=wd, momentum=ca.SX.zeros(3),
                     angular_momentum=self.inertia * wd, position=pos)
-        return Contribution(bodies=[core], loads=[Load(-self.damping * relative, relative)])
+        # the torque acts on the core's rate relative to the hub (its housing turns at a
+        # constant rate relative to the hub, so the partial velocities are the same)
+        return Contribution(bodies=[core], loads=[Load(-self.damping * relative, wd - frame.w)])
 
 
 @dataclass(frozen=True)
@@ -280,6 +284,11 @@ class Slosh(Part):
     ``position`` on a spring of ``stiffness`` ``k`` (or ``frequency`` ``sqrt(k/m)``) and a
     dashpot ``damping`` (states ``s`` [m], ``s_dot`` [m/s]), as a `PointMassDamper` with
     an infinite ``body_mass``.
+
+    The two pendulum angles are singular where the rod is perpendicular to ``p1`` and
+    ``direction`` both (``theta2 = +-pi/2``, 90 degrees from rest): slosh under thrust or
+    spin stays far from it, but a pendulum free of any restoring field can swing there,
+    where ``theta1'`` grows without bound and the integrator's steps shrink.
 
     The mass is a point mass; on an attitude-only hub it moves about the fixed reference
     point, on a six-degree-of-freedom hub the hub's mass reacts to it.

@@ -5,7 +5,8 @@ A wheel ``i`` turns about the unit hub axis ``a_i`` at ``W_i`` relative to the h
 axial moment ``J_i``: absolute angular velocity ``w + W_i a_i`` and, as only its axial moment
 is left out of the hub's inertia, angular momentum ``J_i (a_i.w + W_i) a_i``. The motor
 torque ``tau_i a_i`` acts on the wheel and ``-tau_i a_i`` on the hub: it does work on the
-relative rate ``W_i a_i``.
+relative rate ``W_i a_i``. For fields (`GravityGradient`) a wheel's body carries its axial
+inertia ``J_i a_i a_i^T`` (the rest is the hub's).
 """
 from __future__ import annotations
 
@@ -94,7 +95,7 @@ class ReactionWheels(Part):
             absolute.append(J * spin)
             bodies.append(Body(velocity=ca.SX.zeros(3), angular_velocity=frame.w + own.speeds[i] * a,
                                momentum=ca.SX.zeros(3), angular_momentum=J * spin * a,
-                               position=ca.SX.zeros(3)))
+                               position=ca.SX.zeros(3), inertia=J * ca.mtimes(a, a.T)))
             loads.append(Load(own.controls[i], own.speeds[i]))
         return Contribution(bodies=bodies, loads=loads,
                             invariants={"wheel_momentum": ca.vertcat(*absolute)})

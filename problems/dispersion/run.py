@@ -25,12 +25,13 @@ from appdyn.dynamics.integrate import METHODS
 from appdyn.dynamics.integrate.inputs import check_t
 from appdyn.dynamics.executors import check_executor, gather
 from appdyn.dynamics.interrupts import check_interrupt, interruptible
-from appdyn.dynamics.model import Model, check_model
+from appdyn.dynamics.model import Model
+from appdyn.dynamics.scene import Scene
 
 from .distributions import check_spec, draw_samples
 from .result import DispersionResult, assemble
-from .sample import (ATTITUDE, SampleTask, accepted, check_callable, picked, run_batch,
-                     run_sample, run_samples)
+from .sample import (ATTITUDE, SampleTask, accepted, as_model, check_callable, picked,
+                     run_batch, run_sample, run_samples)
 
 __all__ = ["dispersion"]
 
@@ -128,10 +129,11 @@ def dispersion(model, x0, t, *, samples: int, seed: int | None, outputs: Mapping
 
     Parameters
     ----------
-    model : Model or callable
-        The dynamics, or a factory ``model(**draws) -> Model`` called in each sample with the
-        drawn ``params`` it names as keywords (all of them if it takes ``**kwargs``), e.g.
-        an inertia that `dynamics.rigid_body` bakes into its model. For a process pool, a
+    model : Model, Scene or callable
+        The dynamics (a `dynamics.scene.Scene` stands for ``scene.model()``), or a factory
+        ``model(**draws) -> Model or Scene`` called in each sample with the drawn ``params``
+        it names as keywords (all of them if it takes ``**kwargs``), e.g. an inertia that
+        `dynamics.rigid_body` or a scene's hub bakes into its model. For a process pool, a
         module-level function.
     x0 : array_like, shape (nx,), or callable
         Nominal initial state, or ``x0(**draws) -> (nx,)`` (keywords as for the factory).
@@ -226,8 +228,10 @@ def dispersion(model, x0, t, *, samples: int, seed: int | None, outputs: Mapping
     (50, True)
     """
     start = time.perf_counter()
+    if isinstance(model, Scene):
+        model = model.model()
     if not (isinstance(model, Model) or callable(model)):
-        raise TypeError(f"`model` must be a Model or a factory callable, got "
+        raise TypeError(f"`model` must be a Model, a Scene or a factory callable, got "
                         f"{type(model).__name__}")
     samples = validate.integer(samples, "samples", minimum=1)
     seed = int(np.random.SeedSequence().entropy) if seed is None else \
@@ -307,7 +311,7 @@ def dispersion(model, x0, t, *, samples: int, seed: int | None, outputs: Mapping
 def _probe(factory, values):
     """The factory's model for one draw (to check names up front), or None if it fails."""
     try:
-        return check_model(factory(**picked(factory, values)))
+        return as_model(factory(**picked(factory, values)))
     except Exception:  # noqa: BLE001 -- that sample will report it
         return None
 

@@ -22,12 +22,30 @@ import numpy as np
 from appdyn.dynamics import simulate, validate
 from appdyn.dynamics.attitude import quat_mul
 from appdyn.dynamics.model import Model, check_model
+from appdyn.dynamics.scene import Scene
 
 __all__ = ["SampleTask", "SampleOutcome", "run_sample", "run_samples", "accepted", "picked", "check_callable",
-           "ATTITUDE", "NOT_SIMULATED"]
+           "ATTITUDE", "NOT_SIMULATED", "as_model"]
 
 ATTITUDE = "attitude"  # the params name of an attitude error (a quaternion composed with x0's)
 NOT_SIMULATED = -2  # sample_status of a sample that failed outside the simulation
+
+
+def as_model(model, name: str = "model") -> Model:
+    """The `Model` of a `dynamics.scene.Scene` (``scene.model()``), or ``model`` checked.
+
+    Raises
+    ------
+    TypeError
+        Naming ``name`` if it is neither a Model nor a Scene.
+
+    Examples
+    --------
+    >>> from appdyn.dynamics.scene import RigidHub, Scene
+    >>> as_model(Scene(RigidHub([1.0, 2.0, 3.0]))).states
+    ('q1', 'q2', 'q3', 'q4', 'w1', 'w2', 'w3')
+    """
+    return model.model() if isinstance(model, Scene) else check_model(model, name)
 
 
 @dataclass(frozen=True)
@@ -146,7 +164,7 @@ def run_sample(task: SampleTask) -> SampleOutcome:
         kwargs = dict(task.simulate_kwargs)
         model = task.model if isinstance(task.model, Model) else \
             task.model(**picked(task.model, task.values))
-        model = check_model(model, "model (returned by the factory)")
+        model = as_model(model, "model (returned by the factory)")
         x0, p = _initial(task, model, kwargs.pop("p", None))
         res = simulate(model, x0, task.t, p=p, **kwargs)
         status = int(res.status)

@@ -33,15 +33,23 @@ def _moments(transverse_inertia, axial_inertia, transverse_asymmetry):
     return np.array([it * (1 + d / 2), it * (1 - d / 2), ia], dtype=float)
 
 
-def _states(res) -> np.ndarray:
-    """``res.x`` of a `spinner` run, checked: finite, shape (7, n)."""
+_QUATERNION = ("q1", "q2", "q3", "q4")
+_RATES = ("w1", "w2", "w3")
+
+
+def _states(res) -> tuple:
+    """``(q, w)``, shapes (4, n) and (3, n), of a run, picked by the state names (a `spinner`
+    run, or a scene's: its hub's ``q1..q4, w1..w3``), checked finite."""
     if not hasattr(res, "x"):
         raise validate.ArgumentTypeError(f"`res` must be a SimulationResult (with states `x`), "
                                          f"got {type(res).__name__}")
     x = validate.finite_array(res.x, "res.x")
-    if x.ndim != 2 or x.shape[0] != 7 or x.shape[1] == 0:
-        raise ValueError(f"`res.x` must have shape (7, n) (a spinner run), got {x.shape}")
-    return x
+    names = tuple(getattr(res, "states", ()))
+    if x.ndim != 2 or x.shape[1] == 0 or not set(_QUATERNION + _RATES) <= set(names) \
+            or x.shape[0] != len(names):
+        raise ValueError(f"`res` must be a run with states q1..q4, w1..w3 (a spinner or a "
+                         f"scene), got states {names} and `res.x` of shape {x.shape}")
+    return (x[[names.index(s) for s in _QUATERNION]], x[[names.index(s) for s in _RATES]])
 
 
 def spinner(transverse_inertia, axial_inertia, transverse_asymmetry=0.0):
@@ -93,7 +101,8 @@ def nutation_history(res, transverse_inertia, axial_inertia, transverse_asymmetr
     TypeError
         If ``res`` is not a simulation result, or an inertia is not a real number.
     ValueError
-        If ``res.x`` is not finite of shape (7, n), or an inertia is not finite and ``> 0``.
+        If ``res.x`` is not finite or has no states ``q1..q4, w1..w3``, or an inertia is not
+        finite and ``> 0``.
 
     Examples
     --------
@@ -107,9 +116,9 @@ def nutation_history(res, transverse_inertia, axial_inertia, transverse_asymmetr
     True
     """
     inertia = _moments(transverse_inertia, axial_inertia, transverse_asymmetry)
-    x = _states(res)
-    h = dcm_from_quat(x[0:4, 0]).T @ (inertia * x[4:7, 0])
-    b = np.einsum("jik,j->ik", dcm_from_quat(x[0:4]), np.array([0.0, 0.0, 1.0]))
+    q, w = _states(res)
+    h = dcm_from_quat(q[:, 0]).T @ (inertia * w[:, 0])
+    b = np.einsum("jik,j->ik", dcm_from_quat(q), np.array([0.0, 0.0, 1.0]))
     return np.arctan2(np.linalg.norm(np.cross(b.T, h), axis=1), b.T @ h)
 
 
@@ -149,7 +158,7 @@ def nutation_closed_form(transverse_inertia, axial_inertia, w0) -> float:
 
 
 def _closed_form_output(res, transverse_inertia, axial_inertia):
-    return nutation_closed_form(transverse_inertia, axial_inertia, res.x[4:7, 0])
+    return nutation_closed_form(transverse_inertia, axial_inertia, _states(res)[1][:, 0])
 
 
 def nutation_spread(samples: int = 200, seed: int | None = 0, *,

@@ -12,12 +12,61 @@ import numpy as np
 
 from appdyn.dynamics import simulate
 from appdyn.dynamics.model import Model
-from appdyn.dynamics.rigid_body import RIGID_BODY_STATES, rigid_body
+from appdyn.dynamics.scene import ExternalTorque, RigidHub, Scene
 from appdyn.dynamics.validate import finite_array, nonnegative
 
 __all__ = ["attitude_loop", "initial_state", "settle_time", "error_angle", "check_scenarios",
            "gain_names", "pd_law", "loop_torque", "linearized_loop", "bang_bang_time",
-           "simulate_loop"]
+           "simulate_loop", "spacecraft_scene", "scene_torque_bound", "Q_VECTOR", "Q_SCALAR",
+           "RATES"]
+
+#: the rigid spacecraft's state blocks, from the scene layout (never literal indices):
+#: the quaternion's vector part, its scalar and the body rates
+_SCENE = Scene(RigidHub([1.0, 1.0, 1.0]))
+_HUB = _SCENE.layout["hub"]
+Q_VECTOR = slice(_HUB.coords.start, _HUB.coords.stop - 1)
+Q_SCALAR = _HUB.coords.stop - 1
+RATES = _HUB.speeds
+
+
+def spacecraft_scene(inertia) -> Scene:
+    """The rigid spacecraft of the gain design as a scene: a hub and one body torque.
+
+    Parameters
+    ----------
+    inertia : array_like, shape (3, 3) or (3,) [kg m^2], or Scene
+        The hub's inertia, or a scene of a hub (attitude only) and at most one
+        `ExternalTorque` (the law's torque; a hub alone gets one).
+
+    Returns
+    -------
+    Scene
+
+    Raises
+    ------
+    ValueError
+        Naming ``inertia``: a scene with a translating hub or other parts (wheels, dampers:
+        the PD law acts on the body torque of a rigid spacecraft), or a bad inertia.
+
+    Examples
+    --------
+    >>> spacecraft_scene([1.0, 2.0, 3.0]).model().controls
+    ('L1', 'L2', 'L3')
+    """
+    if not isinstance(inertia, Scene):
+        return Scene(RigidHub(inertia), ExternalTorque())
+    others = [type(p).__name__ for p in inertia.parts if not isinstance(p, ExternalTorque)]
+    if inertia.hub.translates or others or len(inertia.parts) > 1:
+        raise ValueError("`inertia` as a scene must be a rigid spacecraft: an attitude-only "
+                         "RigidHub with at most one ExternalTorque; got "
+                         f"{'a translating hub' if inertia.hub.translates else 'the parts'} "
+                         f"{[type(p).__name__ for p in inertia.parts]}")
+    return inertia if inertia.parts else Scene(inertia.hub, ExternalTorque(), name=inertia.name)
+
+
+def scene_torque_bound(scene: Scene):
+    """The ``u_max`` of the scene's `ExternalTorque` (None if unbounded)."""
+    return next((p.u_max for p in scene.parts if isinstance(p, ExternalTorque)), None)
 
 
 # --------------------------------------------------------------------------- input checks
@@ -52,7 +101,7 @@ def initial_state(angle, axis, w0=None) -> np.ndarray:
         raise ValueError("`axis` must be nonzero")
     e = e / np.linalg.norm(e)
     w = np.zeros(3) if w0 is None else finite_array(w0, "w0", (3,))
-    return np.concatenate([e * math.sin(a / 2), [math.cos(a / 2)], w])
+    return _SCENE.state(q=np.r_[e * math.sin(a / 2), math.cos(a / 2)], w=w)
 
 
 def check_scenarios(scenarios) -> tuple[np.ndarray, list[dict]]:
@@ -75,12 +124,12 @@ def check_scenarios(scenarios) -> tuple[np.ndarray, list[dict]]:
             x0 = initial_state(sc["angle"], sc["axis"], sc.get("w0"))
         except (TypeError, ValueError) as exc:
             raise type(exc)(f"`scenarios[{k}]`: {exc}") from None
-        if not (np.any(x0[:3] != 0) or np.any(x0[4:] != 0)):
+        if not (np.any(x0[Q_VECTOR] != 0) or np.any(x0[RATES] != 0)):
             raise ValueError(f"`scenarios[{k}]` starts at the target at rest (costs nothing)")
         axis = np.asarray(sc["axis"], dtype=float)
         cols.append(x0)
         info.append({"angle": float(sc["angle"]), "axis": axis / np.linalg.norm(axis),
-                     "w0": x0[4:].copy()})
+                     "w0": x0[RATES].copy()})
     return np.array(cols).T, info
 
 
@@ -92,15 +141,17 @@ def gain_names(per_axis: bool) -> tuple[str, ...]:
 def pd_law(x, p, per_axis: bool):
     """``u = -2 kp q_e - kd w`` (SX/MX or numbers)."""
     kp, kd = (p[0:3], p[3:6]) if per_axis else (p[0], p[1])
-    return -2 * kp * x[0:3] - kd * x[4:7]
+    return -2 * kp * x[Q_VECTOR] - kd * x[RATES]
 
 
 def attitude_loop(inertia, *, per_axis: bool = False) -> Model:
-    """The closed loop ``rigid_body(inertia)`` + ``u = -2 kp q_e - kd w``, gains as parameters.
+    """The closed loop of the rigid spacecraft (`spacecraft_scene`: ``rigid_body(inertia)``)
+    + ``u = -2 kp q_e - kd w``, gains as parameters.
 
     Parameters
     ----------
-    inertia : array_like, shape (3, 3) or (3,) [kg m^2]
+    inertia : array_like, shape (3, 3) or (3,) [kg m^2], or Scene
+        See `spacecraft_scene`.
     per_axis : bool
         Gains ``kp1..3, kd1..3`` (per body axis) instead of ``kp, kd``.
 
@@ -111,15 +162,20 @@ def attitude_loop(inertia, *, per_axis: bool = False) -> Model:
         [rad/s]), no controls, parameters the gains ([N m/rad], [N m s/rad]), ``attitude``
         marker ``(0, 4)``, built in SX.
     """
-    body = rigid_body(inertia)
+    scene = spacecraft_scene(inertia)
+    body = scene.model()
     names = gain_names(per_axis)
-    x, p = ca.SX.sym("x", 7), ca.SX.sym("p", len(names))
-    xdot = body.f(x, pd_law(x, p, per_axis), ca.DM(0, 1))
+    x, p = ca.SX.sym("x", body.nx), ca.SX.sym("p", len(names))
+    torque = next(n for n, part in zip(scene.part_names, scene.parts)
+                  if isinstance(part, ExternalTorque))
+    u = ca.SX.zeros(body.nu)
+    u[scene.layout[torque].controls] = pd_law(x, p, per_axis)
+    xdot = body.f(x, u, ca.DM(0, 1))
     f = ca.Function("attitude_pd_loop", [x, ca.SX.sym("u", 0), p], [xdot], ["x", "u", "p"], ["xdot"])
-    units = {**{k: v for k, v in dict(body.units).items() if k in RIGID_BODY_STATES},
+    units = {**{k: v for k, v in dict(body.units).items() if k in body.states},
              **{n: ("N m/rad" if n.startswith("kp") else "N m s/rad") for n in names}}
-    return Model(f, RIGID_BODY_STATES, (), names, p_default=np.ones(len(names)), units=units,
-                 name="attitude_pd_loop", attitude=(0, 4))
+    return Model(f, body.states, (), names, p_default=np.ones(len(names)), units=units,
+                 name="attitude_pd_loop", attitude=body.attitude)
 
 
 def loop_torque(x: np.ndarray, gains: np.ndarray, per_axis: bool) -> np.ndarray:
@@ -128,13 +184,13 @@ def loop_torque(x: np.ndarray, gains: np.ndarray, per_axis: bool) -> np.ndarray:
         kp, kd = gains[0:3, None], gains[3:6, None]
     else:
         kp, kd = gains[0], gains[1]
-    return -2 * kp * x[0:3] - kd * x[4:7]
+    return -2 * kp * x[Q_VECTOR] - kd * x[RATES]
 
 
 def error_angle(x) -> np.ndarray:
     """Attitude error angle [rad] in ``[0, pi]`` of states (7, n) (or quaternions (4, n))."""
     x = np.asarray(x, dtype=float)
-    return 2 * np.arctan2(np.linalg.norm(x[0:3], axis=0), np.abs(x[3]))
+    return 2 * np.arctan2(np.linalg.norm(x[Q_VECTOR], axis=0), np.abs(x[Q_SCALAR]))
 
 
 def settle_time(t, angle, band: float) -> float:
@@ -164,10 +220,12 @@ def settle_time(t, angle, band: float) -> float:
 
 def linearized_loop(loop: Model, gains: np.ndarray) -> np.ndarray:
     """Jacobian (6, 6) of the loop in ``(q1, q2, q3, w1, w2, w3)`` at the target at rest."""
-    x = ca.SX.sym("x", 7)
+    x = ca.SX.sym("x", loop.nx)
     jac = ca.Function("loop_jacobian", [x], [ca.jacobian(loop.f(x, ca.DM(0, 1), ca.DM(gains)), x)])
-    J = np.asarray(jac(np.array([0, 0, 0, 1.0, 0, 0, 0])), dtype=float)
-    keep = [0, 1, 2, 4, 5, 6]
+    target = np.zeros(loop.nx)
+    target[Q_SCALAR] = 1.0
+    J = np.asarray(jac(target), dtype=float)
+    keep = [i for i in range(loop.nx) if i != Q_SCALAR]
     return J[np.ix_(keep, keep)]
 
 

@@ -48,11 +48,12 @@ import casadi as ca
 import numpy as np
 
 from appdyn import ocp
-from appdyn.dynamics.validate import check_inertia, finite_array, nonnegative, positive, positive_each
+from appdyn.dynamics.validate import finite_array, nonnegative, positive, positive_each
 
-from .attitude_loop import (attitude_loop, check_scenarios, error_angle, gain_names, initial_state,
-                            linearized_loop, loop_torque, pd_law, settle_time, simulate_loop,
-                            bang_bang_time)
+from .attitude_loop import (Q_SCALAR, Q_VECTOR, RATES, attitude_loop, bang_bang_time,
+                            check_scenarios, error_angle, gain_names, initial_state,
+                            linearized_loop, loop_torque, pd_law, scene_torque_bound,
+                            settle_time, simulate_loop, spacecraft_scene)
 from .result import STATUS_LIMITS, STATUS_UNSTABLE, GainDesign
 
 __all__ = ["attitude_gains", "attitude_loop", "initial_state", "settle_time", "error_angle",
@@ -77,14 +78,18 @@ def attitude_gains(inertia, scenarios, *, u_max, horizon=None, per_axis: bool = 
 
     Parameters
     ----------
-    inertia : array_like, shape (3, 3) or (3,) [kg m^2]
-        Inertia about the mass center, body axes (or principal moments).
+    inertia : array_like, shape (3, 3) or (3,) [kg m^2], or Scene
+        Inertia about the mass center, body axes (or principal moments); or the spacecraft
+        as a `dynamics.scene.Scene`: an attitude-only hub with at most one `ExternalTorque`
+        (`problems.gains.attitude_loop.spacecraft_scene`); ``u_max=None`` takes its
+        torque's bound.
     scenarios : sequence of mappings
         Initial conditions, each ``{'angle': float [rad], 'axis': (3,), 'w0': (3,) [rad/s]}``
         (``w0`` optional, default rest): the body rotated by ``angle`` (``0 <= angle < pi``)
         about ``axis`` from the target. Their designs share one set of gains.
     u_max : float or array_like, shape (3,) [N m]
         Torque limit per body axis; a path constraint in every scenario (also at ``t = 0``).
+        ``None`` (with a scene whose torque is bounded): that bound.
     horizon : float [s], optional
         The cost's horizon; default 5 times the eigenaxis rest-to-rest bang-bang time
         ``2 sqrt(angle / alpha)`` of the largest-angle scenario (``alpha = min_i u_max_i /
@@ -174,8 +179,13 @@ def attitude_gains(inertia, scenarios, *, u_max, horizon=None, per_axis: bool = 
     (True, True, True)
     """
     t_start = time.perf_counter()
-    I = check_inertia(inertia)
+    scene = spacecraft_scene(inertia)
+    I = scene.hub.inertia_matrix
     X0, info = check_scenarios(scenarios)
+    if u_max is None:
+        u_max = scene_torque_bound(scene)
+        if u_max is None:
+            raise ValueError("`u_max` is required (or a scene whose ExternalTorque has u_max)")
     umax = positive_each(u_max, "u_max", 3)
     if not isinstance(per_axis, (bool, np.bool_)):
         raise TypeError(f"`per_axis` must be True or False, got {per_axis!r}")
@@ -217,12 +227,12 @@ def attitude_gains(inertia, scenarios, *, u_max, horizon=None, per_axis: bool = 
             raise ValueError("`gain_bounds` must have lower < upper for every gain")
     g0 = np.clip(g0, lo, hi)
 
-    loop = attitude_loop(I, per_axis=bool(per_axis))
+    loop = attitude_loop(scene, per_axis=bool(per_axis))
     umax_dm = ca.DM(umax)
 
     def cost(x, u, p):
         tau = pd_law(x, p, bool(per_axis)) / umax_dm
-        return 4 * ca.sumsqr(x[0:3]) + w_eff * ca.sumsqr(tau)
+        return 4 * ca.sumsqr(x[Q_VECTOR]) + w_eff * ca.sumsqr(tau)
 
     torque = ocp.Constraint(lambda x, u, p: pd_law(x, p, bool(per_axis)), -umax, umax, umax, _TORQUE)
     extra = {}
@@ -237,12 +247,12 @@ def attitude_gains(inertia, scenarios, *, u_max, horizon=None, per_axis: bool = 
         Id = ca.DM(I)
 
         def settled(x0, xf, p):
-            Xf = ca.reshape(xf, 7, K)
+            Xf = ca.reshape(xf, loop.nx, K)
             # |q_e|^2 <= sin^2(band / 2) at the horizon
-            rows = [ca.sumsqr(Xf[0:3, k]) - math.sin(band / 2) ** 2 for k in range(K)]
+            rows = [ca.sumsqr(Xf[Q_VECTOR, k]) - math.sin(band / 2) ** 2 for k in range(K)]
             if not per_axis:  # and the Lyapunov function V = 1/2 w.Jw + 4 kp (1 - q4) <= 4 kp c
-                rows += [0.5 * ca.mtimes([Xf[4:7, k].T, Id, Xf[4:7, k]]) + 4 * p[0] * (1 - Xf[3, k] - c)
-                         for k in range(K)]
+                rows += [0.5 * ca.mtimes([Xf[RATES, k].T, Id, Xf[RATES, k]])
+                         + 4 * p[0] * (1 - Xf[Q_SCALAR, k] - c) for k in range(K)]
             return ca.vertcat(*rows)
 
         row_scale = [math.sin(band / 2) ** 2] * K + ([] if per_axis else [4 * max(float(g0[0]), 1e-9) * c] * K)

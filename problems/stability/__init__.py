@@ -10,7 +10,9 @@ stability boundaries), gain/phase margins for feedback loops, and ``success`` / 
 Cases
 -----
 =====================  ======================================================================
-`spin`                 torque-free spin about a principal axis, optionally with an energy damper
+`spin`                 spin of any `dynamics.scene.Scene` about a hub axis, its parts at rest on
+                       the hub (mode labels by part); or torque-free spin of a rigid body
+                       about a principal axis, optionally with an energy damper
 `heavy_top`            Method III, Example 1 (Eqs. 4.122-4.132)
 `spinning_projectile`  Example 2: aerodynamic overturning moment in place of ``m g l``
 `rotor`                Example 3: whirl (4.134-4.135) and internal-damping instability
@@ -33,14 +35,16 @@ Cases
 Modules: `verdict` (the rule: an eigenvalue with ``|Re| <= ZERO_RTOL * rho`` counts as on
 the imaginary axis; "marginally stable" needs those to be semisimple), `report` (the report,
 its statuses, `analyze`), `closed_forms`, `spin`, `tilt` and `launch_vehicle` (the cases),
+`spin_scene` (a scene's relative equilibrium, linearization and reduction),
 `launch_vehicle_plots` (Bode, Nichols), `launch_vehicle_response` (time response), `loop`,
 `periodic` (time-periodic operating points), `constrained` (relative equilibria),
 `cases` (the table of names), `sweep`, `common` (shared conversions and checks).
 
 Spin cases report the *reduced* motion: the spin phase about the axis (cyclic) and the
 conserved spin-axis momentum (a first integral, whose steady spins form a one-parameter
-family with eigenvalue 0) are factored out by `Linearization.quotient` and
-`Linearization.restrict`; the notes say which states went. The launch vehicle's translation
+family with eigenvalue 0), and a scene's further first integrals (a free wheel's axial
+momentum), are factored out by `Linearization.quotient` and `Linearization.restrict`; the
+notes say which states went. The launch vehicle's translation
 (rigid-body drift, for guidance to correct) is factored out the same way.
 
 Examples
@@ -48,6 +52,11 @@ Examples
 >>> from appdyn.problems import stability
 >>> stability.spin([2.0, 3.0, 4.5], axis=[0, 0, 1], rate=5.0).verdict
 'marginally stable'
+>>> from appdyn.dynamics.scene import PointMassDamper, RigidHub, Scene
+>>> scene = Scene(RigidHub([5.0, 3.0, 4.0]),
+...               PointMassDamper(0.5, 60.0, 0.8, position=(0, 0.6, 0), direction=(1, 0, 0)))
+>>> stability.spin(scene, axis=[1, 0, 0], rate=4.0).verdict  # major axis, energy damper
+'asymptotically stable'
 """
 from appdyn.dynamics.spinning import PointMassDamper, SphericalDamper
 

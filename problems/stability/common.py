@@ -9,7 +9,7 @@ import numpy as np
 from appdyn.dynamics.figures import axes_or_new_figure, finish_figure
 from appdyn.dynamics.serialize import jsonable, plain
 
-__all__ = ["STANDARD_GRAVITY", "check_number", "plain", "jsonable", "format_complex",
+__all__ = ["STANDARD_GRAVITY", "check_number", "block", "plain", "jsonable", "format_complex",
            "format_number", "param_text", "axes_or_new_figure", "finish_figure"]
 
 #: standard gravity [m/s^2], the default ``gravity`` of `problems.stability.heavy_top`
@@ -50,6 +50,29 @@ def check_number(value, name, *, positive=False, nonzero=False, nonnegative=Fals
     if nonnegative and v < 0:
         raise ValueError(f"`{name}` must be non-negative, got {v}")
     return v
+
+
+def block(states, first: str, last: str) -> slice:
+    """The slice of the consecutive named states ``first..last`` (a model's state blocks by
+    name, never by literal index).
+
+    Raises
+    ------
+    ValueError
+        If a name is missing or ``last`` comes before ``first``.
+
+    Examples
+    --------
+    >>> block(("q1", "q2", "q3", "q4", "w1", "w2", "w3"), "w1", "w3")
+    slice(4, 7, None)
+    """
+    states = tuple(states)
+    if first not in states or last not in states:
+        raise ValueError(f"no state block {first!r}..{last!r} in {states}")
+    i, j = states.index(first), states.index(last) + 1
+    if j <= i:
+        raise ValueError(f"state {last!r} comes before {first!r} in {states}")
+    return slice(i, j)
 
 
 def format_complex(z, width=13) -> str:

@@ -18,13 +18,16 @@ from appdyn.dynamics.linearize import linearization
 from appdyn.dynamics.model import Model
 
 from .closed_forms import axis_kind, principal_moments, rigid_spin_lambda2
-from .common import check_number
+from .common import block, check_number
 from .report import Quantity, StabilityReport, build_report
 
 __all__ = ["hinged_spin", "ball_tilt_eigenvalues"]
 
 _HINGED_STATES = ("q1", "q2", "q3", "q4", "w1", "w2", "w3", "q1_rel", "q2_rel", "q3_rel",
                   "q4_rel", "w1_2", "w2_2", "w3_2")
+_Y = {"q1": block(_HINGED_STATES, "q1", "q4"), "w1": block(_HINGED_STATES, "w1", "w3"),
+      "q_rel": block(_HINGED_STATES, "q1_rel", "q4_rel"),
+      "w2": block(_HINGED_STATES, "w1_2", "w3_2")}  # the blocks of the relative states
 
 
 @cache.memoize
@@ -39,8 +42,8 @@ def _hinged_relative(m1, inertia1, m2, inertia2, r1, r2, kind):
     axis = [0.0, 0.0, 1.0] if kind == "revolute" else None
     full = hinged_bodies(m1, np.reshape(inertia1, (3, 3)), m2, np.reshape(inertia2, (3, 3)),
                          list(r1), list(r2), kind=kind, axis=axis, stabilization=None)
-    y, u, p = ca.SX.sym("y", 14), ca.SX.sym("u", 0), ca.SX.sym("p", 0)
-    q1, w1, qr, w2 = y[0:4], y[4:7], y[7:11], y[11:14]
+    y, u, p = ca.SX.sym("y", len(_HINGED_STATES)), ca.SX.sym("u", 0), ca.SX.sym("p", 0)
+    q1, w1, qr, w2 = (y[_Y[k]] for k in ("q1", "w1", "q_rel", "w2"))
     q2 = quat_mul(qr, q1)
     A1, A2 = dcm_from_quat(q1), dcm_from_quat(q2)
     M = m1 + m2
@@ -50,12 +53,14 @@ def _hinged_relative(m1, inertia1, m2, inertia2, r1, r2, kind):
     x = ca.vertcat(q1, w1, ca.mtimes(A1, -m2 / M * dd), -m2 / M * d,
                    q2, w2, ca.mtimes(A2, m1 / M * dd), m1 / M * d)
     xdot = full.f(x, u, p)
-    q1dot, q2dot = xdot[0:4], xdot[13:17]
+    names = full.states
+    q1dot, q2dot = xdot[block(names, "q1", "q4")], xdot[block(names, "q1_2", "q4_2")]
     qrdot = quat_mul(q2dot, quat_conj(q1)) + quat_mul(q2, quat_conj(q1dot))
     f = ca.Function("hinged_spin", [y, u, p],
-                    [ca.vertcat(q1dot, xdot[4:7], qrdot, xdot[17:20])], ["x", "u", "p"],
+                    [ca.vertcat(q1dot, xdot[block(names, "w1", "w3")], qrdot,
+                                xdot[block(names, "w1_2", "w3_2")])], ["x", "u", "p"],
                     ["xdot"])
-    units = {**dict.fromkeys(_HINGED_STATES[:4] + _HINGED_STATES[7:11], "-"),
+    units = {**dict.fromkeys(_HINGED_STATES[_Y["q1"]] + _HINGED_STATES[_Y["q_rel"]], "-"),
              **dict.fromkeys(("w1", "w2", "w3", "w1_2", "w2_2", "w3_2"), "rad/s")}
     model = Model(f, _HINGED_STATES, (), (), units=units, name=f"hinged_spin_{kind}",
                   attitude=(0, 4))
@@ -73,7 +78,7 @@ def _error_functions(assemble, full, kind):
     y = ca.vertcat(q1, xr[3:])
     x = assemble(y)
     H = full.invariants["momentum_angular"](x, ca.DM.zeros(0))
-    rows = [ca.sumsqr(y[7:11])]
+    rows = [ca.sumsqr(y[_Y["q_rel"]])]
     if kind == "revolute":
         phi, _, bnu = full.constraints(x, ca.DM.zeros(0))
         rows += [bnu[3], bnu[4], phi[3], phi[4]]
@@ -245,10 +250,12 @@ def hinged_spin(*, m1, inertia1, m2, inertia2, r1, r2, rate, kind="revolute",
     key = (m1, tuple(I1.ravel().tolist()), m2, tuple(I2.ravel().tolist()),
            tuple(r1.tolist()), tuple(r2.tolist()), kind)
     model, assemble, full = _hinged_relative(*key)
-    y0 = np.array([0, 0, 0, 1, 0, 0, W, 0, 0, 0, 1, 0, 0, W], dtype=float)
+    y0 = np.zeros(len(_HINGED_STATES))
+    for name, value in (("q4", 1.0), ("w3", W), ("q4_rel", 1.0), ("w3_2", W)):
+        y0[_HINGED_STATES.index(name)] = value
     lin = linearization(model, y0)
     g_rows, g_hz = _error_functions(assemble, full, kind)
-    xr0 = np.r_[np.zeros(3), y0[4:]]
+    xr0 = np.r_[np.zeros(3), y0[_Y["q1"].stop:]]  # dth replaces body 1's quaternion
     L = np.asarray(g_rows(xr0), dtype=float)
     c_hz = np.asarray(g_hz(xr0), dtype=float).ravel()
     elim = ["q4_rel"] + (["w1_2", "w2_2", "q1_rel", "q2_rel"] if kind == "revolute" else [])

@@ -1,67 +1,31 @@
-"""Free-spin cases: `spin` (rigid or with an energy damper) and `gyrostat` (dual spin).
+"""Free-spin cases: `spin` (any scene; a rigid body, optionally with an energy damper) and
+`gyrostat` (dual spin).
 
-Both are linearized in body rates (``frame='rates'``; the attitude does not enter
-torque-free dynamics) and restricted to a first integral (``|H|^2``, else the energy), which
-removes the eigenvalue 0 of the neighbouring steady spins; the notes say which state went.
+Every case builds its vehicle as a `dynamics.scene.Scene` and analyses its spin with
+`problems.stability.spin_scene`: linearized in body rates (``frame='rates'``; the attitude
+does not enter torque-free dynamics) and restricted to the first integrals (``|H|^2``, the
+parts' conserved invariants), which removes the eigenvalue 0 of the neighbouring steady
+spins; the notes say which state went. The closed forms stay per case.
 """
 from __future__ import annotations
 
 import math
 
-import casadi as ca
 import numpy as np
 
-from appdyn.dynamics.linearize import Linearization, linearization
-from appdyn.dynamics.rigid_body import check_inertia, rigid_body
-from appdyn.dynamics.spinning import (PointMassDamper, SphericalDamper, gyrostat_model,
-                               steady_spin_state, unit_vector)
+from appdyn.dynamics.rigid_body import check_inertia
+from appdyn.dynamics.scene import (ExternalForce, ExternalTorque, HeldRotor, ReactionWheels,
+                                   RigidHub, Scene, TiltTorque)
+from appdyn.dynamics.spinning import (PointMassDamper, SphericalDamper, gyrostat_scene,
+                                      unit_vector)
 
-from .closed_forms import (axis_kind, gyrostat_lambda2, principal_moments, rigid_spin_lambda2,
-                           spherical_damper_roots)
+from .closed_forms import (axis_kind, gyrostat_lambda2, method3_roots, principal_moments,
+                           rigid_spin_lambda2, spherical_damper_roots, with_conjugates)
 from .common import check_number, plain
 from .report import Quantity, StabilityReport, build_report
+from .spin_scene import spin_linearization
 
-__all__ = ["spin", "gyrostat", "reduce_free_spin"]
-
-
-def _case_linearization(model, x, frame, damper):
-    """Linearize a steady spin; a damper that spoils the relative equilibrium is named."""
-    try:
-        return linearization(model, x, frame=frame)
-    except ValueError as exc:
-        if damper is None:
-            raise
-        raise ValueError(f"`damper`: no steady spin about `axis` with this damper: {exc}") from None
-
-
-def _invariant_gradient(model, x, lin: Linearization, key: str) -> np.ndarray:
-    """Gradient of ``|invariant|^2`` at ``x``, in the (non-attitude) states of ``lin``."""
-    xs = ca.SX.sym("x", model.nx)
-    value = model.invariants[key](xs, ca.DM(model.resolve_p()))
-    grad = ca.Function("grad", [xs], [ca.gradient(ca.sumsqr(value), xs)])
-    g = np.asarray(grad(x), dtype=float).reshape(-1)
-    return np.array([g[model.states.index(s)] if s in model.states else 0.0 for s in lin.states])
-
-
-def reduce_free_spin(model, x, lin: Linearization) -> tuple[Linearization, list]:
-    """Remove the neutral spin-rate direction of a torque-free spin (rates frame).
-
-    ``|H|^2`` is a first integral; where ``H = 0`` its gradient vanishes and the energy (a
-    first integral, or decaying to second order at the steady spin) takes over."""
-    notes = []
-    for name, key in (("|H|^2", "momentum_inertial"), ("energy", "energy")):
-        c = _invariant_gradient(model, x, lin, key)
-        if np.max(np.abs(c)) == 0:
-            continue
-        try:
-            red = lin.restrict(c, reason=f"{name} is a first integral; the steady spins form a "
-                               "one-parameter family, whose eigenvalue 0 goes")
-        except ValueError:
-            continue
-        return red, notes
-    notes.append("no first integral with a non-zero gradient: the neutral eigenvalue 0 of the "
-                 "spin-rate family stays in the model")
-    return lin, notes
+__all__ = ["spin", "gyrostat"]
 
 
 def _damper_dict(damper):
@@ -69,7 +33,19 @@ def _damper_dict(damper):
 
 
 def spin(inertia, axis, rate, *, damper=None) -> StabilityReport:
-    """Torque-free spin ``w = rate * axis`` about a principal axis, optionally with a damper.
+    """Spin ``w = rate * axis`` of a scene, or torque-free spin of a rigid body about a
+    principal axis, optionally with a damper.
+
+    Given a `dynamics.scene.Scene` (``spin(scene, axis, rate)``): the relative equilibrium
+    with every part at rest relative to the hub (`problems.stability.spin_scene`: part
+    speeds from `Part.spin_speeds`, part coordinates solved so that the part speeds stay
+    constant), linearized in body rates, reduced by the momentum and the parts' first
+    integrals, modes labelled by part (``'nutation'`` for the hub, else the part's name).
+    Closed forms where known: a hub with held rotors and reaction wheels (at rest relative
+    to the hub, axes along or normal to the spin) spins as a gyrostat of wheel momentum
+    ``h = sum(held momenta) + rate sum(J_i, wheels along the axis)``; a hub with one energy
+    damper as below; a hub symmetric about the axis under an upright `TiltTorque` by
+    Method III (Eq. 4.127, in the frame spinning with the hub).
 
     The body-rate perturbations (Rheinfurth & Wilson, NASA RP-1262, Sec. 4.5 C,
     Eqs. 4.94-4.95) have the eigenvalues
@@ -85,14 +61,15 @@ def spin(inertia, axis, rate, *, damper=None) -> StabilityReport:
 
     Parameters
     ----------
-    inertia : array_like, shape (3, 3) or (3,) [kg m^2]
-        Of the rigid body about its mass center (without the damper mass / core inertia).
+    inertia : Scene, or array_like, shape (3, 3) or (3,) [kg m^2]
+        A scene with an attitude-only hub, or the inertia of the rigid body about its mass
+        center (without the damper mass / core inertia).
     axis : array_like, shape (3,)
-        Spin axis in body axes; must be a principal axis of ``inertia``.
+        Spin axis in body (hub) axes; must be a principal axis of the (loaded) body.
     rate : float [rad/s]
-        Spin rate, finite and non-zero.
+        Spin rate, finite and non-zero (a scene: finite).
     damper : PointMassDamper or SphericalDamper, optional
-        An energy damper on the body.
+        An energy damper on the body (not with a scene: mount it on the scene).
 
     Returns
     -------
@@ -126,7 +103,20 @@ def spin(inertia, axis, rate, *, damper=None) -> StabilityReport:
     ...                                    position=[0, 0.6, 0], direction=[1, 0, 0])
     >>> stability.spin([2.0, 3.0, 4.5], [1, 0, 0], 4.0, damper=damper).verdict  # minor axis
     'unstable'
+
+    A scene: a hub with a held rotor (a gyrostat, ``Ia + h/W = 4.5`` between 4 and 5):
+
+    >>> from appdyn.dynamics.scene import HeldRotor, RigidHub, Scene
+    >>> rep = stability.spin(Scene(RigidHub([3.0, 4.0, 5.0]), HeldRotor([1, 0, 0], 3.0)),
+    ...                      [1, 0, 0], 2.0)
+    >>> rep.verdict, rep.status, [m.label for m in rep.modes]
+    ('unstable', 0, ['nutation', 'nutation'])
     """
+    if isinstance(inertia, Scene):
+        if damper is not None:
+            raise ValueError("`damper` is for an inertia; mount the damper on the scene as a "
+                             "part")
+        return _scene_spin(inertia, axis, rate)
     I = check_inertia(inertia)
     a = unit_vector(axis, "axis")
     rate = check_number(rate, "rate", nonzero=True)
@@ -135,56 +125,165 @@ def spin(inertia, axis, rate, *, damper=None) -> StabilityReport:
         raise ValueError("`damper` must be None, a PointMassDamper or a SphericalDamper, got "
                          f"{type(damper).__name__}")
     params = {"inertia": I, "axis": a, "rate": rate, "damper": _damper_dict(damper)}
-    notes, quantities, cf = [], [], None
     if damper is None:
-        model = rigid_body(I)
-        x = np.concatenate([[0.0, 0.0, 0.0, 1.0], rate * a])
+        sl = _scene_case(Scene(RigidHub(I)), a, rate)
         title = "Torque-free spin about a principal axis (RP-1262, Sec. 4.5)"
-    else:
-        model = gyrostat_model(I, wheel_axis=a, damper=damper)
-        x = steady_spin_state(a, rate, damper=damper)
-        title = (f"Spin about a principal axis with a {type(damper).__name__} "
-                 "(RP-1262, Sec. 4.5 NOTE)")
-    lin = _case_linearization(model, x, "rates", damper)
-    red, more = reduce_free_spin(model, x, lin)
-    notes += list(red.notes) + more
-    kind = axis_kind(Ia, Ib, Ic)
-    lam2 = rigid_spin_lambda2(Ia, Ib, Ic, rate)
-    if damper is None:
+        kind = axis_kind(Ia, Ib, Ic)
+        lam2 = rigid_spin_lambda2(Ia, Ib, Ic, rate)
         root = np.sqrt(complex(lam2))
         cf = np.array([root, -root])
-        quantities.append(Quantity("lambda^2 = -rate^2 (Ia - Ib)(Ia - Ic) / (Ib Ic)", None, lam2,
-                                   "1/s^2", "Eqs. 4.94-4.95"))
+        quantities = [Quantity("lambda^2 = -rate^2 (Ia - Ib)(Ia - Ic) / (Ib Ic)", None, lam2,
+                               "1/s^2", "Eqs. 4.94-4.95")]
         if lam2 < 0:
             quantities.append(Quantity("nutation frequency (body rates)",
-                                       _pair_frequency(red.eigenvalues()), float(abs(root.imag)),
-                                       "rad/s", "Sec. 4.5 C: sqrt(lambda1 lambda2)"))
+                                       _pair_frequency(sl.reduced.eigenvalues()),
+                                       float(abs(root.imag)), "rad/s",
+                                       "Sec. 4.5 C: sqrt(lambda1 lambda2)"))
+        more = []
     else:
-        comp = I + (damper.inertia_at(float(x[7])) if isinstance(damper, PointMassDamper)
-                    else damper.inertia * np.eye(3))
-        Ja, Jb, Jc = principal_moments(comp, a)
-        kind = axis_kind(Ja, Jb, Jc)
-        quantities += [Quantity("loaded axial moment Ja", None, Ja, "kg m^2"),
-                       Quantity("loaded transverse moment Jb", None, Jb, "kg m^2"),
-                       Quantity("loaded transverse moment Jc", None, Jc, "kg m^2"),
-                       Quantity("locked-damper lambda^2 = -rate^2 (Ja-Jb)(Ja-Jc)/(Jb Jc)", None,
-                                rigid_spin_lambda2(Ja, Jb, Jc, rate), "1/s^2",
-                                "Eqs. 4.94-4.95, damper locked")]
-        if isinstance(damper, SphericalDamper) and abs(Ib - Ic) <= 1e-12 * Ib:
-            cf = spherical_damper_roots(Ib, damper.inertia, damper.damping, Ia * rate, rate,
-                                        rate, Ia)
-        expected = {"major": "asymptotically stable", "minor": "unstable",
-                    "intermediate": "unstable"}.get(kind)
-        if expected:
-            notes.append(f"Kelvin-Tait-Chetaev: energy dissipation makes a {kind}-axis spin "
-                         f"{expected} (if the damper is excited by the nutation)")
+        sl = _scene_case(gyrostat_scene(I, wheel_axis=a, damper=damper), a, rate, damper=True)
+        title = (f"Spin about a principal axis with a {type(damper).__name__} "
+                 "(RP-1262, Sec. 4.5 NOTE)")
+        kind, quantities, cf, more = _damper_terms(I, a, rate, damper, _damper_offset(sl))
+    notes = _notes(sl) + more
     notes.insert(0, f"spin about the {kind} axis{' of the loaded body' if damper else ''}; "
                     f"rigid moments Ia = {Ia:.10g}, Ib = {Ib:.10g}, Ic = {Ic:.10g} kg m^2")
-    rates = [s for s in red.states if s.startswith("w") and not s.startswith("wd")]
-    others = [s for s in red.states if s not in rates]
-    return build_report("spin", title, params, red.ss, lin=lin, closed_form=cf,
-                        groups={"nutation": rates, "damper": others},
-                        quantities=quantities, notes=notes)
+    return build_report("spin", title, params, sl.reduced.ss, lin=sl.lin, closed_form=cf,
+                        groups=sl.groups, quantities=quantities, notes=notes)
+
+
+def _damper_offset(sl) -> float:
+    """The point-mass damper's resting displacement ``s`` [m] at the spin point (0 else)."""
+    return float(sl.point.values[0]) if sl.point.values else 0.0
+
+
+def _damper_terms(I, a, rate, damper, s) -> tuple:
+    """``(kind, quantities, closed_form, notes)`` of a torque-free body carrying one energy
+    damper: its loaded moments, the locked-damper ``lambda^2``, the closed form of a
+    symmetric body with a spherical damper and the Kelvin-Tait-Chetaev note."""
+    Ia, Ib, Ic = principal_moments(I, a)
+    comp = I + (damper.inertia_at(s) if isinstance(damper, PointMassDamper)
+                else damper.inertia * np.eye(3))
+    Ja, Jb, Jc = principal_moments(comp, a)
+    kind = axis_kind(Ja, Jb, Jc)
+    quantities = [Quantity("loaded axial moment Ja", None, Ja, "kg m^2"),
+                  Quantity("loaded transverse moment Jb", None, Jb, "kg m^2"),
+                  Quantity("loaded transverse moment Jc", None, Jc, "kg m^2"),
+                  Quantity("locked-damper lambda^2 = -rate^2 (Ja-Jb)(Ja-Jc)/(Jb Jc)", None,
+                           rigid_spin_lambda2(Ja, Jb, Jc, rate), "1/s^2",
+                           "Eqs. 4.94-4.95, damper locked")]
+    cf, notes = None, []
+    if isinstance(damper, SphericalDamper) and abs(Ib - Ic) <= 1e-12 * Ib:
+        cf = spherical_damper_roots(Ib, damper.inertia, damper.damping, Ia * rate, rate, rate,
+                                    Ia)
+    expected = {"major": "asymptotically stable", "minor": "unstable",
+                "intermediate": "unstable"}.get(kind)
+    if expected:
+        notes.append(f"Kelvin-Tait-Chetaev: energy dissipation makes a {kind}-axis spin "
+                     f"{expected} (if the damper is excited by the nutation)")
+    return kind, quantities, cf, notes
+
+
+def _held_momentum(scene: Scene, a) -> tuple | None:
+    """``(per_rate, held)``: the axial wheel momentum per unit rate [N m s^2] and the held
+    momentum [N m s] of a scene whose parts are held rotors along ``a``, reaction wheels
+    along or normal to it, and loads; None for any other part (no closed form)."""
+    per_rate, held = 0.0, 0.0
+    for part in scene.parts:
+        if isinstance(part, (ExternalTorque, ExternalForce)):
+            continue
+        if isinstance(part, HeldRotor) and abs(abs(np.dot(part.axis, a)) - 1) <= 1e-12:
+            held += part.momentum * float(np.dot(part.axis, a))
+        elif isinstance(part, ReactionWheels):
+            c = part.axes_matrix.T @ a
+            if np.any((np.abs(c) > 1e-12) & (np.abs(np.abs(c) - 1) > 1e-12)):
+                return None
+            per_rate += float(np.sum(np.asarray(part.inertia) * c ** 2))
+        else:
+            return None
+    return per_rate, held
+
+
+def _scene_spin(scene: Scene, axis, rate) -> StabilityReport:
+    """`spin` of a scene (its docstring)."""
+    a = unit_vector(axis, "axis")
+    W = check_number(rate, "rate")
+    sl = _scene_case(scene, a, W)
+    notes, quantities, cf = _notes(sl), [], None
+    rotors = _held_momentum(scene, a)
+    damper, tilt = _lone_damper(scene), _upright_tilt(scene, a, sl)
+    if tilt is not None:
+        Ia, Ib, _ = principal_moments(scene.hub.inertia_matrix, a)
+        (r1, r2), G, K = method3_roots(Ia, Ib, tilt.overturning, W, tilt.internal_damping)
+        cf = with_conjugates((r1, r2))
+        quantities += [Quantity("K = (I1 - I2) w0^2 - kappa", None, K, "N m/rad",
+                                "Eq. 4.122"),
+                       Quantity("G = 2 I2 - I1", None, G, "kg m^2", "Eq. 4.122")]
+        notes.append("eigenvalues in the frame spinning at w0 (Method III, Eq. 4.127)")
+    elif damper is not None:
+        kind, quantities, cf, more = _damper_terms(scene.hub.inertia_matrix, a, W, damper,
+                                                   _damper_offset(sl))
+        notes = [f"spin about the {kind} axis of the loaded body"] + notes + more
+    elif rotors is not None:
+        Ia, Ib, Ic = principal_moments(scene.hub.inertia_matrix, a)
+        h = rotors[0] * W + rotors[1]
+        lam2 = gyrostat_lambda2(Ia, Ib, Ic, W, h)
+        root = np.sqrt(complex(lam2))
+        cf = np.array([root, -root])
+        quantities += [Quantity("axial wheel momentum h", None, h, "N m s"),
+                       Quantity("lambda^2 = -(Ia W + h - Ib W)(Ia W + h - Ic W) / (Ib Ic)",
+                                None, lam2, "1/s^2", "Eqs. 4.94-4.95 with a wheel")]
+        if W:
+            kind = axis_kind(Ia + h / W, Ib, Ic)
+            notes.insert(0, f"spin about the {kind} axis of the hub with its wheels: "
+                            f"Ia + h/W = {Ia + h / W:.10g}, Ib = {Ib:.10g}, Ic = {Ic:.10g} "
+                            "kg m^2")
+    title = f"Spin of {scene.name or 'a scene'} about a hub axis"
+    params = {"scene": repr(scene), "axis": a, "rate": W}
+    return build_report("spin", title, params, sl.reduced.ss, lin=sl.lin, closed_form=cf,
+                        groups=sl.groups, quantities=quantities, notes=notes)
+
+
+def _upright_tilt(scene: Scene, a, sl):
+    """The `TiltTorque` of a scene that is a hub symmetric about ``a`` with a tilt torque
+    about ``a`` from the direction ``a`` (Method III upright) and loads, linearized in the
+    spinning frame; None for any other scene."""
+    parts = [p for p in scene.parts if not isinstance(p, (ExternalTorque, ExternalForce))]
+    if len(parts) != 1 or not isinstance(parts[0], TiltTorque) or sl.lin.frame != "spinning":
+        return None
+    tilt = parts[0]
+    _, Ib, Ic = principal_moments(scene.hub.inertia_matrix, a)
+    aligned = min(np.dot(tilt.axis, a), np.dot(tilt.direction, a)) >= 1 - 1e-12
+    return tilt if aligned and abs(Ib - Ic) <= 1e-12 * Ib else None
+
+
+def _lone_damper(scene: Scene):
+    """The energy damper of a scene that is a hub, one damper on the hub and loads; None for
+    any other scene."""
+    loads = (ExternalTorque, ExternalForce)
+    dampers = [p for p in scene.parts if not isinstance(p, loads)]
+    if len(dampers) != 1 or not (
+            isinstance(dampers[0], PointMassDamper)
+            or isinstance(dampers[0], SphericalDamper) and not any(dampers[0].housing_rate)):
+        return None
+    return dampers[0]
+
+
+def _scene_case(scene: Scene, a, rate, *, damper: bool = False):
+    """`spin_linearization` of a case's scene; with a damper, a spin that is no relative
+    equilibrium is blamed on ``damper`` (the rigid body's axis was checked before)."""
+    try:
+        return spin_linearization(scene, a, rate)
+    except ValueError as exc:
+        if not damper:
+            raise
+        raise ValueError(f"`damper`: no steady spin about `axis` with this damper: {exc}") \
+            from None
+
+
+def _notes(sl) -> list:
+    """The reduction's notes of a `SpinLinearization`."""
+    return list(sl.reduced.notes) + list(sl.notes)
 
 
 def _pair_frequency(ev) -> float | None:
@@ -260,12 +359,10 @@ def gyrostat(inertia, axis, rate, wheel_momentum, *, wheel_inertia=None, damper=
                          "turns at rate + wheel_momentum / wheel_inertia)")
     if W == 0 and h == 0:
         raise ValueError("`rate` and `wheel_momentum` are both zero: nothing spins")
-    model = gyrostat_model(I, wheel_axis=a, wheel_momentum=h, damper=damper,
+    scene = gyrostat_scene(I, wheel_axis=a, wheel_momentum=h, damper=damper,
                            damper_on=damper_on, wheel_rate=Wr)
-    x = steady_spin_state(a, W, damper=damper, damper_on=damper_on, wheel_rate=Wr)
-    lin = _case_linearization(model, x, "rates", damper)
-    red, notes = reduce_free_spin(model, x, lin)
-    notes = list(red.notes) + notes
+    sl = _scene_case(scene, a, W, damper=damper is not None)
+    lin, red, notes, groups = sl.lin, sl.reduced, _notes(sl), sl.groups
     params = {"inertia": I, "axis": a, "rate": W, "wheel_momentum": h,
               "wheel_inertia": wheel_inertia, "damper": _damper_dict(damper),
               "damper_on": damper_on}
@@ -293,12 +390,9 @@ def gyrostat(inertia, axis, rate, wheel_momentum, *, wheel_inertia=None, damper=
             quantities.append(Quantity("boundary h = Jr (Ia - It) W / (It - Jr)", None,
                                        Jr * (Ia - It) * W / (It - Jr), "N m s",
                                        "housing at the nutation rate"))
-    rates = [s for s in red.states if s in ("w1", "w2", "w3")]
     title = "Gyrostat (dual spin)" + (f" with a {type(damper).__name__} on the {damper_on}"
                                       if damper else "")
-    others = [s for s in red.states if s not in rates]
     return build_report("gyrostat", title, params, red.ss, lin=lin, closed_form=cf,
-                        groups={"nutation": rates, "damper": others},
-                        quantities=quantities, notes=notes)
+                        groups=groups, quantities=quantities, notes=notes)
 
 

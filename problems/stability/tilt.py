@@ -11,12 +11,13 @@ import math
 
 import numpy as np
 
-from appdyn.dynamics.linearize import Linearization, linearization
-from appdyn.dynamics.spinning import tilt_torque_body
+from appdyn.dynamics.linearize import Linearization
+from appdyn.dynamics.spinning import tilt_torque_scene
 
 from .closed_forms import method3_roots, sleeping_rate, with_conjugates
 from .common import STANDARD_GRAVITY, check_number
 from .report import Quantity, StabilityReport, build_report
+from .spin_scene import spin_linearization
 
 __all__ = ["heavy_top", "spinning_projectile", "rotor"]
 
@@ -230,12 +231,9 @@ def rotor(axial_inertia, transverse_inertia, stiffness, bearing_distance, rate, 
 
 def _tilt_report(case, title, I1, I2, kappa, rate, damping, params, symbol):
     """Shared by the Method III cases: ``kappa`` replaces ``m g l``, ``symbol`` names it."""
-    model = tilt_torque_body(np.diag([I1, I2, I2]), kappa, internal_damping=damping)
-    x = np.array([0.0, 0.0, 0.0, 1.0, rate, 0.0, 0.0])
-    lin = linearization(model, x, frame="spinning")
-    red = lin.quotient("dth1", reason="the spin phase about the symmetry axis is cyclic")
-    red = red.restrict("w1", reason="the spin rate w1 is constant to first order (L1 = 0, "
-                       "I2 = I3): Method III's I1 phi'' = L1 = 0")
+    scene = tilt_torque_scene(np.diag([I1, I2, I2]), kappa, internal_damping=damping)
+    sl = spin_linearization(scene, np.array([1.0, 0.0, 0.0]), rate, frame="spinning")
+    lin, red = sl.lin, sl.reduced
     (r1, r2), G, K = method3_roots(I1, I2, kappa, rate, damping)
     inertial_cf = sorted((complex(r) - 1j * rate for r in (r1, r2)), key=lambda z: abs(z.imag))
     inertial = _inertial_roots(red, rate)

@@ -608,7 +608,7 @@ def test_one_case_table_serves_library_and_cli():
 
 
 @pytest.mark.parametrize("module", ["__init__", "verdict", "report", "closed_forms", "spin",
-                                    "tilt", "loop", "cases", "sweep"])
+                                    "spin_scene", "common", "tilt", "loop", "cases", "sweep"])
 def test_docstring_examples_run(module):
     """The Examples sections of problems.stability, printed values included."""
     import doctest

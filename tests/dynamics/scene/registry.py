@@ -18,6 +18,11 @@ AXES = np.array([[1.0, 0.0, 0.0, 0.57735026918962573],
                  [0.0, 0.0, 1.0, 0.57735026918962573]])
 I_HUB = np.array([[10.0, 1.2, -0.8], [1.2, 12.0, 0.6], [-0.8, 0.6, 8.0]])
 MOMENTA = ("momentum_inertial", "momentum_linear")
+_B = np.deg2rad(54.74)
+#: the four-CMG pyramid (DESIGN.md truth catalogue): gimbal axes and spin axes at zero angles
+PYRAMID_G = np.array([[np.sin(_B), 0.0, -np.sin(_B), 0.0], [0.0, np.sin(_B), 0.0, -np.sin(_B)],
+                      [np.cos(_B)] * 4])
+PYRAMID_S = np.array([[0.0, -1.0, 0.0, 1.0], [1.0, 0.0, -1.0, 0.0], [0.0, 0.0, 0.0, 0.0]])
 
 
 @dataclass
@@ -26,7 +31,11 @@ class Entry:
 
     make: Callable
     conserves: tuple = ("energy",) + MOMENTA
-    work: dict = field(default_factory=dict)  # control prefix -> f(state dict, part name) -> (n,)
+    #: control prefix -> f(state dict, part name) -> (n,); None: the controls prescribe a
+    #: motion (a rate-driven gimbal), so there is no energy-work law of the form u . v
+    work: dict | None = field(default_factory=dict)
+    #: rk8 steps per 10 s over the 100 s run (the scene takes the most of its parts')
+    steps: int = 1000
 
 
 def _point_velocity(point):
@@ -37,12 +46,39 @@ def _point_velocity(point):
     return velocity
 
 
+#: the parts of the scene with all of them (the pendulum slosh only in pairs: see its entry)
 PARTS: dict[str, Entry] = {
     "wheels": Entry(lambda: sc.ReactionWheels(AXES, [0.05, 0.04, 0.06, 0.03]),
                     work={"tau": lambda s, n: np.array([s[k] for k in s["__speeds__"][n]])}),
     "rotor": Entry(lambda: sc.HeldRotor([0.3, -0.5, 0.8], 2.5)),
     "torque": Entry(lambda: sc.ExternalTorque(), conserves=("energy", "momentum_linear"),
                     work={"L": lambda s, n: np.array([s["w1"], s["w2"], s["w3"]])}),
+    "damper": Entry(lambda: sc.PointMassDamper(mass=2.0, stiffness=50.0, damping=0.0,
+                                               position=(0.5, 0.2, -0.1),
+                                               direction=(0.0, 0.6, 0.8))),
+    "core": Entry(lambda: sc.SphericalDamper(inertia=0.4, damping=0.0)),
+    # the pendulum's two angles are singular 90 degrees from rest (theta2 = +-pi/2): in the
+    # scene with every part, free of any restoring field, it wanders there within 100 s
+    "slosh": Entry(lambda: sc.Slosh(3.0, length=0.4, hinge=(0.1, -0.3, 0.6),
+                                    direction=(0.0, 0.0, -1.0)), steps=4000),
+    "slosh_spring": Entry(lambda: sc.Slosh(1.5, kind="spring", frequency=2.0,
+                                           position=(-0.3, 0.2, 0.4),
+                                           direction=(1.0, 0.0, 0.0))),
+    "panel": Entry(lambda: sc.HingedPanel(4.0, [0.8, 0.3, 0.6], [0.0, 0.6, 0.1],
+                                          [0.0, 0.7, 0.0], axis=[1.0, 0.0, 0.0],
+                                          stiffness=6.0)),
+    "ball_panel": Entry(lambda: sc.HingedPanel(3.0, [0.5, 0.2, 0.4], [0.0, -0.6, 0.0],
+                                               [0.1, -0.5, 0.0], stiffness=4.0)),
+    "cmgs": Entry(lambda: sc.CMGCluster(PYRAMID_G, PYRAMID_S, [1.0, 1.2, 0.9, 1.1],
+                                        rotor_inertia=0.01, gimbal_inertia=0.004), work=None),
+    "cmgs_torque": Entry(lambda: sc.CMGCluster(PYRAMID_G[:, :2], PYRAMID_S[:, :2], [1.0, 0.8],
+                                               rotor_inertia=0.01, gimbal_inertia=0.004,
+                                               drive="torque"),
+                         work={"tg": lambda s, n: np.array([s[k] for k in s["__speeds__"][n]])}),
+    "tilt": Entry(lambda: sc.TiltTorque(3.0, axis=(0.0, 0.0, 1.0), direction=(0.0, 0.0, 1.0)),
+                  conserves=("energy", "momentum_linear")),
     "force": Entry(lambda: sc.ExternalForce(point=[0.2, 0.4, -0.3]), conserves=("energy",),
                    work={"F": _point_velocity([0.2, 0.4, -0.3])}),
 }
+
+ALL = tuple(name for name in PARTS if name != "slosh")
