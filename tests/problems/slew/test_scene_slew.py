@@ -412,7 +412,7 @@ def test_a_ball_hinge_is_held_at_rest_by_its_vector_part():
 @pytest.mark.slow
 def test_wheels_damper_and_ball_panel_slewed_at_least_effort():
     """The docs' vehicle (wheels, a damper, a ball-hinged panel): verified, the damper and the
-    panel at rest at the end of the re-simulation (40 s; before the vector-part end
+    panel at rest at the end of the re-simulation (40-55 s; before the vector-part end
     condition, IPOPT stopped at its acceptable level after 165 s)."""
     ball, _ = _panel_parts()
     scene = Scene(RigidHub([10.0, 12.0, 8.0]), ReactionWheels(np.eye(3), 0.05, u_max=0.1),
