@@ -43,8 +43,8 @@ from .options import SlewOptions, with_fields
 from .problem import attitude_guess, rough_time, slew_problem
 from .targets import targets, vector3
 
-__all__ = ["slew", "scene_problem", "torque_map", "scene_intervals", "DEFAULT_N",
-           "INTERVALS_PER_PERIOD", "MAX_AUTO_N"]
+__all__ = ["slew", "scene_problem", "torque_map", "scene_intervals", "quaternion_blocks",
+           "DEFAULT_N", "INTERVALS_PER_PERIOD", "MAX_AUTO_N"]
 
 #: Collocation intervals of the first solve when `SlewOptions.N` is None, by objective (the
 #: defaults of `time_optimal` and `min_effort`; the device engines use 30 for both).
@@ -448,6 +448,8 @@ def scene_problem(scene, *, objective, angle=None, axis=None, q_final=None, T=No
     xf = scene.state(q=qf, w=wf)
     xf[[names["terminal"][s] == "free" for s in model.states]] = np.nan
     xf[:4] = np.nan
+    for block in quaternion_blocks(scene):  # at rest up to sign: the vector part only
+        xf[block.stop - 1] = np.nan
     lo, hi = model.limits("controls")
     I = scene.hub.inertia_matrix
     torque = I @ torque_map(model, x0)
@@ -477,6 +479,53 @@ def scene_problem(scene, *, objective, angle=None, axis=None, q_final=None, T=No
         return dict(t=t, x=x, u=u, T=guess["T"])
 
     return problem, rigid, convert
+
+
+def quaternion_blocks(scene) -> list:
+    """The parts' unit-quaternion coordinates: runs of four coordinates of one part at rest
+    ``(0, 0, 0, 1)`` whose norm the model's rates preserve (``p . p' = 0`` at random states
+    and controls), as slices of the state. Read from the model alone (a ball hinge's
+    relative attitude, ...).
+
+    A slew holds such a block at rest at the end by its vector part only (the norm keeps the
+    fourth): fixing all four over-determines the end and IPOPT then stalls (a ball-hinged
+    panel, 30 s: ``Solved_To_Acceptable_Level`` after 165 s, measured).
+
+    Parameters
+    ----------
+    scene : dynamics.scene.Scene
+
+    Returns
+    -------
+    list of slice
+
+    Examples
+    --------
+    >>> from appdyn.dynamics.scene import ExternalTorque, RigidHub, Scene
+    >>> from appdyn.problems.slew.scene_slew import quaternion_blocks
+    >>> quaternion_blocks(Scene(RigidHub([1.0, 2.0, 2.5]), ExternalTorque()))  # not the hub's
+    []
+    """
+    model = scene.model()
+    rest = np.array([scene.variable_names()["rest"][s] for s in model.states])
+    rng = np.random.default_rng(0)
+    blocks = []
+    for name, lay in scene.layout.items():
+        if name == "hub":
+            continue
+        for k in range(lay.coords.start, lay.coords.stop - 3):
+            if not np.array_equal(rest[k:k + 4], [0.0, 0.0, 0.0, 1.0]):
+                continue
+            preserved = True
+            for _ in range(3):
+                x = rng.normal(size=model.nx)
+                x[k:k + 4] /= np.linalg.norm(x[k:k + 4])
+                xdot = np.asarray(model.rhs(x, rng.normal(size=model.nu)), dtype=float)
+                preserved &= abs(x[k:k + 4] @ xdot[k:k + 4]) <= 1e-12 * max(
+                    1.0, np.linalg.norm(xdot[k:k + 4]))
+            if preserved:
+                blocks.append(slice(k, k + 4))
+    return blocks
 
 
 def _keep_out(cone) -> Constraint:
