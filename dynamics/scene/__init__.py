@@ -39,10 +39,10 @@ from .gravity import GravityGradient
 from .hubs import RigidHub
 from .loads import ExternalForce, ExternalTorque
 from .panels import HingedPanel
-from .scene import Scene
+from .scene import Scene, check_scene
 from .wheels import HeldRotor, ReactionWheels
 
-__all__ = ["Scene", "RigidHub", "Part", "PartLayout", "Variable", "PartVariables", "Body", "Load",
+__all__ = ["Scene", "check_scene", "RigidHub", "Part", "PartLayout", "Variable", "PartVariables", "Body", "Load",
            "Contribution", "Frame", "ReactionWheels", "HeldRotor", "ExternalTorque",
            "ExternalForce", "PointMassDamper", "SphericalDamper", "Slosh", "TiltTorque",
            "HingedPanel", "GravityGradient", "CMGCluster"]

@@ -13,7 +13,7 @@ from .assembly import PartLayout, assemble
 from .contract import Frame, Part
 from .hubs import RigidHub
 
-__all__ = ["Scene"]
+__all__ = ["Scene", "check_scene"]
 
 HUB = "hub"
 
@@ -257,6 +257,14 @@ class Scene:
         for key, val in singles.items():
             x[index[key]] = val
         return x
+
+
+def check_scene(scene, name: str = "scene") -> Scene:
+    """``scene`` if it is a `Scene`; a ``TypeError`` naming ``name`` otherwise."""
+    if not isinstance(scene, Scene):
+        raise TypeError(f"`{name}` must be a dynamics.scene.Scene (Scene(RigidHub(inertia), "
+                        f"*parts)), got {type(scene).__name__}")
+    return scene
 
 
 def _rebuild_scene(hub, parts, name) -> Scene:

@@ -33,7 +33,7 @@ import numpy as np
 from appdyn.dynamics.attitude import dcm_from_quat
 from appdyn.dynamics.interrupts import interruptible
 from appdyn.dynamics.momentum import ClusterGeometry
-from appdyn.dynamics.scene import ExternalTorque, ReactionWheels, Scene
+from appdyn.dynamics.scene import ExternalTorque, ReactionWheels, Scene, check_scene
 from appdyn.dynamics.validate import one_of
 from appdyn.ocp import Constraint, Problem, Solution, annotate
 
@@ -131,9 +131,7 @@ def slew(scene, *, objective="time", angle=None, axis=None, q_final=None, T=None
     >>> sol.success, sol.info["engine"]
     (True, 'scene')
     """
-    if not isinstance(scene, Scene):
-        raise TypeError(f"`scene` must be a dynamics.scene.Scene (Scene(RigidHub(inertia), "
-                        f"*parts)), got {type(scene).__name__}")
+    check_scene(scene)
     objective = one_of(objective, "objective", ("time", "effort"))
     opts = with_fields(options, fields)
     model = scene.model()
@@ -438,7 +436,11 @@ def scene_problem(scene, *, objective, angle=None, axis=None, q_final=None, T=No
     >>> guess["x"].shape, guess["u"].shape
     ((10, 5), (3, 5))
     """
+    check_scene(scene)
+    objective = one_of(objective, "objective", ("time", "effort"))
     opts = SlewOptions() if options is None else options
+    if not isinstance(opts, SlewOptions):
+        raise TypeError(f"`options` must be a SlewOptions, got {type(opts).__name__}")
     model = scene.model()
     names = scene.variable_names()
     q0, qf = targets(opts.q0, q_final, angle, axis, qf_name="q_final")

@@ -192,6 +192,9 @@ VALID = {
     "angles": lambda: np.array([0.1, 0.2, 0.3]),
     "h": lambda: 0.1,
     "model": _rigid,
+    "scene": lambda: __import__("appdyn.dynamics.scene", fromlist=["Scene"]).Scene(
+        __import__("appdyn.dynamics.scene", fromlist=["RigidHub"]).RigidHub([1.0, 2.0, 3.0]),
+        __import__("appdyn.dynamics.scene", fromlist=["ExternalTorque"]).ExternalTorque(u_max=1.0)),
     "x0": lambda: np.array([0.0, 0.0, 0.0, 1.0, 0.1, 0.2, 0.3]),
     "x": lambda: np.array([0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 1.0]),
     "controller": _controller,
@@ -435,6 +438,8 @@ EXTRA = {
     "appdyn.problems.slew.min_effort": lambda: {"angle": 1.0, "axis": [0.0, 0.0, 1.0]},
     "appdyn.problems.slew.wheel_slew": lambda: {"angle": 1.0, "axis": [0.0, 0.0, 1.0]},
     "appdyn.problems.slew.cmg_slew": lambda: {"angle": 1.0, "axis": [0.0, 0.0, 1.0]},
+    "appdyn.problems.slew.slew": lambda: {"angle": 1.0, "axis": [0.0, 0.0, 1.0]},
+    "appdyn.problems.slew.scene_problem": lambda: {"angle": 1.0, "axis": [0.0, 0.0, 1.0], "T": 2.0},
     "appdyn.problems.stability.sweep": lambda: {"inertia": np.diag([1.0, 2.0, 3.0]),
                                          "axis": np.array([0.0, 0.0, 1.0])},
 }
@@ -456,6 +461,7 @@ EXPENSIVE = {
     "appdyn.ocp.solve", "appdyn.ocp.solve_phases", "appdyn.ocp.refine", "appdyn.ocp.solve_multistart",
     "appdyn.ocp.polish_switches", "appdyn.ocp.optimize_switch_times", "appdyn.problems.slew.time_optimal",
     "appdyn.problems.slew.min_effort", "appdyn.problems.slew.wheel_slew", "appdyn.problems.slew.cmg_slew",
+    "appdyn.problems.slew.slew",
     "appdyn.problems.slew.maneuver_table", "appdyn.problems.gains.state_feedback_gains",
     "appdyn.problems.gains.attitude_gains", "appdyn.problems.gains.launch_vehicle_gains",
     "appdyn.problems.ascent.planar_ascent", "appdyn.problems.dispersion.dispersion",

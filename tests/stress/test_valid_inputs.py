@@ -463,6 +463,8 @@ for _f in ("appdyn.dynamics.momentum.sr_inverse_steering", "appdyn.dynamics.mome
 # are drawn where they are built (rigid_body, slew_problem, ocp.solve ... are all swept)
 FIXED = {
     "model": "a Model: its builders are swept with random inertias and sizes",
+    "scene": "a Scene: its parts are swept by tests/dynamics/scene (Hypothesis states, the "
+             "conservation matrix over every pair of parts)",
     "problem": "an ocp.Problem: slew_problem/scenario_problem are swept",
     "solution": "an ocp.Solution: ocp.solve is swept",
     "controller": "a CasADi Function",
