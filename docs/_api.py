@@ -92,7 +92,9 @@ def constant_doc(package: str, name: str) -> str:
 def home(package: str, name: str, packages: list[str]) -> str:
     """Where ``package.name`` is documented: the dotted name of the public package below
     ``package`` that exports the same object under the same name (or that is the object),
-    else ``package`` itself."""
+    else the public package that defines it and exports it under that name (a class one
+    package re-exports from another branch, as `problems.stability` the dampers of
+    `dynamics.scene`), else ``package`` itself."""
     obj = getattr(importlib.import_module(package), name)
     if inspect.ismodule(obj) and obj.__name__ in packages:
         return obj.__name__
@@ -100,6 +102,15 @@ def home(package: str, name: str, packages: list[str]) -> str:
         if sub.startswith(f"{package}.") and name in public_names(sub) \
                 and getattr(importlib.import_module(sub), name) is obj:
             return home(sub, name, packages)
+    defining = getattr(obj, "__module__", None) or ""
+    if defining == package or defining.startswith(f"{package}."):
+        return package
+    for other in sorted(packages, key=len, reverse=True):  # a re-export from another branch:
+        if (defining == other or defining.startswith(f"{other}.")) \
+                and not package.startswith(f"{other}.") \
+                and name in public_names(other) \
+                and getattr(importlib.import_module(other), name) is obj:
+            return home(other, name, packages)  # documented where it is defined
     return package
 
 

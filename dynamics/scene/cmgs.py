@@ -95,9 +95,11 @@ def spin_transverse(spin_axes0, transverse_axes0, delta):
 
 @dataclass(frozen=True)
 class CMGCluster(Part):
-    """``n`` single-gimbal CMGs (module docstring): states ``d1..dn`` [rad], and either the
-    gimbal-rate controls ``d1_dot..dn_dot`` [rad/s] (``drive="rate"``) or the gimbal-rate
-    states ``d1_dot..dn_dot`` with the gimbal-torque controls ``tg1..tgn`` [N m]
+    """Single-gimbal control moment gyros, driven by gimbal rates or by gimbal torques.
+
+    ``n`` units (module docstring): states ``d1..dn`` [rad], and either the gimbal-rate
+    controls ``d1_dot..dn_dot`` [rad/s] (``drive="rate"``) or the gimbal-rate states
+    ``d1_dot..dn_dot`` with the gimbal-torque controls ``tg1..tgn`` [N m]
     (``drive="torque"``).
 
     Parameters

@@ -164,7 +164,7 @@ class Body:
 
 @dataclass
 class Load:
-    """A generalized load: ``vector`` does work on ``velocity`` (power ``vector . velocity``).
+    """A generalized load: ``vector`` does work on ``velocity`` (its power is their dot product).
 
     A force and the velocity of its point, a torque and the angular velocity of the body it
     acts on (relative to the hub for an internal motor), or a scalar spring force and its

@@ -201,7 +201,7 @@ class PointMassDamper(Part):
 
 @dataclass(frozen=True)
 class SphericalDamper(Part):
-    """A spherical core (e.g. fluid in a spherical cavity) coupled to its housing viscously.
+    """A spherical core (fluid in a spherical cavity, say) coupled to its housing viscously.
 
     The core has isotropic inertia ``J_d`` about its center, which lies at the hub's mass
     center (its mass belongs to the hub's); it receives the torque ``-c (w_d - w_h)``,
