@@ -3,10 +3,12 @@ parts").
 
 * ``hub-only scene vs rigid_body`` -- the torque-free body I = [[10,1.2,-0.8],[1.2,12,0.6],
   [-0.8,0.6,8]] over 60 s (121 outputs), simulated from the same state by
-  ``Scene(RigidHub(I)).model()`` and by `dynamics.rigid_body` (``rk8``, 20 steps per output,
-  compiled; and ``auto`` at rtol 1e-10), in the same process, interleaved: the median wall
-  time of each and their ratio; the state count and the right-hand side's instruction count
-  of each.
+  ``Scene(RigidHub(I)).model()`` and by the hand-written rigid body that `rigid_body` was
+  before it became a scene (kept as the tests' reference,
+  ``tests/dynamics/scene/legacy_momentum.py``; today's `rigid_body` when that file is
+  absent), ``rk8`` with 20 steps per output, compiled, and ``auto`` at rtol 1e-10, in the
+  same process, interleaved: the median wall time of each and their ratio; the state count
+  and the right-hand side's instruction count of each.
 * ``build time`` -- ``Scene(...).model()`` with the one cache cleared first, for scenes of 1
   to 10 parts (the parts of `PARTS`, the first k of them): the median of 5 builds.
 * ``multipliers formed`` -- whether building the 10-part scene called the multiplier
@@ -17,6 +19,7 @@ Run: ``appdyn bench scene`` or ``python bench/scene.py [--quick]``.
 """
 from __future__ import annotations
 
+import importlib.util
 import statistics
 import sys
 import time
@@ -91,9 +94,20 @@ def _build_times(repeats: int) -> list:
     return out
 
 
+def _hand_written_rigid_body():
+    """The hand-written rigid body of before the scene (the tests' reference), or None."""
+    path = Path(__file__).resolve().parents[1] / "tests" / "dynamics" / "scene" / "legacy_momentum.py"
+    if not path.is_file():
+        return None
+    spec = importlib.util.spec_from_file_location("appdyn_bench_legacy_momentum", path)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module.rigid_body(INERTIA)
+
+
 def _speed(repeats: int) -> list:
     hub_only = sc.Scene(sc.RigidHub(INERTIA)).model()
-    rb = rigid_body(INERTIA)
+    rb = _hand_written_rigid_body() or rigid_body(INERTIA)
     rows = []
     for label, kw in (("rk8, 20 steps/output, compiled", dict(method="rk8", steps=20, jit=True)),
                       ("auto, rtol 1e-10", dict(method="auto", rtol=1e-10, atol=1e-12))):
@@ -139,8 +153,9 @@ def run(quick: bool, out: Path):
               out / f"{NAME}.csv")
     rows = []
     for r in speed:
-        rows.append(Row(NAME, f"hub-only scene vs rigid_body, 60 s torque-free, {r['case']}",
-                        "wall time ratio (scene / rigid_body)", r["ratio"], "x",
+        rows.append(Row(NAME, f"hub-only scene vs hand-written rigid body, 60 s torque-free, "
+                              f"{r['case']}",
+                        "wall time ratio (scene / hand-written)", r["ratio"], "x",
                         f"{r['scene_s'] * 1e3:.3g} ms vs {r['rigid_body_s'] * 1e3:.3g} ms; "
                         f"{r['states']} states; {r['instructions_scene']} vs "
                         f"{r['instructions_rigid_body']} instructions; states differ by "
