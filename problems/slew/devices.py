@@ -320,7 +320,8 @@ def cmg_slew(inertia, geometry, *, objective="time", T=None, angle=None, axis=No
         m_min = positive(min_measure, "min_measure")
         if float(np.sqrt(gram_determinant(cluster_jacobian(geometry, d0)))) < m_min:
             raise ValueError(f"`delta0` starts below `min_measure` {m_min:g}")
-        path = (Constraint(lambda x, u, p: gram_determinant(cluster_jacobian(geometry, x[7:])),
+        gimbals = model.layout["cmgs"].coords  # the gimbal angles, read by name
+        path = (Constraint(lambda x, u, p: gram_determinant(cluster_jacobian(geometry, x[gimbals])),
                            lower=m_min ** 2, upper=np.inf, name="singularity"),)
     body_max = float(np.min(geometry.h)) * (float(np.min(rmax)) if rmax is not None else 1.0)
     T_ref = rough_time(I, q0, qf, np.full(3, body_max))
@@ -349,5 +350,6 @@ def cmg_slew(inertia, geometry, *, objective="time", T=None, angle=None, axis=No
     sol = solve_converted(problem, rb, convert, objective, starts=starts, seed=seed, N=N,
                           tol=tol, verbose=verbose, ipopt_options=ipopt_options, ptol=ptol,
                           rtol=rtol, scale=float(np.sum(geometry.h)), polish=False)
-    measure = np.sqrt(np.maximum(gram_determinant(cluster_jacobian(geometry, sol.x[7:])), 0.0))
+    angles = sol.x[model.layout["cmgs"].coords]
+    measure = np.sqrt(np.maximum(gram_determinant(cluster_jacobian(geometry, angles)), 0.0))
     return annotate(sol, {"min_measure": float(np.min(measure))})
