@@ -23,6 +23,9 @@ Parts
 `GravityGradient`      gravity on every body: forces and gravity-gradient torques
 =====================  =====================================================================
 
+Parts sit on the hub, or on a part that carries parts (a `HingedPanel`) named by their
+``parent`` keyword: ``ReactionWheels(axes, 0.05, parent="panel")``.
+
 Examples
 --------
 >>> from appdyn.dynamics.scene import ExternalTorque, RigidHub, Scene
