@@ -26,7 +26,8 @@ Cases
 `conical_pendulum`     steady cone of the spherical pendulum (3-1-3 or 3-2-1 form), reduced by
                        its symmetry about the vertical (Routh)
 `hinged_spin`          two hinged bodies spinning together about a common axis (ball or
-                       revolute hinge), reduced to the independent tilt coordinates
+                       revolute hinge), reduced to the independent tilt coordinates;
+                       `hinged_scene` its scene (a six-degree-of-freedom hub and a panel)
 `analyze`              any ``StateSpace`` (e.g. from `dynamics.linearize.linearize`)
 =====================  ======================================================================
 
@@ -63,7 +64,7 @@ from appdyn.dynamics.spinning import PointMassDamper, SphericalDamper
 from .cases import CASE_ALIASES, CASES, resolve_case
 from .common import STANDARD_GRAVITY
 from .constrained import conical_pendulum
-from .hinged import hinged_spin
+from .hinged import hinged_scene, hinged_spin
 from .launch_vehicle import launch_vehicle
 from .launch_vehicle_plots import bode_plot, loop_transfer, nichols_plot
 from .launch_vehicle_response import AutopilotResponse, launch_vehicle_response
@@ -84,5 +85,5 @@ __all__ = [
     "sweep", "CASES",
     "CASE_ALIASES", "resolve_case", "STANDARD_GRAVITY", "STATUS_VERIFIED", "STATUS_UNCHECKED",
     "STATUS_MISMATCH", "CLOSED_FORM_RTOL", "shaken_pendulum", "conical_pendulum",
-    "PeriodicStabilityReport", "FloquetMode", "hinged_spin",
+    "PeriodicStabilityReport", "FloquetMode", "hinged_spin", "hinged_scene",
 ]
