@@ -13,7 +13,8 @@ import math
 import casadi as ca
 import numpy as np
 
-from appdyn.dynamics.scene import HingedPanel, RigidHub, Scene
+from appdyn.dynamics.hinged import hinged_scene
+from appdyn.dynamics.scene import Scene
 
 from .closed_forms import axis_kind, principal_moments, rigid_spin_lambda2
 from .common import check_number
@@ -21,53 +22,6 @@ from .report import Quantity, StabilityReport, build_report
 from .spin_scene import attitude_subsystem, spin_linearization
 
 __all__ = ["hinged_spin", "hinged_scene", "ball_tilt_eigenvalues"]
-
-
-def hinged_scene(m1, inertia1, m2, inertia2, r1, r2, kind="revolute", axis=None) -> Scene:
-    """The two hinged bodies of `dynamics.hinged.hinged_bodies` as a scene, in minimal
-    coordinates: body 1 the six-degree-of-freedom hub, body 2 a `HingedPanel`.
-
-    Parameters
-    ----------
-    m1, m2 : float [kg]
-    inertia1, inertia2 : array_like, shape (3, 3) or (3,) [kg m^2]
-        About each mass centre, each body's axes (parallel at zero hinge angle).
-    r1, r2 : array_like, shape (3,) [m]
-        The hinge point from each mass centre (``hinged_bodies``' convention): the panel's
-        ``hinge_point`` is ``r1``, its ``cm_offset`` ``-r2``.
-    kind : {'revolute', 'ball'}, optional
-    axis : array_like, shape (3,), optional
-        The revolute hinge axis (body-1 axes; default ``[0, 0, 1]``).
-
-    Returns
-    -------
-    Scene
-        ``Scene(RigidHub(inertia1, mass=m1), HingedPanel(m2, inertia2, r1, -r2, axis=...),
-        name=f"hinged_{kind}")``; states ``q, w, r, v`` (body 1's mass centre) then
-        ``theta, theta_dot`` (revolute) or ``p1..p4, u1..u3`` (ball).
-
-    Raises
-    ------
-    ValueError
-        From `dynamics.scene.RigidHub` and `dynamics.scene.HingedPanel`, naming the
-        argument (their names: ``mass``, ``inertia``, ``hinge_point``...).
-
-    Examples
-    --------
-    >>> scene = hinged_scene(10.0, [2.0, 2.0, 3.0], 2.0, [0.2, 0.2, 0.3], [0, 0, 0.5],
-    ...                      [0, 0, -0.2])
-    >>> scene.model().states[7:]
-    ('r1', 'r2', 'r3', 'v1', 'v2', 'v3', 'theta', 'theta_dot')
-    """
-    if kind not in ("revolute", "ball"):
-        raise ValueError(f"`kind` must be 'revolute' or 'ball', got {kind!r}")
-    if kind == "ball" and axis is not None:
-        raise ValueError(f"`axis` applies to kind='revolute' only, got {axis!r}")
-    hinge_axis = None if kind == "ball" else ([0.0, 0.0, 1.0] if axis is None else axis)
-    cm = -np.asarray(r2, dtype=float)
-    return Scene(RigidHub(inertia1, mass=m1),
-                 HingedPanel(m2, inertia2, hinge_point=r1, cm_offset=cm, axis=hinge_axis),
-                 name=f"hinged_{kind}")
 
 
 _TWO_BODY = {"p1": "q1_rel", "p2": "q2_rel", "u1": "w1_2", "u2": "w2_2"}
