@@ -2,7 +2,7 @@
 the Jacobi-elliptic solution (`problems.torque_free`). ``appdyn simulate launch-vehicle``: the
 launch-vehicle autopilot's response to an attitude error and a wind gust
 (`problems.stability.launch_vehicle_response`). ``appdyn simulate hinged``: two rigid bodies
-joined by a ball or revolute hinge, as a scene in minimal coordinates (`dynamics.hinged_scene`)
+joined by a ball or revolute hinge, as a scene in minimal coordinates (`dynamics.hinged.hinged_scene`)
 or the multiplier model (`dynamics.hinged_bodies`), checked by the latter's invariants."""
 from __future__ import annotations
 
@@ -279,7 +279,7 @@ def _hinged_run(args, stabilized, progress=None, model_kind=None):
 
 
 def _scene_run(args, model, x0, t, options):
-    """The `dynamics.hinged_scene` run from the two-body state ``x0`` (identity attitudes),
+    """The `dynamics.hinged.hinged_scene` run from the two-body state ``x0`` (identity attitudes),
     as a `SimulationResult` in the two-body states with ``model``'s invariants."""
     from dataclasses import replace
 
