@@ -305,6 +305,17 @@ def _scene_run(args, model, x0, t, options):
     return replace(res, x=x, invariants=invariants, _dense=None)
 
 
+def _two_body_blocks() -> dict:
+    """The named state blocks of `dynamics.hinged_bodies` (``q1``, ``w1``, ``v1``,
+    ``position1``, then body 2's), as slices of its ``x``."""
+    from appdyn.dynamics.hinged import HINGED_STATES
+    from appdyn.problems.stability.common import block
+
+    ends = {"q": ("q1", "q4"), "w": ("w1", "w3"), "v": ("v1", "v3"), "position": ("x", "z")}
+    return {f"{k}{i}": block(HINGED_STATES, a + sfx, b + sfx)
+            for i, sfx in ((1, ""), (2, "_2")) for k, (a, b) in ends.items()}
+
+
 def _drift_history(res, name):
     """``|I(t) - I(0)| / |I(0)|`` (absolute where ``I(0) = 0``) along the run."""
     import numpy as np
@@ -344,15 +355,14 @@ def _hinged_summary(args, res, stabilized) -> dict:
                        "t_final": args.t_final, "points": args.points, "steps": args.steps,
                        "stabilization": stabilized, "tol": args.tol},
         "method": res.method, "wall_time": res.wall_time, "compiled": res.compiled,
-        "final": {"t": float(res.t[-1]), "q1": x[0:4], "w1": x[4:7], "v1": x[7:10],
-                  "position1": x[10:13], "q2": x[13:17], "w2": x[17:20], "v2": x[20:23],
-                  "position2": x[23:26]},
+        "final": {"t": float(res.t[-1]), **{k: x[sl] for k, sl in _two_body_blocks().items()}},
         "hinge_force_range": [float(force.min()), float(force.max())],
         "hinge_torque_range": [float(torque.min()), float(torque.max())],
         "drift": drift,
         "constraint_residual_max": {"position": float(residual[0].max()),
                                     "velocity": float(residual[1].max())},
-        "history": {"t": res.t, "w1": res.x[4:7], "w2": res.x[17:20],
+        "history": {"t": res.t, "w1": res.x[_two_body_blocks()["w1"]],
+                    "w2": res.x[_two_body_blocks()["w2"]],
                     "hinge_force": inv["hinge_force"], "hinge_torque": inv["hinge_torque"],
                     "constraint_residual": residual},
     }
@@ -403,9 +413,11 @@ def _hinged_figure(args, runs):
     fig = new_figure((11.0, 8.0))
     ax = fig.subplots(2, 2)
     t = main_run.t
+    rates = _two_body_blocks()
+    w1, w2 = main_run.x[rates["w1"]], main_run.x[rates["w2"]]
     for i, c in enumerate("rgb"):
-        ax[0, 0].plot(t, main_run.x[4 + i], c, label=f"w{i + 1} body 1")
-        ax[0, 0].plot(t, main_run.x[17 + i], c + "--", label=f"w{i + 1} body 2")
+        ax[0, 0].plot(t, w1[i], c, label=f"w{i + 1} body 1")
+        ax[0, 0].plot(t, w2[i], c + "--", label=f"w{i + 1} body 2")
     ax[0, 0].set(xlabel="t [s]", ylabel="rate [rad/s]", title="body rates")
     ax[0, 0].legend(fontsize=7, ncol=2)
     force = np.asarray(main_run.invariants["hinge_force"])
