@@ -45,8 +45,9 @@ Spin cases report the *reduced* motion: the spin phase about the axis (cyclic) a
 conserved spin-axis momentum (a first integral, whose steady spins form a one-parameter
 family with eigenvalue 0), and a scene's further first integrals (a free wheel's axial
 momentum), are factored out by `Linearization.quotient` and `Linearization.restrict`; the
-notes say which states went. The launch vehicle's translation
-(rigid-body drift, for guidance to correct) is factored out the same way.
+notes say which states went. A scene's six-degree-of-freedom hub is reduced to its attitude
+with the system mass centre at rest (`spin_scene.attitude_subsystem`). The launch vehicle's
+translation (rigid-body drift, for guidance to correct) is factored out the same way.
 
 Examples
 --------
