@@ -558,7 +558,8 @@ def two_body_state(scene) -> ca.Function:
 
     hub, parts = scene.hub, scene.parts
     if (not hub.translates or any(hub.reference) or len(parts) != 1
-            or not isinstance(parts[0], HingedPanel)):
+            or not isinstance(parts[0], HingedPanel)
+            or getattr(parts[0], "parent", None) is not None):
         raise ValueError("`scene` must be a hinged_scene: a hub with `mass` (reference at its "
                          f"mass centre) and one HingedPanel, got {scene!r}")
     panel, model = parts[0], scene.model()
