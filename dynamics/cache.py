@@ -30,6 +30,9 @@ API
     The lock to hold around casadi construction outside `get` (see Threads below).
 ``memoize``
     Decorator for factories of hashable arguments (e.g. ``rigid_body``'s model builder).
+``memoize_values``
+    Decorator for public builders of array-like arguments, keyed by their values (a repeated
+    ``rigid_body([1, 2, 3])`` skips its checks and scene).
 ``compiler()``
     Path of the C compiler (``gcc`` or ``cc`` on the ``PATH``), or ``None``.
 ``compile_function(f)``
@@ -112,7 +115,7 @@ import casadi as ca
 from .validate import integer
 
 __all__ = ["MAXSIZE", "JIT_MIN_WORK", "CacheInfo", "FunctionCache", "get", "contains", "clear",
-           "info", "set_maxsize", "function_key", "memoize", "checkout", "construction_lock", "POOL_SIZE", "compiler",
+           "info", "set_maxsize", "function_key", "memoize", "memoize_values", "value_key", "checkout", "construction_lock", "POOL_SIZE", "compiler",
            "should_compile", "compile_function"]
 
 #: Most entries kept (least recently used are dropped first).
@@ -364,6 +367,72 @@ def memoize(fun: Callable) -> Callable:
     @functools.wraps(fun)
     def cached(*args):
         return get((name,) + args, lambda: fun(*args))
+
+    return cached
+
+
+class _Unkeyable(Exception):
+    """An argument `value_key` cannot key by value (the call is not cached)."""
+
+
+def value_key(v) -> Hashable:
+    """A hashable key of one argument by value: a list, tuple or array of real numbers as
+    ``("array", shape, values)`` (so ``[1, 2]`` and ``np.array([1.0, 2.0])`` are one key),
+    a real number as ``("num", float)``, ``None``, a string, a boolean or a hashable
+    dataclass (a part) with its type name. Raises `_Unkeyable` for anything else (booleans
+    inside arrays, ragged lists, CasADi symbols, other objects): such calls are not cached."""
+    import dataclasses
+    import numbers
+
+    import numpy as np
+
+    if isinstance(v, (list, tuple, np.ndarray)):
+        try:
+            a = np.asarray(v)
+        except (TypeError, ValueError):
+            raise _Unkeyable from None
+        if a.dtype.kind not in "fi":
+            if isinstance(v, tuple) and a.dtype.kind == "O":
+                return ("tuple",) + tuple(value_key(e) for e in v)
+            raise _Unkeyable
+        return ("array", a.shape, tuple(a.astype(float).ravel().tolist()))
+    if isinstance(v, numbers.Real) and not isinstance(v, (bool, np.bool_)):
+        return ("num", float(v))
+    if not (v is None or isinstance(v, (str, bool, np.bool_))
+            or dataclasses.is_dataclass(v) and not isinstance(v, type)):
+        raise _Unkeyable
+    try:
+        hash(v)
+    except TypeError:
+        raise _Unkeyable from None
+    return (type(v).__name__, v)
+
+
+def memoize_values(fun: Callable) -> Callable:
+    """Decorator: cache ``fun(*args, **kwargs)`` in the one cache, keyed by the arguments'
+    values (`value_key`), before ``fun`` checks them.
+
+    For public builders that check array-like arguments and build a scene whose model is
+    cached (``rigid_body``): a repeated call returns the cached model without the checks
+    (a bad argument is never cached: its call raises on every miss). Calls whose arguments
+    cannot be keyed are not cached.
+
+    Examples
+    --------
+    >>> from appdyn.dynamics import rigid_body
+    >>> rigid_body([1.0, 2.0, 3.0]) is rigid_body((1, 2, 3))
+    True
+    """
+    name = f"{fun.__module__}.{fun.__qualname__}"
+
+    @functools.wraps(fun)
+    def cached(*args, **kwargs):
+        try:
+            key = (name, tuple(value_key(a) for a in args),
+                   tuple(sorted((k, value_key(v)) for k, v in kwargs.items())))
+        except _Unkeyable:
+            return fun(*args, **kwargs)
+        return get(key, lambda: fun(*args, **kwargs))
 
     return cached
 
