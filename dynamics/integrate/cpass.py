@@ -290,27 +290,28 @@ int rk8_adaptive(casadi_real* x, casadi_real* hio, int nint, const casadi_real* 
 def pass_library(model: Model) -> object | None:
     """The compiled pass of ``model`` (a ``ctypes`` function, cached); None without a C
     compiler or when the model cannot be code-generated (the pass is worth it only as C)."""
-    def build():
+    def make():
         step = kernel(model, "rk8", "linear", error=True)
         rhs = _renamed(model.f, "pass_rhs")
         sizes = dict(every=CHECK_EVERY, nx=model.nx, nu=model.nu, nw=max(step.sz_w(), rhs.sz_w()), niw=max(step.sz_iw(), rhs.sz_iw()),
                      narg=max(step.sz_arg(), rhs.sz_arg()), nres=max(step.sz_res(), rhs.sz_res()))  # (the plain step needs less)
         steps = [_renamed(step, "rk8_step_err"), _renamed(kernel(model, "rk8", "linear"),
                                                            "rk8_step"), rhs]
+        return steps, _DRIVER % sizes + _STEPPER
+
+    def job(opt):
+        return cache.Job(make, opt, ctypes.CDLL, cache.recipe("rk8_pass", model.f, opt))
+
+    def build():
         # auto's multi-run search (the fallback) runs the rk8 chunk loop: compiled now, at
         # the same time (a later call with this model then compiles nothing)
         chunk = chunk_compile_job(model, "rk8", "linear")
-        source = _DRIVER % sizes + _STEPPER
-        jobs = [(steps, source, _OPTS[0], ctypes.CDLL)] + ([chunk[0]] if chunk else [])
-        lib, *rest = cache.compile_parallel(jobs)
+        lib, *rest = cache.compile_parallel([job(_OPTS[0])] + ([chunk[0]] if chunk else []))
         if chunk:
             chunk[1](rest[0])
         if isinstance(lib, RuntimeError):  # (e.g. a compiler without -march=native)
-            try:
-                lib = cache.compile_c(steps, source, _OPTS[1], ctypes.CDLL)
-            except RuntimeError:
-                return None
-        if lib is None:
+            lib = cache.compile_parallel([job(_OPTS[1])])[0]
+        if lib is None or isinstance(lib, RuntimeError):
             return None
         fun = lib.rk8_pass_ws
         ptr, i32 = ctypes.c_void_p, ctypes.c_int

@@ -56,11 +56,11 @@ def chunk_function(model: Model, method: str, mode: str, jit: bool, size: int = 
                          keepalive=model.f)
 
     def build_compiled():
-        loop = _build_chunk(model, method, mode, size)
-        try:
-            return cache.compile_function(loop, _OPT), True
-        except RuntimeError:  # e.g. a right-hand side that cannot be code-generated
-            return loop, False
+        job, built = _chunk_job(model, method, mode, size)
+        result = cache.compile_parallel([job])[0]
+        if result is None or isinstance(result, RuntimeError):  # e.g. a right-hand side
+            return built() or _build_chunk(model, method, mode, size), False  # not generated
+        return result, True
 
     return cache.get(base_key + (True,), build_compiled, keepalive=model.f)
 
@@ -73,14 +73,34 @@ def chunk_compile_job(model: Model, method: str, mode: str):
     key = chunk_key(model, method, mode) + (True,)
     if cache.compiler() is None or cache.contains(key):
         return None
-    loop = _build_chunk(model, method, mode)
+    job, built = _chunk_job(model, method, mode, CHUNK)
 
     def store(result):
-        value = (loop, False) if isinstance(result, RuntimeError) else (result, True)
+        value = ((built() or _build_chunk(model, method, mode), False)
+                 if result is None or isinstance(result, RuntimeError) else (result, True))
         return cache.get(key, lambda: value, keepalive=model.f)
 
-    name = loop.name()
-    return ([loop], "", _OPT, lambda library: ca.external(name, library)), store
+    return job, store
+
+
+def _chunk_job(model: Model, method: str, mode: str, size: int):
+    """The `cache.Job` compiling the chunk Function (built only when the persistent cache
+    does not have it) and ``built()``: the Function when it was built, else None."""
+    made = []
+
+    def make():
+        made.append(_build_chunk(model, method, mode, size))
+        return [made[0]], ""
+
+    name = _chunk_name(method, size)
+    att = model.attitude if method == "lie" else None
+    job = cache.Job(make, _OPT, lambda library: ca.external(name, library),
+                    cache.recipe("chunk", model.f, att, method, mode, size, _BLOCK, _BASE))
+    return job, lambda: made[0] if made else None
+
+
+def _chunk_name(method: str, size: int) -> str:
+    return f"simulate_{method}" + ("" if size == CHUNK else f"_{size}")
 
 
 def chunk_key(model: Model, method: str, mode: str) -> tuple:
@@ -125,7 +145,7 @@ def _build_chunk(model, method, mode, size: int = CHUNK) -> ca.Function:
     step_on = ca.DM(np.arange(size, dtype=float)).T < n
     block_on = ca.DM(np.arange(0, size, _BLOCK, dtype=float)).T < n
     out = loop.call([x0, block_on, step_on] + ins[2:-1] + [ca.repmat(ins[-1], 1, size)])
-    return ca.Function(f"simulate_{method}" + ("" if size == CHUNK else f"_{size}"), ins, [out[1]])
+    return ca.Function(_chunk_name(method, size), ins, [out[1]])
 
 
 def _gated(step: ca.Function, args: list, name: str) -> ca.Function:
