@@ -11,7 +11,7 @@ import casadi as ca
 
 from .. import cache
 from ..model import Model
-from .kernels import kernel
+from .kernels import calls_rhs, kernel
 from .loops import chunk_compile_job
 
 __all__ = ["BMAX", "CHECK_EVERY", "NOISE", "pass_library"]
@@ -291,12 +291,13 @@ def pass_library(model: Model) -> object | None:
     """The compiled pass of ``model`` (a ``ctypes`` function, cached); None without a C
     compiler or when the model cannot be code-generated (the pass is worth it only as C)."""
     def make():
-        step = kernel(model, "rk8", "linear", error=True)
-        rhs = _renamed(model.f, "pass_rhs")
+        step = kernel(model, "rk8", "linear", error=True, compiled=True)
+        # (a step that calls the rhs shares its C function with pass_rhs: one copy of it)
+        rhs = _renamed(model.f, "pass_rhs", ca.MX if calls_rhs(model, "rk8") else None)
         sizes = dict(every=CHECK_EVERY, nx=model.nx, nu=model.nu, nw=max(step.sz_w(), rhs.sz_w()), niw=max(step.sz_iw(), rhs.sz_iw()),
                      narg=max(step.sz_arg(), rhs.sz_arg()), nres=max(step.sz_res(), rhs.sz_res()))  # (the plain step needs less)
-        steps = [_renamed(step, "rk8_step_err"), _renamed(kernel(model, "rk8", "linear"),
-                                                           "rk8_step"), rhs]
+        steps = [_renamed(step, "rk8_step_err"),
+                 _renamed(kernel(model, "rk8", "linear", compiled=True), "rk8_step"), rhs]
         return steps, _DRIVER % sizes + _STEPPER
 
     def job(opt):
@@ -329,10 +330,11 @@ def pass_library(model: Model) -> object | None:
     return cache.get(("rk8_pass", cache.function_key(model.f)), build, keepalive=model.f)
 
 
-def _renamed(fun: ca.Function, name: str) -> ca.Function:
-    """``fun`` under ``name`` (the generated C function's name)."""
+def _renamed(fun: ca.Function, name: str, sym=None) -> ca.Function:
+    """``fun`` under ``name`` (the generated C function's name); ``sym=casadi.MX``: a
+    wrapper calling ``fun`` (not a copy of its expressions)."""
     if fun.name() == name:
         return fun
-    ins = [fun.sx_in(i) for i in range(fun.n_in())] if fun.is_a("SXFunction") else \
-        [fun.mx_in(i) for i in range(fun.n_in())]
+    ins = [fun.sx_in(i) for i in range(fun.n_in())] if fun.is_a("SXFunction") and sym is None \
+        else [fun.mx_in(i) for i in range(fun.n_in())]
     return ca.Function(name, ins, fun.call(ins))

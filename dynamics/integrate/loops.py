@@ -56,10 +56,9 @@ def chunk_function(model: Model, method: str, mode: str, jit: bool, size: int = 
                          keepalive=model.f)
 
     def build_compiled():
-        job, built = _chunk_job(model, method, mode, size)
-        result = cache.compile_parallel([job])[0]
+        result = cache.compile_parallel([_chunk_job(model, method, mode, size)])[0]
         if result is None or isinstance(result, RuntimeError):  # e.g. a right-hand side
-            return built() or _build_chunk(model, method, mode, size), False  # not generated
+            return _build_chunk(model, method, mode, size), False  # that is not generated
         return result, True
 
     return cache.get(base_key + (True,), build_compiled, keepalive=model.f)
@@ -73,30 +72,23 @@ def chunk_compile_job(model: Model, method: str, mode: str):
     key = chunk_key(model, method, mode) + (True,)
     if cache.compiler() is None or cache.contains(key):
         return None
-    job, built = _chunk_job(model, method, mode, CHUNK)
 
     def store(result):
-        value = ((built() or _build_chunk(model, method, mode), False)
+        value = ((_build_chunk(model, method, mode), False)
                  if result is None or isinstance(result, RuntimeError) else (result, True))
         return cache.get(key, lambda: value, keepalive=model.f)
 
-    return job, store
+    return _chunk_job(model, method, mode, CHUNK), store
 
 
-def _chunk_job(model: Model, method: str, mode: str, size: int):
+def _chunk_job(model: Model, method: str, mode: str, size: int) -> cache.Job:
     """The `cache.Job` compiling the chunk Function (built only when the persistent cache
-    does not have it) and ``built()``: the Function when it was built, else None."""
-    made = []
-
-    def make():
-        made.append(_build_chunk(model, method, mode, size))
-        return [made[0]], ""
-
+    does not have it)."""
     name = _chunk_name(method, size)
     att = model.attitude if method == "lie" else None
-    job = cache.Job(make, _OPT, lambda library: ca.external(name, library),
-                    cache.recipe("chunk", model.f, att, method, mode, size, _BLOCK, _BASE))
-    return job, lambda: made[0] if made else None
+    return cache.Job(lambda: ([_build_chunk(model, method, mode, size, compiled=True)], ""),
+                     _OPT, lambda library: ca.external(name, library),
+                     cache.recipe("chunk", model.f, att, method, mode, size, _BLOCK, _BASE))
 
 
 def _chunk_name(method: str, size: int) -> str:
@@ -117,12 +109,13 @@ _OPT = "-O1"
 _BLOCK = 16  # steps per block of a chunk: a chunk is `CHUNK // _BLOCK` blocks
 
 
-def _build_chunk(model, method, mode, size: int = CHUNK) -> ca.Function:
+def _build_chunk(model, method, mode, size: int = CHUNK, compiled: bool = False) -> ca.Function:
     """``mapaccum`` of ``size`` (default `CHUNK`) steps that takes only the first ``n``: the chunk is a
     ``mapaccum`` of blocks of `_BLOCK` steps, each block and each step inside a block a
     ``Function.conditional`` that skips (copies the state) past step ``n``. A short run
-    then costs its own steps plus about 25 us, not the 512 steps of a full chunk."""
-    step = kernel(model, method, mode)
+    then costs its own steps plus about 25 us, not the 512 steps of a full chunk.
+    ``compiled``: built to generate C from (`kernels.kernel`)."""
+    step = kernel(model, method, mode, compiled=compiled)
     args = [ca.MX.sym(step.name_in(i), step.sparsity_in(i)) for i in range(step.n_in())]
     gated = _gated(step, args, "step")
     inner = gated.mapaccum("steps", _BLOCK, {"base": _BASE})
