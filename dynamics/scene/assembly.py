@@ -209,6 +209,7 @@ def assemble(scene) -> Model:
     n_hub = 6 if hub.translates else 3
     offset = n_hub
     owns = {}
+    frozen = set()
     for part, pname in zip(scene.parts, scene.part_names):
         local = named["local"][pname]
         own = PartSymbols(_column([sym[local[k]] for k in local["__coords__"]]),
@@ -216,6 +217,7 @@ def assemble(scene) -> Model:
                           _column([sym[local[k]] for k in local["__controls__"]]),
                           {k: sym[vname] for k, vname in local.items() if not k.startswith("__")})
         owns[pname] = own
+        frozen.update(local[v.name] for v in part.variables().coords if v.frozen)
         c = part.contribute(frame, own)
         if own.coords.numel():
             rates = ca.SX(c.rates) if c.rates is not None else own.speeds
@@ -252,7 +254,8 @@ def assemble(scene) -> Model:
     speeds = ca.vertcat(*speed_syms)
     coords = ca.vertcat(*coord_syms)
     cdot = ca.vertcat(*coord_rates)
-    M, F = kane_equations(all_bodies, loads, w, speeds, coords, cdot)
+    moving = [k for k in range(coords.numel()) if coords[k].name() not in frozen]
+    M, F = kane_equations(all_bodies, loads, w, speeds, coords[moving], cdot[moving])
     nud = solve_blocks(M, F, n_hub, part_speed_slices)
 
     # x' in state order

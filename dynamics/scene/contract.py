@@ -88,6 +88,10 @@ class Variable:
         Lower and upper bound (controls: from ``u_max``; states: a speed limit).
     terminal : {'rest', 'free'}, optional
         Whether a rest-to-rest slew holds it at ``rest`` at the end.
+    frozen : bool, optional
+        A coordinate the inertia forces hold frozen: a mass that flows out of the vehicle
+        (seed Sec. 3.4, control-volume law ``m v' = F``, no ``m' v`` term). Kane's equations
+        then leave out the momenta's derivative along its rate.
     """
 
     name: str
@@ -95,6 +99,7 @@ class Variable:
     rest: float = 0.0
     bounds: tuple = (-math.inf, math.inf)
     terminal: Literal["rest", "free"] = "rest"
+    frozen: bool = False
 
 
 @dataclass(frozen=True)
