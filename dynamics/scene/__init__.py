@@ -21,6 +21,10 @@ Parts
 `TiltTorque`           a torque from the tilt of a hub axis (heavy top, projectile, bearings)
 `HingedPanel`          a rigid panel on a revolute (``theta``) or ball (``p1..p4``) hinge
 `GravityGradient`      gravity on every body: forces and gravity-gradient torques
+`Engine`               gimbaled thrust (controls ``dp, dy`` or an actuator), mass flow
+                       (state ``m_p``), internal-flow Coriolis force and jet damping
+`Aerodynamics`         normal and axial air force at a centre of pressure (6-DoF hub; wind
+                       controls ``wind1..wind3`` optional)
 =====================  =====================================================================
 
 Examples
@@ -30,9 +34,11 @@ Examples
 >>> model.nx, model.controls
 (7, ('L1', 'L2', 'L3'))
 """
+from .aero import Aerodynamics
 from .assembly import PartLayout
 from .cmgs import CMGCluster
 from .contract import Body, Contribution, Frame, Load, Part, PartVariables, Variable
+from .engine import Engine
 from .dampers import PointMassDamper, Slosh, SphericalDamper
 from .fields import TiltTorque
 from .gravity import GravityGradient
@@ -45,4 +51,4 @@ from .wheels import HeldRotor, ReactionWheels
 __all__ = ["Scene", "check_scene", "RigidHub", "Part", "PartLayout", "Variable", "PartVariables", "Body", "Load",
            "Contribution", "Frame", "ReactionWheels", "HeldRotor", "ExternalTorque",
            "ExternalForce", "PointMassDamper", "SphericalDamper", "Slosh", "TiltTorque",
-           "HingedPanel", "GravityGradient", "CMGCluster"]
+           "HingedPanel", "GravityGradient", "CMGCluster", "Aerodynamics", "Engine"]
