@@ -16,7 +16,9 @@ analytic function of ``|v_c|`` (``atan(t)/t``, ``t = |v_c| / v_ax``, by its seri
 axis), so the force and its derivatives are exact at zero crossflow, where the linearizations
 of straight flight are taken. In the yaw plane (``v_az = 0``, ``v_ax > 0``) the normal force is
 ``qbar S C_N_alpha atan2(-v_ay, v_ax)`` along ``+y``: the launch vehicle's ``alpha`` and
-``f_A``. The density is constant or an exponential atmosphere ``rho0 exp(-h / H)`` in the
+``f_A``, except that the launch vehicle takes the air velocity of the mass centre:
+``air_velocity="mass_centre"`` does the same here (no aerodynamic damping from the turning
+rate), and the yaw-plane restriction then equals that model. The density is constant or an exponential atmosphere ``rho0 exp(-h / H)`` in the
 altitude ``h = up . r`` of the hub's reference point.
 """
 from __future__ import annotations
@@ -107,6 +109,10 @@ class Aerodynamics(Part):
         The inertial direction of the altitude ``h = up . r`` (default ``(0, 0, 1)``).
     wind : {'zero', 'control'}, optional
         The inertial wind: none, or the controls ``wind1..wind3`` [m/s] (inertial axes).
+    air_velocity : {'centre_of_pressure', 'mass_centre'}, optional
+        Whose velocity sets the angle of attack: the centre of pressure's (default: with the
+        aerodynamic damping of the turning rate) or the hub's mass centre's (the launch
+        vehicle's quasi-steady model).
     parent : str, optional
         The scene name of the part it sits on (None: the hub).
     name : str, optional
@@ -143,6 +149,7 @@ class Aerodynamics(Part):
     scale_height: float | None = None
     up: tuple = (0.0, 0.0, 1.0)
     wind: str = "zero"
+    air_velocity: str = "centre_of_pressure"
     parent: str | None = None
     name: str | None = None
     kind = "aero"
@@ -161,6 +168,8 @@ class Aerodynamics(Part):
                                                    positive=True))
         setf(self, "up", tuple(unit_vector(self.up, "up").tolist()))
         setf(self, "wind", one_of(self.wind, "wind", ("zero", "control")))
+        setf(self, "air_velocity", one_of(self.air_velocity, "air_velocity",
+                                          ("centre_of_pressure", "mass_centre")))
 
     def variables(self) -> PartVariables:
         if self.wind == "zero":
@@ -186,6 +195,9 @@ class Aerodynamics(Part):
         require_translating_hub(frame, "Aerodynamics")
         rho_cp = frame.point(self.centre_of_pressure)
         v_cp = frame.velocity(rho_cp)
-        v_air = v_cp if self.wind == "zero" else v_cp - ca.mtimes(frame.dcm, own.controls)
+        v_air = v_cp if self.air_velocity == "centre_of_pressure" else frame.velocity(
+            frame.point((0.0, 0.0, 0.0)))
+        if self.wind == "control":
+            v_air = v_air - ca.mtimes(frame.dcm, own.controls)
         return Contribution(loads=[Load(self.force(v_air, self.air_density(frame)), v_cp)])
 

@@ -344,23 +344,27 @@ def test_yaw_plane_restriction_equals_the_launch_vehicle_with_mass_flow(actuator
             assert xdot[-3] == 0.0  # pitch deflection at rest with a zero command
 
 
-def test_yaw_plane_restriction_equals_the_launch_vehicle_with_aero():
+@pytest.mark.parametrize("air_velocity", ["mass_centre", "centre_of_pressure"])
+def test_yaw_plane_restriction_equals_the_launch_vehicle_with_aero(air_velocity):
     """Aero of the planar model: alpha of the mass centre's air velocity at a fixed dynamic
-    pressure, so the planar states here do not turn (psi' = 0: the 3-D part also sees the
-    centre of pressure's rotational velocity) and the density gives that dynamic pressure."""
+    pressure (the density here gives it at each state). With the centre of pressure's air
+    velocity (the 3-D default) the states do not turn (psi' = 0): it adds the rotational
+    crossflow psi' l_cp, which the planar model leaves out."""
     F, I, l, m = 2.0e6, 4.0e7, 20.0, 1.0e5
     qbar, S, cna, lcp = 3.0e4, 10.0, 3.0, 5.0
     planar = launch_vehicle(thrust=F, inertia=I, arm=l, mass=m,
-                               aero=Aero(qbar, S, cna, lcp, wind="control"))
+                            aero=Aero(qbar, S, cna, lcp, wind="control"))
     rng = np.random.default_rng(9)
     for _ in range(10):
         s = _planar_state(rng)
-        s[5] = 0.0
+        if air_velocity == "centre_of_pressure":
+            s[5] = 0.0
         wind = rng.normal(scale=20.0, size=2)
         v_air = s[3:5] - wind
         scene = Scene(RigidHub([1.0e6, I, I], mass=m), Engine(F, (-l, 0.0, 0.0), gimbal=0.2),
                       Aerodynamics(S, cna, centre_of_pressure=(lcp, 0.0, 0.0),
-                                   density=2 * qbar / float(v_air @ v_air), wind="control"))
+                                   density=2 * qbar / float(v_air @ v_air), wind="control",
+                                   air_velocity=air_velocity))
         delta = rng.uniform(-0.1, 0.1)
         rates, _ = _planar_rates(scene.model(), _scene_state(scene, s),
                                  [0.0, delta, wind[0], wind[1], 0.0])
