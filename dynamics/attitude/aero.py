@@ -42,7 +42,7 @@ import math
 import numpy as np
 
 from .. import validate
-from .backend import checked, finite_any, ops_for
+from .backend import checked, finite_vector, ops_for
 
 __all__ = ["aero_angles", "total_aoa", "aero_angles_from_total", "total_aoa_from_aero_angles",
            "velocity_direction", "velocity_direction_total"]
@@ -198,8 +198,8 @@ def velocity_direction(alpha, beta):
     >>> np.round(velocity_direction(np.pi / 2, 0.0), 12) + 0.0
     array([0., 0., 1.])
     """
-    a = checked(alpha, "alpha", (), finite_any)
-    b = checked(beta, "beta", (), finite_any)
+    a = checked(alpha, "alpha", (), finite_vector)
+    b = checked(beta, "beta", (), finite_vector)
     o = ops_for(a, b)
     cb = o.cos(b)
     return o.stack([o.cos(a) * cb, o.sin(b) + 0 * a, o.sin(a) * cb])
@@ -232,8 +232,8 @@ def velocity_direction_total(alpha_T, phi_R):
     >>> np.round(velocity_direction_total(np.pi / 2, np.pi / 2), 12) + 0.0
     array([0., 1., 0.])
     """
-    a = checked(alpha_T, "alpha_T", (), finite_any)
-    p = checked(phi_R, "phi_R", (), finite_any)
+    a = checked(alpha_T, "alpha_T", (), finite_vector)
+    p = checked(phi_R, "phi_R", (), finite_vector)
     o = ops_for(a, p)
     sa = o.sin(a)
     return o.stack([o.cos(a) + 0 * p, sa * o.sin(p), sa * o.cos(p)])

@@ -27,6 +27,9 @@ Parts
                        controls ``wind1..wind3`` optional)
 =====================  =====================================================================
 
+`launch_vehicle_scene` builds the launch vehicle of `dynamics.launch_vehicle` from these (six
+degrees of freedom; its yaw plane is the planar model).
+
 Examples
 --------
 >>> from appdyn.dynamics.scene import ExternalTorque, RigidHub, Scene
@@ -45,10 +48,11 @@ from .gravity import GravityGradient
 from .hubs import RigidHub
 from .loads import ExternalForce, ExternalTorque
 from .panels import HingedPanel
+from .rocket import launch_vehicle_scene
 from .scene import Scene, check_scene
 from .wheels import HeldRotor, ReactionWheels
 
 __all__ = ["Scene", "check_scene", "RigidHub", "Part", "PartLayout", "Variable", "PartVariables", "Body", "Load",
            "Contribution", "Frame", "ReactionWheels", "HeldRotor", "ExternalTorque",
            "ExternalForce", "PointMassDamper", "SphericalDamper", "Slosh", "TiltTorque",
-           "HingedPanel", "GravityGradient", "CMGCluster", "Aerodynamics", "Engine"]
+           "HingedPanel", "GravityGradient", "CMGCluster", "Aerodynamics", "Engine", "launch_vehicle_scene"]

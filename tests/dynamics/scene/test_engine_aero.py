@@ -369,3 +369,30 @@ def test_yaw_plane_restriction_equals_the_launch_vehicle_with_aero(air_velocity)
         rates, _ = _planar_rates(scene.model(), _scene_state(scene, s),
                                  [0.0, delta, wind[0], wind[1], 0.0])
         _rel(rates, planar.rhs(s, [delta, *wind]))
+
+
+def test_launch_vehicle_scene_yaw_plane_equals_the_planar_model():
+    """The builder: thrust, aero (wind controls), mass flow and actuator together, random
+    planar states at the reference mass (the dynamic pressure at the flight speed)."""
+    from appdyn.dynamics.scene import launch_vehicle_scene
+    F, I, l, m, V = 2.0e6, 4.0e7, 20.0, 1.0e5, 400.0
+    parts = dict(aero=Aero(3.0e4, 10.0, 3.0, 5.0, wind="control"),
+                 mass_flow=MassFlow(rate=700.0, flow_start=-5.0, nozzle_exit=22.0),
+                 actuator=Actuator(0.05, rate_limit=0.3))
+    planar = launch_vehicle(thrust=F, inertia=I, arm=l, mass=m, **parts)
+    scene = launch_vehicle_scene(thrust=F, inertia=I, arm=l, mass=m, velocity=V, **parts)
+    model = scene.model()
+    assert model.controls == ("dp_c", "dy_c", "wind1", "wind2", "wind3")
+    mp = scene.state()[-1]
+    rng = np.random.default_rng(10)
+    for _ in range(10):
+        s = _planar_state(rng)
+        wind = rng.normal(size=2)
+        gamma = 0.05 * rng.normal()  # air speed V: the planar dynamic pressure
+        s[3:5] = wind + V * np.array([np.cos(gamma), np.sin(gamma)])
+        delta, cmd = rng.uniform(-0.1, 0.1, size=2)
+        rates, xdot = _planar_rates(model, _scene_state(scene, s, [0.0, delta, mp]),
+                                    [0.0, cmd, wind[0], wind[1], 0.0])
+        ref = planar.rhs(np.concatenate([s, [m, delta]]), [cmd, *wind])
+        _rel(rates, ref[:6])
+        _rel(xdot[-2:][::-1], ref[6:8])

@@ -1,0 +1,108 @@
+"""The thrust-vectored launch vehicle as a six-degree-of-freedom scene: `launch_vehicle_scene`.
+
+The yaw-plane model of `dynamics.launch_vehicle` takes its parts (`Aero`, `MassFlow`,
+`Actuator`) as plain numbers; here the same numbers build a `Scene`: a `RigidHub` with the
+vehicle's mass and inertia (axisymmetric: ``inertia`` in pitch and yaw, ``roll_inertia`` about
+the axis ``x``), an `Engine` at ``(-arm, 0, 0)`` gimbaled in pitch and yaw, and
+`Aerodynamics` at ``(cp_arm, 0, 0)``. The propellant sits at the mass centre, so the inertia
+is the given one at the reference mass, as in the planar model. Restricted to the yaw plane
+(``psi`` about ``z``, ``dp = 0``) the scene's right-hand side is the planar one: ``x' = r1'``,
+``x'' = (A^T (v' + w x v))_1``, ``psi'' = w3'``, ``delta = dy``
+(`tests/dynamics/scene/test_engine_aero.py`).
+
+The planar aero holds the dynamic pressure fixed; the scene computes it from the air speed,
+so the density is chosen to give ``dynamic_pressure`` at ``velocity`` (the flight speed the
+stability cases linearize at). Slosh and bending of the planar model are not mapped yet.
+"""
+from __future__ import annotations
+
+from ..launch_vehicle.parts import Aero, MassFlow
+from ..validate import positive
+from .aero import Aerodynamics
+from .engine import Engine
+from .hubs import RigidHub
+from .scene import Scene
+
+__all__ = ["launch_vehicle_scene"]
+
+
+def launch_vehicle_scene(*, thrust, inertia, arm, mass, roll_inertia=None, aero=None,
+                         velocity=None, mass_flow=None, actuator=None, gimbal=0.2) -> Scene:
+    """The launch vehicle of `dynamics.launch_vehicle` in six degrees of freedom.
+
+    Parameters
+    ----------
+    thrust : float [N]
+    inertia : float [kg m^2]
+        Pitch and yaw inertia about the mass centre (at ``mass``).
+    arm : float [m]
+        Mass centre to the gimbal (aft).
+    mass : float [kg]
+        Vehicle mass, propellant included.
+    roll_inertia : float [kg m^2], optional
+        About the axis (default ``inertia / 40``).
+    aero : dynamics.launch_vehicle.Aero, optional
+        Its ``dynamic_pressure`` is reached at ``velocity``; its ``wind`` mode ``'control'``
+        gives the controls ``wind1..wind3``.
+    velocity : float [m/s], optional
+        Flight speed of ``aero`` (needed with it).
+    mass_flow : dynamics.launch_vehicle.MassFlow, optional
+        Rate, ``flow_start``, ``nozzle_exit``; the propellant ``mass_flow.rate *
+        burn_time`` (or half the mass) is the state ``m_p`` at the mass centre.
+    actuator : dynamics.launch_vehicle.Actuator, optional
+    gimbal : float [rad], optional
+        Deflection bound of the controls (or commands).
+
+    Returns
+    -------
+    Scene
+        Parts ``engine`` and, with ``aero``, ``aero`` (air velocity of the mass centre, as
+        the planar model).
+
+    Raises
+    ------
+    ValueError
+        Naming the argument (non-positive numbers, ``velocity`` missing with ``aero``).
+    TypeError
+        If a part is not of its class.
+
+    Examples
+    --------
+    >>> from appdyn.dynamics.launch_vehicle import Aero
+    >>> from appdyn.dynamics.scene import launch_vehicle_scene
+    >>> scene = launch_vehicle_scene(thrust=2.0e6, inertia=4.0e7, arm=20.0, mass=1.0e5,
+    ...                              aero=Aero(3.0e4, 10.0, 3.0, 5.0), velocity=400.0)
+    >>> scene.part_names, scene.model().controls
+    (('engine', 'aero'), ('dp', 'dy'))
+    """
+    F, I, l, m = (positive(v, n) for v, n in ((thrust, "thrust"), (inertia, "inertia"),
+                                              (arm, "arm"), (mass, "mass")))
+    I_roll = I / 40.0 if roll_inertia is None else positive(roll_inertia, "roll_inertia")
+    for part, cls, label in ((aero, Aero, "aero"), (mass_flow, MassFlow, "mass_flow")):
+        if part is not None and not isinstance(part, cls):
+            raise TypeError(f"`{label}` must be a dynamics.launch_vehicle.{cls.__name__}, "
+                            f"got {type(part).__name__}")
+    engine = dict(gimbal=gimbal, actuator=actuator)
+    m_hub = m
+    if mass_flow is not None:
+        burn = mass_flow.burn_time
+        mp = mass_flow.rate * burn if burn is not None else 0.5 * m
+        m_hub = m - mp
+        engine.update(mass_flow=mass_flow.rate, propellant=mp,
+                      flow_start=(-mass_flow.flow_start, 0.0, 0.0),
+                      nozzle_exit=None if mass_flow.nozzle_exit is None else (
+                          -mass_flow.nozzle_exit, 0.0, 0.0))
+    parts = [Engine(F, (-l, 0.0, 0.0), **engine)]
+    if aero is not None:
+        if velocity is None:
+            raise ValueError("`velocity` is needed with `aero` (its dynamic pressure is "
+                             "reached at that flight speed)")
+        V = positive(velocity, "velocity")
+        parts.append(Aerodynamics(aero.area, aero.normal_force_slope,
+                                  centre_of_pressure=(aero.cp_arm, 0.0, 0.0),
+                                  density=2.0 * aero.dynamic_pressure / V ** 2,
+                                  wind="control" if aero.wind == "control" else "zero",
+                                  air_velocity="mass_centre"))
+    elif velocity is not None:
+        raise ValueError("`velocity` is the flight speed of `aero`; give it only with `aero`")
+    return Scene(RigidHub([I_roll, I, I], mass=m_hub), *parts, name="launch_vehicle")
