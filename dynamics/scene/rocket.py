@@ -12,13 +12,27 @@ is the given one at the reference mass, as in the planar model. Restricted to th
 
 The planar aero holds the dynamic pressure fixed; the scene computes it from the air speed,
 so the density is chosen to give ``dynamic_pressure`` at ``velocity`` (the flight speed the
-stability cases linearize at). Slosh and bending of the planar model are not mapped yet.
+stability cases linearize at).
+
+Slosh (a pendulum): the planar model measures its stations from ``O``, the mass centre with
+the propellant at rest; the hub here is the rigid part (mass ``m - m_s`` at
+``rho_r = -(m_s / m_r) rho0`` from ``O``, inertia ``I_r`` of
+`dynamics.launch_vehicle.vehicle.rigid_part`), its reference point is ``O``, and the
+pendulum (`dynamics.scene.Slosh`, hanging aft, ``theta1 = -theta_s`` in the yaw plane)
+swings in pitch and yaw; its hinge damping is the planar one at the reference mass,
+``c = 2 zeta m_s L^2 sqrt(F / (m L))``. The planar spring-mass has no two-axis scene part
+yet, nor the bending mode. With slosh the aerodynamic angle of attack is that of the rigid
+part's mass centre (the planar model's is of the whole vehicle's).
 """
 from __future__ import annotations
 
+import math
+
 from ..launch_vehicle.parts import Aero, MassFlow
+from ..launch_vehicle.parts import Slosh as PlanarSlosh
 from ..validate import positive
 from .aero import Aerodynamics
+from .dampers import Slosh
 from .engine import Engine
 from .hubs import RigidHub
 from .scene import Scene
@@ -27,7 +41,8 @@ __all__ = ["launch_vehicle_scene"]
 
 
 def launch_vehicle_scene(*, thrust, inertia, arm, mass, roll_inertia=None, aero=None,
-                         velocity=None, mass_flow=None, actuator=None, gimbal=0.2) -> Scene:
+                         velocity=None, mass_flow=None, slosh=None, actuator=None,
+                         gimbal=0.2) -> Scene:
     """The launch vehicle of `dynamics.launch_vehicle` in six degrees of freedom.
 
     Parameters
@@ -49,6 +64,8 @@ def launch_vehicle_scene(*, thrust, inertia, arm, mass, roll_inertia=None, aero=
     mass_flow : dynamics.launch_vehicle.MassFlow, optional
         Rate, ``flow_start``, ``nozzle_exit``; the propellant ``mass_flow.rate *
         burn_time`` (or half the mass) is the state ``m_p`` at the mass centre.
+    slosh : dynamics.launch_vehicle.Slosh, optional
+        A pendulum (module docstring); its ``mass`` is part of ``mass``.
     actuator : dynamics.launch_vehicle.Actuator, optional
     gimbal : float [rad], optional
         Deflection bound of the controls (or commands).
@@ -56,13 +73,14 @@ def launch_vehicle_scene(*, thrust, inertia, arm, mass, roll_inertia=None, aero=
     Returns
     -------
     Scene
-        Parts ``engine`` and, with ``aero``, ``aero`` (air velocity of the mass centre, as
-        the planar model).
+        Parts ``engine``, with ``aero`` ``aero`` (air velocity of the mass centre, as the
+        planar model), with ``slosh`` ``slosh``.
 
     Raises
     ------
     ValueError
-        Naming the argument (non-positive numbers, ``velocity`` missing with ``aero``).
+        Naming the argument (non-positive numbers, ``velocity`` missing with ``aero``, a
+        spring-mass ``slosh``, a slosh mass not below ``mass``).
     TypeError
         If a part is not of its class.
 
@@ -78,31 +96,53 @@ def launch_vehicle_scene(*, thrust, inertia, arm, mass, roll_inertia=None, aero=
     F, I, l, m = (positive(v, n) for v, n in ((thrust, "thrust"), (inertia, "inertia"),
                                               (arm, "arm"), (mass, "mass")))
     I_roll = I / 40.0 if roll_inertia is None else positive(roll_inertia, "roll_inertia")
-    for part, cls, label in ((aero, Aero, "aero"), (mass_flow, MassFlow, "mass_flow")):
+    for part, cls, label in ((aero, Aero, "aero"), (mass_flow, MassFlow, "mass_flow"),
+                             (slosh, PlanarSlosh, "slosh")):
         if part is not None and not isinstance(part, cls):
             raise TypeError(f"`{label}` must be a dynamics.launch_vehicle.{cls.__name__}, "
                             f"got {type(part).__name__}")
+    m_hub, I_hub, shift, slosh_parts = m, I, 0.0, []
+    if slosh is not None:
+        from ..launch_vehicle.vehicle import rigid_part
+        if slosh.kind != "pendulum":
+            raise ValueError("`slosh`: only a pendulum has a scene part in pitch and yaw; a "
+                             "planar spring-mass is not mapped yet")
+        m_hub, _, I_hub = rigid_part(slosh, m, I)
+        rho0 = slosh.hinge - slosh.length
+        shift = slosh.mass / m_hub * rho0  # O from the rigid part's mass centre
+        L = slosh.length
+        slosh_parts.append(Slosh(slosh.mass, length=L, hinge=(slosh.hinge + shift, 0.0, 0.0),
+                                 direction=(-1.0, 0.0, 0.0),
+                                 damping=2.0 * slosh.damping_ratio * slosh.mass * L ** 2
+                                 * math.sqrt(F / (m * L))))
+
+    def station(s):
+        """A station along the axis (from ``O``, ahead positive) as a hub point."""
+        return (s + shift, 0.0, 0.0)
+
     engine = dict(gimbal=gimbal, actuator=actuator)
-    m_hub = m
     if mass_flow is not None:
         burn = mass_flow.burn_time
-        mp = mass_flow.rate * burn if burn is not None else 0.5 * m
-        m_hub = m - mp
-        engine.update(mass_flow=mass_flow.rate, propellant=mp,
-                      flow_start=(-mass_flow.flow_start, 0.0, 0.0),
-                      nozzle_exit=None if mass_flow.nozzle_exit is None else (
-                          -mass_flow.nozzle_exit, 0.0, 0.0))
-    parts = [Engine(F, (-l, 0.0, 0.0), **engine)]
+        mp = mass_flow.rate * burn if burn is not None else 0.5 * m_hub
+        m_hub = m_hub - mp
+        engine.update(mass_flow=mass_flow.rate, propellant=mp, tank=station(-shift),
+                      flow_start=station(-mass_flow.flow_start),
+                      nozzle_exit=None if mass_flow.nozzle_exit is None else station(
+                          -mass_flow.nozzle_exit))
+    parts = [Engine(F, station(-l), **engine)]
     if aero is not None:
         if velocity is None:
             raise ValueError("`velocity` is needed with `aero` (its dynamic pressure is "
                              "reached at that flight speed)")
         V = positive(velocity, "velocity")
         parts.append(Aerodynamics(aero.area, aero.normal_force_slope,
-                                  centre_of_pressure=(aero.cp_arm, 0.0, 0.0),
+                                  centre_of_pressure=station(aero.cp_arm),
                                   density=2.0 * aero.dynamic_pressure / V ** 2,
                                   wind="control" if aero.wind == "control" else "zero",
                                   air_velocity="mass_centre"))
     elif velocity is not None:
         raise ValueError("`velocity` is the flight speed of `aero`; give it only with `aero`")
-    return Scene(RigidHub([I_roll, I, I], mass=m_hub), *parts, name="launch_vehicle")
+    parts += slosh_parts
+    reference = None if slosh is None else (shift, 0.0, 0.0)
+    return Scene(RigidHub([I_roll, I_hub, I_hub], mass=m_hub, reference=reference), *parts,
+                 name="launch_vehicle")

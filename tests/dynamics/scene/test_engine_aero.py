@@ -396,3 +396,63 @@ def test_launch_vehicle_scene_yaw_plane_equals_the_planar_model():
         ref = planar.rhs(np.concatenate([s, [m, delta]]), [cmd, *wind])
         _rel(rates, ref[:6])
         _rel(xdot[-2:][::-1], ref[6:8])
+
+
+@pytest.mark.parametrize("with_flow", [False, True])
+def test_launch_vehicle_scene_with_slosh_yaw_plane_equals_the_planar_model(with_flow):
+    """A slosh pendulum: the planar states are the vehicle's mass centre, the scene's the
+    point O of the rigid hub; the mass centre's velocity and acceleration are read from the
+    scene's linear momentum (P / m, and (P' + mdot v_tank) / m: P' loses the momentum the
+    propellant takes with it), theta_s = -theta1."""
+    from appdyn.dynamics.launch_vehicle import Slosh as PlanarSlosh
+    from appdyn.dynamics.scene import launch_vehicle_scene
+    F, I, l, m = 2.0e6, 4.0e7, 20.0, 1.0e5
+    sl = PlanarSlosh(mass=8.0e3, hinge=6.0, length=2.5, damping_ratio=0.03)
+    parts = dict(slosh=sl, actuator=Actuator(0.05))
+    if with_flow:
+        parts["mass_flow"] = MassFlow(rate=700.0, flow_start=-5.0)
+    planar = launch_vehicle(thrust=F, inertia=I, arm=l, mass=m, **parts)
+    scene = launch_vehicle_scene(thrust=F, inertia=I, arm=l, mass=m, **parts)
+    model = scene.model()
+    n = model.nx
+    xs, us = ca.SX.sym("x", n), ca.SX.sym("u", model.nu)
+    P = model.invariants["momentum_linear"](xs, ca.DM(0, 1))
+    Pdot = ca.Function("Pd", [xs, us], [P, ca.mtimes(ca.jacobian(P, xs),
+                                                      model.f(xs, us, ca.DM(0, 1)))])
+    ms, L, h = sl.mass, sl.length, sl.hinge
+    rng = np.random.default_rng(11)
+    idx = {s: model.states.index(s) for s in model.states}
+    for _ in range(10):
+        s = _planar_state(rng)
+        th, thd = rng.normal(scale=0.2), rng.normal(scale=0.3)
+        delta, cmd = rng.uniform(-0.1, 0.1, size=2)
+        psi, psid = s[2], s[5]
+        # the mass centre's shift from O and its rate (body axes): Delta = ms/m (rho_s - rho0)
+        e, e_t = np.array([-np.cos(th), -np.sin(th), 0.0]), np.array([np.sin(th), -np.cos(th), 0.0])
+        Delta = ms / m * L * (e - [-1.0, 0.0, 0.0])
+        Delta_dot = ms / m * L * e_t * thd
+        w = np.array([0.0, 0.0, psid])
+        x = scene.state()
+        x[0:4] = [0.0, 0.0, np.sin(psi / 2), np.cos(psi / 2)]
+        A = np.asarray(dcm_from_quat(x[0:4]))
+        x[6] = psid
+        x[idx["r1"]:idx["r3"] + 1] = np.array([s[0], s[1], 0.0]) - A.T @ Delta
+        x[idx["v1"]:idx["v3"] + 1] = A @ np.array([s[3], s[4], 0.0]) - np.cross(w, Delta) - Delta_dot
+        x[idx["theta1"]], x[idx["theta1_dot"]] = -th, -thd
+        x[idx["dy"]] = delta
+        u = [0.0, cmd]
+        p_in, p_dot = (np.ravel(v) for v in Pdot(x, u))
+        xdot = model.rhs(x, u)
+        mass_state = [m] if with_flow else []
+        ref = planar.rhs(np.concatenate([s, mass_state, [th, thd, delta]]), [cmd])
+        if with_flow:  # the propellant leaves from the rigid part's mass centre
+            v_O = x[idx["v1"]:idx["v3"] + 1]
+            p_dot = p_dot + 700.0 * A.T @ (v_O + np.cross(w, -np.asarray(scene.hub.reference)))
+        mine = np.concatenate([p_in[:2] / m, [psid], p_dot[:2] / m, [xdot[6]]])
+        _rel(mine, ref[:6])
+        k = 6
+        if with_flow:
+            _rel(xdot[idx["m_p"]], ref[6])
+            k = 7
+        _rel([-xdot[idx["theta1"]], -xdot[idx["theta1_dot"]], xdot[idx["dy"]]], ref[k:k + 3])
+        assert abs(xdot[idx["theta2_dot"]]) < 1e-12 and xdot[idx["dp"]] == 0.0

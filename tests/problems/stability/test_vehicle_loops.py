@@ -6,7 +6,7 @@ import math
 import numpy as np
 import pytest
 
-from appdyn.dynamics.launch_vehicle import Actuator, Aero, MassFlow
+from appdyn.dynamics.launch_vehicle import Actuator, Aero, MassFlow, Slosh
 from appdyn.dynamics.scene import ExternalTorque, RigidHub, Scene, launch_vehicle_scene
 from appdyn.problems import stability
 
@@ -18,6 +18,10 @@ CASES = {
     "mass_flow": dict(mass_flow=MassFlow(rate=700.0, flow_start=-5.0)),
     "aero_actuator": dict(aero=Aero(3.0e4, 10.0, 3.0, -2.0), velocity=300.0,
                           actuator=Actuator(0.08)),
+    "slosh": dict(slosh=Slosh(8.0e3, 6.0, length=2.5, damping_ratio=0.03)),
+    "slosh_flow_actuator": dict(slosh=Slosh(5.0e3, -3.0, length=1.5),
+                                mass_flow=MassFlow(rate=700.0, flow_start=-5.0),
+                                actuator=Actuator(0.05)),
 }
 
 
@@ -37,6 +41,10 @@ def test_each_axis_equals_the_planar_autopilot_loop(case):
         rep = loops[axis]
         assert rep.verdict == planar.verdict
         ref, got = _margins(planar.margins), _margins(rep.margins)
+        if ref[0] > 1e6 or got[0] > 1e6:  # |L| ~ 1e-9 where the phase crosses: a slosh
+            # pole and zero cancel to roundoff, whether a crossover is found is noise
+            assert ref[0] > 1e6 and got[0] > 1e6, (axis, got, ref)
+            ref, got = ref[1:3], got[1:3]
         same = np.isclose(got, ref, rtol=1e-8, atol=0.0) | (np.isnan(ref) & np.isnan(got)) | (
             np.isinf(ref) & np.isinf(got))
         assert np.all(same), (axis, got, ref)
