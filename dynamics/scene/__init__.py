@@ -28,7 +28,7 @@ Parts
 =====================  =====================================================================
 
 `launch_vehicle_scene` builds the launch vehicle of `dynamics.launch_vehicle` from these (six
-degrees of freedom; its yaw plane is the planar model).
+degrees of freedom; its yaw plane is the planar model); `attitude_autopilot` flies it.
 
 Examples
 --------
@@ -48,11 +48,11 @@ from .gravity import GravityGradient
 from .hubs import RigidHub
 from .loads import ExternalForce, ExternalTorque
 from .panels import HingedPanel
-from .rocket import launch_vehicle_scene
+from .rocket import attitude_autopilot, launch_vehicle_scene
 from .scene import Scene, check_scene
 from .wheels import HeldRotor, ReactionWheels
 
 __all__ = ["Scene", "check_scene", "RigidHub", "Part", "PartLayout", "Variable", "PartVariables", "Body", "Load",
            "Contribution", "Frame", "ReactionWheels", "HeldRotor", "ExternalTorque",
            "ExternalForce", "PointMassDamper", "SphericalDamper", "Slosh", "TiltTorque",
-           "HingedPanel", "GravityGradient", "CMGCluster", "Aerodynamics", "Engine", "launch_vehicle_scene"]
+           "HingedPanel", "GravityGradient", "CMGCluster", "Aerodynamics", "Engine", "launch_vehicle_scene", "attitude_autopilot"]

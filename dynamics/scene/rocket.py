@@ -37,7 +37,7 @@ from .engine import Engine
 from .hubs import RigidHub
 from .scene import Scene
 
-__all__ = ["launch_vehicle_scene"]
+__all__ = ["launch_vehicle_scene", "attitude_autopilot"]
 
 
 def launch_vehicle_scene(*, thrust, inertia, arm, mass, roll_inertia=None, aero=None,
@@ -146,3 +146,68 @@ def launch_vehicle_scene(*, thrust, inertia, arm, mass, roll_inertia=None, aero=
     reference = None if slosh is None else (shift, 0.0, 0.0)
     return Scene(RigidHub([I_roll, I_hub, I_hub], mass=m_hub, reference=reference), *parts,
                  name="launch_vehicle")
+
+
+def attitude_autopilot(scene, *, k_psi, k_psidot, engine=None):
+    """The launch vehicle's attitude/rate autopilot in pitch and yaw, ``u = k(x)``.
+
+    ``dp = -(k_psi theta + k_psidot w2)``, ``dy = -(k_psi psi + k_psidot w3)`` with the
+    hub's pitch and yaw angles ``theta = 2 atan2(q2, q4)``, ``psi = 2 atan2(q3, q4)``
+    (exact for a turn about one axis, the planar model's ``psi``; the small-angle ``2 q2``,
+    ``2 q3`` of `problems.stability.vehicle_loops` to first order); the deflections, or their
+    commands with an actuator; every other control (wind) zero.
+
+    Parameters
+    ----------
+    scene : Scene
+        With an `Engine` gimbaled in pitch and yaw.
+    k_psi : float [rad/rad]
+    k_psidot : float [rad/(rad/s)]
+    engine : str, optional
+        The engine's name (needed with several).
+
+    Returns
+    -------
+    casadi.Function
+        ``autopilot(x) -> u`` for `dynamics.closed_loop`.
+
+    Raises
+    ------
+    TypeError
+        If ``scene`` is not a Scene.
+    ValueError
+        Naming ``engine`` (none, several, or no ``gimbal``) or a non-finite gain.
+
+    Examples
+    --------
+    >>> from appdyn.dynamics import closed_loop
+    >>> from appdyn.dynamics.scene import attitude_autopilot, launch_vehicle_scene
+    >>> scene = launch_vehicle_scene(thrust=2.0e6, inertia=4.0e7, arm=20.0, mass=1.0e5)
+    >>> law = attitude_autopilot(scene, k_psi=2.0, k_psidot=1.0)
+    >>> x = scene.state(q=[0.0, 0.0, 0.0499792, 0.99875])  # 0.1 rad of yaw
+    >>> [round(float(v), 6) for v in law(x).full().ravel()]  # dp, dy
+    [-0.0, -0.2]
+    """
+    import casadi as ca
+
+    from ..validate import finite_scalar
+    from .scene import check_scene
+
+    scene = check_scene(scene)
+    k, kd = finite_scalar(k_psi, "k_psi"), finite_scalar(k_psidot, "k_psidot")
+    names = [n for n, p in zip(scene.part_names, scene.parts) if isinstance(p, Engine)]
+    if engine is None and len(names) != 1 or engine is not None and engine not in names:
+        raise ValueError(f"`engine` must name one Engine of the scene {names}, got {engine!r}")
+    name = engine or names[0]
+    part = scene.part(name)
+    if part.gimbal is None:
+        raise ValueError(f"`engine` {name!r} has no gimbal: give Engine(..., gimbal=...)")
+    model = scene.model()
+    x = ca.SX.sym("x", model.nx)
+    theta = 2 * ca.atan2(x[1], x[3])
+    psi = 2 * ca.atan2(x[2], x[3])
+    local = scene.variable_names()["local"][name]
+    tail = "" if part.actuator is None else "_c"
+    law = {local["dp" + tail]: -(k * theta + kd * x[5]), local["dy" + tail]: -(k * psi + kd * x[6])}
+    u = ca.vertcat(*[law.get(c, ca.SX(0)) for c in model.controls])
+    return ca.Function("autopilot", [x], [u], ["x"], ["u"])

@@ -456,3 +456,39 @@ def test_launch_vehicle_scene_with_slosh_yaw_plane_equals_the_planar_model(with_
             k = 7
         _rel([-xdot[idx["theta1"]], -xdot[idx["theta1_dot"]], xdot[idx["dy"]]], ref[k:k + 3])
         assert abs(xdot[idx["theta2_dot"]]) < 1e-12 and xdot[idx["dp"]] == 0.0
+
+
+def test_flown_by_the_autopilot_equals_the_planar_closed_loop():
+    """Slosh and actuator, the autopilot closed on both axes, a yaw error and rate at t = 0:
+    the scene stays in the yaw plane and its yaw angle, the slosh angle and the deflection
+    follow the planar model with the same gains (both rk8, same steps)."""
+    from appdyn.dynamics import closed_loop, simulate
+    from appdyn.dynamics.launch_vehicle import Slosh as PlanarSlosh
+    from appdyn.dynamics.scene import attitude_autopilot, launch_vehicle_scene
+    F, I, l, m = 2.0e6, 4.0e7, 20.0, 1.0e5
+    parts = dict(slosh=PlanarSlosh(mass=8.0e3, hinge=6.0, length=2.5, damping_ratio=0.05),
+                 actuator=Actuator(0.05, deflection_limits=(-0.08, 0.08), rate_limit=0.3))
+    planar = launch_vehicle(thrust=F, inertia=I, arm=l, mass=m, k_psi=2.0, k_psidot=1.5,
+                            **parts)
+    scene = launch_vehicle_scene(thrust=F, inertia=I, arm=l, mass=m, **parts)
+    loop = closed_loop(scene.model(), attitude_autopilot(scene, k_psi=2.0, k_psidot=1.5))
+    psi0, psid0 = 0.12, -0.05
+    x0 = scene.state(q=[0.0, 0.0, np.sin(psi0 / 2), np.cos(psi0 / 2)], w=[0.0, 0.0, psid0],
+                     v=[300.0 * np.cos(psi0), -300.0 * np.sin(psi0), 0.0])
+    # O moves with the rigid part; slosh at rest: the mass centre is O (Delta = 0)
+    p0 = np.zeros(planar.nx)
+    p0[[2, 3, 5]] = psi0, 300.0, psid0
+    t = np.linspace(0.0, 4.0, 9)
+    mine = simulate(loop, x0, t, method="rk8", steps=400)
+    ref = simulate(planar, p0, t, method="rk8", steps=400)
+    assert mine.success and ref.success
+    X = np.asarray(mine.x)
+    idx = {s: i for i, s in enumerate(loop.states)}
+    psi = 2 * np.arctan2(X[idx["q3"]], X[idx["q4"]])
+    R = np.asarray(ref.x)
+    pidx = {s: i for i, s in enumerate(planar.states)}
+    np.testing.assert_allclose(psi, R[pidx["psi"]], rtol=0, atol=1e-10)
+    np.testing.assert_allclose(-X[idx["theta1"]], R[pidx["theta_s"]], rtol=0, atol=1e-10)
+    np.testing.assert_allclose(X[idx["dy"]], R[pidx["delta"]], rtol=0, atol=1e-10)
+    assert np.max(np.abs(X[[idx["q1"], idx["q2"], idx["theta2"], idx["dp"]]])) < 1e-13
+    assert abs(psi[-1]) < 0.3 * psi0  # the autopilot brings the yaw error down
