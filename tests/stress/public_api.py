@@ -332,8 +332,6 @@ OVERRIDES = {
     "appdyn.problems.stability.vehicle_loops": {"scene": lambda: __import__(
         "appdyn.dynamics.scene", fromlist=["x"]).launch_vehicle_scene(
             thrust=2.0e6, inertia=4.0e7, arm=20.0, mass=1.0e5)},
-    "appdyn.dynamics.scene.launch_vehicle_scene": {"inertia": lambda: 2.0e6,
-                                                   "mass": lambda: 5.0e4},
     "appdyn.dynamics.launch_vehicle": {"inertia": lambda: 2.0e6, "mass": lambda: 5.0e4},
     "appdyn.dynamics.launch_vehicle.launch_vehicle": {"inertia": lambda: 2.0e6, "mass": lambda: 5.0e4},
     "appdyn.problems.stability.launch_vehicle": {"inertia": lambda: 2.0e6, "mass": lambda: 5.0e4},
