@@ -86,7 +86,8 @@ def aero_angles(v_body):
     Returns
     -------
     alpha : float or ndarray (n,) [rad], or CasADi scalar
-        Angle of attack, ``-pi <= alpha <= pi`` (``-pi`` for a signed ``v_z = -0.0``) (0 when ``v_x = v_z = 0``).
+        Angle of attack, ``-pi <= alpha <= pi`` (``-pi`` for a signed ``v_z = -0.0``; 0 when
+        ``v_x = v_z = 0``).
     beta : float or ndarray (n,) [rad], or CasADi scalar
         Sideslip, ``-pi/2 <= beta <= pi/2`` (positive for the wind from the right, ``v_y > 0``).
 

@@ -41,8 +41,8 @@ from .aero import Aerodynamics
 from .assembly import PartLayout
 from .cmgs import CMGCluster
 from .contract import Body, Contribution, Frame, Load, Part, PartVariables, Variable
-from .engine import Engine
 from .dampers import PointMassDamper, Slosh, SphericalDamper
+from .engine import Engine
 from .fields import TiltTorque
 from .gravity import GravityGradient
 from .hubs import RigidHub
@@ -55,4 +55,5 @@ from .wheels import HeldRotor, ReactionWheels
 __all__ = ["Scene", "check_scene", "RigidHub", "Part", "PartLayout", "Variable", "PartVariables", "Body", "Load",
            "Contribution", "Frame", "ReactionWheels", "HeldRotor", "ExternalTorque",
            "ExternalForce", "PointMassDamper", "SphericalDamper", "Slosh", "TiltTorque",
-           "HingedPanel", "GravityGradient", "CMGCluster", "Aerodynamics", "Engine", "launch_vehicle_scene", "attitude_autopilot"]
+           "HingedPanel", "GravityGradient", "CMGCluster", "Aerodynamics", "Engine",
+           "launch_vehicle_scene", "attitude_autopilot"]

@@ -18,8 +18,9 @@ of straight flight are taken. In the yaw plane (``v_az = 0``, ``v_ax > 0``) the 
 ``qbar S C_N_alpha atan2(-v_ay, v_ax)`` along ``+y``: the launch vehicle's ``alpha`` and
 ``f_A``, except that the launch vehicle takes the air velocity of the mass centre:
 ``air_velocity="mass_centre"`` does the same here (no aerodynamic damping from the turning
-rate), and the yaw-plane restriction then equals that model. The density is constant or an exponential atmosphere ``rho0 exp(-h / H)`` in the
-altitude ``h = up . r`` of the hub's reference point.
+rate), and the yaw-plane restriction then equals that model. The density is constant or an
+exponential atmosphere ``rho0 exp(-h / H)`` in the altitude ``h = up . r`` of the hub's
+reference point.
 """
 from __future__ import annotations
 
@@ -45,7 +46,7 @@ def require_translating_hub(frame, part: str):
     >>> Scene(RigidHub([1.0, 1.0, 1.0]), Aerodynamics(1.0, 2.0)).model()
     Traceback (most recent call last):
         ...
-    ValueError: `Aerodynamics` needs a six-degree-of-freedom hub: give the hub a mass, RigidHub(inertia, mass=...)
+    ValueError: `Aerodynamics` needs a six-degree-of-freedom hub: ...
     """
     if frame.r is None:
         raise ValueError(f"`{part}` needs a six-degree-of-freedom hub: give the hub a mass, "

@@ -53,7 +53,7 @@ from .contract import (Body, Contribution, Load, Part, PartVariables, Variable,
                        bounds_from_u_max)
 from .dampers import real_number, unit_vector
 
-__all__ = ["Engine", "G0", "gimbal_basis", "coriolis_load"]
+__all__ = ["Engine", "G0", "gimbal_basis", "coriolis_load", "gimbaled_engine"]
 
 G0 = 9.80665
 """Standard gravity [m/s^2] of the specific impulse (``C = isp g0``, seed Eq. 3.40)."""
@@ -277,3 +277,30 @@ class Engine(Part):
         return Contribution(rates=ca.vertcat(*rates) if rates else None, bodies=bodies,
                             loads=loads)
 
+
+
+def gimbaled_engine(scene, engine=None):
+    """``(name, part)`` of the gimbaled `Engine` of ``scene`` (the only one, or ``engine``).
+
+    Raises
+    ------
+    ValueError
+        Naming ``engine``: no Engine, several and none named, an unknown name, or an engine
+        without ``gimbal``.
+
+    Examples
+    --------
+    >>> from appdyn.dynamics.scene import Engine, RigidHub, Scene
+    >>> from appdyn.dynamics.scene.engine import gimbaled_engine
+    >>> gimbaled_engine(Scene(RigidHub([1.0, 1.0, 1.0], mass=1.0),
+    ...                       Engine(1.0, (-1.0, 0.0, 0.0), gimbal=0.1)))[0]
+    'engine'
+    """
+    names = [n for n, p in zip(scene.part_names, scene.parts) if isinstance(p, Engine)]
+    if engine is None and len(names) != 1 or engine is not None and engine not in names:
+        raise ValueError(f"`engine` must name one Engine of the scene {names}, got {engine!r}")
+    name = engine or names[0]
+    part = scene.part(name)
+    if part.gimbal is None:
+        raise ValueError(f"`engine` {name!r} has no gimbal: give Engine(..., gimbal=...)")
+    return name, part

@@ -33,7 +33,7 @@ from ..launch_vehicle.parts import Slosh as PlanarSlosh
 from ..validate import positive
 from .aero import Aerodynamics
 from .dampers import Slosh
-from .engine import Engine
+from .engine import Engine, gimbaled_engine
 from .hubs import RigidHub
 from .scene import Scene
 
@@ -195,13 +195,7 @@ def attitude_autopilot(scene, *, k_psi, k_psidot, engine=None):
 
     scene = check_scene(scene)
     k, kd = finite_scalar(k_psi, "k_psi"), finite_scalar(k_psidot, "k_psidot")
-    names = [n for n, p in zip(scene.part_names, scene.parts) if isinstance(p, Engine)]
-    if engine is None and len(names) != 1 or engine is not None and engine not in names:
-        raise ValueError(f"`engine` must name one Engine of the scene {names}, got {engine!r}")
-    name = engine or names[0]
-    part = scene.part(name)
-    if part.gimbal is None:
-        raise ValueError(f"`engine` {name!r} has no gimbal: give Engine(..., gimbal=...)")
+    name, part = gimbaled_engine(scene, engine)
     model = scene.model()
     x = ca.SX.sym("x", model.nx)
     theta = 2 * ca.atan2(x[1], x[3])

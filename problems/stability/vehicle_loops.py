@@ -25,7 +25,8 @@ from dataclasses import replace
 import casadi as ca
 import numpy as np
 
-from appdyn.dynamics.scene import Engine, check_scene
+from appdyn.dynamics.scene import check_scene
+from appdyn.dynamics.scene.engine import gimbaled_engine
 
 from .common import check_number
 from .loop import loop
@@ -33,17 +34,6 @@ from .loop import loop
 __all__ = ["vehicle_loops"]
 
 _AXES = {"pitch": ("dp", "q2", "w2"), "yaw": ("dy", "q3", "w3")}
-
-
-def _engine_name(scene, engine):
-    names = [n for n, p in zip(scene.part_names, scene.parts) if isinstance(p, Engine)]
-    if engine is None:
-        if len(names) != 1:
-            raise ValueError(f"`engine`: name the engine part, the scene has {names}")
-        return names[0]
-    if engine not in names:
-        raise ValueError(f"`engine` must name an Engine of the scene {names}, got {engine!r}")
-    return engine
 
 
 def _reduce(A, C, states, frozen):
@@ -134,10 +124,7 @@ def vehicle_loops(scene, *, k_psi, k_psidot, velocity=0.0, engine=None) -> dict:
     k = check_number(k_psi, "k_psi")
     kd = check_number(k_psidot, "k_psidot")
     V = check_number(velocity, "velocity", nonnegative=True)
-    name = _engine_name(scene, engine)
-    part = scene.part(name)
-    if part.gimbal is None:
-        raise ValueError(f"`engine` {name!r} has no gimbal: give Engine(..., gimbal=...)")
+    name, part = gimbaled_engine(scene, engine)
     model = scene.model()
     local = scene.variable_names()["local"][name]
     frozen = {local[v.name] for v in part.variables().coords if v.frozen}

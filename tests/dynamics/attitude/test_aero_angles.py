@@ -22,7 +22,8 @@ def test_angles_reproduce_the_seed_components(v):
     V = np.linalg.norm(v)
     a, b = aero_angles(v)
     aT, phi = total_aoa(v)
-    # Type I: v = V (cos a cos b, sin b, sin a cos b); Type II: V (cos aT, sin aT sin phi, sin aT cos phi)
+    # Type I: v = V (cos a cos b, sin b, sin a cos b)
+    # Type II: v = V (cos aT, sin aT sin phi, sin aT cos phi)
     np.testing.assert_allclose([V * math.cos(a) * math.cos(b), V * math.sin(b),
                                 V * math.sin(a) * math.cos(b)], v, rtol=0, atol=1e-12 * V)
     np.testing.assert_allclose([V * math.cos(aT), V * math.sin(aT) * math.sin(phi),
@@ -91,7 +92,8 @@ def test_batch_equals_columns_and_casadi_equals_numpy():
         np.testing.assert_allclose(np.array(sx(V[:, k])).ravel(), col, rtol=0, atol=1e-14)
         np.testing.assert_allclose(np.array(mx(V[:, k])).ravel(), col, rtol=0, atol=1e-14)
         dm = ca.DM(V[:, k])
-        np.testing.assert_allclose(np.array(ca.vertcat(*aero_angles(dm))).ravel(), col[:2], atol=1e-14)
+        got = np.array(ca.vertcat(*aero_angles(dm))).ravel()
+        np.testing.assert_allclose(got, col[:2], atol=1e-14)
     assert batch[3, 2] == 0.0 and not batch[4, 2] and batch[4].sum() == 6
 
 
@@ -110,7 +112,8 @@ def test_type_two_indeterminate_is_reported_not_nan(v):
     # pure sideslip: alpha indeterminate, 0 by convention, finite derivatives
     sym = ca.SX.sym("v", 3)
     out = ca.vertcat(*aero_angles(sym))
-    val, jac = (np.array(m) for m in ca.Function("g", [sym], [out, ca.jacobian(out, sym)])([0, -2.0, 0]))
+    g = ca.Function("g", [sym], [out, ca.jacobian(out, sym)])
+    val, jac = (np.array(m) for m in g([0, -2.0, 0]))
     assert np.all(np.isfinite(jac)) and val.ravel().tolist() == [0.0, -math.pi / 2]
 
 
@@ -121,8 +124,8 @@ def test_derivatives_match_finite_differences_away_from_the_axis():
     v0 = np.array([40.0, -3.0, 7.0])
     jac = np.array(f(v0)[1])
     h = 1e-6
-    fd = np.column_stack([(np.array(f(v0 + h * e)[0]) - np.array(f(v0 - h * e)[0])).ravel() / (2 * h)
-                          for e in np.eye(3)])
+    fd = np.column_stack([(np.array(f(v0 + h * e)[0]) - np.array(f(v0 - h * e)[0])).ravel()
+                          / (2 * h) for e in np.eye(3)])
     np.testing.assert_allclose(jac, fd, rtol=1e-7, atol=1e-10)
 
 

@@ -437,7 +437,8 @@ def test_launch_vehicle_scene_with_slosh_yaw_plane_equals_the_planar_model(with_
         A = np.asarray(dcm_from_quat(x[0:4]))
         x[6] = psid
         x[idx["r1"]:idx["r3"] + 1] = np.array([s[0], s[1], 0.0]) - A.T @ Delta
-        x[idx["v1"]:idx["v3"] + 1] = A @ np.array([s[3], s[4], 0.0]) - np.cross(w, Delta) - Delta_dot
+        v_cm = A @ np.array([s[3], s[4], 0.0])
+        x[idx["v1"]:idx["v3"] + 1] = v_cm - np.cross(w, Delta) - Delta_dot
         x[idx["theta1"]], x[idx["theta1_dot"]] = -th, -thd
         x[idx["dy"]] = delta
         u = [0.0, cmd]
