@@ -493,3 +493,37 @@ def test_flown_by_the_autopilot_equals_the_planar_closed_loop():
     np.testing.assert_allclose(X[idx["dy"]], R[pidx["delta"]], rtol=0, atol=1e-10)
     assert np.max(np.abs(X[[idx["q1"], idx["q2"], idx["theta2"], idx["dp"]]])) < 1e-13
     assert abs(psi[-1]) < 0.3 * psi0  # the autopilot brings the yaw error down
+
+
+def test_energy_work_balance_with_motors_engine_and_air():
+    """Wheels driven by their motors, the engine burning and the air on one scene:
+    E' = sum tau_i W_i + F d . v_g + F_C . v_M - mdot |v_tank|^2 / 2 + F_air . v_cp."""
+    from appdyn.dynamics.scene import ReactionWheels
+    scene = Scene(RigidHub(I_HUB, mass=MASS, reference=REF),
+                  ReactionWheels(np.eye(3), [0.05, 0.04, 0.06]),
+                  Engine(2500.0, GIMBAL, gimbal=0.1, isp=250.0, propellant=40.0, tank=TANK,
+                         flow_start=START, nozzle_exit=EXIT),
+                  Aerodynamics(**AERO))
+    model = scene.model()
+    assert model.controls == ("tau1", "tau2", "tau3", "dp", "dy")
+    mdot = 2500.0 / (250.0 * G0)
+    xs, us = ca.SX.sym("x", model.nx), ca.SX.sym("u", model.nu)
+    E = model.invariants["energy"](xs, ca.DM(0, 1))
+    Edot = ca.Function("Ed", [xs, us], [ca.mtimes(ca.jacobian(E, xs),
+                                                   model.f(xs, us, ca.DM(0, 1)))])
+    rng = np.random.default_rng(12)
+    for _ in range(10):
+        x = _random_state(scene, rng)
+        x[13:16] = rng.normal(scale=20.0, size=3)  # wheel speeds
+        x[16] = rng.uniform(5.0, 40.0)
+        u = np.concatenate([rng.normal(scale=0.2, size=3), rng.uniform(-0.1, 0.1, size=2)])
+        w, v = x[4:7], x[10:13]
+
+        def vel(p):
+            return v + np.cross(w, p - REF)
+        F_T = 2500.0 * _thrust_direction(*u[3:])
+        F_C = -2 * mdot * np.cross(w, EXIT - START)
+        v_t, v_cp = vel(TANK), vel(CP)
+        power = (u[:3] @ x[13:16] + F_T @ vel(GIMBAL) + F_C @ vel(0.5 * (START + EXIT))
+                 - 0.5 * mdot * v_t @ v_t + _aero_force(v_cp, 1.225, 0.8, 2.7, 0.3) @ v_cp)
+        _rel(float(Edot(x, u)), power, 1e-11)
