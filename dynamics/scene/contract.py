@@ -18,7 +18,9 @@ that names the field). It sets ``kind`` (the default name, ``"wheels"``), and im
     its *speeds* (generalized speeds whose derivatives the assembly solves for) and its
     *controls*, each a `Variable` with a name, a unit, a rest value, bounds, and for states
     whether the slew jobs hold it at rest at the end (``terminal="rest"``) or leave it free
-    (``"free"``: a wheel speed, a gimbal angle). ``u_max`` is the one word for a control
+    (``"free"``: a wheel speed, a gimbal angle). A coordinate that is a mass flowing out of
+    the vehicle (an engine's propellant) is declared ``frozen=True``: the inertia forces hold
+    it constant (the control-volume law; the momentum the flow carries is in the thrust). ``u_max`` is the one word for a control
     bound: pass it to `Variable` as ``bounds=(-u_max, u_max)``. Names are local (``"s"``,
     ``"W1"``); the scene makes them unique (a second damper's states become ``s_2``, ...).
 ``contribute(self, frame, own) -> Contribution``
