@@ -236,6 +236,7 @@ def assemble(scene) -> Model:
     n_hub = 6 if hub.translates else 3
     offset = n_hub
     owns, frames = {}, {}
+    frozen = set()
     for i in scene.mount_order:
         part, pname, parent = scene.parts[i], scene.part_names[i], scene.parents[i]
         local = named["local"][pname]
@@ -245,6 +246,7 @@ def assemble(scene) -> Model:
                           {k: sym[vname] for k, vname in local.items() if not k.startswith("__")})
         owns[pname] = own
         on = frame if parent is None else frames[parent]
+        frozen.update(local[v.name] for v in part.variables().coords if v.frozen)
         c = in_hub_axes(on, part.contribute(on, own))
         if pname in scene.parents:
             frames[pname] = part.body_frame(on, own)
@@ -283,7 +285,8 @@ def assemble(scene) -> Model:
     speeds = ca.vertcat(*speed_syms)
     coords = ca.vertcat(*coord_syms)
     cdot = ca.vertcat(*coord_rates)
-    M, F = kane_equations(all_bodies, loads, w, speeds, coords, cdot)
+    moving = [k for k in range(coords.numel()) if coords[k].name() not in frozen]
+    M, F = kane_equations(all_bodies, loads, w, speeds, coords[moving], cdot[moving])
     nud = solve_blocks(M, F, n_hub, part_speed_slices)
 
     # x' in state order

@@ -18,7 +18,9 @@ that names the field). It sets ``kind`` (the default name, ``"wheels"``), and im
     its *speeds* (generalized speeds whose derivatives the assembly solves for) and its
     *controls*, each a `Variable` with a name, a unit, a rest value, bounds, and for states
     whether the slew jobs hold it at rest at the end (``terminal="rest"``) or leave it free
-    (``"free"``: a wheel speed, a gimbal angle). ``u_max`` is the one word for a control
+    (``"free"``: a wheel speed, a gimbal angle). A coordinate that is a mass flowing out of
+    the vehicle (an engine's propellant) is declared ``frozen=True``: the inertia forces hold
+    it constant (the control-volume law; the momentum the flow carries is in the thrust). ``u_max`` is the one word for a control
     bound: pass it to `Variable` as ``bounds=(-u_max, u_max)``. Names are local (``"s"``,
     ``"W1"``); the scene makes them unique (a second damper's states become ``s_2``, ...).
 ``contribute(self, frame, own) -> Contribution``
@@ -104,6 +106,10 @@ class Variable:
         Lower and upper bound (controls: from ``u_max``; states: a speed limit).
     terminal : {'rest', 'free'}, optional
         Whether a rest-to-rest slew holds it at ``rest`` at the end.
+    frozen : bool, optional
+        A coordinate the inertia forces hold frozen: a mass that flows out of the vehicle
+        (seed Sec. 3.4, control-volume law ``m v' = F``, no ``m' v`` term). Kane's equations
+        then leave out the momenta's derivative along its rate.
     """
 
     name: str
@@ -111,6 +117,7 @@ class Variable:
     rest: float = 0.0
     bounds: tuple = (-math.inf, math.inf)
     terminal: Literal["rest", "free"] = "rest"
+    frozen: bool = False
 
 
 @dataclass(frozen=True)

@@ -20,6 +20,8 @@ Cases
 `launch_vehicle`       thrust-vectored vehicle under the attitude/rate autopilot (Sec. 5.4):
                        margins at the engine deflection, named modes; `bode_plot`,
                        `nichols_plot`, `launch_vehicle_response` (time response)
+`vehicle_loops`        pitch and yaw autopilot loops of a thrust-vectored vehicle scene (an
+                       `Engine` on a six-degree-of-freedom hub): margins per axis
 `loop`                 any plant with a feedback law: margins via ``control.stability_margins``
 `shaken_pendulum`      hanging / inverted pendulum on a shaken hinge: Floquet multipliers
                        (a `PeriodicStabilityReport`), checked against Mathieu's chart
@@ -76,6 +78,7 @@ from .report import (CLOSED_FORM_RTOL, STATUS_MISMATCH, STATUS_UNCHECKED, STATUS
 from .spin import gyrostat, spin
 from .sweep import Boundary, SweepResult, sweep
 from .tilt import heavy_top, rotor, spinning_projectile
+from .vehicle_loops import vehicle_loops
 from .verdict import VERDICTS, ZERO_RTOL, classify
 
 __all__ = [
@@ -86,5 +89,5 @@ __all__ = [
     "sweep", "CASES",
     "CASE_ALIASES", "resolve_case", "STANDARD_GRAVITY", "STATUS_VERIFIED", "STATUS_UNCHECKED",
     "STATUS_MISMATCH", "CLOSED_FORM_RTOL", "shaken_pendulum", "conical_pendulum",
-    "PeriodicStabilityReport", "FloquetMode", "hinged_spin", "hinged_scene",
+    "PeriodicStabilityReport", "FloquetMode", "hinged_spin", "hinged_scene", "vehicle_loops",
 ]

@@ -12,6 +12,7 @@ from typing import Callable
 import numpy as np
 
 from appdyn.dynamics import scene as sc
+from appdyn.dynamics.launch_vehicle import Actuator
 
 AXES = np.array([[1.0, 0.0, 0.0, 0.57735026918962573],
                  [0.0, 1.0, 0.0, 0.57735026918962573],
@@ -80,6 +81,10 @@ PARTS: dict[str, Entry] = {
                   conserves=("energy", "momentum_linear")),
     "force": Entry(lambda: sc.ExternalForce(point=[0.2, 0.4, -0.3]), conserves=("energy",),
                    work={"F": _point_velocity([0.2, 0.4, -0.3])}),
+    # engine off (no thrust, no mass flow): its gimbal actuator states move, nothing else
+    "engine": Entry(lambda: sc.Engine(0.0, (-0.5, 0.1, 0.0), gimbal=0.1,
+                                      actuator=Actuator(0.2, rate_limit=1.0)),
+                    work={"dp_c": lambda s, n: np.zeros(2)}),
 }
 
 ALL = tuple(name for name in PARTS if name != "slosh")
