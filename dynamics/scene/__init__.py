@@ -25,10 +25,13 @@ Parts
                        (state ``m_p``), internal-flow Coriolis force and jet damping
 `Aerodynamics`         normal and axial air force at a centre of pressure (6-DoF hub; wind
                        controls ``wind1..wind3`` optional)
+`BendingMode`          a free-free body bending mode per transverse plane in mean axes
+                       (``eta, eta_dot``); carries parts at a station (an engine on the
+                       gimbal), gyro invariants ``gyro_tilt``, ``gyro_tilt_rate``
 =====================  =====================================================================
 
-Parts sit on the hub, or on a part that carries parts (a `HingedPanel`) named by their
-``parent`` keyword: ``ReactionWheels(axes, 0.05, parent="panel")``.
+Parts sit on the hub, or on a part that carries parts (a `HingedPanel`, a `BendingMode`)
+named by their ``parent`` keyword: ``ReactionWheels(axes, 0.05, parent="panel")``.
 
 `launch_vehicle_scene` builds the launch vehicle of `dynamics.launch_vehicle` from these (six
 degrees of freedom; its yaw plane is the planar model); `attitude_autopilot` flies it.
@@ -42,6 +45,7 @@ Examples
 """
 from .aero import Aerodynamics
 from .assembly import PartLayout
+from .bending import BendingMode
 from .cmgs import CMGCluster
 from .contract import Body, Contribution, Frame, Load, Part, PartVariables, Variable
 from .dampers import PointMassDamper, Slosh, SphericalDamper
@@ -51,7 +55,7 @@ from .gravity import GravityGradient
 from .hubs import RigidHub
 from .loads import ExternalForce, ExternalTorque
 from .panels import HingedPanel
-from .rocket import attitude_autopilot, launch_vehicle_scene
+from .rocket import attitude_autopilot, launch_vehicle_scene, sensed_attitude
 from .scene import Scene, check_scene
 from .wheels import HeldRotor, ReactionWheels
 
@@ -59,4 +63,4 @@ __all__ = ["Scene", "check_scene", "RigidHub", "Part", "PartLayout", "Variable",
            "Contribution", "Frame", "ReactionWheels", "HeldRotor", "ExternalTorque",
            "ExternalForce", "PointMassDamper", "SphericalDamper", "Slosh", "TiltTorque",
            "HingedPanel", "GravityGradient", "CMGCluster", "Aerodynamics", "Engine",
-           "launch_vehicle_scene", "attitude_autopilot"]
+           "launch_vehicle_scene", "attitude_autopilot", "BendingMode", "sensed_attitude"]

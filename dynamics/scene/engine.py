@@ -280,7 +280,8 @@ class Engine(Part):
 
 
 def gimbaled_engine(scene, engine=None):
-    """``(name, part)`` of the gimbaled `Engine` of ``scene`` (the only one, or ``engine``).
+    """``(name, part)`` of the gimbaled `Engine` of ``scene`` (the only one, the only gimbaled
+    one, or ``engine``).
 
     Raises
     ------
@@ -297,6 +298,9 @@ def gimbaled_engine(scene, engine=None):
     'engine'
     """
     names = [n for n, p in zip(scene.part_names, scene.parts) if isinstance(p, Engine)]
+    gimbaled = [n for n in names if scene.part(n).gimbal is not None]
+    if engine is None and len(names) != 1 and len(gimbaled) == 1:
+        engine = gimbaled[0]  # one gimbaled engine (a propellant feed beside it)
     if engine is None and len(names) != 1 or engine is not None and engine not in names:
         raise ValueError(f"`engine` must name one Engine of the scene {names}, got {engine!r}")
     name = engine or names[0]

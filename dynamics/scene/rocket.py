@@ -21,28 +21,38 @@ the propellant at rest; the hub here is the rigid part (mass ``m - m_s`` at
 pendulum (`dynamics.scene.Slosh`, hanging aft, ``theta1 = -theta_s`` in the yaw plane)
 swings in pitch and yaw; its hinge damping is the planar one at the reference mass,
 ``c = 2 zeta m_s L^2 sqrt(F / (m L))``. The planar spring-mass has no two-axis scene part
-yet, nor the bending mode. With slosh the aerodynamic angle of attack is that of the rigid
-part's mass centre (the planar model's is of the whole vehicle's).
+yet. With slosh the aerodynamic angle of attack is that of the rigid part's mass centre (the
+planar model's is of the whole vehicle's).
+
+Bending: the planar `Bending` is a `BendingMode` in both transverse planes (``eta1`` bends
+towards ``y``, the yaw plane; ``eta2`` towards ``z``, the pitch plane) at the gimbal station,
+and the engine sits on it (``Engine(..., parent="bending")`` at the section): its thrust
+point and direction move with the mode and its thrust excites it. With a mass flow the
+propellant and its internal flow stay on the rigid hub (a thrustless `Engine` named
+``propellant``, state ``m_p``). The gyros read the hub's angles turned by the mode's slope
+at the sensor (`sensed_attitude`), which `attitude_autopilot` and
+`problems.stability.vehicle_loops` close the loops on.
 """
 from __future__ import annotations
 
 import math
 
-from ..launch_vehicle.parts import Aero, MassFlow
+from ..launch_vehicle.parts import Aero, Bending, MassFlow
 from ..launch_vehicle.parts import Slosh as PlanarSlosh
 from ..validate import positive
 from .aero import Aerodynamics
+from .bending import BendingMode
 from .dampers import Slosh
 from .engine import Engine, gimbaled_engine
 from .hubs import RigidHub
 from .scene import Scene
 
-__all__ = ["launch_vehicle_scene", "attitude_autopilot"]
+__all__ = ["launch_vehicle_scene", "attitude_autopilot", "sensed_attitude"]
 
 
 def launch_vehicle_scene(*, thrust, inertia, arm, mass, roll_inertia=None, aero=None,
-                         velocity=None, mass_flow=None, slosh=None, actuator=None,
-                         gimbal=0.2) -> Scene:
+                         velocity=None, mass_flow=None, slosh=None, bending=None,
+                         actuator=None, gimbal=0.2) -> Scene:
     """The launch vehicle of `dynamics.launch_vehicle` in six degrees of freedom.
 
     Parameters
@@ -66,6 +76,9 @@ def launch_vehicle_scene(*, thrust, inertia, arm, mass, roll_inertia=None, aero=
         burn_time`` (or half the mass) is the state ``m_p`` at the mass centre.
     slosh : dynamics.launch_vehicle.Slosh, optional
         A pendulum (module docstring); its ``mass`` is part of ``mass``.
+    bending : dynamics.launch_vehicle.Bending, optional
+        The mode in both transverse planes, the engine on it at the gimbal (module
+        docstring).
     actuator : dynamics.launch_vehicle.Actuator, optional
     gimbal : float [rad], optional
         Deflection bound of the controls (or commands).
@@ -74,7 +87,8 @@ def launch_vehicle_scene(*, thrust, inertia, arm, mass, roll_inertia=None, aero=
     -------
     Scene
         Parts ``engine``, with ``aero`` ``aero`` (air velocity of the mass centre, as the
-        planar model), with ``slosh`` ``slosh``.
+        planar model), with ``slosh`` ``slosh``, with ``bending`` ``bending`` (states
+        ``eta1, eta2, eta1_dot, eta2_dot``) and with a mass flow beside it ``propellant``.
 
     Raises
     ------
@@ -97,7 +111,7 @@ def launch_vehicle_scene(*, thrust, inertia, arm, mass, roll_inertia=None, aero=
                                               (arm, "arm"), (mass, "mass")))
     I_roll = I / 40.0 if roll_inertia is None else positive(roll_inertia, "roll_inertia")
     for part, cls, label in ((aero, Aero, "aero"), (mass_flow, MassFlow, "mass_flow"),
-                             (slosh, PlanarSlosh, "slosh")):
+                             (slosh, PlanarSlosh, "slosh"), (bending, Bending, "bending")):
         if part is not None and not isinstance(part, cls):
             raise TypeError(f"`{label}` must be a dynamics.launch_vehicle.{cls.__name__}, "
                             f"got {type(part).__name__}")
@@ -120,16 +134,21 @@ def launch_vehicle_scene(*, thrust, inertia, arm, mass, roll_inertia=None, aero=
         """A station along the axis (from ``O``, ahead positive) as a hub point."""
         return (s + shift, 0.0, 0.0)
 
-    engine = dict(gimbal=gimbal, actuator=actuator)
+    engine, feed = dict(gimbal=gimbal, actuator=actuator), {}
     if mass_flow is not None:
         burn = mass_flow.burn_time
         mp = mass_flow.rate * burn if burn is not None else 0.5 * m_hub
         m_hub = m_hub - mp
-        engine.update(mass_flow=mass_flow.rate, propellant=mp, tank=station(-shift),
-                      flow_start=station(-mass_flow.flow_start),
-                      nozzle_exit=None if mass_flow.nozzle_exit is None else station(
-                          -mass_flow.nozzle_exit))
-    parts = [Engine(F, station(-l), **engine)]
+        feed = dict(mass_flow=mass_flow.rate, propellant=mp, tank=station(-shift),
+                    flow_start=station(-mass_flow.flow_start),
+                    nozzle_exit=None if mass_flow.nozzle_exit is None else station(
+                        -mass_flow.nozzle_exit))
+    if bending is None:
+        parts = [Engine(F, station(-l), **engine, **feed)]
+    else:
+        parts = [Engine(F, (0.0, 0.0, 0.0), **engine, parent="bending")]
+        if feed:  # the propellant and its flow on the rigid hub, thrust on the mode
+            parts.append(Engine(0.0, station(-l), **feed, name="propellant"))
     if aero is not None:
         if velocity is None:
             raise ValueError("`velocity` is needed with `aero` (its dynamic pressure is "
@@ -143,6 +162,12 @@ def launch_vehicle_scene(*, thrust, inertia, arm, mass, roll_inertia=None, aero=
     elif velocity is not None:
         raise ValueError("`velocity` is the flight speed of `aero`; give it only with `aero`")
     parts += slosh_parts
+    if bending is not None:
+        parts.append(BendingMode(bending.generalized_mass, bending.frequency,
+                                 damping_ratio=bending.damping_ratio, station=station(-l),
+                                 deflection=bending.deflection_gimbal,
+                                 slope=bending.slope_gimbal,
+                                 sensor_slope=bending.slope_sensor))
     reference = None if slosh is None else (shift, 0.0, 0.0)
     return Scene(RigidHub([I_roll, I_hub, I_hub], mass=m_hub, reference=reference), *parts,
                  name="launch_vehicle")
@@ -152,10 +177,9 @@ def attitude_autopilot(scene, *, k_psi, k_psidot, engine=None):
     """The launch vehicle's attitude/rate autopilot in pitch and yaw, ``u = k(x)``.
 
     ``dp = -(k_psi theta + k_psidot w2)``, ``dy = -(k_psi psi + k_psidot w3)`` with the
-    hub's pitch and yaw angles ``theta = 2 atan2(q2, q4)``, ``psi = 2 atan2(q3, q4)``
-    (exact for a turn about one axis, the planar model's ``psi``; the small-angle ``2 q2``,
-    ``2 q3`` of `problems.stability.vehicle_loops` to first order); the deflections, or their
-    commands with an actuator; every other control (wind) zero.
+    angles and rates the gyros read (`sensed_attitude`: the hub's, plus the bending modes'
+    slope at the sensor); the deflections, or their commands with an actuator; every other
+    control (wind) zero.
 
     Parameters
     ----------
@@ -198,10 +222,63 @@ def attitude_autopilot(scene, *, k_psi, k_psidot, engine=None):
     name, part = gimbaled_engine(scene, engine)
     model = scene.model()
     x = ca.SX.sym("x", model.nx)
-    theta = 2 * ca.atan2(x[1], x[3])
-    psi = 2 * ca.atan2(x[2], x[3])
+    theta, psi, q, r = ca.vertsplit(sensed_attitude(scene)(x))
     local = scene.variable_names()["local"][name]
     tail = "" if part.actuator is None else "_c"
-    law = {local["dp" + tail]: -(k * theta + kd * x[5]), local["dy" + tail]: -(k * psi + kd * x[6])}
+    law = {local["dp" + tail]: -(k * theta + kd * q), local["dy" + tail]: -(k * psi + kd * r)}
     u = ca.vertcat(*[law.get(c, ca.SX(0)) for c in model.controls])
     return ca.Function("autopilot", [x], [u], ["x"], ["u"])
+
+
+def sensed_attitude(scene):
+    """What the gyros read: pitch and yaw angles and rates of the hub, turned by the bending.
+
+    ``theta = 2 atan2(q2, q4) + t2``, ``psi = 2 atan2(q3, q4) + t3``, ``w2 + t2'``,
+    ``w3 + t3'``, with ``t`` the sum of the `BendingMode` invariants ``gyro_tilt`` (its rate
+    ``gyro_tilt_rate``; zero without a mode). The hub's angles are exact for a turn about one
+    axis (the planar model's ``psi``; the small-angle ``2 q2``, ``2 q3`` to first order); the
+    yaw plane's mode gives the planar gyros' ``psi + sigma_s eta``, ``psi' + sigma_s eta'``.
+
+    Parameters
+    ----------
+    scene : Scene
+
+    Returns
+    -------
+    casadi.Function
+        ``sensed(x) -> (4, 1)``: ``theta`` [rad], ``psi`` [rad], ``q`` [rad/s], ``r`` [rad/s].
+
+    Raises
+    ------
+    TypeError
+        If ``scene`` is not a Scene.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from appdyn.dynamics.launch_vehicle import Bending
+    >>> from appdyn.dynamics.scene import launch_vehicle_scene, sensed_attitude
+    >>> scene = launch_vehicle_scene(thrust=2.0e6, inertia=4.0e7, arm=20.0, mass=1.0e5,
+    ...                              bending=Bending(12.0, 5.0e3, slope_sensor=0.5))
+    >>> x = scene.state(q=[0.0, 0.0, np.sin(0.05), np.cos(0.05)])  # 0.1 rad of yaw
+    >>> x[scene.model().states.index("eta1")] = 0.02  # the yaw plane's mode
+    >>> [round(float(v), 12) for v in sensed_attitude(scene)(x).full().ravel()]
+    [0.0, 0.11, 0.0, 0.0]
+    """
+    import casadi as ca
+
+    from .scene import check_scene
+
+    scene = check_scene(scene)
+    model = scene.model()
+    x = ca.SX.sym("x", model.nx)
+    p = ca.SX(0, 1)
+    tilt, rate = ca.SX.zeros(3), ca.SX.zeros(3)
+    for key, f in model.invariants.items():
+        if key.startswith("gyro_tilt_rate"):
+            rate = rate + f(x, p)
+        elif key.startswith("gyro_tilt"):
+            tilt = tilt + f(x, p)
+    out = ca.vertcat(2 * ca.atan2(x[1], x[3]) + tilt[1], 2 * ca.atan2(x[2], x[3]) + tilt[2],
+                     x[5] + rate[1], x[6] + rate[2])
+    return ca.Function("sensed_attitude", [x], [out], ["x"], ["sensed"])

@@ -3,7 +3,8 @@
 The scene (a six-degree-of-freedom `RigidHub` with an `Engine` gimbaled in pitch and yaw,
 e.g. `dynamics.scene.launch_vehicle_scene`) is linearized about steady flight along the hub
 axis ``x`` at ``velocity`` (attitude at rest, parts at rest); the small attitude angles are
-``theta = 2 q2`` (pitch, about ``y``) and ``psi = 2 q3`` (yaw, about ``z``). The thrust
+``theta = 2 q2`` (pitch, about ``y``) and ``psi = 2 q3`` (yaw, about ``z``), as the gyros
+read them (`dynamics.scene.sensed_attitude`: plus a bending mode's slope at the sensor). The thrust
 accelerates the vehicle, so this is not an equilibrium and the linearization depends on the
 coordinates: the hub velocity is taken in inertial components ``V = A^T v`` (the states
 ``v1..v3`` stand for them), as the planar case's ``x_dot, y_dot``, which keeps its frozen
@@ -25,7 +26,7 @@ from dataclasses import replace
 import casadi as ca
 import numpy as np
 
-from appdyn.dynamics.scene import check_scene
+from appdyn.dynamics.scene import check_scene, sensed_attitude
 from appdyn.dynamics.scene.engine import gimbaled_engine
 
 from .common import check_number
@@ -33,7 +34,7 @@ from .loop import loop
 
 __all__ = ["vehicle_loops"]
 
-_AXES = {"pitch": ("dp", "q2", "w2"), "yaw": ("dy", "q3", "w3")}
+_AXES = {"pitch": "dp", "yaw": "dy"}
 
 
 def _reduce(A, C, states, frozen):
@@ -135,12 +136,11 @@ def vehicle_loops(scene, *, k_psi, k_psidot, velocity=0.0, engine=None) -> dict:
     x0 = scene.state(v=[V, 0.0, 0.0])
     A, B = _inertial_velocity_jacobians(model, x0)
     inputs = {axis: model.controls.index(local[d] if part.actuator is None else local[d + "_c"])
-              for axis, (d, _, _) in _AXES.items()}
+              for axis, d in _AXES.items()}
     out = {}
-    C = np.zeros((4, model.nx))
-    for r, (axis, (_, qn, wn)) in enumerate(_AXES.items()):
-        C[2 * r, model.states.index(qn)] = 2.0
-        C[2 * r + 1, model.states.index(wn)] = 1.0
+    xs = ca.SX.sym("x", model.nx)
+    sensed = ca.Function("C", [xs], [ca.jacobian(sensed_attitude(scene)(xs), xs)])
+    C = np.asarray(sensed(x0), dtype=float)[[0, 2, 1, 3]]  # pitch angle, rate; yaw
     keep, removed = _reduce(A, C, model.states, frozen)
     A, C = A[np.ix_(keep, keep)], C[:, keep]
     states = [model.states[i] for i in keep]
