@@ -81,6 +81,9 @@ PARTS: dict[str, Entry] = {
                   conserves=("energy", "momentum_linear")),
     "force": Entry(lambda: sc.ExternalForce(point=[0.2, 0.4, -0.3]), conserves=("energy",),
                    work={"F": _point_velocity([0.2, 0.4, -0.3])}),
+    # a mean-axes bending mode, undamped (it carries parts at its station: a carrier)
+    "bending": Entry(lambda: sc.BendingMode(2.0, 3.0, station=(-0.5, 0.1, 0.0), deflection=0.6,
+                                            slope=0.4, sensor_slope=0.2)),
     # engine off (no thrust, no mass flow): its gimbal actuator states move, nothing else
     "engine": Entry(lambda: sc.Engine(0.0, (-0.5, 0.1, 0.0), gimbal=0.1,
                                       actuator=Actuator(0.2, rate_limit=1.0)),

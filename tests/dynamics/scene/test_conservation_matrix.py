@@ -116,16 +116,16 @@ def test_energy_changes_at_the_power_of_the_controls(hub):
 
 # ------------------------------------------------------------------ parts on parts
 #: the parts that can carry parts, and every part that can sit on one (fields cannot)
-CARRIERS = ("panel", "ball_panel")
+CARRIERS = ("panel", "ball_panel", "bending")
 MOUNTABLE = tuple(n for n in PARTS if n != "tilt")
 ON_PARTS = [pytest.param(c, (n,), marks=pytest.mark.slow) for c in CARRIERS for n in MOUNTABLE
             ] + [("panel", tuple(n for n in ALL if n in MOUNTABLE and n != "panel"))]
 
 
 def _mounted_scene(hub, carrier, names):
-    """The hub, a carrier panel, and ``names`` each on the carrier."""
+    """The hub, a carrier (a panel, a bending mode), and ``names`` each on the carrier."""
     parts = [PARTS[carrier].make()]
-    parts += [dataclasses.replace(PARTS[n].make(), parent="panel") for n in names]
+    parts += [dataclasses.replace(PARTS[n].make(), parent=parts[0].kind) for n in names]
     return Scene(HUBS[hub](), *parts)
 
 
