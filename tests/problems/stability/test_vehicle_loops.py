@@ -1,12 +1,13 @@
 """`stability.vehicle_loops` on the six-degree-of-freedom launch vehicle scene against the
 planar case `stability.launch_vehicle` (an independent model and reduction): each axis's
-margins and closed-loop eigenvalues, rigid, with air, with the actuator and with mass flow."""
+margins and closed-loop eigenvalues, rigid, with air, with the actuator, with mass flow, with
+slosh and with the body bending mode (the engine on it, the gyros on its slope)."""
 import math
 
 import numpy as np
 import pytest
 
-from appdyn.dynamics.launch_vehicle import Actuator, Aero, MassFlow, Slosh
+from appdyn.dynamics.launch_vehicle import Actuator, Aero, Bending, MassFlow, Slosh
 from appdyn.dynamics.scene import ExternalTorque, RigidHub, Scene, launch_vehicle_scene
 from appdyn.problems import stability
 
@@ -22,6 +23,16 @@ CASES = {
     "slosh_flow_actuator": dict(slosh=Slosh(5.0e3, -3.0, length=1.5),
                                 mass_flow=MassFlow(rate=700.0, flow_start=-5.0),
                                 actuator=Actuator(0.05)),
+    # the gyros on the mode's slope drive it unstable (no bending filter); at a node, stable
+    "bending": dict(bending=Bending(12.0, 5.0e3, damping_ratio=0.02, slope_sensor=0.03,
+                                    deflection_gimbal=1.4, slope_gimbal=-0.05)),
+    "bending_sensor_at_a_node": dict(bending=Bending(12.0, 5.0e3, damping_ratio=0.02,
+                                                     deflection_gimbal=1.4, slope_gimbal=-0.05)),
+    "bending_aero_actuator": dict(bending=Bending(12.0, 5.0e3, damping_ratio=0.02,
+                                                  slope_sensor=0.03, deflection_gimbal=1.4,
+                                                  slope_gimbal=-0.05),
+                                  aero=Aero(3.0e4, 10.0, 3.0, -2.0), velocity=300.0,
+                                  actuator=Actuator(0.05)),
 }
 
 
