@@ -159,7 +159,10 @@ class BendingMode(Part):
         setf(self, "station", tuple(finite_array(self.station, "station", (3,)).tolist()))
         a = unit_vector(self.axis, "axis")
         setf(self, "axis", tuple(a.tolist()))
-        dirs = np.atleast_2d(np.asarray(self.directions, dtype=float))
+        try:
+            dirs = np.atleast_2d(np.asarray(self.directions, dtype=float))
+        except (TypeError, ValueError):
+            dirs = np.zeros((0, 0))
         if dirs.ndim != 2 or dirs.shape[1] != 3 or not 1 <= dirs.shape[0] <= 2:
             raise ValueError("`directions` must be one or two 3-vectors, got "
                              f"{self.directions!r}")

@@ -94,6 +94,8 @@ def test_bending_mode_arguments():
         BendingMode(1.0, 1.0, directions=((1.0, 0.0, 0.0),))
     with pytest.raises(ValueError, match="directions"):
         BendingMode(1.0, 1.0, directions=((0.0, 1.0, 0.0), (0.0, 0.6, 0.8)))
+    with pytest.raises(ValueError, match="directions"):
+        BendingMode(1.0, 1.0, directions="y")
     with pytest.raises(TypeError, match="bending"):
         launch_vehicle_scene(thrust=F, inertia=I, arm=L, mass=M, bending=1.0)
     one = Scene(RigidHub(I_HUB, mass=1.0), BendingMode(1.0, 1.0, directions=(0.0, 0.0, 1.0)))
