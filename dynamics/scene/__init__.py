@@ -21,6 +21,8 @@ Parts
 `TiltTorque`           a torque from the tilt of a hub axis (heavy top, projectile, bearings)
 `HingedPanel`          a rigid panel on a revolute (``theta``) or ball (``p1..p4``) hinge
 `GravityGradient`      gravity on every body: forces and gravity-gradient torques
+`FlexibleAppendage`    a flexible cantilever by clamped-free modes (``eta``, ``xi``), with
+                       geometric stiffening; `flexible_antenna_satellite`: seed Example 6
 =====================  =====================================================================
 
 Examples
@@ -35,6 +37,7 @@ from .cmgs import CMGCluster
 from .contract import Body, Contribution, Frame, Load, Part, PartVariables, Variable
 from .dampers import PointMassDamper, Slosh, SphericalDamper
 from .fields import TiltTorque
+from .flexible import FlexibleAppendage, flexible_antenna_satellite
 from .gravity import GravityGradient
 from .hubs import RigidHub
 from .loads import ExternalForce, ExternalTorque
@@ -45,4 +48,5 @@ from .wheels import HeldRotor, ReactionWheels
 __all__ = ["Scene", "check_scene", "RigidHub", "Part", "PartLayout", "Variable", "PartVariables", "Body", "Load",
            "Contribution", "Frame", "ReactionWheels", "HeldRotor", "ExternalTorque",
            "ExternalForce", "PointMassDamper", "SphericalDamper", "Slosh", "TiltTorque",
-           "HingedPanel", "GravityGradient", "CMGCluster"]
+           "HingedPanel", "GravityGradient", "CMGCluster", "FlexibleAppendage",
+           "flexible_antenna_satellite"]
