@@ -167,3 +167,35 @@ def test_bad_input_names_the_argument():
         FlexibleAppendage(1.0, 1.0, 1.0, modes=0)
     with pytest.raises(ValueError, match="length"):
         FlexibleAppendage(-1.0, 1.0, 1.0)
+
+
+def test_seed_example6_hub_locked_limit_gives_cantilever_frequencies():
+    from appdyn.dynamics.scene import flexible_antenna_satellite
+    from appdyn.problems import stability
+    L, m, EI = 3.0, 0.2, (20.0, 35.0)
+    sat = flexible_antenna_satellite(np.diag([1e12, 1e12, 1e12]), L, m, EI, hub_radius=0.8,
+                                     modes=2)
+    rep = stability.spin(sat, [0, 0, 1], 0.0)   # rate 0 allowed
+    found = np.sort(rep.eigenvalues.imag[rep.eigenvalues.imag > 1e-6])
+    cantilever = np.sort(np.concatenate([TEXTBOOK[:2] ** 2 * np.sqrt(ei / (m * L ** 4))
+                                         for ei in EI] * 4))
+    assert np.max(np.abs(found / cantilever - 1)) < 1e-8
+    flex = [md for md in rep.modes if md.wn > 1e-6]
+    # in plane (eta, along spin x direction) at EI[0], out of plane (xi) at EI[1]
+    for md in flex:
+        coord = md.label.split(": ")[1]
+        ei = EI[0] if coord.startswith("eta") else EI[1]
+        k = int(coord[3 if coord.startswith("eta") else 2])
+        assert abs(md.wn / (TEXTBOOK[k - 1] ** 2 * np.sqrt(ei / (m * L ** 4))) - 1) < 1e-8
+
+
+def test_seed_example6_spinning_stiffens_and_stays_stable():
+    from appdyn.dynamics.scene import flexible_antenna_satellite
+    from appdyn.problems import stability
+    sat = flexible_antenna_satellite([300.0, 300.0, 500.0], 3.0, 0.2, 20.0, hub_radius=0.8,
+                                     modes=2)
+    w1 = sat.parts[0].frequencies()[0, 0]
+    rep = stability.spin(sat, [0, 0, 1], 2.0)
+    assert rep.verdict == "marginally stable"
+    out = [md.wn for md in rep.modes if ": xi1" in md.label]
+    assert out and min(out) > w1   # the out-of-plane bending is stiffened by the spin
