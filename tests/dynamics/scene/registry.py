@@ -78,7 +78,7 @@ PARTS: dict[str, Entry] = {
     "tilt": Entry(lambda: sc.TiltTorque(3.0, axis=(0.0, 0.0, 1.0), direction=(0.0, 0.0, 1.0)),
                   conserves=("energy", "momentum_linear")),
     "flexible": Entry(lambda: sc.FlexibleAppendage(2.0, 0.5, (0.5, 0.8), root=(0.3, -0.4, 0.2),
-                                                   direction=(0.6, 0.0, 0.8), modes=2,
+                                                   direction=(0.6, 0.0, 0.8), modes=1,
                                                    tip_mass=0.2)),
     "force": Entry(lambda: sc.ExternalForce(point=[0.2, 0.4, -0.3]), conserves=("energy",),
                    work={"F": _point_velocity([0.2, 0.4, -0.3])}),
