@@ -148,6 +148,15 @@ class FlexibleAppendage(Part):
         Include the axial foreshortening (True). False gives the plain linear modal model,
         *for comparison only* (it misses the centrifugal stiffening: a spin-up diverges).
 
+    Raises
+    ------
+    ValueError
+        Naming the argument: a non-positive ``length``, ``mass_per_length`` or
+        ``bending_stiffness``, a negative ``tip_mass``, ``modes`` < 1, a zero or non-finite
+        ``direction`` or ``normal``, a ``normal`` not perpendicular to ``direction``.
+    TypeError
+        A ``parent`` that is not a str (or a non-integer ``modes``).
+
     Notes
     -----
     States: ``eta1..etaN`` (along ``normal``), ``xi1..xiN`` (along ``direction x normal``)

@@ -199,3 +199,20 @@ def test_seed_example6_spinning_stiffens_and_stays_stable():
     assert rep.verdict == "marginally stable"
     out = [md.wn for md in rep.modes if ": xi1" in md.label]
     assert out and min(out) > w1   # the out-of-plane bending is stiffened by the spin
+
+
+def test_parent_is_a_field_and_must_be_a_name():
+    part = FlexibleAppendage(1.0, 1.0, 1.0, parent="panel")
+    assert part.parent == "panel" and FlexibleAppendage(1.0, 1.0, 1.0).parent is None
+    with pytest.raises(TypeError, match="parent"):
+        FlexibleAppendage(1.0, 1.0, 1.0, parent=3)
+
+
+def test_default_normal_is_perpendicular_and_right_handed_planes():
+    rng = np.random.default_rng(0)
+    for _ in range(20):
+        d = rng.normal(size=3)
+        part = FlexibleAppendage(1.0, 1.0, 1.0, direction=d, modes=1)
+        n, b, dd = map(np.asarray, (part.normal, part.binormal, part.direction))
+        assert abs(n @ dd) < 1e-15 and abs(np.linalg.norm(n) - 1) < 1e-15
+        assert np.allclose(np.cross(dd, n), b, atol=1e-15)
