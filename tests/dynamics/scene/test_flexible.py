@@ -216,3 +216,44 @@ def test_default_normal_is_perpendicular_and_right_handed_planes():
         n, b, dd = map(np.asarray, (part.normal, part.binormal, part.direction))
         assert abs(n @ dd) < 1e-15 and abs(np.linalg.norm(n) - 1) < 1e-15
         assert np.allclose(np.cross(dd, n), b, atol=1e-15)
+
+
+def _textbook_shapes(x, L, m, roots):
+    """Clamped-free shapes from the textbook formula, normalized by their own quadrature."""
+    b = np.asarray(roots)[:, None] / L
+    sig = (np.cosh(roots) + np.cos(roots)) / (np.sinh(roots) + np.sin(roots))
+    phi = np.cosh(b * x) - np.cos(b * x) - sig[:, None] * (np.sinh(b * x) - np.sin(b * x))
+    xs, ws = np.polynomial.legendre.leggauss(200)
+    xs, ws = 0.5 * L * (xs + 1), 0.5 * L * ws
+    ref = np.cosh(b * xs) - np.cos(b * xs) - sig[:, None] * (np.sinh(b * xs) - np.sin(b * xs))
+    return phi / np.sqrt(m * (ref ** 2) @ ws)[:, None]
+
+
+def test_seed_example6_in_plane_modes_coupled_with_the_hub():
+    """At rate 0 the in-plane bending couples with the hub's rotation about the spin axis:
+    ``[[I, b^T], [b, E]] q.. + diag(0, Omega^2) q = 0`` per antenna, ``b_i = int m (r + x)
+    phi_i`` (textbook shapes, own quadrature); the symmetric scene's frequencies hold them."""
+    from appdyn.dynamics.scene import flexible_antenna_satellite
+    from appdyn.problems import stability
+    L, m, EI, r, Iz, n = 3.0, 0.2, 20.0, 0.8, 500.0, 2
+    sat = flexible_antenna_satellite([300.0, 300.0, Iz], L, m, EI, hub_radius=r, modes=n)
+    found = stability.spin(sat, [0, 0, 1], 0.0).eigenvalues
+    xs, ws = np.polynomial.legendre.leggauss(200)
+    xs, ws = 0.5 * L * (xs + 1), 0.5 * L * ws
+    phi = _textbook_shapes(xs, L, m, TEXTBOOK[:n])
+    b = m * phi @ (ws * (r + xs))
+    I_tot = Iz + 4 * m * ws @ (r + xs) ** 2
+    om2 = TEXTBOOK[:n] ** 4 * EI / (m * L ** 4)
+    M = np.eye(1 + 4 * n)
+    M[0, 0] = I_tot
+    M[0, 1:] = M[1:, 0] = np.tile(b, 4)
+    K = np.diag(np.r_[0.0, np.tile(om2, 4)])
+    lam = np.sort(np.linalg.eigvals(np.linalg.solve(M, K)).real)[1:]  # without the rigid 0
+    expected = np.sqrt(lam)
+    for f in expected:
+        assert np.min(np.abs(found.imag - f)) < 1e-9 * f, f
+    # n of them (all antennas bending alike, the hub turning against them) are stiffer than
+    # the cantilever's; the other 3 n are the cantilever's
+    stiffer = expected[np.min(np.abs(expected[:, None] - np.sqrt(om2)[None, :]), axis=1)
+                       > 1e-6 * expected]
+    assert stiffer.size == n and np.all(stiffer > np.sqrt(om2))
