@@ -16,6 +16,11 @@ conserves; DESIGN.md's truth catalogue):
 5. ``hinged``        -- two bodies on a ball hinge, no Baumgarte stabilization, 100 s: drift of
    energy, inertial angular and linear momentum, and the hinge residual ``[|phi|, |B nu|]``
    (all zero / conserved for the exact solution);
+   ``hinged_scene`` -- the same two bodies and start as a scene in minimal coordinates
+   (`dynamics.hinged.hinged_scene`: a hub with a ball-hinged panel, 20 states, no
+   multipliers), its run mapped to the two bodies (`dynamics.hinged.two_body_state`) and
+   measured by the same invariants of the multiplier model (the hinge residual is then
+   round-off: the hinge holds by construction);
 6. ``launch_vehicle`` -- rigid launch vehicle in the yaw plane with the autopilot closed
    (no aero, no mass flow), 20 s from psi0 = 1e-6 rad: all six states against the affine
    closed-loop solution ``expm`` of the Jacobian at the origin augmented by ``f(0)``.
@@ -182,17 +187,24 @@ def case_cmg():
                 parts=parts, lie=True)
 
 
-def case_hinged():
+_HINGED = dict(m1=10.0, inertia1=[1.0, 2.0, 2.5], m2=2.0, inertia2=[0.2, 0.3, 0.4],
+               r1=[0.4, 0.0, 0.0], r2=[-0.3, 0.0, 0.0])
+_HINGED_W1, _HINGED_W2 = np.array([0.1, 0.3, 1.0]), np.array([0.5, -0.2, 0.3])
+
+
+def _hinged_start():
+    """``(model, x0, parts)``: the ball-hinged pair's multiplier model (no stabilization),
+    its start and the error parts of a run given as two-body states."""
     from appdyn.dynamics import hinged_bodies
     from appdyn.dynamics.attitude import quat_from_axis_angle
 
-    model = hinged_bodies(10.0, [1.0, 2.0, 2.5], 2.0, [0.2, 0.3, 0.4], [0.4, 0.0, 0.0],
-                          [-0.3, 0.0, 0.0], kind="ball", stabilization=None)
+    a = _HINGED
+    model = hinged_bodies(a["m1"], a["inertia1"], a["m2"], a["inertia2"], a["r1"], a["r2"],
+                          kind="ball", stabilization=None)
     q2 = np.asarray(quat_from_axis_angle(np.array([0.0, 0.6, 0.8]), 0.7), dtype=float).ravel()
-    w1, w2 = np.array([0.1, 0.3, 1.0]), np.array([0.5, -0.2, 0.3])
-    x0 = model.initial_state([0, 0, 0, 1], w1, [0.2, 0.0, 0.0], q2, w2)
-    t = np.linspace(0.0, 100.0, 101)
-    length, speed = 0.7, 0.7 * max(np.linalg.norm(w1), np.linalg.norm(w2))
+    x0 = model.initial_state([0, 0, 0, 1], _HINGED_W1, [0.2, 0.0, 0.0], q2, _HINGED_W2)
+    length = 0.7
+    speed = length * max(np.linalg.norm(_HINGED_W1), np.linalg.norm(_HINGED_W2))
 
     def parts(x):
         res = np.asarray(model.invariant("constraint_residual", x))
@@ -202,9 +214,43 @@ def case_hinged():
                 "hinge_position": float(np.max(res[0]) / length),
                 "hinge_velocity": float(np.max(res[1]) / speed)}
 
+    return model, x0, parts
+
+
+def case_hinged():
+    model, x0, parts = _hinged_start()
+    t = np.linspace(0.0, 100.0, 101)
     return Case("hinged", "two bodies on a ball hinge (no stabilization), 100 s", model, x0, t,
                 _finite_or_inf(lambda x: max(parts(x).values())),
                 "conserved energy and momenta, zero hinge residual", parts=parts, lie=True)
+
+
+def case_hinged_scene():
+    from appdyn.dynamics.attitude import dcm_from_quat
+    from appdyn.dynamics.hinged import HINGED_STATES, hinged_scene, two_body_state
+
+    a = _HINGED
+    _, x0, two_body_parts = _hinged_start()
+    scene = hinged_scene(a["m1"], a["inertia1"], a["m2"], a["inertia2"], a["r1"], a["r2"],
+                         "ball")
+    at = dict(zip(HINGED_STATES, x0))
+    p = np.array([at[f"q{i}_2"] for i in range(1, 5)])   # body 1 at identity: q_2 = p
+    w1 = np.array([at[f"w{i}"] for i in range(1, 4)])
+    u = np.array([at[f"w{i}_2"] for i in range(1, 4)]) - np.asarray(
+        dcm_from_quat(p), dtype=float) @ w1              # w_2 = A(p) w1 + u
+    y0 = scene.state(w=w1, v=[at["v1"], at["v2"], at["v3"]], panel=np.r_[p, u])
+    mapping = two_body_state(scene)
+    if not np.allclose(np.asarray(mapping(y0)).ravel(), x0, rtol=0, atol=1e-14):
+        raise RuntimeError("hinged_scene: the scene's start is not the two bodies' start")
+    t = np.linspace(0.0, 100.0, 101)
+
+    def parts(y):
+        return two_body_parts(np.asarray(mapping.map(y.shape[1])(y)))
+
+    return Case("hinged_scene", "the same pair as a scene (hub + ball-hinged panel), 100 s",
+                scene.model(), y0, t, _finite_or_inf(lambda y: max(parts(y).values())),
+                "conserved energy and momenta of the two-body model, zero hinge residual",
+                parts=parts, lie=True)
 
 
 def case_launch_vehicle():
@@ -248,7 +294,7 @@ def case_launch_vehicle():
 
 
 CASES = (case_torque_free, case_axisymmetric, case_wheels, case_cmg, case_hinged,
-         case_launch_vehicle)
+         case_hinged_scene, case_launch_vehicle)
 
 
 # ------------------------------------------------------------------ scipy's right-hand side

@@ -30,6 +30,9 @@ API
     The lock to hold around casadi construction outside `get` (see Threads below).
 ``memoize``
     Decorator for factories of hashable arguments (e.g. ``rigid_body``'s model builder).
+``memoize_values``
+    Decorator for public builders of array-like arguments, keyed by their values (a repeated
+    ``rigid_body([1, 2, 3])`` skips its checks and scene).
 ``compiler()``
     Path of the C compiler (``gcc`` or ``cc`` on the ``PATH``), or ``None``.
 ``compile_function(f)``
@@ -93,6 +96,42 @@ model was used before. `should_compile`:
   against 3.4 ms compiled.)
 
 A Function that cannot be code-generated falls back to the interpreted one.
+
+Compiled once per machine
+-------------------------
+Every compile (`compile_parallel`) goes through the persistent compile cache,
+`dynamics.diskcache`: a library compiled before on this machine, by any process, is loaded
+instead of compiled. The chunk loops and ``auto``'s pass are looked up by their *recipe*
+(`Job`, `recipe`: the serialized model Function, the method and this code's version), before
+any step Function is built or any C generated, so a fresh process's first ``simulate`` of a
+known model costs milliseconds (``bench/compile_cache.py``). `clear` empties only the
+in-memory cache; ``appdyn cache clear`` (`diskcache.clear`) the disk.
+
+First compile
+-------------
+What the first-ever ``simulate`` of a model waits for is the C compiler (the pass and the
+chunk loop compile in parallel). gcc's time at ``-O1`` grows faster than linearly with the
+size of one C function, and a Runge-Kutta step that inlines the right-hand side in each
+stage is ``stages`` times its size: the two hinged bodies' (26 states, 666 instructions)
+rk8 step was 484 kB of C and its first ``simulate`` 4.8 s; a 10-part scene's (35 states,
+3,760 instructions) 2 MB and 42 s. Choices weighed:
+
+* running interpreted while the compile finishes in a background thread: rejected, the
+  answer would depend on timing (``auto``'s C pass and its interpreted fallback are
+  different algorithms), against the deterministic jit policy above;
+* ``-O0`` for big sources: 3-5x faster compiles, but 3x slower steps for every later run
+  (measured on the hinged bodies' chunk loop);
+* **smaller generated code (chosen)**: a compiled step whose inlined right-hand side
+  evaluations exceed `kernels.INLINE_MAX` (2,000 instructions) calls the right-hand side as
+  one C function and combines the stages as vector loops (`kernels.calls_rhs`; the pass
+  shares that function with its rhs). Generated C: hinged bodies 484 to 79 kB (pass) and 243
+  to 64 kB (chunk), the scene 2 MB to 149 kB and 994 to 134 kB; compiler CPU (about the
+  wall time of the parallel compiles on an idle machine) 0.75 s for the hinged bodies and
+  1.2 s for the scene, against 4.6 s and 42 s. The steps cost 1.2x the inlined ones on the
+  hinged bodies (21.8 against 18.0 us per step in the compiled chunk, a loaded machine) and
+  0.7x on the scene (38.7 against 57.2 us: the smaller code fits the instruction cache); the
+  results are the same to the last bit or within 3e-17. Small models (the rigid body: 12 x
+  67 instructions) keep the inlined step, which is 1.8x faster there.
 """
 from __future__ import annotations
 
@@ -109,11 +148,13 @@ from typing import Callable, Hashable, NamedTuple
 
 import casadi as ca
 
+from . import diskcache
 from .validate import integer
 
 __all__ = ["MAXSIZE", "JIT_MIN_WORK", "CacheInfo", "FunctionCache", "get", "contains", "clear",
-           "info", "set_maxsize", "function_key", "memoize", "checkout", "construction_lock", "POOL_SIZE", "compiler",
-           "should_compile", "compile_function"]
+           "info", "set_maxsize", "function_key", "memoize", "memoize_values", "value_key",
+           "checkout", "construction_lock", "POOL_SIZE", "compiler", "should_compile",
+           "compile_function", "compile_c", "compile_parallel", "Job", "recipe"]
 
 #: Most entries kept (least recently used are dropped first).
 MAXSIZE = 512
@@ -286,41 +327,134 @@ def compile_c(functions: list, extra: str, opt: str, load: Callable[[str], objec
     return out
 
 
+class Job(NamedTuple):
+    """A compile for `compile_parallel` whose functions are built only when needed.
+
+    ``make()`` returns ``(functions, extra)`` (the casadi Functions to generate, the first
+    naming the library, and C source appended to them); ``opt`` the compiler flags;
+    ``load(path)`` the loaded result; ``recipe`` a text that determines the generated source
+    (with the code of `diskcache.code_version`): the persistent cache is looked up by it
+    before anything is built (`recipe`). ``None``: the source is generated and hashed.
+    """
+
+    make: Callable[[], tuple]
+    opt: str
+    load: Callable[[str], object]
+    recipe: str | None = None
+
+
+def recipe(*parts) -> str | None:
+    """The `Job.recipe` of ``parts``: casadi Functions by their serialized form, anything else
+    by its ``repr``; None when a Function cannot be serialized (the job then hashes its
+    generated source).
+
+    Examples
+    --------
+    >>> import casadi as ca
+    >>> from appdyn.dynamics import cache
+    >>> x = ca.SX.sym("x")
+    >>> f = ca.Function("f", [x], [2 * x])
+    >>> cache.recipe("chunk", f, "rk8") == cache.recipe("chunk", f, "rk8")
+    True
+    """
+    out = []
+    for part in parts:
+        if isinstance(part, ca.Function):
+            try:
+                part = part.serialize()
+            except RuntimeError:
+                return None
+        out.append(repr(part))
+    return "\0".join(out)
+
+
 def compile_parallel(jobs: list) -> list:
-    """`compile_c` of several ``(functions, extra, opt, load)`` jobs, the C compilers running
-    at once (one process each): per job, in order, the loaded result or the ``RuntimeError``
-    saying why it failed (returned, not raised); a list of None without a C compiler."""
+    """`compile_c` of several jobs (`Job`, or ``(functions, extra, opt, load)``), the C
+    compilers running at once (one process each): per job, in order, the loaded result or
+    the ``RuntimeError`` saying why it failed (returned, not raised); a list of None without
+    a C compiler.
+
+    A library compiled before on this machine is loaded from the persistent compile cache
+    (`dynamics.diskcache`) instead: looked up by the job's recipe before anything is built,
+    or by the hash of the generated C source; the compiler runs only for the jobs whose
+    library is not there (or is rejected as corrupted or foreign)."""
     compiler = _CACHE.compiler()
     if compiler is None:
         return [None] * len(jobs)
-    with tempfile.TemporaryDirectory(prefix="appdyn-cc-") as work:
+    jobs = [job if isinstance(job, Job) else
+            Job(lambda job=job: (job[0], job[1]), job[2], job[3]) for job in jobs]
+    results: list = [None] * len(jobs)
+    with contextlib.ExitStack() as stack:
+        work = None  # the scratch directory, made at the first compile
         procs = []
-        for functions, extra, opt, _ in jobs:
-            name = functions[0].name()
-            source = os.path.join(work, f"{name}.c")
+        for i, job in enumerate(jobs):
+            flags = [*job.opt.split(), "-w", "-fPIC", "-shared"]
+            key = None
+            if job.recipe is not None:
+                key = diskcache.artifact_key(job.recipe.encode() + diskcache.code_version(),
+                                             compiler, flags)
+                if _load_cached(key, job, results, i):
+                    continue
+            if work is None:
+                work = stack.enter_context(tempfile.TemporaryDirectory(prefix="appdyn-cc-"))
+            try:
+                functions, extra = job.make()
+                name = functions[0].name()
+                source = _generate_c(functions, extra, work)
+            except RuntimeError as exc:  # (a Function that cannot be code-generated)
+                results[i] = RuntimeError(f"generating C failed: {exc}")
+                continue
+            if key is None:
+                with open(source, "rb") as f:
+                    key = diskcache.artifact_key(f.read(), compiler, flags)
+                if _load_cached(key, job, results, i):
+                    continue
             library = os.path.join(work, f"{name}.so")
-            gen = ca.CodeGenerator(f"{name}.c", {"with_header": False})
-            for fun in functions:
-                gen.add(fun)
-            gen.generate(work + os.sep)
-            if extra:
-                with open(source, "a") as out:
-                    out.write(extra)
-            procs.append((name, library, subprocess.Popen(
-                [compiler, *opt.split(), "-w", "-fPIC", "-shared", source, "-o", library, "-lm"],
+            diskcache.compiled()
+            procs.append((i, name, key, library, subprocess.Popen(
+                [compiler, *flags, os.path.basename(source), "-o", library, "-lm"], cwd=work,
                 stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)))
-        results = []
-        for (name, library, proc), job in zip(procs, jobs):
+        for i, name, key, library, proc in procs:
             _, err = proc.communicate()
             if proc.returncode != 0:
-                results.append(RuntimeError(f"C compilation of {name} failed: "
-                                            f"{err.strip()[-500:]}"))
+                results[i] = RuntimeError(f"C compilation of {name} failed: "
+                                          f"{err.strip()[-500:]}")
                 continue
             try:
-                results.append(job[3](library))
+                results[i] = jobs[i].load(diskcache.publish(key, library))
             except (OSError, RuntimeError) as exc:  # (a library that does not load)
-                results.append(RuntimeError(f"loading {name} failed: {exc}"))
+                results[i] = RuntimeError(f"loading {name} failed: {exc}")
         return results
+
+
+def _load_cached(key: str, job: Job, results: list, i: int) -> bool:
+    """Load the library of ``key`` from the persistent cache into ``results[i]``; whether
+    it was there (one that fails to load is deleted, to be rebuilt)."""
+    found = diskcache.lookup(key)
+    if found is None:
+        return False
+    try:
+        results[i] = job.load(found)
+    except (OSError, RuntimeError):
+        diskcache.discard(key)
+        return False
+    diskcache.hit()
+    return True
+
+
+def _generate_c(functions: list, extra: str, work: str) -> str:
+    """Generate the C source of the casadi ``functions`` (named after the first) into the
+    directory ``work``, with the C source ``extra`` appended; returns its path."""
+    name = functions[0].name()
+    gen = ca.CodeGenerator(f"{name}.c", {"with_header": False})
+    for fun in functions:
+        gen.add(fun)
+    gen.generate(work + os.sep)
+    source = os.path.join(work, f"{name}.c")
+    if extra:
+        with open(source, "a") as out:
+            out.write(extra)
+    return source
 
 
 _CACHE = FunctionCache()
@@ -364,6 +498,72 @@ def memoize(fun: Callable) -> Callable:
     @functools.wraps(fun)
     def cached(*args):
         return get((name,) + args, lambda: fun(*args))
+
+    return cached
+
+
+class _Unkeyable(Exception):
+    """An argument `value_key` cannot key by value (the call is not cached)."""
+
+
+def value_key(v) -> Hashable:
+    """A hashable key of one argument by value: a list, tuple or array of real numbers as
+    ``("array", shape, values)`` (so ``[1, 2]`` and ``np.array([1.0, 2.0])`` are one key),
+    a real number as ``("num", float)``, ``None``, a string, a boolean or a hashable
+    dataclass (a part) with its type name. Raises `_Unkeyable` for anything else (booleans
+    inside arrays, ragged lists, CasADi symbols, other objects): such calls are not cached."""
+    import dataclasses
+    import numbers
+
+    import numpy as np
+
+    if isinstance(v, (list, tuple, np.ndarray)):
+        try:
+            a = np.asarray(v)
+        except (TypeError, ValueError):
+            raise _Unkeyable from None
+        if a.dtype.kind not in "fi":
+            if isinstance(v, tuple) and a.dtype.kind == "O":
+                return ("tuple",) + tuple(value_key(e) for e in v)
+            raise _Unkeyable
+        return ("array", a.shape, tuple(a.astype(float).ravel().tolist()))
+    if isinstance(v, numbers.Real) and not isinstance(v, (bool, np.bool_)):
+        return ("num", float(v))
+    if not (v is None or isinstance(v, (str, bool, np.bool_))
+            or dataclasses.is_dataclass(v) and not isinstance(v, type)):
+        raise _Unkeyable
+    try:
+        hash(v)
+    except TypeError:
+        raise _Unkeyable from None
+    return (type(v).__name__, v)
+
+
+def memoize_values(fun: Callable) -> Callable:
+    """Decorator: cache ``fun(*args, **kwargs)`` in the one cache, keyed by the arguments'
+    values (`value_key`), before ``fun`` checks them.
+
+    For public builders that check array-like arguments and build a scene whose model is
+    cached (``rigid_body``): a repeated call returns the cached model without the checks
+    (a bad argument is never cached: its call raises on every miss). Calls whose arguments
+    cannot be keyed are not cached.
+
+    Examples
+    --------
+    >>> from appdyn.dynamics import rigid_body
+    >>> rigid_body([1.0, 2.0, 3.0]) is rigid_body((1, 2, 3))
+    True
+    """
+    name = f"{fun.__module__}.{fun.__qualname__}"
+
+    @functools.wraps(fun)
+    def cached(*args, **kwargs):
+        try:
+            key = (name, tuple(value_key(a) for a in args),
+                   tuple(sorted((k, value_key(v)) for k, v in kwargs.items())))
+        except _Unkeyable:
+            return fun(*args, **kwargs)
+        return get(key, lambda: fun(*args, **kwargs))
 
     return cached
 

@@ -82,7 +82,8 @@ from .rigid_body import RIGID_BODY_STATES
 from .validate import (check_inertia, finite_array, one_of, positive, unit_axes, unit_quaternion,
                        unit_vector)
 
-__all__ = ["ASSEMBLY_TOL", "HINGED_STATES", "Hinge", "HingedBodies", "hinge_terms", "hinged_bodies"]
+__all__ = ["ASSEMBLY_TOL", "HINGED_STATES", "Hinge", "HingedBodies", "hinge_terms", "hinged_bodies",
+           "hinged_scene", "two_body_state"]
 
 _BODY = RIGID_BODY_STATES + ("v1", "v2", "v3", "x", "y", "z")
 #: State names: body 1, then body 2 (suffix ``_2``); see `hinged_bodies`.
@@ -463,3 +464,118 @@ def hinged_bodies(m1, I1, m2, I2, r1, r2, *, kind: str = "ball", axis=None,
     as_tuple = lambda a: tuple(float(v) for v in np.ravel(a))  # noqa: E731
     return _hinged(Hinge(m1, as_tuple(I1), m2, as_tuple(I2), as_tuple(r1), as_tuple(r2), kind,
                          axis, stabilization))
+
+
+def hinged_scene(m1, inertia1, m2, inertia2, r1, r2, kind="revolute", axis=None) -> "Scene":
+    """The two hinged bodies of `hinged_bodies` as a scene, in minimal coordinates: body 1
+    the six-degree-of-freedom hub, body 2 a `dynamics.scene.HingedPanel` (no multipliers,
+    no constraint drift; `two_body_state` maps its states to `hinged_bodies`').
+
+    Parameters
+    ----------
+    m1, m2 : float [kg]
+    inertia1, inertia2 : array_like, shape (3, 3) or (3,) [kg m^2]
+        About each mass centre, each body's axes (parallel at zero hinge angle).
+    r1, r2 : array_like, shape (3,) [m]
+        The hinge point from each mass centre (``hinged_bodies``' convention): the panel's
+        ``hinge_point`` is ``r1``, its ``cm_offset`` ``-r2``.
+    kind : {'revolute', 'ball'}, optional
+    axis : array_like, shape (3,), optional
+        The revolute hinge axis (body-1 axes; default ``[0, 0, 1]``).
+
+    Returns
+    -------
+    Scene
+        ``Scene(RigidHub(inertia1, mass=m1), HingedPanel(m2, inertia2, r1, -r2, axis=...),
+        name=f"hinged_{kind}")``; states ``q, w, r, v`` (body 1's mass centre) then
+        ``theta, theta_dot`` (revolute) or ``p1..p4, u1..u3`` (ball).
+
+    Raises
+    ------
+    ValueError
+        From `dynamics.scene.RigidHub` and `dynamics.scene.HingedPanel`, naming the
+        argument (their names: ``mass``, ``inertia``, ``hinge_point``...).
+
+    Examples
+    --------
+    >>> from appdyn.dynamics.hinged import hinged_scene
+    >>> scene = hinged_scene(10.0, [2.0, 2.0, 3.0], 2.0, [0.2, 0.2, 0.3], [0, 0, 0.5],
+    ...                      [0, 0, -0.2])
+    >>> scene.model().states[7:]
+    ('r1', 'r2', 'r3', 'v1', 'v2', 'v3', 'theta', 'theta_dot')
+    """
+    from .scene import HingedPanel, RigidHub, Scene
+
+    if kind not in ("revolute", "ball"):
+        raise ValueError(f"`kind` must be 'revolute' or 'ball', got {kind!r}")
+    if kind == "ball" and axis is not None:
+        raise ValueError(f"`axis` applies to kind='revolute' only, got {axis!r}")
+    hinge_axis = None if kind == "ball" else ([0.0, 0.0, 1.0] if axis is None else axis)
+    cm = -np.asarray(r2, dtype=float)
+    return Scene(RigidHub(inertia1, mass=m1),
+                 HingedPanel(m2, inertia2, hinge_point=r1, cm_offset=cm, axis=hinge_axis),
+                 name=f"hinged_{kind}")
+
+def two_body_state(scene) -> ca.Function:
+    """The state of `hinged_bodies` (26) from the state of a `hinged_scene`.
+
+    Body 1 is the hub (``q, w``; ``v`` its mass-centre velocity, hub axes; ``x, y, z = r``);
+    body 2 the panel: ``q_2 = p (x) q`` (``p`` the panel's relative quaternion, hub -> panel;
+    revolute: `~dynamics.attitude.quat_from_axis_angle` of ``theta`` about the axis),
+    ``w_2 = R^T (w + w_rel)`` and ``v_2 = R^T (v + w x rho + w_rel x R c)`` in panel axes,
+    position ``r + A(q)^T rho`` (``R`` panel -> hub, ``rho = hinge_point + R c``, ``c`` the
+    panel's ``cm_offset``; `dynamics.scene.HingedPanel`).
+
+    Parameters
+    ----------
+    scene : Scene
+        A `hinged_scene` (a hub with ``mass`` at its mass centre and one `HingedPanel`).
+
+    Returns
+    -------
+    casadi.Function
+        ``x (nx of the scene) -> x2 (26)``, in `HINGED_STATES` order; with
+        ``hinged_bodies(...).invariants`` it gives the two-body energy, momenta, constraint
+        residual and hinge reaction along a scene's run.
+
+    Raises
+    ------
+    ValueError
+        Naming ``scene``, if it is not a hub at its mass centre with one hinged panel.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> scene = hinged_scene(10.0, [2.0, 2.0, 3.0], 2.0, [0.2, 0.2, 0.3], [0, 0, 0.5],
+    ...                      [0, 0, -0.2])
+    >>> x2 = np.asarray(two_body_state(scene)(scene.state(w=[0, 0, 1.0]))).ravel()
+    >>> x2[20:23].round(12), x2[23:26]  # body 2 turns about z: v_2 = 0, 0.7 m above body 1
+    (array([0., 0., 0.]), array([0. , 0. , 0.7]))
+    """
+    from types import SimpleNamespace
+
+    from .scene import HingedPanel
+
+    hub, parts = scene.hub, scene.parts
+    if (not hub.translates or any(hub.reference) or len(parts) != 1
+            or not isinstance(parts[0], HingedPanel)
+            or getattr(parts[0], "parent", None) is not None):
+        raise ValueError("`scene` must be a hinged_scene: a hub with `mass` (reference at its "
+                         f"mass centre) and one HingedPanel, got {scene!r}")
+    panel, model = parts[0], scene.model()
+    x = ca.SX.sym("x", model.nx)
+    hub_lay, lay = model.layout["hub"], model.layout[scene.part_names[0]]
+    names = model.states
+    q, w = x[hub_lay.coords], x[hub_lay.speeds]
+    r = x[names.index("r1"):names.index("r3") + 1]
+    v = x[names.index("v1"):names.index("v3") + 1]
+    own = SimpleNamespace(coords=x[lay.coords], speeds=x[lay.speeds])
+    R, w_rel = panel.attitude(own)
+    p = own.coords if not panel.revolute else quat_from_axis_angle(ca.DM(panel.axis),
+                                                                   own.coords[0])
+    arm = ca.mtimes(R, ca.DM(panel.cm_offset))
+    rho = ca.DM(panel.hinge_point) + arm
+    v2 = v + ca.cross(w, rho) + ca.cross(w_rel, arm)
+    x2 = ca.vertcat(q, w, v, r, quat_mul(p, q), ca.mtimes(R.T, w + w_rel), ca.mtimes(R.T, v2),
+                    r + ca.mtimes(dcm_from_quat(q).T, rho))
+    return ca.Function("two_body_state", [x], [x2], ["x"], ["x2"])

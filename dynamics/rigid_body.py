@@ -8,6 +8,7 @@ mass center. Dynamics ``I wdot = u - w x (I w)`` with a full symmetric inertia m
 """
 from __future__ import annotations
 
+from . import cache
 from .model import Model
 from .scene import ExternalTorque, RigidHub, Scene
 from .validate import check_inertia  # re-exported: its old home
@@ -17,6 +18,7 @@ __all__ = ["check_inertia", "rigid_body", "RIGID_BODY_STATES"]
 RIGID_BODY_STATES = ("q1", "q2", "q3", "q4", "w1", "w2", "w3")
 
 
+@cache.memoize_values
 def rigid_body(inertia) -> Model:
     """Torque-driven rigid body with quaternion attitude.
 

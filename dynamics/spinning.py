@@ -25,6 +25,7 @@ import dataclasses
 
 import numpy as np
 
+from . import cache
 from .model import Model
 from .scene import (ExternalTorque, HeldRotor, PointMassDamper, RigidHub, Scene,
                     SphericalDamper, TiltTorque)
@@ -37,6 +38,7 @@ __all__ = ["PointMassDamper", "SphericalDamper", "tilt_torque_body", "tilt_torqu
 
 
 # -------------------------------------------------------------------- tilt torque
+@cache.memoize_values
 def tilt_torque_body(inertia, overturning, *, axis=(1.0, 0.0, 0.0), direction=(1.0, 0.0, 0.0),
                      internal_damping: float = 0.0) -> Model:
     """Rigid body about a fixed point with a tilt-dependent torque ([1]_, Method III).
@@ -125,6 +127,7 @@ def _check_damper(damper, damper_on):
                          "point mass on the spinning rotor makes the motion time-periodic")
 
 
+@cache.memoize_values
 def gyrostat_model(inertia, *, wheel_axis=(1.0, 0.0, 0.0), wheel_momentum: float = 0.0,
                    damper=None, damper_on: str = "platform", wheel_rate: float = 0.0) -> Model:
     """Gyrostat (rigid body + wheel of constant relative speed) with an optional damper.

@@ -44,10 +44,14 @@ Modules (every name in ``__all__`` is importable from ``dynamics.attitude``):
 * `dcm` -- DCM <-> quaternion and axis-angle conversions;
 * `euler` -- elementary rotations, 3-1-3 and 3-2-1 angles;
 * `principal` -- principal axes of an inertia matrix;
+* `aero` -- aerodynamic (direction) angles of the body-frame air velocity: Type I
+  ``(alpha, beta)``, Type II ``(alpha_T, phi_R)`` and the conversions (seed Sec. 4.3 E);
 * `backend` -- the numpy/CasADi dispatch and argument checks the others share.
 """
 from __future__ import annotations
 
+from .aero import (aero_angles, aero_angles_from_total, total_aoa, total_aoa_from_aero_angles,
+                   velocity_direction, velocity_direction_total)
 from .dcm import (axis_angle_from_quat, dcm_from_axis_angle, dcm_from_quat, quat_from_axis_angle,
                   quat_from_dcm)
 from .euler import (dcm_axis, dcm_from_euler313, dcm_from_euler321, euler313_from_dcm,
@@ -81,4 +85,10 @@ __all__ = [
     "quat_from_euler321",
     "euler321_from_quat",
     "principal_axes",
+    "aero_angles",
+    "total_aoa",
+    "aero_angles_from_total",
+    "total_aoa_from_aero_angles",
+    "velocity_direction",
+    "velocity_direction_total",
 ]

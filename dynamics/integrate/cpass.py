@@ -11,7 +11,7 @@ import casadi as ca
 
 from .. import cache
 from ..model import Model
-from .kernels import kernel
+from .kernels import calls_rhs, kernel
 from .loops import chunk_compile_job
 
 __all__ = ["BMAX", "CHECK_EVERY", "NOISE", "pass_library"]
@@ -290,27 +290,29 @@ int rk8_adaptive(casadi_real* x, casadi_real* hio, int nint, const casadi_real* 
 def pass_library(model: Model) -> object | None:
     """The compiled pass of ``model`` (a ``ctypes`` function, cached); None without a C
     compiler or when the model cannot be code-generated (the pass is worth it only as C)."""
-    def build():
-        step = kernel(model, "rk8", "linear", error=True)
-        rhs = _renamed(model.f, "pass_rhs")
+    def make():
+        step = kernel(model, "rk8", "linear", error=True, compiled=True)
+        # (a step that calls the rhs shares its C function with pass_rhs: one copy of it)
+        rhs = _renamed(model.f, "pass_rhs", ca.MX if calls_rhs(model, "rk8") else None)
         sizes = dict(every=CHECK_EVERY, nx=model.nx, nu=model.nu, nw=max(step.sz_w(), rhs.sz_w()), niw=max(step.sz_iw(), rhs.sz_iw()),
                      narg=max(step.sz_arg(), rhs.sz_arg()), nres=max(step.sz_res(), rhs.sz_res()))  # (the plain step needs less)
-        steps = [_renamed(step, "rk8_step_err"), _renamed(kernel(model, "rk8", "linear"),
-                                                           "rk8_step"), rhs]
+        steps = [_renamed(step, "rk8_step_err"),
+                 _renamed(kernel(model, "rk8", "linear", compiled=True), "rk8_step"), rhs]
+        return steps, _DRIVER % sizes + _STEPPER
+
+    def job(opt):
+        return cache.Job(make, opt, ctypes.CDLL, cache.recipe("rk8_pass", model.f, opt))
+
+    def build():
         # auto's multi-run search (the fallback) runs the rk8 chunk loop: compiled now, at
         # the same time (a later call with this model then compiles nothing)
         chunk = chunk_compile_job(model, "rk8", "linear")
-        source = _DRIVER % sizes + _STEPPER
-        jobs = [(steps, source, _OPTS[0], ctypes.CDLL)] + ([chunk[0]] if chunk else [])
-        lib, *rest = cache.compile_parallel(jobs)
+        lib, *rest = cache.compile_parallel([job(_OPTS[0])] + ([chunk[0]] if chunk else []))
         if chunk:
             chunk[1](rest[0])
         if isinstance(lib, RuntimeError):  # (e.g. a compiler without -march=native)
-            try:
-                lib = cache.compile_c(steps, source, _OPTS[1], ctypes.CDLL)
-            except RuntimeError:
-                return None
-        if lib is None:
+            lib = cache.compile_parallel([job(_OPTS[1])])[0]
+        if lib is None or isinstance(lib, RuntimeError):
             return None
         fun = lib.rk8_pass_ws
         ptr, i32 = ctypes.c_void_p, ctypes.c_int
@@ -328,10 +330,11 @@ def pass_library(model: Model) -> object | None:
     return cache.get(("rk8_pass", cache.function_key(model.f)), build, keepalive=model.f)
 
 
-def _renamed(fun: ca.Function, name: str) -> ca.Function:
-    """``fun`` under ``name`` (the generated C function's name)."""
+def _renamed(fun: ca.Function, name: str, sym=None) -> ca.Function:
+    """``fun`` under ``name`` (the generated C function's name); ``sym=casadi.MX``: a
+    wrapper calling ``fun`` (not a copy of its expressions)."""
     if fun.name() == name:
         return fun
-    ins = [fun.sx_in(i) for i in range(fun.n_in())] if fun.is_a("SXFunction") else \
-        [fun.mx_in(i) for i in range(fun.n_in())]
+    ins = [fun.sx_in(i) for i in range(fun.n_in())] if fun.is_a("SXFunction") and sym is None \
+        else [fun.mx_in(i) for i in range(fun.n_in())]
     return ca.Function(name, ins, fun.call(ins))

@@ -10,7 +10,12 @@ from ..attitude import propagate_quat, quat_rate
 from ..model import Model
 from .tableaux import DOP853_E3, DOP853_E5, TABLEAUX, unique_nodes
 
-__all__ = ["kernel", "check_lie_model"]
+__all__ = ["kernel", "check_lie_model", "INLINE_MAX", "calls_rhs"]
+
+#: Most right-hand-side instructions a compiled Runge-Kutta step inlines (stages times the
+#: rhs's instruction count); a larger step calls the rhs as a C function instead (see
+#: `calls_rhs` and the module docstring of `dynamics.cache`, First compile).
+INLINE_MAX = 2000
 
 
 def _sym(f: ca.Function):
@@ -43,8 +48,13 @@ def _stage_control(mode, ins, nu, nodes_unique, linear_u):
     return u_at
 
 
-def _rk_kernel(f: ca.Function, method: str, mode: str, error: bool = False) -> ca.Function:
+def _rk_kernel(f: ca.Function, method: str, mode: str, error: bool = False,
+               sym=None) -> ca.Function:
     """One explicit Runge-Kutta step ``(x, h, u-data, p) -> x_next`` as a Function.
+
+    ``sym`` (``casadi.SX`` or ``casadi.MX``) forces the symbol type: on MX the step calls
+    ``f`` (generated once as its own C function) and combines the stages as vectors;
+    default SX where ``f`` allows (``f`` inlined in every stage).
 
     ``error`` (``rk8`` only): inputs ``rtol`` (scalar) and ``atol (nx)`` follow, and a
     second output is DOP853's embedded error estimate of the step (`DOP853_E5`), in units
@@ -53,7 +63,7 @@ def _rk_kernel(f: ca.Function, method: str, mode: str, error: bool = False) -> c
     tab = TABLEAUX[method]
     nx, nu, np_ = f.numel_in(0), f.numel_in(1), f.numel_in(2)
     nodes = unique_nodes(method)
-    sym = _sym(f)
+    sym = sym or _sym(f)
     ins, linear_u = _kernel_inputs(sym, nx, nu, np_, mode, len(nodes))
     u_at = _stage_control(mode, ins, nu, nodes, linear_u)
     x, h, p = ins[0], ins[1], ins[-1]
@@ -175,16 +185,37 @@ def _lie_kinematics_check(model: Model, x0: np.ndarray, p: np.ndarray) -> bool:
     return True
 
 
-def kernel(model: Model, method: str, mode: str, error: bool = False) -> ca.Function:
+def calls_rhs(model: Model, method: str) -> bool:
+    """Whether the compiled step of ``method`` calls the right-hand side rather than
+    inlining it: a Runge-Kutta step whose inlined rhs evaluations (stages times
+    ``model.f.n_instructions()``) exceed `INLINE_MAX` (``lie`` always inlines).
+
+    Examples
+    --------
+    >>> from appdyn.dynamics import hinged_bodies, rigid_body
+    >>> from appdyn.dynamics.integrate.kernels import calls_rhs
+    >>> calls_rhs(rigid_body([1.0, 2.0, 3.0]), "rk8")
+    False
+    >>> calls_rhs(hinged_bodies(1.0, [1, 1, 1], 1.0, [1, 1, 1], [0, 0, 1], [0, 0, -1]), "rk8")
+    True
+    """
+    if method == "lie":
+        return False
+    return TABLEAUX[method].stages * model.f.n_instructions() > INLINE_MAX
+
+
+def kernel(model: Model, method: str, mode: str, error: bool = False,
+           compiled: bool = False) -> ca.Function:
     """The step Function of ``model`` and ``method`` (cached); ``error``: with DOP853's
-    embedded error estimate (``rk8``; see `_rk_kernel`)."""
+    embedded error estimate (``rk8``; see `_rk_kernel`); ``compiled``: the form to generate
+    C from (the rhs called, not inlined, when `calls_rhs`; else the same Function)."""
+    call = compiled and calls_rhs(model, method)
     key = ("kernel", cache.function_key(model.f), model.attitude if method == "lie" else None,
-           method, mode) + (("error",) if error else ())
+           method, mode) + (("error",) if error else ()) + (("call",) if call else ())
 
     def build():
         if method == "lie":
             return _lie_kernel(model.f, model.attitude, mode)
-        return _rk_kernel(model.f, method, mode, error)
+        return _rk_kernel(model.f, method, mode, error, ca.MX if call else None)
 
     return cache.get(key, build, keepalive=model.f)
-

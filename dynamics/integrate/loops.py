@@ -56,11 +56,10 @@ def chunk_function(model: Model, method: str, mode: str, jit: bool, size: int = 
                          keepalive=model.f)
 
     def build_compiled():
-        loop = _build_chunk(model, method, mode, size)
-        try:
-            return cache.compile_function(loop, _OPT), True
-        except RuntimeError:  # e.g. a right-hand side that cannot be code-generated
-            return loop, False
+        result = cache.compile_parallel([_chunk_job(model, method, mode, size)])[0]
+        if result is None or isinstance(result, RuntimeError):  # e.g. a right-hand side
+            return _build_chunk(model, method, mode, size), False  # that is not generated
+        return result, True
 
     return cache.get(base_key + (True,), build_compiled, keepalive=model.f)
 
@@ -73,14 +72,27 @@ def chunk_compile_job(model: Model, method: str, mode: str):
     key = chunk_key(model, method, mode) + (True,)
     if cache.compiler() is None or cache.contains(key):
         return None
-    loop = _build_chunk(model, method, mode)
 
     def store(result):
-        value = (loop, False) if isinstance(result, RuntimeError) else (result, True)
+        value = ((_build_chunk(model, method, mode), False)
+                 if result is None or isinstance(result, RuntimeError) else (result, True))
         return cache.get(key, lambda: value, keepalive=model.f)
 
-    name = loop.name()
-    return ([loop], "", _OPT, lambda library: ca.external(name, library)), store
+    return _chunk_job(model, method, mode, CHUNK), store
+
+
+def _chunk_job(model: Model, method: str, mode: str, size: int) -> cache.Job:
+    """The `cache.Job` compiling the chunk Function (built only when the persistent cache
+    does not have it)."""
+    name = _chunk_name(method, size)
+    att = model.attitude if method == "lie" else None
+    return cache.Job(lambda: ([_build_chunk(model, method, mode, size, compiled=True)], ""),
+                     _OPT, lambda library: ca.external(name, library),
+                     cache.recipe("chunk", model.f, att, method, mode, size, _BLOCK, _BASE))
+
+
+def _chunk_name(method: str, size: int) -> str:
+    return f"simulate_{method}" + ("" if size == CHUNK else f"_{size}")
 
 
 def chunk_key(model: Model, method: str, mode: str) -> tuple:
@@ -97,12 +109,13 @@ _OPT = "-O1"
 _BLOCK = 16  # steps per block of a chunk: a chunk is `CHUNK // _BLOCK` blocks
 
 
-def _build_chunk(model, method, mode, size: int = CHUNK) -> ca.Function:
+def _build_chunk(model, method, mode, size: int = CHUNK, compiled: bool = False) -> ca.Function:
     """``mapaccum`` of ``size`` (default `CHUNK`) steps that takes only the first ``n``: the chunk is a
     ``mapaccum`` of blocks of `_BLOCK` steps, each block and each step inside a block a
     ``Function.conditional`` that skips (copies the state) past step ``n``. A short run
-    then costs its own steps plus about 25 us, not the 512 steps of a full chunk."""
-    step = kernel(model, method, mode)
+    then costs its own steps plus about 25 us, not the 512 steps of a full chunk.
+    ``compiled``: built to generate C from (`kernels.kernel`)."""
+    step = kernel(model, method, mode, compiled=compiled)
     args = [ca.MX.sym(step.name_in(i), step.sparsity_in(i)) for i in range(step.n_in())]
     gated = _gated(step, args, "step")
     inner = gated.mapaccum("steps", _BLOCK, {"base": _BASE})
@@ -125,7 +138,7 @@ def _build_chunk(model, method, mode, size: int = CHUNK) -> ca.Function:
     step_on = ca.DM(np.arange(size, dtype=float)).T < n
     block_on = ca.DM(np.arange(0, size, _BLOCK, dtype=float)).T < n
     out = loop.call([x0, block_on, step_on] + ins[2:-1] + [ca.repmat(ins[-1], 1, size)])
-    return ca.Function(f"simulate_{method}" + ("" if size == CHUNK else f"_{size}"), ins, [out[1]])
+    return ca.Function(_chunk_name(method, size), ins, [out[1]])
 
 
 def _gated(step: ca.Function, args: list, name: str) -> ca.Function:

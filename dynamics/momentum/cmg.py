@@ -54,6 +54,7 @@ from typing import Literal
 
 import numpy as np
 
+from .. import cache
 from ..model import Model
 from ..scene import CMGCluster, ExternalTorque, RigidHub, Scene
 from ..scene.cmgs import FIDELITIES
@@ -61,6 +62,7 @@ from ..scene.cmgs import FIDELITIES
 __all__ = ["FIDELITIES", "cmg_spacecraft"]
 
 
+@cache.memoize_values
 def cmg_spacecraft(inertia, gimbal_axes, spin_axes0, h, *,
                    fidelity: Literal["exact", "torque"] = "exact", rotor_inertia=None,
                    gimbal_inertia=None, external_torque: bool = False) -> Model:

@@ -32,6 +32,7 @@ from __future__ import annotations
 import casadi as ca
 import numpy as np
 
+from .. import cache
 from ..model import Model
 from ..scene import ExternalTorque, ReactionWheels, RigidHub, Scene
 from ..validate import check_inertia, finite_array, is_symbolic, positive_each, unit_axes
@@ -116,6 +117,7 @@ def rotor_dynamics(inertia, axes, w, h, torque=None, *, wheel_inertia=None, moto
     return H, wdot, tau - ca.DM(J) * ca.mtimes(A.T, wdot)
 
 
+@cache.memoize_values
 def wheel_spacecraft(inertia, axes, wheel_inertia, *, external_torque: bool = False) -> Model:
     """Rigid hub with ``n`` reaction wheels driven by motor torques (module docstring).
 

@@ -23,7 +23,17 @@ Parts
 `GravityGradient`      gravity on every body: forces and gravity-gradient torques
 `FlexibleAppendage`    a flexible cantilever by clamped-free modes (``eta``, ``xi``), with
                        geometric stiffening; `flexible_antenna_satellite`: seed Example 6
+`Engine`               gimbaled thrust (controls ``dp, dy`` or an actuator), mass flow
+                       (state ``m_p``), internal-flow Coriolis force and jet damping
+`Aerodynamics`         normal and axial air force at a centre of pressure (6-DoF hub; wind
+                       controls ``wind1..wind3`` optional)
 =====================  =====================================================================
+
+Parts sit on the hub, or on a part that carries parts (a `HingedPanel`) named by their
+``parent`` keyword: ``ReactionWheels(axes, 0.05, parent="panel")``.
+
+`launch_vehicle_scene` builds the launch vehicle of `dynamics.launch_vehicle` from these (six
+degrees of freedom; its yaw plane is the planar model); `attitude_autopilot` flies it.
 
 Examples
 --------
@@ -32,21 +42,25 @@ Examples
 >>> model.nx, model.controls
 (7, ('L1', 'L2', 'L3'))
 """
+from .aero import Aerodynamics
 from .assembly import PartLayout
 from .cmgs import CMGCluster
 from .contract import Body, Contribution, Frame, Load, Part, PartVariables, Variable
 from .dampers import PointMassDamper, Slosh, SphericalDamper
+from .engine import Engine
 from .fields import TiltTorque
 from .flexible import FlexibleAppendage, flexible_antenna_satellite
 from .gravity import GravityGradient
 from .hubs import RigidHub
 from .loads import ExternalForce, ExternalTorque
 from .panels import HingedPanel
+from .rocket import attitude_autopilot, launch_vehicle_scene
 from .scene import Scene, check_scene
 from .wheels import HeldRotor, ReactionWheels
 
 __all__ = ["Scene", "check_scene", "RigidHub", "Part", "PartLayout", "Variable", "PartVariables", "Body", "Load",
            "Contribution", "Frame", "ReactionWheels", "HeldRotor", "ExternalTorque",
            "ExternalForce", "PointMassDamper", "SphericalDamper", "Slosh", "TiltTorque",
-           "HingedPanel", "GravityGradient", "CMGCluster", "FlexibleAppendage",
+           "HingedPanel", "GravityGradient", "CMGCluster", "Aerodynamics", "Engine",
+           "launch_vehicle_scene", "attitude_autopilot", "FlexibleAppendage",
            "flexible_antenna_satellite"]

@@ -21,16 +21,16 @@ over the derivative (their own derivative is not a model input).
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import casadi as ca
 import numpy as np
 
 from ..attitude import dcm_from_quat, quat_rate
 from ..model import Model
-from .contract import Body, Frame, PartSymbols
+from .contract import Body, Contribution, Frame, PartSymbols
 
-__all__ = ["PartLayout", "assemble", "kane_equations"]
+__all__ = ["PartLayout", "assemble", "kane_equations", "in_hub_axes"]
 
 
 @dataclass(frozen=True)
@@ -178,6 +178,33 @@ def solve_blocks(M, F, n_hub: int, part_slices: list):
     return ca.vertcat(*out)
 
 
+def in_hub_axes(frame: Frame, c: Contribution) -> Contribution:
+    """A contribution written in a part's body frame (parts on parts), in hub axes.
+
+    Bodies' vectors are turned by ``frame.to_hub`` and their positions moved to the hub's
+    reference point; a momentum override (about the frame's origin) gains ``origin x P``.
+    Loads need no turning: their power ``F . v`` and partial velocities are the same in any
+    axes fixed to the hub or turning with the coordinates only.
+    """
+    if frame.is_hub:
+        return c
+    T, o = frame.to_hub, frame.origin
+
+    def turn(vec):
+        return ca.mtimes(T, ca.SX(vec))
+
+    bodies = [Body(velocity=turn(b.velocity), angular_velocity=turn(b.angular_velocity),
+                   momentum=turn(b.momentum), angular_momentum=turn(b.angular_momentum),
+                   position=o + turn(b.position), mass=b.mass,
+                   inertia=None if b.inertia is None else ca.mtimes([T, ca.SX(b.inertia), T.T]))
+              for b in c.bodies]
+    momentum = c.momentum
+    if momentum is not None:
+        P = sum((b.momentum for b in bodies), ca.SX.zeros(3))
+        momentum = turn(momentum) + ca.cross(o, P)
+    return replace(c, bodies=bodies, momentum=momentum)
+
+
 def assemble(scene) -> Model:
     """The `Model` of ``scene`` (module docstring); use `Scene.model`, which caches it."""
     hub = scene.hub
@@ -208,15 +235,21 @@ def assemble(scene) -> Model:
     part_speed_slices = []
     n_hub = 6 if hub.translates else 3
     offset = n_hub
-    owns = {}
-    for part, pname in zip(scene.parts, scene.part_names):
+    owns, frames = {}, {}
+    frozen = set()
+    for i in scene.mount_order:
+        part, pname, parent = scene.parts[i], scene.part_names[i], scene.parents[i]
         local = named["local"][pname]
         own = PartSymbols(_column([sym[local[k]] for k in local["__coords__"]]),
                           _column([sym[local[k]] for k in local["__speeds__"]]),
                           _column([sym[local[k]] for k in local["__controls__"]]),
                           {k: sym[vname] for k, vname in local.items() if not k.startswith("__")})
         owns[pname] = own
-        c = part.contribute(frame, own)
+        on = frame if parent is None else frames[parent]
+        frozen.update(local[v.name] for v in part.variables().coords if v.frozen)
+        c = in_hub_axes(on, part.contribute(on, own))
+        if pname in scene.parents:
+            frames[pname] = part.body_frame(on, own)
         if own.coords.numel():
             rates = ca.SX(c.rates) if c.rates is not None else own.speeds
             if rates.numel() != own.coords.numel():
@@ -252,7 +285,8 @@ def assemble(scene) -> Model:
     speeds = ca.vertcat(*speed_syms)
     coords = ca.vertcat(*coord_syms)
     cdot = ca.vertcat(*coord_rates)
-    M, F = kane_equations(all_bodies, loads, w, speeds, coords, cdot)
+    moving = [k for k in range(coords.numel()) if coords[k].name() not in frozen]
+    M, F = kane_equations(all_bodies, loads, w, speeds, coords[moving], cdot[moving])
     nud = solve_blocks(M, F, n_hub, part_speed_slices)
 
     # x' in state order

@@ -127,6 +127,9 @@ class CMGCluster(Part):
     drive : {'rate', 'torque'}, optional
         What the controls are (module docstring).
     name : str, optional
+    parent : str, optional
+        The scene name of the part it sits on (default: the hub); its positions and axes
+        are then that part's (`dynamics.scene.contract`, parts on parts).
 
     Notes
     -----
@@ -183,6 +186,7 @@ class CMGCluster(Part):
     u_max: tuple | None = None
     drive: str = "rate"
     name: str | None = None
+    parent: str | None = None
     kind = "cmgs"
 
     def __post_init__(self):

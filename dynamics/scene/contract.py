@@ -18,7 +18,9 @@ that names the field). It sets ``kind`` (the default name, ``"wheels"``), and im
     its *speeds* (generalized speeds whose derivatives the assembly solves for) and its
     *controls*, each a `Variable` with a name, a unit, a rest value, bounds, and for states
     whether the slew jobs hold it at rest at the end (``terminal="rest"``) or leave it free
-    (``"free"``: a wheel speed, a gimbal angle). ``u_max`` is the one word for a control
+    (``"free"``: a wheel speed, a gimbal angle). A coordinate that is a mass flowing out of
+    the vehicle (an engine's propellant) is declared ``frozen=True``: the inertia forces hold
+    it constant (the control-volume law; the momentum the flow carries is in the thrust). ``u_max`` is the one word for a control
     bound: pass it to `Variable` as ``bounds=(-u_max, u_max)``. Names are local (``"s"``,
     ``"W1"``); the scene makes them unique (a second damper's states become ``s_2``, ...).
 ``contribute(self, frame, own) -> Contribution``
@@ -54,6 +56,22 @@ that names the field). It sets ``kind`` (the default name, ``"wheels"``), and im
     unless its speeds are absolute rates, as a spherical damper's core rate); used by
     `Scene.state` and the spin stability case.
 
+Parts on parts
+--------------
+A part sits on the hub unless its ``parent`` field names another part of the scene (every part
+has the keyword ``parent=None``; the scene checks that the parent exists, comes in no cycle
+and can carry parts). A part that can carry parts sets ``carries_parts = True`` and implements
+
+``body_frame(self, frame, own) -> Frame``
+    The frame of its body, built from the frame it sits on by `Frame.child` (its rotation,
+    the origin of its axes on the parent and its angular velocity relative to the parent).
+
+A part on a parent is written exactly as one on the hub: the assembly hands it its parent's
+`Frame` (the parent's axes, its points measured from the parent frame's origin, ``frame.mass``
+None) and rotates what it returns into hub axes, so nothing in a part knows where it sits.
+Fields that act on the whole scene (``field_loads``) set ``mountable = False``: they cannot
+name a parent.
+
 Constraints are not part of the contract yet: every part is written in minimal coordinates,
 so an assembled model never forms a multiplier system (`dynamics.constrained` holds that
 machinery for the hand-written constrained models).
@@ -88,6 +106,10 @@ class Variable:
         Lower and upper bound (controls: from ``u_max``; states: a speed limit).
     terminal : {'rest', 'free'}, optional
         Whether a rest-to-rest slew holds it at ``rest`` at the end.
+    frozen : bool, optional
+        A coordinate the inertia forces hold frozen: a mass that flows out of the vehicle
+        (seed Sec. 3.4, control-volume law ``m v' = F``, no ``m' v`` term). Kane's equations
+        then leave out the momenta's derivative along its rate.
     """
 
     name: str
@@ -95,6 +117,7 @@ class Variable:
     rest: float = 0.0
     bounds: tuple = (-math.inf, math.inf)
     terminal: Literal["rest", "free"] = "rest"
+    frozen: bool = False
 
 
 @dataclass(frozen=True)
@@ -190,12 +213,16 @@ class Contribution:
 
 @dataclass
 class Frame:
-    """The hub as its parts see it (hub axes).
+    """The hub, or the body a part sits on, as its parts see it (its axes).
+
+    A part on the hub receives the hub's frame; a part on another part receives that part's
+    body frame (`Frame.child`): the same attributes in the parent's axes, its points
+    measured from the parent's origin.
 
     Attributes
     ----------
-    q : SX, 4x1
-        Hub attitude quaternion (scalar-last, inertial -> hub).
+    q : SX, 4x1 or None
+        Hub attitude quaternion (scalar-last, inertial -> hub); None in a body frame.
     dcm : SX, 3x3
         ``A(q)``: inertial -> hub components.
     w : SX, 3x1 [rad/s]
@@ -208,7 +235,11 @@ class Frame:
     reference : tuple of float, shape (3,) [m]
         The reference point from the hub's mass centre.
     mass : float or None [kg]
-        Hub mass (None: attitude-only hub).
+        Hub mass (None: attitude-only hub, or a part's body frame).
+    to_hub : SX, 3x3 or None
+        This frame's axes -> hub axes (None: the hub's frame).
+    origin : SX, 3x1 or None [m]
+        This frame's origin from the hub's reference point, hub axes (None: the hub's).
     """
 
     q: ca.SX
@@ -218,6 +249,47 @@ class Frame:
     r: ca.SX | None
     reference: tuple
     mass: float | None
+    to_hub: ca.SX | None = None
+    origin: ca.SX | None = None
+
+    @property
+    def is_hub(self) -> bool:
+        """Whether this is the hub's frame (not a part's body frame)."""
+        return self.to_hub is None
+
+    def child(self, rotation, origin, w_rel, v_rel=None) -> "Frame":
+        """The frame of a body mounted on this one (parts on parts).
+
+        Parameters
+        ----------
+        rotation : SX, 3x3
+            Child axes -> this frame's axes (components).
+        origin : SX, 3x1 [m]
+            The child frame's origin (a hinge, say) from this frame's reference point, in
+            this frame's axes (``frame.point(hinge_point)``).
+        w_rel : SX, 3x1 [rad/s]
+            The child's angular velocity relative to this frame, this frame's axes.
+        v_rel : SX, 3x1 [m/s], optional
+            The velocity of the child's origin relative to this frame (zero for a hinge).
+
+        Returns
+        -------
+        Frame
+            In the child's axes: ``w`` and ``v`` (of the child's origin) absolute,
+            ``dcm`` inertial -> child, ``r`` the origin's inertial position (six-degree-of-
+            freedom hub only), ``reference`` zero (points from the origin), ``mass`` None,
+            ``q`` None, and ``to_hub``/``origin`` for the assembly (child axes -> hub axes;
+            the origin from the hub's reference point, hub axes).
+        """
+        R, o = ca.SX(rotation), ca.SX(origin)
+        Rt = R.T
+        v = self.velocity(o, v_rel)
+        r = None if self.r is None else self.r + ca.mtimes(self.dcm.T, o)
+        to_hub = R if self.is_hub else ca.mtimes(self.to_hub, R)
+        at = o if self.is_hub else self.origin + ca.mtimes(self.to_hub, o)
+        return Frame(q=None, dcm=ca.mtimes(Rt, self.dcm), w=ca.mtimes(Rt, self.w + w_rel),
+                     v=ca.mtimes(Rt, v), r=r, reference=(0.0, 0.0, 0.0), mass=None,
+                     to_hub=to_hub, origin=at)
 
     def point(self, from_mass_centre) -> ca.SX:
         """A hub point given from the hub's mass centre, as measured from the reference."""
@@ -249,10 +321,13 @@ class Part:
     """Base class of the parts of a `Scene` (the contract is the module docstring).
 
     Subclasses are frozen dataclasses with a ``name`` field (``None``: the scene names it
-    after ``kind``).
+    after ``kind``) and a ``parent`` field (``None``: the hub; the module docstring, parts on
+    parts).
     """
 
     kind: ClassVar[str] = "part"
+    carries_parts: ClassVar[bool] = False
+    mountable: ClassVar[bool] = True
 
     def variables(self) -> PartVariables:
         """The part's coordinates, speeds and controls."""
@@ -265,6 +340,10 @@ class Part:
     def field_loads(self, frame: Frame, bodies: list, own: PartSymbols) -> Contribution:
         """Loads that act on every body of the scene (gravity); none by default."""
         return Contribution()
+
+    def body_frame(self, frame: Frame, own: PartSymbols) -> Frame:
+        """The frame of the part's body, for parts sitting on it (``carries_parts``)."""
+        raise NotImplementedError(f"{type(self).__name__} cannot carry parts")
 
     def spin_speeds(self, frame: Frame, own: PartSymbols):
         """The part's speeds at rest relative to a hub turning at ``frame.w`` (zero)."""

@@ -141,6 +141,9 @@ class PointMassDamper(Part):
         six-degree-of-freedom hub (`RigidHub` with ``mass``) the hub's own mass plays this
         part: a finite ``body_mass`` is refused there.
     name : str, optional
+    parent : str, optional
+        The scene name of the part it sits on (default: the hub); its positions and axes
+        are then that part's (`dynamics.scene.contract`, parts on parts).
 
     Examples
     --------
@@ -159,6 +162,7 @@ class PointMassDamper(Part):
     direction: tuple = (1.0, 0.0, 0.0)
     body_mass: float = math.inf
     name: str | None = None
+    parent: str | None = None
     kind = "damper"
 
     def __post_init__(self):
@@ -222,6 +226,9 @@ class SphericalDamper(Part):
         housing is the hub). A damper on a gyrostat's rotor turning at ``W`` about ``a``
         has ``housing_rate = W a``.
     name : str, optional
+    parent : str, optional
+        The scene name of the part it sits on (default: the hub); its positions and axes
+        are then that part's (`dynamics.scene.contract`, parts on parts).
 
     Examples
     --------
@@ -238,6 +245,7 @@ class SphericalDamper(Part):
     damping: float
     housing_rate: tuple = (0.0, 0.0, 0.0)
     name: str | None = None
+    parent: str | None = None
     kind = "damper"
 
     def __post_init__(self):
@@ -314,6 +322,9 @@ class Slosh(Part):
     damping : float, optional
         ``c >= 0``: [N m s] on each pendulum angle rate, [N s/m] on the spring's.
     name : str, optional
+    parent : str, optional
+        The scene name of the part it sits on (default: the hub); its positions and axes
+        are then that part's (`dynamics.scene.contract`, parts on parts).
 
     Raises
     ------
@@ -343,6 +354,7 @@ class Slosh(Part):
     stiffness: float | None = None
     damping: float = 0.0
     name: str | None = None
+    parent: str | None = None
 
     def __post_init__(self):
         set_ = lambda key, value: object.__setattr__(self, key, value)  # noqa: E731
@@ -363,6 +375,10 @@ class Slosh(Part):
             return
         if self.length is not None:
             raise ValueError("`length` is for kind='pendulum'")
+        if self.frequency is not None and self.stiffness is not None:
+            f = real_number(self.frequency, "frequency", positive=True)
+            if math.isclose(self.stiffness, self.mass * f * f, rel_tol=1e-12):
+                set_("stiffness", None)  # a copy (dataclasses.replace) carries both
         if (self.frequency is None) == (self.stiffness is None):
             raise ValueError("a slosh spring needs exactly one of `frequency` [rad/s] and "
                              f"`stiffness` [N/m], got frequency={self.frequency!r}, "

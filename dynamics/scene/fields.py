@@ -87,6 +87,7 @@ class TiltTorque(Part):
     internal_damping: float = 0.0
     name: str | None = None
     kind = "tilt"
+    mountable = False
 
     def __post_init__(self):
         object.__setattr__(self, "overturning", real_number(self.overturning, "overturning"))

@@ -101,6 +101,7 @@ class GravityGradient(Part):
     radius: float | None
     name: str | None
     kind = "gravity"
+    mountable = False
 
     def __init__(self, mu, radius=None, *, name=None):
         object.__setattr__(self, "mu", positive(mu, "mu"))

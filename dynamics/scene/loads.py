@@ -32,6 +32,9 @@ class ExternalTorque(Part):
     u_max : float or array_like, shape (3,) [N m], optional
         Per-axis bound ``|L_i| <= u_max_i`` (unbounded by default).
     name : str, optional
+    parent : str, optional
+        The scene name of the part it sits on (default: the hub); its positions and axes
+        are then that part's (`dynamics.scene.contract`, parts on parts).
 
     Examples
     --------
@@ -45,6 +48,7 @@ class ExternalTorque(Part):
 
     u_max: tuple | None = None
     name: str | None = None
+    parent: str | None = None
     kind = "torque"
 
     def __post_init__(self):
@@ -70,6 +74,9 @@ class ExternalForce(Part):
     u_max : float or array_like, shape (3,) [N], optional
         Per-component bound.
     name : str, optional
+    parent : str, optional
+        The scene name of the part it sits on (default: the hub); its positions and axes
+        are then that part's (`dynamics.scene.contract`, parts on parts).
 
     Notes
     -----
@@ -89,6 +96,7 @@ class ExternalForce(Part):
     frame: str = "body"
     u_max: tuple | None = None
     name: str | None = None
+    parent: str | None = None
     kind = "force"
 
     def __post_init__(self):

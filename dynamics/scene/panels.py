@@ -56,7 +56,8 @@ class HingedPanel(Part):
     inertia : array_like, shape (3, 3) or (3,) [kg m^2]
         About the panel's mass centre, panel axes (products with the seed's sign).
     hinge_point : array_like, shape (3,) [m]
-        The hinge from the hub's mass centre, hub axes.
+        The hinge from the hub's mass centre, hub axes (on a ``parent`` panel: from its
+        hinge, in its axes).
     cm_offset : array_like, shape (3,) [m]
         The panel's mass centre from the hinge, panel axes (= hub axes at zero hinge angle).
     axis : array_like, shape (3,), optional
@@ -70,6 +71,9 @@ class HingedPanel(Part):
     damping : float, optional
         Hinge damper ``c >= 0`` [N m s/rad]: torque ``-c theta_dot`` or ``-c u``.
     name : str, optional
+    parent : str, optional
+        The scene name of the part it sits on (default: the hub); its positions and axes
+        are then that part's (`dynamics.scene.contract`, parts on parts).
 
     Notes
     -----
@@ -109,10 +113,14 @@ class HingedPanel(Part):
     stiffness: float
     damping: float
     name: str | None
+    parent: str | None
     kind = "panel"
+    carries_parts = True
 
     def __init__(self, mass, inertia, hinge_point, cm_offset, *, axis=None, stiffness=0.0,
-                 damping=0.0, name=None):
+                 damping=0.0, name=None, parent=None):
+        if isinstance(inertia, tuple) and len(inertia) == 9:  # a copy (dataclasses.replace)
+            inertia = np.reshape(inertia, (3, 3))
         I = check_inertia(inertia)
         fields = {
             "mass": positive(mass, "mass"),
@@ -123,6 +131,7 @@ class HingedPanel(Part):
             "stiffness": nonnegative(stiffness, "stiffness"),
             "damping": nonnegative(damping, "damping"),
             "name": name,
+            "parent": parent,
         }
         for key, value in fields.items():
             object.__setattr__(self, key, value)
@@ -164,6 +173,12 @@ class HingedPanel(Part):
             return R, own.speeds[0] * a
         R = ca.SX(dcm_from_quat(own.coords)).T
         return R, ca.mtimes(R, own.speeds)
+
+    def body_frame(self, frame, own):
+        """The panel's frame: its axes, origin at the hinge (parts on the panel give their
+        points from the hinge, in panel axes)."""
+        R, w_rel = self.attitude(own)
+        return frame.child(R, frame.point(self.hinge_point), w_rel)
 
     def contribute(self, frame, own) -> Contribution:
         R, w_rel = self.attitude(own)

@@ -47,7 +47,8 @@ class Scene:
     TypeError
         If ``hub`` is not a `RigidHub` or a part is not a `Part`.
     ValueError
-        If two parts are given the same ``name``.
+        If two parts are given the same ``name``, or a ``parent`` is not a part of the
+        scene, cannot carry parts, or closes a cycle.
 
     Examples
     --------
@@ -66,7 +67,7 @@ class Scene:
     array([ 0. ,  0. ,  0. ,  1. ,  0. ,  0. ,  0.1, 10. ,  0. ,  0. ])
     """
 
-    __slots__ = ("hub", "parts", "name", "_names", "_vars")
+    __slots__ = ("hub", "parts", "name", "_names", "_vars", "_parents", "_order")
 
     def __init__(self, hub, *parts, name=None):
         if not isinstance(hub, RigidHub):
@@ -82,6 +83,8 @@ class Scene:
         object.__setattr__(self, "name", name)
         object.__setattr__(self, "_names", _part_names(parts))
         object.__setattr__(self, "_vars", None)
+        object.__setattr__(self, "_parents", _part_parents(self.parts, self._names))
+        object.__setattr__(self, "_order", _mount_order(self._names, self._parents))
 
     def __setattr__(self, key, value):
         raise AttributeError("a Scene is immutable; build a new one")
@@ -105,6 +108,16 @@ class Scene:
     def part_names(self) -> tuple:
         """The parts' names, in order."""
         return self._names
+
+    @property
+    def parents(self) -> tuple:
+        """Each part's parent: the name of the part it sits on, None for the hub."""
+        return self._parents
+
+    @property
+    def mount_order(self) -> tuple:
+        """Part indices with every parent before the parts it carries (else scene order)."""
+        return self._order
 
     def variable_names(self) -> dict:
         """States, controls, units, bounds and each part's local -> scene names."""
@@ -248,12 +261,20 @@ class Scene:
         frame = Frame(q=ca.DM(x[0:4]), dcm=ca.DM(dcm_from_quat(x[0:4])), w=ca.DM(x[4:7]),
                       v=ca.DM.zeros(3), r=None, reference=self.hub.reference,
                       mass=self.hub.mass)
-        for part, pname in zip(self.parts, self._names):
+        for key, val in singles.items():  # before: a part's frame may depend on them
+            x[index[key]] = val
+        frames = {}
+        for i in self._order:
+            part, pname, parent = self.parts[i], self._names[i], self._parents[i]
             lay = self.layout[pname]
-            if pname in given_parts or lay.speeds.stop == lay.speeds.start:
-                continue
-            own = _NumericOwn(x[lay.coords], x[lay.speeds])
-            x[lay.speeds] = np.asarray(ca.DM(part.spin_speeds(frame, own))).reshape(-1)
+            on = frame if parent is None else frames[parent]
+            if pname not in given_parts and lay.speeds.stop > lay.speeds.start:
+                own = _NumericOwn(x[lay.coords], x[lay.speeds])
+                x[lay.speeds] = np.asarray(ca.evalf(part.spin_speeds(on, own))).reshape(-1)
+                for key in set(singles) & set(self.states[lay.speeds]):
+                    x[index[key]] = singles[key]  # a speed given by name wins
+            if pname in self._parents:
+                frames[pname] = part.body_frame(on, _NumericOwn(x[lay.coords], x[lay.speeds]))
         for key, val in singles.items():
             x[index[key]] = val
         return x
@@ -278,6 +299,50 @@ class _NumericOwn:
     def __init__(self, coords, speeds):
         import casadi as ca
         self.coords, self.speeds, self.controls = ca.DM(coords), ca.DM(speeds), ca.DM(0, 1)
+
+
+def _part_parents(parts, names) -> tuple:
+    """Each part's parent name (None: the hub), checked (module docstring of the contract)."""
+    parents = []
+    for part, pname in zip(parts, names):
+        parent = getattr(part, "parent", None)
+        if parent is None or parent == HUB:
+            parents.append(None)
+            continue
+        if not isinstance(parent, str):
+            raise TypeError(f"part {pname!r}: `parent` must be the name of a part (str) or "
+                            f"None, got {type(parent).__name__}")
+        if not type(part).mountable:
+            raise ValueError(f"part {pname!r} ({type(part).__name__}) acts on the whole scene "
+                             f"and cannot sit on another part: drop `parent`")
+        if parent not in names:
+            raise ValueError(f"part {pname!r}: `parent` {parent!r} is not a part of the scene; "
+                             f"the parts are {list(names)}")
+        host = parts[names.index(parent)]
+        if not type(host).carries_parts:
+            raise ValueError(f"part {pname!r}: its `parent` {parent!r} "
+                             f"({type(host).__name__}) cannot carry parts (a HingedPanel can)")
+        parents.append(parent)
+    for pname in names:
+        seen, at = {pname}, parents[names.index(pname)]
+        while at is not None:
+            if at in seen:
+                raise ValueError(f"the parents of part {pname!r} form a cycle through "
+                                 f"{at!r}; every chain of parents must end at the hub")
+            seen.add(at)
+            at = parents[names.index(at)]
+    return tuple(parents)
+
+
+def _mount_order(names, parents) -> tuple:
+    """Indices of the parts, parents first, else in the scene's order."""
+    order, placed = [], set()
+    while len(order) < len(names):
+        for i, (pname, parent) in enumerate(zip(names, parents)):
+            if pname not in placed and (parent is None or parent in placed):
+                order.append(i)
+                placed.add(pname)
+    return tuple(order)
 
 
 def _part_names(parts) -> tuple:

@@ -38,6 +38,9 @@ class ReactionWheels(Part):
     speed_max : float or array_like, shape (n,) [rad/s], optional
         Wheel-speed bound (relative to the hub), carried as a state bound.
     name : str, optional
+    parent : str, optional
+        The scene name of the part it sits on (default: the hub); its positions and axes
+        are then that part's (`dynamics.scene.contract`, parts on parts).
 
     Notes
     -----
@@ -58,6 +61,7 @@ class ReactionWheels(Part):
     u_max: tuple | None = None
     speed_max: tuple | None = None
     name: str | None = None
+    parent: str | None = None
     kind = "wheels"
 
     def __post_init__(self):
@@ -116,6 +120,9 @@ class HeldRotor(Part):
     momentum : float [N m s]
         Relative angular momentum ``h`` (either sign).
     name : str, optional
+    parent : str, optional
+        The scene name of the part it sits on (default: the hub); its positions and axes
+        are then that part's (`dynamics.scene.contract`, parts on parts).
 
     Examples
     --------
@@ -129,6 +136,7 @@ class HeldRotor(Part):
     axis: tuple
     momentum: float
     name: str | None = None
+    parent: str | None = None
     kind = "rotor"
 
     def __post_init__(self):

@@ -17,9 +17,10 @@
     appdyn ascent delta3 [--N N] [--refine-tol TOL | --no-refine] [--plot F.png] [--json F]
     appdyn demo
     appdyn bench [NAME ...] [--quick] [--out DIR] [--docs]
+    appdyn cache info|clear
 
 One module per command (`simulate`, `slew`, `stability`, `cmg`, `gains`, `dispersion`, `ascent`, `demo`,
-`bench`), each with
+`bench`, `cache`), each with
 ``add_parser(subparsers)``, ``check(parser, args)`` (checks across options, before any
 computation) and ``run(args) -> exit status``; `common` holds what they share.
 
@@ -42,7 +43,7 @@ import sys
 
 import appdyn
 
-from appdyn.problems.cli import ascent, bench, cmg, demo, dispersion, gains, simulate, slew, stability
+from appdyn.problems.cli import ascent, bench, cache, cmg, demo, dispersion, gains, simulate, slew, stability
 from appdyn.problems.cli.common import attach_negative_values
 from appdyn.problems.cli.slew import rest_to_rest_bound
 
@@ -51,7 +52,7 @@ __all__ = ["main", "build_parser", "COMMANDS", "rest_to_rest_bound"]
 #: command name -> its module (``add_parser``, ``check``, ``run``), in the order of ``--help``
 COMMANDS = {"simulate": simulate, "slew": slew, "stability": stability, "cmg": cmg,
             "gains": gains, "dispersion": dispersion, "ascent": ascent, "demo": demo,
-            "bench": bench}
+            "bench": bench, "cache": cache}
 
 
 def build_parser() -> argparse.ArgumentParser:

@@ -2,7 +2,8 @@
 the Jacobi-elliptic solution (`problems.torque_free`). ``appdyn simulate launch-vehicle``: the
 launch-vehicle autopilot's response to an attitude error and a wind gust
 (`problems.stability.launch_vehicle_response`). ``appdyn simulate hinged``: two rigid bodies
-joined by a ball or revolute hinge (`dynamics.hinged_bodies`), checked by its invariants."""
+joined by a ball or revolute hinge, as a scene in minimal coordinates (`dynamics.hinged.hinged_scene`)
+or the multiplier model (`dynamics.hinged_bodies`), checked by the latter's invariants."""
 from __future__ import annotations
 
 import re
@@ -19,7 +20,8 @@ from appdyn.problems.cli.common import finish, write_json, write_outputs
 from appdyn.problems.cli.stability import (add_launch_vehicle_options, call_naming_parts, check_flight,
                                    launch_vehicle_kwargs)
 
-__all__ = ["add_parser", "check", "run", "FIXED_STEP", "HINGED_TOL", "HINGED_CONSERVED"]
+__all__ = ["add_parser", "check", "run", "FIXED_STEP", "HINGED_TOL", "HINGED_CONSERVED",
+           "HINGED_MODELS"]
 
 #: methods that take ``--steps``
 FIXED_STEP = ("rk4", "rk8", "lie")
@@ -186,6 +188,8 @@ def run(args) -> int:
 HINGED_TOL = 1e-8
 #: invariants a free pair of hinged bodies conserves (relative drift checked against --tol)
 HINGED_CONSERVED = ("energy", "momentum_linear", "momentum_angular", "quat_norm", "quat_norm_2")
+#: the models of ``simulate hinged --model``
+HINGED_MODELS = ("scene", "multiplier")
 _FLOOR = 1e-17  # zero on the log axes of the drift plot
 
 
@@ -193,8 +197,11 @@ def _add_hinged(sim_sub) -> None:
     hg = sim_sub.add_parser(
         "hinged", help="two rigid bodies joined by a ball or revolute hinge (RP-1262 Ch. 6 Ex. 5)",
         description="Simulate two rigid bodies joined by a frictionless ball or revolute hinge "
-                    "in free space (Lagrange multipliers, Baumgarte drift control; rk8 fixed "
-                    "step), both starting with the identity attitude. Prints the final states, "
+                    "in free space, both starting with the identity attitude (rk8 fixed step): "
+                    "by default the scene in minimal coordinates (a hub with a hinged panel), "
+                    "its states mapped to the two bodies; --model multiplier integrates both "
+                    "bodies in full (Lagrange multipliers, Baumgarte drift control). The "
+                    "multiplier model's invariants check either run. Prints the final states, "
                     "the hinge reaction range and the invariant drift. Exit status 1 when the "
                     "integrator fails, energy, linear and angular momentum or a quaternion norm "
                     "drift by more than --tol (relative; absolute where the initial value is "
@@ -209,6 +216,9 @@ def _add_hinged(sim_sub) -> None:
                         help=f"hinge point from body {i}'s mass centre, body-{i} axes [m]")
     hg.add_argument("--kind", choices=["ball", "revolute"], default="ball",
                     help="hinge kind (ball)")
+    hg.add_argument("--model", choices=HINGED_MODELS, default="scene",
+                    help="scene: minimal coordinates, the hinge holds by construction; "
+                         "multiplier: two free bodies held by Lagrange multipliers (scene)")
     hg.add_argument("--axis", type=_vector((3,)),
                     help="revolute hinge axis, unit vector in body-1 axes (= body-2 axes at "
                          "the start)")
@@ -224,8 +234,8 @@ def _add_hinged(sim_sub) -> None:
                     help=f"check: largest invariant drift and constraint residual "
                          f"({HINGED_TOL:g})")
     hg.add_argument("--no-stabilization", action="store_true",
-                    help="no Baumgarte drift control (the constraints drift with the "
-                         "integration error)")
+                    help="--model multiplier: no Baumgarte drift control (the constraints "
+                         "drift with the integration error)")
     hg.add_argument("--no-jit", action="store_true",
                     help="do not compile the integration loop to C (faster for short runs)")
     _add_outputs(hg, "rates, hinge reaction and drift with and without stabilization",
@@ -239,8 +249,10 @@ def _check_hinged(parser, args) -> None:
         parser.error("argument --axis: only with --kind revolute")
 
 
-def _hinged_run(args, stabilized, progress=None):
-    """``(model, SimulationResult)`` of the hinged bodies with or without drift control."""
+def _hinged_run(args, stabilized, progress=None, model_kind=None):
+    """``(model, SimulationResult)`` of the hinged bodies: the multiplier model with or
+    without drift control, or (``model_kind='scene'``, the default ``args.model``) the scene
+    run with its states mapped to the two bodies and the multiplier model's invariants."""
     import numpy as np
 
     from appdyn.dynamics import hinged_bodies, simulate
@@ -259,9 +271,49 @@ def _hinged_run(args, stabilized, progress=None):
     v1 = np.zeros(3) if args.v1 is None else args.v1
     x0 = model.initial_state(identity, args.w1, v1, identity, args.w2)
     t = np.linspace(0.0, args.t_final, args.points)
-    res = simulate(model, x0, t, method="rk8", steps=args.steps, invariants=True,
-                   jit=False if args.no_jit else None, progress=progress)
-    return model, res
+    options = dict(method="rk8", steps=args.steps, jit=False if args.no_jit else None,
+                   progress=progress)
+    if (model_kind or args.model) == "multiplier":
+        return model, simulate(model, x0, t, invariants=True, **options)
+    return model, _scene_run(args, model, x0, t, options)
+
+
+def _scene_run(args, model, x0, t, options):
+    """The `dynamics.hinged.hinged_scene` run from the two-body state ``x0`` (identity attitudes),
+    as a `SimulationResult` in the two-body states with ``model``'s invariants."""
+    from dataclasses import replace
+
+    import casadi as ca
+    import numpy as np
+
+    from appdyn.dynamics import simulate
+    from appdyn.dynamics.hinged import HINGED_STATES, hinged_scene, two_body_state
+
+    scene = hinged_scene(args.m1, inertia_matrix(args.inertia1), args.m2,
+                         inertia_matrix(args.inertia2), args.r1, args.r2, args.kind, args.axis)
+    at = {s: x0[HINGED_STATES.index(s)] for s in HINGED_STATES}
+    w1 = np.array([at[f"w{i}"] for i in (1, 2, 3)])
+    w_rel = np.array([at[f"w{i}_2"] for i in (1, 2, 3)]) - w1   # body axes agree at the start
+    speeds = [float(w_rel @ scene.parts[0].axis)] if args.kind == "revolute" else w_rel
+    lay = scene.layout[scene.part_names[0]]
+    y0 = scene.state(w=w1, v=[at["v1"], at["v2"], at["v3"]], r=[at["x"], at["y"], at["z"]])
+    y0[lay.speeds] = speeds
+    res = simulate(scene.model(), y0, t, **options)
+    x = np.asarray(two_body_state(scene).map(t.size)(res.x))
+    p = ca.DM.zeros(0, t.size)
+    invariants = {k: np.asarray(f.map(t.size)(x, p)) for k, f in model.invariants.items()}
+    return replace(res, x=x, invariants=invariants, _dense=None)
+
+
+def _two_body_blocks() -> dict:
+    """The named state blocks of `dynamics.hinged_bodies` (``q1``, ``w1``, ``v1``,
+    ``position1``, then body 2's), as slices of its ``x``."""
+    from appdyn.dynamics.hinged import HINGED_STATES
+    from appdyn.problems.stability.common import block
+
+    ends = {"q": ("q1", "q4"), "w": ("w1", "w3"), "v": ("v1", "v3"), "position": ("x", "z")}
+    return {f"{k}{i}": block(HINGED_STATES, a + sfx, b + sfx)
+            for i, sfx in ((1, ""), (2, "_2")) for k, (a, b) in ends.items()}
 
 
 def _drift_history(res, name):
@@ -295,25 +347,29 @@ def _hinged_summary(args, res, stabilized) -> dict:
                                   residual.max(axis=1)) if not v <= args.tol]
         message = f"{', '.join(bad)} above --tol {args.tol:g} (largest {worst:.3g})"
     return {
-        "case": "hinged", "kind": args.kind, "success": verified, "message": message,
-        "parameters": {"m1": args.m1, "inertia1": args.inertia1, "r1": args.r1,
+        "case": "hinged", "kind": args.kind, "model": args.model, "success": verified,
+        "message": message,
+        "parameters": {"model": args.model, "m1": args.m1, "inertia1": args.inertia1, "r1": args.r1,
                        "m2": args.m2, "inertia2": args.inertia2, "r2": args.r2,
                        "axis": args.axis, "w1": args.w1, "w2": args.w2, "v1": args.v1,
                        "t_final": args.t_final, "points": args.points, "steps": args.steps,
                        "stabilization": stabilized, "tol": args.tol},
         "method": res.method, "wall_time": res.wall_time, "compiled": res.compiled,
-        "final": {"t": float(res.t[-1]), "q1": x[0:4], "w1": x[4:7], "v1": x[7:10],
-                  "position1": x[10:13], "q2": x[13:17], "w2": x[17:20], "v2": x[20:23],
-                  "position2": x[23:26]},
+        "final": {"t": float(res.t[-1]), **{k: x[sl] for k, sl in _two_body_blocks().items()}},
         "hinge_force_range": [float(force.min()), float(force.max())],
         "hinge_torque_range": [float(torque.min()), float(torque.max())],
         "drift": drift,
         "constraint_residual_max": {"position": float(residual[0].max()),
                                     "velocity": float(residual[1].max())},
-        "history": {"t": res.t, "w1": res.x[4:7], "w2": res.x[17:20],
+        "history": {"t": res.t, "w1": res.x[_two_body_blocks()["w1"]],
+                    "w2": res.x[_two_body_blocks()["w2"]],
                     "hinge_force": inv["hinge_force"], "hinge_torque": inv["hinge_torque"],
                     "constraint_residual": residual},
     }
+
+
+_MODEL_TEXT = {"scene": "scene in minimal coordinates (hub + hinged panel)",
+               "multiplier": "two free bodies with Lagrange multipliers"}
 
 
 def _hinged_text(s) -> str:
@@ -321,10 +377,12 @@ def _hinged_text(s) -> str:
     f, p = s["final"], s["parameters"]
     units = "m, m/s" if s["kind"] == "ball" else "m or rad, m/s or rad/s"
     lines = [
-        f"Hinged bodies, {s['kind']} hinge (RP-1262 Ch. 6 Ex. 5): {s['method']}, "
-        f"{p['steps']} steps per output interval, {p['points']} points, "
+        f"Hinged bodies, {s['kind']} hinge (RP-1262 Ch. 6 Ex. 5): {_MODEL_TEXT[s['model']]}, "
+        f"{s['method']}, {p['steps']} steps per output interval, {p['points']} points, "
         f"t_final {p['t_final']:g} s",
-        "  drift control: " + ("Baumgarte stabilization" if p["stabilization"] else "none"),
+        "  drift control: " + ("none needed (minimal coordinates)" if s["model"] == "scene"
+                               else "Baumgarte stabilization" if p["stabilization"]
+                               else "none"),
         f"final state (t = {f['t']:g} s):",
         f"  body 1  w {vec(f['w1'])} rad/s  v {vec(f['v1'])} m/s",
         f"          q {vec(f['q1'])}",
@@ -345,18 +403,21 @@ def _hinged_text(s) -> str:
 
 
 def _hinged_figure(args, runs):
-    """Rates, hinge reaction, and drift/residual of ``runs`` = {stabilized: result}."""
+    """Rates, hinge reaction, and drift/residual of ``runs`` = {label: result}, the main run
+    first."""
     import numpy as np
 
     from appdyn.dynamics.figures import finish_figure, new_figure
 
-    main_run = runs[not args.no_stabilization]
+    main_run = next(iter(runs.values()))
     fig = new_figure((11.0, 8.0))
     ax = fig.subplots(2, 2)
     t = main_run.t
+    rates = _two_body_blocks()
+    w1, w2 = main_run.x[rates["w1"]], main_run.x[rates["w2"]]
     for i, c in enumerate("rgb"):
-        ax[0, 0].plot(t, main_run.x[4 + i], c, label=f"w{i + 1} body 1")
-        ax[0, 0].plot(t, main_run.x[17 + i], c + "--", label=f"w{i + 1} body 2")
+        ax[0, 0].plot(t, w1[i], c, label=f"w{i + 1} body 1")
+        ax[0, 0].plot(t, w2[i], c + "--", label=f"w{i + 1} body 2")
     ax[0, 0].set(xlabel="t [s]", ylabel="rate [rad/s]", title="body rates")
     ax[0, 0].legend(fontsize=7, ncol=2)
     force = np.asarray(main_run.invariants["hinge_force"])
@@ -366,23 +427,21 @@ def _hinged_figure(args, runs):
                   label="|torque| [N m]")
     ax[0, 1].set(xlabel="t [s]", ylabel="[N]", title="hinge reaction on body 2 (inertial)")
     ax[0, 1].legend(fontsize=7)
-    styles = {True: "-", False: ":"}
-    for stabilized, res in runs.items():
-        tag = "stabilized" if stabilized else "unstabilized"
+    for (tag, res), style in zip(runs.items(), ("-", ":")):
         for name, c in zip(("energy", "momentum_linear", "momentum_angular"), "rgb"):
             ax[1, 0].semilogy(res.t, np.maximum(_drift_history(res, name), _FLOOR),
-                              c + styles[stabilized], label=f"{name} ({tag})")
+                              c + style, label=f"{name} ({tag})")
         r = np.asarray(res.invariants["constraint_residual"])
-        ax[1, 1].semilogy(res.t, np.maximum(r[0], _FLOOR), "b" + styles[stabilized],
+        ax[1, 1].semilogy(res.t, np.maximum(r[0], _FLOOR), "b" + style,
                           label=f"position ({tag})")
-        ax[1, 1].semilogy(res.t, np.maximum(r[1], _FLOOR), "r" + styles[stabilized],
+        ax[1, 1].semilogy(res.t, np.maximum(r[1], _FLOOR), "r" + style,
                           label=f"velocity ({tag})")
     for a in (ax[1, 0], ax[1, 1]):
         a.axhline(args.tol, color="k", lw=0.8, alpha=0.5, label=f"--tol {args.tol:g}")
         a.legend(fontsize=7)
     ax[1, 0].set(xlabel="t [s]", ylabel="relative drift", title="invariant drift")
     ax[1, 1].set(xlabel="t [s]", ylabel="|residual|",
-                 title="constraint residual with and without stabilization")
+                 title="constraint residual: " + " vs ".join(runs))
     for a in ax.flat:
         a.grid(True, alpha=0.3)
     return finish_figure(fig)
@@ -397,9 +456,15 @@ def _run_hinged(args) -> int:
         progress.close()
     summary = _hinged_summary(args, res, stabilized)
     print(_hinged_text(summary))
-    if args.plot:  # the comparison: the same run with the other drift control
-        _, other = _hinged_run(args, not stabilized)
-        save_figure(_hinged_figure(args, {stabilized: res, not stabilized: other}), args.plot)
+    if args.plot:  # the comparison: the multiplier model (with the other drift control)
+        tag = {True: "stabilized", False: "unstabilized"}
+        if args.model == "scene":
+            runs = {"scene": res, f"multipliers, {tag[stabilized]}":
+                    _hinged_run(args, stabilized, model_kind="multiplier")[1]}
+        else:
+            runs = {tag[stabilized]: res,
+                    tag[not stabilized]: _hinged_run(args, not stabilized)[1]}
+        save_figure(_hinged_figure(args, runs), args.plot)
         print(f"plot written to {args.plot}")
     if args.json:
         write_json(summary, args.json)

@@ -95,9 +95,10 @@ def _momentum_info(sol, scale) -> dict:
     return {"momentum_drift": drift}
 
 
-def _body_momentum(x_rb, H_inertial):
-    """Total momentum in body axes along a rigid-body guess: ``A(q) H_inertial``."""
-    return np.einsum("ijk,j->ik", dcm_from_quat(x_rb[:4]), H_inertial)
+def _body_momentum(q, H_inertial):
+    """Total momentum in body axes along the quaternions ``q`` (4, n) of a rigid-body guess:
+    ``A(q) H_inertial``."""
+    return np.einsum("ijk,j->ik", dcm_from_quat(q), H_inertial)
 
 
 def solve_converted(problem, rb_problem, convert, objective, *, starts, seed, N, tol, verbose,
@@ -225,17 +226,21 @@ def wheel_slew(inertia, axes, wheel_inertia, *, objective="time", T=None, angle=
     body_max = float(np.min(tmax)) * float(sigma[-1]) if tmax is not None else None
     T_ref = rough_time(I, q0, qf, np.full(3, body_max if body_max else 1.0))
     horizon = slew_horizon(objective, T, T_max, T_ref)
-    lo = np.r_[np.full(7, -np.inf), -smax if smax is not None else np.full(n, -np.inf)]
+    lo = np.full(model.nx, -np.inf)
+    if smax is not None:
+        lo[model.layout["wheels"].speeds] = -smax
     problem, rb = _problems(model, I, objective, horizon, q0, qf, W0, Wf, tmax,
                             body_max if body_max else None, "wheel", x_bounds=(lo, -lo))
     H_in = A @ (J * W0)  # at rest: the wheels carry it all (identity body = inertial at t0)
     H_in = dcm_from_quat(q0).T @ H_in
     AJ_pinv, A_pinv = np.linalg.pinv(A * J), np.linalg.pinv(A)
 
+    hub = rb.model.layout["hub"]
+
     def convert(g):
         x, t = g["x"], g["t"]
-        w = x[4:7]
-        Hb = _body_momentum(x, H_in)
+        w = x[hub.speeds]
+        Hb = _body_momentum(x[hub.coords], H_in)
         W = AJ_pinv @ (Hb - I @ w) - A.T @ w
         wdot = np.gradient(w, t, axis=1, edge_order=2)
         tau = -A_pinv @ (I @ wdot + np.cross(w.T, Hb.T).T)
@@ -329,10 +334,11 @@ def cmg_slew(inertia, geometry, *, objective="time", T=None, angle=None, axis=No
     problem, rb = _problems(model, I, objective, horizon, q0, qf, d0, df, rmax, body_max, "cmg",
                             path=path)
     H_in = dcm_from_quat(q0).T @ cluster_momentum(geometry, d0)
+    hub = rb.model.layout["hub"]
 
     def convert(g):
         x, t = g["x"], g["t"]
-        Hc = _body_momentum(x, H_in) - I @ x[4:7]  # what the cluster must carry
+        Hc = _body_momentum(x[hub.coords], H_in) - I @ x[hub.speeds]  # the cluster's share
         d = np.empty((n, t.size))
         d[:, 0] = d0
         for k in range(1, t.size):  # track Hc by damped pseudo-inverse (Newton) steps

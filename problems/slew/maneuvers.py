@@ -17,7 +17,7 @@ from appdyn.dynamics.validate import integer
 from appdyn.dynamics.interrupts import interruptible
 from appdyn.ocp.progress import stage_sink
 
-from .problem import (attitude_guess, inertia_of, is_rest_to_rest, rough_time, seeded_guesses,
+from .problem import (attitude_blocks, attitude_guess, inertia_of, is_rest_to_rest, rough_time, seeded_guesses,
                       slew_angle, slew_problem)
 from .report import polish_text
 from .targets import (ARCSEC, MIN_REFINE_TOL, POINTING_TOL, RATE_TOL, STATUS_POINTING,
@@ -77,7 +77,7 @@ def verify(solution: Solution, *, pointing_tol: float = POINTING_TOL, rate_tol: 
     # every fixed final state after the quaternion: body rates, and wheel speeds or gimbal
     # angles of the device slews where their final values are given
     fixed = np.isfinite(np.asarray(solution.problem.x_final, dtype=float))
-    fixed[:4] = False
+    fixed[attitude_blocks(solution.problem.model)[0]] = False
     term = solution.terminal_error[fixed]
     rerr = float(np.max(term, initial=0.0)) if np.all(np.isfinite(term)) else float("nan")
     info = {"pointing_error": perr, "final_rate_error": rerr, "pointing_tol": ptol, "rate_tol": rtol}
@@ -247,7 +247,8 @@ def time_optimal(inertia, *, angle=None, axis=None, q0=None, qf=None, u_max=1.0,
     rest = _rest(problem, 0.0, ptol, rtol)
     if rest is not None:
         return rest
-    T_est = rough_time(inertia_of(problem.model), problem.x_initial[:4], problem.q_final,
+    q0 = problem.x_initial[attitude_blocks(problem.model)[0]]
+    T_est = rough_time(inertia_of(problem.model), q0, problem.q_final,
                         problem.u_bounds[1], floor=1e-14 if is_rest_to_rest(problem) else 1e-3)
     if control not in CONTROLS:
         raise ValueError(f"`control` must be one of {CONTROLS}, got {control!r}")

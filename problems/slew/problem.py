@@ -16,7 +16,8 @@ from appdyn.ocp.attitude import slerp
 
 from .targets import KeepOut, check_angle, check_u_max, targets, vector3
 
-__all__ = ["slew_problem", "eigenaxis_time", "attitude_guess", "rough_time", "is_rest_to_rest",
+__all__ = ["slew_problem", "eigenaxis_time", "attitude_guess", "attitude_blocks", "rough_time",
+           "is_rest_to_rest",
            "slew_angle", "inertia_of", "seeded_guesses"]
 
 
@@ -177,13 +178,39 @@ def rough_time(I, q0, qf, u_lim, floor=1e-3):
     return max(2.0 * math.sqrt(max(angle, floor) / alpha), 1e-6)
 
 
+def attitude_blocks(model) -> tuple:
+    """``(q, w)``: the slices of an attitude model's quaternion (4) and body rates (3) in
+    ``x``, from ``model.attitude`` (a scene's hub: ``model.layout["hub"]``'s coordinates
+    and speeds).
+
+    Raises
+    ------
+    ValueError
+        If ``model`` has no attitude.
+
+    Examples
+    --------
+    >>> from appdyn.dynamics import rigid_body
+    >>> attitude_blocks(rigid_body([1.0, 2.0, 2.5]))
+    (slice(0, 4, None), slice(4, 7, None))
+    """
+    if model.attitude is None:
+        raise ValueError(f"`model` {model.name!r} has no attitude (quaternion and body rates)")
+    iq, iw = model.attitude
+    return slice(iq, iq + 4), slice(iw, iw + 3)
+
+
 def is_rest_to_rest(problem) -> bool:
-    return bool(np.all(problem.x_initial[4:] == 0) and np.all(problem.x_final[4:] == 0))
+    """Whether every state but the attitude quaternion is zero at both ends."""
+    rest = np.ones(problem.model.nx, dtype=bool)
+    rest[attitude_blocks(problem.model)[0]] = False
+    return bool(np.all(problem.x_initial[rest] == 0) and np.all(problem.x_final[rest] == 0))
 
 
 def slew_angle(problem) -> float:
     """Rotation angle [rad] from ``q0`` to the target, in [0, pi]."""
-    return float(rotation_angle(quat_mul(np.asarray(problem.q_final), quat_conj(problem.x_initial[:4]))))
+    q0 = problem.x_initial[attitude_blocks(problem.model)[0]]
+    return float(rotation_angle(quat_mul(np.asarray(problem.q_final), quat_conj(q0))))
 
 
 # ---------------------------------------------------------------------------- guesses
@@ -219,7 +246,8 @@ def attitude_guess(problem: Problem, *, tilt_axis=None, tilt=0.0, T=None, n=201)
     if getattr(problem, "q_final", None) is None:
         raise ValueError("`problem` must be a slew problem (with an attitude target `q_final`)")
     model = problem.model
-    q0 = problem.x_initial[:4]
+    iq, iw = attitude_blocks(model)
+    q0 = problem.x_initial[iq]
     qf = np.array(problem.q_final)
     if np.dot(qf, q0) < 0:
         qf = -qf  # the shorter way round
@@ -237,7 +265,7 @@ def attitude_guess(problem: Problem, *, tilt_axis=None, tilt=0.0, T=None, n=201)
     t = s * T
     qdot = np.gradient(q, t, axis=1, edge_order=2)
     w = 2.0 * quat_mul(qdot, quat_conj(q))[:3]
-    w[:, 0], w[:, -1] = problem.x_initial[4:], np.nan_to_num(problem.x_final[4:])
+    w[:, 0], w[:, -1] = problem.x_initial[iw], np.nan_to_num(problem.x_final[iw])
     I = inertia_of(model)
     wdot = np.gradient(w, t, axis=1, edge_order=2)
     u = I @ wdot + np.cross(w.T, (I @ w).T).T
@@ -247,9 +275,12 @@ def attitude_guess(problem: Problem, *, tilt_axis=None, tilt=0.0, T=None, n=201)
 
 def inertia_of(model):
     """Recover the inertia matrix of a rigid-body model from its Jacobian (exact)."""
-    x, u = ca.SX.sym("x", 7), ca.SX.sym("u", 3)
-    J = ca.Function("J", [x, u], [ca.jacobian(model.f(x, u, ca.DM.zeros(0))[4:], u)])
-    return np.linalg.inv(np.array(J(np.r_[0, 0, 0, 1, 0, 0, 0], np.zeros(3))))
+    iq, iw = attitude_blocks(model)
+    x, u = ca.SX.sym("x", model.nx), ca.SX.sym("u", model.nu)
+    J = ca.Function("J", [x, u], [ca.jacobian(model.f(x, u, ca.DM.zeros(0))[iw], u)])
+    x0 = np.zeros(model.nx)
+    x0[iq] = [0.0, 0.0, 0.0, 1.0]
+    return np.linalg.inv(np.array(J(x0, np.zeros(model.nu))))
 
 
 def seeded_guesses(problem, starts, seed, *, eigenaxis=True):

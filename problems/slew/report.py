@@ -10,6 +10,7 @@ from appdyn.dynamics.attitude import dcm_from_quat
 from appdyn.ocp import Solution, control_switches
 from appdyn.ocp.solution import draw_bounds
 
+from .problem import attitude_blocks
 from .targets import ARCSEC
 
 __all__ = ["switch_times", "polish_text", "summary", "format_summary", "plot_slew"]
@@ -154,7 +155,7 @@ def summary(solution: Solution, *, eigenaxis=None) -> dict:
     perr = info.get("pointing_error", solution.pointing_error)
     rerr = info.get("final_rate_error")
     if rerr is None:
-        term = solution.terminal_error[4:7]
+        term = solution.terminal_error[attitude_blocks(solution.problem.model)[1]]
         rerr = float(np.max(term)) if np.all(np.isfinite(term)) else float("nan")
     out = dict(
         success=bool(solution.success),
@@ -277,8 +278,9 @@ def plot_slew(solution: Solution, path=None, *, fig=None, dpi: int = 110):
         raise TypeError(f"`fig` must be a matplotlib Figure, got {type(fig).__name__}")
     t = np.linspace(solution.t[0], solution.t[-1], 400)
     x, u = solution.sample(t)
-    panels = [(x[:4], "quaternion", [f"q{i + 1}" for i in range(4)]),
-              (x[4:], "body rate [rad/s]", ["w1", "w2", "w3"]),
+    iq, iw = attitude_blocks(solution.problem.model)
+    panels = [(x[iq], "quaternion", [f"q{i + 1}" for i in range(4)]),
+              (x[iw], "body rate [rad/s]", ["w1", "w2", "w3"]),
               (u, "torque [N m]", ["u1", "u2", "u3"])]
     for k, (data, label, names) in enumerate(panels):
         ax = fig.add_subplot(2, 2, k + 1)
@@ -289,7 +291,7 @@ def plot_slew(solution: Solution, path=None, *, fig=None, dpi: int = 110):
         ax.legend(loc="best", fontsize=8)
         ax.grid(alpha=0.3)
     ax = fig.add_subplot(2, 2, 4, projection="3d")
-    A = dcm_from_quat(x[:4] / np.linalg.norm(x[:4], axis=0))  # (3, 3, n): rows = body axes
+    A = dcm_from_quat(x[iq] / np.linalg.norm(x[iq], axis=0))  # (3, 3, n): rows = body axes
     for i, c in enumerate(("tab:red", "tab:green", "tab:blue")):
         ax.plot(A[i, 0], A[i, 1], A[i, 2], color=c, label=f"body axis {i + 1}")
         ax.scatter(*A[i, :, -1], color=c, marker="o")

@@ -20,13 +20,16 @@ Cases
 `launch_vehicle`       thrust-vectored vehicle under the attitude/rate autopilot (Sec. 5.4):
                        margins at the engine deflection, named modes; `bode_plot`,
                        `nichols_plot`, `launch_vehicle_response` (time response)
+`vehicle_loops`        pitch and yaw autopilot loops of a thrust-vectored vehicle scene (an
+                       `Engine` on a six-degree-of-freedom hub): margins per axis
 `loop`                 any plant with a feedback law: margins via ``control.stability_margins``
 `shaken_pendulum`      hanging / inverted pendulum on a shaken hinge: Floquet multipliers
                        (a `PeriodicStabilityReport`), checked against Mathieu's chart
 `conical_pendulum`     steady cone of the spherical pendulum (3-1-3 or 3-2-1 form), reduced by
                        its symmetry about the vertical (Routh)
 `hinged_spin`          two hinged bodies spinning together about a common axis (ball or
-                       revolute hinge), reduced to the independent tilt coordinates
+                       revolute hinge), reduced to the independent tilt coordinates;
+                       `hinged_scene` its scene (a six-degree-of-freedom hub and a panel)
 `analyze`              any ``StateSpace`` (e.g. from `dynamics.linearize.linearize`)
 =====================  ======================================================================
 
@@ -44,8 +47,9 @@ Spin cases report the *reduced* motion: the spin phase about the axis (cyclic) a
 conserved spin-axis momentum (a first integral, whose steady spins form a one-parameter
 family with eigenvalue 0), and a scene's further first integrals (a free wheel's axial
 momentum), are factored out by `Linearization.quotient` and `Linearization.restrict`; the
-notes say which states went. The launch vehicle's translation
-(rigid-body drift, for guidance to correct) is factored out the same way.
+notes say which states went. A scene's six-degree-of-freedom hub is reduced to its attitude
+with the system mass centre at rest (`spin_scene.attitude_subsystem`). The launch vehicle's
+translation (rigid-body drift, for guidance to correct) is factored out the same way.
 
 Examples
 --------
@@ -63,7 +67,7 @@ from appdyn.dynamics.spinning import PointMassDamper, SphericalDamper
 from .cases import CASE_ALIASES, CASES, resolve_case
 from .common import STANDARD_GRAVITY
 from .constrained import conical_pendulum
-from .hinged import hinged_spin
+from .hinged import hinged_scene, hinged_spin
 from .launch_vehicle import launch_vehicle
 from .launch_vehicle_plots import bode_plot, loop_transfer, nichols_plot
 from .launch_vehicle_response import AutopilotResponse, launch_vehicle_response
@@ -74,6 +78,7 @@ from .report import (CLOSED_FORM_RTOL, STATUS_MISMATCH, STATUS_UNCHECKED, STATUS
 from .spin import gyrostat, spin
 from .sweep import Boundary, SweepResult, sweep
 from .tilt import heavy_top, rotor, spinning_projectile
+from .vehicle_loops import vehicle_loops
 from .verdict import VERDICTS, ZERO_RTOL, classify
 
 __all__ = [
@@ -84,5 +89,5 @@ __all__ = [
     "sweep", "CASES",
     "CASE_ALIASES", "resolve_case", "STANDARD_GRAVITY", "STATUS_VERIFIED", "STATUS_UNCHECKED",
     "STATUS_MISMATCH", "CLOSED_FORM_RTOL", "shaken_pendulum", "conical_pendulum",
-    "PeriodicStabilityReport", "FloquetMode", "hinged_spin",
+    "PeriodicStabilityReport", "FloquetMode", "hinged_spin", "hinged_scene", "vehicle_loops",
 ]

@@ -13,110 +13,51 @@ import math
 import casadi as ca
 import numpy as np
 
-from appdyn.dynamics import cache
-from appdyn.dynamics.linearize import linearization
-from appdyn.dynamics.model import Model
+from appdyn.dynamics.hinged import hinged_scene
+from appdyn.dynamics.scene import Scene
 
 from .closed_forms import axis_kind, principal_moments, rigid_spin_lambda2
-from .common import block, check_number
+from .common import check_number
 from .report import Quantity, StabilityReport, build_report
+from .spin_scene import attitude_subsystem, spin_linearization
 
-__all__ = ["hinged_spin", "ball_tilt_eigenvalues"]
-
-_HINGED_STATES = ("q1", "q2", "q3", "q4", "w1", "w2", "w3", "q1_rel", "q2_rel", "q3_rel",
-                  "q4_rel", "w1_2", "w2_2", "w3_2")
-_Y = {"q1": block(_HINGED_STATES, "q1", "q4"), "w1": block(_HINGED_STATES, "w1", "w3"),
-      "q_rel": block(_HINGED_STATES, "q1_rel", "q4_rel"),
-      "w2": block(_HINGED_STATES, "w1_2", "w3_2")}  # the blocks of the relative states
+__all__ = ["hinged_spin", "hinged_scene", "ball_tilt_eigenvalues"]
 
 
-@cache.memoize
-def _hinged_relative(m1, inertia1, m2, inertia2, r1, r2, kind):
-    """``(model, assemble, full)``: the hinged pair with the system mass centre at rest at the
-    origin, in the states ``(q1, w1, q_rel, w2)`` (``q2 = q_rel (x) q1``, ``w2`` body-2
-    axes), ``assemble(y)`` the full 26-state ``x`` and ``full`` the `hinged_bodies` model
-    (no Baumgarte term: the constraints are then exact first integrals)."""
-    from appdyn.dynamics.attitude import dcm_from_quat, quat_conj, quat_mul
-    from appdyn.dynamics.hinged import hinged_bodies
-
-    axis = [0.0, 0.0, 1.0] if kind == "revolute" else None
-    full = hinged_bodies(m1, np.reshape(inertia1, (3, 3)), m2, np.reshape(inertia2, (3, 3)),
-                         list(r1), list(r2), kind=kind, axis=axis, stabilization=None)
-    y, u, p = ca.SX.sym("y", len(_HINGED_STATES)), ca.SX.sym("u", 0), ca.SX.sym("p", 0)
-    q1, w1, qr, w2 = (y[_Y[k]] for k in ("q1", "w1", "q_rel", "w2"))
-    q2 = quat_mul(qr, q1)
-    A1, A2 = dcm_from_quat(q1), dcm_from_quat(q2)
-    M = m1 + m2
-    d = ca.mtimes(A1.T, ca.DM(r1)) - ca.mtimes(A2.T, ca.DM(r2))          # C2 - C1, inertial
-    dd = (ca.mtimes(A1.T, ca.cross(w1, ca.DM(r1)))
-          - ca.mtimes(A2.T, ca.cross(w2, ca.DM(r2))))                      # its rate
-    x = ca.vertcat(q1, w1, ca.mtimes(A1, -m2 / M * dd), -m2 / M * d,
-                   q2, w2, ca.mtimes(A2, m1 / M * dd), m1 / M * d)
-    xdot = full.f(x, u, p)
-    names = full.states
-    q1dot, q2dot = xdot[block(names, "q1", "q4")], xdot[block(names, "q1_2", "q4_2")]
-    qrdot = quat_mul(q2dot, quat_conj(q1)) + quat_mul(q2, quat_conj(q1dot))
-    f = ca.Function("hinged_spin", [y, u, p],
-                    [ca.vertcat(q1dot, xdot[block(names, "w1", "w3")], qrdot,
-                                xdot[block(names, "w1_2", "w3_2")])], ["x", "u", "p"],
-                    ["xdot"])
-    units = {**dict.fromkeys(_HINGED_STATES[_Y["q1"]] + _HINGED_STATES[_Y["q_rel"]], "-"),
-             **dict.fromkeys(("w1", "w2", "w3", "w1_2", "w2_2", "w3_2"), "rad/s")}
-    model = Model(f, _HINGED_STATES, (), (), units=units, name=f"hinged_spin_{kind}",
-                  attitude=(0, 4))
-    return model, ca.Function("assemble", [y], [x]), full
+_TWO_BODY = {"p1": "q1_rel", "p2": "q2_rel", "u1": "w1_2", "u2": "w2_2"}
+"""The ball panel's reduced states -> the two-body names (``q_rel``: body 1 -> body 2, which
+is the panel's ``p``; ``w_2``: body 2's angular velocity in its own axes)."""
 
 
-def _error_functions(assemble, full, kind):
-    """``(xr) -> conserved / constraint functions`` in the linearization's 13 coordinates
-    (``dth`` for body 1's attitude about the reference ``q_ref = [0, 0, 0, 1]``)."""
-    from appdyn.dynamics.attitude import quat_mul
-
-    xr = ca.SX.sym("xr", 13)
-    dth = xr[0:3]
-    q1 = quat_mul(ca.vertcat(dth / 2, ca.sqrt(1 - ca.sumsqr(dth) / 4)), ca.DM([0, 0, 0, 1]))
-    y = ca.vertcat(q1, xr[3:])
-    x = assemble(y)
-    H = full.invariants["momentum_angular"](x, ca.DM.zeros(0))
-    rows = [ca.sumsqr(y[_Y["q_rel"]])]
-    if kind == "revolute":
-        phi, _, bnu = full.constraints(x, ca.DM.zeros(0))
-        rows += [bnu[3], bnu[4], phi[3], phi[4]]
-    rows += [H[0], H[1]]
-    return (ca.Function("rows", [xr], [ca.jacobian(ca.vertcat(*rows), xr)]),
-            ca.Function("hz", [xr], [ca.jacobian(H[2], xr)]))
-
-
-def _restrict_subspace(lin, L, eliminate, reason):
-    """Restrict ``lin`` to the invariant subspace ``ker L`` (``L A = R L``: first integrals,
-    constraints whose rates are those first integrals, or quantities that rotate among
-    themselves), the states ``eliminate`` being solved from ``L x = 0``."""
+def _two_body_coordinates(scene: Scene, x, red):
+    """``red`` (reduced states ``w1, w2, p1, p2, u1, u2`` of a ball panel) in the two-body
+    coordinates ``w1, w2, q1_rel, q2_rel, w1_2, w2_2``: ``q_rel = p`` and body 2's rate
+    ``w_2 = A(p) w + u`` (panel axes), linearized at ``x`` (a similarity transform: the
+    eigenvalues do not change)."""
     from dataclasses import replace
 
-    L = np.atleast_2d(np.asarray(L, dtype=float))
-    k = [lin.index(s) for s in eliminate]
-    r = [i for i in range(lin.n) if i not in k]
-    Lk = L[:, k]
-    if np.linalg.cond(Lk) > 1e10:
-        raise ValueError(f"cannot solve the conserved quantities for {list(eliminate)} "
-                         f"(condition {np.linalg.cond(Lk):.3e})")
-    P = -np.linalg.solve(Lk, L[:, r])                 # x[k] = P x[r]
-    E = np.zeros((lin.n, len(r)))
-    E[r, range(len(r))] = 1.0
-    E[k, :] = P
-    AE = lin.A @ E
-    err = np.max(np.abs(L @ AE))                       # A (ker L) in ker L
-    scale = max(float(np.max(np.abs(lin.A))), 1e-300)
-    if err > 1e-9 * scale * max(1.0, np.max(np.abs(L))) * max(1.0, np.max(np.abs(E))):
-        raise ValueError(f"ker L is not invariant under A: max |L A E| = {err:.3e}")
-    n = len(r)
-    states = tuple(lin.states[i] for i in r)
-    note = (f"restricted to the invariant subspace of {len(k)} conserved / constraint "
-            f"quantities, {list(eliminate)} eliminated ({reason})")
-    return replace(lin, A=AE[r], B=lin.B[r], C=np.eye(n), D=np.zeros((n, len(lin.inputs))),
-                   states=states, residual=lin.residual[r],
-                   units={s: lin.units.get(s, "") for s in states},
-                   notes=lin.notes + (note,)), E
+    from appdyn.dynamics.attitude import dcm_from_quat
+
+    model = attitude_subsystem(scene)
+    xs = ca.SX.sym("x", model.nx)
+    lay = model.layout["panel"]
+    p, u = xs[lay.coords], xs[lay.speeds]
+    w = xs[model.layout["hub"].speeds]
+    jac = ca.Function("w_2", [xs], [ca.jacobian(ca.mtimes(dcm_from_quat(p), w) + u, xs)])
+    J = np.asarray(jac(x), dtype=float)
+    T = np.eye(red.n)   # the eliminated w3, p3, p4, u3 do not enter w1_2, w2_2 here
+    for i, name in enumerate(red.states):
+        if name in ("u1", "u2"):
+            T[i] = [J[int(name[1]) - 1, model.states.index(s)] for s in red.states]
+    Ti = np.linalg.inv(T)
+    states = tuple(_TWO_BODY.get(s, s) for s in red.states)
+    units = {s: ("-" if s.startswith("q") else "rad/s") for s in states}
+    return replace(red, A=T @ red.A @ Ti, B=T @ red.B, C=np.eye(red.n),
+                   D=np.zeros((red.n, len(red.inputs))), states=states,
+                   residual=T @ red.residual, units=units,
+                   notes=red.notes + ("two-body coordinates: q1_rel, q2_rel = p1, p2 (the "
+                                      "relative quaternion body 1 -> body 2); w1_2, w2_2 = "
+                                      "body 2's rate A(p) w + u in its own axes",))
 
 
 def _hinged_check(m1, inertia1, m2, inertia2, r1, r2, rate, kind, axis):
@@ -194,23 +135,25 @@ def hinged_spin(*, m1, inertia1, m2, inertia2, r1, r2, rate, kind="revolute",
 
     Reduction
     ---------
-    The pair is written in ``(q1, w1, q_rel, w2)`` (``q2 = q_rel (x) q1``, ``w2`` body-2
-    axes) with ``v1, v2, R1, R2`` taken from the ball constraint and the system mass centre
-    at rest (its translation removed exactly; the hinge constraints run without Baumgarte
-    term, so they are exact first integrals), and linearized in the frame spinning at
-    ``rate`` (`~dynamics.linearize.linearization`; body 1's quaternion becomes ``dth``). Then:
-    ``ker L`` is kept, ``L`` the gradients of ``|q_rel|^2`` (quaternion norm), for the
-    revolute hinge the two constraint rates ``B_r nu`` and positions ``phi_r`` (tilt of
-    ``q_rel`` and transverse ``w2`` eliminated), and the inertial transverse angular
-    momentum ``H_x, H_y`` (the direction of ``H``: its ``+-i rate`` mode, ``dth1, dth2``
-    eliminated); restricted to ``w3_2`` (body 2's axial rate: no hinge torque along z) and
-    the axial momentum ``H_z`` (``w3`` eliminated); quotient by the spin phase ``dth3`` and
-    the twist of body 2 about z ``q3_rel`` (the hinge angle). Revolute: left is ``(w1, w2)``,
-    body 1's transverse rates, and the pair is one rigid body of inertia
-    ``I1 + I2 + mu |r1 - r2|^2 (E - e3 e3^T)`` (``mu = m1 m2 / (m1 + m2)``) about the system
-    mass centre: ``lambda^2 = -rate^2 (Iz - Ix)(Iz - Iy) / (Ix Iy)``. Ball: left are
-    ``(w1, w2, q1_rel, q2_rel, w1_2, w2_2)``, the two bodies' tilts; no closed form is
-    attached.
+    The pair is the scene `hinged_scene` (body 1 the six-degree-of-freedom hub, body 2 a
+    `dynamics.scene.HingedPanel`: minimal coordinates, no multipliers) and goes through
+    `spin_linearization`, as `spin` does: its translation is removed exactly
+    (`attitude_subsystem`: ``r`` is cyclic, and on the level set ``P = 0`` of the linear
+    momentum the hub's ``v`` follows from the other speeds), it is linearized in body rates
+    (the attitude, with the spin phase, does not enter), the hinge angle (``theta``, or the
+    relative quaternion's twist and norm) is factored out as cyclic, and the state is
+    restricted to the conserved ``|H|^2`` (``w3`` eliminated) or, for the ball, to the
+    constant spin rate. Then the panel's axial rate relative to the hub (``theta_dot`` or
+    ``u3``; body 2's absolute axial rate ``w3_2`` with ``w3``) is restricted: the hinge
+    exerts no torque about z. Revolute: left is ``(w1, w2)``, body 1's transverse rates,
+    and the pair is one rigid body of inertia ``I1 + I2 + mu |r1 - r2|^2 (E - e3 e3^T)``
+    (``mu = m1 m2 / (m1 + m2)``) about the system mass centre:
+    ``lambda^2 = -rate^2 (Iz - Ix)(Iz - Iy) / (Ix Iy)``. Ball: left are
+    ``(w1, w2, q1_rel, q2_rel, w1_2, w2_2)``, the two bodies' tilts, in the two-body
+    coordinates (``q_rel`` = the panel's ``p``; ``w_2 = A(p) w + u`` body 2's rate in its
+    own axes: a similarity transform of the panel's ``u1, u2``); the closed form
+    `ball_tilt_eigenvalues` for axisymmetric bodies. The multiplier model
+    `dynamics.hinged_bodies`, reduced by hand, gives the same matrix (tests).
 
     Parameters
     ----------
@@ -247,33 +190,15 @@ def hinged_spin(*, m1, inertia1, m2, inertia2, r1, r2, rate, kind="revolute",
     """
     m1, I1, m2, I2, r1, r2, W = _hinged_check(m1, inertia1, m2, inertia2, r1, r2, rate, kind,
                                               axis)
-    key = (m1, tuple(I1.ravel().tolist()), m2, tuple(I2.ravel().tolist()),
-           tuple(r1.tolist()), tuple(r2.tolist()), kind)
-    model, assemble, full = _hinged_relative(*key)
-    y0 = np.zeros(len(_HINGED_STATES))
-    for name, value in (("q4", 1.0), ("w3", W), ("q4_rel", 1.0), ("w3_2", W)):
-        y0[_HINGED_STATES.index(name)] = value
-    lin = linearization(model, y0)
-    g_rows, g_hz = _error_functions(assemble, full, kind)
-    xr0 = np.r_[np.zeros(3), y0[_Y["q1"].stop:]]  # dth replaces body 1's quaternion
-    L = np.asarray(g_rows(xr0), dtype=float)
-    c_hz = np.asarray(g_hz(xr0), dtype=float).ravel()
-    elim = ["q4_rel"] + (["w1_2", "w2_2", "q1_rel", "q2_rel"] if kind == "revolute" else [])
-    elim += ["dth1", "dth2"]
-    red, E = _restrict_subspace(
-        lin, L, elim, "quaternion norm of q_rel" + (", revolute constraint rates and positions"
-                                                     if kind == "revolute" else "")
-        + ", direction of the inertial angular momentum (its +-i rate mode)")
-    red = red.restrict("w3_2", reason="body 2's axial rate: the hinge exerts no torque about "
-                       "z (a first integral to first order)")
-    kept = [s for s in lin.states if s not in elim]   # the columns of E
-    c = c_hz @ E                                       # H_z on ker L; w3_2's level set: c[r]
-    c = np.array([c[kept.index(s)] for s in red.states])
-    red = red.restrict(c, eliminate="w3", reason="axial angular momentum H_z is conserved; "
-                       "the neighbouring spins' eigenvalue 0 goes")
-    red = red.quotient("dth3", reason="the spin phase about z is cyclic")
-    red = red.quotient("q3_rel", reason="the twist of body 2 about z (the hinge angle) is "
-                       "cyclic: a family of relative equilibria")
+    scene = hinged_scene(m1, I1, m2, I2, r1, r2, kind)
+    sl = spin_linearization(scene, np.array([0.0, 0.0, 1.0]), W)
+    lin = sl.lin
+    axial = "theta_dot" if kind == "revolute" else "u3"
+    red = sl.reduced.restrict(axial, reason="body 2's axial rate w3_2 = w3 + "
+                              f"{axial}: the hinge exerts no torque about z (a first integral "
+                              "to first order)")
+    if kind == "ball":
+        red = _two_body_coordinates(scene, sl.point.x, red)
     mu = m1 * m2 / (m1 + m2)
     dist = float(np.linalg.norm(r1 - r2))
     comp = I1 + I2 + mu * dist ** 2 * np.diag([1.0, 1.0, 0.0])
@@ -303,12 +228,16 @@ def hinged_spin(*, m1, inertia1, m2, inertia2, r1, r2, rate, kind="revolute",
     notes = [f"{kind} hinge; combined moments about the system mass centre Iz = {Ia:.10g}, "
              f"Ix = {Ib:.10g}, Iy = {Ic:.10g} kg m^2 (spin about the "
              f"{axis_kind(Ia, Ib, Ic)} axis of the locked pair)",
-             "the system mass centre is held at rest and v1, v2, R1, R2 are taken from the "
-             "ball constraint (its translation and the 3 + 3 translational directions are "
-             "removed exactly); hinge constraints without Baumgarte term",
+             "the scene in minimal coordinates (body 1 the hub, body 2 a HingedPanel: "
+             "hinged_scene); the system mass centre is held at rest (linear momentum P = 0: "
+             "attitude_subsystem removes r, v exactly)",
+             "body rates only: the attitude (the error angles dth1..dth3; dth3 the spin "
+             "phase) does not enter; the inertial angular momentum |H| is conserved",
+             "the hinge angle (theta, or the twist q3_rel of the relative quaternion q_rel = "
+             "p; q4_rel its norm) is cyclic: a family of relative equilibria",
              f"unreduced spectrum ({lin.n} states): "
              + ", ".join(f"{z.real:+.3e}{z.imag:+.6e}j" for z in lin.eigenvalues()),
-             *red.notes]
+             *red.notes, *sl.notes]
     title = (f"Hinged pair ({kind} hinge) spinning about the common axis z at "
              f"{W:.6g} rad/s")
     params = dict(m1=m1, inertia1=I1, m2=m2, inertia2=I2, r1=r1, r2=r2, rate=W, kind=kind,

@@ -15,8 +15,7 @@ import numpy as np
 
 from appdyn.dynamics.rigid_body import check_inertia
 from appdyn.dynamics.scene import (ExternalForce, ExternalTorque, FlexibleAppendage, HeldRotor,
-                                   ReactionWheels,
-                                   RigidHub, Scene, TiltTorque)
+                                   ReactionWheels, RigidHub, Scene, TiltTorque)
 from appdyn.dynamics.spinning import (PointMassDamper, SphericalDamper, gyrostat_scene,
                                       unit_vector)
 
@@ -63,7 +62,8 @@ def spin(inertia, axis, rate, *, damper=None) -> StabilityReport:
     Parameters
     ----------
     inertia : Scene, or array_like, shape (3, 3) or (3,) [kg m^2]
-        A scene with an attitude-only hub, or the inertia of the rigid body about its mass
+        A scene (a six-degree-of-freedom hub is reduced to its attitude with the system mass
+        centre at rest: `~problems.stability.spin_scene.attitude_subsystem`), or the inertia of the rigid body about its mass
         center (without the damper mass / core inertia).
     axis : array_like, shape (3,)
         Spin axis in body (hub) axes; must be a principal axis of the (loaded) body.

@@ -5,7 +5,9 @@ has the part speeds of `Part.spin_speeds` (`Scene.state`) and part coordinates t
 part speeds' derivatives vanish (a point-mass damper's centrifugal offset), found by Newton's
 method with the hub rate held (`spin_point`). The whole right-hand side is then checked by
 `dynamics.linearize.linearization` (a hub rate derivative that does not vanish means the axis
-is not principal for the loaded body).
+is not principal for the loaded body). A six-degree-of-freedom hub is reduced to its
+attitude first (`attitude_subsystem`: the position is cyclic, and the system mass centre is
+held at rest, ``P = 0``), so every state and layout below is that subsystem's.
 
 `spin_linearization` linearizes in body rates (``frame='rates'``; in the spinning frame, with
 the spin phase factored out by `Linearization.quotient`, when a load depends on the
@@ -22,11 +24,13 @@ from dataclasses import dataclass
 import casadi as ca
 import numpy as np
 
+from appdyn.dynamics import cache
 from appdyn.dynamics.linearize import ANGLE_STATES, Linearization, linearization
-from appdyn.dynamics.scene import Scene
+from appdyn.dynamics.model import Model
+from appdyn.dynamics.scene import PartLayout, Scene
 
 __all__ = ["SpinPoint", "SpinLinearization", "spin_point", "spin_linearization",
-           "spin_groups", "NEWTON_RTOL", "NEWTON_MAX_ITER"]
+           "spin_groups", "attitude_subsystem", "NEWTON_RTOL", "NEWTON_MAX_ITER"]
 
 NEWTON_RTOL = 1e-13
 """Relative tolerance of the part-coordinate solve (`spin_point`)."""
@@ -43,7 +47,8 @@ class SpinPoint:
     Attributes
     ----------
     x : ndarray, shape (nx,)
-        The state: identity attitude, ``w = rate * axis``, parts at rest relative to the hub.
+        The state: identity attitude, ``w = rate * axis``, parts at rest relative to the hub
+        (a translating hub: the state of `attitude_subsystem`, without ``r``, ``v``).
     coordinates : tuple of str
         The part coordinates solved for.
     residual : float
@@ -87,6 +92,107 @@ class SpinLinearization:
     groups: dict
 
 
+TRANSLATION = ("r1", "r2", "r3", "v1", "v2", "v3")
+"""The translational states of a six-degree-of-freedom hub, removed by `attitude_subsystem`."""
+
+
+def _shifted(lay: PartLayout, index: dict) -> PartLayout:
+    """``lay`` with its state slices renumbered by ``index`` (old -> new position; states
+    not in ``index`` dropped, the others contiguous)."""
+    def cut(sl):
+        kept = [index[i] for i in range(sl.start, sl.stop) if i in index]
+        return slice(kept[0], kept[-1] + 1) if kept else slice(0, 0)
+    names = tuple(n for n in lay.names if n not in TRANSLATION)
+    return PartLayout(states=cut(lay.states), controls=lay.controls, coords=cut(lay.coords),
+                      speeds=cut(lay.speeds), names=names)
+
+
+@cache.memoize
+def attitude_subsystem(scene: Scene) -> Model:
+    """The attitude of ``scene`` at zero linear momentum: the hub's ``r``, ``v`` removed.
+
+    A free vehicle's translation decouples from its attitude. The hub's position ``r`` is
+    cyclic (nothing in the right-hand side depends on it: checked), so its rows go; the
+    linear momentum ``P`` is conserved, and on its level set ``P = 0`` (the system mass
+    centre at rest) the hub's velocity is fixed by the other speeds: with the body-axis
+    momentum ``P_b = dT/dv = M v + w x S + sum m_i v_rel,i`` (``T`` the kinetic energy,
+    affine in ``v``), ``v = -J^-1 P_b(v = 0)``, ``J = dP_b/dv``. The flow on that level set
+    is exact: ``x' = f(x(y))`` without the ``r``, ``v`` rows, ``x(y)`` the full state with
+    ``r = 0`` and that ``v``. The invariants are the scene's at ``x(y)`` (the angular
+    momentum about the origin is then the one about any point), ``momentum_linear``
+    (identically zero) excepted. An attitude-only scene's model is returned unchanged.
+
+    Parameters
+    ----------
+    scene : Scene
+
+    Returns
+    -------
+    Model
+        States of ``scene.model()`` without ``r1..r3, v1..v3``; controls, units, bounds and
+        ``layout`` (renumbered) likewise. Controls that exert a force are kept, but their
+        effect on ``P`` is not represented.
+
+    Raises
+    ------
+    ValueError
+        Naming ``scene``, if its right-hand side depends on the hub's position ``r`` (a
+        field that acts on the position).
+
+    Examples
+    --------
+    >>> from appdyn.dynamics.scene import HingedPanel, RigidHub, Scene
+    >>> scene = Scene(RigidHub([2.0, 2.0, 3.0], mass=10.0),
+    ...               HingedPanel(2.0, [0.2, 0.2, 0.3], [0, 0, 0.5], [0, 0, 0.2],
+    ...                           axis=[0, 0, 1]))
+    >>> attitude_subsystem(scene).states
+    ('q1', 'q2', 'q3', 'q4', 'w1', 'w2', 'w3', 'theta', 'theta_dot')
+    """
+    model = scene.model()
+    if not scene.hub.translates:
+        return model
+    names = model.states
+    ir = [names.index(s) for s in TRANSLATION[:3]]
+    iv = [names.index(s) for s in TRANSLATION[3:]]
+    keep = [i for i in range(model.nx) if i not in ir + iv]
+    y, u = ca.SX.sym("y", len(keep)), ca.SX.sym("u", model.nu)
+    p = ca.SX.sym("p", model.np)
+    v = ca.SX.sym("v", 3)
+    x = ca.SX.zeros(model.nx)
+    for k, i in enumerate(keep):
+        x[i] = y[k]
+    for k, i in enumerate(iv):
+        x[i] = v[k]
+    Pb = ca.gradient(model.invariants["energy"](x, p), v)      # dT/dv, affine in v
+    J = ca.jacobian(Pb, v)
+    vstar = -ca.solve(J, ca.substitute(Pb, v, ca.SX.zeros(3)))
+    x = ca.substitute(x, v, vstar)
+    xs = ca.SX.sym("x", model.nx)
+    if ca.depends_on(model.f(xs, u, p)[keep], xs[ir]):
+        raise ValueError("`scene`: its right-hand side depends on the hub's position r, so the "
+                         "translation does not decouple from the attitude")
+    f = ca.Function(model.name, [y, u, p], [model.f(x, u, p)[keep]], ["x", "u", "p"],
+                    ["xdot"])
+    invariants = {key: ca.Function(key, [y, p], [fun(x, p)], ["x", "p"], [key])
+                  for key, fun in model.invariants.items() if key != "momentum_linear"}
+    index = {i: k for k, i in enumerate(keep)}
+    states = tuple(names[i] for i in keep)
+    return Model(f, states, model.controls, model.params, p_default=model.p_default,
+                 units={k: v for k, v in model.units.items() if k not in TRANSLATION},
+                 invariants=invariants, name=f"{model.name}_attitude", attitude=(0, 4),
+                 layout={k: _shifted(lay, index) for k, lay in model.layout.items()},
+                 bounds={k: b for k, b in model.bounds.items() if k not in TRANSLATION})
+
+
+def _rest_state(scene: Scene, w) -> np.ndarray:
+    """`Scene.state` at the hub rate ``w``, in the states of `attitude_subsystem`."""
+    x = scene.state(w=w)
+    if not scene.hub.translates:
+        return x
+    drop = {scene.states.index(s) for s in TRANSLATION}
+    return np.array([x[i] for i in range(x.size) if i not in drop])
+
+
 def _indices(model, key: str) -> list:
     """State indices of every part's coordinates (``key='coords'``) or speeds, hub excluded."""
     out = []
@@ -118,8 +224,8 @@ def spin_point(scene: Scene, axis: np.ndarray, rate: float) -> SpinPoint:
     >>> pt.x, pt.converged
     (array([0., 0., 0., 1., 2., 0., 0.]), True)
     """
-    model = scene.model()
-    x = scene.state(w=rate * np.asarray(axis, dtype=float))
+    model = attitude_subsystem(scene)
+    x = _rest_state(scene, rate * np.asarray(axis, dtype=float))
     ic, iv = _indices(model, "coords"), _indices(model, "speeds")
     names = tuple(model.states[i] for i in ic)
     if not ic or not iv:
@@ -225,7 +331,7 @@ def reduce_spin(scene: Scene, x, lin: Linearization, axis) -> tuple:
     (Linearization, list of str)
         The reduced linearization and notes.
     """
-    model = scene.model()
+    model = attitude_subsystem(scene)
     red = lin
     cyclic = [model.states[i] for i in _indices(model, "coords")]
     scale = max(float(np.max(np.abs(lin.A), initial=0.0)), 1e-300)
@@ -322,11 +428,7 @@ def spin_linearization(scene: Scene, axis: np.ndarray, rate: float, *,
     >>> sl.reduced.states, sl.groups
     (('w2', 'w3'), {'nutation': ['w2', 'w3']})
     """
-    if scene.hub.translates:
-        raise ValueError("`scene`: spin needs an attitude-only hub (RigidHub without `mass`); "
-                         "a free spinner's translation decouples from its attitude: drop the "
-                         "hub's `mass`")
-    model = scene.model()
+    model = attitude_subsystem(scene)
     point = spin_point(scene, axis, rate)
     where = f"`axis` = {np.round(axis, 12).tolist()} at `rate` = {rate:g} rad/s"
     if not point.converged:

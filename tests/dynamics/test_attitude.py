@@ -380,6 +380,12 @@ VALID_CALLS = {
     "quat_from_euler321": (at.quat_from_euler321, dict(angles=_E)),
     "euler321_from_quat": (at.euler321_from_quat, dict(q=_Q)),
     "principal_axes": (at.principal_axes, dict(inertia=GEMINI)),
+    "aero_angles": (at.aero_angles, dict(v_body=_W)),
+    "total_aoa": (at.total_aoa, dict(v_body=_W)),
+    "aero_angles_from_total": (at.aero_angles_from_total, dict(alpha_T=0.4, phi_R=2.0)),
+    "total_aoa_from_aero_angles": (at.total_aoa_from_aero_angles, dict(alpha=0.3, beta=-0.2)),
+    "velocity_direction": (at.velocity_direction, dict(alpha=0.3, beta=-0.2)),
+    "velocity_direction_total": (at.velocity_direction_total, dict(alpha_T=0.4, phi_R=2.0)),
 }
 NUMERIC_ARGS = [(name, arg) for name, (_, kw) in VALID_CALLS.items() for arg in kw
                 if not (name == "dcm_axis" and arg == "component")]
@@ -516,7 +522,11 @@ def test_dm_is_checked_by_value_and_stays_casadi():
 
 
 # Arguments of the CasADi-capable functions as (numeric value, CasADi shape).
-_SYMBOLIC = [name for name in VALID_CALLS if name not in ("axis_angle_from_quat", "principal_axes")]
+# (the aerodynamic angles return pairs: tests/dynamics/attitude/test_aero_angles.py checks
+# them in SX and MX against numpy)
+_SYMBOLIC = [name for name in VALID_CALLS if name not in (
+    "axis_angle_from_quat", "principal_axes", "aero_angles", "total_aoa",
+    "aero_angles_from_total", "total_aoa_from_aero_angles")]
 
 
 @pytest.mark.filterwarnings("error")

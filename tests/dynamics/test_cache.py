@@ -86,3 +86,37 @@ def test_clear_caches_removes_compiled_files_and_rebuilds(tmp_path, monkeypatch)
     assert info.entries == 0
     again = simulate(model, X0, t, method="rk4", jit=True)
     assert again.compiled and np.allclose(again.x, first.x, rtol=0, atol=1e-14)
+
+
+# ------------------------------------------------------------ memoize_values (wrappers)
+def test_memoize_values_keys_by_value_before_the_checks():
+    """A repeated wrapper call is one cache hit (no checks, no scene): equal values in a
+    list, a tuple or an array are one key; a different value is a miss."""
+    import numpy as np
+
+    from appdyn.dynamics import cache as c
+    from appdyn.dynamics import rigid_body
+
+    first = rigid_body([1.0, 2.0, 2.5])
+    before = c.info()
+    assert rigid_body((1, 2, 2.5)) is first and rigid_body(np.array([1.0, 2.0, 2.5])) is first
+    after = c.info()
+    assert after.hits == before.hits + 2 and after.misses == before.misses
+    assert rigid_body([1.0, 2.0, 2.25]) is not first
+
+
+def test_memoize_values_never_caches_bad_input_and_keeps_types_apart():
+    import numpy as np
+
+    from appdyn.dynamics import cache as c
+    from appdyn.dynamics import wheel_spacecraft
+
+    for _ in range(2):   # raised on every call: nothing was cached
+        with pytest.raises(ValueError, match="inertia"):
+            wheel_spacecraft([1.0, 2.0, -3.0], np.eye(3), 0.05)
+    assert c.value_key(True) != c.value_key(1.0) and c.value_key(1) == c.value_key(1.0)
+    assert c.value_key([1, 2]) == c.value_key(np.array([1.0, 2.0]))
+    for unkeyable in ([True, False], [[1, 2], [3]], object()):
+        with pytest.raises(c._Unkeyable):
+            c.value_key(unkeyable)
+    assert c.value_key(float("nan")) != c.value_key(float("nan"))   # NaN: always a miss

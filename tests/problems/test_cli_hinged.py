@@ -6,6 +6,7 @@ import json
 import math
 import re
 
+import numpy as np
 import pytest
 
 from appdyn.problems.cli import main
@@ -64,6 +65,26 @@ def test_revolute_hinge_without_stabilization(tmp_path, capsys):
     assert data["parameters"]["stabilization"] is False and data["success"] is True
     w1, w2 = data["final"]["w1"], data["final"]["w2"]
     assert all(math.isfinite(v) for v in w1 + w2)
+
+
+@pytest.mark.parametrize("argv", [BALL, REVOLUTE])
+def test_the_scene_run_equals_the_multiplier_model(argv, tmp_path, capsys):
+    """The default run is the scene (minimal coordinates); --model multiplier integrates
+    the two free bodies: the same final states (rk8, both at round-off level per step), and
+    the scene's mapped run keeps the multiplier model's constraints to round-off."""
+    runs = {}
+    for model in ("scene", "multiplier"):
+        out = tmp_path / f"{model}.json"
+        assert main([*argv, "--model", model, "--json", str(out)]) == 0
+        text = capsys.readouterr().out
+        runs[model] = strict_json(out)
+        assert runs[model]["model"] == model and runs[model]["parameters"]["model"] == model
+        assert ("minimal coordinates" in text) == (model == "scene")
+    a, b = runs["scene"], runs["multiplier"]
+    for key, value in b["final"].items():
+        assert np.allclose(a["final"][key], value, rtol=0, atol=1e-10), key
+    assert max(a["constraint_residual_max"].values()) < 1e-13
+    assert np.allclose(a["hinge_force_range"], b["hinge_force_range"], rtol=1e-9)
 
 
 def test_a_tolerance_below_round_off_fails_with_status_1(capsys):

@@ -245,6 +245,9 @@ VALID = {
     "path_radius": lambda: 0.5,
     "cone_angle": lambda: 0.3,
     "alpha": lambda: 0.1,
+    "alpha_T": lambda: 0.2,
+    "phi_R": lambda: 1.0,
+    "v_body": lambda: np.array([100.0, 5.0, -3.0]),
     "alpha_dot": lambda: 0.0,
     "amp_y": lambda: 0.02,
     "theta0": lambda: 0.3,
@@ -326,6 +329,9 @@ _ASC_R = lambda: np.array([6.4e6, 0.0, 0.0])  # noqa: E731
 _ASC_V = lambda: np.array([0.0, 7.5e3, 0.0])  # noqa: E731
 
 OVERRIDES = {
+    "appdyn.problems.stability.vehicle_loops": {"scene": lambda: __import__(
+        "appdyn.dynamics.scene", fromlist=["x"]).launch_vehicle_scene(
+            thrust=2.0e6, inertia=4.0e7, arm=20.0, mass=1.0e5)},
     "appdyn.dynamics.launch_vehicle": {"inertia": lambda: 2.0e6, "mass": lambda: 5.0e4},
     "appdyn.dynamics.launch_vehicle.launch_vehicle": {"inertia": lambda: 2.0e6, "mass": lambda: 5.0e4},
     "appdyn.problems.stability.launch_vehicle": {"inertia": lambda: 2.0e6, "mass": lambda: 5.0e4},

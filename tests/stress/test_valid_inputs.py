@@ -151,6 +151,9 @@ RANDOM = {
     "h": log_floats(1e-3, 1.0),
     "x0": rigid_states(),
     "x": rigid_states(),
+    "v_body": st.tuples(unit_vectors(), log_floats(1.0, 1e3)).map(lambda a: a[0] * a[1]),
+    "alpha_T": floats(0.0, math.pi),
+    "phi_R": floats(0.0, 2 * math.pi),
     # momentum exchange
     "axes": st.sampled_from([np.eye(3), np.eye(3)[:, :2]]),
     "wheel_inertia": vectors(3, 1e-3, 0.05),

@@ -12,6 +12,7 @@ from typing import Callable
 import numpy as np
 
 from appdyn.dynamics import scene as sc
+from appdyn.dynamics.launch_vehicle import Actuator
 
 AXES = np.array([[1.0, 0.0, 0.0, 0.57735026918962573],
                  [0.0, 1.0, 0.0, 0.57735026918962573],
@@ -74,6 +75,7 @@ PARTS: dict[str, Entry] = {
     "cmgs_torque": Entry(lambda: sc.CMGCluster(PYRAMID_G[:, :2], PYRAMID_S[:, :2], [1.0, 0.8],
                                                rotor_inertia=0.01, gimbal_inertia=0.004,
                                                drive="torque"),
+                         steps=2000,  # on a ball-jointed panel: 5e-10 at 1000, 3e-13 at 2000
                          work={"tg": lambda s, n: np.array([s[k] for k in s["__speeds__"][n]])}),
     "tilt": Entry(lambda: sc.TiltTorque(3.0, axis=(0.0, 0.0, 1.0), direction=(0.0, 0.0, 1.0)),
                   conserves=("energy", "momentum_linear")),
@@ -82,6 +84,10 @@ PARTS: dict[str, Entry] = {
                                                    tip_mass=0.2)),
     "force": Entry(lambda: sc.ExternalForce(point=[0.2, 0.4, -0.3]), conserves=("energy",),
                    work={"F": _point_velocity([0.2, 0.4, -0.3])}),
+    # engine off (no thrust, no mass flow): its gimbal actuator states move, nothing else
+    "engine": Entry(lambda: sc.Engine(0.0, (-0.5, 0.1, 0.0), gimbal=0.1,
+                                      actuator=Actuator(0.2, rate_limit=1.0)),
+                    work={"dp_c": lambda s, n: np.zeros(2)}),
 }
 
 ALL = tuple(name for name in PARTS if name != "slosh")

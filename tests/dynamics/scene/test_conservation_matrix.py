@@ -7,12 +7,14 @@ relative over 100 s; with the controls on, the energy changes exactly at the pow
 controls (``E' = sum u . v_u``, each control with the velocity it does work on), at random
 states.
 """
+import dataclasses
 import itertools
 
 import numpy as np
 import pytest
 
 from appdyn.dynamics import simulate
+from appdyn.dynamics.attitude import dcm_from_axis_angle
 from appdyn.dynamics.scene import RigidHub, Scene
 
 from .registry import ALL, I_HUB, PARTS
@@ -70,11 +72,16 @@ def test_invariants_conserved_with_controls_off(hub, names):
     steps = max(PARTS[n].steps for n in names)
     res = simulate(model, x0, t, method="rk8", steps=steps, jit=False)
     assert res.success, res.message
+    assert_conserved(model, res, keys)
+
+
+def assert_conserved(model, res, keys):
+    """Each invariant in ``keys`` constant along ``res`` to `RTOL` relative."""
     for key in keys:
-        values = np.asarray(model.invariant(key, res.x)).reshape(-1, t.size)
+        values = np.asarray(model.invariant(key, res.x)).reshape(-1, res.t.size)
         scale = max(float(np.max(np.abs(values))), 1e-300)
         drift = float(np.max(np.abs(values - values[:, :1]))) / scale
-        assert drift < RTOL, f"{key} drifts by {drift:.2e} (relative) over 100 s"
+        assert drift < RTOL, f"{key} drifts by {drift:.2e} (relative) over {res.t[-1]} s"
 
 
 def _named(scene, x):
@@ -104,4 +111,57 @@ def test_energy_changes_at_the_power_of_the_controls(hub):
                 power += float(np.dot(u[lay.controls], velocity(s, part_name)))
         dE0 = float(np.asarray(grad(x, [], 0)[0]).reshape(-1) @ model.rhs(x, np.zeros(model.nu)))
         assert abs(dE0) < 1e-12 * max(1.0, abs(power))
+        assert abs(dE - power) <= 1e-10 * max(1.0, abs(power)), (dE, power)
+
+
+# ------------------------------------------------------------------ parts on parts
+#: the parts that can carry parts, and every part that can sit on one (fields cannot)
+CARRIERS = ("panel", "ball_panel")
+MOUNTABLE = tuple(n for n in PARTS if n != "tilt")
+ON_PARTS = [pytest.param(c, (n,), marks=pytest.mark.slow) for c in CARRIERS for n in MOUNTABLE
+            ] + [("panel", tuple(n for n in ALL if n in MOUNTABLE and n != "panel"))]
+
+
+def _mounted_scene(hub, carrier, names):
+    """The hub, a carrier panel, and ``names`` each on the carrier."""
+    parts = [PARTS[carrier].make()]
+    parts += [dataclasses.replace(PARTS[n].make(), parent="panel") for n in names]
+    return Scene(HUBS[hub](), *parts)
+
+
+@pytest.mark.parametrize("hub", HUBS)
+@pytest.mark.parametrize("carrier, names", ON_PARTS,
+                         ids=lambda p: p if isinstance(p, str) else
+                         ("+".join(p) if len(p) < 3 else "all"))
+def test_invariants_conserved_with_parts_on_a_panel(hub, carrier, names):
+    scene = _mounted_scene(hub, carrier, names)
+    model = scene.model()
+    keys = _conserved((carrier,) + names, hub)
+    x0 = _random_state(scene, np.random.default_rng(11))
+    t = np.linspace(0.0, 100.0, 11)
+    steps = max(PARTS[n].steps for n in (carrier,) + names)
+    res = simulate(model, x0, t, method="rk8", steps=steps, jit=False)
+    assert res.success, res.message
+    assert_conserved(model, res, keys)
+
+
+@pytest.mark.parametrize("hub", HUBS)
+def test_energy_changes_at_the_power_of_controls_on_a_panel(hub):
+    """Wheel motors on the panel work on the wheels' relative speeds; a body torque on the
+    panel (panel axes) on the panel's absolute angular velocity ``R^T (w + theta_dot a)``."""
+    panel = PARTS["panel"].make()
+    scene = _mounted_scene(hub, "panel", ("wheels", "torque"))
+    model = scene.model()
+    grad = model.invariants["energy"].jacobian()
+    rng = np.random.default_rng(5)
+    a = np.asarray(panel.axis)
+    for _ in range(5):
+        x = _random_state(scene, rng)
+        u = rng.normal(size=model.nu)
+        s = dict(zip(model.states, x))
+        R = dcm_from_axis_angle(a, s["theta"]).T  # panel -> hub
+        w_panel = R.T @ (np.array([s["w1"], s["w2"], s["w3"]]) + s["theta_dot"] * a)
+        wheels, torque = model.layout["wheels"], model.layout["torque"]
+        power = float(u[wheels.controls] @ x[wheels.speeds] + u[torque.controls] @ w_panel)
+        dE = float(np.asarray(grad(x, [], 0)[0]).reshape(-1) @ model.rhs(x, u))
         assert abs(dE - power) <= 1e-10 * max(1.0, abs(power)), (dE, power)

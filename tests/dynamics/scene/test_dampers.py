@@ -5,6 +5,7 @@
 * each part against an independent truth: conservation of energy and inertial momentum,
   the energy's decay at the dissipation rate, the slosh pendulum's closed-form frequencies.
 """
+import dataclasses
 import math
 
 import casadi as ca
@@ -295,7 +296,10 @@ def test_bad_parts_are_refused_by_field_name():
     with pytest.raises(ValueError, match="exactly one of `frequency`"):
         Slosh(1.0, kind="spring")
     with pytest.raises(ValueError, match="exactly one of `frequency`"):
-        Slosh(1.0, kind="spring", frequency=1.0, stiffness=1.0)
+        Slosh(1.0, kind="spring", frequency=1.0, stiffness=2.0)
+    # both, when they agree (k = m f^2), are a copy's fields: dataclasses.replace works
+    spring = Slosh(1.5, kind="spring", frequency=2.0)
+    assert dataclasses.replace(spring, parent="panel").stiffness == spring.stiffness
     with pytest.raises(ValueError, match="`frequency` is for kind='spring'"):
         Slosh(1.0, length=1.0, frequency=2.0)
     with pytest.raises(ValueError, match="kind"):

@@ -226,3 +226,25 @@ def test_two_ball_panels_keep_their_own_names_and_invariants():
                     panel=[0.0, 0.0, 0.0, 2.0, 0.0, 0.0, 0.0])
     assert float(model.invariant("panel_quat_norm", x)) == 2.0
     assert float(model.invariant("panel_quat_norm_2", x)) == 1.0
+
+
+@pytest.mark.parametrize("kind", ["revolute", "ball"])
+def test_two_body_state_equals_the_test_mapping(kind):
+    """`dynamics.hinged.two_body_state` (the library's map, used by ``simulate hinged``)
+    against this file's `to_hinged`, at random states; and `hinged_scene` is `scenes`."""
+    from appdyn.dynamics.hinged import hinged_scene, two_body_state
+
+    scene, _ = scenes(kind)
+    assert hinged_scene(M1, I1, M2, I2, R1, R2, kind,
+                        AXIS if kind == "revolute" else None).parts == scene.parts
+    fun = two_body_state(scene)
+    rng = np.random.default_rng(11)
+    for _ in range(5):
+        x = scene.state(**start(kind))
+        x[4:] += rng.normal(scale=0.3, size=x.size - 4)
+        if kind == "ball":
+            x[13:17] /= np.linalg.norm(x[13:17])
+        np.testing.assert_allclose(np.asarray(fun(x)).ravel(),
+                                   np.asarray(to_hinged(scene, x)).ravel(), rtol=0, atol=1e-14)
+    with pytest.raises(ValueError, match="`scene`"):
+        two_body_state(Scene(RigidHub(I1, mass=M1)))

@@ -314,7 +314,6 @@ def test_rotor_off_the_spin_axis_is_not_a_relative_equilibrium():
     (lambda: st.spin(Scene(RigidHub([1.0, 2.0, 3.0])), [0, 0, 0], 1.0), "`axis`"),
     (lambda: st.spin(Scene(RigidHub([1.0, 2.0, 3.0])), [1, 0, 0], np.nan), "`rate`"),
     (lambda: st.spin(Scene(RigidHub([1.0, 2.0, 3.0])), [1, 0, 0], "fast"), "`rate`"),
-    (lambda: st.spin(Scene(RigidHub([1.0, 2.0, 3.0], mass=5.0)), [1, 0, 0], 1.0), "`scene`"),
     (lambda: st.spin(Scene(RigidHub([1.0, 2.0, 3.0])), [1, 0, 0], 1.0,
                      damper=st.SphericalDamper(0.1, 0.1)), "`damper`"),
     (lambda: st.spin("a scene", [1, 0, 0], 1.0), "inertia"),
@@ -322,6 +321,38 @@ def test_rotor_off_the_spin_axis_is_not_a_relative_equilibrium():
 def test_bad_input_names_the_argument(call, match):
     with pytest.raises((ValueError, TypeError), match=match):
         call()
+
+
+@pytest.mark.parametrize("reference", [None, [0.3, -0.2, 0.1]])
+@pytest.mark.parametrize("axis", [[1, 0, 0], [0, 1, 0]])
+def test_a_translating_hub_spins_as_the_attitude_only_hub(reference, axis):
+    """A free spinner's translation decouples: the six-degree-of-freedom hub (about its mass
+    centre or another reference point, whose velocity at P = 0 is then w x reference) has
+    the eigenvalues and verdict of the attitude-only hub, and the states of its attitude."""
+    I = [2.0, 3.0, 4.5]
+    rep = st.spin(Scene(RigidHub(I, mass=5.0, reference=reference)), axis, 3.0)
+    ref = st.spin(Scene(RigidHub(I)), axis, 3.0)
+    assert rep.verdict == ref.verdict and rep.ss.state_labels == ref.ss.state_labels
+    assert np.allclose(np.sort_complex(rep.eigenvalues), np.sort_complex(ref.eigenvalues),
+                       rtol=1e-12, atol=1e-12)
+
+
+def test_the_attitude_subsystem_holds_the_mass_centre():
+    """``v`` at P = 0 is w x (reference from the mass centre) in hub axes: the reduced
+    right-hand side is the full one there, without the rows of r and v."""
+    from appdyn.problems.stability.spin_scene import attitude_subsystem
+
+    scene = Scene(RigidHub([2.0, 3.0, 4.5], mass=5.0, reference=[0.3, -0.2, 0.1]))
+    model, full = attitude_subsystem(scene), scene.model()
+    assert model.states == full.states[:7] and "momentum_linear" not in model.invariants
+    w = np.array([0.4, -1.0, 2.0])
+    y = scene.state(w=w)[:7]
+    v = np.cross(w, [0.3, -0.2, 0.1])
+    x = scene.state(w=w, v=v)
+    assert np.allclose(np.asarray(full.invariants["momentum_linear"](x, [])).ravel(), 0,
+                       atol=1e-14)
+    assert np.allclose(np.asarray(model.f(y, [], [])).ravel(),
+                       np.asarray(full.f(x, [], [])).ravel()[:7], rtol=1e-14, atol=1e-14)
 
 
 def test_sweep_over_the_rate_of_a_scene():

@@ -1,0 +1,215 @@
+"""The persistent compile cache (`dynamics.diskcache`): a second process loads what the
+first compiled; corrupted, foreign or unloadable artifacts are rebuilt, never loaded;
+concurrent processes both succeed; the size bound holds; the cache can be turned off.
+
+The truths: the oscillator ``x'' = -c x`` from ``(1, 0)`` is ``cos(sqrt(c) t)``; a compiled
+``k x`` evaluates to ``k x``; the compiles and loads counted by `diskcache.info`.
+"""
+import hashlib
+import json
+import os
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import casadi as ca
+import numpy as np
+import pytest
+
+from appdyn.dynamics import cache, diskcache
+from appdyn.problems.cli import main
+
+ROOT = Path(__file__).resolve().parents[2]
+pytestmark = pytest.mark.skipif(shutil.which("gcc") is None and shutil.which("cc") is None,
+                                reason="no C compiler")
+
+# one simulate of an oscillator (compiled rk8 chunk loop), checked against its closed form;
+# prints the cache counts of the process
+SCRIPT = """
+import json, sys
+import casadi as ca
+import numpy as np
+from appdyn.dynamics import Model, diskcache, simulate
+c = float(sys.argv[1])
+x, u, p = ca.SX.sym("x", 2), ca.SX.sym("u", 0), ca.SX.sym("p", 0)
+f = ca.Function("osc", [x, u, p], [ca.vertcat(x[1], -c * x[0])], ["x", "u", "p"], ["xdot"])
+t = np.linspace(0.0, 1.0, 11)
+res = simulate(Model(f=f, states=("a", "b"), controls=()), [1.0, 0.0], t, method="rk8",
+               steps=4, jit=True)
+assert res.compiled and res.success, res.message
+err = float(np.max(np.abs(res.x[0] - np.cos(np.sqrt(c) * t))))
+print(json.dumps({**diskcache.info()._asdict(), "err": err}))
+"""
+
+
+def run_script(cache_dir, c=1.5, env=None, wait=True):
+    full = {**os.environ, "APPDYN_CACHE_DIR": str(cache_dir), **(env or {})}
+    proc = subprocess.Popen([sys.executable, "-c", SCRIPT, str(c)], cwd=ROOT, env=full,
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    return finish(proc) if wait else proc
+
+
+def finish(proc):
+    out, err = proc.communicate(timeout=600)
+    assert proc.returncode == 0, err
+    return json.loads(out.strip().splitlines()[-1])
+
+
+def artifacts(directory):
+    return sorted(Path(directory).glob("*.so"))
+
+
+def verified(library: Path) -> bool:
+    """The sidecar names this key and the library's size and hash (an independent check)."""
+    meta = json.loads(library.with_suffix(".json").read_text())
+    data = library.read_bytes()
+    return (meta["key"] == library.stem and meta["size"] == len(data)
+            and meta["sha256"] == hashlib.sha256(data).hexdigest())
+
+
+@pytest.fixture
+def disk(tmp_path):
+    """This process's compile cache in ``tmp_path`` (restored afterwards)."""
+    old = diskcache.configure(directory=tmp_path, enabled=True, max_bytes=None)
+    yield tmp_path
+    diskcache.configure(**old)
+
+
+def scaled(k):
+    """A compiled ``x -> k x`` (a Function of its own source for each ``k``)."""
+    x = ca.SX.sym("x")
+    fun = ca.Function("scaled", [x], [k * x])
+    return cache.compile_c([fun], "", "-O0", lambda path: ca.external("scaled", path))
+
+
+def counts():
+    info = diskcache.info()
+    return np.array([info.hits, info.compiles, info.rejected, info.evicted])
+
+
+def test_a_second_process_loads_what_the_first_compiled(tmp_path):
+    first = run_script(tmp_path)
+    assert first["compiles"] >= 1 and first["hits"] == 0 and first["err"] < 1e-9
+    libraries = artifacts(tmp_path)
+    assert len(libraries) == first["compiles"] and all(verified(p) for p in libraries)
+    second = run_script(tmp_path)
+    assert second["compiles"] == 0 and second["hits"] == first["compiles"]
+    assert second["err"] == first["err"]
+    assert artifacts(tmp_path) == libraries
+
+
+def test_a_truncated_artifact_is_rebuilt_not_loaded(tmp_path):
+    run_script(tmp_path)
+    (library,) = artifacts(tmp_path)
+    whole = library.read_bytes()
+    library.write_bytes(whole[: len(whole) // 2])
+    again = run_script(tmp_path)
+    assert again["rejected"] == 1 and again["compiles"] == 1 and again["hits"] == 0
+    assert again["err"] < 1e-9
+    assert artifacts(tmp_path) == [library] and verified(library)
+
+
+def test_a_foreign_artifact_is_rebuilt_not_loaded(tmp_path):
+    """The library and sidecar of another model under this model's key."""
+    run_script(tmp_path, c=1.5)
+    (mine,) = artifacts(tmp_path)
+    run_script(tmp_path, c=4.0)
+    (other,) = [p for p in artifacts(tmp_path) if p != mine]
+    shutil.copy(other, mine)
+    shutil.copy(other.with_suffix(".json"), mine.with_suffix(".json"))
+    again = run_script(tmp_path, c=1.5)
+    assert again["rejected"] == 1 and again["compiles"] == 1 and again["err"] < 1e-9
+    assert verified(mine) and verified(other)
+
+
+def test_a_library_that_does_not_load_is_rebuilt(disk):
+    assert float(scaled(3.0)(2.0)) == 6.0
+    (library,) = artifacts(disk)
+    junk = b"not a shared library" * 100
+    library.write_bytes(junk)  # consistent metadata: only loading can tell
+    library.with_suffix(".json").write_text(json.dumps(
+        {"key": library.stem, "size": len(junk), "sha256": hashlib.sha256(junk).hexdigest()}))
+    before = counts()
+    assert float(scaled(3.0)(2.0)) == 6.0
+    assert list(counts() - before) == [0, 1, 1, 0]
+    assert verified(library)
+
+
+def test_two_processes_compiling_at_once_both_succeed(tmp_path):
+    procs = [run_script(tmp_path, wait=False) for _ in range(2)]
+    results = [finish(p) for p in procs]
+    assert all(r["err"] < 1e-9 for r in results)
+    assert sum(r["compiles"] + r["hits"] for r in results) == 2
+    (library,) = artifacts(tmp_path)
+    assert verified(library) and not list(tmp_path.glob(".tmp-*"))
+
+
+def test_in_process_hits_and_the_key(disk):
+    before = counts()
+    scaled(5.0)
+    scaled(5.0)  # (a second compile of the same source: loaded from disk)
+    assert list(counts() - before) == [1, 1, 0, 0]
+    key = diskcache.artifact_key(b"int f;", "/usr/bin/gcc", ["-O1"])
+    assert key != diskcache.artifact_key(b"int f;", "/usr/bin/gcc", ["-O2"])
+    assert key != diskcache.artifact_key(b"int g;", "/usr/bin/gcc", ["-O1"])
+
+
+def test_eviction_keeps_the_bound_and_drops_the_least_recently_used(disk):
+    scaled(2.0)
+    (a,) = artifacts(disk)
+    scaled(3.0)
+    (b,) = [p for p in artifacts(disk) if p != a]
+    bound = diskcache.info().size + 64  # room for these two only
+    diskcache.configure(max_bytes=bound)
+    assert float(scaled(2.0)(1.0)) == 2.0  # a hit: `a` is now the most recently used
+    before = counts()
+    scaled(7.0)
+    info = diskcache.info()
+    assert info.size <= bound and info.entries == 2 and list(counts() - before) == [0, 1, 0, 1]
+    assert a.exists() and not b.exists()
+
+
+def test_disabled_writes_nothing(disk, tmp_path):
+    diskcache.configure(enabled=False)
+    assert diskcache.directory() is None and not diskcache.enabled()
+    before = counts()
+    assert float(scaled(11.0)(1.0)) == 11.0
+    assert artifacts(disk) == [] and list(counts() - before) == [0, 1, 0, 0]
+
+
+@pytest.mark.parametrize("env", [{"APPDYN_DISK_CACHE": "0"}, {"APPDYN_CACHE_DIR": ""}])
+def test_disabled_by_the_environment(tmp_path, env):
+    out = run_script(tmp_path, env=env)
+    assert out["directory"] is None and out["compiles"] == 1 and out["err"] < 1e-9
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_the_default_directory_follows_xdg(monkeypatch, tmp_path):
+    monkeypatch.delenv("APPDYN_CACHE_DIR", raising=False)
+    monkeypatch.delenv("APPDYN_DISK_CACHE", raising=False)
+    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path))
+    assert diskcache.directory() == tmp_path / "appdyn"
+    monkeypatch.setenv("APPDYN_CACHE_DIR", str(tmp_path / "mine"))
+    assert diskcache.directory() == tmp_path / "mine"
+
+
+def test_the_test_suite_never_uses_the_users_cache():
+    home = Path(os.path.expanduser("~")) / ".cache" / "appdyn"
+    assert diskcache.directory() is not None and diskcache.directory() != home
+
+
+def test_configure_rejects_bad_values():
+    with pytest.raises(ValueError, match="max_bytes"):
+        diskcache.configure(max_bytes=-1)
+    with pytest.raises(TypeError, match="enabled"):
+        diskcache.configure(enabled="yes")
+
+
+def test_cli_info_and_clear(disk, capsys):
+    scaled(13.0)
+    assert main(["cache", "info"]) == 0
+    out = capsys.readouterr().out
+    assert str(disk) in out and "entries:   1" in out
+    assert main(["cache", "clear"]) == 0
+    assert "removed 1 entries" in capsys.readouterr().out and artifacts(disk) == []
