@@ -257,3 +257,34 @@ def test_seed_example6_in_plane_modes_coupled_with_the_hub():
     stiffer = expected[np.min(np.abs(expected[:, None] - np.sqrt(om2)[None, :]), axis=1)
                        > 1e-6 * expected]
     assert stiffer.size == n and np.all(stiffer > np.sqrt(om2))
+
+
+def test_on_a_locked_hinged_boom_it_is_the_same_beam_as_on_the_hub():
+    """Parts on parts: the appendage clamped on a panel (root and direction in panel axes,
+    from the hinge) that a very heavy, very stiff hinge holds at zero angle: locked, its
+    frequencies are the cantilever's; spinning, those of the same beam clamped on the hub at
+    hinge + root (the centrifugal stiffening depends on that radius)."""
+    from appdyn.dynamics.scene import HingedPanel
+    L, m, EI = 2.0, 0.5, (10.0, 17.0)
+    boom = HingedPanel(1e12, [1e12, 1e12, 1e12], hinge_point=[0.0, 0.5, 0.0],
+                       cm_offset=[0.0, 0.5, 0.0], axis=[1.0, 0.0, 0.0], stiffness=1e16,
+                       name="boom")
+    on_boom = Scene(RigidHub(LOCKED), boom,
+                    FlexibleAppendage(L, m, EI, root=(0.0, 1.0, 0.0), direction=(0.0, 1.0, 0.0),
+                                      modes=3, parent="boom"))
+    on_hub = Scene(RigidHub(LOCKED),
+                   FlexibleAppendage(L, m, EI, root=(0.0, 1.5, 0.0), direction=(0.0, 1.0, 0.0),
+                                     modes=3))
+    names = {p: [f"{p}{i}" for i in range(1, 4)] + [f"{p}{i}_dot" for i in range(1, 4)]
+             for p in ("eta", "xi")}
+    for rate in (0.0, 5.0):
+        a, b = (linearization(s.model(), s.state(w=[0.0, 0.0, rate]), frame="rates")
+                for s in (on_boom, on_hub))
+        for plane, ei in zip(("eta", "xi"), EI):
+            fa, fb = _freqs(a, names[plane]), _freqs(b, names[plane])
+            assert np.max(np.abs(fa / fb - 1)) < 1e-9
+            if rate == 0.0:
+                expected = TEXTBOOK[:3] ** 2 * np.sqrt(ei / (m * L ** 4))
+                assert np.max(np.abs(fa / expected - 1)) < 1e-8
+            else:
+                assert fa[0] > TEXTBOOK[0] ** 2 * np.sqrt(ei / (m * L ** 4)) * 1.05
