@@ -240,7 +240,7 @@ def _scene_spin(scene: Scene, axis, rate) -> StabilityReport:
                             f"Ia + h/W = {Ia + h / W:.10g}, Ib = {Ib:.10g}, Ic = {Ic:.10g} "
                             "kg m^2")
     title = f"Spin of {scene.name or 'a scene'} about a hub axis"
-    params = {"scene": repr(scene), "axis": a, "rate": W}
+    params = {"scene": str(scene), "axis": a, "rate": W}
     return build_report("spin", title, params, sl.reduced.ss, lin=sl.lin, closed_form=cf,
                         groups=sl.groups, labeler=_modal_labeler(scene, sl),
                         quantities=quantities, notes=notes)
