@@ -21,6 +21,8 @@ Parts
 `TiltTorque`           a torque from the tilt of a hub axis (heavy top, projectile, bearings)
 `HingedPanel`          a rigid panel on a revolute (``theta``) or ball (``p1..p4``) hinge
 `GravityGradient`      gravity on every body: forces and gravity-gradient torques
+`FlexibleAppendage`    a flexible cantilever by clamped-free modes (``eta``, ``xi``), with
+                       geometric stiffening; `flexible_antenna_satellite`: seed Example 6
 `Engine`               gimbaled thrust (controls ``dp, dy`` or an actuator), mass flow
                        (state ``m_p``), internal-flow Coriolis force and jet damping
 `Aerodynamics`         normal and axial air force at a centre of pressure (6-DoF hub; wind
@@ -51,6 +53,7 @@ from .contract import Body, Contribution, Frame, Load, Part, PartVariables, Vari
 from .dampers import PointMassDamper, Slosh, SphericalDamper
 from .engine import Engine
 from .fields import TiltTorque
+from .flexible import FlexibleAppendage, flexible_antenna_satellite
 from .gravity import GravityGradient
 from .hubs import RigidHub
 from .loads import ExternalForce, ExternalTorque
@@ -63,4 +66,5 @@ __all__ = ["Scene", "check_scene", "RigidHub", "Part", "PartLayout", "Variable",
            "Contribution", "Frame", "ReactionWheels", "HeldRotor", "ExternalTorque",
            "ExternalForce", "PointMassDamper", "SphericalDamper", "Slosh", "TiltTorque",
            "HingedPanel", "GravityGradient", "CMGCluster", "Aerodynamics", "Engine",
-           "launch_vehicle_scene", "attitude_autopilot", "BendingMode", "sensed_attitude"]
+           "launch_vehicle_scene", "attitude_autopilot", "FlexibleAppendage",
+           "flexible_antenna_satellite", "BendingMode", "sensed_attitude"]

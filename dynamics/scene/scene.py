@@ -103,6 +103,12 @@ class Scene:
         inner = ", ".join([repr(self.hub)] + [repr(p) for p in self.parts])
         return f"Scene({inner}{'' if self.name is None else f', name={self.name!r}'})"
 
+    def __str__(self):
+        hub = "RigidHub" + (" (6-DoF)" if self.hub.translates else "")
+        parts = [f"{n} ({type(p).__name__}{'' if at is None else ' on ' + at})"
+                 for p, n, at in zip(self.parts, self._names, self._parents)]
+        return f"{self.name or 'scene'}: " + " + ".join([hub] + parts)
+
     # --------------------------------------------------------------- naming
     @property
     def part_names(self) -> tuple:

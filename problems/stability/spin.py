@@ -14,8 +14,8 @@ import math
 import numpy as np
 
 from appdyn.dynamics.rigid_body import check_inertia
-from appdyn.dynamics.scene import (ExternalForce, ExternalTorque, HeldRotor, ReactionWheels,
-                                   RigidHub, Scene, TiltTorque)
+from appdyn.dynamics.scene import (ExternalForce, ExternalTorque, FlexibleAppendage, HeldRotor,
+                                   ReactionWheels, RigidHub, Scene, TiltTorque)
 from appdyn.dynamics.spinning import (PointMassDamper, SphericalDamper, gyrostat_scene,
                                       unit_vector)
 
@@ -240,9 +240,33 @@ def _scene_spin(scene: Scene, axis, rate) -> StabilityReport:
                             f"Ia + h/W = {Ia + h / W:.10g}, Ib = {Ib:.10g}, Ic = {Ic:.10g} "
                             "kg m^2")
     title = f"Spin of {scene.name or 'a scene'} about a hub axis"
-    params = {"scene": repr(scene), "axis": a, "rate": W}
+    params = {"scene": str(scene), "axis": a, "rate": W}
     return build_report("spin", title, params, sl.reduced.ss, lin=sl.lin, closed_form=cf,
-                        groups=sl.groups, quantities=quantities, notes=notes)
+                        groups=sl.groups, labeler=_modal_labeler(scene, sl),
+                        quantities=quantities, notes=notes)
+
+
+def _modal_labeler(scene: Scene, sl):
+    """Mode labels naming the dominant modal coordinate of a flexible appendage
+    (``'antenna_2: eta1_2'``: the part, then the coordinate of the largest eigenvector
+    entry among the part's states, a rate named by its coordinate); None (labels by part)
+    for a scene without one."""
+    flexible = {name for name, part in zip(scene.part_names, scene.parts)
+                if isinstance(part, FlexibleAppendage)}
+    if not flexible:
+        return None
+    states = sl.reduced.states
+
+    def label(_, v):
+        share = {g: float(np.sum(np.abs(v[[states.index(s) for s in names]]) ** 2))
+                 for g, names in sl.groups.items()}
+        group = max(share, key=share.get)
+        if group not in flexible:
+            return group
+        own = [states.index(s) for s in sl.groups[group]]
+        best = states[max(own, key=lambda i: abs(v[i]))]
+        return f"{group}: {best.replace('_dot', '')}"
+    return label
 
 
 def _upright_tilt(scene: Scene, a, sl):

@@ -79,6 +79,9 @@ PARTS: dict[str, Entry] = {
                          work={"tg": lambda s, n: np.array([s[k] for k in s["__speeds__"][n]])}),
     "tilt": Entry(lambda: sc.TiltTorque(3.0, axis=(0.0, 0.0, 1.0), direction=(0.0, 0.0, 1.0)),
                   conserves=("energy", "momentum_linear")),
+    "flexible": Entry(lambda: sc.FlexibleAppendage(2.0, 0.5, (0.5, 0.8), root=(0.3, -0.4, 0.2),
+                                                   direction=(0.6, 0.0, 0.8), modes=1,
+                                                   tip_mass=0.2)),
     "force": Entry(lambda: sc.ExternalForce(point=[0.2, 0.4, -0.3]), conserves=("energy",),
                    work={"F": _point_velocity([0.2, 0.4, -0.3])}),
     # a mean-axes bending mode, undamped (it carries parts at its station: a carrier)
