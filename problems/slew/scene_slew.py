@@ -168,17 +168,25 @@ def slew(scene, *, objective="time", angle=None, axis=None, q_final=None, T=None
     # parts the slew must bring to rest (a damper, a panel, a slosh mass): the time-optimal
     # control switches again and again to settle their modes (module docstring)
     settle = objective == "time" and bool(settling_parts(scene, problem))
-    starts = opts.starts if opts.starts is not None else (
-        1 if settle else DEFAULT_STARTS_TIME if objective == "time" else DEFAULT_STARTS_EFFORT)
     N = opts.N or scene_intervals(problem, DEFAULT_N[objective], attitude_guess(rb, n=3)["T"])
-    polish = opts.polish is True if settle else opts.polish is not False
-    sol = solve_converted(problem, rb, convert, objective, starts=starts, seed=opts.seed or 0,
-                          N=N, tol=opts.tol, verbose=opts.verbose,
-                          ipopt_options=_dict(opts.ipopt_options), ptol=opts.pointing_tol,
-                          rtol=opts.rate_tol, polish=polish and not keep_out,
-                          guess=opts.guess, transcription=opts.transcription,
-                          control=opts.control, eigenaxis=not keep_out,
-                          seed_control=opts.control if settle else None)
+    run = dict(seed=opts.seed or 0, N=N, tol=opts.tol, verbose=opts.verbose,
+               ipopt_options=_dict(opts.ipopt_options), ptol=opts.pointing_tol,
+               rtol=opts.rate_tol, guess=opts.guess, transcription=opts.transcription,
+               control=opts.control, eigenaxis=not keep_out)
+    if settle:
+        sol = solve_converted(problem, rb, convert, objective, starts=opts.starts or 1,
+                              polish=opts.polish is True and not keep_out,
+                              seed_control=opts.control, **run)
+        if sol.success or opts.starts is not None or opts.polish is not None:
+            return _engine(sol, "scene")
+        failed = sol  # then the pipeline of the other scenes (slower)
+    starts = opts.starts if opts.starts is not None else (
+        DEFAULT_STARTS_TIME if objective == "time" else DEFAULT_STARTS_EFFORT)
+    sol = solve_converted(problem, rb, convert, objective, starts=starts,
+                          polish=opts.polish is not False and not keep_out, **run)
+    if settle:
+        sol = annotate(sol, {"settle": f"the bounded single start failed first: "
+                                      f"{failed.message[:300]}"})
     return _engine(sol, "scene")
 
 
@@ -359,7 +367,8 @@ def settling_parts(scene, problem) -> tuple:
 
     A time-optimal slew of such a scene is solved at once with the bounded control of
     `SlewOptions.control` (piecewise constant by default), from the eigenaxis start alone
-    and without the switch-time polish (unless ``starts`` or ``polish=True`` are given):
+    and without the switch-time polish (unless ``starts`` or ``polish=True`` are given;
+    should that fail, by the pipeline of the other scenes, ``info['settle']`` saying why):
     its control switches many times to settle the parts' modes, so the polynomial seed
     overshoots its bounds between the nodes and the polish of its many arcs runs out of its
     budget. The README craft (wheels, a damper, a revolute panel; 90 deg): 226 s through
