@@ -101,7 +101,8 @@ def slew(scene, *, objective="time", angle=None, axis=None, q_final=None, T=None
         start at rest (or at ``state0``) and end at rest where their `Variable.terminal`
         says ``'rest'`` (free otherwise: wheel speeds, gimbal angles). ``info['engine']``
         names the pipeline (``'time_optimal'``, ``'min_effort'``, ``'wheel_slew'``,
-        ``'cmg_slew'`` or ``'scene'``).
+        ``'cmg_slew'`` or ``'scene'``); ``info['settle']``, why a time-optimal slew of
+        parts brought to rest left its bounded single start (`settling_parts`).
 
     Raises
     ------
