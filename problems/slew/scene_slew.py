@@ -21,8 +21,9 @@ the parts at rest and the controls that best produce the hub's torque, on enough
 for the fastest oscillation of the model (`scene_intervals`), and the pipelines of
 `time_optimal` and `min_effort` (`solve_converted`). A time-optimal slew that must bring
 parts to rest (a damper, a panel, a slosh mass: `settling_parts`) is solved at once with the
-bounded piecewise-constant control, from the eigenaxis start, without the switch-time polish:
-its control switches again and again to settle the parts' modes. Every result says
+bounded piecewise-constant control, from the eigenaxis start, without the switch-time polish
+(its control switches again and again to settle the parts' modes), or else warm from a
+minimum-effort slew of a longer horizon. Every result says
 ``success=True`` only when verified by re-simulation (pointing, rates and every fixed final
 part state within the tolerances; `verify`).
 """
@@ -47,7 +48,7 @@ from .problem import attitude_guess, rough_time, slew_problem
 from .targets import targets, vector3
 
 __all__ = ["slew", "scene_problem", "torque_map", "scene_intervals", "quaternion_blocks",
-           "settling_parts",
+           "settling_parts", "EFFORT_HORIZON",
            "DEFAULT_N", "INTERVALS_PER_PERIOD", "MAX_AUTO_N"]
 
 #: Collocation intervals of the first solve when `SlewOptions.N` is None, by objective (the
@@ -406,7 +407,9 @@ def settling_parts(scene, problem) -> tuple:
     A time-optimal slew of such a scene is solved at once with the bounded control of
     `SlewOptions.control` (piecewise constant by default), from the eigenaxis start alone
     and without the switch-time polish (unless ``starts`` or ``polish=True`` are given;
-    should that fail, by the pipeline of the other scenes, ``info['settle']`` saying why):
+    should that fail, warm from the verified minimum-effort slew of `EFFORT_HORIZON` times
+    its T, and failing that by the pipeline of the other scenes; ``info['settle']`` says
+    which):
     its control switches many times to settle the parts' modes, so the polynomial seed
     overshoots its bounds between the nodes and the polish of its many arcs runs out of its
     budget. The README craft (wheels, a damper, a revolute panel; 90 deg): 226 s through
