@@ -103,13 +103,19 @@ def _body_momentum(q, H_inertial):
 
 def solve_converted(problem, rb_problem, convert, objective, *, starts, seed, N, tol, verbose,
                     ipopt_options, ptol, rtol, polish, scale=None, guess=None,
-                    transcription="radau", control="constant", eigenaxis=True):
+                    transcription="radau", control="constant", eigenaxis=True,
+                    seed_control=None):
     """Solve the slew ``problem`` from the rigid-body guesses of ``rb_problem`` converted by
     ``convert`` (a guess dict of the hub -> one of ``problem``), by the pipelines of
     `time_optimal` (``'time'``: the best of ``starts`` seeded starts, polished when
     ``polish``, kept within its bounds with ``control``) and `min_effort` (``'effort'``:
     the eigenaxis start, or with ``eigenaxis=False`` -- a keep-out cone -- the best of the
     seeded tilted starts; refined to ``tol``), verified by re-simulation.
+
+    ``seed_control`` is the control interpolant of the first time-optimal solve (default the
+    transcription's own, polynomial for Radau: the seed whose switches the polish reads;
+    ``'constant'`` or ``'linear'`` keep the bounds between the nodes, so that no bounded
+    re-solve follows: `scene_slew.settling_parts`).
 
     ``guess`` (a solution or mapping of ``problem``) replaces the starts. With ``scale``
     [N m s] the result's ``info['momentum_drift']`` is the largest change of the total
@@ -119,7 +125,8 @@ def solve_converted(problem, rb_problem, convert, objective, *, starts, seed, N,
     if objective == "time":
         guesses = None if guess is not None else [
             convert(g) for g in seeded_guesses(rb_problem, starts, seed, eigenaxis=eigenaxis)]
-        first = dict(opts, transcription=transcription, **SEED_OPTIONS)  # as time_optimal
+        first = dict(opts, transcription=transcription, control=seed_control,
+                     **SEED_OPTIONS)  # as time_optimal
         sol = solve_time_optimal(problem, guess, guesses, first,
                                  polish=polish, pointing_tol=ptol, rate_tol=rtol,
                                  ipopt_options=ipopt_options, verbose=verbose)

@@ -19,9 +19,13 @@ alone (never a part's class), with guesses converted from the rigid-body ones of
 (`attitude_guess`: the SLERP with a smooth-step profile, tilted for the further starts) with
 the parts at rest and the controls that best produce the hub's torque, on enough intervals
 for the fastest oscillation of the model (`scene_intervals`), and the pipelines of
-`time_optimal` and `min_effort` (`solve_converted`). Every result says ``success=True`` only
-when verified by re-simulation (pointing, rates and every fixed final part state within the
-tolerances; `verify`).
+`time_optimal` and `min_effort` (`solve_converted`). A time-optimal slew that must bring
+parts to rest (a damper, a panel, a slosh mass: `settling_parts`) is solved at once with the
+bounded piecewise-constant control, from the eigenaxis start, without the switch-time polish
+(its control switches again and again to settle the parts' modes), or else warm from a
+minimum-effort slew of a longer horizon. Every result says
+``success=True`` only when verified by re-simulation (pointing, rates and every fixed final
+part state within the tolerances; `verify`).
 """
 from __future__ import annotations
 
@@ -44,6 +48,7 @@ from .problem import attitude_guess, rough_time, slew_problem
 from .targets import targets, vector3
 
 __all__ = ["slew", "scene_problem", "torque_map", "scene_intervals", "quaternion_blocks",
+           "settling_parts", "EFFORT_HORIZON",
            "DEFAULT_N", "INTERVALS_PER_PERIOD", "MAX_AUTO_N"]
 
 #: Collocation intervals of the first solve when `SlewOptions.N` is None, by objective (the
@@ -97,7 +102,8 @@ def slew(scene, *, objective="time", angle=None, axis=None, q_final=None, T=None
         start at rest (or at ``state0``) and end at rest where their `Variable.terminal`
         says ``'rest'`` (free otherwise: wheel speeds, gimbal angles). ``info['engine']``
         names the pipeline (``'time_optimal'``, ``'min_effort'``, ``'wheel_slew'``,
-        ``'cmg_slew'`` or ``'scene'``).
+        ``'cmg_slew'`` or ``'scene'``); ``info['settle']``, why a time-optimal slew of
+        parts brought to rest left its bounded single start (`settling_parts`).
 
     Raises
     ------
@@ -161,16 +167,66 @@ def slew(scene, *, objective="time", angle=None, axis=None, q_final=None, T=None
     keep_out = opts.keep_out is not None
     if keep_out and opts.polish:
         _ignored(opts, polish=None, why="with `keep_out` (not bang-bang per axis)")
+    # parts the slew must bring to rest (a damper, a panel, a slosh mass): the time-optimal
+    # control switches again and again to settle their modes (module docstring)
+    settle = objective == "time" and bool(settling_parts(scene, problem))
+    N = opts.N or scene_intervals(problem, DEFAULT_N[objective], attitude_guess(rb, n=3)["T"])
+    run = dict(seed=opts.seed or 0, N=N, tol=opts.tol, verbose=opts.verbose,
+               ipopt_options=_dict(opts.ipopt_options), ptol=opts.pointing_tol,
+               rtol=opts.rate_tol, guess=opts.guess, transcription=opts.transcription,
+               control=opts.control, eigenaxis=not keep_out)
+    if settle:
+        sol = solve_converted(problem, rb, convert, objective, starts=opts.starts or 1,
+                              polish=opts.polish is True and not keep_out,
+                              seed_control=opts.control, **run)
+        if sol.success or opts.starts is not None or opts.polish is not None:
+            return _engine(sol, "scene")
+        failed = sol
+        if opts.guess is None:  # warm from a verified minimum-effort slew of a longer T
+            sol = _from_effort(scene, problem, failed, angle, axis, q_final, w0, wf, opts, run)
+            if sol is not None and sol.success:
+                return _engine(sol, "scene")
+        # then the pipeline of the other scenes (slower)
     starts = opts.starts if opts.starts is not None else (
         DEFAULT_STARTS_TIME if objective == "time" else DEFAULT_STARTS_EFFORT)
-    N = opts.N or scene_intervals(problem, DEFAULT_N[objective], attitude_guess(rb, n=3)["T"])
-    sol = solve_converted(problem, rb, convert, objective, starts=starts, seed=opts.seed or 0,
-                          N=N, tol=opts.tol, verbose=opts.verbose,
-                          ipopt_options=_dict(opts.ipopt_options), ptol=opts.pointing_tol,
-                          rtol=opts.rate_tol, polish=opts.polish is not False and not keep_out,
-                          guess=opts.guess, transcription=opts.transcription,
-                          control=opts.control, eigenaxis=not keep_out)
+    sol = solve_converted(problem, rb, convert, objective, starts=starts,
+                          polish=opts.polish is not False and not keep_out, **run)
+    if settle:
+        sol = annotate(sol, {"settle": f"the bounded single start failed first: "
+                                      f"{failed.message[:300]}"})
     return _engine(sol, "scene")
+
+
+#: Horizon of the minimum-effort slew the time-optimal slew of parts brought to rest is warm
+#: started from, when its single start fails, relative to that start's T (`_from_effort`):
+#: a ball-hinged panel (0.3 rad) failed at T = 12.68 s; 15 s of minimum effort verified
+#: (127 intervals), the time-optimal slew warm from it verified in 14 s, T = 12.606 s.
+EFFORT_HORIZON = 1.2
+
+
+def _from_effort(scene, problem, failed, angle, axis, q_final, w0, wf, opts, run):
+    """The time-optimal slew ``problem`` of parts brought to rest, warm from the verified
+    minimum-effort slew over `EFFORT_HORIZON` times the ``failed`` start's T (a homotopy in
+    the cost: the effort slew is feasible and smooth, settles the parts, and sits near the
+    time-optimal one), on its refined mesh, with the bounded control; None if there is
+    no such T or the effort slew fails."""
+    if not (np.isfinite(failed.T) and failed.T > 0):
+        return None
+    T_effort = EFFORT_HORIZON * float(failed.T)
+    effort, rb, convert = scene_problem(scene, objective="effort", angle=angle, axis=axis,
+                                        q_final=q_final, T=T_effort, w0=w0, wf=wf,
+                                        options=opts)
+    warm = solve_converted(effort, rb, convert, "effort", starts=1, polish=False,
+                           **{**run, "N": max(run["N"], DEFAULT_N["effort"])})
+    if not warm.success:
+        return None
+    rigid = scene_problem(scene, objective="time", angle=angle, axis=axis, q_final=q_final,
+                          w0=w0, wf=wf, options=opts)[1]
+    sol = solve_converted(problem, rigid, convert, "time", starts=1, polish=False,
+                          seed_control=opts.control, **{**run, "N": warm.mesh.N, "guess": warm})
+    return annotate(sol, {"settle": f"warm from the minimum-effort slew of {T_effort:.6g} s "
+                                    f"(the bounded single start failed: "
+                                    f"{failed.message[:200]})"})
 
 
 # ----------------------------------------------------------------------- checks
@@ -341,6 +397,51 @@ def torque_map(model, x) -> np.ndarray:
     p = ca.DM(model.resolve_p())
     jac = ca.Function("B", [xs, us], [ca.jacobian(model.f(xs, us, p)[4:7], us)])
     return np.array(jac(np.asarray(x, float), np.zeros(model.nu)))
+
+
+def settling_parts(scene, problem) -> tuple:
+    """The parts of ``scene`` that the slew ``problem`` brings to rest: those with a fixed
+    final state (`Variable.terminal` ``'rest'``: a damper, a hinged panel, a slosh mass; not
+    wheel speeds or gimbal angles, which end free).
+
+    A time-optimal slew of such a scene is solved at once with the bounded control of
+    `SlewOptions.control` (piecewise constant by default), from the eigenaxis start alone
+    and without the switch-time polish (unless ``starts`` or ``polish=True`` are given;
+    should that fail, warm from the verified minimum-effort slew of `EFFORT_HORIZON` times
+    its T, and failing that by the pipeline of the other scenes; ``info['settle']`` says
+    which):
+    its control switches many times to settle the parts' modes, so the polynomial seed
+    overshoots its bounds between the nodes and the polish of its many arcs runs out of its
+    budget. The README craft (wheels, a damper, a revolute panel; 90 deg): 226 s through
+    three polynomial starts, the polish (64 s, not converged), a refinement and a constant
+    re-solve on 400 intervals, against one constant-control solve on 200 intervals, 19 s
+    (both verified; T = 56.464 and 56.480 s; measured on a loaded machine).
+
+    Parameters
+    ----------
+    scene : dynamics.scene.Scene
+    problem : ocp.Problem
+        A slew of ``scene`` (`scene_problem`).
+
+    Returns
+    -------
+    tuple of str
+        Part names, in the scene's order.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from appdyn.dynamics.scene import PointMassDamper, ReactionWheels, RigidHub, Scene
+    >>> from appdyn.problems.slew.scene_slew import scene_problem, settling_parts
+    >>> scene = Scene(RigidHub([10.0, 12.0, 8.0]), ReactionWheels(np.eye(3), 0.05, u_max=0.1),
+    ...               PointMassDamper(0.5, 2.0, 0.8, position=[0.5, 0, 0], direction=[0, 1, 0]))
+    >>> settling_parts(scene, scene_problem(scene, objective="time", angle=0.3,
+    ...                                     axis=[0, 0, 1])[0])
+    ('damper',)
+    """
+    fixed = np.isfinite(np.asarray(problem.x_final, dtype=float))
+    return tuple(name for name, lay in scene.layout.items()
+                 if name != "hub" and bool(np.any(fixed[lay.states])))
 
 
 def scene_intervals(problem, least: int, horizon: float) -> int:
