@@ -26,7 +26,6 @@ import statistics
 import subprocess
 import sys
 import tempfile
-import time
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -36,12 +35,12 @@ import numpy as np
 from appdyn.dynamics import rigid_body, simulate
 from appdyn.dynamics.truth import torque_free_omega
 
-from _common import Row, script_main, write_csv
+from _common import Row, script_main, timed, write_csv
 
 from simulate import numbalsoda  # noqa: E402  (the peer's runner)
 
-REPEATS = 21
-TOLS = [10.0 ** -k for k in np.arange(4.0, 13.01, 0.5)]
+REPEATS = 11
+TOLS = [10.0 ** -k for k in np.arange(4.0, 12.01, 1.0)]
 
 
 @dataclass(frozen=True)
@@ -76,9 +75,10 @@ def compiled_model(name, case, n, target, build: Path) -> Workload:
     tight = simulate(model, x0, t, rtol=1e-12, atol=1e-14)
     steps = max(4 * tight.n_steps // (n - 1), 64)
     ref = simulate(model, x0, t, method="rk8", steps=steps).x
+    slug = "".join(ch if ch.isalnum() else "_" for ch in name.split(" (")[0])
     return Workload(name, model, x0, t, target,
                     lambda x: float(np.max(np.abs(x - ref))), {"library": str(peer_library(
-                        model, build / f"{name}.so"))})
+                        model, build / f"peer_{slug}.so"))})
 
 
 def peer_library(model, path: Path) -> Path:
@@ -86,8 +86,8 @@ def peer_library(model, path: Path) -> Path:
     calling the casadi-generated C of ``model.f`` at zero control and default parameters."""
     f = model.f
     gen = ca.CodeGenerator(path.stem + ".c", {"with_header": False})
-    gen.add(ca.Function("peer_f", [f.mx_in(0), f.mx_in(1), f.mx_in(2)],
-                        f.call([f.mx_in(0), f.mx_in(1), f.mx_in(2)])))
+    ins = [f.mx_in(i) for i in range(3)]
+    gen.add(ca.Function("peer_f", ins, f.call(ins)))
     src = path.with_suffix(".c")
     gen.generate(str(path.parent) + "/")
     p = np.asarray(model.p_default if hasattr(model, "p_default") else np.zeros(f.numel_in(2)),
@@ -133,13 +133,8 @@ def workloads(quick: bool, build: Path) -> list[Workload]:
 
 
 def median_time(fun, repeats: int) -> float:
-    fun()
-    times = []
-    for _ in range(repeats):
-        t0 = time.perf_counter()
-        fun()
-        times.append(time.perf_counter() - t0)
-    return statistics.median(times)
+    """The median of ``repeats`` calls after a first one [s]."""
+    return statistics.median(timed(fun, repeats)[1])
 
 
 def appdyn_sweep(w: Workload, tols, repeats) -> list[dict]:
@@ -176,7 +171,7 @@ def cheapest(rows, target):
 
 def run(quick: bool, out: Path) -> list[Row]:
     tols = TOLS[::2] if quick else TOLS
-    repeats = 5 if quick else REPEATS
+    repeats = 3 if quick else REPEATS
     detail, summary = [], []
     with tempfile.TemporaryDirectory() as tmp:
         for w in workloads(quick, Path(tmp)):

@@ -78,6 +78,18 @@ static casadi_real pass_steps(pass_ctx* c, const casadi_real* x0, casadi_real* x
   return err;
 }
 
+/* Hairer's DOP853 controller (`stepcontrol.next_step`) after a step of `hs` with the error
+   factor `fac` (err^(1/8) / 0.9): the next proposal from the current one `h`; safety 0.9,
+   the step changed by a factor in [1/3, 6], no growth right after a rejection; a step cut
+   short (by an output time or hmax) says nothing against the proposal. */
+static casadi_real ctl_next(casadi_real hs, casadi_real h, casadi_real fac, int accepted,
+                            int rejected) {
+  if (!accepted) return hs / fmin(3.0, fac);
+  fac = fmax(1.0 / 6.0, fmin(3.0, fac));
+  fac = rejected ? fmin(hs, hs / fac) : hs / fac;
+  return hs < h && fac < h ? h : fac;
+}
+
 /* the model's right-hand side at (x, u): its rounding noise is measured with it */
 static void pass_rhs_at(pass_ctx* c, const casadi_real* x, const casadi_real* u,
                         casadi_real* xdot) {
@@ -267,13 +279,11 @@ int rk8_adaptive(casadi_real* x, casadi_real* hio, int nint, const casadi_real* 
         count[0] += 1;
         if (hs > hbig[k]) hbig[k] = hs;
         if (hs < count[3]) count[3] = hs;
-        fac = fmax(1.0 / 6.0, fmin(3.0, fac));
-        fac = rejected ? fmin(hs, hs / fac) : hs / fac;
-        h = hs < h && fac < h ? h : fac;
+        h = ctl_next(hs, h, fac, 1, rejected);
         rejected = 0;
       } else {
         count[1] += 1;
-        h = hs / fmin(3.0, fac);
+        h = ctl_next(hs, h, fac, 0, rejected);
         rejected = 1;
       }
       if (count[0] + count[1] > max_steps) { count[2] = 3; break; }
@@ -404,13 +414,11 @@ int rk8_dense(casadi_real* x, casadi_real* t, casadi_real* hio, int nout,
           if (fabs(f1[i] - f0[i]) > count[8 + i]) count[8 + i] = fabs(f1[i] - f0[i]);
       }
       if (hs < count[3] && !last) count[3] = hs;
-      fac = fmax(1.0 / 6.0, fmin(3.0, fac));
-      fac = rejected ? fmin(hs, hs / fac) : hs / fac;
-      h = hs < h && fac < h ? h : fac;
+      h = ctl_next(hs, h, fac, 1, rejected);
       rejected = 0;
     } else {
       count[1] += 1;
-      h = hs / fmin(3.0, fac);
+      h = ctl_next(hs, h, fac, 0, rejected);
       rejected = 1;
     }
     if (count[0] + count[1] > max_steps) { count[2] = 3; break; }
