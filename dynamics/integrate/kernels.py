@@ -120,7 +120,8 @@ def dense_kernels(model: Model, compiled: bool = False) -> tuple[ca.Function, ca
     True
     """
     call = compiled and calls_rhs(model, "rk8")
-    key = ("dense_kernels", cache.function_key(model.f)) + (("call",) if call else ())
+    key = ("dense_kernels", cache.function_key(model.f)) + (("call",) if call else ()) + \
+        (("compiled",) if compiled else ())
 
     def build():
         f, tab = model.f, TABLEAUX["rk8"]
@@ -133,6 +134,9 @@ def dense_kernels(model: Model, compiled: bool = False) -> tuple[ca.Function, ca
         step = ca.Function("rk8_step_k", [x, h, u, p, rtol, atol],
                            [x_next, _embedded_error(x, x_next, k, h, rtol, atol),
                             ca.vertcat(*k)])
+        # the extension's 4 rhs inline unless they too exceed `INLINE_MAX` (as `calls_rhs`)
+        sym = ca.MX if compiled and 4 * f.n_instructions() > INLINE_MAX else _sym(f)
+        x, h, u, p = sym.sym("x", nx), sym.sym("h"), sym.sym("u", nu), sym.sym("p", np_)
         xn, K = sym.sym("x_next", nx), sym.sym("K", tab.stages * nx)
         k = [K[i * nx:(i + 1) * nx] for i in range(tab.stages)]
         k = _stages(f, ((),), (1.0,), xn, h, lambda c: u, p, k)  # k13 = f(x_next)
