@@ -81,13 +81,29 @@ static casadi_real pass_steps(pass_ctx* c, const casadi_real* x0, casadi_real* x
 /* Hairer's DOP853 controller (`stepcontrol.next_step`) after a step of `hs` with the error
    factor `fac` (err^(1/8) / 0.9): the next proposal from the current one `h`; safety 0.9,
    the step changed by a factor in [1/3, 6], no growth right after a rejection; a step cut
-   short (by an output time or hmax) says nothing against the proposal. */
+   short (by an output time or hmax) says nothing against the proposal. `rejected` (in/out):
+   whether the step before was rejected; a rejection is counted in count[1]. */
 static casadi_real ctl_next(casadi_real hs, casadi_real h, casadi_real fac, int accepted,
-                            int rejected) {
-  if (!accepted) return hs / fmin(3.0, fac);
+                            int* rejected, casadi_real* count) {
+  int was = *rejected;
+  *rejected = !accepted;
+  if (!accepted) {
+    count[1] += 1;  /* rejected steps */
+    return hs / fmin(3.0, fac);
+  }
   fac = fmax(1.0 / 6.0, fmin(3.0, fac));
-  fac = rejected ? fmin(hs, hs / fac) : hs / fac;
+  fac = was ? fmin(hs, hs / fac) : hs / fac;
   return hs < h && fac < h ? h : fac;
+}
+
+/* Why a stepper stops after a step (0: it goes on): 3 more than max_steps steps (accepted
+   and rejected, `count[0] + count[1]`), 2 the proposal `h` underflowed against `span`,
+   1 a non-finite state or estimate (`finite` 0). */
+static int ctl_flag(const casadi_real* count, casadi_real max_steps, casadi_real h,
+                    casadi_real span, int finite) {
+  if (count[0] + count[1] > max_steps) return 3;
+  if (!(h > 64 * DBL_EPSILON * span)) return finite ? 2 : 1;
+  return 0;
 }
 
 /* the model's right-hand side at (x, u): its rounding noise is measured with it */
@@ -279,15 +295,9 @@ int rk8_adaptive(casadi_real* x, casadi_real* hio, int nint, const casadi_real* 
         count[0] += 1;
         if (hs > hbig[k]) hbig[k] = hs;
         if (hs < count[3]) count[3] = hs;
-        h = ctl_next(hs, h, fac, 1, rejected);
-        rejected = 0;
-      } else {
-        count[1] += 1;
-        h = ctl_next(hs, h, fac, 0, rejected);
-        rejected = 1;
       }
-      if (count[0] + count[1] > max_steps) { count[2] = 3; break; }
-      if (!(h > 64 * DBL_EPSILON * Hk)) { count[2] = finite ? 2 : 1; break; }
+      h = ctl_next(hs, h, fac, finite && err <= 1.0, &rejected, count);
+      if ((count[2] = ctl_flag(count, max_steps, h, Hk, finite))) break;
     }
     if (count[2]) break;
     for (i = 0; i < PASS_NX; ++i) X[i * ldx + k] = x[i];
@@ -414,15 +424,9 @@ int rk8_dense(casadi_real* x, casadi_real* t, casadi_real* hio, int nout,
           if (fabs(f1[i] - f0[i]) > count[8 + i]) count[8 + i] = fabs(f1[i] - f0[i]);
       }
       if (hs < count[3] && !last) count[3] = hs;
-      h = ctl_next(hs, h, fac, 1, rejected);
-      rejected = 0;
-    } else {
-      count[1] += 1;
-      h = ctl_next(hs, h, fac, 0, rejected);
-      rejected = 1;
     }
-    if (count[0] + count[1] > max_steps) { count[2] = 3; break; }
-    if (!(h > 64 * DBL_EPSILON * fmax(fabs(*t), fabs(tend)))) { count[2] = finite ? 2 : 1; break; }
+    h = ctl_next(hs, h, fac, finite && err <= 1.0, &rejected, count);
+    if ((count[2] = ctl_flag(count, max_steps, h, fmax(fabs(*t), fabs(tend)), finite))) break;
   }
   *hio = h;
   count[5] = j;
