@@ -26,6 +26,8 @@ END = "<!-- bench:end -->"
 TITLES = {
     "simulate": "Simulation, torque-free rigid body against its Jacobi-elliptic truth "
                 "(`bench/simulate.py`)",
+    "integrate_peers": "Single runs against numbalsoda dop853 at matched error, several "
+                       "workloads (`bench/integrate_peers.py`)",
     "workprecision": "Work-precision of every integration method against scipy, every model "
                      "with a truth (`bench/workprecision.py`)",
     "slew": "Optimal slews (`bench/slew.py`)",

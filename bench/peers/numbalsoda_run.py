@@ -4,6 +4,11 @@ Reads a JSON job from stdin, prints JSON to stdout. Job: ``inertia``, ``t`` (out
 ``x0`` (7,), ``tols`` (rtol list; atol = rtol/100), ``repeats``, and optionally ``batch``:
 ``{"x0s": (K, 7), "t": grid, "rtol": r}`` for the numba-jitted loop of dop853 runs.
 Answers carry body rates (the main process computes errors against the Jacobi truth).
+
+A job with ``library`` (path of a shared library exporting ``peer_rhs(t, x, dx, p)``, the
+signature of numbalsoda's ``lsoda_sig``: the right-hand side of any appdyn model compiled
+from the same casadi-generated C as appdyn's own, see bench/integrate_peers.py) instead of
+``inertia`` integrates that model; its answers carry the whole state (``x``).
 """
 import json
 import sys
@@ -33,19 +38,27 @@ def make_rhs(inertia):
 
 def main():
     job = json.load(sys.stdin)
-    ptr = make_rhs(job["inertia"])
+    if job.get("library"):
+        import ctypes
+        lib = ctypes.CDLL(job["library"])
+        ptr = ctypes.cast(lib.peer_rhs, ctypes.c_void_p).value
+    else:
+        ptr = make_rhs(job["inertia"])
     t = np.asarray(job["t"], float)
     x0 = np.asarray(job["x0"], float)
     out = {"runs": []}
     for name, solver in (("lsoda", lsoda), ("dop853", dop853)):
+        if name not in job.get("solvers", ("lsoda", "dop853")):
+            continue
         for rtol in job["tols"]:
             times = []
             for k in range(job["repeats"] + 1):
                 t0 = time.perf_counter()
                 usol, ok = solver(ptr, x0, t, rtol=rtol, atol=rtol * 1e-2)
                 times.append(time.perf_counter() - t0)
+            answer = dict(x=usol.tolist()) if job.get("library") else dict(w=usol[:, 4:7].tolist())
             out["runs"].append(dict(solver=name, rtol=rtol, first=times[0], times=times[1:],
-                                    success=bool(ok), w=usol[:, 4:7].tolist()))
+                                    success=bool(ok), **answer))
     if job.get("batch"):
         b = job["batch"]
         x0s, tb, rtol = np.asarray(b["x0s"], float), np.asarray(b["t"], float), b["rtol"]

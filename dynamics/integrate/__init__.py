@@ -20,7 +20,9 @@ The public entry points are `dynamics.simulate`, `dynamics.SimulationResult`,
                  runs on threads, ``auto``'s error control over the batch; `BatchResult`
 ``sanity``       fixed-step runs checked against the model's invariants (status 4)
 ``smoothness``   the non-smooth operations (kinks, jumps) of a model's expression graph
-``stepcontrol``  DOP853 with step rejection for non-smooth right-hand sides (``auto``)
+``stepcontrol``  DOP853 with step rejection for non-smooth right-hand sides, and stepping
+                 by its error estimate alone with dense output (`stepcontrol.run_dense`)
+                 for a smooth one under a constant control (``auto``)
 ===============  ===========================================================================
 
 Every fixed-step integration (``rk4``, ``rk8``, ``lie`` and the runs ``auto`` makes) calls
@@ -52,7 +54,11 @@ callable ``u(t) -> (nu,)`` evaluated at every stage time (fixed-step methods; th
 made from Python before the compiled loop runs) or at every right-hand-side evaluation
 (``cvodes``, through a ``casadi.Callback``).
 
-The error of a fixed-step run is controlled by the number of substeps; ``auto`` chooses it
+For a smooth right-hand side under a control constant over the run, ``auto`` steps DOP853
+by its embedded error estimate alone and fills the outputs from its continuous extension of
+order 7 (`auto.dense_pass`): its work follows the solution, not the output grid; the answer
+is checked against a run at a 100x looser local tolerance. Otherwise:
+the error of a fixed-step run is controlled by the number of substeps; ``auto`` chooses it
 per output interval from DOP853's embedded error estimate in one compiled pass and checks the
 *global* error at the output times against a run with half the steps (`adaptive`), or, when
 that check fails, from Richardson estimates of runs with different step counts (`auto`; see

@@ -2,7 +2,8 @@
 around the casadi-generated rk8 steps and right-hand side of a model), the step-controlled
 DOP853 of `dynamics.integrate.stepcontrol` (`_STEPPER`, in the same library) and their
 build (`pass_library`: compiled once per model for this machine, loaded with ``ctypes``;
-the stepper is the attribute ``stepper`` of the returned function)."""
+the stepper is the attribute ``stepper`` of the returned function), and DOP853 stepping by
+its error estimate alone with dense output (`_DENSE`, the attribute ``dense``)."""
 from __future__ import annotations
 
 import ctypes
@@ -11,7 +12,7 @@ import casadi as ca
 
 from .. import cache
 from ..model import Model
-from .kernels import calls_rhs, kernel
+from .kernels import calls_rhs, dense_kernels, kernel
 from .loops import chunk_compile_job
 
 __all__ = ["BMAX", "CHECK_EVERY", "NOISE", "pass_library"]
@@ -75,6 +76,34 @@ static casadi_real pass_steps(pass_ctx* c, const casadi_real* x0, casadi_real* x
     for (i = 0; i < PASS_NX; ++i) x[i] = xn[i];
   }
   return err;
+}
+
+/* Hairer's DOP853 controller (`stepcontrol.next_step`) after a step of `hs` with the error
+   factor `fac` (err^(1/8) / 0.9): the next proposal from the current one `h`; safety 0.9,
+   the step changed by a factor in [1/3, 6], no growth right after a rejection; a step cut
+   short (by an output time or hmax) says nothing against the proposal. `rejected` (in/out):
+   whether the step before was rejected; a rejection is counted in count[1]. */
+static casadi_real ctl_next(casadi_real hs, casadi_real h, casadi_real fac, int accepted,
+                            int* rejected, casadi_real* count) {
+  int was = *rejected;
+  *rejected = !accepted;
+  if (!accepted) {
+    count[1] += 1;  /* rejected steps */
+    return hs / fmin(3.0, fac);
+  }
+  fac = fmax(1.0 / 6.0, fmin(3.0, fac));
+  fac = was ? fmin(hs, hs / fac) : hs / fac;
+  return hs < h && fac < h ? h : fac;
+}
+
+/* Why a stepper stops after a step (0: it goes on): 3 more than max_steps steps (accepted
+   and rejected, `count[0] + count[1]`), 2 the proposal `h` underflowed against `span`,
+   1 a non-finite state or estimate (`finite` 0). */
+static int ctl_flag(const casadi_real* count, casadi_real max_steps, casadi_real h,
+                    casadi_real span, int finite) {
+  if (count[0] + count[1] > max_steps) return 3;
+  if (!(h > 64 * DBL_EPSILON * span)) return finite ? 2 : 1;
+  return 0;
 }
 
 /* the model's right-hand side at (x, u): its rounding noise is measured with it */
@@ -266,23 +295,143 @@ int rk8_adaptive(casadi_real* x, casadi_real* hio, int nint, const casadi_real* 
         count[0] += 1;
         if (hs > hbig[k]) hbig[k] = hs;
         if (hs < count[3]) count[3] = hs;
-        fac = fmax(1.0 / 6.0, fmin(3.0, fac));
-        fac = rejected ? fmin(hs, hs / fac) : hs / fac;
-        h = hs < h && fac < h ? h : fac;
-        rejected = 0;
-      } else {
-        count[1] += 1;
-        h = hs / fmin(3.0, fac);
-        rejected = 1;
       }
-      if (count[0] + count[1] > max_steps) { count[2] = 3; break; }
-      if (!(h > 64 * DBL_EPSILON * Hk)) { count[2] = finite ? 2 : 1; break; }
+      h = ctl_next(hs, h, fac, finite && err <= 1.0, &rejected, count);
+      if ((count[2] = ctl_flag(count, max_steps, h, Hk, finite))) break;
     }
     if (count[2]) break;
     for (i = 0; i < PASS_NX; ++i) X[i * ldx + k] = x[i];
   }
   *hio = h;
   return k;
+}
+"""
+
+
+# DOP853 stepping by its error estimate alone, for a control constant over the run (used by
+# `dynamics.integrate.stepcontrol.run_dense`): the output times never cut a step (but the
+# last of each call); an output inside a step is filled from the step's continuous
+# extension of order 7 (`rk8_cont`, four more right-hand sides, only on such a step), as
+# Hairer's DOP853 with dense output does.
+_DENSE = r"""
+#define DENSE_NOISE_EVERY 8
+/* The first step (Hairer, Norsett & Wanner I, II.4; scipy's `select_initial_step` for an
+   error estimate of order 7), at most the run's length. */
+static casadi_real dense_first_step(pass_ctx* c, const casadi_real* x, const casadi_real* u,
+                                    casadi_real t, casadi_real tend, casadi_real* lipschitz) {
+  casadi_real f0[PASS_NX], f1[PASS_NX], x1[PASS_NX], sk, d0 = 0, d1 = 0, d2 = 0, h0, h1;
+  int i;
+  pass_rhs_at(c, x, u, f0);
+  for (i = 0; i < PASS_NX; ++i) {
+    sk = c->atol[i] + c->rtol * fabs(x[i]);
+    d0 += (x[i] / sk) * (x[i] / sk);
+    d1 += (f0[i] / sk) * (f0[i] / sk);
+  }
+  d0 = sqrt(d0 / PASS_NX); d1 = sqrt(d1 / PASS_NX);
+  h0 = d0 < 1e-5 || d1 < 1e-5 || !isfinite(d0 + d1) ? 1e-6 : 0.01 * d0 / d1;
+  h0 = fmin(h0, tend - t);
+  for (i = 0; i < PASS_NX; ++i) x1[i] = x[i] + h0 * f0[i];
+  pass_rhs_at(c, x1, u, f1);
+  for (i = 0; i < PASS_NX; ++i) {
+    sk = c->atol[i] + c->rtol * fabs(x[i]);
+    d2 += ((f1[i] - f0[i]) / sk) * ((f1[i] - f0[i]) / sk);
+  }
+  d2 = sqrt(d2 / PASS_NX) / h0;
+  *lipschitz = d1 > 0 && isfinite(d2 / d1) ? d2 / d1 : 0;
+  h1 = d1 <= 1e-15 && d2 <= 1e-15 ? fmax(1e-6, 1e-3 * h0)
+                                   : pow(0.01 / fmax(d1, d2), 1.0 / 8.0);
+  h1 = fmin(100 * h0, h1);
+  return isfinite(h1) && h1 > 0 ? fmin(h1, tend - t) : tend - t;
+}
+
+/* Steps of x (in/out) from time *t (in/out) towards ts[nout - 1], the outputs at the times
+   ts (increasing, after the start) in X (nx, ldx); control u throughout; `hio` (in/out) the
+   controller's proposed step (<= 0: `dense_first_step`); `count` (in/out): accepted steps,
+   rejected steps, flag (as `rk8_adaptive`'s), smallest accepted step, steps whose continuous
+   extension was evaluated, outputs filled, 1 after a rejection, the Lipschitz estimate of
+   `dense_first_step` (flag 4 when that many times the run's length over DOP853's stability
+   interval 6 exceeds `stiff_steps`: no step is taken), then per state the rounding noise max |f_i(x (1 + eps s)) - f_i(x)| of
+   the right-hand side at every DENSE_NOISE_EVERY-th accepted state (s = +-1 alternating
+   over the states and the samples). At most `budget` steps per
+   call (the caller checks for interrupts between calls). Returns the outputs filled. The
+   controller is `rk8_adaptive`'s; the last step lands on ts[nout - 1]. */
+int rk8_dense(casadi_real* x, casadi_real* t, casadi_real* hio, int nout,
+              const casadi_real* ts, const casadi_real* u, const casadi_real* p,
+              casadi_real rtol, const casadi_real* atol, casadi_real max_steps,
+              casadi_real* X, int ldx, casadi_real* count, int budget,
+              casadi_real stiff_steps) {
+  pass_ctx c;
+  const casadi_real* arg[PASS_NARG + 7];
+  casadi_real* res[PASS_NRES + 3];
+  casadi_real xn[PASS_NX], K[12 * PASS_NX], F[7 * PASS_NX];
+  casadi_real h = *hio, hp, hs, err, fac, s, r, tend = ts[nout - 1], tn;
+  int j = (int) count[5], i, last, rejected = count[6] > 0, finite, have;
+  c.p = p; c.atol = atol; c.rtol = rtol;
+  if (!(h > 0)) {
+    h = dense_first_step(&c, x, u, *t, tend, count + 7);
+    if (count[7] * (tend - *t) / 6.0 > stiff_steps) {  /* stability alone: too many steps */
+      count[2] = 4;
+      return j;
+    }
+  }
+  while (j < nout && budget-- > 0) {
+    hp = h;
+    last = *t + 1.01 * hp >= tend;
+    hs = last ? tend - *t : hp;
+    arg[0] = x; arg[1] = &hs; arg[2] = u; arg[3] = p; arg[4] = &c.rtol; arg[5] = atol;
+    res[0] = xn; res[1] = &err; res[2] = K;
+    rk8_step_k(arg, res, c.iw, c.w, 0);
+    finite = isfinite(err);
+    for (i = 0; i < PASS_NX && finite; ++i) finite = isfinite(xn[i]);
+    fac = finite ? pow(err, 0.125) / 0.9 : 3.0;
+    if (finite && err <= 1.0) {
+      tn = last ? tend : *t + hs;
+      have = 0;
+      while (j < nout && ts[j] < tn) {
+        if (!have) {
+          arg[0] = x; arg[1] = xn; arg[2] = K; arg[3] = &hs; arg[4] = u; arg[5] = p;
+          res[0] = F;
+          rk8_cont(arg, res, c.iw, c.w, 0);
+          have = 1;
+          count[4] += 1;
+        }
+        s = (ts[j] - *t) / hs;
+        for (i = 0; i < PASS_NX; ++i) {
+          r = F[5 * PASS_NX + i] + s * F[6 * PASS_NX + i];
+          r = F[4 * PASS_NX + i] + (1 - s) * r;
+          r = F[3 * PASS_NX + i] + s * r;
+          r = F[2 * PASS_NX + i] + (1 - s) * r;
+          r = F[PASS_NX + i] + s * r;
+          r = F[i] + (1 - s) * r;
+          X[i * ldx + j] = x[i] + s * r;
+        }
+        ++j;
+      }
+      for (i = 0; i < PASS_NX; ++i) x[i] = xn[i];
+      *t = tn;
+      while (j < nout && ts[j] == tn) {  /* an output on the step's end */
+        for (i = 0; i < PASS_NX; ++i) X[i * ldx + j] = x[i];
+        ++j;
+      }
+      count[0] += 1;
+      if (((int) count[0]) % DENSE_NOISE_EVERY == 1) {
+        casadi_real f0[PASS_NX], f1[PASS_NX], sg = ((int) count[0] / DENSE_NOISE_EVERY) % 2
+                                                    ? -DBL_EPSILON : DBL_EPSILON;
+        pass_rhs_at(&c, x, u, f0);
+        for (i = 0; i < PASS_NX; ++i) xn[i] = x[i] * (1 + (i % 2 ? -sg : sg));
+        pass_rhs_at(&c, xn, u, f1);
+        for (i = 0; i < PASS_NX; ++i)
+          if (fabs(f1[i] - f0[i]) > count[8 + i]) count[8 + i] = fabs(f1[i] - f0[i]);
+      }
+      if (hs < count[3] && !last) count[3] = hs;
+    }
+    h = ctl_next(hs, h, fac, finite && err <= 1.0, &rejected, count);
+    if ((count[2] = ctl_flag(count, max_steps, h, fmax(fabs(*t), fabs(tend)), finite))) break;
+  }
+  *hio = h;
+  count[5] = j;
+  count[6] = rejected;
+  return j;
 }
 """
 
@@ -294,11 +443,15 @@ def pass_library(model: Model) -> object | None:
         step = kernel(model, "rk8", "linear", error=True, compiled=True)
         # (a step that calls the rhs shares its C function with pass_rhs: one copy of it)
         rhs = _renamed(model.f, "pass_rhs", ca.MX if calls_rhs(model, "rk8") else None)
-        sizes = dict(every=CHECK_EVERY, nx=model.nx, nu=model.nu, nw=max(step.sz_w(), rhs.sz_w()), niw=max(step.sz_iw(), rhs.sz_iw()),
-                     narg=max(step.sz_arg(), rhs.sz_arg()), nres=max(step.sz_res(), rhs.sz_res()))  # (the plain step needs less)
+        dense = dense_kernels(model, compiled=True)
+        funs = (step, rhs) + dense  # (the plain step needs less)
+        sizes = dict(every=CHECK_EVERY, nx=model.nx, nu=model.nu,
+                     nw=max(f.sz_w() for f in funs), niw=max(f.sz_iw() for f in funs),
+                     narg=max(f.sz_arg() for f in funs), nres=max(f.sz_res() for f in funs))
         steps = [_renamed(step, "rk8_step_err"),
-                 _renamed(kernel(model, "rk8", "linear", compiled=True), "rk8_step"), rhs]
-        return steps, _DRIVER % sizes + _STEPPER
+                 _renamed(kernel(model, "rk8", "linear", compiled=True), "rk8_step"), rhs,
+                 *dense]
+        return steps, _DRIVER % sizes + _STEPPER + _DENSE
 
     def job(opt):
         return cache.Job(make, opt, ctypes.CDLL, cache.recipe("rk8_pass", model.f, opt))
@@ -325,6 +478,11 @@ def pass_library(model: Model) -> object | None:
                             i32, ptr, ptr]
         stepper.restype = i32
         fun.stepper = stepper  # (`dynamics.integrate.stepcontrol`)
+        dense = lib.rk8_dense
+        dense.argtypes = [ptr, ptr, ptr, i32, ptr, ptr, ptr, f64, ptr, f64, ptr, i32, ptr, i32,
+                          f64]
+        dense.restype = i32
+        fun.dense = dense  # (`dynamics.integrate.stepcontrol.run_dense`)
         return fun
 
     return cache.get(("rk8_pass", cache.function_key(model.f)), build, keepalive=model.f)

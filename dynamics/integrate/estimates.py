@@ -153,7 +153,7 @@ def rho_sigma(J: np.ndarray) -> tuple[float, float] | None:
 
 
 def _floor(target, run: Run, rtol, atol, lipschitz: float, jit: bool,
-           progress) -> tuple[float, int]:
+           progress, rerun=None) -> tuple[float, int]:
     """Scaled error floor of ``run`` from rounding; returns ``(floor, extra steps made)``.
 
     Rounding that every run shares (the model's own formulas) does not show in differences
@@ -172,7 +172,10 @@ def _floor(target, run: Run, rtol, atol, lipschitz: float, jit: bool,
     the worst time for it). The floor is never below ``_FLOOR_ULPS`` ulps of a state's size
     (the rounding of the state itself, shared alike: near a separatrix every run, rk8 at
     16-400 steps per interval and scipy's DOP853 alike, was off by 900 ulps of ``|w|``
-    while they agreed to 90).
+    while they agreed to 90). ``rerun(x0) -> Run | None`` makes the check run of a
+    step-controlled ``run`` (the same local tolerance from the moved start; its steps
+    differ a little, so the difference also holds truncation: conservative; inf when it
+    returns None); default ``target.run`` with ``run``'s fixed substeps.
     """
     x = run.x
     horizon = float(target.t[-1] - target.t[0])
@@ -192,7 +195,12 @@ def _floor(target, run: Run, rtol, atol, lipschitz: float, jit: bool,
     bound = _screen(e, np.min(scale, axis=1), horizon, lipschitz, target.runs)
     if bound <= 0.1 * _AUTO_ACCEPT:
         return max(bound, ulps), 0
-    check = target.run(target.x0 + signs * e, run.substeps, jit, progress)
+    if rerun is not None:
+        check = rerun(target.x0 + signs * e)
+        if check is None:
+            return math.inf, 0
+    else:
+        check = target.run(target.x0 + signs * e, run.substeps, jit, progress)
     return max(local, ulps, _scaled_diff(check.x[:, 1:], x[:, 1:], scale)), check.n_steps
 
 

@@ -8,9 +8,10 @@ import numpy as np
 from .. import cache
 from ..attitude import propagate_quat, quat_rate
 from ..model import Model
-from .tableaux import DOP853_E3, DOP853_E5, TABLEAUX, unique_nodes
+from .tableaux import (DOP853_DENSE_A, DOP853_DENSE_C, DOP853_DENSE_D, DOP853_E3, DOP853_E5,
+                       TABLEAUX, unique_nodes)
 
-__all__ = ["kernel", "check_lie_model", "INLINE_MAX", "calls_rhs"]
+__all__ = ["kernel", "check_lie_model", "INLINE_MAX", "calls_rhs", "dense_kernels"]
 
 #: Most right-hand-side instructions a compiled Runge-Kutta step inlines (stages times the
 #: rhs's instruction count); a larger step calls the rhs as a C function instead (see
@@ -67,23 +68,86 @@ def _rk_kernel(f: ca.Function, method: str, mode: str, error: bool = False,
     ins, linear_u = _kernel_inputs(sym, nx, nu, np_, mode, len(nodes))
     u_at = _stage_control(mode, ins, nu, nodes, linear_u)
     x, h, p = ins[0], ins[1], ins[-1]
-    k = []
-    for i in range(tab.stages):
-        xi = x
-        for j, aij in enumerate(tab.a[i]):
-            if aij != 0.0:
-                xi = xi + (aij * h) * k[j]
-        k.append(f.call([xi, u_at(tab.c[i]), p])[0])
+    k = _stages(f, tab.a, tab.c, x, h, u_at, p, [])
     x_next = x + h * _combine(tab.b, k)
     if not error:
         return ca.Function(f"{method}_step", ins, [x_next])
     rtol, atol = sym.sym("rtol"), sym.sym("atol", nx)
+    err = _embedded_error(x, x_next, k, h, rtol, atol)
+    return ca.Function(f"{method}_step_err", ins + [rtol, atol], [x_next, err])
+
+
+def _stages(f: ca.Function, a, c, x, h, u_at, p, k: list) -> list:
+    """The stages ``k_i = f(x + h sum_j a_ij k_j, u(c_i h), p)`` of the rows ``a`` (nodes
+    ``c``) appended to the stages ``k`` already known; returns ``k``."""
+    for ai, ci in zip(a, c):
+        xi = x
+        for j, aij in enumerate(ai):
+            if aij != 0.0:
+                xi = xi + (aij * h) * k[j]
+        k.append(f.call([xi, u_at(ci), p])[0])
+    return k
+
+
+def _embedded_error(x, x_next, k: list, h, rtol, atol):
+    """DOP853's embedded error estimate of a step (`DOP853_E5`, `DOP853_E3`) in units of
+    the tolerance ``atol + rtol max(|x|, |x_next|)``."""
     scale = atol + rtol * ca.fmax(ca.fabs(x), ca.fabs(x_next))
     e5 = ca.sumsqr(_combine(DOP853_E5, k) / scale)
     e3 = ca.sumsqr(_combine(DOP853_E3, k) / scale)
     # (0/0 where both vanish: the floor keeps the quotient 0)
-    err = ca.fabs(h) * e5 / ca.sqrt(nx * ca.fmax(e5 + 0.01 * e3, 1e-300))
-    return ca.Function(f"{method}_step_err", ins + [rtol, atol], [x_next, err])
+    return ca.fabs(h) * e5 / ca.sqrt(x.numel() * ca.fmax(e5 + 0.01 * e3, 1e-300))
+
+
+def dense_kernels(model: Model, compiled: bool = False) -> tuple[ca.Function, ca.Function]:
+    """DOP853 with its dense output for a control constant over the run (cached):
+    ``rk8_step_k (x, h, u, p, rtol, atol) -> (x_next, err, K)`` (``err`` as the ``error``
+    step of `kernel`; ``K (12 nx)`` the stages, stacked) and ``rk8_cont (x, x_next, K, h,
+    u, p) -> F (7 nx)``, the coefficients of the step's continuous extension of order 7
+    (`tableaux.DOP853_DENSE_D`; four more right-hand sides, spent only on a step that
+    holds an output time). ``compiled``: the form to generate C from (see `kernel`).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from appdyn.dynamics import rigid_body
+    >>> from appdyn.dynamics.integrate.kernels import dense_kernels
+    >>> step, cont = dense_kernels(rigid_body([1.0, 2.0, 3.0]))
+    >>> x0, u, p = np.r_[0, 0, 0, 1, 0.1, 0.2, 0.3], np.zeros(3), np.zeros(0)
+    >>> xn, err, K = step(x0, 0.5, u, p, 1e-8, 1e-10 * np.ones(7))
+    >>> F = np.asarray(cont(x0, xn, K, 0.5, u, p)).reshape(7, 7)
+    >>> bool(np.allclose(F[0], np.ravel(xn - x0)))  # F0 = x_next - x: the end is exact
+    True
+    """
+    call = compiled and calls_rhs(model, "rk8")
+    key = ("dense_kernels", cache.function_key(model.f)) + (("call",) if call else ()) + \
+        (("compiled",) if compiled else ())
+
+    def build():
+        f, tab = model.f, TABLEAUX["rk8"]
+        sym = ca.MX if call else _sym(f)
+        nx, nu, np_ = model.nx, model.nu, f.numel_in(2)
+        x, h, u, p = sym.sym("x", nx), sym.sym("h"), sym.sym("u", nu), sym.sym("p", np_)
+        rtol, atol = sym.sym("rtol"), sym.sym("atol", nx)
+        k = _stages(f, tab.a, tab.c, x, h, lambda c: u, p, [])
+        x_next = x + h * _combine(tab.b, k)
+        step = ca.Function("rk8_step_k", [x, h, u, p, rtol, atol],
+                           [x_next, _embedded_error(x, x_next, k, h, rtol, atol),
+                            ca.vertcat(*k)])
+        # the extension's 4 rhs inline unless they too exceed `INLINE_MAX` (as `calls_rhs`)
+        sym = ca.MX if compiled and 4 * f.n_instructions() > INLINE_MAX else _sym(f)
+        x, h, u, p = sym.sym("x", nx), sym.sym("h"), sym.sym("u", nu), sym.sym("p", np_)
+        xn, K = sym.sym("x_next", nx), sym.sym("K", tab.stages * nx)
+        k = [K[i * nx:(i + 1) * nx] for i in range(tab.stages)]
+        k = _stages(f, ((),), (1.0,), xn, h, lambda c: u, p, k)  # k13 = f(x_next)
+        k = _stages(f, DOP853_DENSE_A, DOP853_DENSE_C, x, h, lambda c: u, p, k)
+        dx = xn - x
+        F = [dx, h * k[0] - dx, 2 * dx - h * (k[12] + k[0])] + \
+            [h * _combine(row, k) for row in DOP853_DENSE_D]
+        cont = ca.Function("rk8_cont", [x, xn, K, h, u, p], [ca.vertcat(*F)])
+        return step, cont
+
+    return cache.get(key, build, keepalive=model.f)
 
 
 def _combine(weights, k: list):

@@ -23,6 +23,16 @@ ONE_PASS = "embedded error control"
 pytestmark = pytest.mark.skipif(cache.compiler() is None, reason="needs a C compiler")
 
 
+@pytest.fixture(autouse=True)
+def _no_dense_path(monkeypatch):
+    """The one-pass path as ``auto`` takes it where DOP853 with dense output
+    (`auto.dense_pass`, tested in test_simulate_dense.py) does not apply, e.g. under a
+    control that varies: here with that path switched off, so that the same closed forms
+    judge the pass."""
+    monkeypatch.setattr("appdyn.dynamics.integrate.auto.dense_pass",
+                        lambda *args: (None, math.nan))
+
+
 def ratio(res, inertia, rtol, atol):
     """max |w - w_true| / (atol + rtol |w_true|) over the rates and output times."""
     w_true = torque_free_omega(inertia, res.x[4:, 0], res.t)

@@ -1,0 +1,205 @@
+"""Single runs of ``simulate`` (default ``auto``) against numbalsoda's ``dop853`` at matched
+error, on several workloads, side by side in the same session (issue 31, items 3 and 5).
+
+Workloads: torque-free rigid bodies of different inertias, rates, horizons and output grids
+(errors against the Jacobi-elliptic truth, `dynamics.truth`), the four-wheel spacecraft and
+the hinged pair as a scene of `bench/workprecision.py` (errors against a fixed-step rk8 run
+with 4x the steps of the tightest ``auto`` answer). numbalsoda integrates the torque-free
+body with its own numba cfunc, and the two models with the same casadi-generated C
+right-hand side appdyn compiles (a shared library exporting ``peer_rhs`` in numbalsoda's
+``lsoda_sig``, built here with the project's compiler flags): the same arithmetic, so the
+ratio is the integrators'.
+
+For each workload both sweep ``rtol`` (``atol = rtol / 100``); each run is timed
+`REPEATS` times (median); the cheapest run of each whose error meets the workload's target
+is compared: ``ratio = numbalsoda time / appdyn time`` (> 1: appdyn faster). numbalsoda
+runs in its own venv (``bench/peers/.venv-numbalsoda``, `bench/peers/README.md`);
+without it the appdyn columns alone are reported.
+
+Writes ``integrate_peers.csv``; returns one ratio row per workload.
+Run: ``appdyn bench integrate_peers`` or ``python bench/integrate_peers.py [--quick]``.
+"""
+from __future__ import annotations
+
+import ctypes
+import statistics
+import subprocess
+import sys
+import tempfile
+from dataclasses import dataclass
+from pathlib import Path
+
+import casadi as ca
+import numpy as np
+
+from appdyn.dynamics import rigid_body, simulate
+from appdyn.dynamics.truth import torque_free_omega
+
+from _common import Row, script_main, timed, write_csv
+
+from simulate import numbalsoda  # noqa: E402  (the peer's runner)
+
+REPEATS = 11
+TOLS = [10.0 ** -k for k in np.arange(4.0, 12.01, 1.0)]
+
+
+@dataclass(frozen=True)
+class Workload:
+    """One single-run case: the model, its start and grid, the error target [state units],
+    how to measure a run's error (``error(x) -> float``), and the peer's job fields."""
+
+    name: str
+    model: object
+    x0: np.ndarray
+    t: np.ndarray
+    target: float
+    error: object
+    peer: dict
+
+
+def torque_free(name, inertia, w0, horizon, n, target) -> Workload:
+    """A torque-free body (error: max |w - w_Jacobi| over the outputs [rad/s])."""
+    t = np.linspace(0.0, horizon, n)
+    w = torque_free_omega(inertia, w0, t)
+    return Workload(name, rigid_body(inertia), np.r_[0.0, 0.0, 0.0, 1.0, w0], t, target,
+                    lambda x: float(np.max(np.abs(x[4:] - w))), {"inertia": list(inertia)})
+
+
+def compiled_model(name, case, n, target, build: Path) -> Workload:
+    """A `bench/workprecision.py` case on ``n`` outputs; its rhs compiled for the peer;
+    error: max over states and outputs against an rk8 run of 4x the steps of appdyn's
+    tightest answer."""
+    c = case()
+    t = np.linspace(float(c.t[0]), float(c.t[-1]), n)
+    model, x0 = c.model, np.asarray(c.x0, float)
+    tight = simulate(model, x0, t, rtol=1e-12, atol=1e-14)
+    steps = max(4 * tight.n_steps // (n - 1), 64)
+    ref = simulate(model, x0, t, method="rk8", steps=steps).x
+    slug = "".join(ch if ch.isalnum() else "_" for ch in name.split(" (")[0])
+    return Workload(name, model, x0, t, target,
+                    lambda x: float(np.max(np.abs(x - ref))), {"library": str(peer_library(
+                        model, build / f"peer_{slug}.so"))})
+
+
+def peer_library(model, path: Path) -> Path:
+    """A shared library with ``void peer_rhs(double t, double* x, double* dx, void* p)``
+    calling the casadi-generated C of ``model.f`` at zero control and default parameters."""
+    f = model.f
+    gen = ca.CodeGenerator(path.stem + ".c", {"with_header": False})
+    ins = [f.mx_in(i) for i in range(3)]
+    gen.add(ca.Function("peer_f", ins, f.call(ins)))
+    src = path.with_suffix(".c")
+    gen.generate(str(path.parent) + "/")
+    p = np.asarray(model.p_default if hasattr(model, "p_default") else np.zeros(f.numel_in(2)),
+                   float).ravel()
+    shim = path.with_name(path.stem + "_shim.c")
+    shim.write_text(
+        f'#include "{src.name}"\n'
+        f"static casadi_real U[{max(f.numel_in(1), 1)}];\n"
+        f"static const casadi_real P[{max(p.size, 1)}] = {{{', '.join(map(repr, p)) or '0'}}};\n"
+        f"static casadi_int IW[{max(f.sz_iw(), 1) + 8}];\n"
+        f"static casadi_real W[{max(f.sz_w(), 1) + 64}];\n"
+        "void peer_rhs(double t, double* x, double* dx, void* p) {\n"
+        "  const casadi_real* arg[16] = {x, U, P}; casadi_real* res[8] = {dx};\n"
+        "  peer_f(arg, res, IW, W, 0);\n}\n")
+    subprocess.run(["cc", "-O1", "-march=native", "-shared", "-fPIC", "-o", str(path),
+                    str(shim)], check=True, cwd=path.parent)
+    ctypes.CDLL(str(path))  # (fails here, not in the peer, when it does not load)
+    return path
+
+
+def workloads(quick: bool, build: Path) -> list[Workload]:
+    """The cases: five torque-free bodies (the issue's, the simulate benchmark's, a fast
+    flat body on a dense grid, a slow long run on a sparse one, a 2-point call), then the
+    wheel spacecraft and the hinged scene."""
+    from workprecision import case_hinged_scene, case_wheels
+
+    out = [torque_free("torque-free, issue 31 (60 s, 121 outputs)", [1.5, 2.5, 3.2],
+                       [0.5, 0.0, 1.0], 60.0, 121, 1e-10),
+           torque_free("torque-free, bench body (100 s, 101 outputs)", [1.0, 2.0, 3.0],
+                       [1.0, 0.1, 0.8], 100.0, 101, 1e-8),
+           torque_free("torque-free, fast flat (20 s, 2001 outputs)", [10.0, 12.0, 21.0],
+                       [2.0, -1.0, 0.5], 20.0, 2001, 1e-8),
+           torque_free("torque-free, slow long (600 s, 61 outputs)", [2.0, 2.6, 3.0],
+                       [0.1, 0.5, 0.3], 600.0, 61, 1e-6),
+           torque_free("torque-free, 2 points (10 s)", [1.0, 2.0, 3.0], [1.0, 0.1, 0.8],
+                       10.0, 2, 1e-10)]
+    if not quick:
+        out += [compiled_model("wheel spacecraft (100 s, 201 outputs)", case_wheels, 201,
+                               1e-6, build),
+                compiled_model("hinged scene (100 s, 101 outputs)", case_hinged_scene, 101,
+                               1e-6, build)]
+    return out
+
+
+def median_time(fun, repeats: int) -> float:
+    """The median of ``repeats`` calls after a first one [s]."""
+    return statistics.median(timed(fun, repeats)[1])
+
+
+def appdyn_sweep(w: Workload, tols, repeats) -> list[dict]:
+    rows = []
+    for rtol in tols:
+        run = (lambda r=rtol: simulate(w.model, w.x0, w.t, rtol=r, atol=r / 100))
+        res = run()
+        rows.append(dict(solver="appdyn auto", rtol=rtol, error=w.error(res.x),
+                         time=median_time(run, repeats), steps=res.n_steps,
+                         success=bool(res.success)))
+    return rows
+
+
+def peer_sweep(w: Workload, tols, repeats) -> list[dict]:
+    job = dict(w.peer, t=w.t.tolist(), x0=w.x0.tolist(), tols=tols, repeats=repeats,
+               solvers=["dop853"])
+    ans = numbalsoda(job)
+    if ans is None:
+        return []
+    rows = []
+    for r in ans["runs"]:
+        x = np.asarray(r["x"]).T if "x" in r else np.vstack([np.zeros((4, w.t.size)),
+                                                             np.asarray(r["w"]).T])
+        rows.append(dict(solver="numbalsoda dop853", rtol=r["rtol"], error=w.error(x),
+                         time=statistics.median(r["times"]), steps=-1,
+                         success=bool(r["success"])))
+    return rows
+
+
+def cheapest(rows, target):
+    ok = [r for r in rows if r["success"] and r["error"] <= target]
+    return min(ok, key=lambda r: r["time"]) if ok else None
+
+
+def run(quick: bool, out: Path) -> list[Row]:
+    tols = TOLS[::2] if quick else TOLS
+    repeats = 3 if quick else REPEATS
+    detail, summary = [], []
+    with tempfile.TemporaryDirectory() as tmp:
+        for w in workloads(quick, Path(tmp)):
+            # the peer first, then appdyn, then the peer again: the VM's speed drifts
+            first = peer_sweep(w, tols, repeats)
+            mine = appdyn_sweep(w, tols, repeats)
+            again = peer_sweep(w, tols, repeats)
+            peer = [dict(a, time=min(a["time"], b["time"])) for a, b in zip(first, again)]
+            for r in mine + peer:
+                detail.append(dict(workload=w.name, target=w.target, **r))
+            a, b = cheapest(mine, w.target), cheapest(peer, w.target)
+            if a:
+                summary.append(Row("integrate_peers", w.name, "appdyn auto time at matched "
+                                   "error", a["time"] * 1e3, "ms",
+                                   f"rtol {a['rtol']:.3g}, {a['steps']} steps, error "
+                                   f"{a['error']:.2g} <= {w.target:g}"))
+            if a and b:
+                summary.append(Row("integrate_peers", w.name, "speed-up vs numbalsoda dop853",
+                                   b["time"] / a["time"], "x",
+                                   f"numbalsoda rtol {b['rtol']:.3g}, {b['time'] * 1e3:.3g} "
+                                   f"ms, error {b['error']:.2g}"))
+    write_csv(detail, out / "integrate_peers.csv")
+    return summary
+
+
+def main(argv=()):
+    return script_main(run, argv)
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv[1:]))

@@ -1,0 +1,114 @@
+"""DOP853 with dense output (`stepcontrol.run_dense`, `auto.dense_pass`): the continuous
+extension's order, steps chosen by the error estimate and not by the output grid, and the
+global tolerance delivered (not exceeded by orders of magnitude) against closed forms."""
+import numpy as np
+import pytest
+
+from appdyn.dynamics import rigid_body, simulate
+from appdyn.dynamics.integrate.inputs import Problem, check_u
+from appdyn.dynamics.integrate.kernels import dense_kernels, kernel
+from appdyn.dynamics.integrate.stepcontrol import run_dense
+from appdyn.dynamics.truth import axisymmetric
+from appdyn.dynamics.truth.torque_free import torque_free_omega
+
+INERTIA = [1.5, 2.5, 3.2]
+X0 = np.r_[0.0, 0.0, 0.0, 1.0, 0.5, 0.0, 1.0]
+
+
+def _problem(model, x0, t):
+    return Problem.new(model, x0, t, check_u(None, model.nu, t), np.zeros(model.f.numel_in(2)))
+
+
+def _interpolate(F, x, s):
+    """The continuous extension at ``s`` in [0, 1] (as `cpass._DENSE` evaluates it)."""
+    r = F[5] + s * F[6]
+    for i, w in ((4, 1 - s), (3, s), (2, 1 - s), (1, s), (0, 1 - s)):
+        r = F[i] + w * r
+    return x + s * r
+
+
+def test_continuous_extension_is_seventh_order():
+    """Inside one step the interpolant's error against a 200-step rk8 reference falls as
+    h^8 (local error of an order-7 extension): 2^8 = 256 per halving, within a factor 2."""
+    model = rigid_body(INERTIA)
+    step, cont = dense_kernels(model)
+    fine = kernel(model, "rk8", "linear")
+    u, p = np.zeros(model.nu), np.zeros(model.f.numel_in(2))
+    errors = []
+    for H in (1.6, 0.8, 0.4):
+        xn, _, K = step(X0, H, u, p, 1e-8, np.full(7, 1e-10))
+        F = np.asarray(cont(X0, xn, K, H, u, p)).reshape(7, 7)
+        assert np.array_equal(F[0], np.ravel(xn) - X0)  # the step's end is exact
+        s = 0.37
+        ref = X0.copy()
+        for _ in range(200):
+            ref = np.ravel(fine(ref, s * H / 200, u, u, p))
+        errors.append(np.abs(_interpolate(F, X0, s) - ref).max())
+    ratios = np.array(errors[:-1]) / np.array(errors[1:])
+    assert np.all((ratios > 128) & (ratios < 512)), ratios
+
+
+@pytest.mark.parametrize("rtol", [1e-6, 1e-9])
+def test_steps_follow_the_error_not_the_grid(rtol):
+    """121 and 1201 outputs over 60 s: the same steps (the outputs never cut one), and the
+    outputs agree with the Jacobi truth within the local tolerance's global error."""
+    model = rigid_body(INERTIA)
+    runs = {}
+    for n in (121, 1201, 2):
+        t = np.linspace(0.0, 60.0, n)
+        run, _ = run_dense(_problem(model, X0, t), rtol, np.full(7, rtol * 1e-2), 10 ** 6)
+        assert run.ok
+        w = torque_free_omega(INERTIA, X0[4:], t)
+        assert np.abs(run.x[4:] - w).max() < 10 * rtol
+        runs[n] = run
+    assert runs[121].n_steps == runs[1201].n_steps == runs[2].n_steps
+    assert np.array_equal(runs[121].x[:, -1], runs[1201].x[:, -1])
+
+
+@pytest.mark.parametrize("rtol", [1e-5, 1e-7, 1e-9])
+@pytest.mark.parametrize("n", [2001, 4001])
+def test_auto_delivers_the_tolerance(rtol, n):
+    """``auto`` on an axisymmetric body (rates and attitude in closed form) on grids dense
+    enough to bind the one pass (so the dense path is taken): the scaled error over every
+    state is within the tolerance and not below it by more than 3 orders of magnitude."""
+    inertia, w0 = [2.0, 2.0, 3.5], [0.4, -0.3, 1.1]
+    t = np.linspace(0.0, 40.0, n)
+    model = rigid_body(inertia)
+    x0 = np.r_[0.0, 0.0, 0.0, 1.0, w0]
+    atol = rtol * 1e-2
+    res = simulate(model, x0, t, rtol=rtol, atol=atol)
+    assert res.success and "dense output" in res.message, res.message
+    w, q = axisymmetric(inertia, w0, x0[:4], t)
+    q = q * np.sign(np.sum(q * res.x[:4], axis=0))
+    truth = np.vstack([q, w])
+    scaled = np.abs(res.x - truth) / (atol + rtol * np.abs(truth))
+    assert 1e-3 < scaled.max() <= 1.0, scaled.max()
+
+
+def test_auto_work_barely_grows_with_the_grid():
+    """``auto``'s steps for 12001 outputs are within 30% of those for 121 (the one pass
+    there, dense output here): the grid-bound pass takes at least 3 steps per output
+    interval, 36000 here."""
+    model = rigid_body(INERTIA)
+    steps = [simulate(model, X0, np.linspace(0.0, 60.0, n), rtol=1e-7, atol=1e-9).n_steps
+             for n in (121, 12001)]
+    assert steps[1] <= 1.3 * steps[0], steps
+
+
+def test_a_sparse_grid_keeps_the_one_pass():
+    """Where the grid does not bind (121 outputs over 60 s), the one pass is cheaper and
+    taken (`auto._grid_bound`)."""
+    res = simulate(rigid_body(INERTIA), X0, np.linspace(0.0, 60.0, 121), rtol=1e-7, atol=1e-9)
+    assert res.success and "embedded error control" in res.message, res.message
+
+
+def test_varying_control_keeps_the_grid_paths():
+    """A control that changes on the grid is not stepped across (its kinks sit there)."""
+    model = rigid_body(INERTIA)
+    t = np.linspace(0.0, 10.0, 11)
+    u = np.zeros((3, 11))
+    u[0] = np.linspace(0.0, 0.1, 11)
+    assert run_dense(_problem(model, X0, t).__class__.new(
+        model, X0, t, check_u(u, 3, t), np.zeros(0)), 1e-8, np.full(7, 1e-10), 10 ** 6) is None
+    res = simulate(model, X0, t, u=u)
+    assert res.success and "dense output" not in res.message
