@@ -492,9 +492,8 @@ def hinged_scene(m1, inertia1, m2, inertia2, r1, r2, kind="revolute", axis=None)
 
     Raises
     ------
-    ValueError
-        From `dynamics.scene.RigidHub` and `dynamics.scene.HingedPanel`, naming the
-        argument (their names: ``mass``, ``inertia``, ``hinge_point``...).
+    TypeError, ValueError
+        Naming the argument (``m1``, ``inertia1``, ``r1``, ``axis``, ...).
 
     Examples
     --------
@@ -511,9 +510,14 @@ def hinged_scene(m1, inertia1, m2, inertia2, r1, r2, kind="revolute", axis=None)
     if kind == "ball" and axis is not None:
         raise ValueError(f"`axis` applies to kind='revolute' only, got {axis!r}")
     hinge_axis = None if kind == "ball" else ([0.0, 0.0, 1.0] if axis is None else axis)
-    cm = -np.asarray(r2, dtype=float)
+    m1, m2 = positive(m1, "m1"), positive(m2, "m2")
+    inertia1 = check_inertia(inertia1, name="inertia1")
+    inertia2 = check_inertia(inertia2, name="inertia2")
+    r1, r2 = finite_array(r1, "r1", (3,)), finite_array(r2, "r2", (3,))
+    if hinge_axis is not None:
+        hinge_axis = unit_axes(hinge_axis, "axis", n=1)[:, 0]
     return Scene(RigidHub(inertia1, mass=m1),
-                 HingedPanel(m2, inertia2, hinge_point=r1, cm_offset=cm, axis=hinge_axis),
+                 HingedPanel(m2, inertia2, hinge_point=r1, cm_offset=-r2, axis=hinge_axis),
                  name=f"hinged_{kind}")
 
 def two_body_state(scene) -> ca.Function:

@@ -47,7 +47,7 @@ import casadi as ca
 import numpy as np
 
 from ..validate import finite_array, integer, nonnegative, positive, positive_each
-from .beams import ClampedFreeModes, gauss_legendre
+from .beams import ClampedFreeModes, TabulatedModes
 from .contract import Body, Contribution, Load, Part, PartVariables, Variable
 from .dampers import unit_vector
 
@@ -75,24 +75,26 @@ def default_normal(direction) -> np.ndarray:
     return n / np.linalg.norm(n)
 
 
+def _beam(length, mass_per_length, modes, tip_mass, shapes):
+    """The appendage's modes: clamped-free, or the Ritz modes of a shape table."""
+    if shapes is None:
+        return ClampedFreeModes(length, mass_per_length, modes, tip_mass)
+    return TabulatedModes(length, mass_per_length, shapes[0], shapes[1], tip_mass)
+
+
 @functools.lru_cache(maxsize=64)
-def _body_coefficients(length, mass_per_length, modes, tip_mass, stiffening):
+def _body_coefficients(length, mass_per_length, modes, tip_mass, stiffening, shapes=None):
     """``(B, mu, K_unit)``: the basis coefficients of the bodies (columns of ``B``, the
     mass-centre body first), their momentum factors, and ``int phi'' phi''`` (module
     docstring). Basis order: ``1, x, phi_1..n, G_ij (i <= j)``."""
-    beam = ClampedFreeModes(length, mass_per_length, modes, tip_mass)
+    beam = _beam(length, mass_per_length, modes, tip_mass, shapes)
     x, w = beam.nodes()
     pairs = [(i, j) for i in range(modes) for j in range(i, modes)] if stiffening else []
 
     def basis(xs):
         rows = [np.ones_like(xs), xs, *beam.shape(xs)]
-        if pairs:
-            G = np.empty((len(pairs), xs.size))
-            for k, xk in enumerate(xs):  # G_ij(xk) = int_0^xk phi_i' phi_j'
-                t, wt = gauss_legendre(0.0, xk, x.size)
-                d1 = beam.shape(t, 1)
-                G[:, k] = [(d1[i] * d1[j]) @ wt for i, j in pairs]
-            rows += list(G)
+        if pairs:  # G_ij(xk) = int_0^xk phi_i' phi_j'
+            rows += list(beam.slope_integrals(xs, pairs))
         return np.array(rows)
 
     c = basis(x)
@@ -121,7 +123,8 @@ def _body_coefficients(length, mass_per_length, modes, tip_mass, stiffening):
 @dataclass(frozen=True, init=False)
 class FlexibleAppendage(Part):
     """A uniform flexible cantilever (an antenna, a boom) bending in two planes, by its
-    clamped-free component modes, with geometric stiffening (module docstring).
+    clamped-free component modes (or a user's shape table), with geometric stiffening
+    (module docstring).
 
     Parameters
     ----------
@@ -147,6 +150,12 @@ class FlexibleAppendage(Part):
     stiffening : bool, optional
         Include the axial foreshortening (True). False gives the plain linear modal model,
         *for comparison only* (it misses the centrifugal stiffening: a spin-up diverges).
+    shapes : (array_like, array_like), optional
+        A user's shape table ``(x, phi)``: stations ``x`` shape (n,) [m] from 0 (the root) to
+        ``length``, and ``phi`` shape (n, modes) admissible shapes (zero at the root, any
+        scale), used instead of the computed clamped-free modes: interpolated by a cubic
+        spline clamped at the root, then made the beam's Ritz modes
+        (`dynamics.scene.beams.TabulatedModes`). ``modes`` is then the table's column count.
 
     Raises
     ------
@@ -192,11 +201,12 @@ class FlexibleAppendage(Part):
     parent: str | None
     name: str | None
     stiffening: bool
+    shapes: tuple | None
     kind = "appendage"
 
     def __init__(self, length, mass_per_length, bending_stiffness, *, root=(0.0, 0.0, 0.0),
                  direction=(1.0, 0.0, 0.0), normal=None, modes=4, tip_mass=0.0, parent=None,
-                 name=None, stiffening=True):
+                 name=None, stiffening=True, shapes=None):
         d = unit_vector(direction, "direction")
         if normal is None:
             n = default_normal(d)
@@ -219,16 +229,25 @@ class FlexibleAppendage(Part):
             "parent": parent,
             "name": name,
             "stiffening": bool(stiffening),
+            "shapes": None,
         }
+        if shapes is not None:
+            if not isinstance(shapes, (tuple, list)) or len(shapes) != 2:
+                raise TypeError(f"`shapes` must be a pair (x, phi), got {type(shapes).__name__}")
+            table = TabulatedModes(fields["length"], fields["mass_per_length"], shapes[0],
+                                   shapes[1], fields["tip_mass"])
+            fields["shapes"] = (table.x, table.shapes)
+            fields["modes"] = table.modes
         if parent is not None and not isinstance(parent, str):
             raise TypeError(f"`parent` must be a part's name (str) or None, got {parent!r}")
         for key, value in fields.items():
             object.__setattr__(self, key, value)
 
     @property
-    def beam(self) -> ClampedFreeModes:
-        """The mode shapes (`dynamics.scene.beams.ClampedFreeModes`)."""
-        return ClampedFreeModes(self.length, self.mass_per_length, self.modes, self.tip_mass)
+    def beam(self):
+        """The mode shapes (`dynamics.scene.beams.ClampedFreeModes`, or `TabulatedModes` for
+        a shape table)."""
+        return _beam(self.length, self.mass_per_length, self.modes, self.tip_mass, self.shapes)
 
     @property
     def binormal(self) -> np.ndarray:
@@ -267,7 +286,7 @@ class FlexibleAppendage(Part):
     def contribute(self, frame, own) -> Contribution:
         n = self.modes
         B, mu, K, pairs = _body_coefficients(self.length, self.mass_per_length, n,
-                                             self.tip_mass, self.stiffening)
+                                             self.tip_mass, self.stiffening, self.shapes)
         q = (own.coords[:n], own.coords[n:])
         qd = (own.speeds[:n], own.speeds[n:])
         d, dirs = ca.DM(self.direction), (ca.DM(self.normal), ca.DM(self.binormal))

@@ -288,3 +288,68 @@ def test_on_a_locked_hinged_boom_it_is_the_same_beam_as_on_the_hub():
                 assert np.max(np.abs(fa / expected - 1)) < 1e-8
             else:
                 assert fa[0] > TEXTBOOK[0] ** 2 * np.sqrt(ei / (m * L ** 4)) * 1.05
+
+
+# ------------------------------------------------------------------ a user's shape table
+def test_polynomial_shape_table_gives_the_two_term_ritz_frequencies():
+    """Shapes x^2, x^3 (exact for the spline): the Ritz eigenproblem of their exact
+    integrals, M = m L [[1/5, 1/6], [1/6, 1/7]], K = EI / L^3 [[4, 6], [6, 12]]."""
+    L, m, EI = 2.0, 0.5, 10.0
+    x = np.linspace(0.0, L, 9)
+    part = FlexibleAppendage(L, m, EI, shapes=(x, np.column_stack([x ** 2, x ** 3])),
+                             root=(0.5, 0.0, 0.0))
+    assert part.modes == 2
+    M = m * L * np.array([[1 / 5, 1 / 6], [1 / 6, 1 / 7]])
+    K = EI / L ** 3 * np.array([[4.0, 6.0], [6.0, 12.0]])
+    expected = np.sqrt(np.sort(np.linalg.eigvals(np.linalg.solve(M, K)).real))
+    assert np.max(np.abs(part.frequencies()[0] / expected - 1)) < 1e-12
+    scene = Scene(RigidHub(LOCKED), part)
+    lin = linearization(scene.model(), scene.state(), frame="rates")
+    names = ["eta1", "eta2", "eta1_dot", "eta2_dot"]
+    assert np.max(np.abs(_freqs(lin, names) / expected - 1)) < 1e-8
+
+
+def test_a_sampled_clamped_free_table_is_the_computed_beam():
+    """The library's own shapes, tabulated at 401 stations, give the same beam: frequencies
+    to 1e-8 (the cubic spline's error), spinning frequencies to 1e-6."""
+    L, m, EI, n = 2.0, 0.5, 10.0, 3
+    x = np.linspace(0.0, L, 401)
+    table = ClampedFreeModes(L, m, n, 0.2).shape(x).T * np.array([1.0, -3.0, 0.5])
+    given = FlexibleAppendage(L, m, EI, root=(0.7, 0, 0), modes=n, tip_mass=0.2)
+    tabulated = FlexibleAppendage(L, m, EI, root=(0.7, 0, 0), tip_mass=0.2, shapes=(x, table))
+    assert np.max(np.abs(tabulated.frequencies() / given.frequencies() - 1)) < 1e-8
+    rate = 1.5 * given.frequencies()[0, 0]
+    eta = [f"eta{i}" for i in range(1, n + 1)] + [f"eta{i}_dot" for i in range(1, n + 1)]
+    f = []
+    for part in (given, tabulated):
+        scene = Scene(RigidHub(LOCKED), part)
+        lin = linearization(scene.model(), scene.state(w=[0, 0, rate]), frame="rates")
+        f.append(_freqs(lin, eta))
+    assert np.max(np.abs(f[1] / f[0] - 1)) < 1e-6
+
+
+def test_a_shape_table_conserves_momentum_and_energy():
+    x = np.linspace(0.0, 1.5, 7)
+    part = FlexibleAppendage(1.5, 0.4, (0.6, 0.9), root=(0.4, 0.1, 0.0),
+                             shapes=(x, np.column_stack([x ** 2, x ** 3 - x ** 2])))
+    scene = Scene(RigidHub([[10.0, 1.2, -0.8], [1.2, 12.0, 0.6], [-0.8, 0.6, 8.0]]), part)
+    model = scene.model()
+    x0 = scene.state(w=[0.3, -0.2, 0.5], eta1=0.05, xi2_dot=0.1)
+    t = np.linspace(0.0, 100.0, 11)
+    res = simulate(model, x0, t, method="rk8", steps=2000, jit=False)
+    assert res.success, res.message
+    for key in ("energy", "momentum_inertial"):
+        v = np.asarray(model.invariant(key, res.x)).reshape(-1, t.size)
+        assert np.max(np.abs(v - v[:, :1])) / np.max(np.abs(v)) < 1e-10, key
+
+
+def test_bad_shape_tables_name_the_argument():
+    x = np.linspace(0.0, 2.0, 6)
+    with pytest.raises(ValueError, match="`shapes` must be zero at the clamped root"):
+        FlexibleAppendage(2.0, 0.5, 10.0, shapes=(x, np.column_stack([x + 1.0])))
+    with pytest.raises(ValueError, match="`x` must increase from 0 to `length`"):
+        FlexibleAppendage(2.0, 0.5, 10.0, shapes=(x[:-1], np.column_stack([x[:-1] ** 2])))
+    with pytest.raises(ValueError, match="linearly independent"):
+        FlexibleAppendage(2.0, 0.5, 10.0, shapes=(x, np.column_stack([x ** 2, 2 * x ** 2])))
+    with pytest.raises(TypeError, match="`shapes` must be a pair"):
+        FlexibleAppendage(2.0, 0.5, 10.0, shapes=x)
