@@ -194,6 +194,10 @@ class Aerodynamics(Part):
 
     def contribute(self, frame, own) -> Contribution:
         require_translating_hub(frame, "Aerodynamics")
+        if self.air_velocity == "mass_centre" and not frame.is_hub:
+            raise ValueError("`air_velocity='mass_centre'` reads the hub's mass centre: an "
+                             "Aerodynamics on another part (`parent`) needs "
+                             "air_velocity='centre_of_pressure'")
         rho_cp = frame.point(self.centre_of_pressure)
         v_cp = frame.velocity(rho_cp)
         v_air = v_cp if self.air_velocity == "centre_of_pressure" else frame.velocity(

@@ -107,3 +107,19 @@ def test_a_child_listed_before_its_parent_is_the_same_model():
     f2 = dict(zip(second.states, second.model().rhs(x2, [0.4])))
     for k in f1:
         assert f1[k] == pytest.approx(f2[k], rel=1e-14, abs=1e-15)
+
+
+def test_aerodynamics_on_a_panel_reads_its_own_point():
+    """On a panel of a six-degree-of-freedom hub the air force acts at the panel's centre of
+    pressure; the hub's mass centre is not the panel's to read."""
+    from appdyn.dynamics.scene import Aerodynamics
+    panel = HingedPanel(2.0, [0.5, 0.1, 0.5], [0.0, 0.6, 0.0], [0.0, 0.5, 0.0],
+                        axis=[1.0, 0.0, 0.0])
+    hub = RigidHub(I_HUB, mass=40.0)
+    scene = Scene(hub, panel, Aerodynamics(1.0, 2.0, parent="panel"))
+    assert scene.model().nx == 15
+    with pytest.raises(ValueError, match="air_velocity='mass_centre'"):
+        Scene(hub, panel, Aerodynamics(1.0, 2.0, air_velocity="mass_centre",
+                                       parent="panel")).model()
+    with pytest.raises(ValueError, match="six-degree-of-freedom hub"):
+        Scene(RigidHub(I_HUB), panel, Aerodynamics(1.0, 2.0, parent="panel")).model()
