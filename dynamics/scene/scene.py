@@ -327,7 +327,7 @@ def _part_parents(parts, names) -> tuple:
         host = parts[names.index(parent)]
         if not type(host).carries_parts:
             raise ValueError(f"part {pname!r}: its `parent` {parent!r} "
-                             f"({type(host).__name__}) cannot carry parts (a HingedPanel can)")
+                             f"({type(host).__name__}) cannot carry parts (a HingedPanel or a BendingMode can)")
         parents.append(parent)
     for pname in names:
         seen, at = {pname}, parents[names.index(pname)]
