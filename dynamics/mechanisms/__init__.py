@@ -13,8 +13,9 @@
 * `bodies` -- constrained rigid bodies: the rolling coin (nonholonomic) with its steady
   circular rolling, and the dumbbell elastically hinged to a free disk with its planar
   swing frequency;
-* `lagrange` -- Lagrange's equations by automatic differentiation and the assembly of a
-  constrained model (shared by `multipliers` and `bodies`);
+* `lagrange` -- Lagrange's equations by automatic differentiation, with applied forces at
+  points, explicit time and velocity-dependent potentials (`lagrange_model`), and the
+  assembly of a constrained model (shared by `multipliers` and `bodies`);
 * `common` -- the shared symbols, model assembly and parameter checks.
 
 Time-dependent mechanisms carry the clock state ``t`` of `dynamics.clock`. Every model
@@ -26,7 +27,7 @@ from __future__ import annotations
 from .common import GRAVITY
 from .bodies import (coin_state, coin_steady_rates, dumbbell_disk, dumbbell_disk_frequency,
                      dumbbell_disk_state, rolling_coin)
-from .lagrange import lagrange_terms
+from .lagrange import generalized_forces, lagrange_model, lagrange_terms
 from .multipliers import (bead_motion, bead_torque, rod_pendulum, rod_reaction,
                           shaken_multiplier_state, shaken_pendulum_multipliers, sliding_bead)
 from .pendulums import (double_pendulum, double_pendulum_modes, pendulum_period, pendulum_swing,
@@ -39,6 +40,7 @@ __all__ = ["GRAVITY", "SEQUENCES", "SHAKEN_DEFAULTS", "bead_motion", "bead_torqu
            "coin_state", "coin_steady_rates", "conical_rate", "double_pendulum",
            "double_pendulum_modes", "dumbbell_disk", "dumbbell_disk_frequency",
            "dumbbell_disk_state", "equivalent_length", "kapitza_frequency", "lagrange_terms",
+           "lagrange_model", "generalized_forces",
            "natural_frequency", "pendulum_period", "pendulum_swing", "resonance_tongue",
            "rod_pendulum", "rod_reaction", "rolling_coin", "shaken_multiplier_state",
            "shaken_pendulum", "shaken_pendulum_multipliers", "sliding_bead",
