@@ -10,6 +10,9 @@
 * `multipliers` -- systems held by Lagrange multipliers (`dynamics.constrained`): the rod
   pendulum in Cartesian coordinates and its rod tension, the shaken pendulum a second time
   (its multipliers the hinge force), the bead on a driven wire (Eq. 5.79);
+* `noninertial` -- a particle in a frame with prescribed motion (Sec. 2.2, Eq. 2.1: the
+  d'Alembert, Euler, centrifugal and Coriolis forces) and the seed's examples: turntable,
+  Foucault pendulum, accelerometer, twirling skater;
 * `bodies` -- constrained rigid bodies: the rolling coin (nonholonomic) with its steady
   circular rolling, and the dumbbell elastically hinged to a free disk with its planar
   swing frequency;
@@ -28,6 +31,10 @@ from .common import GRAVITY
 from .bodies import (coin_state, coin_steady_rates, dumbbell_disk, dumbbell_disk_frequency,
                      dumbbell_disk_state, rolling_coin)
 from .lagrange import generalized_forces, lagrange_model, lagrange_terms
+from .noninertial import (EARTH_RATE, accelerometer, accelerometer_offset, foucault_pendulum,
+                          foucault_precession_rate, foucault_swing, noninertial_particle,
+                          skater_rate, skater_work, turntable, turntable_path,
+                          twirling_skater)
 from .multipliers import (bead_motion, bead_torque, rod_pendulum, rod_reaction,
                           shaken_multiplier_state, shaken_pendulum_multipliers, sliding_bead)
 from .pendulums import (double_pendulum, double_pendulum_modes, pendulum_period, pendulum_swing,
@@ -44,4 +51,7 @@ __all__ = ["GRAVITY", "SEQUENCES", "SHAKEN_DEFAULTS", "bead_motion", "bead_torqu
            "natural_frequency", "pendulum_period", "pendulum_swing", "resonance_tongue",
            "rod_pendulum", "rod_reaction", "rolling_coin", "shaken_multiplier_state",
            "shaken_pendulum", "shaken_pendulum_multipliers", "sliding_bead",
-           "spherical_mass_matrix", "spherical_pendulum", "variable_length_pendulum"]
+           "spherical_mass_matrix", "spherical_pendulum", "variable_length_pendulum",
+           "EARTH_RATE", "accelerometer", "accelerometer_offset", "foucault_pendulum",
+           "foucault_precession_rate", "foucault_swing", "noninertial_particle", "skater_rate",
+           "skater_work", "turntable", "turntable_path", "twirling_skater"]
