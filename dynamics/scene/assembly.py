@@ -1,7 +1,8 @@
 """Assemble a `Scene` into one `Model` by Kane's method on the symbols.
 
 Generalized speeds ``nu = (w, [v], part speeds)``, coordinates ``c = (q, [r], part
-coordinates)`` with ``q' = -1/2 Wbar(w) q`` (seed Eq. 4.70) and ``r' = A^T v``. Each body
+coordinates)`` with ``q' = -1/2 Wbar(w) q`` (seed Eq. 4.70) and ``r' = A^T v`` (relative
+to a turning frame with ``RigidHub(reference_rate=...)``: `reference_rates`). Each body
 ``b`` (the hub's and every part's) has the absolute velocity ``v_b`` of its mass centre and
 angular velocity ``w_b``, linear momentum ``p_b`` and angular momentum ``h_b`` about its mass
 centre, all in hub axes. Their inertial derivatives in hub components are
@@ -30,7 +31,7 @@ from ..attitude import dcm_from_quat, quat_rate
 from ..model import Model
 from .contract import Body, Contribution, Frame, PartSymbols
 
-__all__ = ["PartLayout", "assemble", "kane_equations", "in_hub_axes"]
+__all__ = ["PartLayout", "assemble", "kane_equations", "in_hub_axes", "reference_rates"]
 
 
 @dataclass(frozen=True)
@@ -205,6 +206,17 @@ def in_hub_axes(frame: Frame, c: Contribution) -> Contribution:
     return replace(c, bodies=bodies, momentum=momentum)
 
 
+def reference_rates(hub, q, w, A, r, v) -> list:
+    """The hub's coordinate rates ``[q', (r')]``: ``q' = -1/2 Wbar(w_rel) q``, ``r' = A^T v``,
+    relative to a frame turning at ``hub.reference_rate`` ``Omega`` when it is given
+    (``w_rel = w - A Omega``, ``r' = A^T v - Omega x r``), else inertial."""
+    if hub.reference_rate is None:
+        return [quat_rate(q, w)] + ([ca.mtimes(A.T, v)] if r is not None else [])
+    Om = ca.DM(hub.reference_rate)
+    return [quat_rate(q, w - ca.mtimes(A, Om))] + (
+        [ca.mtimes(A.T, v) - ca.cross(Om, r)] if r is not None else [])
+
+
 def assemble(scene) -> Model:
     """The `Model` of ``scene`` (module docstring); use `Scene.model`, which caches it."""
     hub = scene.hub
@@ -230,7 +242,7 @@ def assemble(scene) -> Model:
     bodies_by_part = {"hub": [hub_body]}
     loads, potential, kinetic, extra, momenta = [], [], [], {}, {}
     coord_syms = [q] + ([r] if r is not None else [])
-    coord_rates = [quat_rate(q, w)] + ([ca.mtimes(A.T, v)] if r is not None else [])
+    coord_rates = reference_rates(hub, q, w, A, r, v)
     speed_syms = [w] + ([v] if hub.translates else [])
     part_speed_slices = []
     n_hub = 6 if hub.translates else 3
