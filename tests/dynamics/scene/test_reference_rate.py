@@ -1,0 +1,83 @@
+"""``RigidHub(reference_rate=Omega)``: attitude (and position) referred to a frame turning at
+a constant rate (seed 000 Eq. 6.42), against the inertial simulation transformed."""
+import numpy as np
+import pytest
+
+from appdyn.dynamics import simulate
+from appdyn.dynamics.attitude import dcm_from_quat
+from appdyn.dynamics.scene import ExternalTorque, RigidHub, Scene
+
+J = np.array([[10.0, 0.4, -0.2], [0.4, 12.0, 0.3], [-0.2, 0.3, 8.0]])
+OMEGA = np.array([0.02, -0.05, 0.1])
+
+
+def _frame_dcm(t):
+    """Inertial -> reference frame, the frame turning at OMEGA (its own and inertial axes)."""
+    n, th = OMEGA / np.linalg.norm(OMEGA), np.linalg.norm(OMEGA) * t
+    K = np.array([[0.0, -n[2], n[1]], [n[2], 0.0, -n[0]], [-n[1], n[0], 0.0]])
+    return (np.eye(3) + np.sin(th) * K + (1 - np.cos(th)) * K @ K).T
+
+
+def _quat(rng):
+    q = rng.normal(size=4)
+    return q / np.linalg.norm(q)
+
+
+def _run(model, x0, t, u=None):
+    res = simulate(model, x0, t, u=u, method="rk8", steps=400, jit=False)
+    assert res.success
+    return res.x
+
+
+def test_at_rest_in_the_turning_frame_keeps_its_attitude():
+    """``w = A Omega`` held by the torque ``w x J w``: ``q`` stays, ``w`` stays."""
+    rng = np.random.default_rng(6)
+    q0 = _quat(rng)
+    w0 = dcm_from_quat(q0) @ OMEGA
+    scene = Scene(RigidHub(J, reference_rate=OMEGA), ExternalTorque())
+    t = np.linspace(0.0, 100.0, 11)
+    x = _run(scene.model(), scene.state(q=q0, w=w0), t, u=np.cross(w0, J @ w0))
+    np.testing.assert_allclose(x[0:4] - q0[:, None], 0.0, atol=1e-13)
+    np.testing.assert_allclose(x[4:7] - w0[:, None], 0.0, atol=1e-13)
+
+
+def test_torque_free_spin_about_a_principal_axis_along_omega():
+    Jd = np.diag([10.0, 12.0, 8.0])
+    Om = np.array([0.0, 0.0, 0.3])
+    scene = Scene(RigidHub(Jd, reference_rate=Om))
+    x = _run(scene.model(), scene.state(w=Om), np.linspace(0.0, 50.0, 6))
+    np.testing.assert_allclose(x[0:4], np.array([0, 0, 0, 1.0])[:, None] + 0 * x[0:4], atol=1e-13)
+
+
+@pytest.mark.parametrize("mass", [None, 50.0])
+def test_turning_reference_equals_the_inertial_simulation_transformed(mass):
+    rng = np.random.default_rng(7 if mass is None else 8)
+    q0, w0 = _quat(rng), rng.normal(scale=0.2, size=3)
+    inertial = Scene(RigidHub(J, mass=mass))
+    turning = Scene(RigidHub(J, mass=mass, reference_rate=OMEGA))
+    extra = {} if mass is None else {"r": [100.0, -20.0, 5.0], "v": [1.0, 2.0, -0.5]}
+    t = np.linspace(0.0, 30.0, 7)
+    xi = _run(inertial.model(), inertial.state(q=q0, w=w0, **extra), t)
+    xr = _run(turning.model(), turning.state(q=q0, w=w0, **extra), t)  # frames agree at t = 0
+    Hr = turning.model().invariant("momentum_inertial", xr)
+    Hi = inertial.model().invariant("momentum_inertial", xi)
+    for j, tj in enumerate(t):
+        R = _frame_dcm(tj)
+        np.testing.assert_allclose(dcm_from_quat(xr[0:4, j]), dcm_from_quat(xi[0:4, j]) @ R.T,
+                                   atol=1e-11)
+        np.testing.assert_allclose(xr[4:7, j], xi[4:7, j], atol=1e-12)
+        if mass is not None:
+            np.testing.assert_allclose(xr[7:10, j], R @ xi[7:10, j], rtol=1e-12, atol=1e-10)
+            np.testing.assert_allclose(xr[10:13, j], xi[10:13, j], atol=1e-12)
+        # inertial momentum conserved: the reference-axes invariant turned back is constant
+        np.testing.assert_allclose(R.T @ np.ravel(Hr[:, j]), np.ravel(Hi[:, 0]), rtol=1e-11,
+                                   atol=1e-11)
+    E = turning.model().invariant("energy", xr)
+    np.testing.assert_allclose(np.ravel(E), float(np.ravel(E)[0]), rtol=1e-12)
+
+
+def test_reference_rate_is_checked_and_part_of_the_scene():
+    with pytest.raises(ValueError, match="reference_rate"):
+        RigidHub(J, reference_rate=[0.0, 1.0])
+    assert RigidHub(J, reference_rate=OMEGA) != RigidHub(J)
+    assert Scene(RigidHub(J, reference_rate=OMEGA)).model() is not Scene(RigidHub(J)).model()
