@@ -10,6 +10,8 @@
 * `multipliers` -- systems held by Lagrange multipliers (`dynamics.constrained`): the rod
   pendulum in Cartesian coordinates and its rod tension, the shaken pendulum a second time
   (its multipliers the hinge force), the bead on a driven wire (Eq. 5.79);
+* `hamel` -- the Boltzmann-Hamel equations (Sec. 6.1): equations of motion in
+  quasi-velocities from ``T*(q, u)`` and the kinematics ``q' = W(q) u``;
 * `noninertial` -- a particle in a frame with prescribed motion (Sec. 2.2, Eq. 2.1: the
   d'Alembert, Euler, centrifugal and Coriolis forces) and the seed's examples: turntable,
   Foucault pendulum, accelerometer, twirling skater;
@@ -30,6 +32,7 @@ from __future__ import annotations
 from .common import GRAVITY
 from .bodies import (coin_state, coin_steady_rates, dumbbell_disk, dumbbell_disk_frequency,
                      dumbbell_disk_state, rolling_coin)
+from .hamel import hamel_model, hamel_terms
 from .lagrange import generalized_forces, lagrange_model, lagrange_terms
 from .noninertial import (EARTH_RATE, accelerometer, accelerometer_offset, foucault_pendulum,
                           foucault_precession_rate, foucault_swing, noninertial_particle,
@@ -52,6 +55,6 @@ __all__ = ["GRAVITY", "SEQUENCES", "SHAKEN_DEFAULTS", "bead_motion", "bead_torqu
            "rod_pendulum", "rod_reaction", "rolling_coin", "shaken_multiplier_state",
            "shaken_pendulum", "shaken_pendulum_multipliers", "sliding_bead",
            "spherical_mass_matrix", "spherical_pendulum", "variable_length_pendulum",
-           "EARTH_RATE", "accelerometer", "accelerometer_offset", "foucault_pendulum",
+           "EARTH_RATE", "hamel_model", "hamel_terms", "accelerometer", "accelerometer_offset", "foucault_pendulum",
            "foucault_precession_rate", "foucault_swing", "noninertial_particle", "skater_rate",
            "skater_work", "turntable", "turntable_path", "twirling_skater"]
