@@ -23,7 +23,7 @@ import casadi as ca
 
 from .. import validate
 from ..clock import CLOCK_STATE, CLOCK_UNIT
-from ..model import Model, model_from_expressions
+from ..model import Model, model_from_expressions, named_symbols
 from .lagrange import generalized_forces
 
 __all__ = ["hamel_terms", "hamel_model"]
@@ -162,7 +162,8 @@ def hamel_model(coords, speeds, T, W, *, t=None, forces=(), quasi_forces=None,
     >>> model.rhs([2.0, 0.0, 1.0, 3.0]).tolist()   # v_r' = v_t^2 / r, v_t' = -v_r v_t / r
     [1.0, 1.5, 4.5, -1.5]
     """
-    q_named, u_named = dict(coords), dict(speeds)
+    q_named = dict(zip(*named_symbols(coords, "coords", required=True)))
+    u_named = dict(zip(*named_symbols(speeds, "speeds", required=True)))
     q, u = ca.vertcat(*q_named.values()), ca.vertcat(*u_named.values())
     M, F = hamel_terms(T, q, u, W, t=t, forces=forces, quasi_forces=quasi_forces)
     states = [*q_named.items(), *u_named.items()] + ([(CLOCK_STATE, t)] if t is not None else [])

@@ -9,7 +9,7 @@ import casadi as ca
 from .. import validate
 from ..clock import CLOCK_STATE, CLOCK_UNIT
 from ..constrained import baumgarte, constrained_accelerations, constraint_terms, residual_invariant
-from ..model import Model, model_from_expressions
+from ..model import Model, model_from_expressions, named_symbols
 from .common import nonnegative
 
 __all__ = ["lagrange_terms", "generalized_forces", "lagrange_model", "stabilization", "constrained_model", "checked_constants"]
@@ -138,6 +138,9 @@ def generalized_forces(forces, q):
     >>> ca.Function("Q", [th], [Q])([ca.pi / 2, ca.pi / 2]).T  # -(m1 + m2) g l1, -m2 g l2
     DM([[-10, -1]])
     """
+    if not validate.is_symbolic(q):
+        raise validate.ArgumentTypeError(f"`q` must be a casadi SX column of coordinate "
+                                         f"symbols, got {type(q).__name__}")
     try:
         pairs = [tuple(pair) for pair in forces]
     except TypeError:
@@ -211,7 +214,8 @@ def lagrange_model(coords, rates, T, V=0.0, *, t=None, forces=(), velocity_poten
     >>> model.rhs([0.0, 0.0, 1.0, 0.0]).tolist()               # e v x B = (0, -2)
     [1.0, 0.0, 0.0, -2.0]
     """
-    q_named, v_named = dict(coords), dict(rates)
+    q_named = dict(zip(*named_symbols(coords, "coords", required=True)))
+    v_named = dict(zip(*named_symbols(rates, "rates", required=True)))
     if len(q_named) != len(v_named):
         raise ValueError(f"`rates` must name one rate per coordinate ({len(q_named)}), got "
                          f"{len(v_named)}")

@@ -196,7 +196,7 @@ def turntable_path(t, *, rate=1.0, speed=1.0):
     >>> x.round(12).tolist(), y.round(12).tolist()
     ([0.0, 0.0], [0.0, -2.0])
     """
-    t = np.asarray(t, float)
+    t = validate.finite_array(t, "t")
     w = validate.finite_scalar(rate, "rate")
     v0 = validate.finite_scalar(speed, "speed")
     z = v0 * t * np.exp(-1j * w * t)
@@ -304,7 +304,7 @@ def foucault_swing(t, *, amplitude=1.0, length=67.0, latitude=np.radians(48.85),
     >>> float(x[0]), float(y[0])
     (0.5, 0.0)
     """
-    t = np.asarray(t, float)
+    t = validate.finite_array(t, "t")
     u = foucault_precession_rate(latitude, earth_rate=earth_rate)
     p = np.sqrt(validate.positive(gravity, "gravity") / validate.positive(length, "length"))
     a = validate.finite_scalar(amplitude, "amplitude")
@@ -442,7 +442,7 @@ def skater_rate(t, *, rate0=1.0, radius0=1.0, pull_speed=0.1):
     w0 = validate.finite_scalar(rate0, "rate0")
     r0 = validate.positive(radius0, "radius0")
     c = validate.finite_scalar(pull_speed, "pull_speed")
-    t = t if validate.is_symbolic(t) else np.asarray(t, float)
+    t = t if validate.is_symbolic(t) else validate.finite_array(t, "t")
     return w0 * r0 ** 2 / (r0 - c * t) ** 2
 
 

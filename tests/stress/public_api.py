@@ -328,7 +328,23 @@ VALID = {
 _ASC_R = lambda: np.array([6.4e6, 0.0, 0.0])  # noqa: E731
 _ASC_V = lambda: np.array([0.0, 7.5e3, 0.0])  # noqa: E731
 
+@functools.cache
+def _lagrange_symbols():
+    """A unit mass on a spring in symbols: Lagrange's and Hamel's builders' example."""
+    q, v = ca.SX.sym("q"), ca.SX.sym("v")
+    return {"q": q, "v": v, "u": v, "T": 0.5 * v ** 2, "coords": {"q": q}, "rates": {"v": v},
+            "speeds": {"v": v}, "W": ca.SX(1.0), "forces": [(-q, q)]}
+
+
+def _lagrange(*params):
+    return {k: (lambda k=k: _lagrange_symbols()[k]) for k in params}
+
+
 OVERRIDES = {
+    "appdyn.dynamics.mechanisms.generalized_forces": _lagrange("forces", "q"),
+    "appdyn.dynamics.mechanisms.lagrange_model": _lagrange("coords", "rates", "T"),
+    "appdyn.dynamics.mechanisms.hamel_terms": _lagrange("T", "q", "u", "W"),
+    "appdyn.dynamics.mechanisms.hamel_model": _lagrange("coords", "speeds", "T", "W"),
     "appdyn.problems.stability.vehicle_loops": {"scene": lambda: __import__(
         "appdyn.dynamics.scene", fromlist=["x"]).launch_vehicle_scene(
             thrust=2.0e6, inertia=4.0e7, arm=20.0, mass=1.0e5)},

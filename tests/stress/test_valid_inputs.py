@@ -318,6 +318,8 @@ RANDOM_OVERRIDES = {
     "appdyn.dynamics.mechanisms.dumbbell_disk_state": {"w": vectors(3)},
     "appdyn.dynamics.mechanisms.spherical_mass_matrix": {"q": vectors(2, 0.2, 1.3)},
     "appdyn.dynamics.mechanisms.pendulum_swing": {"t": time_grids()},
+    "appdyn.dynamics.mechanisms.foucault_precession_rate": {"latitude": floats(-1.5, 1.5)},
+    "appdyn.dynamics.mechanisms.skater_work": {"radius": log_floats(0.05, 1.0)},
     "appdyn.dynamics.momentum.pseudo_inverse_steering": {},
     "appdyn.ocp.unstack": {},
     "appdyn.ocp.state_scale": {"x": st.integers(1, 4).flatmap(
@@ -577,6 +579,10 @@ SYMBOLIC = {
     "appdyn.dynamics.constrained.constraint_terms": ("q", "qdot", "v"),
     "appdyn.dynamics.constrained.residual_invariant": ("x", "p"),
     "appdyn.dynamics.mechanisms.lagrange_terms": ("T", "V", "q", "v"),
+    "appdyn.dynamics.mechanisms.generalized_forces": ("forces", "q"),
+    "appdyn.dynamics.mechanisms.lagrange_model": ("coords", "rates", "T"),
+    "appdyn.dynamics.mechanisms.hamel_terms": ("T", "q", "u", "W"),
+    "appdyn.dynamics.mechanisms.hamel_model": ("coords", "speeds", "T", "W"),
 }
 
 
