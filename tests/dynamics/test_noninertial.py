@@ -28,6 +28,31 @@ def test_turntable_archimedean_spiral():
     np.testing.assert_allclose(r[1:], -(v0 / w) * (phi[1:] - phi[1] - w * t[1]), atol=1e-9)
 
 
+def test_turntable_free_particle_moves_straight_in_inertial_space():
+    w, v0 = 0.7, 0.3
+    t = np.linspace(0.0, 10.0, 11)
+    x = _run(turntable(w), [0, 0, 0, v0, 0, 0], t, steps=500)
+    X = np.cos(w * t) * x[0] - np.sin(w * t) * x[1]            # turntable -> inertial
+    Y = np.sin(w * t) * x[0] + np.cos(w * t) * x[1]
+    np.testing.assert_allclose(X, v0 * t, atol=1e-10)
+    np.testing.assert_allclose(Y, 0.0, atol=1e-10)
+
+
+def test_radial_groove_traces_an_archimedean_spiral_in_inertial_space():
+    """Held in a radial groove at constant relative speed ``c`` (the groove's reaction
+    ``(-m w^2 x, 2 m w x', 0)`` cancels the centrifugal and Coriolis forces): in inertial
+    space ``r = c t``, ``phi = w t``, i.e. ``r = (c / w) phi``."""
+    m, w, c = 0.5, 1.3, 0.2
+    model = noninertial_particle(mass=m, rate=(0, 0, w),
+                                 force=lambda r, v, t: m * ca.vertcat(-w ** 2 * r[0],
+                                                                      2 * w * v[0], 0))
+    t = np.linspace(0.0, 8.0, 17)
+    x = _run(model, [0, 0, 0, c, 0, 0], t, steps=200)
+    Z = (x[0] + 1j * x[1]) * np.exp(1j * w * t)                # turntable -> inertial
+    np.testing.assert_allclose(np.abs(Z), c * t, atol=1e-12)
+    np.testing.assert_allclose(np.abs(Z[1:]), c / w * np.unwrap(np.angle(Z[1:])), atol=1e-12)
+
+
 def test_foucault_pendulum_precesses_at_omega_sin_latitude():
     args = dict(length=2.0, latitude=np.radians(40.0), earth_rate=0.05, gravity=9.80665)
     u, p = foucault_precession_rate(args["latitude"], earth_rate=0.05), np.sqrt(9.80665 / 2.0)
