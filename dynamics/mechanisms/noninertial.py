@@ -47,11 +47,11 @@ def _of_time(value, t: ca.SX, name: str) -> ca.SX:
     if callable(value):
         try:
             out = value(t)
+            out = ca.vec(ca.vertcat(*out) if isinstance(out, (list, tuple)) else ca.SX(out))
         except Exception as exc:  # a user callable: say which argument failed
             raise validate.ArgumentTypeError(
                 f"`{name}` must be 3 numbers or a callable t -> 3-vector of casadi "
                 f"expressions; calling it with a casadi symbol failed: {exc}") from exc
-        out = ca.vec(ca.vertcat(*out) if isinstance(out, (list, tuple)) else ca.SX(out))
         if out.numel() != 3:
             raise ValueError(f"`{name}` must give 3 components, got {out.numel()}")
         return out

@@ -161,3 +161,14 @@ def test_bad_arguments_are_named():
         noninertial_particle(force=3.0)
     with pytest.raises(ValueError, match="`mass`"):
         noninertial_particle(mass=0.0)
+    with pytest.raises(TypeError, match="`rate`"):
+        noninertial_particle(rate=lambda t: "x")
+
+
+def test_rate_as_a_casadi_function_and_a_given_rate_dot():
+    t = ca.SX.sym("t")
+    spun = noninertial_particle(rate=ca.Function("w", [t], [ca.vertcat(0, 0, 0.1 * t)]))
+    x = [1.0, 0, 0, 0, 0, 0, 0.0]
+    np.testing.assert_allclose(spun.rhs(x)[4], -0.1, rtol=1e-15)       # Euler: -w' x r
+    held = noninertial_particle(rate=lambda t: [0, 0, 0.1 * t], rate_dot=[0.0, 0.0, 0.0])
+    np.testing.assert_allclose(held.rhs(x)[3:6], 0.0, atol=0)
