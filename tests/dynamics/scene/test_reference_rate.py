@@ -5,7 +5,7 @@ import pytest
 
 from appdyn.dynamics import simulate
 from appdyn.dynamics.attitude import dcm_from_quat
-from appdyn.dynamics.scene import ExternalTorque, RigidHub, Scene
+from appdyn.dynamics.scene import ExternalTorque, ReactionWheels, RigidHub, Scene
 
 J = np.array([[10.0, 0.4, -0.2], [0.4, 12.0, 0.3], [-0.2, 0.3, 8.0]])
 OMEGA = np.array([0.02, -0.05, 0.1])
@@ -49,13 +49,16 @@ def test_torque_free_spin_about_a_principal_axis_along_omega():
     np.testing.assert_allclose(x[0:4], np.array([0, 0, 0, 1.0])[:, None] + 0 * x[0:4], atol=1e-13)
 
 
-@pytest.mark.parametrize("mass", [None, 50.0])
-def test_turning_reference_equals_the_inertial_simulation_transformed(mass):
+@pytest.mark.parametrize("mass, wheels", [(None, False), (50.0, False), (None, True)])
+def test_turning_reference_equals_the_inertial_simulation_transformed(mass, wheels):
     rng = np.random.default_rng(7 if mass is None else 8)
     q0, w0 = _quat(rng), rng.normal(scale=0.2, size=3)
-    inertial = Scene(RigidHub(J, mass=mass))
-    turning = Scene(RigidHub(J, mass=mass, reference_rate=OMEGA))
+    parts = (ReactionWheels(np.eye(3), 0.05),) if wheels else ()
+    inertial = Scene(RigidHub(J, mass=mass), *parts)
+    turning = Scene(RigidHub(J, mass=mass, reference_rate=OMEGA), *parts)
     extra = {} if mass is None else {"r": [100.0, -20.0, 5.0], "v": [1.0, 2.0, -0.5]}
+    if wheels:
+        extra["wheels"] = [30.0, -10.0, 5.0]
     t = np.linspace(0.0, 30.0, 7)
     xi = _run(inertial.model(), inertial.state(q=q0, w=w0, **extra), t)
     xr = _run(turning.model(), turning.state(q=q0, w=w0, **extra), t)  # frames agree at t = 0
@@ -66,6 +69,8 @@ def test_turning_reference_equals_the_inertial_simulation_transformed(mass):
         np.testing.assert_allclose(dcm_from_quat(xr[0:4, j]), dcm_from_quat(xi[0:4, j]) @ R.T,
                                    atol=1e-11)
         np.testing.assert_allclose(xr[4:7, j], xi[4:7, j], atol=1e-12)
+        np.testing.assert_allclose(xr[7:, j] if wheels else 0, xi[7:, j] if wheels else 0,
+                                   rtol=1e-12)                         # wheel speeds
         if mass is not None:
             np.testing.assert_allclose(xr[7:10, j], R @ xi[7:10, j], rtol=1e-12, atol=1e-10)
             np.testing.assert_allclose(xr[10:13, j], xi[10:13, j], atol=1e-12)
