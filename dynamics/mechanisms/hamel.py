@@ -29,7 +29,7 @@ from .lagrange import generalized_forces
 __all__ = ["hamel_terms", "hamel_model"]
 
 
-def hamel_terms(T, q, u, W, *, t=None, forces=(), quasi_forces=None):
+def hamel_terms(T, q, u, W, *, potential=None, t=None, forces=(), quasi_forces=None):
     """Mass matrix and forces of the Boltzmann-Hamel equations ``M u' = F`` (seed Eq. 6.17).
 
     Parameters
@@ -42,6 +42,8 @@ def hamel_terms(T, q, u, W, *, t=None, forces=(), quasi_forces=None):
         Quasi-velocities (symbols), ``m <= n``.
     W : casadi.SX, n x m
         The kinematics ``q' = W(q) u`` (full column rank; independent of ``u``).
+    potential : casadi.SX, optional
+        Potential energy ``V(q, t)`` [J] (scalar): its forces ``k = -W^T dV/dq``.
     t : casadi.SX, optional
         Time symbol, when ``T`` or a force depends on time explicitly.
     forces : sequence of (casadi.SX, casadi.SX), optional
@@ -81,14 +83,15 @@ def hamel_terms(T, q, u, W, *, t=None, forces=(), quasi_forces=None):
     DM([[-1, 1, -0.333333]])
     """
     for name, a in (("T", T), ("q", q), ("u", u), ("W", W), ("t", t),
-                    ("quasi_forces", quasi_forces)):
-        if a is None and name in ("t", "quasi_forces"):
+                    ("quasi_forces", quasi_forces), ("potential", potential)):
+        if a is None and name in ("t", "quasi_forces", "potential"):
             continue
         if not validate.is_symbolic(a) and not (name == "W" and isinstance(a, ca.DM)):
             raise validate.ArgumentTypeError(f"`{name}` must be a casadi SX/MX expression, "
                                              f"got {type(a).__name__}")
-    if T.shape != (1, 1):
-        raise ValueError(f"`T` must be a scalar (1x1) expression, got shape {T.shape}")
+    for name, a in (("T", T), ("potential", potential)):
+        if a is not None and a.shape != (1, 1):
+            raise ValueError(f"`{name}` must be a scalar (1x1) expression, got shape {a.shape}")
     n, m = q.numel(), u.numel()
     W = ca.SX(W)
     if W.shape != (n, m):
@@ -110,6 +113,8 @@ def hamel_terms(T, q, u, W, *, t=None, forces=(), quasi_forces=None):
             raise ValueError(f"`quasi_forces` must have {m} entries (one per quasi-velocity), "
                              f"got {kq.numel()}")
         k = k + kq
+    if potential is not None:
+        k = k - ca.mtimes(W.T, ca.gradient(potential, q))
     F = k + ca.mtimes(W.T, ca.gradient(T, q)) - ca.mtimes(ca.jacobian(p, q), qdot) \
         - ca.mtimes(C.T, p)
     if t is not None:
@@ -117,7 +122,7 @@ def hamel_terms(T, q, u, W, *, t=None, forces=(), quasi_forces=None):
     return M, F
 
 
-def hamel_model(coords, speeds, T, W, *, t=None, forces=(), quasi_forces=None,
+def hamel_model(coords, speeds, T, W, *, potential=None, t=None, forces=(), quasi_forces=None,
                 controls=None, params=None, p_default=None, units=None,
                 name: str = "boltzmann_hamel", attitude=None) -> Model:
     """A `Model` from the Boltzmann-Hamel equations (`hamel_terms`).
@@ -128,7 +133,7 @@ def hamel_model(coords, speeds, T, W, *, t=None, forces=(), quasi_forces=None,
     ----------
     coords, speeds : mapping of str to casadi.SX, or sequence of (str, casadi.SX)
         The coordinates ``q`` and the quasi-velocities ``u``: names and scalar symbols.
-    T, W, t, forces, quasi_forces
+    T, W, potential, t, forces, quasi_forces
         As `hamel_terms` (in these symbols, the controls and the parameters).
     controls, params : mapping of str to casadi.SX, or sequence of (str, casadi.SX), optional
         Control and parameter symbols the forces use (``p_default`` by name or in order).
@@ -141,8 +146,7 @@ def hamel_model(coords, speeds, T, W, *, t=None, forces=(), quasi_forces=None,
     -------
     Model
         States: coordinates, quasi-velocities (and the clock ``t``); invariant ``energy`` [J]
-        (``T*``: conserved without forces and explicit time, a natural system's kinetic
-        energy).
+        (``T* + V``: conserved without applied forces and explicit time).
 
     Raises
     ------
@@ -165,11 +169,13 @@ def hamel_model(coords, speeds, T, W, *, t=None, forces=(), quasi_forces=None,
     q_named = dict(zip(*named_symbols(coords, "coords", required=True)))
     u_named = dict(zip(*named_symbols(speeds, "speeds", required=True)))
     q, u = ca.vertcat(*q_named.values()), ca.vertcat(*u_named.values())
-    M, F = hamel_terms(T, q, u, W, t=t, forces=forces, quasi_forces=quasi_forces)
+    M, F = hamel_terms(T, q, u, W, potential=potential, t=t, forces=forces,
+                       quasi_forces=quasi_forces)
+    V = 0.0 if potential is None else potential
     states = [*q_named.items(), *u_named.items()] + ([(CLOCK_STATE, t)] if t is not None else [])
     xdot = (ca.vertsplit(ca.mtimes(ca.SX(W), u)) + ca.vertsplit(ca.solve(M, F))
             + ([1.0] if t is not None else []))
     units = {**({CLOCK_STATE: CLOCK_UNIT} if t is not None else {}), **dict(units or {})}
     return model_from_expressions(states, xdot, controls=controls, params=params,
                                   p_default=p_default, units=units, name=name,
-                                  invariants={"energy": T}, attitude=attitude)
+                                  invariants={"energy": T + V}, attitude=attitude)

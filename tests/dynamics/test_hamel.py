@@ -6,7 +6,7 @@ import pytest
 
 from appdyn.dynamics.attitude import dcm_from_quat, quat_rate
 from appdyn.dynamics.mechanisms import hamel_model, hamel_terms, lagrange_model
-from appdyn.dynamics.scene import ExternalForce, ExternalTorque, RigidHub, Scene
+from appdyn.dynamics.scene import ExternalForce, ExternalTorque, PointMassDamper, RigidHub, Scene
 from tests.dynamics.scene.legacy_momentum import rigid_body as legacy_rigid_body
 
 J = np.array([[10.0, 0.4, -0.2], [0.4, 12.0, 0.3], [-0.2, 0.3, 8.0]])
@@ -77,6 +77,30 @@ def test_hamel_six_dof_equals_the_scene_hub():
         rx, ru = (np.array(a) for a in Jr(x, u))
         _close(jx[np.ix_(order, order)], rx)
         _close(ju[order], ru)
+
+
+def test_hamel_body_with_a_sliding_mass_equals_the_scene_damper():
+    """``u = (w, s')``: body rates and a relative (modal-like) rate, ``T(w, s', s)`` of
+    Eq. 6.18, spring potential and dashpot force, against Kane's method in the scene."""
+    m, k, c = 0.5, 60.0, 0.8
+    b, d = np.array([0.3, -0.2, 0.5]), np.array([0.0, 0.6, 0.8])
+    qs, ws = _named("q", 4), _named("w", 3)
+    s, sd = ca.SX.sym("s"), ca.SX.sym("s_dot")
+    q, w = ca.vertcat(*qs.values()), ca.vertcat(*ws.values())
+    rho = ca.DM(b) + s * ca.DM(d)
+    vel = ca.cross(w, rho) + sd * ca.DM(d)
+    T = 0.5 * ca.dot(w, ca.mtimes(ca.DM(J), w)) + 0.5 * m * ca.dot(vel, vel)
+    W = ca.diagcat(ca.jacobian(quat_rate(q, w), w), ca.SX(1.0))
+    model = hamel_model({**qs, "s": s}, {**ws, "s_dot": sd}, T, W, potential=0.5 * k * s ** 2,
+                        quasi_forces=ca.vertcat(0, 0, 0, -c * sd))
+    ref = Scene(RigidHub(J), PointMassDamper(m, k, c, position=b, direction=d)).model()
+    order = [model.states.index(n) for n in ref.states]
+    for _ in range(20):
+        x = np.r_[_quat(), RNG.normal(size=3), RNG.normal(scale=0.1), RNG.normal()]
+        xh = np.empty(9)
+        xh[order] = x
+        _close(model.rhs(xh)[order], ref.rhs(x))
+        _close(model.invariant("energy", xh), ref.invariant("energy", x))
 
 
 def test_hamel_polar_particle_equals_lagrange():
