@@ -42,8 +42,11 @@ class RigidHub:
         reference frame -> hub, ``q' = -1/2 Wbar(w - A(q) Omega) q``, and ``r`` (six degrees of
         freedom) is the position in that frame, ``r' = A^T v - Omega x r``. ``w`` and ``v``
         stay absolute (hub axes), so Euler's law is unchanged; ``frame.dcm`` is reference ->
-        hub, and the ``momentum_inertial`` and ``momentum_linear`` invariants are in the
-        reference frame's axes (they turn there at ``-Omega``: ``H' = -Omega x H``).
+        hub (``frame.reference_rate`` tells the parts: `GravityGradient` keeps its orbit
+        inertial, `Aerodynamics` takes the air at rest in the turning frame, a `TiltTorque`
+        direction is fixed in it), and the ``momentum_inertial`` and ``momentum_linear``
+        invariants are in the reference frame's axes (they turn there at ``-Omega``:
+        ``H' = -Omega x H``).
 
     Raises
     ------

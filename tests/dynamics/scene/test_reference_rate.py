@@ -86,3 +86,57 @@ def test_reference_rate_is_checked_and_part_of_the_scene():
         RigidHub(J, reference_rate=[0.0, 1.0])
     assert RigidHub(J, reference_rate=OMEGA) != RigidHub(J)
     assert Scene(RigidHub(J, reference_rate=OMEGA)).model() is not Scene(RigidHub(J)).model()
+
+
+def test_gravity_gradient_in_the_orbit_frame_equals_the_inertial_simulation_transformed():
+    """``reference_rate = (0, 0, n)``: the attitude from the local-vertical frame; the orbit
+    stays inertial, so the run is the inertial one seen from the turning frame."""
+    from appdyn.dynamics.scene import GravityGradient
+    mu, radius = 3.986004418e14, 7.0e6
+    n = np.sqrt(mu / radius ** 3)
+    Om = np.array([0.0, 0.0, n])
+    rng = np.random.default_rng(11)
+    q0, w0 = _quat(rng), rng.normal(scale=2e-3, size=3)
+    inertial = Scene(RigidHub(J), GravityGradient(mu, radius))
+    lvlh = Scene(RigidHub(J, reference_rate=Om), GravityGradient(mu, radius))
+    t = np.linspace(0.0, 3000.0, 7)
+    xi = _run(inertial.model(), inertial.state(q=q0, w=w0), t)
+    xr = _run(lvlh.model(), lvlh.state(q=q0, w=w0), t)
+    for j, tj in enumerate(t):
+        th = n * tj
+        R = np.array([[np.cos(th), np.sin(th), 0.0], [-np.sin(th), np.cos(th), 0.0],
+                      [0.0, 0.0, 1.0]])                       # inertial -> orbit frame
+        np.testing.assert_allclose(dcm_from_quat(xr[0:4, j]), dcm_from_quat(xi[0:4, j]) @ R.T,
+                                   atol=1e-10)
+        np.testing.assert_allclose(xr[4:7, j], xi[4:7, j], atol=1e-12)
+    # the nadir is fixed in the orbit frame: a body held along it feels the same torque at
+    # every time (the torque of the inertial scene at t = 0)
+    f_r, f_i = lvlh.model().rhs, inertial.model().rhs
+    x = lvlh.state(q=q0, w=w0)
+    for tj in (0.0, 700.0, 2900.0):
+        x[-1] = tj
+        np.testing.assert_allclose(np.ravel(f_r(x)[4:7]),
+                                   np.ravel(f_i(inertial.state(q=q0, w=w0))[4:7]),
+                                   rtol=1e-12, atol=1e-18)
+
+
+def test_air_at_rest_in_the_turning_frame_gives_no_aerodynamic_force():
+    """A vehicle at rest in an Earth-fixed frame (``w = A Omega``, ``v = A (Omega x r)``)
+    sees no air velocity: its rates equal those of the same hub without air."""
+    from appdyn.dynamics.attitude import dcm_from_quat as dq
+    from appdyn.dynamics.scene import Aerodynamics
+    Om = np.array([0.0, 0.0, 7.2921159e-5])
+    hub = RigidHub(J, mass=1000.0, reference_rate=Om)
+    air = Scene(hub, Aerodynamics(2.0, 3.5, axial_force=0.3, centre_of_pressure=(1.5, 0.0, 0.0)))
+    vacuum = Scene(hub)
+    rng = np.random.default_rng(3)
+    q0, r0 = _quat(rng), np.array([6.4e6, 1.0e5, 3.0e5])
+    A = dq(q0)
+    x = dict(q=q0, w=A @ Om, r=r0, v=A @ np.cross(Om, r0))
+    np.testing.assert_allclose(np.ravel(air.model().rhs(air.state(**x))),
+                               np.ravel(vacuum.model().rhs(vacuum.state(**x))),
+                               rtol=1e-12, atol=1e-15)
+    # moving through that air at 10 m/s along body x: drag opposes the motion
+    x["v"] = x["v"] + np.array([10.0, 0.0, 0.0])
+    d = np.ravel(air.model().rhs(air.state(**x)) - vacuum.model().rhs(vacuum.state(**x)))
+    assert d[-3] < 0.0
