@@ -13,6 +13,10 @@
 * `bodies` -- constrained rigid bodies: the rolling coin (nonholonomic) with its steady
   circular rolling, and the dumbbell elastically hinged to a free disk with its planar
   swing frequency;
+* `impacts` -- impact dynamics (Sec. 3.5): `impact` (restitution, sticking and sliding
+  contact on a generalized-coordinate model), `contact_jump` (its jump map for an impact
+  event of `simulate`) and Examples 1-5 (`central_collision`, `ballistic_pendulum`,
+  `dumbbell_impact`, `carriage_impact`, `falling_bar_impact`);
 * `lagrange` -- Lagrange's equations by automatic differentiation and the assembly of a
   constrained model (shared by `multipliers` and `bodies`);
 * `common` -- the shared symbols, model assembly and parameter checks.
@@ -26,6 +30,8 @@ from __future__ import annotations
 from .common import GRAVITY
 from .bodies import (coin_state, coin_steady_rates, dumbbell_disk, dumbbell_disk_frequency,
                      dumbbell_disk_state, rolling_coin)
+from .impacts import (ImpactResult, ballistic_pendulum, carriage_impact, central_collision,
+                      contact_jump, dumbbell_impact, falling_bar_impact, impact)
 from .lagrange import lagrange_terms
 from .multipliers import (bead_motion, bead_torque, rod_pendulum, rod_reaction,
                           shaken_multiplier_state, shaken_pendulum_multipliers, sliding_bead)
@@ -35,7 +41,8 @@ from .shaken import (SHAKEN_DEFAULTS, equivalent_length, kapitza_frequency, natu
                      resonance_tongue, shaken_pendulum)
 from .spherical import SEQUENCES, conical_rate, spherical_mass_matrix, spherical_pendulum
 
-__all__ = ["GRAVITY", "SEQUENCES", "SHAKEN_DEFAULTS", "bead_motion", "bead_torque",
+__all__ = ["GRAVITY", "ImpactResult", "SEQUENCES", "ballistic_pendulum", "carriage_impact",
+           "central_collision", "contact_jump", "dumbbell_impact", "falling_bar_impact", "impact", "SHAKEN_DEFAULTS", "bead_motion", "bead_torque",
            "coin_state", "coin_steady_rates", "conical_rate", "double_pendulum",
            "double_pendulum_modes", "dumbbell_disk", "dumbbell_disk_frequency",
            "dumbbell_disk_state", "equivalent_length", "kapitza_frequency", "lagrange_terms",
