@@ -11,7 +11,7 @@
   pendulum in Cartesian coordinates and its rod tension, the shaken pendulum a second time
   (its multipliers the hinge force), the bead on a driven wire (Eq. 5.79);
 * `bodies` -- constrained rigid bodies: the rolling coin (nonholonomic) with its steady
-  circular rolling, and the dumbbell elastically hinged to a free disk with its planar
+  circular rolling, the rolling sphere (Sec. 5.5 a, its 2 x 5 constraint matrix), and the dumbbell elastically hinged to a free disk with its planar
   swing frequency;
 * `impacts` -- impact dynamics (Sec. 3.5): `impact` (restitution, sticking and sliding
   contact on a generalized-coordinate model), `contact_jump` (its jump map for an impact
@@ -29,7 +29,8 @@ from __future__ import annotations
 
 from .common import GRAVITY
 from .bodies import (coin_state, coin_steady_rates, dumbbell_disk, dumbbell_disk_frequency,
-                     dumbbell_disk_state, rolling_coin)
+                     dumbbell_disk_state, rolling_coin, rolling_sphere, sphere_constraint_matrix,
+                     sphere_state)
 from .impacts import (ImpactResult, ballistic_pendulum, carriage_impact, central_collision,
                       contact_jump, dumbbell_impact, falling_bar_impact, impact)
 from .lagrange import lagrange_terms
@@ -41,12 +42,15 @@ from .shaken import (SHAKEN_DEFAULTS, equivalent_length, kapitza_frequency, natu
                      resonance_tongue, shaken_pendulum)
 from .spherical import SEQUENCES, conical_rate, spherical_mass_matrix, spherical_pendulum
 
-__all__ = ["GRAVITY", "ImpactResult", "SEQUENCES", "ballistic_pendulum", "carriage_impact",
-           "central_collision", "contact_jump", "dumbbell_impact", "falling_bar_impact", "impact", "SHAKEN_DEFAULTS", "bead_motion", "bead_torque",
-           "coin_state", "coin_steady_rates", "conical_rate", "double_pendulum",
-           "double_pendulum_modes", "dumbbell_disk", "dumbbell_disk_frequency",
-           "dumbbell_disk_state", "equivalent_length", "kapitza_frequency", "lagrange_terms",
-           "natural_frequency", "pendulum_period", "pendulum_swing", "resonance_tongue",
-           "rod_pendulum", "rod_reaction", "rolling_coin", "shaken_multiplier_state",
-           "shaken_pendulum", "shaken_pendulum_multipliers", "sliding_bead",
-           "spherical_mass_matrix", "spherical_pendulum", "variable_length_pendulum"]
+__all__ = ["GRAVITY", "ImpactResult", "SEQUENCES", "SHAKEN_DEFAULTS",
+           "ballistic_pendulum", "bead_motion", "bead_torque", "carriage_impact",
+           "central_collision", "coin_state", "coin_steady_rates", "conical_rate",
+           "contact_jump", "double_pendulum", "double_pendulum_modes", "dumbbell_disk",
+           "dumbbell_disk_frequency", "dumbbell_disk_state", "dumbbell_impact",
+           "equivalent_length", "falling_bar_impact", "impact", "kapitza_frequency",
+           "lagrange_terms", "natural_frequency", "pendulum_period", "pendulum_swing",
+           "resonance_tongue", "rod_pendulum", "rod_reaction", "rolling_coin",
+           "rolling_sphere", "shaken_multiplier_state", "shaken_pendulum",
+           "shaken_pendulum_multipliers", "sliding_bead", "sphere_constraint_matrix",
+           "sphere_state", "spherical_mass_matrix", "spherical_pendulum",
+           "variable_length_pendulum"]
