@@ -134,11 +134,11 @@ class ImpactResult:
                        f"{self.names}, the derived quantities {tuple(self.derived)}")
 
 
-def _matrix(M, n: int | None) -> np.ndarray:
+def _matrix(M, n: int) -> np.ndarray:
     M = validate.finite_array(M, "mass_matrix")
     M = M.reshape(1, 1) if M.ndim == 0 else M
-    if M.ndim != 2 or M.shape[0] != M.shape[1] or (n is not None and M.shape[0] != n):
-        raise ValueError(f"`mass_matrix` must be square of size {n if n else 'n_q'}, got shape "
+    if M.ndim != 2 or M.shape[0] != M.shape[1] or M.shape[0] != n:
+        raise ValueError(f"`mass_matrix` must be square of the size of `v` ({n}), got shape "
                          f"{M.shape}")
     if not np.allclose(M, M.T, rtol=1e-12, atol=0.0):
         raise ValueError("`mass_matrix` must be symmetric")
@@ -223,7 +223,10 @@ def impact(mass_matrix, normal, v, *, tangent=None, e=0.0, mu=math.inf,
     >>> res.regime, res.v.tolist(), res.normal_impulse, res.energy_loss
     ('frictionless', [1.5, 3.0], 3.0, 2.25)
     """
-    v = validate.finite_array(v, "v").reshape(-1)
+    v = validate.finite_array(v, "v")
+    if v.ndim > 1:
+        raise ValueError(f"`v` must be a vector of rates (n_q,), got shape {v.shape}")
+    v = v.reshape(-1)
     M = _matrix(mass_matrix, v.size)
     n, D = _jacobians(normal, tangent, v.size)
     e = validate.finite_scalar(e, "e")
@@ -260,7 +263,12 @@ def impact(mass_matrix, normal, v, *, tangent=None, e=0.0, mu=math.inf,
             d = P[1:] / pt if pt > 0 else np.zeros(k)
             den = W[0, 0] + mu * float(W[0, 1:] @ d)
             regime = SLIDING
-            if den > 0:
+            if not math.isfinite(mu):
+                ok, P = False, np.zeros(k + 1)
+                message = ("sticking would need a pulling normal impulse and the friction is "
+                           "unbounded (mu = inf): no impulse on the friction cone stops the "
+                           "approach (the contact jams); give a finite mu")
+            elif den > 0:
                 need = f" (sticking would need mu >= {pt / P[0]:.6g})" if P[0] > 0 else ""
                 pn = -(1 + e) * un / den
                 P = np.r_[pn, mu * pn * d]
@@ -313,7 +321,7 @@ def contact_jump(mass_matrix, normal, *, tangent=None, e=0.0, mu=math.inf, nq: i
     """
     nq = validate.integer(nq, "nq", minimum=1)
     for name, fun in (("mass_matrix", mass_matrix), ("normal", normal), ("tangent", tangent)):
-        if fun is not None and not callable(fun):
+        if (fun is not None or name != "tangent") and not callable(fun):
             raise TypeError(f"`{name}` must be a callable of (q, p), got {type(fun).__name__}")
 
     def numbers(fun, q, p):

@@ -179,6 +179,13 @@ def test_falling_bar_seed_misprints():
     assert res["x_dot"] + l / 2 * s * w == pytest.approx(0.0, abs=1e-14)
 
 
+def test_a_jammed_contact_is_a_failure_not_an_exception():
+    res = falling_bar_impact(1.0, 1.0, -4.0, 0.5)          # sticking would pull: F < 0
+    assert not res.success and "jams" in res.message
+    assert res.v.tolist() == res.v_before.tolist()
+    assert falling_bar_impact(1.0, 1.0, -4.0, 0.5, mu=0.3).success
+
+
 def test_newton_friction_energy_gain_is_reported():
     """Kane's paradox: the seed's law gains energy for the bar sliding backwards."""
     res = falling_bar_impact(1.0, 1.0, -1.0, 1.0, e=1.0)
@@ -275,7 +282,8 @@ def test_contact_jump_matches_impact():
 @pytest.mark.parametrize("kwargs, match", [
     (dict(mass_matrix=[[1.0, 2.0], [0.0, 1.0]]), "symmetric"),
     (dict(mass_matrix=[[1.0, 0.0], [0.0, -1.0]]), "positive definite"),
-    (dict(mass_matrix=np.eye(3)), "square of size 2"),
+    (dict(mass_matrix=np.eye(3)), "square of the size of `v`"),
+    (dict(v=np.ones((2, 2))), "`v` must be a vector"),
     (dict(normal=[0.0, 0.0]), "`normal`"),
     (dict(tangent=np.ones((3, 2))), "`tangent`"),
     (dict(tangent=[[2.0, 0.0]]), "full row rank"),
