@@ -16,7 +16,7 @@ import casadi as ca
 import numpy as np
 
 from .. import cache, validate
-from ..attitude import dcm_from_quat, quat_rate
+from ..attitude import dcm_from_euler321, dcm_from_quat, quat_rate
 from ..constrained import DEFAULT_TIME_CONSTANT
 from ..model import Model
 from .common import GRAVITY, nonnegative, with_parameters
@@ -228,13 +228,7 @@ def _sphere_omega(q, qd):
     phi, psi, th = q[2], q[3], q[4]
     phid, psid, thd = qd[2], qd[3], qd[4]
     c, s = ca.cos, ca.sin
-    A1 = ca.vertcat(ca.horzcat(1, 0, 0), ca.horzcat(0, c(phi), s(phi)),
-                    ca.horzcat(0, -s(phi), c(phi)))
-    A2 = ca.vertcat(ca.horzcat(c(th), 0, -s(th)), ca.horzcat(0, 1, 0),
-                    ca.horzcat(s(th), 0, c(th)))
-    A3 = ca.vertcat(ca.horzcat(c(psi), s(psi), 0), ca.horzcat(-s(psi), c(psi), 0),
-                    ca.horzcat(0, 0, 1))
-    A = ca.mtimes(A1, ca.mtimes(A2, A3))
+    A = dcm_from_euler321(ca.vertcat(psi, th, phi))
     wb = ca.vertcat(phid - psid * s(th), thd * c(phi) + psid * c(th) * s(phi),
                     -thd * s(phi) + psid * c(th) * c(phi))
     return ca.mtimes(A.T, wb), A
