@@ -130,6 +130,14 @@ class ImpactRecord:
         ``info.normal_impulse`` when the jump map reports one, else NaN.
     info : object
         What the jump map returned besides the state (None if nothing).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from appdyn.dynamics import ImpactRecord
+    >>> r = ImpactRecord(0.5, np.array([0.0, -2.0]), np.array([0.0, 1.0]), 1.0, 3.0)
+    >>> r.t, r.x_after[1], r.info is None
+    (0.5, np.float64(1.0), True)
     """
 
     t: float
@@ -253,9 +261,11 @@ def simulate_impacts(simulate: Callable, model: Model, x0: np.ndarray, t: np.nda
             k += 1
         if rate <= impact.rest_speed or len(records) >= impact.max_impacts or k >= t.size:
             if k < t.size:
-                why = (f"the contact came to rest (rebound speed {rate:.6g} <= rest_speed "
-                       f"{impact.rest_speed:g})" if rate <= impact.rest_speed
-                       else f"max_impacts = {impact.max_impacts} reached")
+                why = (f"max_impacts = {impact.max_impacts} reached" if rate > impact.rest_speed
+                       else f"the contact came to rest (rebound speed {rate:.6g} <= rest_speed "
+                       f"{impact.rest_speed:g})" if rate >= 0
+                       else f"the contact does not separate after the jump (guard rate "
+                       f"{rate:.6g} < 0)")
                 stop_message = (f"stopped at impact {len(records)} ({impact.name}) at t = "
                                 f"{te:.15g} s: {why}")
                 end = (te, x_plus)

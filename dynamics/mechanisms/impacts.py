@@ -118,6 +118,14 @@ class ImpactResult:
     names: tuple = ()
     derived: Mapping[str, float] = field(default_factory=lambda: MappingProxyType({}))
 
+    def __getstate__(self) -> dict:
+        return dict(self.__dict__, derived=dict(self.derived))
+
+    def __setstate__(self, state: dict) -> None:
+        for key, value in state.items():
+            object.__setattr__(self, key, MappingProxyType(dict(value)) if key == "derived"
+                               else value)
+
     def __getitem__(self, name: str) -> float:
         """The rate ``name`` after the impact, or a derived quantity.
 
@@ -289,7 +297,8 @@ def impact(mass_matrix, normal, v, *, tangent=None, e=0.0, mu=math.inf,
                         (un, float(n @ v_plus)), D @ v_plus, loss, ok, message, names)
 
 
-def contact_jump(mass_matrix, normal, *, tangent=None, e=0.0, mu=math.inf, nq: int):
+def contact_jump(mass_matrix, normal, *, tangent=None, e=0.0, mu=math.inf, nq: int,
+                 names=None):
     """The jump map of an impact event of `simulate` for a mechanism with the state
     ``x = [q (nq), v (nq), ...]``: at the contact, ``v`` jumps as `impact` says.
 
@@ -304,6 +313,8 @@ def contact_jump(mass_matrix, normal, *, tangent=None, e=0.0, mu=math.inf, nq: i
         As for `impact`.
     nq : int
         Number of coordinates.
+    names : sequence of str, optional
+        Names of the ``nq`` rates, for ``info[name]`` (e.g. ``model.states[nq:2 * nq]``).
 
     Returns
     -------
@@ -320,6 +331,9 @@ def contact_jump(mass_matrix, normal, *, tangent=None, e=0.0, mu=math.inf, nq: i
     ([0.0, 4.0], 9.0)
     """
     nq = validate.integer(nq, "nq", minimum=1)
+    names = None if names is None else tuple(names)
+    if names is not None and len(names) != nq:
+        raise ValueError(f"`names` must name the {nq} rates, got {len(names)}")
     for name, fun in (("mass_matrix", mass_matrix), ("normal", normal), ("tangent", tangent)):
         if (fun is not None or name != "tangent") and not callable(fun):
             raise TypeError(f"`{name}` must be a callable of (q, p), got {type(fun).__name__}")
@@ -331,7 +345,8 @@ def contact_jump(mass_matrix, normal, *, tangent=None, e=0.0, mu=math.inf, nq: i
         x = np.asarray(x, dtype=float)
         q, v = x[:nq], x[nq:2 * nq]
         res = impact(numbers(mass_matrix, q, p), numbers(normal, q, p), v,
-                     tangent=None if tangent is None else numbers(tangent, q, p), e=e, mu=mu)
+                     tangent=None if tangent is None else numbers(tangent, q, p), e=e, mu=mu,
+                     names=names)
         x_plus = x.copy()
         x_plus[nq:2 * nq] = res.v
         return x_plus, res

@@ -186,6 +186,13 @@ def test_a_jammed_contact_is_a_failure_not_an_exception():
     assert falling_bar_impact(1.0, 1.0, -4.0, 0.5, mu=0.3).success
 
 
+def test_results_pickle():
+    import pickle
+    res = carriage_impact(1.0, 2.0, 0.5, 1.0, e=0.5)
+    back = pickle.loads(pickle.dumps(res))
+    assert back["travel"] == res["travel"] and back.v.tolist() == res.v.tolist()
+
+
 def test_newton_friction_energy_gain_is_reported():
     """Kane's paradox: the seed's law gains energy for the bar sliding backwards."""
     res = falling_bar_impact(1.0, 1.0, -1.0, 1.0, e=1.0)

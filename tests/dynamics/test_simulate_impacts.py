@@ -162,3 +162,29 @@ def test_bad_jump_and_options():
     bad = Impact(floor, lambda t, x, u, p: np.zeros(3))
     with pytest.raises(ValueError, match="2 finite states"):
         simulate(model, [1.0, 0.0], [0.0, 1.0], method="rk8", impacts=bad)
+
+
+def test_docking_two_carts_central_collision():
+    """A docking on a line (Example 1 in a simulation): impact time gap / (u1 - u2), the
+    velocities after as `central_collision`, momentum conserved across the run; the result
+    pickles with its records."""
+    import pickle
+    from appdyn.dynamics.mechanisms import central_collision
+    m1, m2, u1, u2, e, gap = 3.0, 1.0, 2.0, -0.5, 0.3, 1.25
+    x, u, p, t = ca.SX.sym("x", 4), ca.SX.sym("u", 0), ca.SX.sym("p", 0), ca.SX.sym("t")
+    carts = Model(f=ca.Function("carts", [x, u, p], [ca.vertcat(x[2], x[3], 0, 0)],
+                                ["x", "u", "p"], ["xdot"]),
+                  states=("x1", "x2", "v1", "v2"), controls=())
+    dock = Impact(ca.Function("gap", [t, x, u, p], [x[1] - x[0] - gap]),
+                  contact_jump(lambda q, p: np.diag([m1, m2]), lambda q, p: [-1.0, 1.0], e=e,
+                               nq=2, names=("v1", "v2")))
+    grid = np.linspace(0.0, 2.0, 5)
+    res = simulate(carts, [0.0, 0.0 + gap + 1.0, u1, u2], grid, method="rk4", impacts=dock)
+    (hit,) = res.impacts
+    assert hit.t == pytest.approx(1.0 / (u1 - u2), rel=1e-14)
+    want = central_collision(m1, m2, u1, u2, e=e)
+    assert hit.x_after[2:] == pytest.approx([want["v1"], want["v2"]], rel=1e-14)
+    assert np.allclose(m1 * res["v1"] + m2 * res["v2"], m1 * u1 + m2 * u2, rtol=1e-14)
+    assert res.success and res.status == 0 and res.t.tolist() == grid.tolist()
+    back = pickle.loads(pickle.dumps(res))
+    assert back.impacts[0].info["v2"] == want["v2"]
