@@ -204,8 +204,9 @@ def simulate(model: Model, x0, t, *, u=None, p=None, hold: Hold = "linear", meth
     if impacts is not None:
         impact = check_impact(impacts)
         if events is not None:
-            raise ValueError("`impacts` cannot be combined with `events` yet; give the events "
-                             "as a separate simulate call on the result's segments")
+            raise ValueError("`impacts` and `events` are not taken together (yet): locate the "
+                             "events on the result of the run with impacts, e.g. by simulating "
+                             "between its impact times with `events`")
         return simulate_impacts(simulate, model, x0, t, impact, u, p, hold, names, dict(
             method=method, rtol=rtol, atol=atol, steps=steps, jit=jit, max_steps=max_steps,
             cvodes_options=cvodes_options, progress=progress))

@@ -19,7 +19,7 @@ guard**: when it is at most ``rest_speed`` (a ball whose bounces shrink geometri
 otherwise bounce infinitely often before a finite time) the solution stops there: ``t``
 ends at the impact time with ``x+``, ``status`` `TERMINAL_EVENT`, ``success`` True and the
 message says the contact came to rest. ``max_impacts`` bounds the number of impacts the
-same way.
+same way. As for events, a zero of the guard at ``t[0]`` is no impact: start apart.
 
 The result's ``impacts`` lists every impact (`ImpactRecord`: time, states before and after,
 the rebound speed and what the jump map reported, e.g. the `dynamics.mechanisms.impact`
