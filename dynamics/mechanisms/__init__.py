@@ -42,15 +42,14 @@ from .shaken import (SHAKEN_DEFAULTS, equivalent_length, kapitza_frequency, natu
                      resonance_tongue, shaken_pendulum)
 from .spherical import SEQUENCES, conical_rate, spherical_mass_matrix, spherical_pendulum
 
-__all__ = ["GRAVITY", "ImpactResult", "SEQUENCES", "SHAKEN_DEFAULTS",
-           "ballistic_pendulum", "bead_motion", "bead_torque", "carriage_impact",
-           "central_collision", "coin_state", "coin_steady_rates", "conical_rate",
-           "contact_jump", "double_pendulum", "double_pendulum_modes", "dumbbell_disk",
-           "dumbbell_disk_frequency", "dumbbell_disk_state", "dumbbell_impact",
-           "equivalent_length", "falling_bar_impact", "impact", "kapitza_frequency",
-           "lagrange_terms", "natural_frequency", "pendulum_period", "pendulum_swing",
-           "resonance_tongue", "rod_pendulum", "rod_reaction", "rolling_coin",
-           "rolling_sphere", "shaken_multiplier_state", "shaken_pendulum",
-           "shaken_pendulum_multipliers", "sliding_bead", "sphere_constraint_matrix",
-           "sphere_state", "spherical_mass_matrix", "spherical_pendulum",
-           "variable_length_pendulum"]
+__all__ = ["GRAVITY", "SEQUENCES", "SHAKEN_DEFAULTS", "bead_motion", "bead_torque",
+           "coin_state", "coin_steady_rates", "conical_rate", "double_pendulum",
+           "double_pendulum_modes", "dumbbell_disk", "dumbbell_disk_frequency",
+           "dumbbell_disk_state", "equivalent_length", "kapitza_frequency", "lagrange_terms",
+           "natural_frequency", "pendulum_period", "pendulum_swing", "resonance_tongue",
+           "rod_pendulum", "rod_reaction", "rolling_coin", "shaken_multiplier_state",
+           "shaken_pendulum", "shaken_pendulum_multipliers", "sliding_bead",
+           "spherical_mass_matrix", "spherical_pendulum", "variable_length_pendulum",
+           "ImpactResult", "ballistic_pendulum", "carriage_impact", "central_collision",
+           "contact_jump", "dumbbell_impact", "falling_bar_impact", "impact", "rolling_sphere",
+           "sphere_constraint_matrix", "sphere_state"]
