@@ -81,6 +81,7 @@ SKIPPED = {
     "appdyn.dynamics.mechanisms.natural_frequency": "no required parameter",
     "appdyn.dynamics.mechanisms.rod_pendulum": "no required parameter",
     "appdyn.dynamics.mechanisms.rolling_coin": "no required parameter",
+    "appdyn.dynamics.mechanisms.rolling_sphere": "no required parameter",
     "appdyn.dynamics.mechanisms.shaken_pendulum": "no required parameter",
     "appdyn.dynamics.mechanisms.shaken_pendulum_multipliers": "no required parameter",
     "appdyn.dynamics.mechanisms.sliding_bead": "no required parameter",
