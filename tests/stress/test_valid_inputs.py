@@ -514,6 +514,20 @@ FIXED = {
 
 # functions without required parameters: random keywords
 OPTIONAL = {
+    "appdyn.dynamics.mechanisms.accelerometer": {
+        "mass": log_floats(1e-3, 0.1), "stiffness": log_floats(10.0, 1000.0),
+        "damping": floats(0.0, 1.0), "specific_force": vectors(3), "rate": vectors(3, -1.0, 1.0)},
+    "appdyn.dynamics.mechanisms.accelerometer_offset": {
+        "mass": log_floats(1e-3, 0.1), "stiffness": log_floats(10.0, 1000.0),
+        "specific_force": vectors(3), "rate": vectors(3, -1.0, 1.0)},
+    "appdyn.dynamics.mechanisms.foucault_pendulum": {
+        "length": log_floats(1.0, 100.0), "latitude": floats(-1.5, 1.5)},
+    "appdyn.dynamics.mechanisms.noninertial_particle": {
+        "mass": log_floats(0.1, 10.0), "rate": vectors(3), "origin_acceleration": vectors(3)},
+    "appdyn.dynamics.mechanisms.turntable": {"mass": log_floats(0.1, 10.0)},
+    "appdyn.dynamics.mechanisms.twirling_skater": {
+        "mass": log_floats(0.1, 10.0), "rate0": log_floats(0.1, 5.0),
+        "radius0": log_floats(0.5, 2.0), "pull_speed": log_floats(0.01, 0.2)},
     "appdyn.dynamics.mechanisms.double_pendulum": {
         "mass1": log_floats(0.1, 10.0), "mass2": log_floats(0.1, 10.0),
         "length1": log_floats(0.1, 3.0), "length2": log_floats(0.1, 3.0)},
