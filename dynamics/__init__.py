@@ -11,8 +11,8 @@ equilibria and steady spins, as a python-control StateSpace), `clear_caches` (em
 cache of built and compiled Functions, `dynamics.cache`), and the modules `attitude`
 (kinematics), `constrained` (the multiplier machinery: accelerations, multipliers, reaction
 forces, Baumgarte stabilization and projection), `mechanisms` (the seed's worked systems with
-their closed forms), `clock` (time-dependent models carry a clock state ``"t"``), `mass` (parallel and rotated
-axes, radius of gyration, specific impulse and the rocket equation), `floquet`
+their closed forms), `clock` (time-dependent models carry a clock state ``"t"``), `mass`
+(parallel and rotated axes, radius of gyration, specific impulse and the rocket equation), `floquet`
 (monodromy matrix and multipliers of periodic motion) and `truth` (closed forms, imported on
 first use).
 """
