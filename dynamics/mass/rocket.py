@@ -4,6 +4,7 @@ from __future__ import annotations
 import numpy as np
 
 from .. import validate
+from ..attitude.backend import finite_vector
 
 __all__ = ["G0", "isp", "delta_v", "rocket_steps", "jet_damping_torque"]
 
@@ -16,8 +17,8 @@ def isp(thrust, mass_flow, *, g0=G0):
 
     Parameters
     ----------
-    thrust : float or array_like [N]
-    mass_flow : float or array_like [kg/s]
+    thrust : float or array_like, shape (n,) [N]
+    mass_flow : float or array_like, shape (n,) [kg/s]
         Propellant flow rate ``mdot > 0`` (the magnitude, as in Eq. 3.39).
     g0 : float [m/s^2], optional
         Standard gravity (`G0`).
@@ -39,8 +40,8 @@ def isp(thrust, mass_flow, *, g0=G0):
     >>> round(isp(628500.0, 17010.0 / 75.2), 3)  # a Delta III solid booster
     283.334
     """
-    F = validate.finite_array(thrust, "thrust")
-    md = validate.finite_array(mass_flow, "mass_flow")
+    F = finite_vector(thrust, "thrust")
+    md = finite_vector(mass_flow, "mass_flow")
     if np.any(md <= 0):
         raise ValueError(f"`mass_flow` must be positive (the flow magnitude), got {md.tolist()}")
     out = F / (md * validate.positive(g0, "g0"))
@@ -55,7 +56,7 @@ def delta_v(initial_mass, final_mass, *, isp=None, exhaust_velocity=None, g0=G0)
 
     Parameters
     ----------
-    initial_mass, final_mass : float or array_like [kg]
+    initial_mass, final_mass : float or array_like, shape (n,) [kg]
         ``M0 >= M > 0``.
     isp : float [s], optional
         Specific impulse; give exactly one of ``isp`` and ``exhaust_velocity``.
@@ -85,8 +86,8 @@ def delta_v(initial_mass, final_mass, *, isp=None, exhaust_velocity=None, g0=G0)
     2695.723
     """
     C = _exhaust_velocity(isp, exhaust_velocity, g0)
-    M0 = validate.finite_array(initial_mass, "initial_mass")
-    M = validate.finite_array(final_mass, "final_mass")
+    M0 = finite_vector(initial_mass, "initial_mass")
+    M = finite_vector(final_mass, "final_mass")
     if np.any(M <= 0) or np.any(M0 < M):
         raise ValueError(f"need `initial_mass` >= `final_mass` > 0, got {M0.tolist()} and "
                          f"{M.tolist()}")
@@ -167,7 +168,7 @@ def jet_damping_torque(mass_flow, rate, l1, l2):
     ----------
     mass_flow : float [kg/s]
         ``mdot >= 0``.
-    rate : float or array_like [rad/s]
+    rate : float or array_like, shape (n,) [rad/s]
         ``w``.
     l1, l2 : float [m]
         Start and end (nozzle exit) of the flow along x.
@@ -190,7 +191,7 @@ def jet_damping_torque(mass_flow, rate, l1, l2):
     -1.8
     """
     md = validate.nonnegative(mass_flow, "mass_flow")
-    w = validate.finite_array(rate, "rate")
+    w = finite_vector(rate, "rate")
     a, b = validate.finite_scalar(l1, "l1"), validate.finite_scalar(l2, "l2")
     out = -md * w * (b * b - a * a)
     return float(out) if out.ndim == 0 else out
