@@ -58,20 +58,15 @@ def test_body_rates_equal_the_derivative_of_the_dcm(seq, angles, r):
 @pytest.mark.parametrize("seq", sorted(SEQ))
 @settings(max_examples=60, deadline=None)
 @given(angles=triples, r=rates3)
-def test_dcm_rate_is_the_derivative_of_the_dcm_built_from_the_angles(seq, angles, r):
-    dcm, _, _, body = SEQ[seq]
-    np.testing.assert_allclose(dcm_rate(dcm(angles), body(angles, r)), _d_dt(dcm, angles, r),
-                               rtol=0, atol=1e-9)
-
-
-@pytest.mark.parametrize("seq", sorted(SEQ))
-@settings(max_examples=60, deadline=None)
-@given(angles=triples, r=rates3)
-def test_agrees_with_the_quaternion_kinematics(seq, angles, r):
-    # d/dt q(angles(t)) = quat_rate(q, w) (Eq. 4.70) with w = body rates of the angle rates
-    _, quat, _, body = SEQ[seq]
-    np.testing.assert_allclose(quat_rate(quat(angles), body(angles, r)), _d_dt(quat, angles, r),
-                               rtol=0, atol=1e-9)
+def test_dcm_rate_and_quat_rate_are_the_derivatives_of_dcm_and_quat_built_from_the_angles(
+        seq, angles, r):
+    # A' = dcm_rate(A, w) (Eq. 4.33) and q' = quat_rate(q, w) (Eq. 4.70), w = the body rates
+    dcm, quat, _, body = SEQ[seq]
+    w = body(angles, r)
+    np.testing.assert_allclose(dcm_rate(dcm(angles), w), _d_dt(dcm, angles, r), rtol=0,
+                               atol=1e-9)
+    np.testing.assert_allclose(quat_rate(quat(angles), w), _d_dt(quat, angles, r), rtol=0,
+                               atol=1e-9)
 
 
 @pytest.mark.parametrize("seq", sorted(SEQ))
