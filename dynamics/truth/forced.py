@@ -57,7 +57,9 @@ def coning_angle(inertia_diag, w0, t, *, misalignment=(0.0, 0.0)):
               + (b2 - i b3) e^{-i w0 t}
 
     with ``B1 = (P - iQ)/2``, ``B2 = (P + iQ)/2``, ``P = w3(0) + i w2(0)``,
-    ``Q = (lambda2 w2(0) - i lambda1 w3(0))/lam``. The last term is the control-axis
+    ``Q = (lambda2 w2(0) - i lambda1 w3(0))/lam``. (Re-derived: the seed's Eq. 4.110 drops
+    the ``i`` of its second exponent, and its proof of ``lam < w0`` (4.109) compares
+    ``lambda1 lambda2`` with ``w0`` where ``w0^2`` is meant.) The last term is the control-axis
     misalignment (Eq. 4.111): a control axis along ``e1 + b2 e2 + b3 e3`` (``b`` small); the
     seed's real ``beta`` is ``b = (0, -beta)``. For ``w2(0) = 0`` the minimum and maximum cone
     angles are ``|A1 + A2| = I3 w3(0) / (I1 w0)`` and ``|A1 - A2|``. First order in the
