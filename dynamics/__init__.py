@@ -5,7 +5,7 @@ devices; cluster analysis and steering laws in `dynamics.momentum`), `launch_veh
 thrust-vectored vehicle in the yaw plane with opt-in aero, mass flow, slosh, bending, actuator
 and autopilot; parts in `dynamics.launch_vehicle`), `hinged_bodies` (two rigid
 bodies joined by a ball or revolute hinge, held by Lagrange multipliers), `closed_loop` (a
-state-feedback law closed around any model), `simulate` (with `SimulationResult`, `METHODS` and `Event`;
+state-feedback law closed around any model), `simulate` (with `SimulationResult`, `METHODS`, `Event` and `Impact`;
 internals in the subpackage `dynamics.integrate`), `linearize` (exact linearization about
 equilibria and steady spins, as a python-control StateSpace), `clear_caches` (empties the one
 cache of built and compiled Functions, `dynamics.cache`), and the modules `attitude`
@@ -23,14 +23,14 @@ import importlib
 from . import attitude, cache, clock, constrained, floquet, mass, mechanisms, momentum
 from .feedback import closed_loop
 from .hinged import hinged_bodies
-from .integrate import METHODS, BatchResult, Event, SimulationResult, simulate
+from .integrate import METHODS, BatchResult, Event, Impact, ImpactRecord, SimulationResult, simulate
 from .launch_vehicle import launch_vehicle
 from .linearize import Linearization, linearization, linearize
 from .model import Model
 from .momentum import cmg_spacecraft, wheel_spacecraft
 from .rigid_body import rigid_body
 
-__all__ = ["METHODS", "BatchResult", "Event", "Linearization", "Model", "SimulationResult", "attitude", "clear_caches",
+__all__ = ["METHODS", "BatchResult", "Event", "Impact", "ImpactRecord", "Linearization", "Model", "SimulationResult", "attitude", "clear_caches",
            "clock", "closed_loop", "cmg_spacecraft", "constrained", "floquet", "hinged_bodies",
            "launch_vehicle", "linearization", "linearize", "mass", "mechanisms", "momentum", "rigid_body", "simulate", "truth",
            "wheel_spacecraft"]

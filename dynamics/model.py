@@ -13,7 +13,7 @@ from typing import Mapping
 import casadi as ca
 import numpy as np
 
-__all__ = ["Model", "check_model", "model_from_expressions"]
+__all__ = ["Model", "check_model", "model_from_expressions", "named_symbols"]
 
 
 def _freeze(mapping: Mapping | None) -> Mapping:
@@ -295,8 +295,42 @@ class Model:
 
 
 # ------------------------------------------------------- models from expressions
-def _named_symbols(arg, argname: str) -> tuple[tuple[str, ...], list]:
-    """``(names, symbols)`` of a mapping name -> scalar SX symbol or a sequence of pairs."""
+def named_symbols(arg, argname: str, *, required: bool = False) -> tuple[tuple[str, ...], list]:
+    """``(names, symbols)`` of a mapping name -> scalar SX symbol or a sequence of pairs.
+
+    Parameters
+    ----------
+    arg : mapping of str to casadi.SX, or sequence of (str, casadi.SX), or None
+    argname : str
+        The argument's name, for the errors.
+    required : bool, optional
+        Refuse ``None`` and an empty ``arg`` (else they give no names).
+
+    Returns
+    -------
+    (tuple of str, list of casadi.SX)
+
+    Raises
+    ------
+    TypeError, ValueError
+        Naming ``argname``: not a mapping or pairs, a name not a str or given twice, a symbol
+        not a scalar ``casadi.SX.sym``; with ``required``, nothing given.
+
+    Examples
+    --------
+    >>> import casadi as ca
+    >>> from appdyn.dynamics.model import named_symbols
+    >>> named_symbols({"x": ca.SX.sym("x"), "v": ca.SX.sym("v")}, "states")
+    (('x', 'v'), [SX(x), SX(v)])
+    >>> named_symbols(None, "coords", required=True)
+    Traceback (most recent call last):
+        ...
+    TypeError: `coords` must name at least one symbol: a mapping name -> casadi.SX symbol ...
+    """
+    if required and (arg is None or (isinstance(arg, (Mapping, list, tuple)) and not len(arg))):
+        error = TypeError if arg is None else ValueError
+        raise error(f"`{argname}` must name at least one symbol: a mapping name -> casadi.SX "
+                    f"symbol or a sequence of (name, symbol) pairs, got {arg!r}")
     if arg is None:
         return (), []
     if isinstance(arg, Mapping):
@@ -410,9 +444,9 @@ def model_from_expressions(states, xdot, controls=None, params=None, *, p_defaul
     >>> float(model.invariant("energy", [0.0, 2.0]))
     2.0
     """
-    state_names, xs = _named_symbols(states, "states")
-    control_names, us = _named_symbols(controls, "controls")
-    param_names, ps = _named_symbols(params, "params")
+    state_names, xs = named_symbols(states, "states")
+    control_names, us = named_symbols(controls, "controls")
+    param_names, ps = named_symbols(params, "params")
     if not state_names:
         raise ValueError("`states` must name at least one state")
     seen: dict[str, str] = {}

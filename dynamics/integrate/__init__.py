@@ -16,6 +16,8 @@ The public entry points are `dynamics.simulate`, `dynamics.SimulationResult`,
 ``evaluate``     buffered numeric evaluation of Functions (no per-element conversion)
 ``events``       event functions (``events=``): zero crossings located on the solution,
                  `Event`; a terminal event truncates the result
+``impacts``      impacts (``impacts=``): a guard's zero crossing applies a jump map and the
+                 integration restarts; `Impact`, `ImpactRecord`, the Zeno guard
 ``batch``        K runs at once (``x0`` of shape (nx, K)): the chunk loop mapped over the
                  runs on threads, ``auto``'s error control over the batch; `BatchResult`
 ``sanity``       fixed-step runs checked against the model's invariants (status 4)
@@ -96,6 +98,7 @@ from __future__ import annotations
 from .api import METHODS, Method, simulate
 from .batch import BatchResult
 from .events import Event
+from .impacts import Impact, ImpactRecord
 from .result import SimulationResult
 
-__all__ = ["METHODS", "BatchResult", "Event", "Method", "SimulationResult", "simulate"]
+__all__ = ["METHODS", "BatchResult", "Event", "Impact", "ImpactRecord", "Method", "SimulationResult", "simulate"]

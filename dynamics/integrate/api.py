@@ -15,6 +15,7 @@ from .auto import solve_auto
 from .batch import BatchResult, check_batch, simulate_batch
 from .cvodes import run_cvodes
 from .events import apply_events, check_events
+from .impacts import check_impact, simulate_impacts
 from .inputs import (Problem, check_cvodes_options, check_invariants, check_t, check_tolerances,
                      check_u, check_x0, fast_x0)
 from .kernels import check_lie_model
@@ -35,7 +36,7 @@ def simulate(model: Model, x0, t, *, u=None, p=None, hold: Hold = "linear", meth
              jit: bool | None = None, max_steps: int = 100_000_000,
              cvodes_options: Mapping | None = None,
              progress: Callable[[int, int], None] | None = None,
-             events=None) -> SimulationResult | BatchResult:
+             events=None, impacts=None) -> SimulationResult | BatchResult:
     """Integrate ``xdot = f(x, u, p)`` of ``model`` from ``x0`` over the grid ``t``.
 
     Parameters
@@ -124,13 +125,19 @@ def simulate(model: Model, x0, t, *, u=None, p=None, hold: Hold = "linear", meth
         occurrences) and ``direction``; `dynamics.Event` gives them to a Function. Results
         in ``t_events`` and ``x_events``; a terminal event ends ``t`` at the event (status
         6). Single runs only (not with ``x0`` of shape (nx, K)).
+    impacts : Impact, optional
+        A contact (`dynamics.Impact`: a guard and a jump map): when the guard crosses zero
+        downwards the state jumps (an impulse: a touchdown, a docking) and the integration
+        restarts from the new state (`dynamics.integrate.impacts`); every impact is listed in
+        ``impacts`` of the result, and a contact that comes to rest (the Zeno guard
+        ``rest_speed``) stops the solution (status 6). Single runs only, not with ``events``.
 
     Returns
     -------
     SimulationResult
         ``t``, ``x (nx, n)``, ``success``, ``status``, ``message``, ``method``, ``wall_time``,
         ``n_steps``, ``n_rhs``, ``substeps``, ``error_estimate``, ``compiled``,
-        ``invariants``, ``t_events``, ``x_events`` and ``sample(t)``.
+        ``invariants``, ``t_events``, ``x_events``, ``impacts`` and ``sample(t)``.
 
     Raises
     ------
@@ -145,8 +152,10 @@ def simulate(model: Model, x0, t, *, u=None, p=None, hold: Hold = "linear", meth
         attitude, unknown ``invariants``, an attitude quaternion in ``x0`` whose norm is
         not 1 to 1e-6, an unknown or ill-typed ``cvodes_options`` entry, ``events`` with a
         batch, an event Function of the wrong inputs or outputs, an event function whose
-        value is not one finite number. ``TypeError`` for ``cvodes_options`` that is not a
-        mapping, ``events`` that are not callables.
+        value is not one finite number, ``impacts`` with ``events`` or a batch, a jump map
+        that returns the wrong number of states. ``TypeError`` for ``cvodes_options`` that
+        is not a mapping, ``events`` that are not callables, ``impacts`` that is not an
+        `Impact`.
 
     Notes
     -----
@@ -177,9 +186,10 @@ def simulate(model: Model, x0, t, *, u=None, p=None, hold: Hold = "linear", meth
     x = fast_x0(x0, model)  # the common x0 at once (shape (nx,): no batch); else in full
     if x is None:
         if np.ndim(x0) == 2 and np.shape(x0)[1] >= 2:
-            if events is not None:
-                raise ValueError("`events` are located for single runs only; simulate the "
-                                 "runs of a batch (`x0` of shape (nx, K)) one by one")
+            for name, given in (("events", events), ("impacts", impacts)):
+                if given is not None:
+                    raise ValueError(f"`{name}` are located for single runs only; simulate "
+                                     "the runs of a batch (`x0` of shape (nx, K)) one by one")
             return _simulate_batch(model, x0, t, u, p, method, rtol, atol, invariants, steps,
                                    jit, max_steps, cvodes_options, progress, start, hold)
         x = check_x0(x0, model)
@@ -191,6 +201,15 @@ def simulate(model: Model, x0, t, *, u=None, p=None, hold: Hold = "linear", meth
     control = None if u is None and hold == "linear" else check_u(u, model.nu, t, hold)
     # (None: zero, made if needed)
     names = check_invariants(invariants, model)
+    if impacts is not None:
+        impact = check_impact(impacts)
+        if events is not None:
+            raise ValueError("`impacts` and `events` are not taken together (yet): locate the "
+                             "events on the result of the run with impacts, e.g. by simulating "
+                             "between its impact times with `events`")
+        return simulate_impacts(simulate, model, x0, t, impact, u, p, hold, names, dict(
+            method=method, rtol=rtol, atol=atol, steps=steps, jit=jit, max_steps=max_steps,
+            cvodes_options=cvodes_options, progress=progress))
     specs = None if events is None else check_events(events, model, t, x0, control, p)
     max_steps, steps, cvodes_options, counter = _check_options(method, max_steps, jit, steps,
                                                                cvodes_options, progress)

@@ -162,6 +162,9 @@ class SimulationResult:
         ``solve_ivp``); ``None`` without ``events``.
     x_events : list of ndarray, shape (k_i, nx), or None
         The states at those times (scipy's ``y_events``).
+    impacts : tuple of ImpactRecord, or None
+        With ``impacts``: every impact in time order (time, states before and after, rebound
+        speed, impulse; `dynamics.integrate.impacts`); ``None`` without.
     """
 
     t: np.ndarray
@@ -180,6 +183,7 @@ class SimulationResult:
     _dense: Dense | None = field(default=None, repr=False)
     t_events: list | None = None
     x_events: list | None = None
+    impacts: tuple | None = None
 
     def __getstate__(self) -> dict:
         state = dict(self.__dict__)
@@ -243,6 +247,10 @@ class SimulationResult:
             "t": self.t, "x": dict(zip(self.states, self.x)),
             "invariants": dict(self.invariants),
             "t_events": self.t_events, "x_events": self.x_events,
+            "impacts": None if self.impacts is None else [
+                {"t": r.t, "x_before": r.x_before, "x_after": r.x_after,
+                 "rebound_speed": r.rebound_speed, "normal_impulse": r.normal_impulse}
+                for r in self.impacts],
         }
 
     def to_json(self) -> str:
@@ -258,6 +266,8 @@ class SimulationResult:
                 ("error estimate", f"{self.error_estimate:.3g} of tolerance"),
                 ("wall time", f"{1e3 * self.wall_time:.3f} ms"),
                 ("message", self.message)]
+        if self.impacts is not None:
+            rows.insert(-1, ("impacts", f"{len(self.impacts)}"))
         if self.t_events is not None:
             rows.insert(-1, ("events", ", ".join(str(te.size) for te in self.t_events)
                              + " occurrence(s)"))
@@ -366,7 +376,7 @@ def new_result(t, x, success, status, message, method, wall_time, n_steps, n_rhs
         t=t, x=x, success=success, status=status, message=message, method=method,
         wall_time=wall_time, n_steps=n_steps, n_rhs=n_rhs, substeps=substeps,
         error_estimate=error_estimate, compiled=compiled, invariants=invariants, _dense=_dense,
-        t_events=None, x_events=None)
+        t_events=None, x_events=None, impacts=None)
     return result
 
 

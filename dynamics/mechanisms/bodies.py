@@ -3,6 +3,9 @@ built on `dynamics.constrained` through `dynamics.mechanisms.lagrange`:
 
 * `rolling_coin` -- a disk rolling without slipping (Example 4; nonholonomic), with the
   steady circular rolling of `coin_steady_rates`;
+* `rolling_sphere` -- a uniform sphere rolling without slipping on a horizontal plane
+  (Sec. 5.5 a; nonholonomic, the 2 x 5 constraint matrix `sphere_constraint_matrix`), with
+  its states `sphere_state`;
 * `dumbbell_disk` -- a dumbbell elastically hinged to a free disk at its mass centre
   (Example 2), with the exact frequency of its planar oscillation
   (`dumbbell_disk_frequency`).
@@ -13,13 +16,14 @@ import casadi as ca
 import numpy as np
 
 from .. import cache, validate
-from ..attitude import dcm_from_quat, quat_rate
+from ..attitude import dcm_from_euler321, dcm_from_quat, quat_rate
 from ..constrained import DEFAULT_TIME_CONSTANT
 from ..model import Model
 from .common import GRAVITY, nonnegative, with_parameters
 from .lagrange import checked_constants, constrained_model, lagrange_terms, stabilization
 
-__all__ = ["rolling_coin", "coin_steady_rates", "coin_state", "dumbbell_disk",
+__all__ = ["rolling_coin", "coin_steady_rates", "coin_state", "rolling_sphere",
+           "sphere_constraint_matrix", "sphere_state", "dumbbell_disk",
            "dumbbell_disk_state", "dumbbell_disk_frequency"]
 
 
@@ -209,6 +213,197 @@ def coin_state(theta, psi_dot, phi_dot, *, radius=0.1, psi=0.0, phi=0.0, theta_d
     spin = np.array([0.0, 0.0, W]) + thd * node + s * axis
     v = -np.cross(spin, R * down)
     return np.r_[x, y, R * np.sin(th), psi, th, phi, v, W, thd, s]
+
+
+# ------------------------------------------------------------------ rolling sphere
+_SPHERE = ("mass", "radius", "inertia")
+_SPHERE_COORDS = ("x", "z", "phi", "psi", "theta")
+
+
+def _sphere_omega(q, qd):
+    """Inertial angular velocity ``(wx, wy, wz)`` (``y`` up) of the 3-2-1 angles
+    ``(psi, theta, phi)`` about the inertial axes ``(3, 2, 1)``: ``A = A1(phi) A2(theta)
+    A3(psi)`` (inertial -> body) and ``w_body = (phi' - psi' s th, th' c ph + psi' c th s ph,
+    -th' s ph + psi' c th c ph)``; ``w = A' w_body``."""
+    phi, psi, th = q[2], q[3], q[4]
+    phid, psid, thd = qd[2], qd[3], qd[4]
+    c, s = ca.cos, ca.sin
+    A = dcm_from_euler321(ca.vertcat(psi, th, phi))
+    wb = ca.vertcat(phid - psid * s(th), thd * c(phi) + psid * c(th) * s(phi),
+                    -thd * s(phi) + psid * c(th) * c(phi))
+    return ca.mtimes(A.T, wb), A
+
+
+@cache.memoize
+def _sphere(tau) -> Model:
+    x = ca.SX.sym("x", 10)
+    p = ca.SX.sym("p", 3)
+    m, a, I = p[0], p[1], p[2]
+    q, v = x[:5], x[5:]
+    w, _ = _sphere_omega(q, v)
+    T = 0.5 * m * (v[0] ** 2 + v[1] ** 2) + 0.5 * I * ca.sumsqr(w)   # Eqs. 5.68, 5.73
+    M, Q = lagrange_terms(T, 0.0, q, v)
+    rolling = ca.vertcat(v[0] + a * w[2], v[1] - a * w[0])            # Eq. 5.71
+    contact_point = ca.vertcat(q[0], 0.0, q[1])
+    centre = ca.vertcat(q[0], a, q[1])
+    momentum = I * w + m * ca.cross(centre - contact_point, ca.vertcat(v[0], 0.0, v[1]))
+    return constrained_model("rolling_sphere", _SPHERE_COORDS, ("m",) * 2 + ("rad",) * 3,
+                             ("m/s",) * 2 + ("rad/s",) * 3, q, v, None, p, _SPHERE,
+                             {"mass": "kg", "radius": "m", "inertia": "kg m^2"},
+                             [1.0, 0.1, 0.004], M, Q, velocity=rolling, time_constant=tau,
+                             extra=lambda lam: {"energy": T, "omega": w,
+                                                "contact_momentum": momentum})
+
+
+def rolling_sphere(*, mass=1.0, radius=0.1, inertia=None,
+                   time_constant=DEFAULT_TIME_CONSTANT) -> Model:
+    """A uniform sphere rolling without slipping on a horizontal plane (Sec. 5.5 a): a
+    nonholonomic system with the 2 x 5 constraint matrix of Eq. 5.72.
+
+    Coordinates (the seed's order) ``q = [x, z, phi, psi, theta]``: the centre ``(x, a, z)``
+    (``y`` up, the height ``a`` eliminated: Eq. 5.71's holonomic row) and the modern
+    (3-2-1) angles, ``A = A1(phi) A2(theta) A3(psi)`` from the inertial axes to the body's
+    (singular at ``theta = +-pi/2``). With the inertial angular velocity ``w`` (Eq. 5.70's
+    components ``w_i = sum_k w_k A_ki``)::
+
+        T = 1/2 m (x'^2 + z'^2) + 1/2 I |w|^2
+          = 1/2 m (x'^2 + z'^2) + 1/2 I (th'^2 + psi'^2 + phi'^2 - 2 phi' psi' sin th)
+        rolling  v_c = w x (a j):   x' + a w_z = 0,   z' - a w_x = 0     (C q' = 0, Eq. 5.72)
+
+    held by two multipliers (`sphere_constraint_matrix` gives ``C``). The contact force
+    exerts no moment about the contact point, so the angular momentum about it
+    (``contact_momentum``) is conserved; with ``|w|`` and the speed fixed by it, the centre
+    rolls on a straight line at constant velocity and ``w`` is constant.
+
+    Parameters
+    ----------
+    mass : float [kg]
+        ``> 0``.
+    radius : float [m]
+        ``a > 0``.
+    inertia : float [kg m^2], optional
+        ``I > 0`` about any diameter (default a uniform solid sphere ``2/5 m a^2``).
+    time_constant : float or None [s]
+        Baumgarte time constant; ``None``: none.
+
+    Returns
+    -------
+    Model
+        ``x = [x, z, phi, psi, theta, <rates>]``; invariants ``multipliers``, ``energy``
+        [J], ``omega`` [rad/s] (inertial), ``contact_momentum`` [N m s] (angular momentum
+        about the contact point, inertial) and ``constraint_residual``. Start on the
+        constraints with `sphere_state`.
+
+    Raises
+    ------
+    ValueError
+        Naming ``mass``, ``radius``, ``inertia`` (not positive) or ``time_constant``.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from appdyn.dynamics.mechanisms import rolling_sphere, sphere_state
+    >>> model = rolling_sphere()
+    >>> x0 = sphere_state([1.0, 0.5], spin=3.0, angles=[0.1, 0.2, 0.3])
+    >>> float(np.abs(model.rhs(x0)[:2] - [1.0, 0.5]).max()), float(np.abs(model.rhs(x0)[5:7]).max()) < 1e-12
+    (0.0, True)
+    """
+    tau = stabilization(time_constant)
+    m = validate.positive(mass, "mass")
+    a = validate.positive(radius, "radius")
+    I = 0.4 * m * a * a if inertia is None else inertia
+    vals = checked_constants(dict(mass=m, radius=a, inertia=I), ("inertia",))
+    return with_parameters(_sphere(tau), vals)
+
+
+@cache.memoize
+def _sphere_functions():
+    q, qd, a = ca.SX.sym("q", 5), ca.SX.sym("qd", 5), ca.SX.sym("a")
+    w, _ = _sphere_omega(q, qd)
+    rolling = ca.vertcat(qd[0] + a * w[2], qd[1] - a * w[0])
+    return (ca.Function("sphere_C", [q, a], [ca.jacobian(rolling, qd)]),
+            ca.Function("sphere_W", [q], [ca.jacobian(w, qd[2:])]))
+
+
+def sphere_constraint_matrix(q, *, radius=0.1) -> np.ndarray:
+    """The constraint matrix ``C`` (2 x 5) of `rolling_sphere`: ``C q' = 0`` (Eq. 5.72).
+
+    Rows: ``x' + a w_z`` and ``z' - a w_x`` as linear forms in
+    ``q' = (x', z', phi', psi', theta')``; the ``phi'`` column is ``a (A13, -A11)`` (the seed's
+    ``a A13 phi'`` and ``-A11 phi'`` terms).
+
+    Parameters
+    ----------
+    q : array_like, shape (5,)
+        ``[x, z, phi, psi, theta]`` [m, m, rad, rad, rad].
+    radius : float [m], optional
+
+    Returns
+    -------
+    numpy.ndarray, shape (2, 5)
+
+    Examples
+    --------
+    >>> from appdyn.dynamics.mechanisms import sphere_constraint_matrix
+    >>> (sphere_constraint_matrix([0, 0, 0, 0, 0], radius=2.0) + 0.0).tolist()
+    [[1.0, 0.0, 0.0, 2.0, 0.0], [0.0, 1.0, -2.0, 0.0, 0.0]]
+    """
+    q = validate.finite_array(q, "q").reshape(-1)
+    if q.shape != (5,):
+        raise ValueError(f"`q` must be [x, z, phi, psi, theta] (5 entries), got {q.size}")
+    a = validate.positive(radius, "radius")
+    return np.asarray(_sphere_functions()[0](q, a), dtype=float)
+
+
+def sphere_state(velocity, *, spin=0.0, angles=(0.0, 0.0, 0.0), radius=0.1,
+                 position=(0.0, 0.0)) -> np.ndarray:
+    """A state of `rolling_sphere` on its constraints: the centre's horizontal velocity
+    ``(x', z')``, the spin ``w_y`` about the vertical, the angles ``(phi, psi, theta)``.
+
+    Rolling fixes ``w_x = z'/a`` and ``w_z = -x'/a``; the angle rates solve
+    ``w(q, q') = (w_x, spin, w_z)``.
+
+    Parameters
+    ----------
+    velocity : array_like, shape (2,) [m/s]
+    spin : float [rad/s], optional
+    angles : array_like, shape (3,) [rad], optional
+        ``(phi, psi, theta)``, ``|theta| < pi/2``.
+    radius : float [m], optional
+    position : array_like, shape (2,) [m], optional
+        ``(x, z)``.
+
+    Returns
+    -------
+    numpy.ndarray, shape (10,)
+
+    Raises
+    ------
+    ValueError
+        Naming ``velocity``, ``angles`` (wrong size, ``theta`` at +-pi/2), ``spin``,
+        ``radius`` or ``position``.
+
+    Examples
+    --------
+    >>> from appdyn.dynamics.mechanisms import sphere_state
+    >>> (sphere_state([0.2, 0.0], radius=0.1) + 0.0).round(12).tolist()   # about -z: psi' = -2
+    [0.0, 0.0, 0.0, 0.0, 0.0, 0.2, 0.0, 0.0, -2.0, 0.0]
+    """
+    vel = validate.finite_array(velocity, "velocity").reshape(-1)
+    ang = validate.finite_array(angles, "angles").reshape(-1)
+    pos = validate.finite_array(position, "position").reshape(-1)
+    for name, arr, n in (("velocity", vel, 2), ("angles", ang, 3), ("position", pos, 2)):
+        if arr.size != n:
+            raise ValueError(f"`{name}` must have {n} entries, got {arr.size}")
+    if abs(np.cos(ang[2])) < 1e-8:
+        raise ValueError(f"`angles` theta must not be +-pi/2 (the 3-2-1 singularity), got "
+                         f"{ang[2]!r}")
+    a = validate.positive(radius, "radius")
+    wy = validate.finite_scalar(spin, "spin")
+    q = np.r_[pos, ang]
+    B = np.asarray(_sphere_functions()[1](q), dtype=float)
+    rates = np.linalg.solve(B, [vel[1] / a, wy, -vel[0] / a])
+    return np.r_[q, vel, rates]
 
 
 # ------------------------------------------------------------------ dumbbell on a disk

@@ -32,6 +32,9 @@ Parts
                        gimbal), gyro invariants ``gyro_tilt``, ``gyro_tilt_rate``
 =====================  =====================================================================
 
+``RigidHub(inertia, reference_rate=Omega)`` refers the attitude to a frame turning at a
+constant rate (Earth-fixed, LVLH) instead of inertial space.
+
 Parts sit on the hub, or on a part that carries parts (a `HingedPanel`, a `BendingMode`)
 named by their ``parent`` keyword: ``ReactionWheels(axes, 0.05, parent="panel")``.
 

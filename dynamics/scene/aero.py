@@ -109,7 +109,9 @@ class Aerodynamics(Part):
     up : array_like, shape (3,), optional
         The inertial direction of the altitude ``h = up . r`` (default ``(0, 0, 1)``).
     wind : {'zero', 'control'}, optional
-        The inertial wind: none, or the controls ``wind1..wind3`` [m/s] (inertial axes).
+        The inertial wind: none, or the controls ``wind1..wind3`` [m/s] (inertial axes). On
+        a hub with a ``reference_rate`` the air is at rest in the turning frame (velocity
+        ``Omega x r``) and the wind is relative to it, in its axes.
     air_velocity : {'centre_of_pressure', 'mass_centre'}, optional
         Whose velocity sets the angle of attack: the centre of pressure's (default: with the
         aerodynamic damping of the turning rate) or the hub's mass centre's (the launch
@@ -200,8 +202,11 @@ class Aerodynamics(Part):
                              "air_velocity='centre_of_pressure'")
         rho_cp = frame.point(self.centre_of_pressure)
         v_cp = frame.velocity(rho_cp)
-        v_air = v_cp if self.air_velocity == "centre_of_pressure" else frame.velocity(
-            frame.point((0.0, 0.0, 0.0)))
+        at = rho_cp if self.air_velocity == "centre_of_pressure" else frame.point((0.0, 0.0, 0.0))
+        v_air = frame.velocity(at)
+        if frame.reference_rate is not None:  # the air is at rest in the turning frame
+            r_at = frame.r + ca.mtimes(frame.dcm.T, at)
+            v_air = v_air - ca.mtimes(frame.dcm, ca.cross(ca.DM(frame.reference_rate), r_at))
         if self.wind == "control":
             v_air = v_air - ca.mtimes(frame.dcm, own.controls)
         return Contribution(loads=[Load(self.force(v_air, self.air_density(frame)), v_cp)])

@@ -1,7 +1,8 @@
 """Assemble a `Scene` into one `Model` by Kane's method on the symbols.
 
 Generalized speeds ``nu = (w, [v], part speeds)``, coordinates ``c = (q, [r], part
-coordinates)`` with ``q' = -1/2 Wbar(w) q`` (seed Eq. 4.70) and ``r' = A^T v``. Each body
+coordinates)`` with ``q' = -1/2 Wbar(w) q`` (seed Eq. 4.70) and ``r' = A^T v`` (relative
+to a turning frame with ``RigidHub(reference_rate=...)``: `reference_rates`). Each body
 ``b`` (the hub's and every part's) has the absolute velocity ``v_b`` of its mass centre and
 angular velocity ``w_b``, linear momentum ``p_b`` and angular momentum ``h_b`` about its mass
 centre, all in hub axes. Their inertial derivatives in hub components are
@@ -26,11 +27,12 @@ from dataclasses import dataclass, replace
 import casadi as ca
 import numpy as np
 
-from ..attitude import dcm_from_quat, quat_rate
+from ..attitude import dcm_from_axis_angle, dcm_from_quat, quat_rate
 from ..model import Model
 from .contract import Body, Contribution, Frame, PartSymbols
 
-__all__ = ["PartLayout", "assemble", "kane_equations", "in_hub_axes"]
+__all__ = ["PartLayout", "assemble", "kane_equations", "in_hub_axes", "reference_rates",
+           "turning_frame_dcm"]
 
 
 @dataclass(frozen=True)
@@ -205,6 +207,48 @@ def in_hub_axes(frame: Frame, c: Contribution) -> Contribution:
     return replace(c, bodies=bodies, momentum=momentum)
 
 
+def reference_rates(hub, q, w, A, r, v) -> list:
+    """The hub's coordinate rates ``[q', (r')]``: ``q' = -1/2 Wbar(w_rel) q``, ``r' = A^T v``,
+    relative to a frame turning at ``hub.reference_rate`` ``Omega`` when it is given
+    (``w_rel = w - A Omega``, ``r' = A^T v - Omega x r``), else inertial."""
+    if hub.reference_rate is None:
+        return [quat_rate(q, w)] + ([ca.mtimes(A.T, v)] if r is not None else [])
+    Om = ca.DM(hub.reference_rate)
+    return [quat_rate(q, w - ca.mtimes(A, Om))] + (
+        [ca.mtimes(A.T, v) - ca.cross(Om, r)] if r is not None else [])
+
+
+def turning_frame_dcm(reference_rate, t):
+    """Inertial -> turning-frame components at time ``t`` for a frame turning at the
+    constant ``reference_rate`` ``Omega`` that coincides with the inertial axes at ``t = 0``.
+
+    ``C(t) = dcm_from_axis_angle(Omega / |Omega|, |Omega| t)`` (seed Eq. 4.45).
+
+    Parameters
+    ----------
+    reference_rate : array_like, shape (3,) [rad/s]
+    t : float or SX scalar [s]
+
+    Returns
+    -------
+    C : DM or SX, 3x3
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> C = turning_frame_dcm([0.0, 0.0, 0.5], np.pi)   # a quarter turn about z
+    >>> np.round(np.array(C), 12) + 0.0                 # inertial x is then -y
+    array([[ 0.,  1.,  0.],
+           [-1.,  0.,  0.],
+           [ 0.,  0.,  1.]])
+    """
+    Om = ca.DM(reference_rate)
+    rate = float(ca.norm_2(Om))
+    if rate == 0.0:
+        return ca.DM.eye(3)
+    return dcm_from_axis_angle(Om / rate, rate * t)
+
+
 def assemble(scene) -> Model:
     """The `Model` of ``scene`` (module docstring); use `Scene.model`, which caches it."""
     hub = scene.hub
@@ -220,7 +264,8 @@ def assemble(scene) -> Model:
     else:
         r, v = None, ca.SX.zeros(3)
     A = dcm_from_quat(q)
-    frame = Frame(q=q, dcm=A, w=w, v=v, r=r, reference=hub.reference, mass=hub.mass)
+    frame = Frame(q=q, dcm=A, w=w, v=v, r=r, reference=hub.reference, mass=hub.mass,
+                  reference_rate=hub.reference_rate)
 
     I_hub = ca.DM(hub.inertia_matrix)
     cm = -ca.DM(hub.reference)
@@ -230,7 +275,7 @@ def assemble(scene) -> Model:
     bodies_by_part = {"hub": [hub_body]}
     loads, potential, kinetic, extra, momenta = [], [], [], {}, {}
     coord_syms = [q] + ([r] if r is not None else [])
-    coord_rates = [quat_rate(q, w)] + ([ca.mtimes(A.T, v)] if r is not None else [])
+    coord_rates = reference_rates(hub, q, w, A, r, v)
     speed_syms = [w] + ([v] if hub.translates else [])
     part_speed_slices = []
     n_hub = 6 if hub.translates else 3

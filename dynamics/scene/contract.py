@@ -240,6 +240,10 @@ class Frame:
         This frame's axes -> hub axes (None: the hub's frame).
     origin : SX, 3x1 or None [m]
         This frame's origin from the hub's reference point, hub axes (None: the hub's).
+    reference_rate : tuple of float, shape (3,) [rad/s], or None
+        The hub's ``reference_rate`` ``Omega``: ``q``, ``dcm`` and ``r`` are then referred to
+        a frame turning at ``Omega`` about the origin of ``r`` (its axes), not to inertial
+        axes; ``w`` and ``v`` stay absolute. None: inertial.
     """
 
     q: ca.SX
@@ -251,6 +255,7 @@ class Frame:
     mass: float | None
     to_hub: ca.SX | None = None
     origin: ca.SX | None = None
+    reference_rate: tuple | None = None
 
     @property
     def is_hub(self) -> bool:
@@ -279,7 +284,8 @@ class Frame:
             ``dcm`` inertial -> child, ``r`` the origin's inertial position (six-degree-of-
             freedom hub only), ``reference`` zero (points from the origin), ``mass`` None,
             ``q`` None, and ``to_hub``/``origin`` for the assembly (child axes -> hub axes;
-            the origin from the hub's reference point, hub axes).
+            the origin from the hub's reference point, hub axes); ``reference_rate`` the
+            hub's.
         """
         R, o = ca.SX(rotation), ca.SX(origin)
         Rt = R.T
@@ -289,7 +295,7 @@ class Frame:
         at = o if self.is_hub else self.origin + ca.mtimes(self.to_hub, o)
         return Frame(q=None, dcm=ca.mtimes(Rt, self.dcm), w=ca.mtimes(Rt, self.w + w_rel),
                      v=ca.mtimes(Rt, v), r=r, reference=(0.0, 0.0, 0.0), mass=None,
-                     to_hub=to_hub, origin=at)
+                     to_hub=to_hub, origin=at, reference_rate=self.reference_rate)
 
     def point(self, from_mass_centre) -> ca.SX:
         """A hub point given from the hub's mass centre, as measured from the reference."""

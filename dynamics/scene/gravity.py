@@ -46,6 +46,7 @@ from dataclasses import dataclass
 import casadi as ca
 
 from ..validate import positive
+from .assembly import turning_frame_dcm
 from .contract import Contribution, Load, Part, PartVariables, Variable
 
 __all__ = ["GravityGradient"]
@@ -74,7 +75,10 @@ class GravityGradient(Part):
     Notes
     -----
     The module docstring gives the potential, forces and torques and the circular orbit of an
-    attitude-only hub. Its orbit's mean motion ``n = sqrt(mu / R^3)`` is `mean_motion`.
+    attitude-only hub. Its orbit's mean motion ``n = sqrt(mu / R^3)`` is `mean_motion`. On a
+    hub with a ``reference_rate`` the orbit stays inertial (`assembly.turning_frame_dcm` turns
+    it into the reference axes): with ``reference_rate = (0, 0, n)`` the hub's attitude is
+    measured from the local-vertical local-horizontal frame, where the nadir is fixed.
 
     Examples
     --------
@@ -167,8 +171,10 @@ class GravityGradient(Part):
         """
         if frame.r is None:
             n = self.mean_motion
-            o = ca.mtimes(frame.dcm, ca.vertcat(-ca.cos(n * t), -ca.sin(n * t), 0.0))
-            return o, self.mu / self.radius ** 3
+            o = ca.vertcat(-ca.cos(n * t), -ca.sin(n * t), 0.0)  # inertial axes
+            if frame.reference_rate is not None:  # the hub's attitude is from a turning frame
+                o = ca.mtimes(turning_frame_dcm(frame.reference_rate, t), o)
+            return ca.mtimes(frame.dcm, o), self.mu / self.radius ** 3
         R = ca.mtimes(frame.dcm, frame.r) + rho
         dist = ca.norm_2(R)
         return -R / dist, self.mu / dist ** 3

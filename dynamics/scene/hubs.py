@@ -35,13 +35,25 @@ class RigidHub:
     reference : array_like, shape (3,) [m], optional
         The reference point (whose position and velocity are the states) from the hub's
         mass centre, hub axes. Needs ``mass``.
+    reference_rate : array_like, shape (3,) [rad/s], optional
+        Refer the attitude to a frame turning at this constant rate ``Omega`` with respect
+        to inertial space (its own axes: ``(0, 0, Omega_E)`` for the Earth-fixed frame, the
+        orbit rate for an LVLH frame of a circular orbit; seed 000 Eq. 6.42): ``q`` is then
+        reference frame -> hub, ``q' = -1/2 Wbar(w - A(q) Omega) q``, and ``r`` (six degrees of
+        freedom) is the position in that frame, ``r' = A^T v - Omega x r``. ``w`` and ``v``
+        stay absolute (hub axes), so Euler's law is unchanged; ``frame.dcm`` is reference ->
+        hub (``frame.reference_rate`` tells the parts: `GravityGradient` keeps its orbit
+        inertial, `Aerodynamics` takes the air at rest in the turning frame, a `TiltTorque`
+        direction is fixed in it), and the ``momentum_inertial`` and ``momentum_linear``
+        invariants are in the reference frame's axes (they turn there at ``-Omega``:
+        ``H' = -Omega x H``).
 
     Raises
     ------
     ValueError
         Naming the argument: bad ``inertia`` (`dynamics.validate.check_inertia`), a
         non-positive ``mass``, a ``reference`` not of 3 finite numbers or given without
-        ``mass``.
+        ``mass``, a ``reference_rate`` not of 3 finite numbers.
 
     Examples
     --------
@@ -50,13 +62,21 @@ class RigidHub:
     ('q1', 'q2', 'q3', 'q4', 'w1', 'w2', 'w3')
     >>> Scene(RigidHub([1.0, 2.0, 3.0], mass=10.0)).model().nx
     13
+
+    Attitude referred to the Earth-fixed frame: at rest there (``w = A Omega``), ``q`` stays:
+
+    >>> hub = RigidHub([1.0, 2.0, 3.0], reference_rate=[0.0, 0.0, 7.2921159e-5])
+    >>> scene = Scene(hub)
+    >>> (scene.model().rhs(scene.state(w=[0.0, 0.0, 7.2921159e-5]))[:4] + 0.0).tolist()
+    [0.0, 0.0, 0.0, 0.0]
     """
 
     inertia: tuple
     mass: float | None
     reference: tuple
+    reference_rate: tuple | None
 
-    def __init__(self, inertia, *, mass=None, reference=None):
+    def __init__(self, inertia, *, mass=None, reference=None, reference_rate=None):
         I = check_inertia(inertia)
         m = None if mass is None else positive(mass, "mass")
         if reference is not None and m is None:
@@ -67,6 +87,8 @@ class RigidHub:
         object.__setattr__(self, "inertia", tuple(np.asarray(I, float).reshape(-1).tolist()))
         object.__setattr__(self, "mass", m)
         object.__setattr__(self, "reference", ref)
+        object.__setattr__(self, "reference_rate", None if reference_rate is None else tuple(
+            finite_array(reference_rate, "reference_rate", (3,)).tolist()))
 
     @property
     def inertia_matrix(self) -> np.ndarray:

@@ -266,7 +266,7 @@ class Scene:
         from ..attitude import dcm_from_quat
         frame = Frame(q=ca.DM(x[0:4]), dcm=ca.DM(dcm_from_quat(x[0:4])), w=ca.DM(x[4:7]),
                       v=ca.DM.zeros(3), r=None, reference=self.hub.reference,
-                      mass=self.hub.mass)
+                      mass=self.hub.mass, reference_rate=self.hub.reference_rate)
         for key, val in singles.items():  # before: a part's frame may depend on them
             x[index[key]] = val
         frames = {}

@@ -301,6 +301,16 @@ VALID = {
     "freq": lambda: 200.0,
     "m1": lambda: 1.0,
     "m2": lambda: 1.0,
+    # impacts (dynamics.mechanisms.impacts) and the rolling sphere
+    "mass_matrix": lambda: np.diag([2.0, 1.0]),
+    "normal": lambda: np.array([-1.0, 1.0]),
+    "u1": lambda: 2.0,
+    "u2": lambda: 0.0,
+    "v1": lambda: 300.0,
+    "v0": lambda: 2.0,
+    "u0": lambda: 1.0,
+    "x1_dot": lambda: 2.0,
+    "velocity": lambda: np.array([1.0, 0.5]),
     "I1": lambda: np.diag([1.0, 2.0, 3.0]),
     "I2": lambda: np.diag([1.0, 2.0, 3.0]),
     "inertia1": lambda: np.diag([1.0, 2.0, 3.0]),
@@ -340,7 +350,23 @@ VALID = {
 _ASC_R = lambda: np.array([6.4e6, 0.0, 0.0])  # noqa: E731
 _ASC_V = lambda: np.array([0.0, 7.5e3, 0.0])  # noqa: E731
 
+@functools.cache
+def _lagrange_symbols():
+    """A unit mass on a spring in symbols: Lagrange's and Hamel's builders' example."""
+    q, v = ca.SX.sym("q"), ca.SX.sym("v")
+    return {"q": q, "v": v, "u": v, "T": 0.5 * v ** 2, "coords": {"q": q}, "rates": {"v": v},
+            "speeds": {"v": v}, "W": ca.SX(1.0), "forces": [(-q, q)]}
+
+
+def _lagrange(*params):
+    return {k: (lambda k=k: _lagrange_symbols()[k]) for k in params}
+
+
 OVERRIDES = {
+    "appdyn.dynamics.mechanisms.generalized_forces": _lagrange("forces", "q"),
+    "appdyn.dynamics.mechanisms.lagrange_model": _lagrange("coords", "rates", "T"),
+    "appdyn.dynamics.mechanisms.hamel_terms": _lagrange("T", "q", "u", "W"),
+    "appdyn.dynamics.mechanisms.hamel_model": _lagrange("coords", "speeds", "T", "W"),
     "appdyn.problems.stability.vehicle_loops": {"scene": lambda: __import__(
         "appdyn.dynamics.scene", fromlist=["x"]).launch_vehicle_scene(
             thrust=2.0e6, inertia=4.0e7, arm=20.0, mass=1.0e5)},
@@ -379,6 +405,11 @@ OVERRIDES = {
         "T": lambda: 0.5 * ca.SX.sym("v") ** 2, "V": lambda: ca.SX(0),
         "q": lambda: ca.SX.sym("q"), "v": lambda: ca.SX.sym("v")},
     "appdyn.dynamics.mechanisms.spherical_mass_matrix": {"q": lambda: np.array([0.1, 0.2])},
+    "appdyn.dynamics.mechanisms.impact": {"v": lambda: np.array([1.0, 0.0])},
+    "appdyn.dynamics.mechanisms.contact_jump": {
+        "mass_matrix": lambda: (lambda q, p: np.eye(1)), "normal": lambda: (lambda q, p: [1.0]),
+        "nq": lambda: 1},
+    "appdyn.dynamics.mechanisms.sphere_constraint_matrix": {"q": lambda: np.full(5, 0.1)},
     "appdyn.ocp.unstack": {"x": lambda: np.zeros((4, 3))},
     "appdyn.ocp.state_scale": {"x": lambda: np.zeros((2, 5))},
     "appdyn.problems.slew.min_effort": {"T": lambda: 5.0},

@@ -57,6 +57,9 @@ for _func, _params in {
     "appdyn.dynamics.mechanisms.bead_motion": ("t", "r0", "r0_dot", "rate"),
     "appdyn.dynamics.mechanisms.bead_torque": ("r", "r_dot", "rate", "rate_dot"),
     "appdyn.dynamics.mechanisms.rod_reaction": ("theta", "theta_dot"),
+    "appdyn.dynamics.mechanisms.turntable_path": ("t",),
+    "appdyn.dynamics.mechanisms.foucault_swing": ("t",),
+    "appdyn.dynamics.mechanisms.skater_rate": ("t",),
 }.items():
     for _param in _params:
         ALLOWED_GARBAGE.setdefault((_func, _param), {})["cube"] = (
@@ -78,6 +81,7 @@ SKIPPED = {
     "appdyn.dynamics.mechanisms.natural_frequency": "no required parameter",
     "appdyn.dynamics.mechanisms.rod_pendulum": "no required parameter",
     "appdyn.dynamics.mechanisms.rolling_coin": "no required parameter",
+    "appdyn.dynamics.mechanisms.rolling_sphere": "no required parameter",
     "appdyn.dynamics.mechanisms.shaken_pendulum": "no required parameter",
     "appdyn.dynamics.mechanisms.shaken_pendulum_multipliers": "no required parameter",
     "appdyn.dynamics.mechanisms.sliding_bead": "no required parameter",

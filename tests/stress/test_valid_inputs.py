@@ -239,6 +239,13 @@ RANDOM = {
     "freq": log_floats(50.0, 2000.0),
     "m1": log_floats(0.1, 10.0),
     "m2": log_floats(0.1, 10.0),
+    "u1": floats(-5.0, 5.0),
+    "u2": floats(-5.0, 5.0),
+    "v1": log_floats(0.1, 500.0),
+    "v0": log_floats(0.1, 10.0),
+    "u0": floats(-5.0, 5.0),
+    "x1_dot": floats(-5.0, 5.0),
+    "velocity": vectors(2),
     "I1": inertia_matrices(),
     "I2": inertia_matrices(),
     "inertia1": inertia_matrices(),
@@ -345,7 +352,17 @@ RANDOM_OVERRIDES = {
     "appdyn.dynamics.mechanisms.bead_torque": {"r": floats(-1.0, 1.0)},
     "appdyn.dynamics.mechanisms.dumbbell_disk_state": {"w": vectors(3)},
     "appdyn.dynamics.mechanisms.spherical_mass_matrix": {"q": vectors(2, 0.2, 1.3)},
+    "appdyn.dynamics.mechanisms.impact": {
+        "mass_matrix": st.tuples(vectors(2, 0.2, 3.0), floats(-0.15, 0.15)).map(
+            lambda d: np.array([[d[0][0], d[1]], [d[1], d[0][1]]])),
+        "normal": unit_vectors(2), "v": vectors(2)},
+    "appdyn.dynamics.mechanisms.contact_jump": {
+        "mass_matrix": st.just(lambda q, p: np.eye(1)), "normal": st.just(lambda q, p: [1.0]),
+        "nq": st.just(1)},
+    "appdyn.dynamics.mechanisms.sphere_constraint_matrix": {"q": vectors(5, -1.2, 1.2)},
     "appdyn.dynamics.mechanisms.pendulum_swing": {"t": time_grids()},
+    "appdyn.dynamics.mechanisms.foucault_precession_rate": {"latitude": floats(-1.5, 1.5)},
+    "appdyn.dynamics.mechanisms.skater_work": {"radius": log_floats(0.05, 1.0)},
     "appdyn.dynamics.momentum.pseudo_inverse_steering": {},
     "appdyn.ocp.unstack": {},
     "appdyn.ocp.state_scale": {"x": st.integers(1, 4).flatmap(
@@ -546,6 +563,8 @@ OPTIONAL = {
                                          "length": floats(0.1, 3.0)},
     "appdyn.dynamics.mechanisms.rolling_coin": {"mass": log_floats(0.01, 10.0),
                                          "radius": floats(0.01, 1.0)},
+    "appdyn.dynamics.mechanisms.rolling_sphere": {"mass": log_floats(0.01, 10.0),
+                                           "radius": floats(0.01, 1.0)},
     "appdyn.dynamics.mechanisms.shaken_pendulum": {"mass": log_floats(0.1, 10.0),
                                             "inertia": log_floats(1e-3, 0.1),
                                             "length": floats(0.05, 0.5),
@@ -595,6 +614,10 @@ ECHOED = {"problem", "model"}
 # numerical drivers where a random valid input may honestly be unsolvable: success=False
 # with a message is accepted (reported as a warning, never an exception)
 MAY_FAIL = {
+    "appdyn.dynamics.mechanisms.falling_bar_impact": (
+        "a bar sliding backwards fast enough (3 u0 + 5 (1 + e) v0 < 0 at 45 deg) would need "
+        "a pulling normal impulse to stick: with unbounded or large friction no impulse on "
+        "the friction cone stops it (the contact jams); success=False says so"),
     "appdyn.problems.gains.attitude_gains": (
         "KNOWN, not fixed: a slew axis with components of 1e-175 (a unit axis hypothesis "
         "draws) makes CVODES give up on the closed-loop re-simulation (CV_REPTD_RHSFUNC_ERR "
@@ -605,6 +628,10 @@ SYMBOLIC = {
     "appdyn.dynamics.constrained.constraint_terms": ("q", "qdot", "v"),
     "appdyn.dynamics.constrained.residual_invariant": ("x", "p"),
     "appdyn.dynamics.mechanisms.lagrange_terms": ("T", "V", "q", "v"),
+    "appdyn.dynamics.mechanisms.generalized_forces": ("forces", "q"),
+    "appdyn.dynamics.mechanisms.lagrange_model": ("coords", "rates", "T"),
+    "appdyn.dynamics.mechanisms.hamel_terms": ("T", "q", "u", "W"),
+    "appdyn.dynamics.mechanisms.hamel_model": ("coords", "speeds", "T", "W"),
 }
 
 
