@@ -11,7 +11,8 @@ equilibria and steady spins, as a python-control StateSpace), `clear_caches` (em
 cache of built and compiled Functions, `dynamics.cache`), and the modules `attitude`
 (kinematics), `constrained` (the multiplier machinery: accelerations, multipliers, reaction
 forces, Baumgarte stabilization and projection), `mechanisms` (the seed's worked systems with
-their closed forms), `clock` (time-dependent models carry a clock state ``"t"``), `floquet`
+their closed forms), `clock` (time-dependent models carry a clock state ``"t"``), `mass`
+(parallel and rotated axes, radius of gyration, specific impulse and the rocket equation), `floquet`
 (monodromy matrix and multipliers of periodic motion) and `truth` (closed forms, imported on
 first use).
 """
@@ -19,7 +20,7 @@ from __future__ import annotations
 
 import importlib
 
-from . import attitude, cache, clock, constrained, floquet, mechanisms, momentum
+from . import attitude, cache, clock, constrained, floquet, mass, mechanisms, momentum
 from .feedback import closed_loop
 from .hinged import hinged_bodies
 from .integrate import METHODS, BatchResult, Event, Impact, ImpactRecord, SimulationResult, simulate
@@ -31,7 +32,7 @@ from .rigid_body import rigid_body
 
 __all__ = ["METHODS", "BatchResult", "Event", "Impact", "ImpactRecord", "Linearization", "Model", "SimulationResult", "attitude", "clear_caches",
            "clock", "closed_loop", "cmg_spacecraft", "constrained", "floquet", "hinged_bodies",
-           "launch_vehicle", "linearization", "linearize", "mechanisms", "momentum", "rigid_body", "simulate", "truth",
+           "launch_vehicle", "linearization", "linearize", "mass", "mechanisms", "momentum", "rigid_body", "simulate", "truth",
            "wheel_spacecraft"]
 
 def clear_caches() -> None:

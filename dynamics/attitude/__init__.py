@@ -43,6 +43,9 @@ Modules (every name in ``__all__`` is importable from ``dynamics.attitude``):
   angle, closed-form propagation;
 * `dcm` -- DCM <-> quaternion and axis-angle conversions;
 * `euler` -- elementary rotations, 3-1-3 and 3-2-1 angles;
+* `rates` -- kinematical differential equations: 3-2-1 and 3-1-3 Euler-angle rates <-> body
+  rates (Eqs. 4.36-4.40, refused at gimbal lock for numbers) and the DCM Poisson equation
+  ``A' = -[w x] A`` (Eq. 4.33);
 * `principal` -- principal axes of an inertia matrix;
 * `aero` -- aerodynamic (direction) angles of the body-frame air velocity: Type I
   ``(alpha, beta)``, Type II ``(alpha_T, phi_R)`` and the conversions (seed Sec. 4.3 E);
@@ -60,6 +63,8 @@ from .euler import (dcm_axis, dcm_from_euler313, dcm_from_euler321, euler313_fro
 from .principal import principal_axes
 from .quaternion import (propagate_quat, quat_conj, quat_kinematics_matrix, quat_mul, quat_normalize,
                          quat_rate, rotation_angle, skew)
+from .rates import (body_rates_from_euler313, body_rates_from_euler321, dcm_rate,
+                    euler313_rates, euler321_rates)
 
 __all__ = [
     "skew",
@@ -84,6 +89,11 @@ __all__ = [
     "euler321_from_dcm",
     "quat_from_euler321",
     "euler321_from_quat",
+    "euler321_rates",
+    "body_rates_from_euler321",
+    "euler313_rates",
+    "body_rates_from_euler313",
+    "dcm_rate",
     "principal_axes",
     "aero_angles",
     "total_aoa",

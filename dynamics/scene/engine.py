@@ -48,6 +48,7 @@ import casadi as ca
 import numpy as np
 
 from ..launch_vehicle.parts import Actuator
+from ..mass import G0
 from ..validate import finite_array
 from .contract import (Body, Contribution, Load, Part, PartVariables, Variable,
                        bounds_from_u_max)
@@ -55,8 +56,8 @@ from .dampers import real_number, unit_vector
 
 __all__ = ["Engine", "G0", "gimbal_basis", "coriolis_load", "gimbaled_engine"]
 
-G0 = 9.80665
-"""Standard gravity [m/s^2] of the specific impulse (``C = isp g0``, seed Eq. 3.40)."""
+# G0: standard gravity [m/s^2] of the specific impulse (``C = isp g0``, seed Eq. 3.40), one
+# constant with `dynamics.mass` (its `isp` and `delta_v`)
 
 
 def gimbal_basis(axis) -> np.ndarray:

@@ -15,6 +15,9 @@ Modules, by topic (every name below is also importable from ``dynamics.truth``):
   constant body rate (`constant_rate_quat`);
 * `cones` -- small-motion formulas: `cone_angles`, `small_asymmetry_rates`,
   `small_asymmetry_frequency`;
+* `forced` -- coning and forced motion of spinners (Secs. 4.5 C, 4.6 Methods I and II):
+  `coning_angle`, `misaligned_thrust`, `floating_frame_accelerations`,
+  `horizontal_gyroscope`;
 * `common` -- input checks, tolerances and the private-to-truth quaternion kernels.
 
 An integer principal-axis argument or result field is ``axis_index`` (0-based); the old
@@ -39,6 +42,8 @@ from __future__ import annotations
 
 from .axisymmetric import SymmetricPrecession, axisymmetric, constant_rate_quat, symmetric_precession
 from .cones import ConeAngles, cone_angles, small_asymmetry_frequency, small_asymmetry_rates
+from .forced import (HorizontalGyroscope, MisalignedThrust, coning_angle,
+                     floating_frame_accelerations, horizontal_gyroscope, misaligned_thrust)
 from .torque_free import (TorqueFreeParameters, energy, momentum_magnitude, torque_free_omega,
                           torque_free_parameters)
 
@@ -56,4 +61,10 @@ __all__ = [
     "small_asymmetry_frequency",
     "SymmetricPrecession",
     "symmetric_precession",
+    "coning_angle",
+    "MisalignedThrust",
+    "misaligned_thrust",
+    "floating_frame_accelerations",
+    "HorizontalGyroscope",
+    "horizontal_gyroscope",
 ]

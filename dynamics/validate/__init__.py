@@ -25,7 +25,8 @@ from .base import ArgumentTypeError, is_symbolic
 from .inertia import check_inertia
 from .numbers import (finite_array, finite_scalar, integer, nonnegative, one_of, positive,
                       positive_each)
-from .rotations import (AXIS_NORM_TOL, DCM_ORTHO_TOL, QUAT_NORM_TOL, rotation_matrix, unit_axes,
+from .rotations import (AXIS_NORM_TOL, DCM_ORTHO_TOL, EULER_LOCK_TOL, QUAT_NORM_TOL,
+                        rotation_matrix, unit_axes,
                         check_unit_quaternion, unit_quaternion, unit_quaternions, unit_vector)
 
 ArgumentTypeError.__module__ = __name__  # shown where users import it from
@@ -35,6 +36,7 @@ __all__ = [
     "QUAT_NORM_TOL",
     "DCM_ORTHO_TOL",
     "AXIS_NORM_TOL",
+    "EULER_LOCK_TOL",
     "is_symbolic",
     "finite_array",
     "finite_scalar",

@@ -8,7 +8,8 @@ import numpy as np
 from .base import check_shape, cross3, dot3, first_index, member, norm, real_array, short_repr
 from .numbers import finite_array
 
-__all__ = ["QUAT_NORM_TOL", "DCM_ORTHO_TOL", "AXIS_NORM_TOL", "unit_vector", "unit_axes",
+__all__ = ["QUAT_NORM_TOL", "DCM_ORTHO_TOL", "AXIS_NORM_TOL", "EULER_LOCK_TOL", "unit_vector",
+           "unit_axes",
            "check_unit_quaternion", "unit_quaternion", "unit_quaternions", "rotation_matrix"]
 
 #: How far a quaternion argument may deviate from unit norm before it is refused.
@@ -20,6 +21,11 @@ DCM_ORTHO_TOL = 1e-6
 #: Largest accepted ``| |axis| - 1 |`` of a device axis (wheel spin axes, CMG gimbal and
 #: spin axes): they define the device, so they are refused, not normalized, when off.
 AXIS_NORM_TOL = 1e-9
+
+#: Smallest accepted ``|cos(theta)|`` (3-2-1) or ``|sin(theta)|`` (3-1-3) of a numeric
+#: ``angles`` argument of ``attitude.euler321_rates`` / ``attitude.euler313_rates``: closer to
+#: gimbal lock the angle rates exceed ``1e9`` times the body rates and mean nothing.
+EULER_LOCK_TOL = 1e-9
 
 
 

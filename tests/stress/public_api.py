@@ -16,6 +16,7 @@ import numpy as np
 
 MODULES = (
     "appdyn.dynamics", "appdyn.dynamics.attitude", "appdyn.dynamics.truth", "appdyn.dynamics.momentum",
+    "appdyn.dynamics.mass",
     "appdyn.dynamics.constrained", "appdyn.dynamics.launch_vehicle", "appdyn.dynamics.mechanisms", "appdyn.ocp",
     "appdyn.problems.slew", "appdyn.problems.stability", "appdyn.problems.gains", "appdyn.problems.dispersion",
     "appdyn.problems.ascent",
@@ -190,6 +191,17 @@ VALID = {
     "axis": lambda: np.array([0.0, 0.0, 1.0]),
     "angle": lambda: 0.5,
     "angles": lambda: np.array([0.1, 0.2, 0.3]),
+    "angle_rates": lambda: np.array([0.1, 0.2, 0.3]),
+    "transverse": lambda: 2.0,
+    "axial": lambda: 1.0,
+    "offset": lambda: np.array([0.1, 0.2, 0.3]),
+    "mass_flow": lambda: 10.0,
+    "initial_mass": lambda: 2.0,
+    "final_mass": lambda: 1.0,
+    "pellet_mass": lambda: 0.1,
+    "exhaust_velocity": lambda: 3000.0,
+    "l1": lambda: 0.0,
+    "l2": lambda: 1.0,
     "h": lambda: 0.1,
     "model": _rigid,
     "scene": lambda: __import__("appdyn.dynamics.scene", fromlist=["Scene"]).Scene(
@@ -381,6 +393,10 @@ OVERRIDES = {
                                                 "p": lambda: _constrained_symbols()[1]},
     "appdyn.dynamics.truth.axisymmetric": {"inertia_diag": lambda: np.array([1.0, 1.0, 2.0])},
     "appdyn.dynamics.truth.symmetric_precession": {"inertia_diag": lambda: np.array([1.0, 1.0, 2.0])},
+    "appdyn.dynamics.truth.misaligned_thrust": {"inertia_diag": lambda: np.array([1.0, 2.0, 2.0]),
+                                                "torque": lambda: 0.1},
+    "appdyn.dynamics.truth.horizontal_gyroscope": {"torque": lambda: 0.1},
+    "appdyn.dynamics.mass.jet_damping_torque": {"rate": lambda: 0.1},
     "appdyn.ocp.scenario_problem": {"T": lambda: 1.0, "x_initial": lambda: np.tile(
         np.array([[0.0], [0.0], [0.0], [1.0], [0.0], [0.0], [0.0]]), (1, 2))},
     "appdyn.dynamics.mechanisms.bead_motion": {"t": lambda: np.linspace(0.0, 1.0, 3)},
@@ -477,6 +493,8 @@ EXTRA = {
     "appdyn.problems.slew.cmg_slew": lambda: {"angle": 1.0, "axis": [0.0, 0.0, 1.0]},
     "appdyn.problems.slew.slew": lambda: {"angle": 1.0, "axis": [0.0, 0.0, 1.0]},
     "appdyn.problems.slew.scene_problem": lambda: {"angle": 1.0, "axis": [0.0, 0.0, 1.0], "T": 2.0},
+    "appdyn.dynamics.mass.delta_v": lambda: {"exhaust_velocity": 3000.0},
+    "appdyn.dynamics.mass.radius_of_gyration": lambda: {"axis": np.array([0.0, 0.0, 1.0])},
     "appdyn.problems.stability.sweep": lambda: {"inertia": np.diag([1.0, 2.0, 3.0]),
                                          "axis": np.array([0.0, 0.0, 1.0])},
 }

@@ -136,6 +136,17 @@ RANDOM = {
     # attitude and rigid bodies
     "inertia": inertia_matrices(),
     "inertia_diag": moments(),
+    "angle_rates": vectors(3),
+    "transverse": log_floats(1.0, 10.0),
+    "axial": log_floats(0.1, 2.0),  # <= 2 transverse: the triangle inequality
+    "offset": vectors(3, -1.0, 1.0),
+    "mass_flow": log_floats(0.1, 1e3),
+    "initial_mass": log_floats(2.0, 1e4),
+    "final_mass": log_floats(0.1, 2.0),
+    "pellet_mass": log_floats(1e-3, 1.0),
+    "exhaust_velocity": log_floats(100.0, 5000.0),
+    "l1": floats(-2.0, 2.0),
+    "l2": floats(-2.0, 2.0),
     "q": unit_quats,
     "p": unit_quats,
     "q0": unit_quats,
@@ -298,7 +309,24 @@ def _nonsingular_delta(draw):
     return d
 
 
+SPIN_RATES = st.tuples(log_floats(0.1, 10.0), floats(-0.05, 0.05), floats(-0.05, 0.05)).map(np.array)
 RANDOM_OVERRIDES = {
+    "appdyn.dynamics.attitude.euler321_rates": {"angles": st.tuples(
+        floats(-math.pi, math.pi), floats(-1.5, 1.5), floats(-math.pi, math.pi)).map(np.array)},
+    "appdyn.dynamics.attitude.euler313_rates": {"angles": st.tuples(
+        floats(-math.pi, math.pi), floats(0.05, 3.1), floats(-math.pi, math.pi)).map(np.array)},
+    "appdyn.dynamics.truth.coning_angle": {
+        "inertia_diag": distinct_moments().map(lambda m: np.sort(m)[::-1]),  # axis 1 the major
+        "w0": SPIN_RATES},
+    "appdyn.dynamics.truth.misaligned_thrust": {
+        "inertia_diag": st.tuples(log_floats(0.1, 10.0), log_floats(0.1, 10.0)).filter(
+            lambda ab: ab[0] < 2 * ab[1] * (1 - 1e-9) and abs(ab[0] - ab[1]) > 1e-3 * ab[1]).map(
+            lambda ab: np.array([ab[0], ab[1], ab[1]])),
+        "w0": SPIN_RATES, "torque": floats(-1.0, 1.0)},
+    "appdyn.dynamics.truth.floating_frame_accelerations": {"angles": st.tuples(
+        floats(-math.pi, math.pi), floats(0.05, 3.1), floats(-math.pi, math.pi)).map(np.array)},
+    "appdyn.dynamics.truth.horizontal_gyroscope": {"torque": floats(-1.0, 1.0)},
+    "appdyn.dynamics.mass.jet_damping_torque": {"rate": RATE},
     "appdyn.dynamics.attitude.quat_normalize": {"q": vectors(4, -3.0, 3.0).filter(
         lambda q: np.linalg.norm(q) > 1e-3)},
     "appdyn.dynamics.launch_vehicle": {"inertia": log_floats(1e6, 1e7), "mass": log_floats(2e4, 1e5)},

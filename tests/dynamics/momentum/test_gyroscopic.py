@@ -260,3 +260,21 @@ def test_docstring_examples_run():
     result = doctest.testmod(gyroscopic,
                              optionflags=doctest.NORMALIZE_WHITESPACE | doctest.ELLIPSIS)
     assert result.attempted > 0 and result.failed == 0
+
+
+def test_seed_bicycle_wheel_and_ore_crusher():
+    """Sec. 4.7 b Examples 2 and 3, from Eq. 4.152 ``L_R = -Omega x H``."""
+    # bicycle (x forward, y left, z up): the wheel's momentum points left; turning the
+    # handlebar to the left (Omega up) gives a torque about +x, which lifts the left side:
+    # the bicycle tilts to the right (homologous parallelism)
+    L = gyroscope_reaction_torque([0.0, 0.0, 0.5], [0.0, 2.0, 0.0])
+    np.testing.assert_allclose(L, [1.0, 0.0, 0.0], atol=1e-15)
+    # ore crusher: a roller of radius r on an arm l driven at Omega about the vertical rolls at
+    # w0 = Omega l / r about the arm; |L_R| = I1 Omega^2 l / r, pressing it onto the track
+    I1, Omega, arm, r = 40.0, 1.5, 1.2, 0.4
+    w0 = Omega * arm / r
+    # arm along +x, roller centre moving at Omega l along +y; rolling without slip on the floor
+    # (contact point at rest: w x (-r z) + Omega l y = 0) spins it about -x
+    L = gyroscope_reaction_torque([0.0, 0.0, Omega], [-I1 * w0, 0.0, 0.0])
+    assert np.linalg.norm(L) == pytest.approx(I1 * Omega**2 * arm / r, rel=1e-15)
+    assert L[1] > 0  # about +y: turns the arm's outer end (the roller) down, onto the track
