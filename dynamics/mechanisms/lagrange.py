@@ -102,7 +102,7 @@ def lagrange_terms(T, V, q, v, *, t=None, forces=(), velocity_potential=None):
 
 
 def generalized_forces(forces, q):
-    """Generalized forces of applied forces, ``Q_k = sum_i F_i . dr_i/dq_k`` (seed Eq. 5.26).
+    """Generalized forces of applied forces, ``Q_k = sum_i F_i^T dr_i/dq_k`` (seed Eq. 5.26).
 
     Parameters
     ----------
