@@ -62,4 +62,4 @@ assert res.success and error < 1e-8
 # The library draws the histogram of the peak nutation and the envelope of the nutation
 # history (median, percentile band, min-max band).
 fig = plt.figure(figsize=(10, 4))
-res.plot(fig=fig)
+res.plot(fig)

@@ -7,6 +7,7 @@ from typing import Mapping
 import numpy as np
 
 from appdyn.dynamics.serialize import jsonable, text_table, to_json
+from appdyn.dynamics.results import Result
 
 __all__ = ["GainDesign", "STATUS_UNSTABLE", "STATUS_LIMITS"]
 
@@ -16,8 +17,8 @@ STATUS_UNSTABLE = "Closed_Loop_Unstable"
 STATUS_LIMITS = "Limits_Not_Met"
 
 
-@dataclass(frozen=True, eq=False)
-class GainDesign:
+@dataclass(frozen=True, eq=False, repr=False)
+class GainDesign(Result):
     """Feedback gains designed by multi-scenario collocation, and their verification.
 
     Attributes
@@ -54,6 +55,8 @@ class GainDesign:
     verification: Mapping
     solution: object = field(repr=False, default=None)
 
+    _repr_fields = ('gains', 'cost')
+
     def __str__(self) -> str:
         rows = [("success", f"{self.success} ({self.status})")]
         rows += [(f"{k} [{self.units.get(k, '-')}]", f"{v:.6g}") for k, v in self.gains.items()]
@@ -76,6 +79,3 @@ class GainDesign:
                          "scenarios": [{"peak": dict(s.get("peak", {}))} for s in self.scenarios],
                          "verification": dict(self.verification)})
 
-    def to_json(self) -> str:
-        """`to_dict` as strict JSON."""
-        return to_json(self.to_dict())

@@ -31,6 +31,7 @@ from appdyn.problems.dispersion.result import ALL_FAILED, ALL_OK, SOME_FAILED
 from .maneuvers import min_effort, time_optimal
 from .targets import check_u_max
 from .targets import targets as target_attitude
+from appdyn.dynamics.results import Result
 
 __all__ = ["maneuver_table", "ManeuverTable", "Target", "check_targets", "example_targets",
            "solve_target", "OBJECTIVES", "ALL_OK", "SOME_FAILED", "ALL_FAILED"]
@@ -146,8 +147,8 @@ def example_targets() -> list:
 
 
 # ---------------------------------------------------------------------------- result
-@dataclass(frozen=True, eq=False)
-class ManeuverTable:
+@dataclass(frozen=True, eq=False, repr=False)
+class ManeuverTable(Result):
     """Outcome of `maneuver_table`: one row per finished target, in catalogue order.
 
     Arrays are **targets first**: row ``k`` belongs to target ``index[k]``.
@@ -223,6 +224,8 @@ class ManeuverTable:
     complete: bool = True
 
     # ------------------------------------------------------------------ verdict
+    _repr_fields = ('objective', 'names', 'T')
+
     @property
     def status(self) -> int:
         """`ALL_OK`, `SOME_FAILED` or `ALL_FAILED` over the finished rows."""
@@ -279,10 +282,6 @@ class ManeuverTable:
             "objective": self.objective, "inertia": self.inertia, "u_max": self.u_max,
             "T_fixed": self.T_fixed, "total": self.total, "complete": self.complete,
             "executor": self.executor, "wall_time": self.wall_time, "rows": self.rows()})
-
-    def to_json(self) -> str:
-        """`to_dict` as strict JSON (non-finite numbers as ``null``)."""
-        return to_json(self.to_dict())
 
     def format(self) -> str:
         """The table as text: a header, then one line per target (angles in degrees)."""

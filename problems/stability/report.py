@@ -13,7 +13,6 @@ closed forms (Rheinfurth & Wilson, NASA RP-1262, Secs. 4.5-4.6):
 """
 from __future__ import annotations
 
-import json
 import math
 from dataclasses import asdict, dataclass, field
 from typing import Mapping, Sequence
@@ -25,6 +24,7 @@ from appdyn.dynamics.linearize import Linearization
 from .common import (axes_or_new_figure, finish_figure, format_number, jsonable, param_text,
                      plain)
 from .verdict import ZERO_RTOL, classify, least_damped
+from appdyn.dynamics.results import Result
 
 __all__ = ["Mode", "Margins", "Quantity", "StabilityReport", "build_report", "analyze",
            "STATUS_VERIFIED", "STATUS_UNCHECKED", "STATUS_MISMATCH", "CLOSED_FORM_RTOL",
@@ -137,8 +137,8 @@ class Quantity:
     equation: str = ""
 
 
-@dataclass(frozen=True)
-class StabilityReport:
+@dataclass(frozen=True, repr=False)
+class StabilityReport(Result):
     """Linear stability of one case.
 
     Attributes
@@ -203,6 +203,8 @@ class StabilityReport:
     closed_form_error: float | None = None
     notes: tuple = ()
     linearization: Linearization | None = field(default=None, repr=False, compare=False)
+
+    _repr_fields = ('case', 'verdict', 'eigenvalues')
 
     def __getstate__(self) -> dict:
         """Pickled state: the fields, ``ss`` as its matrices and names (python-control's
@@ -273,10 +275,6 @@ class StabilityReport:
             "notes": list(self.notes),
         })
 
-    def to_json(self) -> str:
-        """`to_dict` as strict JSON text."""
-        return json.dumps(self.to_dict(), indent=2, allow_nan=False)
-
     def __str__(self) -> str:
         lines = [self.title]
         width = max([len(k) for k in self.parameters] + [5])
@@ -319,13 +317,11 @@ class StabilityReport:
             lines.append(f"note: {n}")
         return "\n".join(lines)
 
-    def plot(self, path=None, *, ax=None):
+    def plot(self, ax=None):
         """Pole map: eigenvalues, closed forms and mode labels.
 
         Parameters
         ----------
-        path : str or path-like, optional
-            Also save the figure there (format from the suffix; PNG without one).
         ax : matplotlib.axes.Axes, optional
             Draw on these axes; by default on a new `matplotlib.figure.Figure` (no pyplot,
             the backend is left alone).
@@ -356,7 +352,7 @@ class StabilityReport:
         ax.set_title(f"{self.title}\n{self.verdict}", fontsize=10)
         ax.grid(True, alpha=0.3)
         ax.legend(loc="lower left", fontsize=8)
-        return finish_figure(fig, path)
+        return finish_figure(fig)
 
 
 def _ss_data(ss) -> dict:
