@@ -11,7 +11,7 @@ from pathlib import Path
 import numpy as np
 
 __all__ = ["new_figure", "cleared_figure", "axes_or_new_figure", "finish_figure", "unit_groups",
-           "plot_signals", "panel_grid", "panel_axes"]
+           "plot_signals", "panel_grid", "panel_axes", "plot_attitude"]
 
 
 def new_figure(figsize=(8.0, 5.0)):
@@ -133,9 +133,10 @@ def plot_signals(t, series, units=None, *, bounds=None, ax=None, title=None, fig
         y label names it.
     bounds : mapping of str to (float, float), optional
         Drawn as dashed horizontal lines (infinite bounds skipped).
-    ax : matplotlib.axes.Axes or sequence of Axes, optional
-        Draw on these: one axes draws every group on it; a sequence needs one per unit group.
-        By default a new `matplotlib.figure.Figure` with one row per group.
+    ax : matplotlib.axes.Axes, sequence of Axes or matplotlib.figure.Figure, optional
+        Draw on these: one axes draws every group on it; a sequence needs one per unit group;
+        a figure is cleared and gets one row per group, as does the new
+        `matplotlib.figure.Figure` made by default.
     title : str, optional
         The figure's title.
     figsize : (float, float), optional
@@ -158,8 +159,9 @@ def plot_signals(t, series, units=None, *, bounds=None, ax=None, title=None, fig
     bounds = dict(bounds or {})
     groups = unit_groups(list(series), units)
     t = np.asarray(t, dtype=float)
-    if ax is None:
-        fig = new_figure(figsize or (8.0, max(2.6, 2.4 * len(groups))))
+    if ax is None or type(ax).__name__ in ("Figure", "SubFigure"):
+        fig = new_figure(figsize or (8.0, max(2.6, 2.4 * len(groups)))) if ax is None else ax
+        fig.clear()
         axes = list(fig.subplots(len(groups), 1, sharex=True, squeeze=False)[:, 0])
     else:
         axes = list(np.ravel(np.asarray(ax, dtype=object)))
@@ -187,3 +189,78 @@ def plot_signals(t, series, units=None, *, bounds=None, ax=None, title=None, fig
         fig.suptitle(title, fontsize=10)
     fig.tight_layout()
     return fig
+
+
+def plot_attitude(t, x, u, model, *, u_bounds=None, ax=None, title=None):
+    """An attitude motion: quaternion, body rates, controls (bounds dashed) and the rotation
+    path (the body axes on the unit sphere, inertial frame).
+
+    Parameters
+    ----------
+    t : array_like, shape (n,) [s]
+    x : array_like, shape (nx, n)
+        States of ``model`` (its ``attitude`` locates the quaternion and the body rates).
+    u : array_like, shape (nu, n)
+        Controls of ``model``, drawn grouped by unit (`Model.units`).
+    model : Model
+        With an ``attitude``.
+    u_bounds : array_like, shape (2, nu), optional
+        Lower and upper control bounds (``+-inf`` for none), dashed.
+    ax : matplotlib.axes.Axes or matplotlib.figure.Figure, optional
+        Draw the four panels in this axes' slot or on this figure (cleared); by default on a
+        new `matplotlib.figure.Figure`.
+    title : str, optional
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from appdyn.dynamics import rigid_body
+    >>> from appdyn.dynamics.figures import plot_attitude
+    >>> t = np.linspace(0.0, 1.0, 3)
+    >>> x = np.tile([[0.0], [0.0], [0.0], [1.0], [0.0], [0.0], [0.0]], (1, 3))
+    >>> fig = plot_attitude(t, x, np.zeros((3, 3)), rigid_body([1.0, 2.0, 3.0]))
+    >>> [a.get_ylabel() for a in fig.axes[:3]]
+    ['quaternion [-]', 'body rate [rad/s]', 'control [N m]']
+    """
+    from .attitude import dcm_from_quat
+
+    if model.attitude is None:
+        raise ValueError(f"`model` {model.name!r} has no attitude (quaternion and body rates)")
+    t, x, u = (np.asarray(v, dtype=float) for v in (t, x, u))
+    iq, iw = model.attitude
+    q, w = x[iq:iq + 4], x[iw:iw + 3]
+    fig, grid = panel_grid(ax, 2, 2, (12.0, 8.0))
+    controls = list(model.controls)
+    units = {c: model.units.get(c) or "-" for c in controls}
+    unit = units[controls[0]] if controls and len(set(units.values())) == 1 else "mixed units"
+    bounds = np.full((2, len(controls)), np.inf) * [[-1], [1]] if u_bounds is None else \
+        np.asarray(u_bounds, dtype=float)
+    panels = [(q, "quaternion [-]", [model.states[iq + i] for i in range(4)], None),
+              (w, f"body rate [{model.units.get(model.states[iw]) or 'rad/s'}]",
+               [model.states[iw + i] for i in range(3)], None),
+              (u, f"control [{unit}]", controls, bounds)]
+    for k, (data, label, names, lim) in enumerate(panels):
+        a = fig.add_subplot(grid[k // 2, k % 2])
+        for j, (row, name) in enumerate(zip(np.atleast_2d(data), names)):
+            line, = a.plot(t, row, label=name)
+            for v in ([] if lim is None else lim[:, j]):
+                if np.isfinite(v):
+                    a.axhline(v, color=line.get_color(), ls="--", lw=0.8, alpha=0.7)
+        a.set(xlabel="t [s]", ylabel=label)
+        a.legend(loc="best", fontsize=8)
+        a.grid(alpha=0.3)
+    a = fig.add_subplot(grid[1, 1], projection="3d")
+    A = dcm_from_quat(q / np.linalg.norm(q, axis=0))  # (3, 3, n): rows = body axes
+    for i, c in enumerate(("tab:red", "tab:green", "tab:blue")):
+        a.plot(A[i, 0], A[i, 1], A[i, 2], color=c, label=f"body axis {i + 1}")
+        a.scatter(*A[i, :, -1], color=c, marker="o")
+    a.set(title="Rotation path (inertial)", xlim=(-1, 1), ylim=(-1, 1), zlim=(-1, 1),
+          xlabel="x [-]", ylabel="y [-]", zlabel="z [-]")
+    a.legend(fontsize=8)
+    if title:
+        fig.suptitle(title, fontsize=10)
+    return finish_figure(fig)

@@ -153,6 +153,8 @@ def summarize(value, width: int = 72) -> str:
             text = f"{type(value).__name__} of {len(value)}"
     elif value is None:
         text = "None"
+    elif isinstance(getattr(value, "name", None), str):
+        text = f"<{type(value).__name__} {value.name!r}>"
     else:
         text = f"<{type(value).__name__}>"
     text = " ".join(text.split())

@@ -136,10 +136,8 @@ class DesignPrintout:
         return out
 
     def plot(self):
-        """`problems.gains.launch_vehicle.plot_design`."""
-        from appdyn.problems.gains.launch_vehicle import plot_design
-
-        return plot_design(self.design)
+        """`GainDesign.plot`."""
+        return self.design.plot()
 
 
 def run(args) -> int:
