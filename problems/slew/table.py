@@ -307,6 +307,40 @@ class ManeuverTable(Result):
 
     __str__ = format
 
+    def plot(self, ax=None):
+        """The maneuver time (or cost) of each target against its rotation angle [deg],
+        failed rows marked; a time-optimal table of a bang-bang body follows
+        ``T = 2 sqrt(theta / alpha)``.
+
+        Parameters
+        ----------
+        ax : matplotlib.axes.Axes, optional
+            Draw on these axes; by default on a new `matplotlib.figure.Figure` (no pyplot).
+
+        Returns
+        -------
+        matplotlib.figure.Figure
+        """
+        from appdyn.dynamics.figures import axes_or_new_figure, finish_figure
+
+        fig, ax = axes_or_new_figure(ax, (7.0, 4.5))
+        y = self.T if self.objective == "time" else self.cost
+        ok = np.asarray(self.row_success, dtype=bool)
+        deg = np.degrees(self.angles)
+        ax.plot(deg[ok], y[ok], "o", color="tab:blue", label="solved")
+        if not ok.all():
+            ax.plot(deg[~ok], y[~ok], "x", color="tab:red", ms=9, label="failed")
+        for name, a, v in zip(self.names, deg, y):
+            ax.annotate(name, (a, v), textcoords="offset points", xytext=(5, 4), fontsize=8)
+        what = "minimum time" if self.objective == "time" else \
+            f"minimum effort over T = {self.T_fixed:g} s"
+        ax.set(xlabel="rotation angle [deg]",
+               ylabel="T [s]" if self.objective == "time" else "cost [N^2 m^2 s]",
+               title=f"Maneuver table ({what}): {int(ok.sum())} of {self.total} solved")
+        ax.grid(True, alpha=0.3)
+        ax.legend(fontsize=8)
+        return finish_figure(fig)
+
 
 # ---------------------------------------------------------------------------- driver
 def solve_target(objective: str, inertia, target: dict, T, u_max, options: dict):
