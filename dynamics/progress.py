@@ -16,10 +16,11 @@ work as ``with progress_reporter(progress, "simulate") as report: ...``.
 from __future__ import annotations
 
 import contextlib
+import functools
 import sys
 import time
 
-__all__ = ["TextBar", "progress_reporter", "check_progress"]
+__all__ = ["TextBar", "progress_reporter", "check_progress", "accepts_progress_bar"]
 
 
 def check_progress(progress, name: str = "progress"):
@@ -152,3 +153,31 @@ def progress_reporter(progress, label: str):
         bar.close()
 
 
+
+
+def accepts_progress_bar(label: str):
+    """Decorator: the function's keyword ``progress`` may also be ``True`` (a bar labelled
+    ``label``, closed when the call returns); the function itself sees a callable or None.
+
+    Examples
+    --------
+    >>> from appdyn.dynamics.progress import accepts_progress_bar
+    >>> @accepts_progress_bar("count")
+    ... def count(n, *, progress=None):
+    ...     for k in range(n):
+    ...         if progress is not None:
+    ...             progress(k + 1, n)
+    ...     return n
+    >>> count(3, progress=lambda d, t: print(d, t))
+    1 3
+    2 3
+    3 3
+    3
+    """
+    def wrap(fun):
+        @functools.wraps(fun)
+        def call(*args, progress=None, **kwargs):
+            with progress_reporter(progress, label) as report:
+                return fun(*args, progress=report, **kwargs)
+        return call
+    return wrap

@@ -182,16 +182,19 @@ def test_solutions_of_the_collocation_engine():
     check_plot(sol)
 
 
-def test_dispersion_result():
+def test_dispersion_result(capsys):
     from appdyn.problems.dispersion import Normal, dispersion, spinner
 
     res = dispersion(spinner, [0, 0, 0, 1, 0.0, 0.0, 1.0], np.linspace(0.0, 2.0, 5), samples=4,
+                     progress=True,
                      seed=0, params={"w1": Normal(0.02, 0.004),
                                      "transverse_inertia": Normal(1000.0, 20.0),
                                      "axial_inertia": Normal(1500.0, 30.0)},
                      outputs={"w1_final": lambda res: res["w1"][-1]})
     check_protocol(res)
     check_plot(res)
+    out, err = capsys.readouterr()
+    assert out == "" and "dispersion |" in err and "100% 4/4" in err  # progress=True: a bar
 
 
 @pytest.mark.slow

@@ -23,6 +23,7 @@ import numpy as np
 
 from appdyn.dynamics.attitude import axis_angle_from_quat, quat_conj, quat_mul
 from appdyn.dynamics.executors import check_executor, gather
+from appdyn.dynamics.progress import accepts_progress_bar
 from appdyn.dynamics.interrupts import check_interrupt, interruptible
 from appdyn.dynamics.serialize import jsonable, text_table, to_json
 from appdyn.dynamics.validate import check_inertia, finite_array, one_of, positive, unit_quaternion
@@ -363,6 +364,7 @@ def _check_options(objective, options: dict) -> dict:
     return dict(options)
 
 
+@accepts_progress_bar("maneuver_table")
 @interruptible
 def maneuver_table(inertia, targets, *, objective: str = "time", T=None, u_max=1.0,
                    executor: Executor | None = None,
@@ -393,8 +395,9 @@ def maneuver_table(inertia, targets, *, objective: str = "time", T=None, u_max=1
         a `KeepOut` and a guess `ocp.Solution` pickle); each worker builds its own NLPs.
         With the ``spawn`` start method the calling script needs the usual
         ``if __name__ == "__main__":`` guard.
-    progress : callable, optional
-        ``progress(done, total)`` in this thread after each finished target.
+    progress : bool or callable, optional
+        ``True``: a bar on stderr (`dynamics.progress`); a callable: ``progress(done,
+        total)`` in this thread after each finished target.
     **options
         Passed to `time_optimal` or `min_effort` for every target: ``N``, ``starts``,
         ``ipopt_options``, ``q0``, ``norm_bound``, ``keep_out``, ``pointing_tol``, ...
