@@ -31,10 +31,9 @@ def _config_file(text):
 
 
 def _example() -> str:
-    """Path of the example configuration installed with the package."""
-    from appdyn.problems.gains.config import EXAMPLE_CONFIG
-
-    return str(EXAMPLE_CONFIG)
+    """Path of the example configuration installed with the package
+    (`problems.gains.config.EXAMPLE_CONFIG`, found without importing the gains package)."""
+    return str(Path(__file__).resolve().parents[1] / "gains" / "launch_vehicle.toml")
 
 
 def add_parser(subparsers) -> argparse.ArgumentParser:
