@@ -428,13 +428,14 @@ class SteeringResult(Result):
 
     def __str__(self) -> str:
         n = self.geometry.n
-        limit = "" if self.rate_limit is None else f" (limit {self.rate_limit:g} rad/s)"
+        limit = "" if self.rate_limit is None else \
+            f" (limit {np.degrees(self.rate_limit):.6g} deg/s)"
         rows = [("success", f"{self.success} (status {self.status})"),
                 ("law", self._law_text()),
                 ("run", f"{n} gimbals, t = {self.t[0]:g} .. {self.t[-1]:g} s, {self.t.size} "
                         f"points, rk8 {self.steps} step(s) per interval"),
                 ("min measure", f"{self.min_measure:.4g} (N m s)^3"),
-                ("max gimbal rate", f"{self.max_rate:.4g} rad/s{limit}"),
+                ("max gimbal rate", f"{np.degrees(self.max_rate):.4g} deg/s{limit}"),
                 ("max torque error", f"{self.max_torque_error:.4g} N m"),
                 ("momentum balance", f"{self.max_momentum_error:.3g} N m s"),
                 ("wall time", f"{self.wall_time:.3f} s"),

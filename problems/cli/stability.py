@@ -123,7 +123,9 @@ def _items(fields):
 def _part(name):
     """The launch-vehicle part class ``name``, imported when an option value is parsed (not
     when the parser is built: ``appdyn --help`` stays light)."""
-    from appdyn.dynamics import launch_vehicle
+    import importlib
+
+    launch_vehicle = importlib.import_module("appdyn.dynamics.launch_vehicle")
 
     return getattr(launch_vehicle, name)
 

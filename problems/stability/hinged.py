@@ -17,7 +17,7 @@ from appdyn.dynamics.hinged import hinged_scene
 from appdyn.dynamics.scene import Scene
 
 from .closed_forms import axis_kind, principal_moments, rigid_spin_lambda2
-from .common import check_number
+from .common import check_number, spectrum_text
 from .report import Quantity, StabilityReport, build_report
 from .spin_scene import attitude_subsystem, spin_linearization
 
@@ -236,7 +236,7 @@ def hinged_spin(*, m1, inertia1, m2, inertia2, r1, r2, rate, kind="revolute",
              "the hinge angle (theta, or the twist q3_rel of the relative quaternion q_rel = "
              "p; q4_rel its norm) is cyclic: a family of relative equilibria",
              f"unreduced spectrum ({lin.n} states): "
-             + ", ".join(f"{z.real:+.3e}{z.imag:+.6e}j" for z in lin.eigenvalues()),
+             + spectrum_text(lin.eigenvalues()),
              *red.notes, *sl.notes]
     title = (f"Hinged pair ({kind} hinge) spinning about the common axis z at "
              f"{W:.6g} rad/s")

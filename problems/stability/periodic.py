@@ -41,7 +41,7 @@ from appdyn.dynamics.mechanisms import shaken_pendulum as shaken_model
 from appdyn.dynamics.results import Result
 
 from .common import (STANDARD_GRAVITY, check_number, finish_figure, format_number, jsonable,
-                     param_text, plain)
+                     param_line, plain)
 from .report import (CLOSED_FORM_RTOL, STATUS_MISMATCH, STATUS_UNCHECKED, STATUS_VERIFIED,
                      Quantity, StabilityReport)
 
@@ -162,7 +162,7 @@ class PeriodicStabilityReport(Result):
 
     def __str__(self) -> str:
         lines = [self.title]
-        lines += [f"  {k:<9}  {param_text(v)}" for k, v in self.parameters.items()]
+        lines += [f"  {k:<9}  {param_line(k, v)}" for k, v in self.parameters.items()]
         lines.append(f"  period     {self.period:.10g} s; states {', '.join(self.states)}")
         lines.append(f"verdict: {self.verdict.upper()} — {self.reason} (closed-form "
                      f"prediction: {self.predicted or '-'})")
