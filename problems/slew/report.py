@@ -122,6 +122,7 @@ def summary(solution: Solution, *, eigenaxis=None) -> dict:
     """JSON-ready summary of a slew solution.
 
     Keys: success, status, message, T [s], cost, switch_times [s] (per torque axis),
+    controls (their names, the model's: ``L1..L3`` for a body torque),
     iterations, solve_time [s], constraint_violation (NLP units, see `ocp.solve`),
     pointing_error_arcsec (final attitude error of the re-simulated control [arcsec]),
     final_rate_error [rad/s] (same re-simulation), propagation_error (largest deviation of
@@ -162,6 +163,7 @@ def summary(solution: Solution, *, eigenaxis=None) -> dict:
         T=float(solution.T),
         cost=float(solution.cost),
         switch_times=[s.tolist() for s in sw],
+        controls=list(solution.problem.model.controls),
         iterations=int(solution.iterations),
         solve_time=float(solution.solve_time),
         constraint_violation=float(solution.constraint_violation),
@@ -204,9 +206,9 @@ def format_summary(data: dict) -> str:
       success                   True (Solve_Succeeded)
       maneuver time T [s]       0.632456
       cost                      0.6324555...
-      switch times u1 [s]       -
-      switch times u2 [s]       -
-      switch times u3 [s]       0.3162
+      switch times L1 [s]       -
+      switch times L2 [s]       -
+      switch times L3 [s]       0.3162
       IPOPT iterations          ...
     """
     if not isinstance(data, Mapping):
@@ -221,8 +223,9 @@ def format_summary(data: dict) -> str:
     if "eigenaxis_T" in data:
         rows.append(("eigenaxis maneuver T [s]", f"{data['eigenaxis_T']:.6f}"))
     rows.append(("cost", f"{data['cost']:.8g}"))
-    for i, s in enumerate(data["switch_times"]):
-        rows.append((f"switch times u{i + 1} [s]", ", ".join(f"{v:.4f}" for v in s) or "-"))
+    names = data.get("controls") or [f"L{i + 1}" for i in range(len(data["switch_times"]))]
+    for name, s in zip(names, data["switch_times"]):
+        rows.append((f"switch times {name} [s]", ", ".join(f"{v:.4f}" for v in s) or "-"))
     rows += [
         ("IPOPT iterations", f"{data['iterations']}"),
         ("solve time [s]", f"{data['solve_time']:.3f}"),
