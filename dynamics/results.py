@@ -128,7 +128,9 @@ def summarize(value, width: int = 72) -> str:
     >>> summarize(np.zeros((7, 101)))
     'array(shape=(7, 101), float64)'
     >>> summarize({"w1": 1.0, "w2": 2.0})
-    "{'w1', 'w2'}"
+    "{'w1': 1, 'w2': 2}"
+    >>> summarize({"t": np.zeros(3), "x": np.zeros((2, 3))})
+    "{'t', 'x'}"
     >>> summarize(0.012345678)
     '0.0123457'
     """
@@ -143,6 +145,10 @@ def summarize(value, width: int = 72) -> str:
         text = str(int(value))
     elif isinstance(value, str):
         text = repr(value)
+    elif hasattr(value, "keys") and hasattr(value, "__getitem__") and len(value) <= 4 and all(
+            isinstance(v, (int, float, np.number)) and not isinstance(v, bool)
+            for v in value.values()):
+        text = "{" + ", ".join(f"{k!r}: {float(v):.6g}" for k, v in value.items()) + "}"
     elif hasattr(value, "keys") and hasattr(value, "__getitem__"):
         keys = list(value.keys())
         text = "{" + ", ".join(repr(k) for k in keys[:8]) + (", ..." if len(keys) > 8 else "") + "}"

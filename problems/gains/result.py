@@ -114,7 +114,7 @@ class GainDesign(Result):
             axes[0].text(0.5, 0.5, f"no scenario to draw: {self.message}", ha="center",
                          va="center", transform=axes[0].transAxes, wrap=True, fontsize=8)
         axes[-1].set_xlabel("t [s]")
-        gains = ", ".join(f"{k} = {v:.4g} {self.units.get(k, '')}".rstrip()
+        gains = ", ".join(f"{k} = {v:.4g} {self.units.get(k, '').strip('-')}".rstrip()
                           for k, v in self.gains.items())
         fig.suptitle(f"Gain design ({'verified' if self.success else 'not verified'}): "
                      f"{gains}", fontsize=9)
