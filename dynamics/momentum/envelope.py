@@ -291,6 +291,24 @@ class MomentumEnvelope(Result):
 
     _repr_fields = ('directions', 'extent')
 
+    @property
+    def success(self) -> bool:
+        """The saturation envelope has points and every point is finite."""
+        return bool(self.points.get(0, np.zeros((3, 0))).size
+                    and all(np.all(np.isfinite(p)) for p in self.points.values()))
+
+    @property
+    def status(self) -> int:
+        """0 when `success`, -1 otherwise."""
+        return 0 if self.success else -1
+
+    @property
+    def message(self) -> str:
+        """`status` in words."""
+        n = sum(p.shape[1] for p in self.points.values())
+        return (f"{n} singular points in {len(self.points)} group(s)" if self.success else
+                "the saturation envelope has no points or non-finite ones")
+
     def max_momentum(self, axis) -> float:
         """Largest projection ``max axis.H`` of the envelope along a unit ``axis`` [N m s].
 
@@ -359,7 +377,8 @@ class MomentumEnvelope(Result):
                        if c[kind]}
             groups[str(k)] = {**c, "max_norm": float(norms.max()) if norms.size else None,
                               "H": by_kind}
-        return {"n": geo.n, "h": geo.h, "gimbal_axes": geo.gimbal_axes,
+        return {"success": self.success, "status": self.status, "message": self.message,
+                "n": geo.n, "h": geo.h, "gimbal_axes": geo.gimbal_axes,
                 "spin_axes0": geo.spin_axes0, "directions": self.directions,
                 "extent": self.extent, "wall_time": self.wall_time, "groups": groups}
 

@@ -69,6 +69,13 @@ class GainDesign(Result):
 
     _repr_fields = ('gains', 'cost')
 
+    @property
+    def wall_time(self) -> float:
+        """Time of the design [s]: ``verification['design_time']`` (or the NLP's
+        ``'solve_time'``); NaN when neither was recorded."""
+        v = self.verification
+        return float(v.get("design_time", v.get("solve_time", float("nan"))))
+
     def plot(self, ax=None):
         """Every re-simulated scenario against time, one panel per signal, limits dashed.
 
