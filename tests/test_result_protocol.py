@@ -213,3 +213,16 @@ def test_quantity_cleans_round_off_and_keeps_significant_digits():
     assert quantity(-7.2e-71 - 1.5j, "1/s", 5) == "0-1.5j 1/s"
     assert quantity(math.inf, "dB", 4) == "inf dB"
     assert clean_number(-0.0) == 0.0 and math.copysign(1, clean_number(-0.0) + 0.0) == 1
+
+
+@pytest.mark.slow
+def test_planar_ascent_and_its_tracking():
+    from appdyn.problems.ascent import fly_pitch_program, planar_ascent
+
+    asc = planar_ascent(target_altitude=65e3, target_gamma=math.radians(40.0), q_max=45e3,
+                        qalpha_max=2e3, N=30)
+    check_protocol(asc)
+    check_plot(asc)
+    track = fly_pitch_program(asc)
+    check_protocol(track)
+    check_plot(track)
