@@ -6,11 +6,9 @@ Library code never selects a backend or touches pyplot's global state (python-co
 """
 from __future__ import annotations
 
-from pathlib import Path
-
 import numpy as np
 
-__all__ = ["new_figure", "cleared_figure", "axes_or_new_figure", "finish_figure", "unit_groups",
+__all__ = ["new_figure", "axes_or_new_figure", "finish_figure", "unit_groups",
            "plot_signals", "panel_grid", "panel_axes", "plot_attitude"]
 
 
@@ -26,13 +24,6 @@ def new_figure(figsize=(8.0, 5.0)):
     from matplotlib.figure import Figure
 
     return Figure(figsize=figsize)
-
-
-def cleared_figure(fig, figsize):
-    """``fig`` cleared for a multi-panel plot, or a new Figure of ``figsize`` [in]."""
-    fig = new_figure(figsize) if fig is None else fig
-    fig.clear()
-    return fig
 
 
 def axes_or_new_figure(ax, figsize):
@@ -95,13 +86,10 @@ def panel_axes(ax, nrows: int, ncols: int, figsize, **subplot_kw):
     return fig, axes
 
 
-def finish_figure(fig, path=None):
-    """Lay ``fig`` out, save it to ``path`` if given (PNG unless the suffix says pdf or svg),
-    and return it."""
+def finish_figure(fig):
+    """Lay ``fig`` out and return it (the caller saves it: only the command line writes
+    files)."""
     fig.tight_layout()
-    if path is not None:
-        suffix = Path(path).suffix.lower().lstrip(".")
-        fig.savefig(path, dpi=110, format=suffix if suffix in ("png", "pdf", "svg") else "png")
     return fig
 
 
