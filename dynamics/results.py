@@ -31,15 +31,17 @@ Rules for a new result class
 """
 from __future__ import annotations
 
+import functools
 import html
 import math
-from dataclasses import fields, is_dataclass
+import time
+from dataclasses import fields, is_dataclass, replace
 
 import numpy as np
 
 from .serialize import to_json
 
-__all__ = ["Result", "quantity", "summarize", "clean_number"]
+__all__ = ["Result", "quantity", "summarize", "clean_number", "timed"]
 
 #: at most this many lines in a result's repr
 REPR_LINES = 10
@@ -254,6 +256,35 @@ class Result:
                        for k, v in self._repr_items())
         return (f"<div><b>{html.escape(type(self).__name__)}</b>"
                 f"<table>{rows}</table></div>")
+
+
+def timed(fun):
+    """Decorator: the result of ``fun`` gets the call's time as ``wall_time`` [s] when its
+    ``wall_time`` field is NaN (not measured inside).
+
+    Examples
+    --------
+    >>> import math
+    >>> from dataclasses import dataclass
+    >>> from appdyn.dynamics.results import Result, timed
+    >>> @dataclass(frozen=True, repr=False)
+    ... class Out(Result):
+    ...     success: bool = True
+    ...     wall_time: float = math.nan
+    >>> @timed
+    ... def job():
+    ...     return Out()
+    >>> math.isfinite(job().wall_time)
+    True
+    """
+    @functools.wraps(fun)
+    def call(*args, **kwargs):
+        start = time.perf_counter()
+        out = fun(*args, **kwargs)
+        if is_dataclass(out) and "wall_time" in _field_names(out) and math.isnan(out.wall_time):
+            out = replace(out, wall_time=time.perf_counter() - start)
+        return out
+    return call
 
 
 def _field_names(obj) -> tuple:

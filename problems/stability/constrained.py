@@ -38,6 +38,7 @@ from appdyn.dynamics import cache
 from appdyn.dynamics.linearize import linearization
 from appdyn.dynamics.mechanisms import SEQUENCES, conical_rate, spherical_pendulum
 from appdyn.dynamics.model import Model
+from appdyn.dynamics.results import timed
 
 from .common import STANDARD_GRAVITY, check_number, spectrum_text
 from .report import Quantity, StabilityReport, build_report
@@ -115,6 +116,7 @@ def _check(mass, length, inertia, gravity, cone_angle):
     return m, l, I, g, a
 
 
+@timed
 def conical_pendulum(*, mass, length, cone_angle, inertia=0.0, gravity=STANDARD_GRAVITY,
                      sequence="3-2-1") -> StabilityReport:
     """Stability of the conical pendulum: steady precession at the cone half-angle

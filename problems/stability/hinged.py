@@ -15,6 +15,7 @@ import numpy as np
 
 from appdyn.dynamics.hinged import hinged_scene
 from appdyn.dynamics.scene import Scene
+from appdyn.dynamics.results import timed
 
 from .closed_forms import axis_kind, principal_moments, rigid_spin_lambda2
 from .common import check_number, spectrum_text
@@ -123,6 +124,7 @@ def ball_tilt_eigenvalues(m1, A1, C1, m2, A2, C2, l1, l2, rate) -> np.ndarray:
     return np.array([s * 1j * f for f in freqs for s in (1, -1)])
 
 
+@timed
 def hinged_spin(*, m1, inertia1, m2, inertia2, r1, r2, rate, kind="revolute",
                 axis=None) -> StabilityReport:
     """Stability of two hinged bodies (`dynamics.hinged.hinged_bodies`) spinning together at

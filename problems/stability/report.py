@@ -168,6 +168,8 @@ class StabilityReport(Result):
     notes : tuple of str
     linearization : Linearization or None
         The full linearization before reduction.
+    wall_time : float [s]
+        Time of the call that made the report (NaN when built directly).
     success : bool
         ``status != STATUS_MISMATCH`` (property).
     status : int
@@ -203,6 +205,7 @@ class StabilityReport(Result):
     closed_form_error: float | None = None
     notes: tuple = ()
     linearization: Linearization | None = field(default=None, repr=False, compare=False)
+    wall_time: float = field(default=math.nan, compare=False)
 
     _repr_fields = ('case', 'verdict', 'eigenvalues')
 

@@ -8,6 +8,7 @@ import numpy as np
 from appdyn.dynamics.executors import check_executor, gather
 from appdyn.dynamics.progress import accepts_progress_bar
 from appdyn.dynamics.interrupts import check_interrupt, interruptible
+from appdyn.dynamics.results import timed
 
 from .cases import resolve_case
 from .common import plain
@@ -19,6 +20,7 @@ _STABLE_UNSTABLE = {"asymptotically stable", "unstable"}
 _BAND_RTOL = 1e-4  # a "marginally stable" stretch this narrow between the two is a zero band
 
 
+@timed
 @accepts_progress_bar("sweep")
 @interruptible
 def sweep(case, parameter: str, values, *, rtol: float = 1e-8, progress=None, executor=None,

@@ -1,7 +1,7 @@
 """The result of `problems.stability.sweep`: `SweepResult` and its `Boundary` entries."""
 from __future__ import annotations
 
-from dataclasses import asdict, dataclass
+from dataclasses import asdict, dataclass, field
 
 import numpy as np
 
@@ -66,6 +66,8 @@ class SweepResult(Result):
     complete : bool
         False for the partial result of an interrupted sweep (`sweep`, Ctrl-C): the grid
         values evaluated before the interrupt, and the boundaries located by then.
+    wall_time : float [s]
+        Time of the `sweep` call (NaN when built directly).
     success : bool
         False when some report disagreed with its closed forms (property).
     status : int
@@ -86,6 +88,7 @@ class SweepResult(Result):
     case_kwargs: dict
     statuses: tuple = ()
     complete: bool = True
+    wall_time: float = field(default=float("nan"), compare=False)
 
     _repr_fields = ('case', 'parameter', 'values', 'boundaries')
 
