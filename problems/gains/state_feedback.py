@@ -217,7 +217,7 @@ def _is_system(value) -> bool:
     return hasattr(value, "A") and hasattr(value, "B") and not isinstance(value, np.ndarray)
 
 
-def state_feedback_gains(A, B, Q, R, initial_states=None, horizon=None, *, N: int = _DEFAULT_N,
+def state_feedback_gains(A, B, Q, R, initial_states, horizon=None, *, N: int = _DEFAULT_N,
                          transcription="radau", ipopt_options: Mapping | None = None,
                          K0=None, K_bounds=None) -> tuple[np.ndarray, GainDesign]:
     """Full-state feedback ``u = -K x`` minimizing a quadratic cost summed over initial states.
@@ -247,7 +247,8 @@ def state_feedback_gains(A, B, Q, R, initial_states=None, horizon=None, *, N: in
         The initial conditions (columns), none zero; they should span ``R^n`` (else a warning:
         ``K`` is then not unique).
     horizon : float [s]
-        The cost's horizon; should be at least ``HORIZON_RATIO_MIN`` (10) times the slowest
+        Required (its default only lets the ``StateSpace`` form shift the arguments). The
+        cost's horizon; should be at least ``HORIZON_RATIO_MIN`` (10) times the slowest
         time constant of the designed loop (else a warning).
     N : int, optional
         Collocation intervals (default 80; uniform mesh, Radau degree 3 by default).
@@ -319,9 +320,10 @@ def state_feedback_gains(A, B, Q, R, initial_states=None, horizon=None, *, N: in
             raise TypeError("with a StateSpace the arguments are (sys, Q, R, initial_states, "
                             "horizon): one too many given")
         (A, B), Q, R, initial_states, horizon = linear_system(A), B, Q, R, initial_states
-    if initial_states is None or horizon is None:
-        raise TypeError("`initial_states` and `horizon` are required")
     A, B, Q, R, X0 = _check_plant(A, B, Q, R, initial_states)
+    if horizon is None:
+        raise TypeError("`horizon` is required: state_feedback_gains(A, B, Q, R, "
+                        "initial_states, horizon) or (sys, Q, R, initial_states, horizon)")
     horizon = positive(horizon, "horizon")
     n, nu = B.shape
     K0 = default_initial_gain(A, B, Q, R) if K0 is None else _check_gain_matrix(K0, nu, n, "K0")
