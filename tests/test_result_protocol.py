@@ -226,3 +226,14 @@ def test_planar_ascent_and_its_tracking():
     track = fly_pitch_program(asc)
     check_protocol(track)
     check_plot(track)
+
+
+def test_multi_phase_solution():
+    from appdyn import ocp
+    from tests.ocp.test_phases import split_energy
+
+    sol = ocp.solve_phases(split_energy())
+    check_protocol(sol)
+    assert sol.wall_time == pytest.approx(sol.build_time + sol.solve_time)
+    fig = check_plot(sol)
+    assert sum(1 for ln in fig.axes[0].lines if ln.get_linestyle() == ":") == 1  # the boundary
