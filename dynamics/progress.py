@@ -19,8 +19,10 @@ import contextlib
 import functools
 import sys
 import time
+from typing import Callable
 
-__all__ = ["TextBar", "progress_reporter", "check_progress", "accepts_progress_bar"]
+__all__ = ["TextBar", "progress_reporter", "check_progress", "accepts_progress_bar",
+           "accepts_round_bar"]
 
 
 def check_progress(progress, name: str = "progress"):
@@ -179,5 +181,48 @@ def accepts_progress_bar(label: str):
         def call(*args, progress=None, **kwargs):
             with progress_reporter(progress, label) as report:
                 return fun(*args, progress=report, **kwargs)
+        return call
+    return wrap
+
+
+def accepts_round_bar(label: str, rounds: Callable[[dict], int]):
+    """Decorator for a function whose ``progress`` callable receives one report per round
+    (`ocp.refine`): ``progress=True`` becomes a bar counting the rounds against at most
+    ``rounds(kwargs)``; at the end it shows the rounds made as the total.
+
+    Examples
+    --------
+    >>> import io, sys
+    >>> from appdyn.dynamics.progress import accepts_round_bar
+    >>> @accepts_round_bar("rounds", lambda kw: kw.get("max_rounds", 5) + 1)
+    ... def work(*, max_rounds=5, progress=None):
+    ...     for r in range(3):
+    ...         if progress is not None:
+    ...             progress(f"round {r}")
+    ...     return 3
+    >>> work(progress=print)
+    round 0
+    round 1
+    round 2
+    3
+    """
+    def wrap(fun):
+        @functools.wraps(fun)
+        def call(*args, progress=None, **kwargs):
+            if progress is not True:
+                return fun(*args, progress=check_progress(progress) or None, **kwargs)
+            bar, done = _bar(label), [0]
+            total = max(1, int(rounds(kwargs)))
+
+            def report(_round):
+                done[0] += 1
+                bar(done[0], max(total, done[0] + 1))
+
+            try:
+                return fun(*args, progress=report, **kwargs)
+            finally:
+                if done[0]:
+                    bar(done[0], done[0])
+                bar.close()
         return call
     return wrap

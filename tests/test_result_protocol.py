@@ -237,3 +237,14 @@ def test_multi_phase_solution():
     assert sol.wall_time == pytest.approx(sol.build_time + sol.solve_time)
     fig = check_plot(sol)
     assert sum(1 for ln in fig.axes[0].lines if ln.get_linestyle() == ":") == 1  # the boundary
+
+
+def test_refine_accepts_progress_true(capsys):
+    from appdyn import ocp
+    from appdyn.ocp.examples import min_energy
+
+    sol = ocp.refine(min_energy(), N=6, tol=1e-6, progress=True)
+    assert sol.success
+    out, err = capsys.readouterr()
+    rounds = len(sol.refinement)
+    assert out == "" and f"100% {rounds}/{rounds}" in err  # a bar of the rounds, on stderr
