@@ -20,12 +20,6 @@ from __future__ import annotations
 
 import importlib
 import os as _os
-from importlib.metadata import PackageNotFoundError, version as _version
-
-try:
-    __version__ = _version("appdyn")
-except PackageNotFoundError:  # a source tree that was not installed
-    __version__ = "0+unknown"
 
 __all__ = ["__version__", "dynamics", "ocp", "problems"]
 
@@ -40,7 +34,20 @@ if (_os.path.isfile(_os.path.join(_ROOT, "pyproject.toml"))
 _SUBPACKAGES = ("dynamics", "ocp", "problems")
 
 
+def _installed_version() -> str:
+    # importlib.metadata costs ~0.1 s to import: looked up on first use of __version__
+    from importlib.metadata import PackageNotFoundError, version
+
+    try:
+        return version("appdyn")
+    except PackageNotFoundError:  # a source tree that was not installed
+        return "0+unknown"
+
+
 def __getattr__(name: str):
+    if name == "__version__":
+        globals()["__version__"] = value = _installed_version()
+        return value
     if name in _SUBPACKAGES:
         return importlib.import_module(f"appdyn.{name}")
     raise AttributeError(f"module 'appdyn' has no attribute {name!r}")

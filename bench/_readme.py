@@ -42,6 +42,8 @@ TITLES = {
              "process (`bench/trust.py`)",
     "scene": "Scenes: a hub-only scene against `rigid_body`, the build time of scenes of 1 to "
              "10 parts (`bench/scene.py`)",
+    "cli": "Start-up of the command line: `appdyn --help` against a bare interpreter, fresh "
+           "processes (`bench/cli.py`)",
     "flexible": "Flexible appendages: the four-antenna satellite's build and simulation, a "
                 "spin-up with and without geometric stiffening (`bench/flexible.py`)",
 }

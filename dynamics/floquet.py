@@ -55,6 +55,7 @@ from .clock import clock_index
 from .figures import axes_or_new_figure, finish_figure
 from .integrate import simulate
 from .model import Model, check_model
+from .results import Result
 from .serialize import jsonable, text_table, to_json
 
 __all__ = ["FloquetResult", "monodromy", "floquet", "variational_model", "classify_multipliers",
@@ -113,8 +114,8 @@ def _build_variational(model: Model) -> Model:
 
 
 # ---------------------------------------------------------------------------- result
-@dataclass(frozen=True)
-class FloquetResult:
+@dataclass(frozen=True, repr=False)
+class FloquetResult(Result):
     """Floquet multipliers of a periodic orbit and the verdict on its stability.
 
     Attributes
@@ -159,6 +160,8 @@ class FloquetResult:
     wall_time: float
     model_name: str = "model"
 
+    _repr_fields = ('verdict', 'period', 'multipliers', 'closure')
+
     @property
     def spectral_radius(self) -> float:
         """``max |mu|``: the growth of the worst perturbation over one period."""
@@ -174,10 +177,6 @@ class FloquetResult:
             "exponents": self.exponents, "monodromy": self.monodromy,
             "spectral_radius": self.spectral_radius, "wall_time": self.wall_time})
 
-    def to_json(self) -> str:
-        """`to_dict` as strict JSON."""
-        return to_json(self.to_dict())
-
     def __str__(self) -> str:
         rows = [("verdict", f"{self.verdict}: {self.reason}"), ("period", f"{self.period:.6g} s"),
                 ("closure", f"{self.closure:.2e} (|x(T) - x0|)")]
@@ -188,15 +187,13 @@ class FloquetResult:
                  ("wall time", f"{1e3 * self.wall_time:.1f} ms"), ("message", self.message)]
         return text_table(f"Floquet analysis of {self.model_name}", rows)
 
-    def plot(self, path=None, *, ax=None):
+    def plot(self, ax=None):
         """The multipliers in the complex plane, with the unit circle.
 
         Parameters
         ----------
-        path : str, optional
-            Also save the figure there.
         ax : matplotlib.axes.Axes, optional
-            Draw on these axes (default: a new Figure, no pyplot).
+            Draw on these axes; by default on a new `matplotlib.figure.Figure` (no pyplot).
 
         Returns
         -------
@@ -207,10 +204,10 @@ class FloquetResult:
         ax.plot(np.cos(phase), np.sin(phase), "k-", lw=0.8, label="|mu| = 1")
         ax.plot(self.multipliers.real, self.multipliers.imag, "x", ms=9, mew=2, label="mu")
         ax.set(xlabel="Re mu", ylabel="Im mu", aspect="equal",
-               title=f"{self.model_name}: {self.verdict}")
+               title=f"Floquet multipliers of {self.model_name}: {self.verdict}")
         ax.grid(True, alpha=0.3)
         ax.legend(fontsize=8)
-        return finish_figure(fig, path)
+        return finish_figure(fig)
 
 
 def classify_multipliers(multipliers, tol: float = TOL) -> tuple[str, str]:

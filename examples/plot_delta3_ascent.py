@@ -27,4 +27,4 @@ assert d3.success and abs(d3.final_mass - 7529.712412) < 1e-3
 # Altitude, speed, mass, thrust direction, dynamic pressure and flight-path angle, the
 # stagings marked.
 fig = plt.figure(figsize=(10, 8))
-d3.plot(fig=fig)
+d3.plot(fig)

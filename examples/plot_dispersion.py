@@ -44,7 +44,7 @@ res = dispersion(spinner, [0, 0, 0, 1, 0.0, 0.0, 1.0], t, samples=100, seed=0,
                          "axial_inertia": Normal(1500.0, 30.0),
                          "w1": Normal(0.02, 0.004)},
                  outputs={"nutation": nutation_history, "peak": nutation_max},
-                 progress=ProgressBar())
+                 units={"nutation": "rad", "peak": "rad"}, progress=ProgressBar())
 print(res.success, res.message)
 peak = res.statistics["peak"]
 mean, std, p99 = np.degrees([peak.mean, peak.std, peak.percentiles[99.0]])
@@ -62,4 +62,4 @@ assert res.success and error < 1e-8
 # The library draws the histogram of the peak nutation and the envelope of the nutation
 # history (median, percentile band, min-max band).
 fig = plt.figure(figsize=(10, 4))
-res.plot(fig=fig)
+res.plot(fig)

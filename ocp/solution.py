@@ -8,8 +8,9 @@ from typing import Mapping
 import numpy as np
 
 from appdyn.dynamics.attitude import quat_conj, quat_mul
-from appdyn.dynamics.figures import finish_figure, new_figure
-from appdyn.dynamics.serialize import text_table, to_json
+from appdyn.dynamics.figures import plot_attitude, plot_signals
+from appdyn.dynamics.results import Result
+from appdyn.dynamics.serialize import text_table
 
 from .checks import BoundViolation, bound_violation
 from .dense import DenseOutput
@@ -39,8 +40,8 @@ def draw_bounds(ax, lines, bounds) -> None:
                 ax.axhline(v, color=line.get_color(), linestyle="--", linewidth=0.8, alpha=0.7)
 
 
-@dataclass(eq=False)
-class Solution:
+@dataclass(eq=False, repr=False)
+class Solution(Result):
     """Outcome of `ocp.solve`.
 
     Build one from arrays with `Solution.from_arrays` (drivers that solve a restated
@@ -157,12 +158,12 @@ class Solution:
                 value.setflags(write=False)
         self.__dict__.update(state)
 
-    def __repr__(self) -> str:
-        return (f"{type(self).__name__}(success={self.success}, status={self.status!r}, "
-                f"cost={self.cost:.10g}, T={self.T:.10g}, "
-                f"constraint_violation={self.constraint_violation:.3g}, "
-                f"transcription={self.transcription.name!r}, N={self.mesh.N}, "
-                f"iterations={self.iterations}, solve_time={self.solve_time:.3g} s)")
+    _repr_fields = ("transcription", "cost", "T", "constraint_violation", "iterations")
+
+    @property
+    def wall_time(self) -> float:
+        """``build_time + solve_time`` [s]: the time `ocp.solve` spent."""
+        return float(self.build_time + self.solve_time)
 
     def __str__(self) -> str:
         sim = self.simulated_cost
@@ -249,20 +250,17 @@ class Solution:
             "p": dict(zip(model.params, self.p)),
         }
 
-    def to_json(self) -> str:
-        """`to_dict` as strict JSON (non-finite numbers as ``null``)."""
-        return to_json(self.to_dict())
-
-    def plot(self, path=None, *, fig=None, n=400):
-        """States (top) and controls (bottom) against time, from the dense output; the
-        controls' finite bounds as dashed lines in their colours.
+    def plot(self, ax=None, *, n: int = 400):
+        """The solution against time from the dense output: states and controls in one
+        labelled subplot per unit (`Model.units`), the finite bounds dashed; an attitude
+        model (a slew) as quaternion, body rates, controls and the rotation path
+        (`dynamics.figures.plot_attitude`).
 
         Parameters
         ----------
-        path : str, optional
-            Also save the figure there (PNG unless the suffix is .pdf or .svg).
-        fig : matplotlib.figure.Figure, optional
-            Draw on this figure; by default a new one (no pyplot, the backend untouched).
+        ax : matplotlib.axes.Axes or matplotlib.figure.Figure, optional
+            Draw on these axes (an attitude figure divides its slot into panels) or on this
+            figure; by default on a new `matplotlib.figure.Figure` (no pyplot).
         n : int, optional
             Samples of the dense output.
 
@@ -271,22 +269,18 @@ class Solution:
         matplotlib.figure.Figure
         """
         model = self.problem.model
-        fig = new_figure((8.0, 6.5)) if fig is None else fig
-        top, bottom = fig.subplots(2, 1, sharex=True)
         ts = np.linspace(self.t0, self.t0 + self.T, n) if self.T > 0 else np.array([self.t0])
-        xs, us = self.sample(ts)
-        for name, row in zip(model.states, np.atleast_2d(xs)):
-            top.plot(ts, row, label=name)
-        curves = [bottom.plot(ts, row, label=name)[0]
-                  for name, row in zip(model.controls, np.atleast_2d(us))]
-        draw_bounds(bottom, curves, self.problem.u_bounds)
-        top.set(ylabel="states", title=f"{self.transcription.name}, N = {self.mesh.N}: "
-                f"cost {self.cost:.6g}, success {self.success}")
-        bottom.set(xlabel="t [s]", ylabel="controls")
-        for ax in (top, bottom):
-            ax.grid(True, alpha=0.3)
-            ax.legend(fontsize=8)
-        return finish_figure(fig, path)
+        xs, us = (np.atleast_2d(v) for v in self.sample(ts))
+        verdict = "" if self.success else f" (not converged: {self.status})"
+        title = (f"{model.name}: {self.transcription.name}, N = {self.mesh.N}, "
+                 f"T = {self.T:.6g} s, cost {self.cost:.6g}{verdict}")
+        if model.attitude is not None:
+            return plot_attitude(ts, xs, us, model, u_bounds=self.problem.u_bounds, ax=ax,
+                                 title=title)
+        lo, hi = np.asarray(self.problem.u_bounds, dtype=float)
+        bounds = {**dict(model.bounds), **{c: (a, b) for c, a, b in zip(model.controls, lo, hi)}}
+        series = {**dict(zip(model.states, xs)), **dict(zip(model.controls, us))}
+        return plot_signals(ts, series, model.units, bounds=bounds, ax=ax, title=title)
 
     # ----------------------------------------------------------- construction
     @classmethod

@@ -10,7 +10,6 @@ the error exceeds what was asked; `STATUS_INTEGRATOR_FAILED` (-1) the integratio
 """
 from __future__ import annotations
 
-import json
 import math
 import warnings
 from dataclasses import asdict, dataclass, field
@@ -22,6 +21,8 @@ from appdyn.dynamics.attitude import principal_axes
 from appdyn.dynamics.rigid_body import check_inertia
 from appdyn.dynamics import simulate
 from appdyn.dynamics.truth import torque_free_omega
+from appdyn.dynamics.figures import finish_figure, panel_grid
+from appdyn.dynamics.results import Result
 
 __all__ = ["TorqueFreeReport", "torque_free", "CHECK_FACTOR", "ROUNDOFF_FACTOR",
            "STATUS_VERIFIED", "STATUS_CHECK_FAILED", "STATUS_INTEGRATOR_FAILED"]
@@ -42,8 +43,8 @@ CHECK_FACTOR = 1.0
 ROUNDOFF_FACTOR = 10.0
 
 
-@dataclass(frozen=True)
-class TorqueFreeReport:
+@dataclass(frozen=True, repr=False)
+class TorqueFreeReport(Result):
     """Outcome of a torque-free run, compared with the exact solution.
 
     Attributes
@@ -124,6 +125,8 @@ class TorqueFreeReport:
     worst_component: int = 0
     _series: dict = field(default_factory=dict, repr=False, compare=False)
 
+    _repr_fields = ('method', 'max_rate_error', 'energy_drift')
+
     @property
     def status(self) -> int:
         """`STATUS_VERIFIED`, `STATUS_CHECK_FAILED` or `STATUS_INTEGRATOR_FAILED`."""
@@ -144,12 +147,6 @@ class TorqueFreeReport:
         d.pop("_series")
         d["status"] = self.status
         return d
-
-    def to_json(self) -> str:
-        """`to_dict` as strict JSON (non-finite numbers as ``null``)."""
-        d = {k: (None if isinstance(v, float) and not math.isfinite(v) else v)
-             for k, v in self.to_dict().items()}
-        return json.dumps(d, indent=2, allow_nan=False)
 
     @property
     def check_text(self) -> str:
@@ -183,50 +180,43 @@ class TorqueFreeReport:
         lines.append(f"  {self.check_text}")
         return "\n".join(lines)
 
-    def plot(self, path=None, *, fig=None):
+    def plot(self, ax=None):
         """Rates (simulated and exact), the polhode, invariant drift and error vs truth.
 
         Parameters
         ----------
-        path : str or path-like, optional
-            Also save the figure there (format from the suffix).
-        fig : matplotlib.figure.Figure, optional
-            Draw the four panels on this figure; by default on a new one (no pyplot, the
-            backend is left alone).
+        ax : matplotlib.axes.Axes or matplotlib.figure.Figure, optional
+            Draw the panels in this axes' slot (divided into the panels) or on this figure
+            (cleared); by default on a new `matplotlib.figure.Figure` (no pyplot).
 
         Returns
         -------
         matplotlib.figure.Figure
         """
-        if fig is None:
-            from matplotlib.figure import Figure
-
-            fig = Figure(figsize=(12, 8))
+        fig, grid = panel_grid(ax, 2, 2, (12.0, 8.0))
         s = self._series
         t, w, w_ex = s["t"], s["w"], s["w_exact"]
-        ax1 = fig.add_subplot(2, 2, 1)
+        ax1 = fig.add_subplot(grid[0, 0])
         for i, c in enumerate("tab:blue tab:orange tab:green".split()):
             ax1.plot(t, w[i], color=c, label=f"w{i + 1}")
             ax1.plot(t, w_ex[i], color="k", ls=":", lw=1)
         ax1.set(xlabel="t [s]", ylabel="body rate [rad/s]", title="Rates (dotted: exact)")
         ax1.legend(loc="upper right")
-        ax2 = fig.add_subplot(2, 2, 2, projection="3d")
+        ax2 = fig.add_subplot(grid[0, 1], projection="3d")
         ax2.plot(w[0], w[1], w[2], lw=1)
-        ax2.set(xlabel="w1", ylabel="w2", zlabel="w3", title="Polhode (body rates)")
-        ax3 = fig.add_subplot(2, 2, 3)
+        ax2.set(xlabel="w1 [rad/s]", ylabel="w2 [rad/s]", zlabel="w3 [rad/s]",
+                title="Polhode (body rates)")
+        ax3 = fig.add_subplot(grid[1, 0])
         tiny = 1e-17
         ax3.semilogy(t, np.abs(s["energy"] / s["energy"][0] - 1) + tiny, label="|dT/T|")
         ax3.semilogy(t, s["momentum_err"] + tiny, label="|dH|/|H|")
         ax3.semilogy(t, np.abs(s["quat_norm"] - 1) + tiny, label="||q| - 1|")
-        ax3.set(xlabel="t [s]", title="Invariant drift")
+        ax3.set(xlabel="t [s]", ylabel="relative drift [-]", title="Invariant drift")
         ax3.legend()
-        ax4 = fig.add_subplot(2, 2, 4)
+        ax4 = fig.add_subplot(grid[1, 1])
         ax4.semilogy(t, np.max(np.abs(w - w_ex), axis=0) + tiny)
         ax4.set(xlabel="t [s]", ylabel="max |w - w_exact| [rad/s]", title="Error vs truth")
-        fig.tight_layout()
-        if path is not None:
-            fig.savefig(path, dpi=110)
-        return fig
+        return finish_figure(fig)
 
 
 def torque_free(inertia, w0, *, t_final=50.0, n_points=1001, q0=None, method="auto",

@@ -177,9 +177,7 @@ def run_pass(problem: Problem, rtol: float, atol: np.ndarray, theta: float, max_
             before = state[2]
             got = fun(work.base, work.off_addr, done, k, ax, axc)
             if progress.fun is not None:
-                new = int(state[2] - before)
-                progress.start(new)
-                progress.advance(new)
+                progress.step(int(state[2] - before), (done + got) / nint)
             done += got
             if state[7]:
                 reason = _REASONS[int(state[7])]

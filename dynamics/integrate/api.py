@@ -11,6 +11,7 @@ import numpy as np
 from .. import cache, validate
 from ..clock import CLOCK_STATE, check_clock_start, clock_index
 from ..model import Model, check_model
+from ..progress import progress_reporter
 from .auto import solve_auto
 from .batch import BatchResult, check_batch, simulate_batch
 from .cvodes import run_cvodes
@@ -35,7 +36,7 @@ def simulate(model: Model, x0, t, *, u=None, p=None, hold: Hold = "linear", meth
              rtol: float = 1e-8, atol=1e-10, invariants=False, steps: int | None = None,
              jit: bool | None = None, max_steps: int = 100_000_000,
              cvodes_options: Mapping | None = None,
-             progress: Callable[[int, int], None] | None = None,
+             progress: bool | Callable[[int, int], None] | None = None,
              events=None, impacts=None) -> SimulationResult | BatchResult:
     """Integrate ``xdot = f(x, u, p)`` of ``model`` from ``x0`` over the grid ``t``.
 
@@ -114,10 +115,13 @@ def simulate(model: Model, x0, t, *, u=None, p=None, hold: Hold = "linear", meth
         ``max_num_steps`` 10 000 per output interval), e.g.
         ``{'linear_multistep_method': 'adams'}`` (about 2x fewer steps than BDF on a
         non-stiff tumbling body).
-    progress : callable, optional
-        ``progress(done, total)`` is called after every chunk of 512 fixed steps with the
-        steps done and planned so far (``total`` grows when ``auto`` starts another run);
-        for a progress line on long runs. Not called by ``cvodes``.
+    progress : bool or callable, optional
+        ``True`` shows a bar on stderr (`dynamics.progress`: tqdm when installed, else a
+        text bar). A callable ``progress(done, total)`` is called after every chunk of 512
+        fixed steps with the steps done and expected so far (``total`` grows when ``auto``
+        starts another run, and counts the run it may need next, so ``done`` reaches
+        ``total`` once, at the end); for a progress line on long runs. Not called by
+        ``cvodes``.
     events : callable, casadi.Function, Event, or a sequence of them, optional
         Event functions ``g(t, x, u, p) -> scalar`` whose zero crossings are located on the
         solution to the integrator's accuracy (`dynamics.integrate.events`: what is
@@ -178,6 +182,12 @@ def simulate(model: Model, x0, t, *, u=None, p=None, hold: Hold = "linear", meth
     >>> bool(np.max(np.abs(res.x[4:] - torque_free_omega(inertia, w0, t))) < 1e-10)
     True
     """
+    if isinstance(progress, bool):  # True: a bar on stderr (`dynamics.progress`)
+        with progress_reporter(progress, "simulate") as bar:
+            return simulate(model, x0, t, u=u, p=p, hold=hold, method=method, rtol=rtol,
+                            atol=atol, invariants=invariants, steps=steps, jit=jit,
+                            max_steps=max_steps, cvodes_options=cvodes_options,
+                            progress=bar, events=events, impacts=impacts)
     start = time.perf_counter()
     model = check_model(model)
     if method not in METHODS:
@@ -231,6 +241,7 @@ def simulate(model: Model, x0, t, *, u=None, p=None, hold: Hold = "linear", meth
         else:
             run, used, status, estimate = solve_auto(problem, rtol, atol, max_steps, jit,
                                                      cvodes_options, counter)
+        counter.finish()
     if method in _FIXED_STEP and run.ok:
         run, status = _sane(model, t, run, control, p, method)
     x = run.x
@@ -266,8 +277,10 @@ def _simulate_batch(model, x0, t, u, p, method, rtol, atol, invariants, steps, j
                                                                cvodes_options, progress)
     if method == "lie":
         check_lie_model(model, batch.x0[:, 0], batch.p[:, 0])
-    return simulate_batch(batch, method, steps, rtol, atol, max_steps, jit, cvodes_options,
-                          counter, start)
+    result = simulate_batch(batch, method, steps, rtol, atol, max_steps, jit, cvodes_options,
+                            counter, start)
+    counter.finish()
+    return result
 
 
 def _check_options(method, max_steps, jit, steps, cvodes_options, progress):
@@ -281,7 +294,7 @@ def _check_options(method, max_steps, jit, steps, cvodes_options, progress):
         raise ValueError(f"`steps` applies to the fixed-step methods {_FIXED_STEP}, not {method!r}")
     cvodes_options = check_cvodes_options(cvodes_options)
     if progress is not None and not callable(progress):
-        raise TypeError(f"`progress` must be None or a callable (done, total), "
+        raise TypeError(f"`progress` must be None, True/False or a callable (done, total), "
                         f"got {type(progress).__name__}")
     return max_steps, steps, cvodes_options, Progress(progress)
 

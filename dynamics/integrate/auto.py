@@ -228,6 +228,7 @@ def auto_runs(target, rtol, atol, max_steps, jit_pref, progress: Progress):
         if m in runs or len(runs) >= _AUTO_RUNS:
             reason = f"the error estimates did not settle in {len(runs)} runs"
             break
+        progress.ahead = 2 * m * nint  # another run, if one is needed, takes about twice the steps
         run = target.run(_perturbed(target.x0, m), m, _auto_jit(jit_pref), progress)
         run.x[:, 0] = target.x0
         runs[m] = run

@@ -30,6 +30,8 @@ from .estimates import jacobian_x, rho_sigma
 from .evaluate import map_eval
 from .inputs import HOLDS, Control, Problem
 from .loops import Progress
+from ..figures import plot_signals
+from ..results import Result
 from .result import (FAILED, OK, OK_STIFF, ROUNDOFF, UNVERIFIED, VIOLATED, Dense,
                      Run, SimulationResult)
 from .smoothness import nonsmooth_operations
@@ -237,8 +239,8 @@ def _sane(batch: Batch, x: np.ndarray, ok: np.ndarray, status: np.ndarray, messa
                     f"{bad[0][1]}); {remedy(method)}")
 
 
-@dataclass(frozen=True)
-class BatchResult:
+@dataclass(frozen=True, repr=False)
+class BatchResult(Result):
     """What `simulate` returns for a batch of K runs (``x0`` of shape ``(nx, K)``).
 
     Attributes
@@ -278,6 +280,8 @@ class BatchResult:
     compiled: bool
     _batch: Batch
 
+    _repr_fields = ("method", "t", "x", "n_steps")
+
     def __len__(self) -> int:
         return self.x.shape[2]
 
@@ -285,6 +289,42 @@ class BatchResult:
     def all_success(self) -> bool:
         """Whether every run succeeded."""
         return bool(np.all(self.success))
+
+    def to_dict(self) -> dict:
+        """Summary and trajectories as plain Python: counters, ``t``, and per state name the
+        runs' histories, shape (n, K) (JSON-ready through `to_json`)."""
+        names = self._batch.model.states
+        return {"success": self.success, "status": self.status, "message": self.message,
+                "method": self.method, "wall_time": self.wall_time, "n_steps": self.n_steps,
+                "error_estimate": self.error_estimate, "compiled": self.compiled,
+                "t": self.t, "x": dict(zip(names, self.x))}
+
+    def plot(self, ax=None, *, states=None):
+        """Every run's states against time, one labelled subplot per unit (`Model.units`),
+        bounds as dashed lines (see `SimulationResult.plot`).
+
+        Parameters
+        ----------
+        ax : matplotlib.axes.Axes or sequence of Axes, optional
+            Draw on these; by default on a new `matplotlib.figure.Figure`.
+        states : sequence of str, optional
+            The states to draw (default all).
+
+        Returns
+        -------
+        matplotlib.figure.Figure
+        """
+        model = self._batch.model
+        names = tuple(model.states) if states is None else tuple(states)
+        unknown = [s for s in names if s not in model.states]
+        if unknown:
+            raise ValueError(f"`states` names unknown states {unknown}; "
+                             f"the states are {tuple(model.states)}")
+        ok = int(np.sum(self.success))
+        return plot_signals(self.t, {n: self.x[model.states.index(n)] for n in names},
+                            model.units, bounds=model.bounds, ax=ax,
+                            title=f"{model.name}: {len(self)} runs ({self.method}, "
+                                  f"{ok} verified)")
 
     def run(self, k: int) -> SimulationResult:
         """Run ``k`` as a `SimulationResult` (dense output, invariants, drift)."""

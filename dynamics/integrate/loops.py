@@ -264,10 +264,13 @@ def interval_ends(s0: int, n: int, m: int) -> tuple[slice, slice]:
 
 class Progress:
     """Counts steps for a ``progress(done, total)`` callback across all runs of one call:
-    ``total`` grows by each run's step count when the run starts."""
+    ``total`` grows by each run's step count when the run starts, plus ``ahead`` (the steps a
+    caller that may start another run, as ``auto`` does, expects next), so ``done`` reaches
+    the reported total once, at `finish`, and the reported total never falls."""
 
     def __init__(self, fun: Callable | None):
-        self.fun, self.done, self.total = fun, 0, 0
+        self.fun, self.done, self.total, self.ahead, self.shown = fun, 0, 0, 0, 0
+        self.stepped = 0  # steps of the adaptive passes (`step`)
 
     def start(self, n: int):
         self.total += n
@@ -275,10 +278,27 @@ class Progress:
     def advance(self, n: int):
         self.done += n
         if self.fun is not None:
-            self.fun(self.done, self.total)
+            self.shown = max(self.shown, self.total + self.ahead,
+                             self.done + (1 if self.ahead else 0))
+            self.fun(self.done, self.shown)
+
+    def step(self, n: int, fraction: float):
+        """``n`` steps of an adaptive pass done, ``fraction`` of its output intervals reached:
+        the steps still ahead are extrapolated from the rate so far."""
+        self.stepped += n
+        self.start(n)
+        if fraction > 0:  # (at least 1 until `finish`: a run may follow the pass)
+            self.ahead = max(1, int(self.stepped * (1.0 - min(fraction, 1.0)) / fraction))
+        self.advance(n)
 
     def abandon(self, n: int):
         self.total -= n
+
+    def finish(self):
+        """Report the end of the call: ``(done, done)`` where steps were counted."""
+        if self.fun is not None and self.done and self.shown != self.done:
+            self.shown = self.done
+            self.fun(self.done, self.done)
 
 
 def run_fixed(problem: Problem, method: str, m: int, jit: bool,

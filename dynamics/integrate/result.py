@@ -10,9 +10,10 @@ from typing import Callable, Mapping
 
 import numpy as np
 
-from ..figures import axes_or_new_figure, finish_figure
+from ..figures import plot_signals
 from ..model import Model
-from ..serialize import text_table, to_json
+from ..results import Result
+from ..serialize import text_table
 from .evaluate import map_eval
 
 __all__ = ["SimulationResult", "make_result", "new_result", "Dense", "Run", "OK", "OK_STIFF", "ROUNDOFF",
@@ -99,8 +100,8 @@ class Dense:
         self._lock = threading.Lock()
 
 
-@dataclass(frozen=True, eq=False)
-class SimulationResult:
+@dataclass(frozen=True, eq=False, repr=False)
+class SimulationResult(Result):
     """Outcome of `simulate`, in the manner of scipy's ``OdeResult``.
 
     Attributes
@@ -185,6 +186,8 @@ class SimulationResult:
     x_events: list | None = None
     impacts: tuple | None = None
 
+    _repr_fields = ("method", "t", "x", "n_steps", "error_estimate")
+
     def __getstate__(self) -> dict:
         state = dict(self.__dict__)
         state["invariants"] = dict(self.invariants)
@@ -253,10 +256,6 @@ class SimulationResult:
                 for r in self.impacts],
         }
 
-    def to_json(self) -> str:
-        """`to_dict` as strict JSON (non-finite numbers as ``null``)."""
-        return to_json(self.to_dict())
-
     def __str__(self) -> str:
         rows = [("success", f"{self.success} (status {self.status})"),
                 ("method", f"{self.method}" + (f", {self.substeps} step(s) per interval"
@@ -273,16 +272,15 @@ class SimulationResult:
                              + " occurrence(s)"))
         return text_table("Simulation", rows)
 
-    def plot(self, path=None, *, ax=None, states=None):
-        """The states against time on one axes.
+    def plot(self, ax=None, *, states=None):
+        """The states against time, one labelled subplot per unit (`Model.units`), bounds
+        (`Model.bounds`) as dashed lines.
 
         Parameters
         ----------
-        path : str, optional
-            Also save the figure there (PNG unless the suffix is .pdf or .svg).
-        ax : matplotlib.axes.Axes, optional
-            Draw on these axes; by default on a new `matplotlib.figure.Figure` (no pyplot,
-            the backend untouched).
+        ax : matplotlib.axes.Axes or sequence of Axes, optional
+            Draw on these (one axes takes every unit group; a sequence needs one per unit);
+            by default on a new `matplotlib.figure.Figure` (no pyplot, the backend untouched).
         states : sequence of str, optional
             The states to draw (default all).
 
@@ -295,13 +293,13 @@ class SimulationResult:
         if unknown:
             raise ValueError(f"`states` names unknown states {unknown}; "
                              f"the states are {self.states}")
-        fig, ax = axes_or_new_figure(ax, (8.0, 5.0))
-        for name in names:
-            ax.plot(self.t, self.x[self.states.index(name)], label=name)
-        ax.set(xlabel="t [s]", title=f"{self.method}: success {self.success}")
-        ax.grid(True, alpha=0.3)
-        ax.legend(fontsize=8)
-        return finish_figure(fig, path)
+        model = None if self._dense is None else self._dense.model
+        verdict = "verified" if self.success else "NOT verified"
+        return plot_signals(self.t, {n: self.x[self.states.index(n)] for n in names},
+                            {} if model is None else model.units,
+                            bounds=None if model is None else model.bounds, ax=ax,
+                            title=f"{getattr(model, 'name', 'simulation')} ({self.method}, "
+                                  f"{verdict}, status {self.status})")
 
     @property
     def invariant_drift(self) -> Mapping[str, float]:

@@ -103,8 +103,7 @@ def run_stepped(problem: Problem, rtol: float, atol: np.ndarray, max_steps: int,
                             addr(ua, done * nu), addr(ud, done * nu), nu, addr(p), rtol,
                             addr(at), float(max_steps), addr(out, done), nint,
                             addr(longest, done), addr(count))
-            progress.start(int(count[0] + count[1] - before))
-            progress.advance(int(count[0] + count[1] - before))
+            progress.step(int(count[0] + count[1] - before), done / nint)
     X[:, 1:done + 1] = out[:, :done]
     return _stepped_run(X, t, count, done, rtol, True), longest
 
@@ -175,8 +174,7 @@ def run_dense(problem: Problem, rtol: float, atol: np.ndarray, max_steps: int,
                 check_interrupt()
                 before = count[0] + count[1]
                 done = lib.dense(*args)
-                progress.start(int(count[0] + count[1] - before))
-                progress.advance(int(count[0] + count[1] - before))
+                progress.step(int(count[0] + count[1] - before), done / nout)
     if done < nout:
         X[:, done + 1:] = np.nan
     run = _stepped_run(X, t, count, done, rtol, True)
@@ -309,8 +307,7 @@ def run_stepped_callable(problem: Problem, rtol: float, atol: np.ndarray, max_st
             if count[2]:
                 return _stepped_run(X, t, count, k, rtol, False), longest
         X[:, k + 1] = x
-        progress.start(count[0] + count[1] - before)
-        progress.advance(count[0] + count[1] - before)
+        progress.step(int(count[0] + count[1] - before), (k + 1) / nint)
     return _stepped_run(X, t, count, nint, rtol, False), longest
 
 

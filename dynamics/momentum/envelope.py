@@ -25,9 +25,10 @@ from typing import NamedTuple
 import numpy as np
 
 from .. import validate
-from ..figures import cleared_figure, finish_figure
+from ..figures import finish_figure, panel_grid
 from ..serialize import to_json
 from .cluster import SINGULAR_TOL, ClusterGeometry
+from ..results import Result
 
 __all__ = ["PARALLEL_TOL", "MIN_DIRECTIONS", "KINDS", "SurfacePoints", "fibonacci_directions",
            "singular_surface", "classify_singularities", "momentum_envelope",
@@ -259,8 +260,8 @@ def _outer_value(geo, axis, v):
     return value, (grad_u - u * (u @ grad_u)) / n
 
 
-@dataclass(frozen=True, eq=False)
-class MomentumEnvelope:
+@dataclass(frozen=True, eq=False, repr=False)
+class MomentumEnvelope(Result):
     """Singular surfaces of a CMG cluster (`momentum_envelope`).
 
     Attributes
@@ -287,6 +288,26 @@ class MomentumEnvelope:
     kinds: dict
     outer_directions: np.ndarray
     wall_time: float = field(default=float("nan"))
+
+    _repr_fields = ('directions', 'extent')
+
+    @property
+    def success(self) -> bool:
+        """The saturation envelope has points and every point is finite."""
+        return bool(self.points.get(0, np.zeros((3, 0))).size
+                    and all(np.all(np.isfinite(p)) for p in self.points.values()))
+
+    @property
+    def status(self) -> int:
+        """0 when `success`, -1 otherwise."""
+        return 0 if self.success else -1
+
+    @property
+    def message(self) -> str:
+        """`status` in words."""
+        n = sum(p.shape[1] for p in self.points.values())
+        return (f"{n} singular points in {len(self.points)} group(s)" if self.success else
+                "the saturation envelope has no points or non-finite ones")
 
     def max_momentum(self, axis) -> float:
         """Largest projection ``max axis.H`` of the envelope along a unit ``axis`` [N m s].
@@ -356,13 +377,10 @@ class MomentumEnvelope:
                        if c[kind]}
             groups[str(k)] = {**c, "max_norm": float(norms.max()) if norms.size else None,
                               "H": by_kind}
-        return {"n": geo.n, "h": geo.h, "gimbal_axes": geo.gimbal_axes,
+        return {"success": self.success, "status": self.status, "message": self.message,
+                "n": geo.n, "h": geo.h, "gimbal_axes": geo.gimbal_axes,
                 "spin_axes0": geo.spin_axes0, "directions": self.directions,
                 "extent": self.extent, "wall_time": self.wall_time, "groups": groups}
-
-    def to_json(self) -> str:
-        """`to_dict` as strict JSON."""
-        return to_json(self.to_dict())
 
     def __str__(self) -> str:
         geo = self.geometry
@@ -382,14 +400,15 @@ class MomentumEnvelope:
         lines.append(f"  wall time {self.wall_time:.3f} s")
         return "\n".join(lines)
 
-    def plot(self, fig=None):
+    def plot(self, ax=None):
         """Sections near the x-z and x-y planes and a 3D view of the envelope (translucent)
         with the internal surfaces coloured by kind (blue elliptic, red hyperbolic).
 
         Parameters
         ----------
-        fig : matplotlib.figure.Figure, optional
-            Draw on this figure (cleared first); by default a new one (no pyplot).
+        ax : matplotlib.axes.Axes or matplotlib.figure.Figure, optional
+            Draw the panels in this axes' slot (divided into the panels) or on this figure
+            (cleared); by default on a new `matplotlib.figure.Figure` (no pyplot).
 
         Returns
         -------
@@ -397,8 +416,8 @@ class MomentumEnvelope:
         """
         from scipy.spatial import ConvexHull
 
-        fig = cleared_figure(fig, (15.0, 5.2))
-        ax3 = fig.add_subplot(1, 3, 3, projection="3d")  # last: its z label at the edge
+        fig, grid = panel_grid(ax, 1, 3, (15.0, 5.2))
+        ax3 = fig.add_subplot(grid[0, 2], projection="3d")  # last: its z label at the edge
         outer = self.points[0][:, :self.outer_directions.shape[1]]
         tri = ConvexHull(self.outer_directions.T).simplices
         ax3.plot_trisurf(*outer, triangles=tri, color="tab:gray", alpha=0.12, linewidth=0)
@@ -417,7 +436,7 @@ class MomentumEnvelope:
         extent = max(float(np.max(np.abs(p))) for p in self.points.values())
         band = 0.02 * extent
         for panel, (i, j, normal, name) in enumerate([(0, 2, 1, "x-z"), (0, 1, 2, "x-y")]):
-            ax = fig.add_subplot(1, 3, panel + 1)
+            ax = fig.add_subplot(grid[0, panel])
             for k, H in self.points.items():
                 near = np.abs(H[normal]) <= band
                 if k == 0:

@@ -23,12 +23,13 @@ import casadi as ca
 import numpy as np
 
 from .. import cache, validate
-from ..figures import cleared_figure, finish_figure
+from ..figures import finish_figure, panel_axes
 from ..integrate import simulate
 from ..model import Model
 from ..serialize import text_table, to_json
 from .cluster import ClusterGeometry, cluster_jacobian, cluster_momentum, singularity_measure
 from .steering import gsr_inverse_steering, pseudo_inverse_steering, sr_inverse_steering
+from ..results import Result
 
 __all__ = ["LAWS", "LAW_OPTIONS", "MOMENTUM_TOL", "TORQUE_TOL", "OK", "RATE_LIMIT",
            "MOMENTUM_BALANCE", "TORQUE_ERROR", "FAILED", "steering_model", "steer",
@@ -323,8 +324,8 @@ def _verdict(res, sim, ok, tol, torque_tol) -> tuple:
     return OK, (f"{sim.message}; momentum balance {res.max_momentum_error:.2g} N m s")
 
 
-@dataclass(frozen=True, eq=False)
-class SteeringResult:
+@dataclass(frozen=True, eq=False, repr=False)
+class SteeringResult(Result):
     """A steering-law run (`steer`); arrays on the output grid ``t`` (m points).
 
     Attributes
@@ -379,6 +380,8 @@ class SteeringResult:
     simulation: object = field(default=None, repr=False)
     wall_time: float = float("nan")
 
+    _repr_fields = ('law', 't', 'delta', 'max_rate', 'max_torque_error')
+
     @property
     def rate_norm(self) -> np.ndarray:
         """``|delta'|`` [rad/s], shape (m,)."""
@@ -423,19 +426,16 @@ class SteeringResult:
                 "commanded": self.commanded, "delivered": self.delivered,
                 "torque_error": self.torque_error, "momentum_error": self.momentum_error}
 
-    def to_json(self) -> str:
-        """`to_dict` as strict JSON (non-finite numbers as ``null``)."""
-        return to_json(self.to_dict())
-
     def __str__(self) -> str:
         n = self.geometry.n
-        limit = "" if self.rate_limit is None else f" (limit {self.rate_limit:g} rad/s)"
+        limit = "" if self.rate_limit is None else \
+            f" (limit {np.degrees(self.rate_limit):.6g} deg/s)"
         rows = [("success", f"{self.success} (status {self.status})"),
                 ("law", self._law_text()),
                 ("run", f"{n} gimbals, t = {self.t[0]:g} .. {self.t[-1]:g} s, {self.t.size} "
                         f"points, rk8 {self.steps} step(s) per interval"),
                 ("min measure", f"{self.min_measure:.4g} (N m s)^3"),
-                ("max gimbal rate", f"{self.max_rate:.4g} rad/s{limit}"),
+                ("max gimbal rate", f"{np.degrees(self.max_rate):.4g} deg/s{limit}"),
                 ("max torque error", f"{self.max_torque_error:.4g} N m"),
                 ("momentum balance", f"{self.max_momentum_error:.3g} N m s"),
                 ("wall time", f"{self.wall_time:.3f} s"),
@@ -453,20 +453,20 @@ class SteeringResult:
                          f"{self.torque_error[k]:>15.3e}")
         return "\n".join(lines)
 
-    def plot(self, fig=None):
+    def plot(self, ax=None):
         """Gimbal angles, singularity measure, gimbal rates and torque error against time.
 
         Parameters
         ----------
-        fig : matplotlib.figure.Figure, optional
-            Draw on this figure (cleared first); by default a new one (no pyplot).
+        ax : matplotlib.axes.Axes or matplotlib.figure.Figure, optional
+            Draw the panels in this axes' slot (divided into the panels) or on this figure
+            (cleared); by default on a new `matplotlib.figure.Figure` (no pyplot).
 
         Returns
         -------
         matplotlib.figure.Figure
         """
-        fig = cleared_figure(fig, (11.0, 7.0))
-        axes = fig.subplots(2, 2, sharex=True)
+        fig, axes = panel_axes(ax, 2, 2, (11.0, 7.0))
         for i in range(self.geometry.n):
             axes[0, 0].plot(self.t, np.degrees(self.delta[i]), label=f"d{i + 1}")
             axes[1, 0].plot(self.t, np.degrees(self.rates[i]), label=f"d{i + 1}")
@@ -482,5 +482,6 @@ class SteeringResult:
             ax.set_xlabel("t [s]")
         axes[0, 0].legend(fontsize=8)
         axes[1, 1].legend(fontsize=8)
-        fig.suptitle(f"CMG steering, {self._law_text()}: success {self.success}")
+        fig.suptitle(f"CMG steering, {self._law_text()}"
+                     + ("" if self.success else f" (failed: status {self.status})"))
         return finish_figure(fig)

@@ -1,17 +1,19 @@
 """`MultiPhaseSolution`: the result of `ocp.solve_phases`."""
 from __future__ import annotations
 
-import json
 from dataclasses import dataclass, field
 from typing import Mapping
 
 import numpy as np
 
+from appdyn.dynamics.figures import plot_signals
+from appdyn.dynamics.results import Result
+
 __all__ = ["MultiPhaseSolution"]
 
 
-@dataclass(frozen=True, eq=False)
-class MultiPhaseSolution:
+@dataclass(frozen=True, eq=False, repr=False)
+class MultiPhaseSolution(Result):
     """The solution of a `MultiPhaseProblem`.
 
     Attributes
@@ -64,9 +66,12 @@ class MultiPhaseSolution:
     info: Mapping = field(default_factory=dict, repr=False)
     nlp_point: Mapping | None = field(default=None, repr=False)
 
-    def __repr__(self) -> str:
-        return (f"MultiPhaseSolution(success={self.success}, status={self.status!r}, "
-                f"cost={self.cost:.10g}, phases={len(self.phases)}, tf={self.tf[-1]:.6g})")
+    _repr_fields = ("cost", "phases", "tf", "constraint_violation", "iterations")
+
+    @property
+    def wall_time(self) -> float:
+        """``build_time + solve_time`` of the last round [s]."""
+        return float(self.build_time + self.solve_time)
 
     def __str__(self) -> str:
         lines = [f"{self.problem.name or 'multi-phase problem'}: {self.message}",
@@ -138,5 +143,41 @@ class MultiPhaseSolution:
                        for i, sol in enumerate(self.phases)],
         }
 
-    def to_json(self) -> str:
-        return json.dumps(self.to_dict())
+    def plot(self, ax=None, *, n: int = 200):
+        """The states and controls every phase shares, against time, one labelled subplot per
+        unit (the first phase's `Model.units`), the phase boundaries dotted.
+
+        Parameters
+        ----------
+        ax : matplotlib.axes.Axes, sequence of Axes or matplotlib.figure.Figure, optional
+            Draw on these (see `dynamics.figures.plot_signals`); by default on a new
+            `matplotlib.figure.Figure`.
+        n : int, optional
+            Samples of each phase's dense output.
+
+        Returns
+        -------
+        matplotlib.figure.Figure
+        """
+        models = [sol.problem.model for sol in self.phases]
+        names = [v for v in (*models[0].states, *models[0].controls)
+                 if all(v in m.states or v in m.controls for m in models)]
+        times, parts = [], {v: [] for v in names}
+        for sol, a, b in zip(self.phases, self.t0, self.tf):
+            ts = np.linspace(a, b, n)
+            x, u = (np.atleast_2d(v) for v in sol.sample(ts))
+            model = sol.problem.model
+            rows = {**dict(zip(model.states, x)), **dict(zip(model.controls, u))}
+            times.append(ts)
+            for v in names:
+                parts[v].append(rows[v])
+        t = np.concatenate(times)
+        series = {v: np.concatenate(parts[v]) for v in names}
+        verdict = "" if self.success else f" (not converged: {self.status})"
+        fig = plot_signals(t, series, models[0].units, ax=ax,
+                           title=f"{self.problem.name or 'multi-phase problem'}: "
+                                 f"{len(self.phases)} phases, cost {self.cost:.6g}{verdict}")
+        for a in fig.axes:
+            for tb in self.tf[:-1]:
+                a.axvline(tb, color="0.5", ls=":", lw=0.8)
+        return fig

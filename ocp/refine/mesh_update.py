@@ -13,6 +13,7 @@ import numpy as np
 
 from appdyn.dynamics.validate import integer, positive
 from appdyn.dynamics.interrupts import interruptible
+from appdyn.dynamics.progress import accepts_round_bar
 from ..checks import (STATUS_BOUND_VIOLATION, STATUS_RESIMULATION, interval_bound_violation,
                       periodic_jumps)
 from ..mesh import Mesh
@@ -186,6 +187,7 @@ def _report(rnd: int, r: RefinementRound, verbose, progress) -> None:
         progress(r)
 
 
+@accepts_round_bar("refine", lambda kwargs: kwargs.get("max_rounds", 6) + 1)
 @interruptible
 def refine(problem: Problem, solution: Solution | None = None, *, tol: float = 1e-6,
            max_rounds: int = 6, max_intervals: int = 400, transcription="radau",
@@ -264,8 +266,9 @@ def refine(problem: Problem, solution: Solution | None = None, *, tol: float = 1
         when ``solution`` or ``mesh`` gives the mesh.
     verbose : bool or callable
         Passed to `ocp.solve`; ``True`` also prints one line per round to ``sys.stderr``.
-    progress : callable, optional
-        Receives each `RefinementRound` as it completes (IPOPT iterations are not passed
+    progress : bool or callable, optional
+        ``True``: a bar of the rounds on stderr (`dynamics.progress`). A callable receives
+        each `RefinementRound` as it completes (IPOPT iterations are not passed
         on; give ``verbose`` a callable for those). Each round is also logged (INFO) to the
         logger ``"appdyn.ocp"``.
     stall_rounds : int or None

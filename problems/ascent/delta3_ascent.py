@@ -21,6 +21,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from appdyn import ocp
+from appdyn.dynamics.results import Result
 from appdyn.dynamics.validate import finite_array
 
 from .delta3 import (FINAL_MASS_BETTS, H_SCALE, OMEGA_E, PHASES, RE, RHO0,
@@ -130,8 +131,8 @@ class PhaseRow:
     vf: float
 
 
-@dataclass(frozen=True, eq=False)
-class AscentResult:
+@dataclass(frozen=True, eq=False, repr=False)
+class AscentResult(Result):
     """Result of `delta3_ascent`.
 
     Attributes
@@ -197,14 +198,21 @@ class AscentResult:
     def __str__(self) -> str:
         return self.summary()
 
-    def plot(self, fig=None, n: int = 60):
-        """Altitude, inertial speed, mass, thrust direction and dynamic pressure against time,
-        the phase boundaries marked; returns a `matplotlib.figure.Figure` (library habit:
-        no pyplot)."""
-        from appdyn.dynamics.figures import cleared_figure
+    _repr_fields = ("final_mass", "final_time")
 
-        fig = cleared_figure(fig, (10.0, 8.0))
-        axes = fig.subplots(3, 2, sharex=True).ravel()
+    @property
+    def wall_time(self) -> float:
+        """``build_time + solve_time`` [s]."""
+        return float(self.build_time + self.solve_time)
+
+    def plot(self, ax=None, n: int = 60):
+        """Altitude, inertial speed, mass, thrust direction and dynamic pressure against time,
+        the phase boundaries marked, on ``ax``'s slot, a Figure, or a new
+        `matplotlib.figure.Figure`; returns the figure (library habit: no pyplot)."""
+        from appdyn.dynamics.figures import panel_axes
+
+        fig, axes = panel_axes(ax, 3, 2, (10.0, 8.0))
+        axes = axes.ravel()
         labels = ("altitude [km]", "inertial speed [km/s]", "mass [t]",
                   "thrust direction u", "dynamic pressure [kPa]", "flight-path angle [deg]")
         for k, sol in enumerate(self.solution.phases):

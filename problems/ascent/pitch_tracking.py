@@ -11,8 +11,9 @@ from typing import Mapping
 import numpy as np
 
 from appdyn.dynamics import simulate
-from appdyn.dynamics.figures import finish_figure, new_figure
-from appdyn.dynamics.serialize import text_table, to_json
+from appdyn.dynamics.figures import finish_figure, panel_axes
+from appdyn.dynamics.results import Result
+from appdyn.dynamics.serialize import text_table
 from appdyn.dynamics.validate import finite_scalar, positive
 
 from .planar import PlanarAscent
@@ -60,8 +61,8 @@ def _gains(gains, veh) -> tuple[float, float]:
             finite_scalar(g["k_thetadot"], "gains['k_thetadot']"))
 
 
-@dataclass(eq=False)
-class PitchTracking:
+@dataclass(eq=False, repr=False)
+class PitchTracking(Result):
     """Result of `fly_pitch_program`.
 
     Attributes
@@ -115,9 +116,6 @@ class PitchTracking:
             "delta_max", "peak_delta_cmd", "final", "optimal", "gains", "wall_time", "t",
             "theta_cmd", "delta_cmd")} | {"x": {n: self.x[i] for i, n in enumerate(TRACKING_STATES)}}
 
-    def to_json(self) -> str:
-        return to_json(self.to_dict())
-
     def __str__(self) -> str:
         d = math.degrees
         rows = [("success", f"{self.success} ({self.status})"),
@@ -131,20 +129,22 @@ class PitchTracking:
         rows.append(("message", self.message))
         return text_table("Pitch program flown through the autopilot", rows)
 
-    def plot(self, path=None):
-        """Pitch and command, tracking error and gimbal deflection against time."""
-        fig = new_figure((8.0, 7.0))
+    _repr_fields = ("max_error", "peak_delta", "gains", "t")
+
+    def plot(self, ax=None):
+        """Pitch and command, tracking error and gimbal deflection against time (on ``ax``'s
+        slot, a Figure, or a new `matplotlib.figure.Figure`); returns the figure."""
+        fig, axes = panel_axes(ax, 3, 1, (8.0, 7.0))
         d = np.degrees
         panels = [(d(np.vstack([self["theta"], self.theta_cmd])), "theta, cmd [deg]"),
                   (d(self["theta"] - self.theta_cmd), "error [deg]"),
                   (d(self["delta"]), "delta [deg]")]
-        for i, (y, label) in enumerate(panels):
-            ax = fig.add_subplot(3, 1, i + 1)
+        for ax, (y, label) in zip(axes[:, 0], panels):
             ax.plot(self.t, np.atleast_2d(y).T)
             ax.set_ylabel(label)
             ax.grid(True, alpha=0.3)
         ax.set_xlabel("t [s]")
-        return finish_figure(fig, path)
+        return finish_figure(fig)
 
 
 def fly_pitch_program(ascent: PlanarAscent, *, gains=None, dt: float = 0.02,

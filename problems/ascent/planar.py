@@ -12,8 +12,9 @@ import casadi as ca
 import numpy as np
 
 from appdyn import ocp
-from appdyn.dynamics.figures import finish_figure, new_figure
-from appdyn.dynamics.serialize import text_table, to_json
+from appdyn.dynamics.figures import finish_figure, panel_axes
+from appdyn.dynamics.results import Result
+from appdyn.dynamics.serialize import text_table
 from appdyn.dynamics.validate import finite_scalar, integer, one_of, positive
 
 from .planar_model import (RHO0, SCALE_HEIGHT, STATES, AscentVehicle, _vehicle, planar_model,
@@ -34,8 +35,8 @@ def _rows_table(title, rows):
     return text_table(title, rows)
 
 
-@dataclass(eq=False)
-class PlanarAscent:
+@dataclass(eq=False, repr=False)
+class PlanarAscent(Result):
     """Result of `planar_ascent`.
 
     Attributes
@@ -108,9 +109,6 @@ class PlanarAscent:
                 "wall_time": self.wall_time, "t": self.t, "theta": self.solution.u[0],
                 "x": {n: self.solution.x[i] for i, n in enumerate(STATES)}}
 
-    def to_json(self) -> str:
-        return to_json(self.to_dict())
-
     def __str__(self) -> str:
         f = self.final
         return _rows_table("Planar ascent (" + self.objective + ")", [
@@ -125,9 +123,12 @@ class PlanarAscent:
             ("burn", f"t = {self.initial['t']:.3f} .. {self.t[-1]:.3f} s"),
             ("wall time", f"{self.wall_time:.2f} s"), ("message", self.message)])
 
-    def plot(self, path=None):
-        """Altitude, speed, pitch / flight-path angle and q, q alpha against time."""
-        fig = new_figure((8.0, 8.0))
+    _repr_fields = ("objective", "burnout_speed", "burnout_mass", "t")
+
+    def plot(self, ax=None):
+        """Altitude, speed, pitch / flight-path angle and q, q alpha against time (on ``ax``'s
+        slot, a Figure, or a new `matplotlib.figure.Figure`); returns the figure."""
+        fig, axes = panel_axes(ax, 4, 1, (8.0, 8.0))
         tt = np.linspace(self.t[0], self.t[-1], 400)
         x, u = self.solution.sample(tt)
         q, qa = _loads(x, u[0])
@@ -135,13 +136,12 @@ class PlanarAscent:
                   (np.degrees(np.vstack([u[0], x[3]])), "theta, gamma [deg]"),
                   (np.vstack([q / self.q_max, np.abs(qa) / self.qalpha_max]),
                    "q / q_max, |q alpha| / limit")]
-        for i, (y, label) in enumerate(panels):
-            ax = fig.add_subplot(4, 1, i + 1)
+        for ax, (y, label) in zip(axes[:, 0], panels):
             ax.plot(tt, np.atleast_2d(y).T)
             ax.set_ylabel(label)
             ax.grid(True, alpha=0.3)
         ax.set_xlabel("t [s]")
-        return finish_figure(fig, path)
+        return finish_figure(fig)
 
 
 def _loads(x, theta, rho0=RHO0):

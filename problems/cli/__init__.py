@@ -37,35 +37,101 @@ Library code never prints or saves files; this package is the one place that doe
 from __future__ import annotations
 
 import argparse
+import importlib
 import os
 import re
 import sys
+from collections.abc import Mapping
 
-import appdyn
+__all__ = ["main", "build_parser", "COMMANDS", "HELP", "rest_to_rest_bound"]
 
-from appdyn.problems.cli import ascent, bench, cache, cmg, demo, dispersion, gains, simulate, slew, stability
-from appdyn.problems.cli.common import attach_negative_values
-from appdyn.problems.cli.slew import rest_to_rest_bound
+#: command name -> its one-line help, in the order of ``--help`` (the modules are imported
+#: only for the command run: ``appdyn --help`` imports neither numpy nor the library)
+HELP = {
+    "simulate": "simulate a model and check it against a truth",
+    "slew": "optimal rigid-body attitude slew (direct collocation)",
+    "stability": "linear stability reports of spinning bodies and mechanisms",
+    "cmg": "CMG pyramid: momentum envelope, steering laws",
+    "gains": "feedback-gain design by direct collocation",
+    "dispersion": "Monte Carlo dispersions",
+    "ascent": "launch-vehicle ascent trajectories",
+    "demo": "a short tour of the toolkit's main jobs (< 1 min)",
+    "bench": "run benchmarks from the bench/ folder",
+    "cache": "the compile cache: where it is and what it holds, or empty it",
+}
 
-__all__ = ["main", "build_parser", "COMMANDS", "rest_to_rest_bound"]
 
-#: command name -> its module (``add_parser``, ``check``, ``run``), in the order of ``--help``
-COMMANDS = {"simulate": simulate, "slew": slew, "stability": stability, "cmg": cmg,
-            "gains": gains, "dispersion": dispersion, "ascent": ascent, "demo": demo,
-            "bench": bench, "cache": cache}
+class _Commands(Mapping):
+    """command name -> its module (``add_parser``, ``check``, ``run``), imported on access."""
+
+    def __getitem__(self, name):
+        if name not in HELP:
+            raise KeyError(name)
+        return importlib.import_module(f"{__name__}.{name}")
+
+    def __iter__(self):
+        return iter(HELP)
+
+    def __len__(self):
+        return len(HELP)
 
 
-def build_parser() -> argparse.ArgumentParser:
-    """The ``appdyn`` parser with every command of `COMMANDS`."""
+#: command name -> its module, in the order of ``--help`` (each imported on first access)
+COMMANDS = _Commands()
+
+
+def __getattr__(name):  # `rest_to_rest_bound` without importing the slew command up front
+    if name == "rest_to_rest_bound":
+        return COMMANDS["slew"].rest_to_rest_bound
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
+
+class _Version(argparse.Action):
+    """``--version``: the installed version, looked up only when asked."""
+
+    def __init__(self, option_strings, dest=argparse.SUPPRESS, default=argparse.SUPPRESS,
+                 help="show the version and exit"):
+        super().__init__(option_strings, dest, nargs=0, default=default, help=help)
+
+    def __call__(self, parser, namespace, values, option_string=None):
+        import appdyn
+
+        sys.stdout.write(f"appdyn {appdyn.__version__}\n")
+        parser.exit()
+
+
+def build_parser(command: str | None = "all") -> argparse.ArgumentParser:
+    """The ``appdyn`` parser.
+
+    Parameters
+    ----------
+    command : str or None
+        ``"all"``: every command's full parser (its module imported); a command name: that
+        command's in full and one-line entries for the others; ``None``: one-line entries
+        only (enough for ``appdyn --help``).
+    """
     parser = argparse.ArgumentParser(
         prog="appdyn", description="Aerospace vehicle dynamics and optimal control on CasADi.",
         epilog="exit status: 0 done (and verified), 1 numerical failure or failed check, "
                "2 bad input")
-    parser.add_argument("--version", action="version", version=f"appdyn {appdyn.__version__}")
+    parser.add_argument("--version", action=_Version)
     sub = parser.add_subparsers(dest="command", required=True)
-    for module in COMMANDS.values():
-        module.add_parser(sub)
+    for name, help_ in HELP.items():
+        if command == "all" or name == command:
+            COMMANDS[name].add_parser(sub)
+        else:
+            sub.add_parser(name, help=help_, add_help=False)
     return parser
+
+
+def _command_of(argv) -> str | None:
+    """The command named in ``argv`` (the first word that is one), else None."""
+    for word in argv:
+        if word in HELP:
+            return word
+        if not word.startswith("-"):
+            return None
+    return None
 
 
 def _one_line(exc) -> str:
@@ -90,8 +156,10 @@ def main(argv=None) -> int:
     failure, failed verification or failure while computing/writing; 2 bad input (a one-line
     message naming the option, before the computation where it can be checked up front).
     """
-    parser = build_parser()
     argv = sys.argv[1:] if argv is None else list(argv)
+    parser = build_parser(_command_of(argv))
+    from appdyn.problems.cli.common import attach_negative_values
+
     args = parser.parse_args(attach_negative_values(parser, argv))
     sub = getattr(args, "_parser", parser)
     command = COMMANDS[args.command]

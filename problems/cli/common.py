@@ -18,9 +18,7 @@ import sys
 import time
 from pathlib import Path
 
-import numpy as np
 
-from appdyn.dynamics.serialize import jsonable, to_json
 
 __all__ = ["vector", "number", "positive", "integer", "output_file", "attach_negative_values",
            "strict_jsonable", "strict_json", "Progress", "progress_enabled", "write_outputs",
@@ -42,8 +40,10 @@ def vector(n_allowed):
             raise argparse.ArgumentTypeError(
                 f"expected {' or '.join(map(str, n_allowed))} comma-separated numbers, got {len(vals)}"
             )
-        if not all(np.isfinite(vals)):
+        if not all(math.isfinite(v) for v in vals):
             raise argparse.ArgumentTypeError(f"numbers must be finite, got {text!r}")
+        import numpy as np  # (imported on use: ``appdyn --help`` stays light)
+
         return np.array(vals)
 
     return parse
@@ -55,7 +55,7 @@ def number(text):
         v = float(text)
     except ValueError:
         raise argparse.ArgumentTypeError(f"expected a number, got {text!r}")
-    if not np.isfinite(v):
+    if not math.isfinite(v):
         raise argparse.ArgumentTypeError(f"expected a finite number, got {text!r}")
     return v
 
@@ -168,8 +168,18 @@ def attach_negative_values(parser, argv) -> list:
 
 # ------------------------------------------------------------------------------ JSON
 # one converter for every result (dynamics.serialize); the CLI's names for it
-strict_jsonable = jsonable
-strict_json = to_json
+def strict_jsonable(data):
+    """`dynamics.serialize.jsonable` (imported on use: ``appdyn --help`` imports no library)."""
+    from appdyn.dynamics.serialize import jsonable
+
+    return jsonable(data)
+
+
+def strict_json(data) -> str:
+    """`dynamics.serialize.to_json` (imported on use)."""
+    from appdyn.dynamics.serialize import to_json
+
+    return to_json(data)
 
 
 # -------------------------------------------------------------------------- progress
@@ -217,7 +227,7 @@ def progress_enabled(args) -> bool:
 
 
 # --------------------------------------------------------------------------- outputs
-def inertia_matrix(values: np.ndarray) -> np.ndarray:
+def inertia_matrix(values):
     """``--inertia`` values: 3 principal moments as they are, 9 entries as a 3x3 matrix."""
     return values if values.size == 3 else values.reshape(3, 3)
 

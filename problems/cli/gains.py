@@ -31,10 +31,9 @@ def _config_file(text):
 
 
 def _example() -> str:
-    """Path of the example configuration installed with the package."""
-    from appdyn.problems.gains.config import EXAMPLE_CONFIG
-
-    return str(EXAMPLE_CONFIG)
+    """Path of the example configuration installed with the package
+    (`problems.gains.config.EXAMPLE_CONFIG`, found without importing the gains package)."""
+    return str(Path(__file__).resolve().parents[1] / "gains" / "launch_vehicle.toml")
 
 
 def add_parser(subparsers) -> argparse.ArgumentParser:
@@ -136,10 +135,8 @@ class DesignPrintout:
         return out
 
     def plot(self):
-        """`problems.gains.launch_vehicle.plot_design`."""
-        from appdyn.problems.gains.launch_vehicle import plot_design
-
-        return plot_design(self.design)
+        """`GainDesign.plot`."""
+        return self.design.plot()
 
 
 def run(args) -> int:

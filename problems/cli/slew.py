@@ -20,7 +20,7 @@ from appdyn.problems.cli.common import output_file as _output_file
 from appdyn.problems.cli.common import positive as _positive
 from appdyn.problems.cli.common import same_file
 from appdyn.problems.cli.common import vector as _vector
-from appdyn.problems.cli.common import write_json
+from appdyn.problems.cli.common import save_figure, write_json
 from appdyn.problems.cli.common import (Progress, add_executor_options, executor_from, finish,
                                  progress_enabled)
 
@@ -231,7 +231,7 @@ def run(args) -> int:
     print(text)
     if args.plot:
         if success:
-            slew.plot_slew(sol, args.plot)
+            save_figure(sol.plot(), args.plot)
             print(f"plot written to {args.plot}")
         else:
             print(f"appdyn slew: --plot {args.plot} skipped: the slew failed ({why})",

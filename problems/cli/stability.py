@@ -120,24 +120,32 @@ def _items(fields):
     return parse
 
 
-def _launch_vehicle_parts():
-    from appdyn.dynamics.launch_vehicle import Actuator, Aero, Bending, Slosh
+def _part(name):
+    """The launch-vehicle part class ``name``, imported when an option value is parsed (not
+    when the parser is built: ``appdyn --help`` stays light)."""
+    import importlib
 
+    launch_vehicle = importlib.import_module("appdyn.dynamics.launch_vehicle")
+
+    return getattr(launch_vehicle, name)
+
+
+def _launch_vehicle_parts():
     slosh = _items(("mass", "hinge", "length", "frequency", "damping_ratio"))
     bending = _items(("frequency", "generalized_mass", "damping_ratio", "slope_sensor",
                       "deflection_gimbal", "slope_gimbal"))
     return [
         ("velocity", "--velocity", _number, "flight speed along X [m/s], with --aero"),
-        ("aero", "--aero", _argument_type(lambda text: Aero(*_floats((4,))(text))),
+        ("aero", "--aero", _argument_type(lambda text: _part("Aero")(*_floats((4,))(text))),
          "dynamic pressure [Pa], reference area [m^2], normal-force slope [1/rad], centre "
          "of pressure ahead of the mass centre [m]"),
-        ("slosh", "--slosh", _argument_type(lambda text: Slosh(**slosh(text))),
+        ("slosh", "--slosh", _argument_type(lambda text: _part("Slosh")(**slosh(text))),
          "slosh mode: mass=KG,hinge=M and length=M (pendulum) or frequency=RAD_S "
          "(spring-mass), optional damping_ratio=Z"),
-        ("bending", "--bending", _argument_type(lambda text: Bending(**bending(text))),
+        ("bending", "--bending", _argument_type(lambda text: _part("Bending")(**bending(text))),
          "bending mode: frequency=RAD_S,generalized_mass=KG, optional damping_ratio, "
          "slope_sensor [rad/m], deflection_gimbal [-], slope_gimbal [rad/m]"),
-        ("actuator", "--actuator", _argument_type(lambda text: Actuator(_positive(text))),
+        ("actuator", "--actuator", _argument_type(lambda text: _part("Actuator")(_positive(text))),
          "gimbal actuator time constant [s]"),
     ]
 

@@ -5,11 +5,12 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from appdyn.dynamics.figures import cleared_figure, finish_figure
+from appdyn.dynamics.figures import finish_figure, panel_grid
 from appdyn.dynamics.serialize import jsonable, text_table, to_json
 from appdyn.dynamics.validate.base import real_array
 
 from .distributions import describe
+from appdyn.dynamics.results import Result
 
 __all__ = ["Statistics", "DispersionResult", "statistics", "assemble", "ALL_OK", "SOME_FAILED",
            "ALL_FAILED"]
@@ -82,8 +83,8 @@ def statistics(values, percentiles=(1.0, 50.0, 99.0)) -> Statistics:
                       {float(p): _num(np.percentile(v, p, axis=0)) for p in percentiles})
 
 
-@dataclass(frozen=True, eq=False)
-class DispersionResult:
+@dataclass(frozen=True, eq=False, repr=False)
+class DispersionResult(Result):
     """Outcome of `dispersion`: inputs, outputs and success of every sample, and statistics.
 
     Arrays are **samples first**: row ``k`` belongs to sample ``index[k]``.
@@ -218,10 +219,6 @@ class DispersionResult:
                            for k, s in self.statistics.items()},
         })
 
-    def to_json(self) -> str:
-        """`to_dict` as strict JSON (non-finite numbers as ``null``)."""
-        return to_json(self.to_dict())
-
     def _unit(self, name: str) -> str:
         unit = self.units.get(name)
         return f" [{unit}]" if unit else ""
@@ -254,7 +251,7 @@ class DispersionResult:
                      f"successful samples\n" + "\n".join(line.rstrip() for line in fmt))
         return text
 
-    def plot(self, path=None, *, outputs=None, fig=None):
+    def plot(self, ax=None, *, outputs=None):
         """Histograms of scalar outputs and envelopes of time histories, one panel each.
 
         A time history is an output of shape ``(n,)`` on the grid ``t``: drawn as its
@@ -263,12 +260,11 @@ class DispersionResult:
 
         Parameters
         ----------
-        path : str or path-like, optional
-            Also save the figure there (PNG unless the suffix is .pdf or .svg).
+        ax : matplotlib.axes.Axes or matplotlib.figure.Figure, optional
+            Draw the panels in this axes' slot (divided into the panels) or on this figure
+            (cleared); by default on a new `matplotlib.figure.Figure` (no pyplot).
         outputs : sequence of str, optional
             The outputs to draw (default: every scalar output and time history).
-        fig : matplotlib.figure.Figure, optional
-            Draw on this figure (cleared); by default on a new one (no pyplot).
 
         Returns
         -------
@@ -289,10 +285,10 @@ class DispersionResult:
                              f"got {bad}")
         ncol = 1 if len(names) <= 1 else 2
         nrow = max(1, -(-len(names) // ncol))
-        fig = cleared_figure(fig, (5.0 * ncol, 3.2 * nrow))
+        fig, grid = panel_grid(ax, nrow, ncol, (5.0 * ncol, 3.2 * nrow))
         ok = self.sample_success
         for k, name in enumerate(names):
-            ax = fig.add_subplot(nrow, ncol, k + 1)
+            ax = fig.add_subplot(grid[k // ncol, k % ncol])
             v = self.outputs[name][ok]
             if v.ndim == 1:
                 finite = v[np.isfinite(v)]
@@ -317,7 +313,7 @@ class DispersionResult:
             ax.grid(True, alpha=0.3)
         fig.suptitle(f"Dispersion: {int(np.count_nonzero(ok))} successful of "
                      f"{len(self.index)} samples (seed {self.seed})", fontsize=10)
-        return finish_figure(fig, path)
+        return finish_figure(fig)
 
 
 def assemble(done, draws, t, seed, samples, params, units, executor, wall_time, complete,

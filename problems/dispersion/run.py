@@ -24,6 +24,7 @@ from appdyn.dynamics import simulate, validate
 from appdyn.dynamics.integrate import METHODS
 from appdyn.dynamics.integrate.inputs import check_t
 from appdyn.dynamics.executors import check_executor, gather
+from appdyn.dynamics.progress import accepts_progress_bar
 from appdyn.dynamics.interrupts import check_interrupt, interruptible
 from appdyn.dynamics.model import Model
 from appdyn.dynamics.scene import Scene
@@ -117,6 +118,7 @@ def _check_picklable(items: dict) -> None:
 
 
 # ---------------------------------------------------------------------------- driver
+@accepts_progress_bar("dispersion")
 @interruptible
 def dispersion(model, x0, t, *, samples: int, seed: int | None, outputs: Mapping,
                params: Mapping | None = None, invariant_drift=False,
@@ -161,8 +163,9 @@ def dispersion(model, x0, t, *, samples: int, seed: int | None, outputs: Mapping
     executor : concurrent.futures.Executor, optional
         Runs the samples (default: serially, here). Results are identical to a serial run
         and ordered by sample; only ``wall_times`` differ.
-    progress : callable, optional
-        ``progress(done, total)`` in this thread after each finished sample.
+    progress : bool or callable, optional
+        ``True``: a bar on stderr (`dynamics.progress`); a callable: ``progress(done,
+        total)`` in this thread after each finished sample.
     percentiles : sequence of float, optional
         Percentiles [%] of the statistics (in ``[0, 100]``).
     units : mapping of str to str, optional

@@ -278,44 +278,19 @@ def launch_vehicle_gains(vehicle, scenarios, *, delta_max, delta_rate_max, weigh
     return GainDesign(True, sol.status, msg, gains, units, float(sol.cost), runs, ver, sol)
 
 
-def plot_design(design: GainDesign, path=None):
-    """Attitude, deflection and deflection rate of every scenario of a launch-vehicle design.
+def plot_design(design: GainDesign, ax=None):
+    """`GainDesign.plot` (kept as a function for existing callers).
 
     Parameters
     ----------
     design : GainDesign
-        From `launch_vehicle_gains` (with re-simulated scenarios).
-    path : str, optional
-        Also save the figure there.
+        From `launch_vehicle_gains`, `attitude_gains` or `state_feedback_gains`.
+    ax : matplotlib.axes.Axes or matplotlib.figure.Figure, optional
 
     Returns
     -------
     matplotlib.figure.Figure
-        Three panels [deg, deg, deg/s] against time [s], the limits dashed.
     """
-    from appdyn.dynamics.figures import finish_figure, new_figure
-
     if not isinstance(design, GainDesign):
         raise TypeError(f"`design` must be a GainDesign, got {type(design).__name__}")
-    fig = new_figure((8.0, 7.0))
-    axes = [fig.add_subplot(3, 1, i + 1) for i in range(3)]
-    for i, run in enumerate(design.scenarios):
-        label = run.get("name") or f"scenario {i}"
-        for ax, key in zip(axes, ("psi", "delta", "delta_rate")):
-            ax.plot(run["t"], np.degrees(run[key]), label=label)
-    for ax, key, ylabel in ((axes[1], "delta_max", "delta [deg]"),
-                            (axes[2], "delta_rate_max", "delta rate [deg/s]"),
-                            (axes[0], None, "psi [deg]")):
-        if key and key in design.verification:
-            v = math.degrees(design.verification[key])
-            ax.axhline(v, ls="--", color="k", lw=0.8)
-            ax.axhline(-v, ls="--", color="k", lw=0.8)
-        ax.set_ylabel(ylabel)
-        ax.grid(True, alpha=0.3)
-    axes[-1].set_xlabel("t [s]")
-    if design.scenarios:
-        axes[0].legend(fontsize=8)
-    g = design.gains
-    axes[0].set_title(f"k_psi = {g.get('k_psi', math.nan):.4g}, "
-                      f"k_psidot = {g.get('k_psidot', math.nan):.4g}")
-    return finish_figure(fig, path)
+    return design.plot(ax)

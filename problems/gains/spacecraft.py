@@ -139,7 +139,7 @@ def attitude_gains(inertia, scenarios, *, u_max, horizon=None, per_axis: bool = 
         ``gains`` ``{'kp': .., 'kd': ..}`` [N m/rad, N m s/rad] (or per axis); ``cost``;
         ``scenarios``: per scenario ``'t'`` (n,) [s], ``'x'`` (7, n) and ``'u'`` (3, n) [N m]
         and ``'angle'`` (n,) [rad] re-simulated over ``2 horizon`` (CVODES, rtol 1e-10),
-        ``'settle_time'`` [s] (inf if not settled), ``'peak'`` ``{'|u1|', '|u2|', '|u3|'}``
+        ``'settle_time'`` [s] (inf if not settled), ``'peak'`` ``{'|L1|', '|L2|', '|L3|'}``
         [N m] and ``'angle'`` [rad] (largest error), ``'angle0'`` [rad]. ``verification``:
 
         * ``'poles'`` (6,) complex [1/s] of the loop linearized at the target, ``'stable'``,
@@ -301,7 +301,7 @@ def attitude_gains(inertia, scenarios, *, u_max, horizon=None, per_axis: bool = 
         settles.append(ts)
         scen.append({"t": t_sim, "x": sim.x, "u": u, "angle": ang, "settle_time": ts,
                      "angle0": float(info[k]["angle"]),
-                     "peak": {"|u1|": float(pk[0]), "|u2|": float(pk[1]), "|u3|": float(pk[2]),
+                     "peak": {"|L1|": float(pk[0]), "|L2|": float(pk[1]), "|L3|": float(pk[2]),
                               "angle": float(np.max(ang))}})
     peaks = np.array(peaks)
     ratio = float(np.max(peaks / umax))

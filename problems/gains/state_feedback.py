@@ -35,7 +35,7 @@ from appdyn.dynamics.validate import finite_array, positive
 
 from .result import STATUS_UNSTABLE, GainDesign
 
-__all__ = ["state_feedback_gains", "default_initial_gain", "HORIZON_RATIO_MIN", "STATUS_SHORT_HORIZON",
+__all__ = ["state_feedback_gains", "linear_system", "default_initial_gain", "HORIZON_RATIO_MIN", "STATUS_SHORT_HORIZON",
            "STATUS_NOT_SPANNING"]
 
 #: a horizon shorter than this many slowest closed-loop time constants draws a warning
@@ -189,7 +189,35 @@ def _lqr_reference(A, B, Q, R, K) -> dict:
             "lqr_max_relative_difference": float(np.max(rel)) if rel.size else None}
 
 
-def state_feedback_gains(A, B, Q, R, initial_states, horizon, *, N: int = _DEFAULT_N,
+def linear_system(sys, name: str = "sys") -> tuple[np.ndarray, np.ndarray]:
+    """``(A, B)`` of a continuous-time linear system given as a python-control ``StateSpace``
+    (or any object with matrices ``A`` and ``B``), as python-control's ``lqr(sys, Q, R)``
+    takes it.
+
+    Raises
+    ------
+    ValueError
+        If ``sys`` is a discrete-time system (``dt`` not 0/None).
+
+    Examples
+    --------
+    >>> import control
+    >>> from appdyn.problems.gains.state_feedback import linear_system
+    >>> A, B = linear_system(control.ss([[0, 1], [0, 0]], [[0], [1]], [[1, 0]], [[0]]))
+    >>> A.shape, B.shape
+    ((2, 2), (2, 1))
+    """
+    dt = getattr(sys, "dt", 0)
+    if dt is True or (dt is not None and dt != 0):
+        raise ValueError(f"`{name}` must be a continuous-time system (dt = 0), got dt = {dt}")
+    return np.asarray(sys.A, dtype=float), np.asarray(sys.B, dtype=float)
+
+
+def _is_system(value) -> bool:
+    return hasattr(value, "A") and hasattr(value, "B") and not isinstance(value, np.ndarray)
+
+
+def state_feedback_gains(A, B, Q, R, initial_states, horizon=None, *, N: int = _DEFAULT_N,
                          transcription="radau", ipopt_options: Mapping | None = None,
                          K0=None, K_bounds=None) -> tuple[np.ndarray, GainDesign]:
     """Full-state feedback ``u = -K x`` minimizing a quadratic cost summed over initial states.
@@ -202,10 +230,13 @@ def state_feedback_gains(A, B, Q, R, initial_states, horizon, *, N: int = _DEFAU
     solves a Riccati equation and never calls ``control.lqr``, which is only the check in
     ``verification``.
 
+    The plant may also be given as one python-control ``StateSpace`` (continuous time), as
+    ``control.lqr`` takes it: ``state_feedback_gains(sys, Q, R, initial_states, horizon)``.
+
     Parameters
     ----------
-    A : array_like, shape (n, n) [1/s]
-        Plant matrix.
+    A : array_like, shape (n, n) [1/s], or control.StateSpace
+        Plant matrix (or the whole plant: the other arguments then shift left by one).
     B : array_like, shape (n, nu)
         Input matrix [state units / (s input unit)].
     Q : array_like, shape (n, n)
@@ -216,7 +247,8 @@ def state_feedback_gains(A, B, Q, R, initial_states, horizon, *, N: int = _DEFAU
         The initial conditions (columns), none zero; they should span ``R^n`` (else a warning:
         ``K`` is then not unique).
     horizon : float [s]
-        The cost's horizon; should be at least ``HORIZON_RATIO_MIN`` (10) times the slowest
+        Required (its default only lets the ``StateSpace`` form shift the arguments). The
+        cost's horizon; should be at least ``HORIZON_RATIO_MIN`` (10) times the slowest
         time constant of the designed loop (else a warning).
     N : int, optional
         Collocation intervals (default 80; uniform mesh, Radau degree 3 by default).
@@ -283,7 +315,15 @@ def state_feedback_gains(A, B, Q, R, initial_states, horizon, *, N: int = _DEFAU
     (True, array([[1.    , 1.7321]]), True)
     """
     t_start = time.perf_counter()
+    if _is_system(A):  # (sys, Q, R, initial_states, horizon)
+        if horizon is not None:
+            raise TypeError("with a StateSpace the arguments are (sys, Q, R, initial_states, "
+                            "horizon): one too many given")
+        (A, B), Q, R, initial_states, horizon = linear_system(A), B, Q, R, initial_states
     A, B, Q, R, X0 = _check_plant(A, B, Q, R, initial_states)
+    if horizon is None:
+        raise TypeError("`horizon` is required: state_feedback_gains(A, B, Q, R, "
+                        "initial_states, horizon) or (sys, Q, R, initial_states, horizon)")
     horizon = positive(horizon, "horizon")
     n, nu = B.shape
     K0 = default_initial_gain(A, B, Q, R) if K0 is None else _check_gain_matrix(K0, nu, n, "K0")

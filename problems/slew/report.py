@@ -6,9 +6,7 @@ from collections.abc import Mapping
 
 import numpy as np
 
-from appdyn.dynamics.attitude import dcm_from_quat
 from appdyn.ocp import Solution, control_switches
-from appdyn.ocp.solution import draw_bounds
 
 from .problem import attitude_blocks
 from .targets import ARCSEC
@@ -124,6 +122,7 @@ def summary(solution: Solution, *, eigenaxis=None) -> dict:
     """JSON-ready summary of a slew solution.
 
     Keys: success, status, message, T [s], cost, switch_times [s] (per torque axis),
+    controls (their names, the model's: ``L1..L3`` for a body torque),
     iterations, solve_time [s], constraint_violation (NLP units, see `ocp.solve`),
     pointing_error_arcsec (final attitude error of the re-simulated control [arcsec]),
     final_rate_error [rad/s] (same re-simulation), propagation_error (largest deviation of
@@ -164,6 +163,7 @@ def summary(solution: Solution, *, eigenaxis=None) -> dict:
         T=float(solution.T),
         cost=float(solution.cost),
         switch_times=[s.tolist() for s in sw],
+        controls=list(solution.problem.model.controls),
         iterations=int(solution.iterations),
         solve_time=float(solution.solve_time),
         constraint_violation=float(solution.constraint_violation),
@@ -206,9 +206,9 @@ def format_summary(data: dict) -> str:
       success                   True (Solve_Succeeded)
       maneuver time T [s]       0.632456
       cost                      0.6324555...
-      switch times u1 [s]       -
-      switch times u2 [s]       -
-      switch times u3 [s]       0.3162
+      switch times L1 [s]       -
+      switch times L2 [s]       -
+      switch times L3 [s]       0.3162
       IPOPT iterations          ...
     """
     if not isinstance(data, Mapping):
@@ -223,8 +223,9 @@ def format_summary(data: dict) -> str:
     if "eigenaxis_T" in data:
         rows.append(("eigenaxis maneuver T [s]", f"{data['eigenaxis_T']:.6f}"))
     rows.append(("cost", f"{data['cost']:.8g}"))
-    for i, s in enumerate(data["switch_times"]):
-        rows.append((f"switch times u{i + 1} [s]", ", ".join(f"{v:.4f}" for v in s) or "-"))
+    names = data.get("controls") or [f"L{i + 1}" for i in range(len(data["switch_times"]))]
+    for name, s in zip(names, data["switch_times"]):
+        rows.append((f"switch times {name} [s]", ", ".join(f"{v:.4f}" for v in s) or "-"))
     rows += [
         ("IPOPT iterations", f"{data['iterations']}"),
         ("solve time [s]", f"{data['solve_time']:.3f}"),
@@ -242,22 +243,14 @@ def format_summary(data: dict) -> str:
     return "\n".join(["Optimal slew"] + [f"  {k:<{width}}  {v}" for k, v in rows])
 
 
-def plot_slew(solution: Solution, path=None, *, fig=None, dpi: int = 110):
-    """Quaternion, rates, torques (with the torque bounds ``+-u_max`` dashed) and the
-    rotation path (body axes on the unit sphere).
-
-    Builds a `matplotlib.figure.Figure` (no pyplot, no backend change) and returns it; the
-    caller shows or saves it. With ``path`` it is also saved there (``Figure.savefig``).
+def plot_slew(solution: Solution, ax=None):
+    """`ocp.Solution.plot` of a slew (kept as a function for existing callers): quaternion,
+    rates, torques (the bounds ``+-u_max`` dashed) and the rotation path.
 
     Parameters
     ----------
     solution : ocp.Solution of a slew
-    path : str or path-like, optional
-        Where to save the figure.
-    fig : matplotlib.figure.Figure, optional
-        Draw into this (empty) figure instead of a new 12 x 8 in one.
-    dpi : int
-        Resolution when saving.
+    ax : matplotlib.axes.Axes or matplotlib.figure.Figure, optional
 
     Returns
     -------
@@ -266,39 +259,8 @@ def plot_slew(solution: Solution, path=None, *, fig=None, dpi: int = 110):
     Raises
     ------
     TypeError
-        If ``solution`` is not an `ocp.Solution`, or ``fig`` not a matplotlib Figure.
+        If ``solution`` is not an `ocp.Solution`.
     """
     if not isinstance(solution, Solution):
         raise TypeError(f"`solution` must be an ocp.Solution, got {type(solution).__name__}")
-    from matplotlib.figure import Figure
-
-    if fig is None:
-        fig = Figure(figsize=(12, 8))
-    elif not isinstance(fig, Figure):
-        raise TypeError(f"`fig` must be a matplotlib Figure, got {type(fig).__name__}")
-    t = np.linspace(solution.t[0], solution.t[-1], 400)
-    x, u = solution.sample(t)
-    iq, iw = attitude_blocks(solution.problem.model)
-    panels = [(x[iq], "quaternion", [f"q{i + 1}" for i in range(4)]),
-              (x[iw], "body rate [rad/s]", ["w1", "w2", "w3"]),
-              (u, "torque [N m]", ["u1", "u2", "u3"])]
-    for k, (data, label, names) in enumerate(panels):
-        ax = fig.add_subplot(2, 2, k + 1)
-        curves = [ax.plot(t, row, label=name)[0] for row, name in zip(data, names)]
-        if label.startswith("torque"):
-            draw_bounds(ax, curves, solution.problem.u_bounds)
-        ax.set(xlabel="t [s]", ylabel=label)
-        ax.legend(loc="best", fontsize=8)
-        ax.grid(alpha=0.3)
-    ax = fig.add_subplot(2, 2, 4, projection="3d")
-    A = dcm_from_quat(x[iq] / np.linalg.norm(x[iq], axis=0))  # (3, 3, n): rows = body axes
-    for i, c in enumerate(("tab:red", "tab:green", "tab:blue")):
-        ax.plot(A[i, 0], A[i, 1], A[i, 2], color=c, label=f"body axis {i + 1}")
-        ax.scatter(*A[i, :, -1], color=c, marker="o")
-    ax.set(title="Rotation path (inertial)", xlim=(-1, 1), ylim=(-1, 1), zlim=(-1, 1))
-    ax.legend(fontsize=8)
-    fig.suptitle(f"T = {solution.T:.5f} s, cost = {solution.cost:.6g}")
-    fig.tight_layout()
-    if path is not None:
-        fig.savefig(path, dpi=dpi)
-    return fig
+    return solution.plot(ax)

@@ -23,6 +23,7 @@ import numpy as np
 
 from appdyn.dynamics.attitude import axis_angle_from_quat, quat_conj, quat_mul
 from appdyn.dynamics.executors import check_executor, gather
+from appdyn.dynamics.progress import accepts_progress_bar
 from appdyn.dynamics.interrupts import check_interrupt, interruptible
 from appdyn.dynamics.serialize import jsonable, text_table, to_json
 from appdyn.dynamics.validate import check_inertia, finite_array, one_of, positive, unit_quaternion
@@ -31,6 +32,7 @@ from appdyn.problems.dispersion.result import ALL_FAILED, ALL_OK, SOME_FAILED
 from .maneuvers import min_effort, time_optimal
 from .targets import check_u_max
 from .targets import targets as target_attitude
+from appdyn.dynamics.results import Result
 
 __all__ = ["maneuver_table", "ManeuverTable", "Target", "check_targets", "example_targets",
            "solve_target", "OBJECTIVES", "ALL_OK", "SOME_FAILED", "ALL_FAILED"]
@@ -146,8 +148,8 @@ def example_targets() -> list:
 
 
 # ---------------------------------------------------------------------------- result
-@dataclass(frozen=True, eq=False)
-class ManeuverTable:
+@dataclass(frozen=True, eq=False, repr=False)
+class ManeuverTable(Result):
     """Outcome of `maneuver_table`: one row per finished target, in catalogue order.
 
     Arrays are **targets first**: row ``k`` belongs to target ``index[k]``.
@@ -223,6 +225,8 @@ class ManeuverTable:
     complete: bool = True
 
     # ------------------------------------------------------------------ verdict
+    _repr_fields = ('objective', 'names', 'T')
+
     @property
     def status(self) -> int:
         """`ALL_OK`, `SOME_FAILED` or `ALL_FAILED` over the finished rows."""
@@ -280,10 +284,6 @@ class ManeuverTable:
             "T_fixed": self.T_fixed, "total": self.total, "complete": self.complete,
             "executor": self.executor, "wall_time": self.wall_time, "rows": self.rows()})
 
-    def to_json(self) -> str:
-        """`to_dict` as strict JSON (non-finite numbers as ``null``)."""
-        return to_json(self.to_dict())
-
     def format(self) -> str:
         """The table as text: a header, then one line per target (angles in degrees)."""
         what = "minimum time" if self.objective == "time" else \
@@ -308,6 +308,40 @@ class ManeuverTable:
 
     __str__ = format
 
+    def plot(self, ax=None):
+        """The maneuver time (or cost) of each target against its rotation angle [deg],
+        failed rows marked; a time-optimal table of a bang-bang body follows
+        ``T = 2 sqrt(theta / alpha)``.
+
+        Parameters
+        ----------
+        ax : matplotlib.axes.Axes, optional
+            Draw on these axes; by default on a new `matplotlib.figure.Figure` (no pyplot).
+
+        Returns
+        -------
+        matplotlib.figure.Figure
+        """
+        from appdyn.dynamics.figures import axes_or_new_figure, finish_figure
+
+        fig, ax = axes_or_new_figure(ax, (7.0, 4.5))
+        y = self.T if self.objective == "time" else self.cost
+        ok = np.asarray(self.row_success, dtype=bool)
+        deg = np.degrees(self.angles)
+        ax.plot(deg[ok], y[ok], "o", color="tab:blue", label="solved")
+        if not ok.all():
+            ax.plot(deg[~ok], y[~ok], "x", color="tab:red", ms=9, label="failed")
+        for name, a, v in zip(self.names, deg, y):
+            ax.annotate(name, (a, v), textcoords="offset points", xytext=(5, 4), fontsize=8)
+        what = "minimum time" if self.objective == "time" else \
+            f"minimum effort over T = {self.T_fixed:g} s"
+        ax.set(xlabel="rotation angle [deg]",
+               ylabel="T [s]" if self.objective == "time" else "cost [N^2 m^2 s]",
+               title=f"Maneuver table ({what}): {int(ok.sum())} of {self.total} solved")
+        ax.grid(True, alpha=0.3)
+        ax.legend(fontsize=8)
+        return finish_figure(fig)
+
 
 # ---------------------------------------------------------------------------- driver
 def solve_target(objective: str, inertia, target: dict, T, u_max, options: dict):
@@ -330,6 +364,7 @@ def _check_options(objective, options: dict) -> dict:
     return dict(options)
 
 
+@accepts_progress_bar("maneuver_table")
 @interruptible
 def maneuver_table(inertia, targets, *, objective: str = "time", T=None, u_max=1.0,
                    executor: Executor | None = None,
@@ -360,8 +395,9 @@ def maneuver_table(inertia, targets, *, objective: str = "time", T=None, u_max=1
         a `KeepOut` and a guess `ocp.Solution` pickle); each worker builds its own NLPs.
         With the ``spawn`` start method the calling script needs the usual
         ``if __name__ == "__main__":`` guard.
-    progress : callable, optional
-        ``progress(done, total)`` in this thread after each finished target.
+    progress : bool or callable, optional
+        ``True``: a bar on stderr (`dynamics.progress`); a callable: ``progress(done,
+        total)`` in this thread after each finished target.
     **options
         Passed to `time_optimal` or `min_effort` for every target: ``N``, ``starts``,
         ``ipopt_options``, ``q0``, ``norm_bound``, ``keep_out``, ``pointing_tol``, ...

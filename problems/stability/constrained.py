@@ -38,8 +38,9 @@ from appdyn.dynamics import cache
 from appdyn.dynamics.linearize import linearization
 from appdyn.dynamics.mechanisms import SEQUENCES, conical_rate, spherical_pendulum
 from appdyn.dynamics.model import Model
+from appdyn.dynamics.results import timed
 
-from .common import STANDARD_GRAVITY, check_number
+from .common import STANDARD_GRAVITY, check_number, spectrum_text
 from .report import Quantity, StabilityReport, build_report
 
 __all__ = ["conical_pendulum", "conical_nutation_frequency", "AZIMUTH"]
@@ -115,6 +116,7 @@ def _check(mass, length, inertia, gravity, cone_angle):
     return m, l, I, g, a
 
 
+@timed
 def conical_pendulum(*, mass, length, cone_angle, inertia=0.0, gravity=STANDARD_GRAVITY,
                      sequence="3-2-1") -> StabilityReport:
     """Stability of the conical pendulum: steady precession at the cone half-angle
@@ -194,7 +196,7 @@ def conical_pendulum(*, mass, length, cone_angle, inertia=0.0, gravity=STANDARD_
                  "Routhian; point mass: (g / (l cos a)) (1 + 3 cos^2 a)"),
         Quantity("azimuth advance per nutation", 2 * math.pi * rate / computed,
                  2 * math.pi * rate / omega, "rad", "2 pi Omega / omega")]
-    full = ", ".join(f"{z.real:+.3e}{z.imag:+.6e}j" for z in lin.eigenvalues())
+    full = spectrum_text(lin.eigenvalues())
     notes = [f"{form} form; conical state {dict(zip(lin.states, np.round(x, 12).tolist()))} "
              f"is an equilibrium of f - Omega xi (turning frame, max |residual| "
              f"{np.max(np.abs(lin.residual)):.1e})",

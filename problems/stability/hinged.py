@@ -15,9 +15,10 @@ import numpy as np
 
 from appdyn.dynamics.hinged import hinged_scene
 from appdyn.dynamics.scene import Scene
+from appdyn.dynamics.results import timed
 
 from .closed_forms import axis_kind, principal_moments, rigid_spin_lambda2
-from .common import check_number
+from .common import check_number, spectrum_text
 from .report import Quantity, StabilityReport, build_report
 from .spin_scene import attitude_subsystem, spin_linearization
 
@@ -123,6 +124,7 @@ def ball_tilt_eigenvalues(m1, A1, C1, m2, A2, C2, l1, l2, rate) -> np.ndarray:
     return np.array([s * 1j * f for f in freqs for s in (1, -1)])
 
 
+@timed
 def hinged_spin(*, m1, inertia1, m2, inertia2, r1, r2, rate, kind="revolute",
                 axis=None) -> StabilityReport:
     """Stability of two hinged bodies (`dynamics.hinged.hinged_bodies`) spinning together at
@@ -236,7 +238,7 @@ def hinged_spin(*, m1, inertia1, m2, inertia2, r1, r2, rate, kind="revolute",
              "the hinge angle (theta, or the twist q3_rel of the relative quaternion q_rel = "
              "p; q4_rel its norm) is cyclic: a family of relative equilibria",
              f"unreduced spectrum ({lin.n} states): "
-             + ", ".join(f"{z.real:+.3e}{z.imag:+.6e}j" for z in lin.eigenvalues()),
+             + spectrum_text(lin.eigenvalues()),
              *red.notes, *sl.notes]
     title = (f"Hinged pair ({kind} hinge) spinning about the common axis z at "
              f"{W:.6g} rad/s")

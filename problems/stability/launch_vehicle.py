@@ -62,6 +62,7 @@ from numpy.polynomial import Polynomial
 
 from appdyn.dynamics.launch_vehicle import launch_vehicle as vehicle_model
 from appdyn.dynamics.linearize import linearization
+from appdyn.dynamics.results import timed
 
 from .common import check_number
 from .loop import loop
@@ -241,6 +242,7 @@ def _title(parts) -> str:
             + (", ".join(given) if given else "rigid vehicle"))
 
 
+@timed
 def launch_vehicle(*, thrust, inertia, arm, mass, k_psi, k_psidot, aero=None, velocity=None,
                    slosh=None, bending=None, actuator=None, mass_flow=None) -> StabilityReport:
     """Stability and margins of the attitude/attitude-rate autopilot of a launch vehicle.

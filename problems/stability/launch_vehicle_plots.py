@@ -7,7 +7,7 @@ import math
 
 import numpy as np
 
-from appdyn.dynamics.figures import axes_or_new_figure, cleared_figure, finish_figure
+from appdyn.dynamics.figures import axes_or_new_figure, finish_figure, panel_grid
 
 from .report import StabilityReport
 
@@ -97,18 +97,16 @@ def _margin_texts(mg):
     return gm, pm
 
 
-def bode_plot(report: StabilityReport, path=None, *, fig=None, omega=None,
-              pole_map: bool = False):
+def bode_plot(report: StabilityReport, ax=None, *, omega=None, pole_map: bool = False):
     """Bode plot of the loop at the engine deflection with the gain and phase margins marked.
 
     Parameters
     ----------
     report : StabilityReport
         From `launch_vehicle`.
-    path : str or path-like, optional
-        Also save the figure there.
-    fig : matplotlib.figure.Figure, optional
-        Draw on this figure (cleared); by default a new one (no pyplot).
+    ax : matplotlib.axes.Axes or matplotlib.figure.Figure, optional
+        Draw the panels in this axes' slot (divided into the panels) or on this figure
+        (cleared); by default on a new `matplotlib.figure.Figure` (no pyplot).
     omega : array_like [rad/s], optional
         Frequencies (default: around the poles and crossovers, lightly damped peaks resolved).
     pole_map : bool
@@ -132,8 +130,7 @@ def bode_plot(report: StabilityReport, path=None, *, fig=None, omega=None,
     """
     w, mag, phase = _loop_response(report, omega)
     mg = report.margins
-    fig = cleared_figure(fig, (13.0, 6.5) if pole_map else (8.0, 6.5))
-    grid = fig.add_gridspec(2, 2 if pole_map else 1)
+    fig, grid = panel_grid(ax, 2, 2 if pole_map else 1, (13.0, 6.5) if pole_map else (8.0, 6.5))
     ax_m = fig.add_subplot(grid[0, 0])
     ax_p = fig.add_subplot(grid[1, 0], sharex=ax_m)
     ax_m.semilogx(w, mag, color="tab:blue")
@@ -158,10 +155,10 @@ def bode_plot(report: StabilityReport, path=None, *, fig=None, omega=None,
         ax.grid(True, which="both", alpha=0.3)
     if pole_map:
         report.plot(ax=fig.add_subplot(grid[:, 1]))
-    return finish_figure(fig, path)
+    return finish_figure(fig)
 
 
-def nichols_plot(report: StabilityReport, path=None, *, ax=None, omega=None):
+def nichols_plot(report: StabilityReport, ax=None, *, omega=None):
     """Nichols plot of the loop at the engine deflection: the critical point (-180 deg, 0 dB),
     the gain margin (vertical) and the phase margin (horizontal) marked.
 
@@ -169,8 +166,6 @@ def nichols_plot(report: StabilityReport, path=None, *, ax=None, omega=None):
     ----------
     report : StabilityReport
         From `launch_vehicle`.
-    path : str or path-like, optional
-        Also save the figure there.
     ax : matplotlib.axes.Axes, optional
         Draw on these axes; by default on a new figure (no pyplot).
     omega : array_like [rad/s], optional
@@ -202,4 +197,4 @@ def nichols_plot(report: StabilityReport, path=None, *, ax=None, omega=None):
            title="Nichols: loop at the engine deflection")
     ax.grid(True, alpha=0.3)
     ax.legend(fontsize=8, loc="best")
-    return finish_figure(fig, path)
+    return finish_figure(fig)

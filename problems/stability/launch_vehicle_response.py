@@ -18,13 +18,14 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from appdyn.dynamics.figures import cleared_figure, finish_figure
+from appdyn.dynamics.figures import finish_figure, panel_axes
 from appdyn.dynamics.integrate import SimulationResult, simulate
 from appdyn.dynamics.launch_vehicle import launch_vehicle as vehicle_model
 from appdyn.dynamics.serialize import jsonable, plain, text_table
 
 from .common import check_number
 from .launch_vehicle import flight_speed, frozen_state
+from appdyn.dynamics.results import Result
 
 __all__ = ["AutopilotResponse", "launch_vehicle_response", "gust"]
 
@@ -43,8 +44,8 @@ def gust(t, speed, start, duration):
     return np.where(inside, 0.5 * speed * (1 - np.cos(2 * np.pi * (t - start) / duration)), 0.0)
 
 
-@dataclass(frozen=True)
-class AutopilotResponse:
+@dataclass(frozen=True, repr=False)
+class AutopilotResponse(Result):
     """Time response of the launch-vehicle autopilot (`launch_vehicle_response`).
 
     Attributes
@@ -68,6 +69,8 @@ class AutopilotResponse:
     units: dict
     parameters: dict
     simulation: SimulationResult = field(repr=False)
+
+    _repr_fields = ('t', 'series')
 
     @property
     def success(self) -> bool:
@@ -100,10 +103,6 @@ class AutopilotResponse:
                          "peaks": {k: self.peak(k) for k in self.series}, "t": self.t,
                          "series": self.series})
 
-    def to_json(self) -> str:
-        """`to_dict` as strict JSON."""
-        return json.dumps(self.to_dict(), indent=2, allow_nan=False)
-
     def __str__(self) -> str:
         sim = self.simulation
         rows = [("success", f"{self.success} (status {self.status}: {self.message})"),
@@ -117,15 +116,14 @@ class AutopilotResponse:
                          f"final {scale * values[-1]:+.6g}"))
         return text_table("Launch-vehicle autopilot response (RP-1262, Sec. 5.4)", rows)
 
-    def plot(self, path=None, *, fig=None):
+    def plot(self, ax=None):
         """Attitude, deflection, slosh, bending and gust panels against time.
 
         Parameters
         ----------
-        path : str or path-like, optional
-            Also save the figure there.
-        fig : matplotlib.figure.Figure, optional
-            Draw on this figure (cleared); by default a new one (no pyplot).
+        ax : matplotlib.axes.Axes or matplotlib.figure.Figure, optional
+            Draw the panels in this axes' slot (divided into the panels) or on this figure
+            (cleared); by default on a new `matplotlib.figure.Figure` (no pyplot).
 
         Returns
         -------
@@ -137,8 +135,8 @@ class AutopilotResponse:
                   ("gust and angle of attack", ("wind_y", "alpha"))]
         panels = [(title, [n for n in names if n in self.series]) for title, names in panels]
         panels = [(title, names) for title, names in panels if names]
-        fig = cleared_figure(fig, (8.0, 2.1 * len(panels) + 0.8))
-        axes = fig.subplots(len(panels), 1, sharex=True, squeeze=False)[:, 0]
+        fig, axes = panel_axes(ax, len(panels), 1, (8.0, 2.1 * len(panels) + 0.8))
+        axes = axes[:, 0]
         for ax, (title, names) in zip(axes, panels):
             for name in names:
                 target = ax.twinx() if name == "alpha" else ax
@@ -154,7 +152,7 @@ class AutopilotResponse:
             ax.set_title(title, fontsize=9)
             ax.grid(True, alpha=0.3)
         axes[-1].set_xlabel("t [s]")
-        return finish_figure(fig, path)
+        return finish_figure(fig)
 
 
 def _atol(model, rtol, speed, t_final, mass) -> np.ndarray:

@@ -4,12 +4,14 @@ from __future__ import annotations
 import math
 
 import numpy as np
+from appdyn.dynamics.results import timed
 
 from .report import Margins, StabilityReport, build_report
 
 __all__ = ["loop"]
 
 
+@timed
 def loop(plant, controller, *, title: str = "Feedback loop", closed_form=None) -> StabilityReport:
     """Closed-loop stability and margins of ``plant`` under ``u = -controller(y)``.
 

@@ -38,8 +38,10 @@ from appdyn.dynamics.integrate import simulate
 from appdyn.dynamics.mechanisms import kapitza_frequency, resonance_tongue
 from appdyn.dynamics.mechanisms import shaken_pendulum as shaken_model
 
+from appdyn.dynamics.results import Result
+
 from .common import (STANDARD_GRAVITY, check_number, finish_figure, format_number, jsonable,
-                     param_text, plain)
+                     param_line, plain)
 from .report import (CLOSED_FORM_RTOL, STATUS_MISMATCH, STATUS_UNCHECKED, STATUS_VERIFIED,
                      Quantity, StabilityReport)
 
@@ -66,8 +68,8 @@ class FloquetMode:
     label: str = ""
 
 
-@dataclass(frozen=True)
-class PeriodicStabilityReport:
+@dataclass(frozen=True, repr=False)
+class PeriodicStabilityReport(Result):
     """Floquet stability of a time-periodic operating point, in the format of
     `StabilityReport` (same verdicts, statuses, quantities, text, JSON, plot).
 
@@ -124,6 +126,8 @@ class PeriodicStabilityReport:
     integrated: bool = True
     floquet: object = field(default=None, repr=False, compare=False)
 
+    _repr_fields = ('case', 'verdict', 'period', 'multipliers')
+
     @property
     def success(self) -> bool:
         """``False`` when the integration failed or the closed forms disagree."""
@@ -142,7 +146,6 @@ class PeriodicStabilityReport:
     # the same contract as StabilityReport's (they read only quantities and eigenvalues)
     least_damped = StabilityReport.least_damped
     quantity = StabilityReport.quantity
-    to_json = StabilityReport.to_json
 
     def to_dict(self) -> dict:
         """JSON-ready summary: complex numbers as ``[re, im]``, non-finite numbers as ``None``."""
@@ -159,7 +162,7 @@ class PeriodicStabilityReport:
 
     def __str__(self) -> str:
         lines = [self.title]
-        lines += [f"  {k:<9}  {param_text(v)}" for k, v in self.parameters.items()]
+        lines += [f"  {k:<9}  {param_line(k, v)}" for k, v in self.parameters.items()]
         lines.append(f"  period     {self.period:.10g} s; states {', '.join(self.states)}")
         lines.append(f"verdict: {self.verdict.upper()} — {self.reason} (closed-form "
                      f"prediction: {self.predicted or '-'})")
@@ -180,16 +183,14 @@ class PeriodicStabilityReport:
         lines += [f"note: {n}" for n in self.notes]
         return "\n".join(lines)
 
-    def plot(self, path=None, *, ax=None):
+    def plot(self, ax=None):
         """The multipliers on the unit circle (`dynamics.floquet.FloquetResult.plot`); dashed,
         the closed-form ``|mu|`` of a damped system.
 
         Parameters
         ----------
-        path : str or path-like, optional
-            Also save the figure there.
         ax : matplotlib.axes.Axes, optional
-            Draw on these axes (default: a new Figure, no pyplot).
+            Draw on these axes; by default on a new `matplotlib.figure.Figure` (no pyplot).
 
         Returns
         -------
@@ -204,7 +205,7 @@ class PeriodicStabilityReport:
                     label=f"closed form |mu| = {r:.6g}")
             ax.legend(loc="lower left", fontsize=8)
         ax.set_title(f"{self.title}\n{self.verdict}", fontsize=9)
-        return finish_figure(fig, path)
+        return finish_figure(fig)
 
 
 # ----------------------------------------------------------------- Mathieu prediction

@@ -13,7 +13,6 @@ closed forms (Rheinfurth & Wilson, NASA RP-1262, Secs. 4.5-4.6):
 """
 from __future__ import annotations
 
-import json
 import math
 from dataclasses import asdict, dataclass, field
 from typing import Mapping, Sequence
@@ -22,9 +21,10 @@ import numpy as np
 
 from appdyn.dynamics.linearize import Linearization
 
-from .common import (axes_or_new_figure, finish_figure, format_number, jsonable, param_text,
+from .common import (axes_or_new_figure, finish_figure, format_number, jsonable, param_line,
                      plain)
 from .verdict import ZERO_RTOL, classify, least_damped
+from appdyn.dynamics.results import Result, clean_number, quantity
 
 __all__ = ["Mode", "Margins", "Quantity", "StabilityReport", "build_report", "analyze",
            "STATUS_VERIFIED", "STATUS_UNCHECKED", "STATUS_MISMATCH", "CLOSED_FORM_RTOL",
@@ -137,8 +137,8 @@ class Quantity:
     equation: str = ""
 
 
-@dataclass(frozen=True)
-class StabilityReport:
+@dataclass(frozen=True, repr=False)
+class StabilityReport(Result):
     """Linear stability of one case.
 
     Attributes
@@ -168,6 +168,8 @@ class StabilityReport:
     notes : tuple of str
     linearization : Linearization or None
         The full linearization before reduction.
+    wall_time : float [s]
+        Time of the call that made the report (NaN when built directly).
     success : bool
         ``status != STATUS_MISMATCH`` (property).
     status : int
@@ -203,6 +205,9 @@ class StabilityReport:
     closed_form_error: float | None = None
     notes: tuple = ()
     linearization: Linearization | None = field(default=None, repr=False, compare=False)
+    wall_time: float = field(default=math.nan, compare=False)
+
+    _repr_fields = ('case', 'verdict', 'eigenvalues')
 
     def __getstate__(self) -> dict:
         """Pickled state: the fields, ``ss`` as its matrices and names (python-control's
@@ -273,15 +278,11 @@ class StabilityReport:
             "notes": list(self.notes),
         })
 
-    def to_json(self) -> str:
-        """`to_dict` as strict JSON text."""
-        return json.dumps(self.to_dict(), indent=2, allow_nan=False)
-
     def __str__(self) -> str:
         lines = [self.title]
         width = max([len(k) for k in self.parameters] + [5])
         for k, v in self.parameters.items():
-            lines.append(f"  {k:<{width}}  {param_text(v)}")
+            lines.append(f"  {k:<{width}}  {param_line(k, v)}")
         lines.append("  states  " + ", ".join(self.ss.state_labels))
         lines.append(f"verdict: {self.verdict.upper()} — {self.reason}")
         lines.append(f"modes (|Re| <= {self.tolerance:.2e} 1/s counts as zero):")
@@ -292,7 +293,7 @@ class StabilityReport:
             ev = _fmt_mode(m.eigenvalue, m.pair)
             cf = "-" if m.closed_form is None else _fmt_mode(m.closed_form, m.pair)
             err = "-" if m.error is None else f"{m.error:.1e}"
-            zeta = "nan" if math.isnan(m.zeta) else f"{round(m.zeta, 4) + 0.0:+.4f}"
+            zeta = "nan" if math.isnan(m.zeta) else quantity(m.zeta, "", 3)
             lines.append(f"  {ev:<31} {m.wn:>11.5e} {zeta:>8}  {m.label:<28}{cf:<31} {err:>9}")
         if self.quantities:
             w = max(len(q.name) for q in self.quantities)
@@ -305,13 +306,19 @@ class StabilityReport:
         if self.margins is not None:
             mg = self.margins
             lines.append("margins:")
-            lines.append(f"  gain margin   {format_number(mg.gain_margin)} "
-                         f"({format_number(mg.gain_margin_db, '.4g')} dB) at "
-                         f"{format_number(mg.phase_crossover)} rad/s")
-            lines.append(f"  phase margin  {format_number(mg.phase_margin, '.6g')} deg at "
-                         f"{format_number(mg.gain_crossover)} rad/s")
-            lines.append(f"  stability margin {format_number(mg.stability_margin, '.6g')} at "
-                         f"{format_number(mg.stability_margin_frequency)} rad/s")
+            lines.append("  gain margin   " + (
+                "inf (no phase crossover: the loop gain may grow without bound)"
+                if not math.isfinite(mg.phase_crossover) else
+                f"{format_number(mg.gain_margin)} ({format_number(mg.gain_margin_db, '.4g')} "
+                f"dB) at {format_number(mg.phase_crossover)} rad/s"))
+            lines.append("  phase margin  " + (
+                "inf (no gain crossover)" if not math.isfinite(mg.gain_crossover) else
+                f"{format_number(mg.phase_margin, '.6g')} deg at "
+                f"{format_number(mg.gain_crossover)} rad/s"))
+            where = (f" at {format_number(mg.stability_margin_frequency)} rad/s"
+                     if math.isfinite(mg.stability_margin_frequency) else "")
+            lines.append(f"  stability margin {format_number(mg.stability_margin, '.6g')} "
+                         f"(least |1 + L|, unitless){where}")
         if self.closed_form_error is not None:
             lines.append(f"closed-form check: max |lambda - closed form| / rho = "
                          f"{self.closed_form_error:.2e}")
@@ -319,13 +326,11 @@ class StabilityReport:
             lines.append(f"note: {n}")
         return "\n".join(lines)
 
-    def plot(self, path=None, *, ax=None):
+    def plot(self, ax=None):
         """Pole map: eigenvalues, closed forms and mode labels.
 
         Parameters
         ----------
-        path : str or path-like, optional
-            Also save the figure there (format from the suffix; PNG without one).
         ax : matplotlib.axes.Axes, optional
             Draw on these axes; by default on a new `matplotlib.figure.Figure` (no pyplot,
             the backend is left alone).
@@ -356,7 +361,7 @@ class StabilityReport:
         ax.set_title(f"{self.title}\n{self.verdict}", fontsize=10)
         ax.grid(True, alpha=0.3)
         ax.legend(loc="lower left", fontsize=8)
-        return finish_figure(fig, path)
+        return finish_figure(fig)
 
 
 def _ss_data(ss) -> dict:
@@ -381,7 +386,8 @@ def _ss_from_data(data: dict):
 
 
 def _fmt_mode(z: complex, pair: bool) -> str:
-    return f"{z.real:+.6e} ± {abs(z.imag):.6e}j" if pair else f"{z.real:+.6e}"
+    re = clean_number(z.real, abs(z))  # round-off (|Re| <= 1e-12 |lambda|) shown as 0
+    return f"{re:+.6e} ± {abs(z.imag):.6e}j" if pair else f"{re:+.6e}"
 
 
 # --------------------------------------------------------------- mode bookkeeping

@@ -18,6 +18,7 @@ from appdyn.dynamics.scene import (ExternalForce, ExternalTorque, FlexibleAppend
                                    ReactionWheels, RigidHub, Scene, TiltTorque)
 from appdyn.dynamics.spinning import (PointMassDamper, SphericalDamper, gyrostat_scene,
                                       unit_vector)
+from appdyn.dynamics.results import timed
 
 from .closed_forms import (axis_kind, gyrostat_lambda2, method3_roots, principal_moments,
                            rigid_spin_lambda2, spherical_damper_roots, with_conjugates)
@@ -32,6 +33,7 @@ def _damper_dict(damper):
     return None if damper is None else plain(damper)
 
 
+@timed
 def spin(inertia, axis, rate, *, damper=None) -> StabilityReport:
     """Spin ``w = rate * axis`` of a scene, or torque-free spin of a rigid body about a
     principal axis, optionally with a damper.
@@ -316,6 +318,7 @@ def _pair_frequency(ev) -> float | None:
     return float(max(im)) if im else None
 
 
+@timed
 def gyrostat(inertia, axis, rate, wheel_momentum, *, wheel_inertia=None, damper=None,
              damper_on: str = "platform") -> StabilityReport:
     """Dual-spin gyrostat: platform spinning at ``rate`` about ``axis``, a wheel along

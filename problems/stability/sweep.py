@@ -6,7 +6,9 @@ import inspect
 import numpy as np
 
 from appdyn.dynamics.executors import check_executor, gather
+from appdyn.dynamics.progress import accepts_progress_bar
 from appdyn.dynamics.interrupts import check_interrupt, interruptible
+from appdyn.dynamics.results import timed
 
 from .cases import resolve_case
 from .common import plain
@@ -18,6 +20,8 @@ _STABLE_UNSTABLE = {"asymptotically stable", "unstable"}
 _BAND_RTOL = 1e-4  # a "marginally stable" stretch this narrow between the two is a zero band
 
 
+@timed
+@accepts_progress_bar("sweep")
 @interruptible
 def sweep(case, parameter: str, values, *, rtol: float = 1e-8, progress=None, executor=None,
           **case_kwargs) -> SweepResult:
@@ -43,8 +47,9 @@ def sweep(case, parameter: str, values, *, rtol: float = 1e-8, progress=None, ex
         Strictly increasing, finite, ``n >= 1``.
     rtol : float, optional
         Relative bracket width of the bisection.
-    progress : callable, optional
-        ``progress(done, total)`` after each grid value (``total = len(values)``; the
+    progress : bool or callable, optional
+        ``True``: a bar on stderr (`dynamics.progress`); a callable: ``progress(done,
+        total)`` after each grid value (``total = len(values)``; the
         bisections that follow are not counted). With an ``executor``, called in the calling
         thread as the grid values complete (in completion order).
     executor : concurrent.futures.Executor, optional

@@ -1,13 +1,15 @@
 """The result of `problems.stability.sweep`: `SweepResult` and its `Boundary` entries."""
 from __future__ import annotations
 
-import json
-from dataclasses import asdict, dataclass
+from dataclasses import asdict, dataclass, field
 
 import numpy as np
 
+from appdyn.dynamics.figures import panel_axes
+
 from .common import finish_figure, format_complex, jsonable, param_text
 from .report import STATUS_MISMATCH, STATUS_UNCHECKED, status_message
+from appdyn.dynamics.results import Result
 
 __all__ = ["Boundary", "SweepResult"]
 
@@ -33,8 +35,8 @@ class Boundary:
     after: str
 
 
-@dataclass(frozen=True)
-class SweepResult:
+@dataclass(frozen=True, repr=False)
+class SweepResult(Result):
     """Verdicts and least-damped eigenvalues of a case along one parameter.
 
     Attributes
@@ -64,6 +66,8 @@ class SweepResult:
     complete : bool
         False for the partial result of an interrupted sweep (`sweep`, Ctrl-C): the grid
         values evaluated before the interrupt, and the boundaries located by then.
+    wall_time : float [s]
+        Time of the `sweep` call (NaN when built directly).
     success : bool
         False when some report disagreed with its closed forms (property).
     status : int
@@ -84,6 +88,9 @@ class SweepResult:
     case_kwargs: dict
     statuses: tuple = ()
     complete: bool = True
+    wall_time: float = field(default=float("nan"), compare=False)
+
+    _repr_fields = ('case', 'parameter', 'values', 'boundaries')
 
     @property
     def status(self) -> int:
@@ -119,10 +126,6 @@ class SweepResult:
                           "rtol": self.rtol, "evaluations": self.evaluations,
                           "case_kwargs": self.case_kwargs, "complete": self.complete})
 
-    def to_json(self) -> str:
-        """`to_dict` as strict JSON text."""
-        return json.dumps(self.to_dict(), indent=2, allow_nan=False)
-
     def __str__(self) -> str:
         lines = [f"Sweep of {self.case} over {self.parameter} ({len(self.values)} values, "
                  f"{self.evaluations} evaluations{'' if self.complete else ', interrupted'})"]
@@ -140,25 +143,21 @@ class SweepResult:
             lines.append("no verdict change along the sweep")
         return "\n".join(lines)
 
-    def plot(self, path=None, *, fig=None):
+    def plot(self, ax=None):
         """Real and imaginary parts of every eigenvalue versus the parameter.
 
         Parameters
         ----------
-        path : str or path-like, optional
-            Also save the figure there (format from the suffix; PNG without one).
-        fig : matplotlib.figure.Figure, optional
-            Draw two axes on this figure; by default on a new one (no pyplot).
+        ax : matplotlib.axes.Axes or matplotlib.figure.Figure, optional
+            Draw the panels in this axes' slot (divided into the panels) or on this figure
+            (cleared); by default on a new `matplotlib.figure.Figure` (no pyplot).
 
         Returns
         -------
         matplotlib.figure.Figure
         """
-        if fig is None:
-            from matplotlib.figure import Figure
-
-            fig = Figure(figsize=(8.0, 6.5))
-        ax1, ax2 = fig.add_subplot(2, 1, 1), fig.add_subplot(2, 1, 2)
+        fig, axes = panel_axes(ax, 2, 1, (8.0, 6.5))
+        ax1, ax2 = axes[:, 0]
         ev = self.eigenvalues
         for j in range(ev.shape[1]):
             ax1.plot(self.values, ev[:, j].real, ".", ms=3, color="tab:blue")
@@ -172,8 +171,9 @@ class SweepResult:
         ax1.set_ylabel("Re [1/s]")
         ax2.set_ylabel("Im [rad/s]")
         ax2.set_xlabel(self.parameter)
-        ax1.set_title(f"{self.case}: eigenvalues vs {self.parameter} (dashed: boundaries)")
+        ax1.set_title(f"{self.case}: eigenvalues vs {self.parameter} (dashed: boundaries)",
+                      fontsize=10)
         ax1.legend(fontsize=8)
         for ax in (ax1, ax2):
             ax.grid(True, alpha=0.3)
-        return finish_figure(fig, path)
+        return finish_figure(fig)

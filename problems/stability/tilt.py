@@ -13,6 +13,7 @@ import numpy as np
 
 from appdyn.dynamics.linearize import Linearization
 from appdyn.dynamics.spinning import tilt_torque_scene
+from appdyn.dynamics.results import timed
 
 from .closed_forms import method3_roots, sleeping_rate, with_conjugates
 from .common import STANDARD_GRAVITY, check_number
@@ -50,6 +51,7 @@ def _inertial_roots(red: Linearization, rate: float) -> list:
 
 
 
+@timed
 def heavy_top(axial_inertia, transverse_inertia, mass, length, rate, *,
               gravity: float = STANDARD_GRAVITY) -> StabilityReport:
     """Heavy top spinning upright about its symmetry axis.
@@ -121,6 +123,7 @@ def heavy_top(axial_inertia, transverse_inertia, mass, length, rate, *,
     return _tilt_report("heavy_top", title, I1, I2, mgl, rate, 0.0, params, "m g l")
 
 
+@timed
 def spinning_projectile(axial_inertia, transverse_inertia, rate, *, dynamic_pressure, area,
                         cn_alpha, cp_offset) -> StabilityReport:
     """Spin-stabilized projectile: the heavy top with ``m g l -> M_alpha = q S C_N_alpha l``.
@@ -176,6 +179,7 @@ def spinning_projectile(axial_inertia, transverse_inertia, rate, *, dynamic_pres
                         "M_alpha")
 
 
+@timed
 def rotor(axial_inertia, transverse_inertia, stiffness, bearing_distance, rate, *,
           internal_damping: float = 0.0) -> StabilityReport:
     """Rotor in elastic bearings: whirl and internal damping.

@@ -34,11 +34,25 @@ def test_failed_run_serializes_non_finite_as_null():
     assert data["x"]["w1"][-1] is None
 
 
-def test_plot_returns_a_figure_of_the_chosen_states(tmp_path):
-    res = simulate(rigid_body([1.0, 2.0, 3.0]), [0, 0, 0, 1, 1.0, 0.1, 0.8],
-                   np.linspace(0.0, 5.0, 6))
-    fig = res.plot(tmp_path / "sim.png", states=["w1", "w3"])
-    assert type(fig).__name__ == "Figure" and len(fig.axes[0].lines) == 2
-    assert (tmp_path / "sim.png").stat().st_size > 5_000
+def test_plot_groups_states_by_unit_on_the_given_axes():
+    from matplotlib.figure import Figure
+    model = rigid_body([1.0, 2.0, 3.0])
+    res = simulate(model, [0, 0, 0, 1, 1.0, 0.1, 0.8], np.linspace(0.0, 5.0, 6))
+    fig = res.plot(states=["q1", "w1", "w3"])
+    labels = [a.get_ylabel() for a in fig.axes]
+    assert labels == [f"[{model.units.get('q1') or '-'}]", f"[{model.units['w1']}]"]
+    assert [len(a.lines) for a in fig.axes] == [1, 2]
+    assert "success" not in fig.texts[0].get_text()  # a readable title, not "rk8: success True"
+    given = Figure().subplots(1, 1)
+    assert res.plot(given, states=["w1"]) is given.figure and len(given.lines) == 1
     with pytest.raises(ValueError, match="`states`"):
         res.plot(states=["w4"])
+
+
+def test_repr_is_compact_and_html_renders():
+    res = simulate(rigid_body([1.0, 2.0, 3.0]), [0, 0, 0, 1, 1.0, 0.1, 0.8],
+                   np.linspace(0.0, 5.0, 101))
+    text = repr(res)
+    assert text.startswith("SimulationResult") and len(text.splitlines()) <= 10
+    assert "array(shape=(7, 101), float64)" in text
+    assert "<table>" in res._repr_html_()

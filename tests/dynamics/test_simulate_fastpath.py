@@ -139,7 +139,7 @@ BAD = [
     (dict(jit="yes"), "`jit` must be None, True or False"),
     (dict(steps=0), "`steps` must be an integer >= 1"),
     (dict(steps=1.5), "`steps` must be an integer"),
-    (dict(progress=3), "`progress` must be None or a callable"),
+    (dict(progress=3), "`progress` must be None, True/False or a callable"),
     (dict(cvodes_options=[1]), "`cvodes_options` must be a mapping"),
 ]
 

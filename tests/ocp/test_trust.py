@@ -49,7 +49,7 @@ def test_constraint_violation_counts_bounds_and_gates_success():
     sol = solve(problem, N=10, verbose=False)
     assert isinstance(sol.constraint_violation, float)
     assert 0.0 <= sol.constraint_violation <= DEFAULT_CONSTRAINT_TOL
-    assert "constraint_violation=" in repr(sol)
+    assert "constraint_violation:" in repr(sol)
     # IPOPT's own loose success, held to a threshold it did not aim at: not verified
     loose = solve(problem, N=10, verbose=False, constraint_tol=1e-300,
                   ipopt_options={"tol": 1e-2, "constr_viol_tol": 1e-2, "max_iter": 3})

@@ -167,3 +167,30 @@ def test_min_effort_verbose_labels_every_stage_on_stderr(tmp_path, capfd):
     assert "[slew]" in stderr and "[refine round 1]" in stderr and "[refine] refine round 0" in stderr
     unlabelled = [line for line in stderr.splitlines() if line and not line.startswith("[")]
     assert not unlabelled, unlabelled[:5]
+
+
+def test_help_imports_neither_numpy_nor_the_library():
+    """`appdyn --help` builds one-line entries only (the benchmark bench/cli.py times it)."""
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    probe = ("import sys, io, contextlib\n"
+             "from appdyn.problems.cli import main\n"
+             "with contextlib.redirect_stdout(io.StringIO()) as out:\n"
+             "    try:\n"
+             "        main(['--help'])\n"
+             "    except SystemExit:\n"
+             "        pass\n"
+             "print('numpy' in sys.modules, 'appdyn.dynamics' in sys.modules, 'slew' in out.getvalue())")
+    root = str(Path(__file__).resolve().parents[2])
+    got = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True,
+                         check=True, env={"PYTHONPATH": root, "PATH": ""}).stdout.split()
+    assert got == ["False", "False", "True"]
+
+
+def test_the_one_line_helps_are_the_commands_own():
+    from appdyn.problems.cli import HELP, build_parser
+
+    sub = next(a for a in build_parser("all")._actions if a.dest == "command")
+    assert {c.dest: c.help for c in sub._choices_actions} == HELP

@@ -95,7 +95,7 @@ def test_negative_scalars_and_ranges_in_stability(capsys):
     assert main(["stability", "projectile", "--axial-inertia", "0.01", "--transverse-inertia",
                  "0.1", "--rate", "100", "--dynamic-pressure", "1000", "--area", "0.01",
                  "--cn-alpha", "2", "--cp-offset", "-0.05"]) == 0
-    assert re.search(r"cp_offset +-0.05\n", capsys.readouterr().out)
+    assert re.search(r"cp_offset +-0.05 m\n", capsys.readouterr().out)  # with its unit
     # intermediate axis: Re(lambda) = |rate| sqrt((I2 - I1)(I3 - I2) / (I1 I3)) (Euler)
     code = main([*SPIN[:6], "0,1,0", "--parameter", "rate", "--values", "-3:-1:3", "--quiet"])
     assert code == 0

@@ -35,6 +35,19 @@ def test_double_integrator_gains_are_the_lqr_gains():
     assert res.verification["lqr_max_relative_difference"] < 1e-5
 
 
+def test_a_statespace_is_taken_as_control_lqr_takes_it():
+    """``state_feedback_gains(sys, Q, R, X0, horizon)`` equals the (A, B) call exactly (the
+    same NLP); a discrete-time system is refused naming ``sys``."""
+    sys = control.ss(A_DI, B_DI, np.eye(2), np.zeros((2, 1)))
+    K_sys, res_sys = state_feedback_gains(sys, np.eye(2), np.eye(1), np.eye(2), 15.0, N=20)
+    K_ab, _ = state_feedback_gains(A_DI, B_DI, np.eye(2), np.eye(1), np.eye(2), 15.0, N=20)
+    np.testing.assert_array_equal(K_sys, K_ab)
+    assert res_sys.success, res_sys.message
+    with pytest.raises(ValueError, match="`sys` must be a continuous-time system"):
+        state_feedback_gains(control.ss(A_DI, B_DI, np.eye(2), np.zeros((2, 1)), 0.1),
+                             np.eye(2), np.eye(1), np.eye(2), 15.0)
+
+
 def test_unstable_three_state_plant_gains_are_the_lqr_gains():
     """A chain with an open-loop pole at +0.81 1/s, Q = diag(1, 0.5, 0.2), R = 0.5; horizon
     14 s = 12.8 time constants, N = 100: measured max relative difference 5.6e-7."""

@@ -63,7 +63,7 @@ def test_a_polynomial_control_is_reported_as_leaving_the_bounds():
 def test_plots_draw_the_torque_bounds():
     sol = slew.time_optimal(np.eye(3), angle=0.1, axis=[0, 0, 1], u_max=[0.5, 0.5, 0.3], N=10,
                             starts=1, polish=False)
-    for fig, panel in ((slew.plot_slew(sol), 2), (sol.plot(), 1)):
+    for fig, panel in ((slew.plot_slew(sol), 2), (sol.plot(), 2)):
         ax = fig.axes[panel]
         levels = sorted(round(float(line.get_ydata()[0]), 12) for line in ax.get_lines()
                         if line.get_linestyle() == "--")

@@ -26,14 +26,16 @@ def test_switch_times_agree_with_the_engine(bilimoria_wie):
         slew.switch_times(sol, axis=3)
 
 
-def test_plot_slew_returns_a_figure_and_saves_on_request(bilimoria_wie, tmp_path):
-    fig = slew.plot_slew(bilimoria_wie)
+def test_a_slew_plots_itself_on_the_axes_given(bilimoria_wie):
+    fig = bilimoria_wie.plot()  # a slew's plot() is the slew figure (plot_slew an alias)
     assert isinstance(fig, Figure) and len(fig.axes) == 4
-    out = tmp_path / "slew.png"
-    fig2 = slew.plot_slew(bilimoria_wie, out)
-    assert isinstance(fig2, Figure) and out.stat().st_size > 0
-    with pytest.raises(TypeError, match="`fig`"):
-        slew.plot_slew(bilimoria_wie, fig="figure")
+    assert [a.get_ylabel() for a in fig.axes[:3]] == ["quaternion [-]", "body rate [rad/s]",
+                                                      "control [N m]"]
+    given = Figure().subplots(1, 2)
+    assert slew.plot_slew(bilimoria_wie, given[0]) is given[1].figure
+    assert len(given[1].figure.axes) == 1 + 4  # the slot of given[0] divided into the panels
+    with pytest.raises(TypeError, match="`ax`"):
+        slew.plot_slew(bilimoria_wie, "figure")
 
 
 def test_switch_times_component_and_the_deprecated_axis(bilimoria_wie):

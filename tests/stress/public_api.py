@@ -37,9 +37,15 @@ def _enumerate():
 FUNCTIONS = _enumerate()
 
 
+#: parameters required although they have a default (the default serves another call form:
+#: ``state_feedback_gains(sys, Q, R, initial_states, horizon)`` shifts the arguments)
+ALSO_REQUIRED = {"state_feedback_gains": ("horizon",)}
+
+
 def _required(fn):
     return [p.name for p in inspect.signature(fn).parameters.values()
-            if p.default is inspect.Parameter.empty
+            if (p.default is inspect.Parameter.empty
+                or p.name in ALSO_REQUIRED.get(fn.__name__, ()))
             and p.kind not in (inspect.Parameter.VAR_POSITIONAL, inspect.Parameter.VAR_KEYWORD)]
 
 
