@@ -248,3 +248,39 @@ def test_refine_accepts_progress_true(capsys):
     out, err = capsys.readouterr()
     rounds = len(sol.refinement)
     assert out == "" and f"100% {rounds}/{rounds}" in err  # a bar of the rounds, on stderr
+
+
+def test_impact_result():
+    from appdyn.dynamics.mechanisms import central_collision, falling_bar_impact
+    res = central_collision(1.0, 2.0, 3.0, -1.0, e=0.5)
+    data = check_protocol(res)
+    assert data["status"] == 0 and data["regime"] == res.regime
+    text = str(res)
+    assert "[N s]" in text or "N s" in text
+    jam = falling_bar_impact(1.0, 1.0, -5.0, 1.0, e=0.0, mu=math.inf)
+    assert not jam.success and jam.status == -1 and strict(jam.to_json())["status"] == -1
+
+
+def test_every_public_result_class_follows_the_protocol():
+    """Enumerated from the packages' public names: a class named like a result, report or
+    solution inherits `Result` (so a new one cannot be written by hand)."""
+    import importlib
+    import inspect
+    import pkgutil
+
+    import appdyn
+    seen = set()
+    for pkg in ("appdyn.dynamics", "appdyn.ocp", "appdyn.problems"):
+        root = importlib.import_module(pkg)
+        mods = [root] + [importlib.import_module(m.name) for m in
+                         pkgutil.walk_packages(root.__path__, pkg + ".")
+                         if not m.name.split(".")[-1].startswith("_")
+                         and ".cli" not in m.name]
+        for mod in mods:
+            for name in getattr(mod, "__all__", ()):
+                obj = getattr(mod, name, None)
+                if inspect.isclass(obj) and name.endswith(("Result", "Report", "Solution")):
+                    seen.add(obj)
+    assert len(seen) >= 15, seen
+    outside = sorted(c.__qualname__ for c in seen if not issubclass(c, Result))
+    assert not outside, outside

@@ -54,6 +54,7 @@ from typing import Mapping
 import numpy as np
 
 from .. import validate
+from ..results import Result, quantity
 
 __all__ = ["ImpactResult", "impact", "contact_jump", "central_collision", "ballistic_pendulum",
            "dumbbell_impact", "carriage_impact", "falling_bar_impact", "SEPARATING", "FRICTIONLESS",
@@ -68,9 +69,12 @@ _CONE_SLACK = 1e-12
 _GAIN_TOL = 1e-12
 
 
-@dataclass(frozen=True)
-class ImpactResult:
+@dataclass(frozen=True, repr=False)
+class ImpactResult(Result):
     """Outcome of `impact`: the rates after the impact and the impulses.
+
+    Follows the result protocol (`dynamics.results.Result`): ``status`` is 0 when the impulse
+    was found, -1 when the contact jams (``success`` False).
 
     Attributes
     ----------
@@ -117,6 +121,30 @@ class ImpactResult:
     message: str = ""
     names: tuple = ()
     derived: Mapping[str, float] = field(default_factory=lambda: MappingProxyType({}))
+
+    _repr_fields = ("regime", "v", "normal_impulse", "normal_velocity", "energy_loss")
+
+    @property
+    def status(self) -> int:
+        """0: the impulse found; -1: the contact jams (no impulse on the friction cone)."""
+        return 0 if self.success else -1
+
+    def to_dict(self) -> dict:
+        """The fields, ``status`` and the derived quantities as plain data."""
+        return dict(super().to_dict(), status=self.status, derived=dict(self.derived))
+
+    def __str__(self) -> str:
+        rates = ", ".join(f"{n} = {quantity(x)}" for n, x in zip(self.names, self.v)) or \
+            ", ".join(quantity(x) for x in self.v)
+        lines = [f"impact ({self.regime}): {'success' if self.success else 'FAILED'}"
+                 + (f" -- {self.message}" if self.message else ""),
+                 f"  normal velocity  {quantity(self.normal_velocity[0], 'm/s')} before, "
+                 f"{quantity(self.normal_velocity[1], 'm/s')} after",
+                 f"  normal impulse   {quantity(self.normal_impulse, 'N s')}",
+                 f"  energy lost      {quantity(self.energy_loss, 'J')}",
+                 f"  rates after      {rates} (model units)"]
+        lines += [f"  {k:<16} {quantity(v)}" for k, v in self.derived.items()]
+        return "\n".join(lines)
 
     def __getstate__(self) -> dict:
         return dict(self.__dict__, derived=dict(self.derived))
