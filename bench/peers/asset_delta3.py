@@ -29,15 +29,14 @@ one entry per segment count with ``segments``, ``final_mass`` (kg), ``final_time
 from __future__ import annotations
 
 import argparse
-import contextlib
-import ctypes
 import json
-import os
 import sys
 import time
 from importlib.metadata import version
 
 import numpy as np
+
+from _stdout import stdout_to_stderr
 
 # ------------------------------------------------------------------ data (SI)
 G0, RE, OMEGA_E, MU = 9.80665, 6378145.0, 7.29211585e-5, 3.986012e14
@@ -53,23 +52,6 @@ LATITUDE = np.deg2rad(28.5)
 
 # canonical units
 L_STAR, T_STAR, M_STAR = RE, 961.0, 301454.0
-
-
-@contextlib.contextmanager
-def stdout_to_stderr():
-    """Point file descriptor 1 at stderr (catches C-level printf too)."""
-    libc = ctypes.CDLL(None)
-    sys.stdout.flush()
-    libc.fflush(None)
-    saved = os.dup(1)
-    os.dup2(2, 1)
-    try:
-        yield
-    finally:
-        sys.stdout.flush()
-        libc.fflush(None)
-        os.dup2(saved, 1)
-        os.close(saved)
 
 
 def canonical():
