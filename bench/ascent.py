@@ -49,90 +49,100 @@ YAPSS_PY = PEERS / ".venv-yapss" / "bin" / "python"
 ASSET_PY = PEERS / ".venv-asset" / "bin" / "python"
 
 
-def appdyn_runs(repeats: int, **kw):
-    """``(first-call wall time, later wall times, last result)``; caches emptied first."""
-    clear_caches()
-    t0 = time.perf_counter()
-    res = delta3_ascent(**kw)
-    first = time.perf_counter() - t0
-    times = []
-    for _ in range(repeats):
+#: appdyn's rows: label and `delta3_ascent` keywords
+CONFIGS = (("appdyn, 5 x Radau-5 per phase", dict(refine_tol=None)),
+           ("appdyn, refined to 1e-9", {}),
+           ("appdyn before: 8 x Radau-4, no relaxed start",
+            dict(refine_tol=None, relaxed_start=False, N=8, degree=4)))
+
+
+def appdyn_round() -> dict:
+    """One call of every appdyn row: ``{label: row dict}``."""
+    out = {}
+    for label, kw in CONFIGS:
         t0 = time.perf_counter()
         res = delta3_ascent(**kw)
-        times.append(time.perf_counter() - t0)
-    return first, np.array(times or [first]), res
-
-
-def yapss_runs(repeats: int):
-    """yapss's answers (one fresh process per run), or None with a notice."""
-    if not YAPSS_PY.exists():
-        print(f"yapss: no {YAPSS_PY.parent.parent} (bash bench/peers/setup_yapss.sh); skipped")
-        return None
-    out = []
-    for _ in range(max(repeats, 1)):
-        proc = subprocess.run([str(YAPSS_PY), str(PEERS / "yapss_delta3.py"), "--json", "--quiet"],
-                              capture_output=True, text=True, timeout=600)
-        if proc.returncode:
-            print(f"yapss: peer failed: {proc.stderr.strip().splitlines()[-1:]}; skipped")
-            return None
-        out.append(json.loads(proc.stdout))
+        wall = time.perf_counter() - t0
+        out[label] = dict(solver=label, final_mass=res.final_mass, final_time=res.final_time,
+                          wall=wall, build=res.build_time, solve=res.solve_time,
+                          iterations=res.iterations, success=res.success,
+                          intervals="/".join(str(s.mesh.N) for s in res.solution.phases))
     return out
 
 
-def asset_runs(repeats: int):
-    """ASSET's answers at 16/32/64 segments per phase (one process), or None with a notice."""
-    if not ASSET_PY.exists():
-        print(f"ASSET: no {ASSET_PY.parent.parent} (bash bench/peers/setup_asset.sh); skipped")
+def _peer(python: Path, script: str, args: list, name: str, setup: str):
+    """The JSON answer of one run of a peer in its own venv, or None with a notice."""
+    if not python.exists():
+        print(f"{name}: no {python.parent.parent} (bash bench/peers/{setup}); skipped")
         return None
-    proc = subprocess.run([str(ASSET_PY), str(PEERS / "asset_delta3.py"), "--json", "--threads", "1",
-                           "--repeats", str(max(repeats, 1))],
-                          capture_output=True, text=True, timeout=1200)
+    proc = subprocess.run([str(python), str(PEERS / script), *args], capture_output=True,
+                          text=True, timeout=1200)
     if proc.returncode:
-        print(f"ASSET: peer failed: {proc.stderr.strip().splitlines()[-1:]}; skipped")
+        print(f"{name}: peer failed: {proc.stderr.strip().splitlines()[-1:]}; skipped")
         return None
     return json.loads(proc.stdout)
 
 
+def yapss_round() -> dict:
+    """One fresh yapss process: ``{label: row dict}`` (empty when skipped)."""
+    p = _peer(YAPSS_PY, "yapss_delta3.py", ["--json", "--quiet"], "yapss", "setup_yapss.sh")
+    if p is None:
+        return {}
+    label = f"yapss {p['yapss']} (casadi {p['casadi']})"
+    return {label: dict(solver=label, final_mass=p["final_mass"], final_time=p["phase_end_times"][-1],
+                        wall=p["solve_time"], build=float("nan"), solve=p["solve_time"],
+                        iterations=p["iterations"], intervals="5/5/5/5 (LGL 5 points)",
+                        success=p["status"].startswith("Optimal"))}
+
+
+def asset_round() -> dict:
+    """One fresh ASSET process solving on 16, 32 and 64 segments: ``{label: row dict}``."""
+    a = _peer(ASSET_PY, "asset_delta3.py", ["--json", "--threads", "1", "--repeats", "1"],
+              "ASSET", "setup_asset.sh")
+    out = {}
+    for r in (a or {}).get("runs", []):
+        n = r["segments"]
+        label = f"ASSET {a['asset']}, {n} x LGL3 per phase"
+        out[label] = dict(solver=label, final_mass=r["final_mass"], final_time=r["final_time"],
+                          wall=r["build_time"] + r["solve_time"], build=r["build_time"],
+                          solve=r["solve_time"], iterations=r["iterations"],
+                          intervals=f"{n}/{n}/{n}/{n} (LGL3)", success=r["status"] == "CONVERGED")
+    return out
+
+
 def run(quick: bool, out: Path) -> list:
-    """Run the benchmark, write ``ascent.csv`` into ``out``; the summary `Row`s."""
+    """Run the benchmark, write ``ascent.csv`` into ``out``; the summary `Row`s.
+
+    Every round calls each solver once, back to back (appdyn in this process, each peer in a
+    fresh process), so a ratio is taken within a round (paired) and the load of a shared
+    machine falls on both sides alike; round 0 starts from empty caches (first calls)."""
     repeats = 0 if quick else 5
-    rows = []
-    f_c, t_c, coarse = appdyn_runs(repeats, refine_tol=None)
-    f_r, t_r, refined = appdyn_runs(repeats)
-    f_o, t_o, cold = appdyn_runs(repeats, refine_tol=None, relaxed_start=False, N=8, degree=4)
-    ref = refined.final_mass
-    for label, first, times, res in (("appdyn, 5 x Radau-5 per phase", f_c, t_c, coarse),
-                                     ("appdyn, refined to 1e-9", f_r, t_r, refined),
-                                     ("appdyn before: 8 x Radau-4, no relaxed start", f_o, t_o, cold)):
-        sol = res.solution
-        rows.append(dict(solver=label, final_mass=res.final_mass, error=abs(res.final_mass - ref),
-                         final_time=res.final_time, first_call=first, wall=float(np.median(times)),
-                         build=res.build_time, solve=res.solve_time, iterations=res.iterations,
-                         intervals="/".join(str(s.mesh.N) for s in sol.phases),
-                         success=res.success))
-    peer = None if quick else yapss_runs(repeats)
+    clear_caches()
+    rounds = []
+    for k in range(repeats + 1):
+        r = appdyn_round()
+        if not quick:
+            r.update(yapss_round())
+            r.update(asset_round())
+        rounds.append(r)
     if quick:
         print("yapss, ASSET: skipped (--quick)")
-    if peer:
-        walls = np.array([p["solve_time"] for p in peer])
-        rows.append(dict(solver=f"yapss {peer[0]['yapss']} (casadi {peer[0]['casadi']})",
-                         final_mass=peer[0]["final_mass"], error=abs(peer[0]["final_mass"] - ref),
-                         final_time=peer[0]["phase_end_times"][-1], first_call=float(walls[0]),
-                         wall=float(np.median(walls)), build=float("nan"),
-                         solve=float(np.median(walls)), iterations=peer[0]["iterations"],
-                         intervals="5/5/5/5 (LGL 5 points)",
-                         success=peer[0]["status"].startswith("Optimal")))
-    asset = None if quick else asset_runs(repeats)
-    if asset:
-        own = asset["runs"][-1]["final_mass"]  # its finest mesh: ASSET's own converged answer
-        for r in asset["runs"]:
-            n = r["segments"]
-            rows.append(dict(solver=f"ASSET {asset['asset']}, {n} x LGL3 per phase",
-                             final_mass=r["final_mass"], error=abs(r["final_mass"] - own),
-                             final_time=r["final_time"], first_call=r["first_solve_time"],
-                             wall=r["build_time"] + r["solve_time"], build=r["build_time"],
-                             solve=r["solve_time"], iterations=r["iterations"],
-                             intervals=f"{n}/{n}/{n}/{n} (LGL3)", success=r["status"] == "CONVERGED"))
+    later = rounds[1:] or rounds
+    ref = rounds[-1][CONFIGS[1][0]]["final_mass"]
+    asset_ref = next((v["final_mass"] for k, v in rounds[-1].items() if ", 64 x" in k), None)
+    rows = []
+    for label, last in rounds[-1].items():
+        row = dict(last)
+        row.update(first_call=rounds[0][label]["wall"] if label in rounds[0] else float("nan"),
+                   wall=float(np.median([r[label]["wall"] for r in later if label in r])),
+                   error=abs(last["final_mass"] - (asset_ref if label.startswith("ASSET") else ref)))
+        rows.append(row)
+    ratios = {}
+    for a_label, _ in CONFIGS:
+        for p_label in rows[len(CONFIGS):]:
+            p_label = p_label["solver"]
+            ratios[(p_label, a_label)] = float(np.median(
+                [r[p_label]["wall"] / r[a_label]["wall"] for r in later if p_label in r]))
     print("Delta III ascent to GTO (maximum final mass), 4 phases; published 7529.712412 kg "
           "(Betts 2010), 7529.712287 kg (yapss)")
     print(f"{'solver':<40}{'final mass [kg]':>17}{'error [kg]':>12}{'tf [s]':>10}{'first [s]':>11}"
@@ -142,15 +152,14 @@ def run(quick: bool, out: Path) -> list:
               f"{r['first_call']:>11.3f}{r['wall']:>12.3f}{r['build']:>11.3f}{r['solve']:>11.3f}"
               f"{r['iterations']:>6}  {r['intervals']}")
     print(f"converged appdyn answer - Betts (2010): {ref - FINAL_MASS_BETTS:+.2e} kg")
-    for r in rows[:3]:
-        for p in rows[3:]:
-            print(f"{p['solver']} median / {r['solver']} median: {p['wall'] / r['wall']:.2f}x")
+    for (p, r), x in ratios.items():
+        print(f"{p} / {r}: {x:.2f}x (median of the per-round ratios)")
     path = write_csv(rows, Path(out) / "ascent.csv")
     print(f"written: {path}")
-    return summary_rows(rows, ref, repeats)
+    return summary_rows(rows, ref, repeats, ratios)
 
 
-def summary_rows(rows, ref, repeats):
+def summary_rows(rows, ref, repeats, ratios):
     """Final mass, error and wall times of each solver; the peers' time over appdyn's."""
     case = "Delta III ascent to GTO, 4 phases"
     how = f"median of {repeats}" if repeats else "one call"
@@ -168,13 +177,13 @@ def summary_rows(rows, ref, repeats):
                        f"{how}; " + (f"first call {r['first_call']:.3g} s; " if repeats else "")
                        + f"build {r['build']:.3g} s, solve {r['solve']:.3g} s; "
                        f"{r['iterations']} iterations; intervals {r['intervals']}{ok}"))
-    peers = {r["solver"]: r for r in rows[3:]}
-    pairs = [(rows[0], p) for p in peers if "yapss" in p or ", 32 x" in p]
-    pairs += [(rows[1], p) for p in peers if "yapss" in p or ", 64 x" in p]
-    pairs += [(rows[2], p) for p in peers if ", 32 x" in p]
-    for r, p in pairs:
-        out.append(Row("ascent", case, f"{p} / {r['solver']}", peers[p]["wall"] / r["wall"], "x",
-                       "wall-time ratio in one run (> 1: appdyn faster)"))
+    wanted = [(p, CONFIGS[0][0]) for p, _ in ratios if "yapss" in p or ", 32 x" in p]
+    wanted += [(p, CONFIGS[1][0]) for p, _ in ratios if "yapss" in p or ", 64 x" in p]
+    wanted += [(p, CONFIGS[2][0]) for p, _ in ratios if ", 32 x" in p]
+    for p, r in dict.fromkeys(wanted):
+        out.append(Row("ascent", case, f"{p} / {r}", ratios[(p, r)], "x",
+                       "wall-time ratio, median over rounds of back-to-back calls (> 1: appdyn "
+                       "faster)"))
     return out
 
 
