@@ -21,6 +21,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from appdyn import ocp
+from appdyn.dynamics import cache
 from appdyn.dynamics.validate import finite_array
 
 from .delta3 import (FINAL_MASS_BETTS, H_SCALE, OMEGA_E, PHASES, RE, RHO0,
@@ -117,8 +118,19 @@ def delta3_problem(*, N: int | tuple = 8, degree: int = 4, target=TARGET_ORBIT,
     missing = [k for k in _ELEMENTS if k not in target]
     if missing:
         raise ValueError(f"`target` must give {list(_ELEMENTS)}; missing {missing}")
-    phases = [ocp.Phase(_phase_problem(k, (lo, hi)), N=int(n), degree=degree, guess=_phase_guess(k, guess_samples),
-                        name=PHASES[k].name) for k, n in enumerate(Ns)]
+    elements = tuple(float(target[k]) for k in _ELEMENTS)
+    return _delta3_problem(tuple(int(n) for n in Ns), degree, elements, guess_samples, lo, hi)
+
+
+@cache.memoize
+def _delta3_problem(Ns: tuple, degree, elements: tuple, guess_samples, lo: float,
+                    hi: float) -> ocp.MultiPhaseProblem:
+    """`delta3_problem` on checked arguments, kept in the one cache (a problem is immutable;
+    `delta3_ascent` states two per call)."""
+    target = dict(zip(_ELEMENTS, elements))
+    phases = [ocp.Phase(_phase_problem(k, (lo, hi)), N=n, degree=degree,
+                        guess=_phase_guess(k, guess_samples), name=PHASES[k].name)
+              for k, n in enumerate(Ns)]
     links = [ocp.Link(k, k + 1, jump={"m": -PHASES[k].dry_mass_dropped})
              for k in range(len(PHASES) - 1)]
     last = len(PHASES) - 1
