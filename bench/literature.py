@@ -4,6 +4,8 @@
   (`ocp.examples.orbit_raising`, literature 1.5253): appdyn (`ocp.solve`, Radau degree 3,
   its default start) on 20 and 40 intervals; ASSET LGL3 on 20-160 segments
   (``bench/peers/asset_orbit_raising.py``).
+  rockit 0.6.7 (DirectCollocation, N = 20, its own start) in ``bench/peers/.venv-rockit``
+  (``bash bench/peers/setup_rockit.sh``; ``bench/peers/rockit_literature.py``).
 * Betts' shuttle reentry, maximum crossrange (`ocp.examples.shuttle_reentry`, 34.1412 deg):
   appdyn on 20 intervals of Radau degree 5 from `shuttle_reentry_guess` (ASSET's start);
   ASSET as its own example, LGL3 on 32-128 segments (``bench/peers/asset_reentry.py``).
@@ -38,6 +40,7 @@ from _common import Row, script_main, write_csv
 
 PEERS = Path(__file__).resolve().parent / "peers"
 ASSET_PY = PEERS / ".venv-asset" / "bin" / "python"
+ROCKIT_PY = PEERS / ".venv-rockit" / "bin" / "python"
 
 
 @dataclass(frozen=True)
@@ -56,13 +59,14 @@ class Case:
     unit: str
     scale: float  # appdyn objective -> the unit
     literature: str
+    rockit: str | None = None  # the case of bench/peers/rockit_literature.py
 
 
 CASES = (
     Case("orbit raising (Bryson & Ho), thrust a unit vector", orbit_raising, None,
          (("appdyn, 20 x Radau-3", dict(N=20)), ("appdyn, 40 x Radau-3", dict(N=40))),
          dict(N=160), "asset_orbit_raising.py", (20, 40, 80, 160), "r_f", "r0", 1.0,
-         f"literature {ORBIT_RAISING_OPTIMUM['r_f']}"),
+         f"literature {ORBIT_RAISING_OPTIMUM['r_f']}", rockit="orbit_raising"),
     Case("shuttle reentry (Betts), maximum crossrange", shuttle_reentry, shuttle_reentry_guess,
          (("appdyn, 20 x Radau-5", dict(N=20, degree=5)),),
          dict(N=80, degree=5), "asset_reentry.py", (32, 64, 128), "theta_f_deg", "deg",
@@ -104,6 +108,30 @@ def asset_round(case: Case) -> dict:
     return out
 
 
+def rockit_round(case: Case) -> dict:
+    """rockit (DirectCollocation, N = 20) in a fresh process of its own venv, or nothing."""
+    if case.rockit is None:
+        return {}
+    if not ROCKIT_PY.exists():
+        print(f"rockit: no {ROCKIT_PY.parent.parent} (bash bench/peers/setup_rockit.sh); skipped")
+        return {}
+    proc = subprocess.run([str(ROCKIT_PY), str(PEERS / "rockit_literature.py"), "--json",
+                           "--case", case.rockit, "--N", "20"],
+                          capture_output=True, text=True, timeout=600)
+    if proc.returncode:
+        print(f"rockit: peer failed: {proc.stderr.strip().splitlines()[-1:]}; skipped")
+        return {}
+    a = json.loads(proc.stdout)
+    out = {}
+    for r in a["runs"]:
+        label = f"rockit {a['rockit']}, {r['N']} x Radau-4"
+        out[label] = dict(solver=label, objective=r["objective"],
+                          wall=r["build_time"] + r["solve_time"], build=r["build_time"],
+                          solve=r["solve_time"], iterations=r["iterations"],
+                          success=r["status"] == "Solve_Succeeded")
+    return out
+
+
 def run_case(case: Case, quick: bool, repeats: int) -> list:
     """The rows of one case (printed) and its summary `Row`s."""
     ref_sol = solve(case.problem(), guess=case.guess() if case.guess else None, **case.reference)
@@ -114,6 +142,7 @@ def run_case(case: Case, quick: bool, repeats: int) -> list:
         r = appdyn_round(case)
         if not quick:
             r.update(asset_round(case))
+            r.update(rockit_round(case))
         rounds.append(r)
     later = rounds[1:] or rounds
     rows = []
@@ -138,7 +167,7 @@ def run_case(case: Case, quick: bool, repeats: int) -> list:
                            f"{how}; build {r['build']:.3g} s, solve {r['solve']:.3g} s; "
                            f"{r['iterations']} iterations{ok}"))
     for a, _ in case.appdyn:
-        for p in (k for k in rounds[-1] if k.startswith("ASSET")):
+        for p in (k for k in rounds[-1] if not k.startswith("appdyn")):
             x = float(np.median([r[p]["wall"] / r[a]["wall"] for r in later]))
             print(f"{p} / {a}: {x:.2f}x")
             summary.append(Row("literature", case.name, f"{p} / {a}", x, "x",
