@@ -20,15 +20,11 @@ prints ``{"asset", "threads", "runs": [...]}``, one run per segment count with
 """
 from __future__ import annotations
 
-import argparse
-import json
-import sys
 import time
-from importlib.metadata import version
 
 import numpy as np
 
-from _stdout import stdout_to_stderr
+from _runner import asset_main
 
 THRUST, MDOT, T_FINAL = 0.1405, 0.0749, 3.32
 
@@ -76,36 +72,5 @@ def run_one(ast, segments: int, threads: int | None) -> dict:
             "status": str(getattr(flag, "name", flag))}
 
 
-def run(segments, repeats: int, threads: int | None) -> dict:
-    import asset_asrl as ast
-
-    runs = []
-    for n in segments:
-        rs = [run_one(ast, n, threads) for _ in range(max(repeats, 1))]
-        times = [r["solve_time"] for r in rs]
-        out = dict(rs[-1])
-        out.update(solve_time=float(np.median(times)), first_solve_time=times[0],
-                   build_time=float(np.median([r["build_time"] for r in rs])))
-        runs.append(out)
-    return {"asset": version("asset-asrl"), "threads": threads, "runs": runs}
-
-
-def main() -> None:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--json", action="store_true", help="print one JSON object on stdout")
-    ap.add_argument("--segments", type=int, nargs="+", default=[20, 40, 80])
-    ap.add_argument("--repeats", type=int, default=3)
-    ap.add_argument("--threads", type=int, default=None)
-    args = ap.parse_args()
-    with stdout_to_stderr():
-        out = run(args.segments, args.repeats, args.threads)
-    if args.json:
-        json.dump(out, sys.stdout)
-        sys.stdout.write("\n")
-    else:
-        for r in out["runs"]:
-            print(r)
-
-
 if __name__ == "__main__":
-    main()
+    asset_main(__doc__, run_one, [20, 40, 80])

@@ -19,15 +19,12 @@ prints ``{"rockit", "casadi", "case", "runs": [...]}``, one run per ``N`` with
 """
 from __future__ import annotations
 
-import argparse
-import json
-import sys
 import time
 from importlib.metadata import version
 
 import numpy as np
 
-from _stdout import stdout_to_stderr
+from _runner import main, repeated
 
 
 def orbit_raising(ca, rk, N):
@@ -130,37 +127,17 @@ def run_one(case: str, N: int) -> dict:
             "status": str(stats.get("return_status", "?"))}
 
 
-def run(case: str, Ns, repeats: int) -> dict:
+def run(args) -> dict:
     import casadi
 
-    runs = []
-    for N in Ns:
-        rs = [run_one(case, N) for _ in range(max(repeats, 1))]
-        times = [r["solve_time"] for r in rs]
-        out = dict(rs[-1])
-        out.update(solve_time=float(np.median(times)), first_solve_time=times[0],
-                   build_time=float(np.median([r["build_time"] for r in rs])))
-        runs.append(out)
-    return {"rockit": version("rockit-meco"), "casadi": casadi.__version__, "case": case,
+    runs = repeated(lambda n: run_one(args.case, n), args.sizes, args.repeats)
+    return {"rockit": version("rockit-meco"), "casadi": casadi.__version__, "case": args.case,
             "runs": runs}
 
 
-def main() -> None:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--json", action="store_true", help="print one JSON object on stdout")
+def _case(ap) -> None:
     ap.add_argument("--case", choices=sorted(CASES), required=True)
-    ap.add_argument("--N", type=int, nargs="+", default=[20, 40])
-    ap.add_argument("--repeats", type=int, default=1)
-    args = ap.parse_args()
-    with stdout_to_stderr():
-        out = run(args.case, args.N, args.repeats)
-    if args.json:
-        json.dump(out, sys.stdout)
-        sys.stdout.write("\n")
-    else:
-        for r in out["runs"]:
-            print(r)
 
 
 if __name__ == "__main__":
-    main()
+    main(__doc__, run, "--N", [20, 40], _case, repeats=1)

@@ -27,7 +27,7 @@ import time
 import warnings
 from importlib.metadata import version
 
-from _stdout import stdout_to_stderr
+from _runner import stdout_to_stderr
 
 
 def run(quiet: bool) -> dict:
