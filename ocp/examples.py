@@ -381,9 +381,12 @@ def shuttle_reentry_guess(n: int = 21) -> dict:
     """
     import numpy as np
 
+    if isinstance(n, bool) or not isinstance(n, numbers.Integral) or n < 2:
+        raise ValueError(f"`n` must be an int >= 2, got {n!r}")
     T = 1000.0 / _T
     f = np.linspace(0.0, 1.0, n)
     h0, _, v0, g0, psi0 = _REENTRY_START
-    x = np.vstack([h0 + f * (_REENTRY_END["h"] - h0), np.zeros(n), v0 + f * (_REENTRY_END["v"] - v0),
-                   g0 + f * (_REENTRY_END["gamma"] - g0), np.full(n, psi0)])
+    end = _REENTRY_END
+    x = np.vstack([h0 + f * (end["h"] - h0), np.zeros(n), v0 + f * (end["v"] - v0),
+                   g0 + f * (end["gamma"] - g0), np.full(n, psi0)])
     return {"t": f * T, "x": x, "u": np.zeros((2, n)), "T": T}
