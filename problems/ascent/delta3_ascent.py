@@ -16,13 +16,15 @@ Published optimum: 7529.712412 kg at 924.139 s (Betts 2010), 7529.712287 kg (yap
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
 from appdyn import ocp
 from appdyn.dynamics import cache
 from appdyn.dynamics.validate import finite_array
+from appdyn.ocp import nlp as ocp_nlp
+from appdyn.ocp.transcription import get_transcription
 
 from .delta3 import (FINAL_MASS_BETTS, H_SCALE, OMEGA_E, PHASES, RE, RHO0,
                      TARGET_ORBIT, delta3_model, guess, initial_state, orbit_residuals,
@@ -290,9 +292,10 @@ def delta3_ascent(*, N: int | tuple = 5, degree: int = 5, refine_tol: float | No
     With ``relaxed_start`` (default), the problem is first solved with ASSET's band
     ``0.5 <= |u| <= 1.5`` (`RELAXED_U_NORM`; the thrust direction is ``u / |u|``, so the
     optimal trajectory is the same) from the interpolated guess, then with ``|u| = 1``
-    warm-started from that solution's primal and dual values (the two NLPs differ in the
-    bounds of the ``|u|`` row only). On the default mesh this takes 70 + 14 IPOPT
-    iterations against 137 for ``|u| = 1`` from the guess.
+    warm-started from that solution's primal and dual values, its controls scaled to unit
+    length (the two NLPs differ in the bounds of the ``|u|`` row only, and the scaled point
+    is optimal for both). On the default mesh this takes 53 + 0 IPOPT iterations, against
+    135 for ``|u| = 1`` from the guess on the former default mesh (8 x Radau-4).
 
     Parameters
     ----------
@@ -335,7 +338,7 @@ def delta3_ascent(*, N: int | tuple = 5, degree: int = 5, refine_tol: float | No
                                                     u_norm=RELAXED_U_NORM),
                                      objective_scale=1e4, ipopt_options=ipopt_options)
             spent = _add_costs(spent, start)
-            start = start if start.success else None
+            start = _unit_directions(start) if start.success else None
         problem = delta3_problem(N=N, degree=degree, guess_samples=int(n))
         sol = ocp.solve_phases(problem, guess=start, refine_tol=refine_tol, objective_scale=1e4,
                                ipopt_options=ipopt_options)
@@ -368,6 +371,22 @@ def delta3_ascent(*, N: int | tuple = 5, degree: int = 5, refine_tol: float | No
         message=message, final_mass=float(xf[6]), final_time=float(sol.tf[-1]), elements=el,
         orbit_error=err, propagation_error=prop, table=table, solution=sol,
         solve_time=spent[0], build_time=spent[1], iterations=spent[2])
+
+
+def _unit_directions(sol):
+    """``sol`` (a solution of the relaxed problem) with every control column scaled to
+    ``|u| = 1`` in its NLP point: the thrust ``T u / |u|`` and so the trajectory are
+    unchanged, and the point is feasible for ``|u| = 1`` (the warm start of the second solve
+    then needs next to no iterations instead of about 13)."""
+    x = np.array(sol.nlp_point["x_phys"], dtype=float)
+    offset = 0
+    for ph in sol.problem.phases:
+        pb = replace(ph.problem, t0=0.0) if ph.problem.t0 != 0.0 else ph.problem
+        layout = ocp_nlp.structure(pb, get_transcription(ph.transcription, ph.degree), ph.N).w
+        cols = offset + layout.indices("U")
+        x[cols] = x[cols] / np.linalg.norm(x[cols], axis=0)
+        offset += layout.size
+    return replace(sol, nlp_point={**sol.nlp_point, "x_phys": x})
 
 
 def _add_costs(spent, sol) -> list:
