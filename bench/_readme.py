@@ -34,6 +34,8 @@ TITLES = {
     "ocp_precision": "Optimal control: objective error against work for every transcription "
                      "(`bench/ocp_precision.py`)",
     "ascent": "Delta III ascent to GTO, 4 phases (`bench/ascent.py`)",
+    "literature": "Literature cases: orbit raising and shuttle reentry, appdyn next to ASSET "
+                  "(`bench/literature.py`)",
     "many": "Many runs: serial against thread and process pools (`bench/many.py`)",
     "overhead": "Per-call Python overhead of `simulate` on a 2-point grid, cached model "
                 "(`bench/overhead.py`)",

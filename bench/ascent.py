@@ -1,17 +1,26 @@
-"""Trajectory benchmark: the four-phase Delta III ascent to GTO, appdyn next to yapss.
+"""Trajectory benchmark: the four-phase Delta III ascent to GTO, appdyn next to yapss and ASSET.
 
-appdyn (`problems.ascent.delta3_ascent`, `ocp.solve_phases`: Radau degree 4 per phase) is run
+appdyn (`problems.ascent.delta3_ascent`, `ocp.solve_phases`: Radau degree 5 per phase) is run
 in this process; yapss 0.2.3 (its own example ``yapss.examples.delta_iii_ascent``: LGL, 5
 segments x 5 points per phase, SI units with its own scaling) in its own venv
 ``bench/peers/.venv-yapss`` (yapss pins casadi <= 3.7.2; ``bash bench/peers/setup_yapss.sh``),
 through ``bench/peers/yapss_delta3.py``, skipped with a notice when that venv is missing.
+ASSET 0.5.1 (its own Delta III formulation: LGL3, 16, 32 and 64 segments per phase, PSIOPT,
+one thread like IPOPT with MUMPS) in ``bench/peers/.venv-asset``
+(``bash bench/peers/setup_asset.sh``) through ``bench/peers/asset_delta3.py``, likewise.
 
 Rows (each timed: first call of the process, then the median of the repeats):
 
-* appdyn, 8 intervals per phase, no refinement (about the size of yapss's mesh);
-* appdyn, default: 8 intervals per phase refined until every interval's estimated error is
+* appdyn, 5 intervals of Radau degree 5 per phase (yapss's mesh: 5 x 5 LGL), no refinement, from the
+  relaxed start (`delta3_ascent`'s default);
+* the solve before issue 32: 8 intervals of Radau degree 4 per phase, |u| = 1 from the guess
+  (``relaxed_start=False``);
+* appdyn, default: 5 intervals per phase refined until every interval's estimated error is
   below 1e-9 (the converged answer: the reference for the "error" column);
-* yapss example (solve = derivative construction + IPOPT; its process import excluded).
+* yapss example (solve = derivative construction + IPOPT; its process import excluded);
+* ASSET, 16/32/64 segments (solve = ``solve_optimize``; build = the phases set up). Its
+  error is against its own 64-segment answer (ASSET's rounded Isp values move its optimum
+  to 7529.7485 kg).
 
 Error = |final mass - converged appdyn answer| [kg]; the published optimum is 7529.712412 kg
 (Betts 2010), 7529.712287 kg (yapss's test). Writes ``ascent.csv`` into the output folder
@@ -37,82 +46,121 @@ from _common import Row, script_main, write_csv
 
 PEERS = Path(__file__).resolve().parent / "peers"
 YAPSS_PY = PEERS / ".venv-yapss" / "bin" / "python"
+ASSET_PY = PEERS / ".venv-asset" / "bin" / "python"
 
 
-def appdyn_runs(repeats: int, **kw):
-    """``(first-call wall time, later wall times, last result)``; caches emptied first."""
-    clear_caches()
-    t0 = time.perf_counter()
-    res = delta3_ascent(**kw)
-    first = time.perf_counter() - t0
-    times = []
-    for _ in range(repeats):
+#: appdyn's rows: label and `delta3_ascent` keywords
+CONFIGS = (("appdyn, 5 x Radau-5 per phase", dict(refine_tol=None)),
+           ("appdyn, refined to 1e-9", {}),
+           ("appdyn before: 8 x Radau-4, no relaxed start",
+            dict(refine_tol=None, relaxed_start=False, N=8, degree=4)))
+
+
+def appdyn_round() -> dict:
+    """One call of every appdyn row: ``{label: row dict}``."""
+    out = {}
+    for label, kw in CONFIGS:
         t0 = time.perf_counter()
         res = delta3_ascent(**kw)
-        times.append(time.perf_counter() - t0)
-    return first, np.array(times or [first]), res
+        wall = time.perf_counter() - t0
+        out[label] = dict(solver=label, final_mass=res.final_mass, final_time=res.final_time,
+                          wall=wall, build=res.build_time, solve=res.solve_time,
+                          iterations=res.iterations, success=res.success,
+                          intervals="/".join(str(s.mesh.N) for s in res.solution.phases))
+    return out
 
 
-def yapss_runs(repeats: int):
-    """yapss's answers (one fresh process per run), or None with a notice."""
-    if not YAPSS_PY.exists():
-        print(f"yapss: no {YAPSS_PY.parent.parent} (bash bench/peers/setup_yapss.sh); skipped")
+def _peer(python: Path, script: str, args: list, name: str, setup: str):
+    """The JSON answer of one run of a peer in its own venv, or None with a notice."""
+    if not python.exists():
+        print(f"{name}: no {python.parent.parent} (bash bench/peers/{setup}); skipped")
         return None
-    out = []
-    for _ in range(max(repeats, 1)):
-        proc = subprocess.run([str(YAPSS_PY), str(PEERS / "yapss_delta3.py"), "--json", "--quiet"],
-                              capture_output=True, text=True, timeout=600)
-        if proc.returncode:
-            print(f"yapss: peer failed: {proc.stderr.strip().splitlines()[-1:]}; skipped")
-            return None
-        out.append(json.loads(proc.stdout))
+    proc = subprocess.run([str(python), str(PEERS / script), *args], capture_output=True,
+                          text=True, timeout=1200)
+    if proc.returncode:
+        print(f"{name}: peer failed: {proc.stderr.strip().splitlines()[-1:]}; skipped")
+        return None
+    return json.loads(proc.stdout)
+
+
+def yapss_round() -> dict:
+    """One fresh yapss process: ``{label: row dict}`` (empty when skipped)."""
+    p = _peer(YAPSS_PY, "yapss_delta3.py", ["--json", "--quiet"], "yapss", "setup_yapss.sh")
+    if p is None:
+        return {}
+    label = f"yapss {p['yapss']} (casadi {p['casadi']})"
+    return {label: dict(solver=label, final_mass=p["final_mass"], final_time=p["phase_end_times"][-1],
+                        wall=p["solve_time"], build=float("nan"), solve=p["solve_time"],
+                        iterations=p["iterations"], intervals="5/5/5/5 (LGL 5 points)",
+                        success=p["status"].startswith("Optimal"))}
+
+
+def asset_round() -> dict:
+    """One fresh ASSET process solving on 16, 32 and 64 segments: ``{label: row dict}``."""
+    a = _peer(ASSET_PY, "asset_delta3.py", ["--json", "--threads", "1", "--repeats", "1"],
+              "ASSET", "setup_asset.sh")
+    out = {}
+    for r in (a or {}).get("runs", []):
+        n = r["segments"]
+        label = f"ASSET {a['asset']}, {n} x LGL3 per phase"
+        out[label] = dict(solver=label, final_mass=r["final_mass"], final_time=r["final_time"],
+                          wall=r["build_time"] + r["solve_time"], build=r["build_time"],
+                          solve=r["solve_time"], iterations=r["iterations"],
+                          intervals=f"{n}/{n}/{n}/{n} (LGL3)", success=r["status"] == "CONVERGED")
     return out
 
 
 def run(quick: bool, out: Path) -> list:
-    """Run the benchmark, write ``ascent.csv`` into ``out``; the summary `Row`s."""
+    """Run the benchmark, write ``ascent.csv`` into ``out``; the summary `Row`s.
+
+    Every round calls each solver once, back to back (appdyn in this process, each peer in a
+    fresh process), so a ratio is taken within a round (paired) and the load of a shared
+    machine falls on both sides alike; round 0 starts from empty caches (first calls)."""
     repeats = 0 if quick else 5
-    rows = []
-    f_c, t_c, coarse = appdyn_runs(repeats, refine_tol=None)
-    f_r, t_r, refined = appdyn_runs(repeats)
-    ref = refined.final_mass
-    for label, first, times, res in (("appdyn, 8 x Radau-4 per phase", f_c, t_c, coarse),
-                                     ("appdyn, refined to 1e-9", f_r, t_r, refined)):
-        sol = res.solution
-        rows.append(dict(solver=label, final_mass=res.final_mass, error=abs(res.final_mass - ref),
-                         final_time=res.final_time, first_call=first, wall=float(np.median(times)),
-                         iterations=sol.info.get("iterations", sol.iterations),
-                         intervals="/".join(str(s.mesh.N) for s in sol.phases),
-                         success=res.success))
-    peer = None if quick else yapss_runs(repeats)
+    clear_caches()
+    rounds = []
+    for k in range(repeats + 1):
+        r = appdyn_round()
+        if not quick:
+            r.update(yapss_round())
+            r.update(asset_round())
+        rounds.append(r)
     if quick:
-        print("yapss: skipped (--quick)")
-    if peer:
-        walls = np.array([p["solve_time"] for p in peer])
-        rows.append(dict(solver=f"yapss {peer[0]['yapss']} (casadi {peer[0]['casadi']})",
-                         final_mass=peer[0]["final_mass"], error=abs(peer[0]["final_mass"] - ref),
-                         final_time=peer[0]["phase_end_times"][-1], first_call=float(walls[0]),
-                         wall=float(np.median(walls)), iterations=peer[0]["iterations"],
-                         intervals="5/5/5/5 (LGL 5 points)",
-                         success=peer[0]["status"].startswith("Optimal")))
+        print("yapss, ASSET: skipped (--quick)")
+    later = rounds[1:] or rounds
+    ref = rounds[-1][CONFIGS[1][0]]["final_mass"]
+    asset_ref = next((v["final_mass"] for k, v in rounds[-1].items() if ", 64 x" in k), None)
+    rows = []
+    for label, last in rounds[-1].items():
+        row = dict(last)
+        row.update(first_call=rounds[0][label]["wall"] if label in rounds[0] else float("nan"),
+                   wall=float(np.median([r[label]["wall"] for r in later if label in r])),
+                   error=abs(last["final_mass"] - (asset_ref if label.startswith("ASSET") else ref)))
+        rows.append(row)
+    ratios = {}
+    for a_label, _ in CONFIGS:
+        for p_label in rows[len(CONFIGS):]:
+            p_label = p_label["solver"]
+            ratios[(p_label, a_label)] = float(np.median(
+                [r[p_label]["wall"] / r[a_label]["wall"] for r in later if p_label in r]))
     print("Delta III ascent to GTO (maximum final mass), 4 phases; published 7529.712412 kg "
           "(Betts 2010), 7529.712287 kg (yapss)")
-    print(f"{'solver':<38}{'final mass [kg]':>17}{'error [kg]':>12}{'tf [s]':>10}{'first [s]':>11}"
-          f"{'median [s]':>12}{'iter':>6}  intervals")
+    print(f"{'solver':<40}{'final mass [kg]':>17}{'error [kg]':>12}{'tf [s]':>10}{'first [s]':>11}"
+          f"{'median [s]':>12}{'build [s]':>11}{'solve [s]':>11}{'iter':>6}  intervals")
     for r in rows:
-        print(f"{r['solver']:<38}{r['final_mass']:>17.6f}{r['error']:>12.1e}{r['final_time']:>10.3f}"
-              f"{r['first_call']:>11.3f}{r['wall']:>12.3f}{r['iterations']:>6}  {r['intervals']}")
+        print(f"{r['solver']:<40}{r['final_mass']:>17.6f}{r['error']:>12.1e}{r['final_time']:>10.3f}"
+              f"{r['first_call']:>11.3f}{r['wall']:>12.3f}{r['build']:>11.3f}{r['solve']:>11.3f}"
+              f"{r['iterations']:>6}  {r['intervals']}")
     print(f"converged appdyn answer - Betts (2010): {ref - FINAL_MASS_BETTS:+.2e} kg")
-    if peer:
-        for r in rows[:2]:
-            print(f"yapss median / {r['solver']} median: {rows[-1]['wall'] / r['wall']:.2f}x")
+    for (p, r), x in ratios.items():
+        print(f"{p} / {r}: {x:.2f}x (median of the per-round ratios)")
     path = write_csv(rows, Path(out) / "ascent.csv")
     print(f"written: {path}")
-    return summary_rows(rows, ref, repeats)
+    return summary_rows(rows, ref, repeats, ratios)
 
 
-def summary_rows(rows, ref, repeats):
-    """Final mass, error and wall times of each solver; the yapss ratios."""
+def summary_rows(rows, ref, repeats, ratios):
+    """Final mass, error and wall times of each solver; the peers' time over appdyn's."""
     case = "Delta III ascent to GTO, 4 phases"
     how = f"median of {repeats}" if repeats else "one call"
     out = [Row("ascent", case, "final mass, refined", ref, "kg",
@@ -121,16 +169,21 @@ def summary_rows(rows, ref, repeats):
     for r in rows:
         ok = "" if r["success"] else "; NOT successful"
         if r is not rows[1]:
+            what = "vs ASSET's 64-segment answer" if r["solver"].startswith("ASSET") else \
+                "vs the refined answer"
             out.append(Row("ascent", case, f"error, {r['solver']}", r["error"], "kg",
-                           f"vs the refined answer{ok}"))
+                           f"final mass {r['final_mass']:.6f} kg; {what}{ok}"))
         out.append(Row("ascent", case, f"wall time, {r['solver']}", r["wall"], "s",
                        f"{how}; " + (f"first call {r['first_call']:.3g} s; " if repeats else "")
-                       + f"{r['iterations']} iterations; "
-                       f"intervals {r['intervals']}{ok}"))
-    if len(rows) > 2:
-        for r in rows[:2]:
-            out.append(Row("ascent", case, f"speed-up vs yapss, {r['solver']}",
-                           rows[-1]["wall"] / r["wall"], "x"))
+                       + f"build {r['build']:.3g} s, solve {r['solve']:.3g} s; "
+                       f"{r['iterations']} iterations; intervals {r['intervals']}{ok}"))
+    wanted = [(p, CONFIGS[0][0]) for p, _ in ratios if "yapss" in p or ", 32 x" in p]
+    wanted += [(p, CONFIGS[1][0]) for p, _ in ratios if "yapss" in p or ", 64 x" in p]
+    wanted += [(p, CONFIGS[2][0]) for p, _ in ratios if ", 32 x" in p]
+    for p, r in dict.fromkeys(wanted):
+        out.append(Row("ascent", case, f"{p} / {r}", ratios[(p, r)], "x",
+                       "wall-time ratio, median over rounds of back-to-back calls (> 1: appdyn "
+                       "faster)"))
     return out
 
 

@@ -48,9 +48,10 @@ from appdyn.dynamics.cache import compile_function, compiler
 
 from .cached import cached, function_key
 from .layout import Layout
-from .transcription import sx_compatible
+from .functions import sx_compatible
 
-__all__ = ["Structure", "Intervals", "intervals", "structure_key", "content_key"]
+__all__ = ["Structure", "Intervals", "intervals", "structure_key", "content_key",
+           "problem_functions"]
 
 
 def content_key(fun: ca.Function | None):
@@ -65,7 +66,9 @@ def content_key(fun: ca.Function | None):
     return (fun.name(), hashlib.blake2b(text.encode(), digest_size=16).hexdigest())
 
 
-def _functions(problem) -> list:
+def problem_functions(problem) -> list:
+    """The CasADi Functions a problem's NLP is built from: the model's ``f``, the Lagrange
+    and Mayer costs (None when absent), every path and boundary constraint's ``fun``."""
     return [problem.model.f, problem.lagrange, problem.mayer,
             *[c.fun for c in problem.path], *[c.fun for c in problem.boundary]]
 
@@ -179,7 +182,7 @@ class Intervals:
         self.common = Layout({"sx": (nx, 1), "su": (nu, 1), "sp": (np_, 1), "sT": (1, 1), "sJ": (1, 1),
                               "spath": (n_path, 1), "sb": (n_bound, 1), "sq": (1, 1), "pval": (np_, 1),
                               "Tfix": (1, 1), "qf": (4 if n_q else 0, 1)})
-        sx_ok = expand and all(f is None or sx_compatible(f) for f in _functions(problem))
+        sx_ok = expand and all(f is None or sx_compatible(f) for f in problem_functions(problem))
         sym = ca.SX if sx_ok else ca.MX
         self.symbolic = sym.__name__
         sign = problem.objective_sign
@@ -259,7 +262,7 @@ def intervals(problem, transcription, expand: bool = True, codegen: bool = False
     """The `Intervals` of ``problem`` transcribed by ``transcription``, from the one cache."""
     key = structure_key(problem, transcription, 0, expand, codegen)
     return cached("nlp_intervals", key, lambda: Intervals(problem, transcription, expand, codegen),
-                  keepalive=tuple(f for f in _functions(problem) if f is not None))
+                  keepalive=tuple(f for f in problem_functions(problem) if f is not None))
 
 
 class Structure:

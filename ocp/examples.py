@@ -67,9 +67,11 @@ import casadi as ca
 
 from appdyn.dynamics.model import Model
 
-from .problem import Problem
+from .problem import Constraint, Problem
 
-__all__ = ["double_integrator", "min_energy", "min_time", "goddard_rocket", "GODDARD_OPTIMUM"]
+__all__ = ["double_integrator", "min_energy", "min_time", "goddard_rocket", "GODDARD_OPTIMUM",
+           "orbit_raising", "ORBIT_RAISING_OPTIMUM", "shuttle_reentry", "shuttle_reentry_guess",
+           "SHUTTLE_REENTRY_OPTIMUM"]
 
 
 def double_integrator() -> Model:
@@ -205,3 +207,186 @@ def goddard_rocket(regularization: float = 0.0) -> Problem:
                    x_bounds={"h": (1.0, None), "v": (0.0, None), "m": (0.6, 1.0)},
                    u_bounds={"thrust": (0.0, 3.5)}, mayer=lambda xf, p, T: xf[0],
                    maximize=True, name=name, **kw)
+
+
+#: Bryson & Ho's orbit raising: the largest final radius [r0], to the four digits the
+#: literature agrees on (Bryson & Ho 1975; Betts 2010: 1.52526; collocation refined to
+#: interval errors of 1e-9 here: 1.5252777).
+ORBIT_RAISING_OPTIMUM = MappingProxyType({"r_f": 1.5253})
+
+
+def _orbit_raising_model() -> Model:
+    thrust, mdot = 0.1405, 0.0749
+    x, u, p = ca.SX.sym("x", 4), ca.SX.sym("u", 2), ca.SX.sym("p", 0)
+    r, vr, vt, m = x[0], x[1], x[2], x[3]
+    f = ca.Function("orbit_raising", [x, u, p],
+                    [ca.vertcat(vr, vt ** 2 / r - 1 / r ** 2 + thrust * u[0] / m,
+                                -vr * vt / r + thrust * u[1] / m, -mdot)],
+                    ["x", "u", "p"], ["xdot"])
+    return Model(f, ("r", "vr", "vt", "m"), ("ur", "ut"), name="orbit_raising",
+                 units={"r": "r0", "vr": "sqrt(mu/r0)", "vt": "sqrt(mu/r0)", "m": "m0",
+                        "ur": "-", "ut": "-"})
+
+
+_ORBIT_RAISING = _orbit_raising_model()
+
+
+def _unit(ur, ut):
+    return ur ** 2 + ut ** 2
+
+
+def _circular(r_f, vt_f):
+    return vt_f - 1 / ca.sqrt(r_f)
+
+
+def _radius(r_f):
+    return r_f
+
+
+def orbit_raising() -> Problem:
+    """Bryson & Ho's low-thrust orbit raising (*Applied Optimal Control*, 1975, sec. 2.5),
+    the thrust direction a unit vector: maximum final radius in a fixed time.
+
+    States ``r`` [r0], radial and tangential velocity ``vr``, ``vt`` [sqrt(mu/r0)], mass
+    ``m`` [m0]; controls ``ur``, ``ut``, the radial and tangential components of the thrust
+    direction with ``ur^2 + ut^2 = 1`` (a path constraint; no angle, so no 2 pi jumps)::
+
+        r' = vr,  vr' = vt^2 / r - 1 / r^2 + 0.1405 ur / m,
+        vt' = -vr vt / r + 0.1405 ut / m,  m' = -0.0749,
+
+    ``mu = 1``, from ``(1, 0, 1, 1)`` over ``T = 3.32`` to a circular orbit (``vr = 0``,
+    ``vt = 1 / sqrt(r)``); ``0.5 <= r <= 5``, ``0.1 <= m <= 1``.
+
+    Returns
+    -------
+    ocp.Problem
+        Maximizes ``r(T)``; optimum 1.5253 (`ORBIT_RAISING_OPTIMUM`).
+
+    Examples
+    --------
+    >>> from appdyn.ocp import solve
+    >>> from appdyn.ocp.examples import orbit_raising
+    >>> sol = solve(orbit_raising(), N=20)
+    >>> sol.success, round(sol.cost, 4), round(sol.simulated_cost, 4)
+    (True, 1.5253, 1.5253)
+    """
+    return Problem(_ORBIT_RAISING, T=3.32, x_initial=[1.0, 0.0, 1.0, 1.0], x_final={"vr": 0.0},
+                   x_bounds={"r": (0.5, 5.0), "m": (0.1, 1.0)},
+                   path=Constraint(_unit, 1.0, 1.0, name="|u| = 1"),
+                   boundary=Constraint(_circular, 0.0, 0.0, name="circular"),
+                   mayer=_radius, maximize=True, name="orbit raising")
+
+
+#: Betts' shuttle reentry without a heating limit: the largest crossrange (final latitude)
+#: [deg] and the final time [s] (Betts 2010, *Practical Methods for Optimal Control*, 2nd
+#: ed., example 6.1: 34.1412 deg at 2008.6 s).
+SHUTTLE_REENTRY_OPTIMUM = MappingProxyType({"theta_f_deg": 34.1412, "T": 2008.6})
+
+# units of the reentry: 1e5 ft, 60 s, the vehicle's mass (as ASSET's example states it)
+_L, _T = 1.0e5, 60.0
+_REENTRY_START = (260000.0 / _L, 0.0, 25600.0 / (_L / _T), math.radians(-1.0), math.radians(90.0))
+_REENTRY_END = {"h": 80000.0 / _L, "v": 2500.0 / (_L / _T), "gamma": math.radians(-5.0)}
+
+
+def _reentry_model() -> Model:
+    g0, weight = 32.2, 203000.0
+    m_star = weight / g0
+    re, area = 20902900.0 / _L, 2690.0 / _L ** 2
+    mass, mu = weight / g0 / m_star, 0.140765e17 / (_L ** 3 / _T ** 2)
+    rho0, h_ref = 0.002378 / (m_star / _L ** 3), 23800.0 / _L
+    x, u, p = ca.SX.sym("x", 5), ca.SX.sym("u", 2), ca.SX.sym("p", 0)
+    h, theta, v, gamma, psi = (x[i] for i in range(5))
+    alpha, beta = u[0], u[1]
+    a = alpha * 180.0 / math.pi
+    cl = -0.20704 + 0.029244 * a
+    cd = 0.07854 - 0.61592e-2 * a + 0.621408e-3 * a ** 2
+    q = 0.5 * rho0 * ca.exp(-h / h_ref) * v ** 2 * area
+    lift, drag = cl * q, cd * q
+    r = h + re
+    g = mu / r ** 2
+    rhs = ca.vertcat(v * ca.sin(gamma),
+                     v / r * ca.cos(gamma) * ca.cos(psi),
+                     -drag / mass - g * ca.sin(gamma),
+                     lift / (mass * v) * ca.cos(beta) + ca.cos(gamma) * (v / r - g / v),
+                     lift * ca.sin(beta) / (mass * v * ca.cos(gamma))
+                     + v / r * ca.cos(gamma) * ca.sin(psi) * ca.tan(theta))
+    f = ca.Function("shuttle_reentry", [x, u, p], [rhs], ["x", "u", "p"], ["xdot"])
+    return Model(f, ("h", "theta", "v", "gamma", "psi"), ("alpha", "beta"),
+                 name="shuttle_reentry",
+                 units={"h": "1e5 ft", "theta": "rad", "v": "1e5 ft / 60 s", "gamma": "rad",
+                        "psi": "rad", "alpha": "rad", "beta": "rad"})
+
+
+_REENTRY = _reentry_model()
+
+
+def _latitude(theta_f):
+    return theta_f
+
+
+def shuttle_reentry() -> Problem:
+    """Betts' space shuttle reentry, maximum crossrange, without a heating limit (Betts
+    2010, example 6.1; the problem of ASSET's and dymos' reentry examples).
+
+    States altitude ``h`` [1e5 ft], latitude ``theta`` [rad] (the crossrange), speed ``v``
+    [1e5 ft per 60 s], flight-path angle ``gamma`` and azimuth ``psi`` [rad]; controls angle
+    of attack ``alpha`` and bank ``beta`` [rad]; time in units of 60 s. Point mass over a
+    spherical non-rotating Earth with an exponential atmosphere; ``C_L = -0.20704 +
+    0.029244 a``, ``C_D = 0.07854 - 0.61592e-2 a + 0.621408e-3 a^2`` (``a`` = ``alpha`` in
+    degrees); W = 203000 lb, S = 2690 ft^2, R_E = 20902900 ft, mu = 0.140765e17 ft^3/s^2,
+    rho0 = 0.002378 slug/ft^3, H = 23800 ft. From 260000 ft, 25600 ft/s, ``gamma = -1``
+    deg, ``psi = 90`` deg at ``theta = 0`` to 80000 ft, 2500 ft/s, ``gamma = -5`` deg in a
+    free time ``T <= 2500`` s; ``|theta|, |gamma| <= 89`` deg, ``|alpha| <= 90`` deg,
+    ``-90 <= beta <= 1`` deg. Solve from `shuttle_reentry_guess`.
+
+    Returns
+    -------
+    ocp.Problem
+        Maximizes ``theta(T)``; optimum 34.1412 deg at T = 2008.6 s
+        (`SHUTTLE_REENTRY_OPTIMUM`).
+
+    Examples
+    --------
+    >>> import math
+    >>> from appdyn.ocp import solve
+    >>> from appdyn.ocp.examples import shuttle_reentry, shuttle_reentry_guess
+    >>> sol = solve(shuttle_reentry(), N=20, degree=5, guess=shuttle_reentry_guess())
+    >>> sol.success, round(math.degrees(sol.cost), 4), round(sol.T * 60, 1)
+    (True, 34.1414, 2008.6)
+
+    (Radau degree 3 on 20 or 40 intervals collocates 34.1416 and 34.1414 deg, but the
+    flight-path angle re-simulated from the control drifts 0.4-0.05 % of its size, above the
+    verification tolerance: not verified.)
+    """
+    lim = math.radians(89.0)
+    return Problem(_REENTRY, T=(0.1, 2500.0 / _T), x_initial=list(_REENTRY_START),
+                   x_final=dict(_REENTRY_END),
+                   x_bounds={"h": (0.0, 3.0), "theta": (-lim, lim), "v": (0.01, 20.0),
+                             "gamma": (-lim, lim), "psi": (-math.pi, 2 * math.pi)},
+                   u_bounds={"alpha": (-math.pi / 2, math.pi / 2),
+                             "beta": (-math.pi / 2, math.radians(1.0))},
+                   mayer=_latitude, maximize=True, name="shuttle reentry")
+
+
+def shuttle_reentry_guess(n: int = 21) -> dict:
+    """The start of ASSET's reentry example: over T = 1000 s, ``h``, ``v`` and ``gamma``
+    straight from their initial to their final values, ``theta = 0``, ``psi = 90`` deg,
+    ``alpha = beta = 0``; ``n`` samples (a guess for `shuttle_reentry`, in its units).
+
+    Examples
+    --------
+    >>> from appdyn.ocp.examples import shuttle_reentry_guess
+    >>> shuttle_reentry_guess(5)["x"].shape
+    (5, 5)
+    """
+    import numpy as np
+
+    if isinstance(n, bool) or not isinstance(n, numbers.Integral) or n < 2:
+        raise ValueError(f"`n` must be an int >= 2, got {n!r}")
+    T = 1000.0 / _T
+    f = np.linspace(0.0, 1.0, n)
+    h0, _, v0, g0, psi0 = _REENTRY_START
+    end = _REENTRY_END
+    x = np.vstack([h0 + f * (end["h"] - h0), np.zeros(n), v0 + f * (end["v"] - v0),
+                   g0 + f * (end["gamma"] - g0), np.full(n, psi0)])
+    return {"t": f * T, "x": x, "u": np.zeros((2, n)), "T": T}

@@ -37,7 +37,26 @@ import numpy as np
 
 from appdyn.dynamics.model import Model
 
-__all__ = ["named_function", "canonical", "by_name", "vocabulary", "valid_names", "POSITIONAL"]
+__all__ = ["named_function", "canonical", "by_name", "vocabulary", "valid_names", "POSITIONAL",
+           "sx_compatible"]
+
+
+def sx_compatible(fun: ca.Function) -> bool:
+    """Whether ``fun`` can be called on SX symbols (then kernels are built expanded, in SX).
+
+    Examples
+    --------
+    >>> import casadi as ca
+    >>> from appdyn.ocp.functions import sx_compatible
+    >>> x = ca.MX.sym("x")
+    >>> sx_compatible(ca.Function("f", [x], [ca.sin(x)]))
+    True
+    """
+    try:
+        fun(*[ca.SX.sym(f"a{i}", fun.sparsity_in(i)) for i in range(fun.n_in())])
+        return True
+    except Exception:  # noqa: BLE001 - e.g. an MX Function holding an integrator
+        return False
 
 #: The positional inputs of each kind of function (the inputs its names refer to).
 POSITIONAL = {

@@ -11,7 +11,7 @@ checked against a small kept table; every other name against the installed IPOPT
 list: its documentation output (``print_options_documentation yes``,
 ``print_advanced_options yes``, ``print_options_mode doxygen``, which names each option's
 type) is captured once in a subprocess (so nothing reaches this process's stdout) and
-parsed (`ipopt_option_table`; the result is kept for the life of the process). If that
+parsed (`ipopt_option_table`; the result is kept in the one cache, `dynamics.cache`). If that
 capture fails, names and values are not checked here and the solver's own error is
 reported instead (see `ocp.solve`).
 
@@ -26,7 +26,6 @@ anything is built.
 from __future__ import annotations
 
 import difflib
-import functools
 import json
 import math
 import re
@@ -36,6 +35,8 @@ from dataclasses import dataclass
 from typing import Mapping
 
 import numpy as np
+
+from appdyn.dynamics import cache
 
 __all__ = ["IpoptOption", "ipopt_option_table", "check_ipopt_options", "parse_documentation",
            "available_linear_solvers", "LINEAR_SOLVERS"]
@@ -181,9 +182,10 @@ def parse_documentation(text: str) -> dict:
     return table
 
 
-@functools.lru_cache(maxsize=1)
+@cache.memoize
 def ipopt_option_table() -> Mapping[str, IpoptOption] | None:
-    """The installed IPOPT's options, captured once per process (``None`` if unavailable).
+    """The installed IPOPT's options, captured once per process (``None`` if unavailable); kept in the one cache
+    (`dynamics.clear_caches` drops it).
 
     Returns
     -------
@@ -226,7 +228,7 @@ def _probe(names, library: tuple) -> dict:
     return found
 
 
-@functools.lru_cache(maxsize=8)
+@cache.memoize
 def _available(library: tuple) -> tuple | None:
     found = _probe(LINEAR_SOLVERS, library)
     if not found.get("mumps", False) and not any(found.values()):

@@ -19,7 +19,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .assembly import Structure, structure_key, _functions
+from .assembly import Structure, problem_functions, structure_key
 from .attitude import target_bounds
 from .cached import cached
 
@@ -41,7 +41,7 @@ def structure(problem, transcription, N: int, expand: bool = True, codegen: bool
     if key is None:  # (serializing the functions for their content keys costs about 60 us each)
         key = structure_key(problem, transcription, N, expand, codegen)
     return cached("nlp_structure", key, build,
-                  keepalive=tuple(f for f in _functions(problem) if f is not None))
+                  keepalive=tuple(f for f in problem_functions(problem) if f is not None))
 
 
 class Discretization:

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
 
 import casadi as ca
 import numpy as np
@@ -11,9 +10,6 @@ import numpy as np
 from appdyn.dynamics.validate.base import real_array
 
 from .cached import cached, function_key
-
-if TYPE_CHECKING:
-    from .solution import Solution
 
 __all__ = ["Propagation", "propagate", "interval_integrator", "stack_interval_controls",
            "state_scale", "SCALE_FLOOR"]
@@ -88,7 +84,7 @@ def state_scale(x: np.ndarray) -> np.ndarray:
     return np.maximum(np.max(np.abs(x), axis=1), SCALE_FLOOR)
 
 
-def propagate(sol: Solution, rtol: float = 1e-12, atol: float = 1e-12) -> Propagation:
+def propagate(sol, rtol: float = 1e-12, atol: float = 1e-12) -> Propagation:
     """`ocp.Solution.propagate` (its docstring): re-simulate ``sol``'s dense control with
     CVODES per mesh interval, with the running cost as a quadrature."""
     for name, v in (("rtol", rtol), ("atol", atol)):
@@ -121,7 +117,7 @@ def propagate(sol: Solution, rtol: float = 1e-12, atol: float = 1e-12) -> Propag
                        cost, scale)
 
 
-def interval_integrator(sol: Solution, grid, rtol: float, atol: float, *,
+def interval_integrator(sol, grid, rtol: float, atol: float, *,
                         lagrange: ca.Function | None = None) -> ca.Function:
     """CVODES over one mesh interval in normalized time ``s in [0, 1]`` under the solution's
     own control polynomial, with outputs at the normalized times ``grid``.
@@ -164,7 +160,7 @@ def _build_interval_integrator(sol, grid, rtol, atol, lagrange=None):
     return ca.integrator("interval", "cvodes", dae, 0.0, [float(v) for v in grid], opts)
 
 
-def _propagator(sol: Solution, rtol: float, atol: float) -> ca.Function:
+def _propagator(sol, rtol: float, atol: float) -> ca.Function:
     """``(x0 (nx,), data (.., N)) -> (xf, x at the owned nodes of every interval, integral of
     L over every interval (1, N))``: the interval integrators chained by ``mapaccum`` over the
     ``N`` intervals (cached; the running cost ``problem.lagrange`` is part of the key, the

@@ -38,7 +38,7 @@ from typing import Mapping
 import casadi as ca
 import numpy as np
 
-from .transcription import sx_compatible
+from .functions import sx_compatible
 
 __all__ = ["Scaling", "auto_scaling"]
 

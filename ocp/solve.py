@@ -100,7 +100,7 @@ from .transcription import get_transcription
 
 __all__ = ["solve", "Progress", "DEFAULT_CONSTRAINT_TOL", "STATUS_CONSTRAINT_TOL", "STATUS_EXCEPTION",
            "STATUS_BOUND_VIOLATION", "STATUS_RESIMULATION", "check_constraint_tol", "verified", "make_solution", "WARM_START_OPTIONS", "run_ipopt",
-           "read_result"]
+           "read_result", "default_mesh", "solver_ipopt_options", "nlp_numbers"]
 
 _SUCCESS = ("Solve_Succeeded",)
 _ACCEPTABLE = "Solved_To_Acceptable_Level"
@@ -117,7 +117,16 @@ WARM_START_OPTIONS = {"warm_start_init_point": "yes", "warm_start_bound_push": 1
                       "mu_init": 1e-6}
 
 
-def _mesh(N, mesh) -> Mesh:
+def default_mesh(N, mesh) -> Mesh:
+    """The mesh of a solve: ``mesh`` (a `Mesh` or its breaks) or ``N`` uniform intervals
+    (20 when both are None); ValueError naming ``N`` when the two disagree.
+
+    Examples
+    --------
+    >>> from appdyn.ocp.solve import default_mesh
+    >>> default_mesh(4, None).N, default_mesh(None, None).N
+    (4, 20)
+    """
     if mesh is None:
         return Mesh.uniform(_DEFAULT_N if N is None else N)
     m = mesh if isinstance(mesh, Mesh) else Mesh(mesh)
@@ -126,7 +135,16 @@ def _mesh(N, mesh) -> Mesh:
     return m
 
 
-def _ipopt_options(ipopt_options, constraint_tol: float) -> dict:
+def solver_ipopt_options(ipopt_options, constraint_tol: float) -> dict:
+    """IPOPT's options of a solve: silent, ``constr_viol_tol = constraint_tol``, then the
+    user's ``ipopt_options`` (checked by `ocp.ipopt_options.check_ipopt_options`).
+
+    Examples
+    --------
+    >>> from appdyn.ocp.solve import solver_ipopt_options
+    >>> solver_ipopt_options({"max_iter": 5}, 1e-6)["max_iter"]
+    5
+    """
     opts = {"print_level": 0, "sb": "yes", "constr_viol_tol": constraint_tol}
     opts.update(check_ipopt_options(ipopt_options))
     return opts
@@ -284,7 +302,7 @@ def solve(problem: Problem, *, transcription="radau", N: int | None = None, degr
     if not isinstance(problem, Problem):
         raise TypeError(f"`problem` must be an ocp.Problem, got {type(problem).__name__}")
     tr = get_transcription(transcription, degree, control)
-    m = _mesh(N, mesh)
+    m = default_mesh(N, mesh)
     sink = iteration_sink(verbose, progress)
     for name, flag in (("expand", expand), ("codegen", codegen), ("verify", verify)):
         if flag not in (True, False):
@@ -292,7 +310,7 @@ def solve(problem: Problem, *, transcription="radau", N: int | None = None, degr
     ctol = check_constraint_tol(constraint_tol)
     vtol = check_verify_tol(verify_tol, tr) if verify else None
     btol = ctol if bound_tol is None else _check_bound_tol(bound_tol)
-    opts = _ipopt_options(ipopt_options, ctol)
+    opts = solver_ipopt_options(ipopt_options, ctol)
 
     t_build = time.perf_counter()
     node_guess = initial_guess(problem, tr, m, guess)
@@ -358,13 +376,16 @@ def _failed(solution: Solution, status: str, why: str) -> Solution:
     return out
 
 
-def _numbers(disc) -> bytes:
-    """Digest of everything numeric in the NLP of ``disc`` besides its structure: the
-    parameter values, variable and constraint bounds (physical), the mesh."""
+def nlp_numbers(disc, bounds: bool = True) -> bytes:
+    """Digest of everything numeric in the NLP of ``disc`` (an `ocp.nlp.Discretization`)
+    besides its structure: the parameter values, the mesh and (``bounds=True``) the variable
+    and constraint bounds (physical); 16 bytes. Two NLPs with equal structure keys and equal
+    digests are the same NLP (a warm start may reuse primal and dual values)."""
     sw, sg, _ = disc.scales()
     P = disc.structure.params.split(disc.P)  # not the scale factors: they depend on the guess
-    parts = (P["pval"], P["Tfix"], P["qf"], P["frac"], disc.lbx * sw, disc.ubx * sw,
-             disc.lbg * sg, disc.ubg * sg)
+    parts = (P["pval"], P["Tfix"], P["qf"], P["frac"])
+    if bounds:
+        parts += (disc.lbx * sw, disc.ubx * sw, disc.lbg * sg, disc.ubg * sg)
     return hashlib.blake2b(b"".join(np.asarray(a, dtype=float).tobytes() for a in parts),
                            digest_size=16).digest()
 
@@ -379,7 +400,7 @@ def _warm_point(guess, disc) -> dict | None:
     cold start from the same primal values (55 against 24 on a time-optimal slew at
     N = 40), so those get the primal values only (`ocp.guess`)."""
     point = getattr(guess, "nlp_point", None)
-    if not point or point.get("key") != disc.key or point.get("numbers") != _numbers(disc):
+    if not point or point.get("key") != disc.key or point.get("numbers") != nlp_numbers(disc):
         return None
     sw, sg, dJ = disc.scales()
     x = np.clip(point["x_phys"] / sw, disc.lbx, disc.ubx)
@@ -503,7 +524,7 @@ def make_solution(problem, tr, mesh, disc, w, lam_g, g, success, status, message
     point = None
     if lam_x is not None:
         sw, sg, dJ = disc.scales()
-        point = {"key": disc.key, "numbers": _numbers(disc), "x_phys": w * sw,
+        point = {"key": disc.key, "numbers": nlp_numbers(disc), "x_phys": w * sw,
                  "lam_x_phys": lam_x * dJ / sw, "lam_g_phys": np.asarray(lam_g) * dJ / sg}
     return Solution.from_arrays(
         problem, tr, mesh, phys["X"], phys["U"], phys["p"], phys["T"], cost=disc.cost(w),

@@ -59,6 +59,7 @@ import casadi as ca
 import numpy as np
 
 from .cached import cached, function_key
+from .functions import sx_compatible
 from .mesh import Mesh
 
 __all__ = ["Transcription", "Trapezoid", "HermiteSimpson", "Radau", "RadauConstantControl",
@@ -98,15 +99,6 @@ def _quadrature_weights(nodes: np.ndarray) -> np.ndarray:
     g, gw = np.polynomial.legendre.leggauss(nodes.size + 1)
     s, gw = 0.5 * (g + 1.0), 0.5 * gw
     return np.array([np.dot(gw, b) for b in _lagrange_basis(nodes, s)])
-
-
-def sx_compatible(fun: ca.Function) -> bool:
-    """Whether ``fun`` can be called on SX symbols (then kernels are built expanded, in SX)."""
-    try:
-        fun(*[ca.SX.sym(f"a{i}", fun.sparsity_in(i)) for i in range(fun.n_in())])
-        return True
-    except Exception:  # noqa: BLE001 - e.g. an MX Function holding an integrator
-        return False
 
 
 @dataclass(frozen=True)

@@ -21,31 +21,13 @@ C-level stdout) is sent to stderr while solving, so stdout carries only the JSON
 from __future__ import annotations
 
 import argparse
-import contextlib
-import ctypes
 import json
-import os
 import sys
 import time
 import warnings
 from importlib.metadata import version
 
-
-@contextlib.contextmanager
-def stdout_to_stderr():
-    """Point file descriptor 1 at stderr (catches C-level printf from IPOPT too)."""
-    libc = ctypes.CDLL(None)
-    sys.stdout.flush()
-    libc.fflush(None)
-    saved = os.dup(1)
-    os.dup2(2, 1)
-    try:
-        yield
-    finally:
-        sys.stdout.flush()
-        libc.fflush(None)
-        os.dup2(saved, 1)
-        os.close(saved)
+from _runner import stdout_to_stderr
 
 
 def run(quiet: bool) -> dict:

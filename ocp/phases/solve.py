@@ -22,10 +22,10 @@ from ..guess import initial_guess
 from ..nlp import Discretization
 from ..progress import LOGGER, IterationCallback, iteration_sink
 from ..refine.errors import interval_errors
-from ..refine.mesh_update import _local_order, _new_mesh
+from ..refine.mesh_update import local_order, new_mesh
 from ..scaling import auto_scaling
-from ..solve import (WARM_START_OPTIONS, _ipopt_options, _mesh, _numbers, check_constraint_tol,
-                     make_solution, read_result, run_ipopt)
+from ..solve import (WARM_START_OPTIONS, check_constraint_tol, default_mesh, make_solution,
+                     nlp_numbers, read_result, run_ipopt, solver_ipopt_options)
 from ..transcription import get_transcription
 from .nlp import PhasedDiscretization, event_row_scales
 from .problem import MultiPhaseProblem
@@ -56,7 +56,7 @@ def _discretize(problem: MultiPhaseProblem, meshes, guesses, expand, codegen):
     out = []
     for i, ph in enumerate(problem.phases):
         tr = get_transcription(ph.transcription, ph.degree)
-        m = meshes[i] if meshes is not None else _mesh(ph.N, ph.mesh)
+        m = meshes[i] if meshes is not None else default_mesh(ph.N, ph.mesh)
         pb = replace(ph.problem, t0=0.0) if ph.problem.t0 != 0.0 else ph.problem
         try:
             ng = initial_guess(pb, tr, m, guesses[i])  # (a Solution is read in normalized time)
@@ -81,7 +81,8 @@ def solve_phases(problem: MultiPhaseProblem, *, guess=None, objective_scale: flo
     problem : MultiPhaseProblem
     guess : None, MultiPhaseSolution or sequence, optional
         A previous solution (each phase's solution becomes that phase's guess; primal and dual
-        values when it solved the same NLP), or one guess per phase (``None`` items take the
+        values when it solved the same NLP up to its bounds, e.g. with a path constraint's band
+        narrowed), or one guess per phase (``None`` items take the
         phase's own ``Phase.guess``). A phase guess is what `ocp.solve` takes, its times from
         the phase's start.
     objective_scale : float, optional
@@ -134,7 +135,7 @@ def solve_phases(problem: MultiPhaseProblem, *, guess=None, objective_scale: flo
         if isinstance(v, bool) or not isinstance(v, (int, np.integer)) or v < (0 if name == "max_rounds" else 1):
             raise ValueError(f"`{name}` must be an int >= {0 if name == 'max_rounds' else 1}, got {v!r}")
     ctol = check_constraint_tol(constraint_tol)
-    opts = _ipopt_options(ipopt_options, ctol)
+    opts = solver_ipopt_options(ipopt_options, ctol)
     sink = iteration_sink(verbose, progress)
     guesses = _phase_guesses(problem, guess)
 
@@ -156,8 +157,8 @@ def solve_phases(problem: MultiPhaseProblem, *, guess=None, objective_scale: flo
             new = None
             if e > refine_tol:
                 est = interval_errors(s)
-                new = _new_mesh(s.mesh, est, s.T, s.t0, refine_tol, _local_order(s.transcription),
-                                max_intervals)
+                new = new_mesh(s.mesh, est, s.T, s.t0, refine_tol, local_order(s.transcription),
+                               max_intervals)
             meshes.append(new or s.mesh)
         if all(m is s.mesh for m, s in zip(meshes, sol.phases)):
             break
@@ -281,14 +282,18 @@ def _phys_scales(disc) -> tuple[np.ndarray, np.ndarray, float]:
 
 
 def _phased_numbers(disc) -> bytes:
+    """Digest of the phases' parameter values and meshes (`ocp.solve.nlp_numbers` without
+    the bounds): a solution of an NLP that differs from this one in its bounds only (a
+    bound homotopy) still gives a warm start."""
     import hashlib
-    parts = [_numbers(d) for d in disc.discs]
+    parts = [nlp_numbers(d, bounds=False) for d in disc.discs]
     return hashlib.blake2b(b"".join(parts), digest_size=16).digest()
 
 
 def _warm_point(sol, disc) -> dict | None:
-    """Primal and dual start values from a `MultiPhaseSolution` of the same NLP (same phase
-    structures, numbers and meshes), in this NLP's scaling; ``None`` otherwise."""
+    """Primal and dual start values from a `MultiPhaseSolution` of the same NLP up to its
+    bounds (same phase structures, parameter values and meshes), in this NLP's scaling and
+    clipped into its bounds; ``None`` otherwise."""
     point = getattr(sol, "nlp_point", None)
     if not point or point.get("key") != disc.key or point.get("numbers") != _phased_numbers(disc):
         return None

@@ -25,7 +25,7 @@ from ..transcription import Radau, Transcription, get_transcription
 from .errors import IntervalErrors, interval_errors
 from .result import RefinedSolution, RefinementRound, annotate
 
-__all__ = ["refine", "STATUS_STALLED"]
+__all__ = ["refine", "STATUS_STALLED", "local_order", "new_mesh"]
 
 _BRACKET = 1.0 / 16.0  # width of the new switch interval relative to the old one
 
@@ -33,15 +33,46 @@ _BRACKET = 1.0 / 16.0  # width of the new switch interval relative to the old on
 STATUS_STALLED = "Refinement_Stalled"
 
 
-def _local_order(tr: Transcription) -> int:
+def local_order(tr: Transcription) -> int:
+    """The local order of accuracy of a transcription's interval error (the power of the
+    interval length in its estimate): ``degree + 1`` for Radau, 3 for the trapezoid, 4
+    otherwise (Hermite-Simpson).
+
+    Examples
+    --------
+    >>> from appdyn.ocp.refine.mesh_update import local_order
+    >>> from appdyn.ocp.transcription import get_transcription
+    >>> local_order(get_transcription("radau", 3))
+    4
+    """
     if isinstance(tr, Radau):
         return tr.degree + 1
     return {"trapezoid": 3}.get(tr.name, 4)
 
 
-def _new_mesh(mesh: Mesh, est: IntervalErrors, T: float, t0: float, tol: float, q: int,
-              max_intervals: int) -> Mesh | None:
-    """Split inaccurate intervals, bracket switches, merge very accurate neighbours."""
+def new_mesh(mesh: Mesh, est: IntervalErrors, T: float, t0: float, tol: float, q: int,
+             max_intervals: int) -> Mesh | None:
+    """The next mesh of a refinement round: split inaccurate intervals, bracket switches,
+    merge very accurate neighbours.
+
+    Parameters
+    ----------
+    mesh : Mesh
+    est : IntervalErrors
+        Of a solution on ``mesh`` (`ocp.refine.interval_errors`).
+    T, t0 : float [s]
+        Horizon and start time of that solution.
+    tol : float
+        Target interval error.
+    q : int
+        Local order of the transcription (`local_order`).
+    max_intervals : int
+
+    Returns
+    -------
+    Mesh or None
+        None when nothing changes.
+    """
     b, h = mesh.breaks, mesh.fractions
     N = mesh.N
     err = np.minimum(np.where(np.isfinite(est.error), est.error, np.inf), 1e12 * tol)
@@ -350,7 +381,7 @@ def refine(problem: Problem, solution: Solution | None = None, *, tol: float = 1
     N = 20 if N is None else N
     tr = get_transcription(_transcription(transcription, 3 if degree is None else degree),
                            None, control)
-    q = _local_order(tr)
+    q = local_order(tr)
 
     t_round = time.perf_counter()
     if solution is not None and solution.problem is problem and solution.transcription == tr:
@@ -390,7 +421,7 @@ def refine(problem: Problem, solution: Solution | None = None, *, tol: float = 1
         if rnd == max_rounds:
             stop = f"max_rounds = {max_rounds} reached"
             break
-        mesh = _new_mesh(sol.mesh, est, sol.T, sol.t0, tol, q, max_intervals)
+        mesh = new_mesh(sol.mesh, est, sol.T, sol.t0, tol, q, max_intervals)
         if mesh is None:
             stop = f"max_intervals = {max_intervals} reached"
             break

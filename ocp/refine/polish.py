@@ -45,7 +45,8 @@ from ..mesh import Mesh
 from ..problem import Constraint, Problem
 from ..solution import Solution
 from ..solve import solve
-from ..transcription import RadauConstantControl, sx_compatible
+from ..functions import sx_compatible
+from ..transcription import RadauConstantControl
 from .result import STATUS_WORSE, RefinedSolution, annotate, graded
 from .switch_times import bang_arcs, optimize_switch_times
 from .switches import find_switches

@@ -8,7 +8,7 @@ import casadi as ca
 from appdyn.dynamics.integrate.tableaux import DOP853
 
 from ..cached import cached, function_key
-from ..transcription import sx_compatible
+from ..functions import sx_compatible
 
 __all__ = ["step_function", "step_jacobian"]
 

@@ -268,13 +268,16 @@ def drag_force(r, v):
 
 
 @cache.memoize
-def _delta3_model(phase: int) -> Model:
+def _delta3_model(phase: int, normalized: bool = False) -> Model:
     data = PHASES[phase]
     xs = {name: ca.SX.sym(name) for name in STATES}
     us = {name: ca.SX.sym(name) for name in CONTROLS}
     r = [xs["rx"], xs["ry"], xs["rz"]]
     v = [xs["vx"], xs["vy"], xs["vz"]]
     u = [us["ux"], us["uy"], us["uz"]]
+    if normalized:
+        size = ca.sqrt(u[0] ** 2 + u[1] ** 2 + u[2] ** 2)
+        u = [c / size for c in u]
     m = xs["m"]
     mu_r3 = MU / (r[0] ** 2 + r[1] ** 2 + r[2] ** 2) ** 1.5
     drag = _drag(r, v, True)
@@ -283,23 +286,28 @@ def _delta3_model(phase: int) -> Model:
     units = {**{k: "m" for k in STATES[:3]}, **{k: "m/s" for k in STATES[3:6]}, "m": "kg",
              **{k: "-" for k in CONTROLS}}
     return model_from_expressions(xs, dict(zip(STATES, xdot)), us, units=units,
-                                  name=f"delta3_phase{phase}")
+                                  name=f"delta3_phase{phase}" + ("_normalized" if normalized else ""))
 
 
-def delta3_model(phase: int) -> Model:
+def delta3_model(phase: int, normalized: bool = False) -> Model:
     """The ECI point-mass ascent model of one phase (module docstring for the equations).
 
     Parameters
     ----------
     phase : int
         0 (six SRBs + stage 1), 1 (three SRBs + stage 1), 2 (stage 1), 3 (stage 2).
+    normalized : bool, optional
+        False (default): the thrust is ``T u`` (impose ``|u| = 1`` in the problem). True:
+        the thrust is ``T u / |u|`` (ASSET's form), so the dynamics do not depend on
+        ``|u|`` and a problem may bound ``|u|`` in a band (``0.5 <= |u| <= 1.5``) instead
+        of the nonconvex ``|u| = 1``; the two agree wherever ``|u| = 1``.
 
     Returns
     -------
     Model
         States ``rx, ry, rz`` [m], ``vx, vy, vz`` [m/s], ``m`` [kg]; controls ``ux, uy, uz``
-        (thrust direction; impose ``|u| = 1`` in the problem); no parameters. Built once
-        per phase and cached (`dynamics.clear_caches` drops it).
+        (thrust direction); no parameters. Built once per phase and form and cached
+        (`dynamics.clear_caches` drops it).
 
     Raises
     ------
@@ -315,7 +323,9 @@ def delta3_model(phase: int) -> Model:
     >>> bool(model.rhs(initial_state())[6] == -PHASES[0].mass_flow)
     True
     """
-    return _delta3_model(_check_phase(phase))
+    if not isinstance(normalized, (bool, np.bool_)):
+        raise TypeError(f"`normalized` must be True or False, got {normalized!r}")
+    return _delta3_model(_check_phase(phase), bool(normalized))
 
 
 def initial_state() -> np.ndarray:

@@ -17,7 +17,8 @@ from appdyn.dynamics.serialize import text_table
 from appdyn.dynamics.validate import finite_scalar, positive
 
 from .planar import PlanarAscent
-from .planar_model import SCALE_HEIGHT, STATES, TRACKING_STATES, AscentVehicle, _vehicle, pitch_model
+from .planar_model import (SCALE_HEIGHT, STATES, TRACKING_STATES, AscentVehicle, check_vehicle,
+                           pitch_model)
 
 __all__ = ["fly_pitch_program", "PitchTracking", "default_gains"]
 
@@ -34,7 +35,7 @@ def default_gains(vehicle: AscentVehicle | None = None, q: float = 3.0e4) -> dic
     dict
         ``{'k_theta': [rad/rad], 'k_thetadot': [rad/(rad/s)]}``.
     """
-    veh = _vehicle(vehicle)
+    veh = check_vehicle(vehicle)
     Fl = veh.thrust * veh.arm
     M = positive(q, "q") * veh.area * veh.normal_force_slope * veh.cp_arm
     k = max(1.0, 3.0 * M / Fl)

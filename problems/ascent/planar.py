@@ -17,7 +17,7 @@ from appdyn.dynamics.results import Result
 from appdyn.dynamics.serialize import text_table
 from appdyn.dynamics.validate import finite_scalar, integer, one_of, positive
 
-from .planar_model import (RHO0, SCALE_HEIGHT, STATES, AscentVehicle, _vehicle, planar_model,
+from .planar_model import (RHO0, SCALE_HEIGHT, STATES, AscentVehicle, check_vehicle, planar_model,
                            vertical_rise)
 
 __all__ = ["planar_ascent", "PlanarAscent", "STATUS_TERMINAL", "STATUS_LIMITS", "STATUS_PROPAGATION"]
@@ -233,7 +233,7 @@ def planar_ascent(*, target_altitude, target_gamma, q_max, qalpha_max,
     (True, 2454, 45.0)
     """
     start = time.perf_counter()
-    veh = _vehicle(vehicle)
+    veh = check_vehicle(vehicle)
     one_of(objective, "objective", ("velocity", "mass"))
     qmax = positive(q_max, "q_max")
     qamax = positive(qalpha_max, "qalpha_max")

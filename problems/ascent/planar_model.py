@@ -78,17 +78,17 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from functools import lru_cache
 
 import casadi as ca
 
+from appdyn.dynamics import cache
 from appdyn.dynamics.model import Model, model_from_expressions
 from appdyn.dynamics.validate import finite_scalar, positive
 
 # the atmosphere, gravity and Earth of the Delta III benchmark (one place for them)
 from .delta3 import G0, H_SCALE as SCALE_HEIGHT, RE as EARTH_RADIUS, RHO0
 
-__all__ = ["RHO0", "SCALE_HEIGHT", "G0", "EARTH_RADIUS", "AXIAL_COEFFICIENT", "MASS_FLOW_RATE",
+__all__ = ["check_vehicle", "RHO0", "SCALE_HEIGHT", "G0", "EARTH_RADIUS", "AXIAL_COEFFICIENT", "MASS_FLOW_RATE",
            "BURN_TIME", "STATES", "TRACKING_STATES", "AscentVehicle", "planar_model", "pitch_model",
            "vertical_rise"]
 
@@ -178,7 +178,7 @@ class AscentVehicle:
         return self.mass - self.mass_flow_rate * self.burn_time
 
 
-@lru_cache(maxsize=1)
+@cache.memoize
 def _default_vehicle() -> AscentVehicle:
     from appdyn.problems.gains import EXAMPLE_CONFIG, load_config
 
@@ -193,7 +193,16 @@ def _default_vehicle() -> AscentVehicle:
                          delta_max=cfg.options["delta_max"])
 
 
-def _vehicle(vehicle) -> AscentVehicle:
+def check_vehicle(vehicle) -> AscentVehicle:
+    """``vehicle``, or `AscentVehicle.default` for None; TypeError naming ``vehicle`` for
+    anything else.
+
+    Examples
+    --------
+    >>> from appdyn.problems.ascent.planar_model import AscentVehicle, check_vehicle
+    >>> check_vehicle(None) == AscentVehicle.default()
+    True
+    """
     if vehicle is None:
         return AscentVehicle.default()
     if not isinstance(vehicle, AscentVehicle):
@@ -229,7 +238,7 @@ def _params():
     return P, {"rho0": RHO0, "g0": G0, "radius": EARTH_RADIUS}
 
 
-@lru_cache(maxsize=16)
+@cache.memoize_values
 def planar_model(vehicle: AscentVehicle | None = None) -> Model:
     """The point-mass pitch-plane ascent model (module docstring), cached by ``vehicle``.
 
@@ -254,7 +263,7 @@ def planar_model(vehicle: AscentVehicle | None = None) -> Model:
     >>> round(float(xdot[2]), 6)  # F / m - g0 with no air, flat Earth
     10.19335
     """
-    veh = _vehicle(vehicle)
+    veh = check_vehicle(vehicle)
     X = {n: ca.SX.sym(n) for n in STATES}
     theta = ca.SX.sym("theta")
     P, defaults = _params()
@@ -266,7 +275,7 @@ def planar_model(vehicle: AscentVehicle | None = None) -> Model:
                                   invariants={"q": q}, name="planar_ascent")
 
 
-@lru_cache(maxsize=16)
+@cache.memoize_values
 def pitch_model(vehicle: AscentVehicle | None, k_theta: float, k_thetadot: float) -> Model:
     """The rigid vehicle's pitch dynamics on the point-mass translation, closed by the
     autopilot and a first-order gimbal (module docstring), cached by its arguments.
@@ -286,7 +295,7 @@ def pitch_model(vehicle: AscentVehicle | None, k_theta: float, k_thetadot: float
         parameters as `planar_model`. Invariants ``q`` [Pa], ``alpha`` [rad] and
         ``delta_dot`` [rad/s] are not given (they need the controls); see `PitchTracking`.
     """
-    veh = _vehicle(vehicle)
+    veh = check_vehicle(vehicle)
     kt, kd = finite_scalar(k_theta, "k_theta"), finite_scalar(k_thetadot, "k_thetadot")
     X = {n: ca.SX.sym(n) for n in TRACKING_STATES}
     U = {n: ca.SX.sym(n) for n in ("theta_cmd", "theta_cmd_dot")}
@@ -339,7 +348,7 @@ def vertical_rise(vehicle: AscentVehicle | None, speed: float, g0: float = G0):
     >>> round(t, 3), round(h, 2), round(m, 1)
     (4.747, 117.38, 96677.2)
     """
-    veh = _vehicle(vehicle)
+    veh = check_vehicle(vehicle)
     V1 = positive(speed, "speed")
     ve, a = veh.exhaust_velocity, veh.mass_flow_rate / veh.mass
     if veh.thrust <= veh.mass * g0:

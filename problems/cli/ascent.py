@@ -32,8 +32,8 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
                                       "GPOPS-II): six + three solid boosters, two stages, "
                                       "maximum mass in the target orbit.")
     d3.set_defaults(_parser=d3)
-    d3.add_argument("--N", type=integer(2), default=8, help="mesh intervals per phase (8)")
-    d3.add_argument("--degree", type=integer(1), default=4, help="Radau degree (4)")
+    d3.add_argument("--N", type=integer(2), default=5, help="mesh intervals per phase (5)")
+    d3.add_argument("--degree", type=integer(1), default=5, help="Radau degree (5)")
     d3.add_argument("--refine-tol", type=positive, default=1e-9, metavar="TOL",
                     help="per-phase mesh refinement target (1e-9)")
     d3.add_argument("--no-refine", action="store_true", help="solve on the initial mesh only")

@@ -5,6 +5,7 @@ to the solver tolerance, warm starts, failures and argument errors."""
 from __future__ import annotations
 
 import json
+from dataclasses import replace
 import math
 
 import casadi as ca
@@ -147,6 +148,24 @@ def test_unrefined_solve_is_close_and_warm_start_reuses_the_nlp():
     again = ocp.solve_phases(mp, guess=sol)
     assert again.success and again.iterations <= 3
     assert again.cost == pytest.approx(sol.cost, rel=1e-12)
+
+
+def test_warm_start_carries_over_to_the_same_nlp_with_other_bounds():
+    """A bound homotopy: the solution of one NLP warm-starts (primal and dual values) the
+    same NLP with other bounds; here a speed bound on the second stage that the optimum
+    meets with room to spare, so the answer is the same in a few iterations."""
+    mp = two_stage_rocket()
+    sol = ocp.solve_phases(mp)
+    assert sol.success
+    bounded = replace(mp.phases[1].problem, x_bounds={"m": (PAYLOAD, M0), "v": (-2e4, 2e4)})
+    other = ocp.MultiPhaseProblem([mp.phases[0], replace(mp.phases[1], problem=bounded)],
+                                  links=mp.links, events=mp.events, objective=mp.objective,
+                                  maximize=True)
+    cold = ocp.solve_phases(other)
+    warm = ocp.solve_phases(other, guess=sol)
+    assert cold.success and warm.success
+    assert warm.iterations <= 3 < cold.iterations
+    assert warm.cost == pytest.approx(cold.cost, rel=1e-9)
 
 
 def test_an_infeasible_event_is_a_failure_not_an_exception():

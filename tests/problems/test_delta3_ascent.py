@@ -51,7 +51,10 @@ def test_links_mass_budget_and_unit_thrust(ascent):
         assert end[6] - start[6] == pytest.approx(PHASES[k].dry_mass_dropped, abs=1e-6)
     for sol, data in zip(phases, PHASES):
         assert sol.x[6, -1] == pytest.approx(sol.x[6, 0] - data.mass_flow * sol.T, rel=1e-10)
-        np.testing.assert_allclose(np.linalg.norm(sol.u, axis=0), 1.0, atol=1e-8)
+        # |u| = 1 at the control nodes (Radau: u[:, 0] at the phase start is extrapolated
+        # from the first interval's collocation points, not a variable of the NLP)
+        assert not sol.transcription.u_at_start
+        np.testing.assert_allclose(np.linalg.norm(sol.u[:, 1:], axis=0), 1.0, atol=1e-8)
     np.testing.assert_allclose(ascent.solution.tf[:3], [75.2, 150.4, 261.0])
     assert ascent.propagation_error < 1e-6
 
@@ -83,6 +86,24 @@ def test_argument_errors():
         delta3_problem(target={"a": 1.0})
     with pytest.raises(ValueError, match="`orbit_tol`"):
         delta3_ascent(orbit_tol=-1.0)
+    for bad in ((1.2, 1.5), (0.5, 0.9), (0.0, 1.0), "band", (0.5,)):
+        with pytest.raises(ValueError, match="`u_norm`"):
+            delta3_problem(u_norm=bad)
+
+
+@pytest.mark.slow
+def test_relaxed_start_reaches_the_same_optimum(ascent):
+    """The default solve starts from ASSET's band 0.5 <= |u| <= 1.5; a cold solve of |u| = 1
+    from the interpolated guess lands on the same optimum (both verified)."""
+    cold = delta3_ascent(refine_tol=None, relaxed_start=False)
+    warm = delta3_ascent(refine_tol=None)
+    assert cold.success and warm.success, (cold.message, warm.message)
+    assert warm.final_mass == pytest.approx(cold.final_mass, abs=1e-6)
+    assert warm.final_time == pytest.approx(cold.final_time, abs=1e-5)
+    for sol in warm.solution.phases:  # the |u| = 1 problem is the one returned
+        assert not sol.transcription.u_at_start  # u[:, 0] is extrapolated, not a variable
+        np.testing.assert_allclose(np.linalg.norm(sol.u[:, 1:], axis=0), 1.0, atol=1e-8)
+    assert ascent.iterations >= ascent.solution.info["iterations"] > 0
 
 
 def test_bad_guess_samples():

@@ -152,6 +152,31 @@ def test_model_is_two_body_without_thrust_and_drag():
         np.testing.assert_allclose(xdot[3:6], -MU * r / np.linalg.norm(r) ** 3, rtol=1e-14)
 
 
+def test_normalized_model_is_the_plain_one_at_the_unit_direction():
+    """``normalized=True`` (ASSET's form, thrust ``T u / |u|``) equals the plain model fed
+    ``u / |u|`` for any ``|u|``, its derivatives included (chain rule through the
+    normalization), and both agree wherever ``|u| = 1``."""
+    rng = np.random.default_rng(7)
+    for phase in range(4):
+        plain, scaled = d3.delta3_model(phase), d3.delta3_model(phase, normalized=True)
+        assert scaled is d3.delta3_model(phase, normalized=True) and scaled is not plain
+        for _ in range(3):
+            r = rng.standard_normal(3)
+            r *= rng.uniform(1.0, 1.2) * d3.RE / np.linalg.norm(r)
+            x = np.r_[r, 7e3 * rng.standard_normal(3), 3.0e4]
+            u = rng.standard_normal(3) * rng.uniform(0.5, 1.5)
+            unit = u / np.linalg.norm(u)
+            np.testing.assert_allclose(scaled.rhs(x, u), plain.rhs(x, unit), rtol=1e-14)
+            np.testing.assert_allclose(scaled.rhs(x, unit), plain.rhs(x, unit), rtol=1e-14)
+        us = ca.SX.sym("u", 3)
+        xs = ca.SX.sym("x", 7)
+        J = ca.Function("J", [xs, us], [ca.jacobian(scaled.f(xs, us, ca.SX(0, 1)), us)])
+        # the thrust does not depend on |u|: d xdot/du . u = 0
+        np.testing.assert_allclose(np.asarray(J(x, u)) @ u, 0.0, atol=1e-9)
+    with pytest.raises(TypeError, match="`normalized`"):
+        d3.delta3_model(0, normalized="yes")
+
+
 # ------------------------------------------------------------ (d) mass flow and masses
 ISP_ASSET = {"srb": 283.33364, "first": 301.68, "second": 467.21}  # [s], as ASSET prints them
 
