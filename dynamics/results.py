@@ -14,10 +14,10 @@ it the shared surface, so no result writes these by hand:
   table);
 - ``__str__``: the class's report, units on every number (each class writes its own rows).
 
-The exception to ``status`` being an int are the collocation solutions of `appdyn.ocp`
-(``Solution``, ``PhasedSolution``) and the jobs that return them, whose ``status`` is the
-NLP solver's return status (a string such as ``"Solve_Succeeded"``), kept for backwards
-compatibility.
+``status`` is an int in every result, the collocation solutions of `appdyn.ocp` and the jobs
+built on them included: their codes (IPOPT's return statuses by IPOPT's numbers, appdyn's
+verification failures) are one table, ``appdyn.ocp.status``, and the text IPOPT returned
+(e.g. ``"Solve_Succeeded"``) is their ``solver_status``.
 
 Rules for a new result class
 ----------------------------

@@ -13,7 +13,9 @@ The library prints nothing unless asked (``verbose=True``): progress goes to an 
 multistart and moving-knot polishing are in `ocp.refine`; attitude targets, quaternion norm
 handling and SLERP guesses in `ocp.attitude`. What the engine builds repeatedly (interval
 kernels, integrators, the NLP and its solver) is kept in `dynamics.cache` (`ocp.cached`);
-`ocp.examples` holds the small problems of the docstring Examples.
+`ocp.examples` holds the small problems of the docstring Examples. Every result's
+``status`` is an int (0 success; the table of codes, IPOPT's and appdyn's, is `ocp.status`)
+and IPOPT's return status text is its ``solver_status``.
 
 Built once, solved many times: every number of a problem is an NLP bound or parameter, so
 the NLP of a *structure* (`ocp.assembly`: derivatives of one interval placed by index maps)
@@ -37,6 +39,7 @@ from .progress import LOGGER
 from .propagation import SCALE_FLOOR, state_scale
 from .solution import Propagation, Solution
 from .rest import STATUS_REST, rest_solution
+from .status import CODES as STATUS_CODES, status_code, status_name
 from .checks import (DEFAULT_VERIFY_TOL, STATUS_BOUND_VIOLATION, STATUS_RESIMULATION,
                      BoundViolation)
 from .solve import DEFAULT_CONSTRAINT_TOL, STATUS_CONSTRAINT_TOL, STATUS_EXCEPTION, Progress, solve
@@ -62,6 +65,9 @@ __all__ = [
     "STATUS_CONSTRAINT_TOL",
     "STATUS_EXCEPTION",
     "STATUS_REST",
+    "STATUS_CODES",
+    "status_code",
+    "status_name",
     "check_ipopt_options",
     "ipopt_option_table",
     "annotate",

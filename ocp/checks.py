@@ -35,6 +35,7 @@ from typing import Mapping
 import numpy as np
 
 from .propagation import SCALE_FLOOR
+from .status import STATUS_BOUND_VIOLATION, STATUS_RESIMULATION
 
 __all__ = ["BoundViolation", "bound_grid", "bound_scale", "bound_violation",
            "interval_bound_violation", "periodic_jumps",
@@ -44,10 +45,6 @@ __all__ = ["BoundViolation", "bound_grid", "bound_scale", "bound_violation",
 
 #: Equally spaced sub-intervals per mesh interval of `bound_grid`.
 BOUND_SAMPLES = 16
-#: Status of a solution whose dense output leaves a bound by more than ``constraint_tol``.
-STATUS_BOUND_VIOLATION = "Bound_Violation"
-#: Status of a solution whose re-simulation disagrees with the collocation.
-STATUS_RESIMULATION = "Resimulation_Mismatch"
 #: Default ``verify_tol`` of `ocp.solve` for transcriptions of order 3 and up (Radau,
 #: Hermite-Simpson): largest scaled re-simulation error (states relative to their magnitude,
 #: cost relative to ``max(|cost|, objective scale)``) of a success. Measured (verify off) on

@@ -33,7 +33,7 @@ junctions with the bang arcs are not smooth. Consequences, measured on `goddard_
   value to trust: it is what the control does);
 * `ocp.refine` cannot drive its error estimate down (4.2e-2, 9.1e-3, 7.7e-3 on 20, 39, 70
   intervals, where a smooth problem gains 16x per round) and stops with status
-  ``'Refinement_Stalled'`` after two rounds, the re-simulated cost then 1.0128361.
+  104 ``Refinement_Stalled`` after two rounds, the re-simulated cost then 1.0128361.
 
 The remedy is a small regularization of the control, here ``regularization * integral
 thrust^2 dt`` subtracted from the maximized altitude (penalized with the sign of the
@@ -158,7 +158,7 @@ def goddard_rocket(regularization: float = 0.0) -> Problem:
     thrust^2 dt`` (``maximize=True``: `Solution.cost` is ``J`` itself).
 
     The optimal thrust has a singular arc (module docstring): without regularization
-    `ocp.refine` stalls (status ``'Refinement_Stalled'``) and the re-simulated cost
+    `ocp.refine` stalls (status 104 ``Refinement_Stalled``) and the re-simulated cost
     `Solution.simulated_cost` is the number to trust; a small ``regularization`` (1e-4:
     the re-simulated altitude 7.7e-7 below the optimum) lets refinement converge. The
     ``'radau'`` thrust polynomial overshoots its bounds on this arc (a ``'Bound_Violation'``
@@ -189,7 +189,7 @@ def goddard_rocket(regularization: float = 0.0) -> Problem:
     >>> from appdyn.ocp.examples import goddard_rocket, GODDARD_OPTIMUM
     >>> sol = ocp.solve(goddard_rocket(), N=20)  # the Radau thrust polynomial overshoots [0, 3.5]
     >>> sol.status, round(sol.cost, 5), round(sol.simulated_cost, 5), GODDARD_OPTIMUM["h_f"]
-    ('Bound_Violation', 1.01286, 1.01282, 1.0128369183)
+    (102, 1.01286, 1.01282, 1.0128369183)
     >>> linear = ocp.solve(goddard_rocket(), N=20, control="linear")  # stays within the bounds
     >>> linear.success, round(linear.cost, 5), round(linear.simulated_cost, 5)
     (True, 1.01283, 1.01283)

@@ -12,13 +12,12 @@ from .nlp import Discretization
 from .problem import Problem
 from .scaling import auto_scaling
 from .solution import Solution
+from .status import SOLVER_REST as STATUS_REST
 from .solve import STATUS_CONSTRAINT_TOL, check_constraint_tol, make_solution
 from .transcription import get_transcription
 
 __all__ = ["rest_solution", "STATUS_REST"]
 
-#: status of `rest_solution`
-STATUS_REST = "Rest_Solution"
 
 
 def rest_solution(problem: Problem, *, T: float | None = None, transcription="radau",
@@ -47,9 +46,9 @@ def rest_solution(problem: Problem, *, T: float | None = None, transcription="ra
     Returns
     -------
     Solution
-        ``status`` `STATUS_REST` (``'Rest_Solution'``) and ``success=True`` when the held
-        state satisfies every constraint to ``constraint_tol``, else ``success=False`` and
-        `STATUS_CONSTRAINT_TOL`. ``iterations = 0``; with ``T = 0`` every node time is
+        ``status`` 0 and ``success=True`` when the held state satisfies every constraint to
+        ``constraint_tol``, else ``success=False`` and `STATUS_CONSTRAINT_TOL` (101); its
+        ``solver_status`` is `STATUS_REST` (``'Rest_Solution'``: no NLP solved). ``iterations = 0``; with ``T = 0`` every node time is
         ``t0`` and `Solution.sample` accepts ``t0`` only.
 
     Raises
@@ -69,8 +68,8 @@ def rest_solution(problem: Problem, *, T: float | None = None, transcription="ra
     >>> stay = ocp.Problem(model, T=1.0, x_initial=[0, 0], x_final=[0, 0],
     ...                    lagrange=lambda x, u, p: 0.5 * u**2)
     >>> sol = ocp.rest_solution(stay)
-    >>> sol.success, sol.status, sol.cost, sol.iterations
-    (True, 'Rest_Solution', 0.0, 0)
+    >>> sol.success, sol.status, sol.solver_status, sol.cost, sol.iterations
+    (True, 0, 'Rest_Solution', 0.0, 0)
     """
     if not isinstance(problem, Problem):
         raise TypeError(f"`problem` must be an ocp.Problem, got {type(problem).__name__}")
@@ -106,7 +105,7 @@ def rest_solution(problem: Problem, *, T: float | None = None, transcription="ra
     viol = disc.violation(g, w) if np.all(np.isfinite(g)) else float("nan")
     success = bool(viol <= ctol)
     if success:
-        status = STATUS_REST
+        status = 0
         message = (f"rest solution: the initial state held under zero control for T = {T:g} s meets "
                    f"every constraint (violation {viol:.2g} <= constraint_tol {ctol:g})")
     else:
@@ -114,4 +113,5 @@ def rest_solution(problem: Problem, *, T: float | None = None, transcription="ra
         message = (f"the initial state held under zero control for T = {T:g} s violates the "
                    f"constraints by {viol:.3g} > constraint_tol {ctol:g}: not a solution")
     return make_solution(problem, tr, mesh, disc, w, np.zeros(disc.g.size), g, success, status,
-                          message, 0, 0.0, time.perf_counter() - t_build)
+                          message, 0, 0.0, time.perf_counter() - t_build,
+                          solver_status=STATUS_REST)

@@ -14,6 +14,7 @@ from appdyn.dynamics.serialize import text_table
 
 from .checks import BoundViolation, bound_violation
 from .dense import DenseOutput
+from .status import describe, status_name
 from .propagation import (SCALE_FLOOR, Propagation, interval_integrator, propagate,
                           stack_interval_controls, state_scale)
 
@@ -65,12 +66,13 @@ class Solution(Result):
         `bound_violation`, and the re-simulation agrees with the collocation to
         ``verify_tol`` (unless ``verify=False``; `ocp.checks`). A failure still carries
         IPOPT's last iterate.
-    status : str
-        IPOPT's return status (``'Solve_Succeeded'``, ``'Solved_To_Acceptable_Level'``,
-        ``'Infeasible_Problem_Detected'``, ``'Maximum_Iterations_Exceeded'``, ...) or one of
-        `ocp.solve`'s own: ``'Constraint_Tol_Not_Met'``, ``'Bound_Violation'``,
-        ``'Resimulation_Mismatch'``, ``'Exception'``, ``'Rest_Solution'``; drivers on top
-        add theirs (see `ocp.refine`, `problems.slew`).
+    status : int
+        0 for a success, else the code of the failure in `ocp.status.CODES`: IPOPT's return
+        status by IPOPT's number (1 ``Solved_To_Acceptable_Level``, 2
+        ``Infeasible_Problem_Detected``, -1 ``Maximum_Iterations_Exceeded``, ...) or one of
+        `ocp.solve`'s own verification failures (101 ``Constraint_Tol_Not_Met``, 102
+        ``Bound_Violation``, 103 ``Resimulation_Mismatch``, -200 ``Exception``); drivers on
+        top add theirs (see `ocp.refine`, `problems.slew`). `ocp.status.status_name` names it.
     message : str
         What happened, in words.
     T : float [s]
@@ -117,6 +119,11 @@ class Solution(Result):
         ``'boundary'``, ``'quat_norm'``, ``'q_final'``), for ``J + nu . g`` (CasADi's sign).
     dense : DenseOutput
         Interval data and interpolant behind `sample`.
+    solver_status : str
+        IPOPT's return status text (``'Solve_Succeeded'``, ``'Maximum_Iterations_Exceeded'``,
+        ...; ``'Exception'`` or ``'Unknown'`` when IPOPT gave none, ``'Rest_Solution'`` from
+        `ocp.rest_solution`), kept when appdyn's verification turns a converged solve into a
+        failure.
     nlp_point : mapping or None
         The NLP point IPOPT returned (``'key'``: the structure of the NLP it belongs to,
         ``'x'``, ``'lam_x'``, ``'lam_g'``: scaled primal and dual values), used by `ocp.solve`
@@ -125,7 +132,7 @@ class Solution(Result):
     """
 
     success: bool
-    status: str
+    status: int
     message: str
     T: float
     t0: float
@@ -145,6 +152,7 @@ class Solution(Result):
     multipliers: Mapping[str, np.ndarray]
     dense: DenseOutput = field(repr=False)
     nlp_point: Mapping | None = field(default=None, repr=False)
+    solver_status: str = "Solve_Succeeded"
 
     def __getstate__(self) -> dict:
         state = dict(self.__dict__)
@@ -168,7 +176,7 @@ class Solution(Result):
     def __str__(self) -> str:
         sim = self.simulated_cost
         errs = self.propagation_errors
-        rows = [("success", f"{self.success} ({self.status})"),
+        rows = [("success", f"{self.success} ({describe(self.status, self.solver_status)})"),
                 ("cost (collocated)", f"{self.cost:.10g}"),
                 ("cost (re-simulated)", f"{sim:.10g} (re-simulated - collocated: "
                                         f"{sim - self.cost:.3g})"),
@@ -234,8 +242,9 @@ class Solution(Result):
         model = self.problem.model
         errs = self.propagation_errors
         return {
-            "success": bool(self.success), "status": self.status, "message": self.message,
-            "cost": self.cost, "simulated_cost": self.simulated_cost,
+            "success": bool(self.success), "status": int(self.status),
+            "solver_status": self.solver_status, "message": self.message, "cost": self.cost,
+            "simulated_cost": self.simulated_cost,
             "propagation_errors": {k: {"absolute": a, "scaled": r} for k, (a, r) in errs.items()},
             "bound_violation": {"max": self.bound_violation.max,
                                 "by_name": dict(self.bound_violation.by_name),
@@ -271,7 +280,7 @@ class Solution(Result):
         model = self.problem.model
         ts = np.linspace(self.t0, self.t0 + self.T, n) if self.T > 0 else np.array([self.t0])
         xs, us = (np.atleast_2d(v) for v in self.sample(ts))
-        verdict = "" if self.success else f" (not converged: {self.status})"
+        verdict = "" if self.success else f" (not converged: {status_name(self.status)})"
         title = (f"{model.name}: {self.transcription.name}, N = {self.mesh.N}, "
                  f"T = {self.T:.6g} s, cost {self.cost:.6g}{verdict}")
         if model.attitude is not None:
@@ -285,7 +294,7 @@ class Solution(Result):
     # ----------------------------------------------------------- construction
     @classmethod
     def from_arrays(cls, problem, transcription, mesh, X, U, p, T, *, cost: float,
-                    success: bool = True, status: str = "Solve_Succeeded", message: str = "",
+                    success: bool = True, status: int = 0, message: str = "",
                     iterations: int = 0, solve_time: float = 0.0, build_time: float = 0.0,
                     constraint_violation: float = float("nan"),
                     multipliers: Mapping[str, np.ndarray] | None = None, **extra) -> "Solution":
@@ -304,7 +313,8 @@ class Solution(Result):
         p : array_like, shape (np,)
         T : float [s]
         cost, success, status, message, iterations, solve_time, build_time, constraint_violation
-            As the attributes of the same name.
+            As the attributes of the same name (``status`` an int; ``solver_status``, IPOPT's
+            text, defaults to ``'Solve_Succeeded'`` and may come in ``extra``).
         multipliers : mapping of str to ndarray, optional
             By block, as `ocp.nlp.Discretization.multipliers`; costates follow from its
             ``'defect'`` entry (Radau). Default: none (empty mapping, no costates).
@@ -342,7 +352,7 @@ class Solution(Result):
             a.setflags(write=False)
         if costates is not None:
             costates.setflags(write=False)
-        return cls(success=bool(success), status=str(status), message=str(message), T=T,
+        return cls(success=bool(success), status=int(status), message=str(message), T=T,
                    t0=problem.t0, cost=float(cost), t=t, x=x, u=u, p=p, iterations=int(iterations),
                    solve_time=float(solve_time), build_time=float(build_time), costates=costates,
                    transcription=tr, mesh=mesh, problem=problem,

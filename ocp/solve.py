@@ -10,13 +10,13 @@ A `Solution` says ``success=True`` only when
 3. the dense output (`Solution.sample`, what `Solution.propagate` replays) keeps the state
    and control bounds between the nodes too: `Solution.bound_violation` (scaled, on the
    grid of `ocp.checks.bound_grid`) is at most ``constraint_tol``; else status
-   `STATUS_BOUND_VIOLATION` (``'Bound_Violation'``) and a message naming the variable,
+   `STATUS_BOUND_VIOLATION` (102 ``Bound_Violation``) and a message naming the variable,
    the time and the remedy (``control='linear'`` or ``'constant'``, mesh refinement), and
 4. unless ``verify=False``: the re-simulation of the returned control (CVODES,
    `Solution.propagation`) agrees with the collocated states (relative to their
    magnitudes) and cost to ``verify_tol`` (default `ocp.checks.default_verify_tol`: 3e-3,
    0.1 for the second-order trapezoid; the measurements behind them are in `ocp.checks`);
-   else status `STATUS_RESIMULATION` (``'Resimulation_Mismatch'``) and a message with the
+   else status `STATUS_RESIMULATION` (103 ``Resimulation_Mismatch``) and a message with the
    worst state, both costs and the likely cause (an unbounded angle control jumping by
    ``2 pi k`` between nodes is named as such). The re-simulation is cached on the
    solution, so `Solution.simulated_cost` and the propagation errors then cost nothing
@@ -40,10 +40,13 @@ started from the acceptable point with the acceptable-level exit disabled
 ``Solve_Succeeded`` it counts (``iterations`` covers both runs, the message says so);
 otherwise the result has ``success=False``.
 
-Status values besides IPOPT's own return statuses: `STATUS_CONSTRAINT_TOL`
-(``'Constraint_Tol_Not_Met'``: IPOPT succeeded but the violation exceeds
-``constraint_tol``), `STATUS_BOUND_VIOLATION`, `STATUS_RESIMULATION` (above), `STATUS_EXCEPTION` (``'Exception'``: an evaluation error inside
-CasADi) and `ocp.rest.STATUS_REST` (``'Rest_Solution'``: `ocp.rest_solution`).
+``status`` is an int (the table in `ocp.status`: 0 success, IPOPT's return statuses by
+IPOPT's numbers); IPOPT's text is kept in ``solver_status``. Status values besides IPOPT's
+own: `STATUS_CONSTRAINT_TOL` (101 ``Constraint_Tol_Not_Met``: IPOPT succeeded but the
+violation exceeds ``constraint_tol``), `STATUS_BOUND_VIOLATION` (102),
+`STATUS_RESIMULATION` (103, above), `STATUS_EXCEPTION` (-200 ``Exception``: an evaluation
+error inside CasADi). `ocp.rest_solution` returns status 0 with ``solver_status``
+``'Rest_Solution'``.
 
 Reuse: build once, solve many
 -----------------------------
@@ -96,6 +99,7 @@ from .problem import Problem
 from .progress import LOGGER, IterationCallback, Progress, iteration_sink
 from .scaling import auto_scaling
 from .solution import Solution
+from .status import STATUS_CONSTRAINT_TOL, STATUS_EXCEPTION, status_code
 from .transcription import get_transcription
 
 __all__ = ["solve", "Progress", "DEFAULT_CONSTRAINT_TOL", "STATUS_CONSTRAINT_TOL", "STATUS_EXCEPTION",
@@ -107,8 +111,6 @@ _ACCEPTABLE = "Solved_To_Acceptable_Level"
 _DEFAULT_N = 20
 _RESOLVE_ITER = 200  # iteration budget of the warm re-solve after an acceptable-level stop
 DEFAULT_CONSTRAINT_TOL = 1e-6
-STATUS_CONSTRAINT_TOL = "Constraint_Tol_Not_Met"
-STATUS_EXCEPTION = "Exception"
 #: IPOPT options of a warm start with primal and dual values (`Solution` of the same structure
 #: on the same mesh as ``guess``); options the caller passes take precedence.
 WARM_START_OPTIONS = {"warm_start_init_point": "yes", "warm_start_bound_push": 1e-9,
@@ -297,7 +299,7 @@ def solve(problem: Problem, *, transcription="radau", N: int | None = None, degr
     >>> energy = min_energy()  # x'' = u from rest at 0 to rest at 1 in T = 1 s
     >>> sol = ocp.solve(energy, N=10)
     >>> sol.success, sol.status, round(sol.cost, 6)
-    (True, 'Solve_Succeeded', 6.0)
+    (True, 0, 6.0)
     """
     if not isinstance(problem, Problem):
         raise TypeError(f"`problem` must be an ocp.Problem, got {type(problem).__name__}")
@@ -364,7 +366,7 @@ def verified(solution: Solution, constraint_tol: float, verify_tol: float | None
     return solution
 
 
-def _failed(solution: Solution, status: str, why: str) -> Solution:
+def _failed(solution: Solution, status: int, why: str) -> Solution:
     """A copy of ``solution`` with ``success=False``, ``status`` and ``why`` appended to the
     message; its cached checks (bounds, re-simulation) carried over."""
     out = dataclasses.replace(solution, success=False, status=status,
@@ -424,13 +426,14 @@ def _solve_built(problem, tr, m, node_guess, opts, ctol, disc, solver, nlp_opts,
             "ocp_resolve", {**nlp_opts, "ipopt": again}))
     build_time += t_re
     solve_time = time.perf_counter() - t_solve - t_re
-    w, lam_g, lam_x, g, success, status, message = read_result(
+    w, lam_g, lam_x, g, success, status, solver_status, message = read_result(
         res, error, status, iterations, note, w0, disc.g.size, disc.violation, ctol)
     if not success and default_guess:
         message += _default_guess_hint(problem, node_guess)
     LOGGER.info("solve %s (%s, N=%d): %s; %.3g s", problem.name, tr.name, m.N, message, solve_time)
     return make_solution(problem, tr, m, disc, w, lam_g, g, success, status, message,
-                          iterations, solve_time, build_time, lam_x=lam_x)
+                          iterations, solve_time, build_time, lam_x=lam_x,
+                          solver_status=solver_status)
 
 
 def run_ipopt(solver, start: dict, bounds: dict, opts: dict, resolver):
@@ -467,13 +470,15 @@ def run_ipopt(solver, start: dict, bounds: dict, opts: dict, resolver):
 
 def read_result(res, error, status: str, iterations: int, note: str, w0, n_g: int,
                 violation, ctol: float):
-    """``(w, lam_g, lam_x, g, success, status, message)`` of a `run_ipopt` result: success
-    only for ``Solve_Succeeded`` with ``violation(g, w) <= ctol`` (module docstring); the
-    start ``w0`` and NaN constraints when IPOPT stopped by an error."""
+    """``(w, lam_g, lam_x, g, success, status, solver_status, message)`` of a `run_ipopt`
+    result (``status`` an int of `ocp.status`, ``solver_status`` IPOPT's text ``status``):
+    success only for ``Solve_Succeeded`` with ``violation(g, w) <= ctol`` (module
+    docstring); the start ``w0`` and NaN constraints when IPOPT stopped by an error."""
     if res is None:
-        status = status if status != "Unknown" else STATUS_EXCEPTION
+        status = status if status != "Unknown" else "Exception"
         return (np.asarray(w0, dtype=float), np.zeros(n_g), np.zeros(np.size(w0)),
-                np.full(n_g, np.nan), False, status, f"IPOPT stopped by an error: {error}")
+                np.full(n_g, np.nan), False, status_code(status), status,
+                f"IPOPT stopped by an error: {error}")
     w = np.asarray(res["x"]).reshape(-1)
     lam_g = np.asarray(res["lam_g"]).reshape(-1)
     lam_x = np.asarray(res["lam_x"]).reshape(-1)
@@ -485,8 +490,8 @@ def read_result(res, error, status: str, iterations: int, note: str, w0, n_g: in
         success = False
         message = (f"{message}; but the constraint violation {viol:.3g} exceeds "
                    f"constraint_tol {ctol:g}: not verified")
-        status = STATUS_CONSTRAINT_TOL
-    return w, lam_g, lam_x, g, success, status, message
+        return w, lam_g, lam_x, g, False, STATUS_CONSTRAINT_TOL, status, message
+    return w, lam_g, lam_x, g, success, status_code(status), status, message
 
 
 def _build_solver(disc, nlp_opts, sink):
@@ -516,9 +521,10 @@ def _run(solver, args):
 
 
 def make_solution(problem, tr, mesh, disc, w, lam_g, g, success, status, message,
-                   iterations, solve_time, build_time, lam_x=None) -> Solution:
+                   iterations, solve_time, build_time, lam_x=None,
+                   solver_status: str = "Solve_Succeeded") -> Solution:
     """The `Solution` at the scaled NLP point ``w`` (multipliers ``lam_g``, ``lam_x``,
-    constraints ``g``)."""
+    constraints ``g``; ``status`` an int of `ocp.status`, ``solver_status`` IPOPT's text)."""
     phys = disc.unpack(w)
     viol = disc.violation(g, w) if np.all(np.isfinite(g)) else float("nan")
     point = None
@@ -530,4 +536,4 @@ def make_solution(problem, tr, mesh, disc, w, lam_g, g, success, status, message
         problem, tr, mesh, phys["X"], phys["U"], phys["p"], phys["T"], cost=disc.cost(w),
         success=success, status=status, message=message, iterations=iterations,
         solve_time=solve_time, build_time=build_time, constraint_violation=viol,
-        multipliers=disc.multipliers(lam_g), nlp_point=point)
+        multipliers=disc.multipliers(lam_g), nlp_point=point, solver_status=str(solver_status))

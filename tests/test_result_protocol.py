@@ -28,6 +28,11 @@ def check_protocol(res, *, nonfinite=False):
     assert "<table>" in res._repr_html_()
     data = strict(res.to_json())
     assert all(v in (True, False) for v in np.atleast_1d(data["success"]))  # a batch: per run
+    if hasattr(res, "status"):  # an int everywhere (a batch: an int array, one per run)
+        status = np.asarray(res.status)
+        assert status.dtype.kind == "i" and not isinstance(res.status, bool), repr(res.status)
+        values = data["status"] if isinstance(data["status"], list) else [data["status"]]
+        assert all(type(v) is int for v in values), data["status"]
     if nonfinite:
         assert "null" in res.to_json()
     return data
@@ -156,7 +161,7 @@ def test_gain_design_draws_any_design_and_nan_is_null():
     from appdyn.problems.gains import GainDesign, plot_design
 
     t = np.linspace(0.0, 1.0, 11)
-    lv = GainDesign(True, "Solve_Succeeded", "ok", {"k_psi": 2.0}, {"k_psi": "rad/rad"},
+    lv = GainDesign(True, 0, "ok", {"k_psi": 2.0}, {"k_psi": "rad/rad"},
                     math.nan, [{"t": t, "psi": 0.1 * t, "delta": 0.01 * t,
                                 "delta_rate": 0.01 + 0 * t, "peak": {"psi": 0.1}}],
                     {"delta_max": 0.05, "delta_rate_max": math.inf})
@@ -166,7 +171,7 @@ def test_gain_design_draws_any_design_and_nan_is_null():
     assert [a.get_ylabel() for a in fig.axes] == ["attitude psi [deg]", "deflection delta [deg]",
                                                   "deflection rate [deg/s]"]
     # an attitude design has no 'psi' (plot_design raised KeyError 'psi')
-    att = GainDesign(True, "Solve_Succeeded", "ok", {"kp": 1.0}, {}, 1.0,
+    att = GainDesign(True, 0, "ok", {"kp": 1.0}, {}, 1.0,
                      [{"t": t, "x": np.zeros((7, 11)), "u": np.ones((3, 11)), "angle": t,
                        "peak": {"angle": 1.0}}], {})
     assert len(plot_design(att).axes) == 3
@@ -284,3 +289,80 @@ def test_every_public_result_class_follows_the_protocol():
     assert len(seen) >= 15, seen
     outside = sorted(c.__qualname__ for c in seen if not issubclass(c, Result))
     assert not outside, outside
+
+
+def _result_classes():
+    """Every `Result` subclass defined in the library's modules (the CLI's printouts aside)."""
+    import importlib
+    import inspect
+    import pkgutil
+
+    seen = set()
+    for pkg in ("appdyn.dynamics", "appdyn.ocp", "appdyn.problems"):
+        root = importlib.import_module(pkg)
+        mods = [root] + [importlib.import_module(m.name) for m in
+                         pkgutil.walk_packages(root.__path__, pkg + ".")
+                         if not m.name.split(".")[-1].startswith("_")
+                         and ".cli" not in m.name]
+        for mod in mods:
+            seen.update(obj for obj in vars(mod).values() if inspect.isclass(obj)
+                        and issubclass(obj, Result) and obj is not Result)
+    return seen
+
+
+def test_every_result_class_declares_an_int_status():
+    """``status`` is declared an int by every result class (a field annotated ``int`` or a
+    property returning ``int``); the batched simulate result holds one int per run. No
+    string statuses: IPOPT's text is ``solver_status`` (issue 33)."""
+    import dataclasses
+    import inspect
+    import typing
+
+    from appdyn.dynamics.integrate.batch import BatchResult
+
+    classes = _result_classes()
+    assert len(classes) >= 20, classes
+    declared = {}
+    for cls in classes:
+        attr = inspect.getattr_static(cls, "status", None)
+        if isinstance(attr, property):
+            declared[cls.__qualname__] = typing.get_type_hints(attr.fget).get("return")
+        elif dataclasses.is_dataclass(cls) and "status" in {f.name for f in dataclasses.fields(cls)}:
+            declared[cls.__qualname__] = typing.get_type_hints(cls).get("status")
+    expected = {name: (np.ndarray if name == BatchResult.__qualname__ else int)
+                for name in declared}
+    assert declared == expected
+    missing = sorted(c.__qualname__ for c in classes if c.__qualname__ not in declared)
+    assert not missing, missing  # every result has a status
+
+
+def test_optimal_control_statuses_are_one_table_of_ints():
+    """`ocp.status`: IPOPT's return statuses keep IPOPT's numbers (``IpReturnCodes_inc.h``),
+    appdyn's own codes do not collide with them, and a solve carries both the int and
+    IPOPT's text."""
+    from appdyn import ocp
+    from appdyn.ocp import status as st
+    from appdyn.ocp.examples import min_energy
+    from tests.ocp.reference import brachistochrone
+
+    # IPOPT's enum ApplicationReturnStatus (independent truth: IPOPT's header)
+    assert (st.status_code("Solve_Succeeded"), st.status_code("Solved_To_Acceptable_Level"),
+            st.status_code("Infeasible_Problem_Detected"), st.status_code("User_Requested_Stop"),
+            st.status_code("Maximum_Iterations_Exceeded"), st.status_code("Maximum_WallTime_Exceeded"),
+            st.status_code("Invalid_Number_Detected"), st.status_code("Internal_Error")) == \
+        (0, 1, 2, 5, -1, -5, -13, -199)
+    codes = list(st.CODES.values())
+    assert len(set(codes)) == len(codes) and all(type(c) is int for c in codes)
+    assert not set(st.APPDYN_CODES.values()) & set(st.IPOPT_CODES.values())
+    assert all(st.status_name(st.status_code(n)) == n for n in st.CODES)
+    assert st.status_code("Not_A_Status") == st.STATUS_UNKNOWN
+    sol = ocp.solve(min_energy(), N=10)
+    assert sol.success and sol.status == 0 and type(sol.status) is int
+    assert sol.solver_status == "Solve_Succeeded"
+    data = strict(sol.to_json())
+    assert data["status"] == 0 and data["solver_status"] == "Solve_Succeeded"
+    problem, truth = brachistochrone()
+    failed = ocp.solve(problem, N=8, guess=truth["guess"], ipopt_options={"max_iter": 2})
+    assert not failed.success and failed.status == st.STATUS_MAX_ITER == -1
+    assert failed.solver_status == "Maximum_Iterations_Exceeded"
+    assert strict(failed.to_json())["status"] == -1

@@ -9,6 +9,8 @@ import numpy as np
 from appdyn.dynamics.figures import plot_signals
 from appdyn.dynamics.results import Result
 
+from ..status import status_name
+
 __all__ = ["MultiPhaseSolution"]
 
 
@@ -22,7 +24,9 @@ class MultiPhaseSolution(Result):
         ``True`` only when IPOPT returned ``Solve_Succeeded`` and the largest violation of
         any row -- every phase's rows, every link and event row -- and of every variable
         bound, in NLP units, is at most ``constraint_tol`` (as for `ocp.solve`).
-    status, message : str
+    status : int
+        0 for a success, else the failure's code in `ocp.status.CODES` (as `ocp.Solution`).
+    message : str
     cost : float
         ``J = Phi(ends) + sum of the phases' own costs`` (the user's sign).
     phases : tuple of ocp.Solution
@@ -46,10 +50,12 @@ class MultiPhaseSolution(Result):
         ``'converged'``, and the totals over the rounds ``'solve_time'``, ``'build_time'``,
         ``'iterations'`` (the attributes of those names are the last round's).
     problem : MultiPhaseProblem
+    solver_status : str
+        IPOPT's return status text (as `ocp.Solution.solver_status`).
     """
 
     success: bool
-    status: str
+    status: int
     message: str
     cost: float
     phases: tuple
@@ -65,6 +71,7 @@ class MultiPhaseSolution(Result):
     problem: object = field(repr=False)
     info: Mapping = field(default_factory=dict, repr=False)
     nlp_point: Mapping | None = field(default=None, repr=False)
+    solver_status: str = "Solve_Succeeded"
 
     _repr_fields = ("cost", "phases", "tf", "constraint_violation", "iterations")
 
@@ -131,7 +138,8 @@ class MultiPhaseSolution(Result):
     def to_dict(self) -> dict:
         """Plain-data summary (JSON-ready): status, cost, times, and per phase its nodes."""
         return {
-            "success": self.success, "status": self.status, "message": self.message,
+            "success": self.success, "status": int(self.status),
+            "solver_status": self.solver_status, "message": self.message,
             "cost": self.cost, "iterations": self.iterations, "solve_time": self.solve_time,
             "build_time": self.build_time, "constraint_violation": self.constraint_violation,
             "event_violation": self.event_violation,
@@ -173,7 +181,7 @@ class MultiPhaseSolution(Result):
                 parts[v].append(rows[v])
         t = np.concatenate(times)
         series = {v: np.concatenate(parts[v]) for v in names}
-        verdict = "" if self.success else f" (not converged: {self.status})"
+        verdict = "" if self.success else f" (not converged: {status_name(self.status)})"
         fig = plot_signals(t, series, models[0].units, ax=ax,
                            title=f"{self.problem.name or 'multi-phase problem'}: "
                                  f"{len(self.phases)} phases, cost {self.cost:.6g}{verdict}")

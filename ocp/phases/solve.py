@@ -223,16 +223,16 @@ def _solve_once(problem, meshes, guesses, warm_from, objective_scale, opts, ipop
             (res, error, status, iterations, note, _), build_time, solve_time = run(built[0])
     else:
         (res, error, status, iterations, note, _), build_time, solve_time = run(build()[0])
-    w, lam_g, lam_x, g, success, status, message = read_result(
+    w, lam_g, lam_x, g, success, status, solver_status, message = read_result(
         res, error, status, iterations, note, start["x0"], disc.lbg.size, disc.violation, ctol)
     LOGGER.info("solve_phases %s (%d phases): %s; %.3g s", problem.name, problem.n_phases, message,
                 solve_time)
     return _solution(problem, disc, parts, w, lam_g, lam_x, g, success, status, message,
-                     iterations, solve_time, build_time)
+                     iterations, solve_time, build_time, solver_status)
 
 
 def _solution(problem, disc, parts, w, lam_g, lam_x, g, success, status, message, iterations,
-              solve_time, build_time) -> MultiPhaseSolution:
+              solve_time, build_time, solver_status) -> MultiPhaseSolution:
     ws = disc.split_w(w)
     lgs, _ = disc.split_g(lam_g)
     gs, ge = disc.split_g(g)
@@ -243,7 +243,8 @@ def _solution(problem, disc, parts, w, lam_g, lam_x, g, success, status, message
         pb = replace(d.problem, t0=start)
         d_t = _Shifted(d, pb)
         phases.append(make_solution(pb, tr, m, d_t, wi, li, gi, success, status, message,
-                                    iterations, solve_time, build_time))
+                                    iterations, solve_time, build_time,
+                                    solver_status=solver_status))
         t0s.append(start)
         start += T
     t0 = np.array(t0s)
@@ -257,10 +258,11 @@ def _solution(problem, disc, parts, w, lam_g, lam_x, g, success, status, message
     point = {"key": disc.key, "numbers": _phased_numbers(disc), "x_phys": w * sw,
              "lam_x_phys": lam_x * dJ / sw, "lam_g_phys": lam_g * dJ / sg}
     return MultiPhaseSolution(
-        success=bool(success), status=str(status), message=message, cost=disc.cost(w),
+        success=bool(success), status=int(status), message=message, cost=disc.cost(w),
         phases=tuple(phases), t0=t0, tf=tf, ends=ends, events=ev, event_violation=ev_viol,
         constraint_violation=viol, iterations=int(iterations), solve_time=float(solve_time),
-        build_time=float(build_time), problem=problem, nlp_point=point)
+        build_time=float(build_time), problem=problem, nlp_point=point,
+        solver_status=str(solver_status))
 
 
 class _Shifted:

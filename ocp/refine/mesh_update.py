@@ -20,6 +20,7 @@ from ..mesh import Mesh
 from ..problem import Problem
 from ..progress import LOGGER, stage_sink
 from ..solution import Solution
+from ..status import STATUS_STALLED
 from ..solve import solve
 from ..transcription import Radau, Transcription, get_transcription
 from .errors import IntervalErrors, interval_errors
@@ -29,8 +30,6 @@ __all__ = ["refine", "STATUS_STALLED", "local_order", "new_mesh"]
 
 _BRACKET = 1.0 / 16.0  # width of the new switch interval relative to the old one
 
-#: `RefinedSolution.status` of a `refine` that stopped because its error estimate stalled.
-STATUS_STALLED = "Refinement_Stalled"
 
 
 def local_order(tr: Transcription) -> int:
@@ -255,7 +254,7 @@ def refine(problem: Problem, solution: Solution | None = None, *, tol: float = 1
     16). When over ``stall_rounds`` consecutive rounds (default 2), the mesh growing, the
     largest estimated error falls by less than ``2**q`` in all (an observed order below
     ``q / stall_rounds``), refinement stops with ``success=False``, status `STATUS_STALLED`
-    (``'Refinement_Stalled'``), ``info['stop'] == 'stalled'`` and a message saying so. This
+    (104 ``Refinement_Stalled``), ``info['stop'] == 'stalled'`` and a message saying so. This
     is typical of *singular arcs* and of non-smooth or chattering controls (also of a ``tol``
     below what the NLP tolerance resolves): the collocated control rings around the singular
     value, the estimate creeps down (or plateaus and drops late) and more rounds mostly cost
@@ -351,7 +350,7 @@ def refine(problem: Problem, solution: Solution | None = None, *, tol: float = 1
     >>> from appdyn.ocp.examples import goddard_rocket
     >>> rocket = ocp.refine(goddard_rocket(), tol=1e-6)
     >>> rocket.status, rocket.info["stop"], len(rocket.refinement) - 1
-    ('Refinement_Stalled', 'stalled', 2)
+    (104, 'stalled', 2)
     >>> smooth = ocp.refine(goddard_rocket(regularization=1e-4), tol=1e-6, control="linear")
     >>> smooth.success, smooth.info["converged"], round(float(smooth.propagation.x[0, -1]), 6)
     (True, True, 1.012836)

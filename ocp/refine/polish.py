@@ -44,6 +44,7 @@ from appdyn.dynamics.validate import integer
 from ..mesh import Mesh
 from ..problem import Constraint, Problem
 from ..solution import Solution
+from ..status import STATUS_WALL_TIME
 from ..solve import solve
 from ..functions import sx_compatible
 from ..transcription import RadauConstantControl
@@ -57,8 +58,8 @@ METHODS = ("auto", "switch-times", "moving-knots")
 
 _STRICT = {"tol": 1e-10, "bound_relax_factor": 0.0, "max_iter": 3000}
 
-#: ``status`` of a polish stopped by its ``budget``.
-STATUS_BUDGET = "Maximum_WallTime_Exceeded"
+#: ``status`` of a polish stopped by its ``budget`` (IPOPT's -5 ``Maximum_WallTime_Exceeded``).
+STATUS_BUDGET = STATUS_WALL_TIME
 _CLOCK, _STRETCH = "t_clock", "t_stretch"
 
 
@@ -184,7 +185,7 @@ def polish_switches(problem: Problem, solution: Solution, *, N: int | None = Non
     Never worse as a success: a polished cost worse than ``solution.cost`` by more than
     `ocp.refine.result.WORSE_SLACK` = 1e-3 relative (the start's own discretization error:
     a fixed mesh can put a minimum time slightly *below* the exact optimum) is returned
-    with ``success=False``, ``status`` ``'Worse_Than_Start'`` and a message saying so
+    with ``success=False``, ``status`` 105 ``Worse_Than_Start`` and a message saying so
     (`ocp.refine.result.graded`); the caller keeps ``solution``.
 
     Moving knots:
@@ -222,7 +223,7 @@ def polish_switches(problem: Problem, solution: Solution, *, N: int | None = Non
         first IPOPT iteration past it (the switch-time NLP through its iteration callback,
         the moving knots through IPOPT's ``max_wall_time``), no further NLP (a finer RK8
         grid, a second structure, the moving knots) is started once it is spent, and a
-        polish cut short is ``success=False`` with ``status`` ``'Maximum_WallTime_Exceeded'``
+        polish cut short is ``success=False`` with ``status`` -5 ``Maximum_WallTime_Exceeded``
         (``info['budget_spent']``). The NLP builds count against it but are not
         interrupted.
     **solve_kwargs

@@ -8,6 +8,7 @@ from typing import Mapping, NamedTuple
 import numpy as np
 
 from ..solution import Solution
+from ..status import STATUS_WORSE
 
 __all__ = ["RefinementRound", "RefinedSolution", "annotate", "graded", "worse_than",
            "WORSE_SLACK", "STATUS_WORSE"]
@@ -21,8 +22,6 @@ __all__ = ["RefinementRound", "RefinedSolution", "annotate", "graded", "worse_th
 #: the larger. (The user's case that asked for this check: 39.997 s from 39.655 s, 8.6e-3.)
 WORSE_SLACK = 1e-3
 
-#: ``status`` of a polish whose cost is worse than its start's beyond `WORSE_SLACK`.
-STATUS_WORSE = "Worse_Than_Start"
 
 _TRAJECTORY = frozenset({"x", "u", "p", "T", "t0", "t", "mesh", "transcription", "problem", "dense"})
 
@@ -62,7 +61,7 @@ class RefinedSolution(Solution):
         NLP solved, first the initial one), ``'converged'`` (max error <= tol), ``'errors'``
         (the final `IntervalErrors`), ``'meshes'`` (the mesh of each round),
         ``'tol'``, ``'stop'`` (why it stopped: ``'tolerance reached'``, ``'stalled'`` (the
-        error estimate stopped falling, status ``'Refinement_Stalled'``, see `refine`),
+        error estimate stopped falling, status 104 ``Refinement_Stalled``, see `refine`),
         ``'max_rounds = ... reached'``, ``'max_intervals = ... reached'``, ``'the NLP of
         round ... failed'``). `solve_multistart`: ``'starts'`` (list of
         dicts with ``index, success, status, cost, T, constraint_violation, iterations,

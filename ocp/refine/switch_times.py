@@ -67,6 +67,7 @@ from ..progress import IterationCallback, iteration_sink
 from ..mesh import Mesh
 from ..problem import Problem
 from ..solution import Solution
+from ..status import status_code
 from ..transcription import RadauConstantControl
 from .arc_nlp import arc_nlp, constraint_bounds
 from .arcs import BangArcs, bang_arcs
@@ -156,7 +157,7 @@ def optimize_switch_times(problem: Problem, solution: Solution, *, arcs: BangArc
         default ``N``.
     max_wall_time : float, optional
         Wall-time budget [s] of the whole call: IPOPT is stopped at the first iteration
-        past it (``status`` ``'Maximum_WallTime_Exceeded'``, not a success; through the
+        past it (``status`` -5 ``Maximum_WallTime_Exceeded``, not a success; through the
         iteration callback, so that the pooled solver is reused whatever the budget), and
         no finer NLP is started once it is spent (the last success is returned, its
         ``integration_error`` saying how accurate it is). Default: none.
@@ -166,7 +167,7 @@ def optimize_switch_times(problem: Problem, solution: Solution, *, arcs: BangArc
     RefinedSolution
         ``success`` when IPOPT returned ``Solve_Succeeded``, the violation is at most
         ``constraint_tol`` and the cost is not worse than that of ``solution`` by more than
-        `ocp.refine.result.WORSE_SLACK` relative (else ``status`` ``'Worse_Than_Start'``;
+        `ocp.refine.result.WORSE_SLACK` relative (else ``status`` 105 ``Worse_Than_Start``;
         ``info['initial_cost']``, ``info['gain']``). Transcription `RadauConstantControl` on the mesh of the RK8
         segments (knots at the switches). ``iterations`` and ``solve_time`` sum over the NLPs
         solved. ``info``: ``'method'`` (``'switch-times'``), ``'switch_times'`` [s],
@@ -354,13 +355,13 @@ def _solve_arcs(problem: Problem, guess: Solution, arcs: BangArcs, nseg: np.ndar
         solve_time = time.perf_counter() - t_solve
         stats = solver.stats()
     check_interrupt()
-    status = str(stats.get("return_status", "Unknown"))
+    status = solver_status = str(stats.get("return_status", "Unknown"))
     if status == "User_Requested_Stop" and deadline is not None and time.perf_counter() >= deadline:
         status = "Maximum_WallTime_Exceeded"  # stopped by the callback at the deadline
     iterations = int(stats.get("iter_count", 0))
     if res is None:
         wopt, lam_g, gval = w0, np.full(lbg.size, np.nan), np.full(lbg.size, np.nan)
-        status = "Exception"
+        status = solver_status = "Exception"
     else:
         wopt = np.asarray(res["x"], float).reshape(-1)
         lam_g = np.asarray(res["lam_g"], float).reshape(-1)
@@ -437,9 +438,9 @@ def _solve_arcs(problem: Problem, guess: Solution, arcs: BangArcs, nseg: np.ndar
         out_status = "Constraint_Tol_Not_Met"
         message += f"; constraint violation {viol:.3g} above constraint_tol {constraint_tol:g}"
     out = Solution.from_arrays(problem, tr, mesh, Xcols, Ucols[:, segs], popt, Topt, cost=cost,
-                               success=success, status=out_status, message=message,
+                               success=success, status=status_code(out_status), message=message,
                                iterations=iterations, solve_time=solve_time, build_time=build_time,
-                               constraint_violation=viol)
+                               constraint_violation=viol, solver_status=solver_status)
     edges = t0 + np.concatenate([[0.0], np.cumsum(dopt)])
     live = np.flatnonzero(dopt > 1e-13 * Topt)
     U_live = np.asarray(arcs.controls, float)[:, live]

@@ -25,6 +25,7 @@ from appdyn.dynamics.results import Result
 from appdyn.dynamics import cache
 from appdyn.dynamics.validate import finite_array
 from appdyn.ocp import nlp as ocp_nlp
+from appdyn.ocp.status import STATUS_CHECK, status_name
 from appdyn.ocp.transcription import get_transcription
 
 from .delta3 import (FINAL_MASS_BETTS, H_SCALE, OMEGA_E, PHASES, RE, RHO0,
@@ -175,7 +176,10 @@ class AscentResult(Result):
         orbit recomputed from the final state within ``orbit_tol`` of the target (``a``
         relative, ``e`` absolute, angles in rad), every phase's re-simulation within
         ``propagation_tol`` (relative) of the collocated trajectory.
-    status, message : str
+    status : int
+        0 for a success; else the solver's (`ocp.MultiPhaseSolution.status`) or 114
+        ``Check_Failed`` (`ocp.status`) when the orbit or re-simulation check failed.
+    message : str
     final_mass : float [kg]
     final_time : float [s]
     elements : OrbitalElements
@@ -192,10 +196,12 @@ class AscentResult(Result):
         IPOPT iterations over every NLP solved.
     reference_mass : float [kg]
         Betts (2010): 7529.712412.
+    solver_status : str
+        IPOPT's return status text of ``solution`` (property).
     """
 
     success: bool
-    status: str
+    status: int
     message: str
     final_mass: float
     final_time: float
@@ -235,6 +241,11 @@ class AscentResult(Result):
         return self.summary()
 
     _repr_fields = ("final_mass", "final_time")
+
+    @property
+    def solver_status(self) -> str:
+        """IPOPT's return status text of the last NLP (`ocp.MultiPhaseSolution.solver_status`)."""
+        return self.solution.solver_status
 
     @property
     def wall_time(self) -> float:
@@ -280,7 +291,8 @@ class AscentResult(Result):
 
     def to_dict(self) -> dict:
         el = self.elements
-        return {"success": self.success, "status": self.status, "message": self.message,
+        return {"success": self.success, "status": int(self.status),
+                "solver_status": self.solver_status, "message": self.message,
                 "final_mass": self.final_mass, "final_time": self.final_time,
                 "reference_mass": self.reference_mass,
                 "elements": {k: float(getattr(el, k)) for k in (*_ELEMENTS, "nu")},
@@ -353,7 +365,7 @@ def delta3_ascent(*, N: int | tuple = 5, degree: int = 5, refine_tol: float | No
         spent = _add_costs(spent, sol)
         if sol.success:
             break
-        failed.append(f"{n} guess samples: {sol.status}")
+        failed.append(f"{n} guess samples: {status_name(sol.status)}")
     last = sol.phases[-1]
     xf = last.x[:, -1]
     el = orbital_elements(xf[0:3], xf[3:6])
@@ -375,7 +387,7 @@ def delta3_ascent(*, N: int | tuple = 5, degree: int = 5, refine_tol: float | No
         message += (f"; but the check failed: orbit error {max(err.values()):.2g} (tol {orbit_tol:g}), "
                     f"re-simulation error {prop:.2g} (tol {propagation_tol:g})")
     return AscentResult(
-        success=bool(sol.success and checks_ok), status=sol.status if checks_ok else "Check_Failed",
+        success=bool(sol.success and checks_ok), status=sol.status if checks_ok else STATUS_CHECK,
         message=message, final_mass=float(xf[6]), final_time=float(sol.tf[-1]), elements=el,
         orbit_error=err, propagation_error=prop, table=table, solution=sol,
         solve_time=spent[0], build_time=spent[1], iterations=spent[2])

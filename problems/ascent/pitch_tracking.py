@@ -15,6 +15,7 @@ from appdyn.dynamics.figures import finish_figure, panel_axes
 from appdyn.dynamics.results import Result
 from appdyn.dynamics.serialize import text_table
 from appdyn.dynamics.validate import finite_scalar, positive
+from appdyn.ocp.status import STATUS_DEFLECTION, STATUS_SIMULATION, STATUS_TRACKING, describe
 
 from .planar import PlanarAscent
 from .planar_model import (SCALE_HEIGHT, STATES, TRACKING_STATES, AscentVehicle, check_vehicle,
@@ -72,8 +73,9 @@ class PitchTracking(Result):
         The simulation succeeded, the tracking error stayed within ``error_max`` and the
         peak commanded and actual deflection stayed within ``delta_max`` (the loop never
         asked the gimbal for more).
-    status : str
-        ``'ok'``, ``'simulation_failed'``, ``'tracking_error'`` or ``'deflection_limit'``.
+    status : int
+        0 for a success, else (the table of `ocp.status`) 110 ``Simulation_Failed``, 115
+        ``Tracking_Error_Exceeded`` or 116 ``Deflection_Limit_Exceeded``.
     message : str
     t : ndarray, shape (n,) [s]
     x : ndarray, shape (8, n)
@@ -92,7 +94,7 @@ class PitchTracking(Result):
     """
 
     success: bool
-    status: str
+    status: int
     message: str
     t: np.ndarray
     x: np.ndarray
@@ -119,7 +121,7 @@ class PitchTracking(Result):
 
     def __str__(self) -> str:
         d = math.degrees
-        rows = [("success", f"{self.success} ({self.status})"),
+        rows = [("success", f"{self.success} ({describe(self.status)})"),
                 ("gains", ", ".join(f"{k} = {v:.4g}" for k, v in self.gains.items())),
                 ("max |theta - cmd|", f"{d(self.max_error):.4f} deg"),
                 ("rms |theta - cmd|", f"{d(self.rms_error):.4f} deg"),
@@ -227,19 +229,19 @@ def fly_pitch_program(ascent: PlanarAscent, *, gains=None, dt: float = 0.02,
               peak_delta_cmd=float(np.max(np.abs(dcmd))) if finite else math.nan,
               final=final, optimal=opt, gains={"k_theta": kt, "k_thetadot": kd})
     if not (res.success and finite):
-        return PitchTracking(False, "simulation_failed", f"simulation failed: {res.message}",
+        return PitchTracking(False, STATUS_SIMULATION, f"simulation failed: {res.message}",
                              wall_time=time.perf_counter() - start, **kw)
     if not kw["max_error"] <= emax:
         msg = (f"tracking lost: max |theta - theta_cmd| {math.degrees(kw['max_error']):.4g} deg "
                f"> {math.degrees(emax):.4g} deg")
-        return PitchTracking(False, "tracking_error", msg,
+        return PitchTracking(False, STATUS_TRACKING, msg,
                              wall_time=time.perf_counter() - start, **kw)
     if max(kw["peak_delta"], kw["peak_delta_cmd"]) > dmax:
         msg = (f"gimbal limit exceeded: peak |delta| {math.degrees(kw['peak_delta']):.3f} deg, "
                f"peak |delta_c| {math.degrees(kw['peak_delta_cmd']):.3f} deg > "
                f"{math.degrees(dmax):.3f} deg")
-        return PitchTracking(False, "deflection_limit", msg,
+        return PitchTracking(False, STATUS_DEFLECTION, msg,
                              wall_time=time.perf_counter() - start, **kw)
     msg = (f"tracked to {math.degrees(kw['max_error']):.3g} deg max; peak |delta| "
            f"{math.degrees(kw['peak_delta']):.3g} deg within {math.degrees(dmax):.3g} deg")
-    return PitchTracking(True, "ok", msg, wall_time=time.perf_counter() - start, **kw)
+    return PitchTracking(True, 0, msg, wall_time=time.perf_counter() - start, **kw)

@@ -16,18 +16,18 @@ from appdyn.dynamics.figures import finish_figure, panel_axes
 from appdyn.dynamics.results import Result
 from appdyn.dynamics.serialize import text_table
 from appdyn.dynamics.validate import finite_scalar, integer, one_of, positive
+from appdyn.ocp.status import STATUS_PATH_LIMITS as STATUS_LIMITS
+from appdyn.ocp.status import STATUS_PROPAGATION, STATUS_TERMINAL, describe
 
 from .planar_model import (RHO0, SCALE_HEIGHT, STATES, AscentVehicle, check_vehicle, planar_model,
                            vertical_rise)
 
 __all__ = ["planar_ascent", "PlanarAscent", "STATUS_TERMINAL", "STATUS_LIMITS", "STATUS_PROPAGATION"]
 
-#: status of a `PlanarAscent`: solved, but the re-propagated end misses the target
-STATUS_TERMINAL = "Terminal_Conditions_Not_Met"
-#: status: solved, but the re-propagated trajectory exceeds q_max or qalpha_max
-STATUS_LIMITS = "Path_Limits_Exceeded"
-#: status: solved, but the re-propagation failed
-STATUS_PROPAGATION = "Propagation_Failed"
+# statuses of a `PlanarAscent` (the table of `ocp.status`): STATUS_TERMINAL (111) solved, but
+# the re-propagated end misses the target; STATUS_LIMITS (112 Path_Limits_Exceeded) the
+# re-propagated trajectory exceeds q_max or qalpha_max; STATUS_PROPAGATION (113) the
+# re-propagation failed
 
 
 # ------------------------------------------------------------------------ results
@@ -46,8 +46,9 @@ class PlanarAscent(Result):
         (`ocp.Solution.propagate`: the returned control integrated by CVODES from the initial
         state) meets the terminal conditions to ``tolerances`` and the path limits to
         ``limit_tol`` relative.
-    status : str
-        The solver's status, or `STATUS_TERMINAL`, `STATUS_LIMITS`, `STATUS_PROPAGATION`.
+    status : int
+        0 for a success; else the solver's (`ocp.Solution.status`), `STATUS_TERMINAL` (111),
+        `STATUS_LIMITS` (112) or `STATUS_PROPAGATION` (113).
     message : str
     solution : ocp.Solution
     objective : {'velocity', 'mass'}
@@ -73,10 +74,12 @@ class PlanarAscent(Result):
         ``t`` [s] after lift-off, ``h``, ``V``, ``gamma``, ``m`` at the start of the
         collocated phase.
     vehicle : AscentVehicle
+    solver_status : str
+        IPOPT's return status text of ``solution`` (property).
     """
 
     success: bool
-    status: str
+    status: int
     message: str
     solution: object = field(repr=False)
     objective: str
@@ -94,13 +97,19 @@ class PlanarAscent(Result):
     initial: Mapping
     vehicle: AscentVehicle = field(repr=False)
 
+    @property
+    def solver_status(self) -> str:
+        """IPOPT's return status text of the collocation (`ocp.Solution.solver_status`)."""
+        return self.solution.solver_status
+
     def theta(self, t):
         """The optimal pitch program [rad] at times ``t`` [s] after lift-off (the
         transcription's control interpolant; ``t`` within the collocated phase)."""
         return self.solution.sample(t)[1][0]
 
     def to_dict(self) -> dict:
-        return {"success": self.success, "status": self.status, "message": self.message,
+        return {"success": self.success, "status": int(self.status),
+                "solver_status": self.solver_status, "message": self.message,
                 "objective": self.objective, "burnout_speed": self.burnout_speed,
                 "burnout_mass": self.burnout_mass, "final": dict(self.final),
                 "targets": dict(self.targets), "peak_q": self.peak_q, "q_max": self.q_max,
@@ -112,7 +121,7 @@ class PlanarAscent(Result):
     def __str__(self) -> str:
         f = self.final
         return _rows_table("Planar ascent (" + self.objective + ")", [
-            ("success", f"{self.success} ({self.status})"),
+            ("success", f"{self.success} ({describe(self.status, self.solver_status)})"),
             ("burnout speed", f"{self.burnout_speed:.2f} m/s"),
             ("burnout mass", f"{self.burnout_mass:.1f} kg"),
             ("final altitude", f"{f['h']:.1f} m (target {self.targets['h']:.1f})"),

@@ -91,9 +91,12 @@ class DesignPrintout:
         self.success, self.status, self.message = design.success, design.status, design.message
 
     def __str__(self) -> str:
+        from appdyn.ocp.status import describe  # the CLI imports the engine only when it runs
+
         d, v = self.design, self.design.verification
+        verdict = "success" if d.success else "FAILED"
         lines = [f"Launch-vehicle autopilot gains ({self.source})",
-                 f"  status    {'success' if d.success else 'FAILED'} ({d.status})"]
+                 f"  status    {verdict} ({describe(d.status, d.solver_status)})"]
         note = "" if "verdict" in v else "  (the solver's last iterate)"
         lines += [f"  {k:<8}  {val:.6g} {d.units.get(k, '')}{note}" for k, val in d.gains.items()]
         if "verdict" in v:

@@ -206,7 +206,9 @@ def run(args) -> int:
         sol = slew.min_effort(inertia, args.min_effort, **common)
     data = slew.summary(sol, eigenaxis=eig)
     success = bool(data.get("success", sol.success))
-    why = f"{data.get('status', '')}: {data.get('message', '')}".strip(": ")
+    from appdyn.ocp.status import describe  # the CLI imports the engine only when it runs
+
+    why = f"{describe(data['status'], data.get('solver_status', ''))}: {data.get('message', '')}"
     rows = []
     if check is not None:
         data["T_lower_bound"] = check[1]

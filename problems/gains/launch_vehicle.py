@@ -243,7 +243,7 @@ def launch_vehicle_gains(vehicle, scenarios, *, delta_max, delta_rate_max, weigh
     gains = {name: float(v) for name, v in zip(model.params, sol.p)}
     units = {name: GAIN_UNITS[name] for name in model.params}
     lim = {"delta": dmax, "delta_rate": rmax}
-    ver = {"solve_time": elapsed, "iterations": sol.iterations, "nlp_status": sol.status,
+    ver = {"solve_time": elapsed, "iterations": sol.iterations, "nlp_status": sol.solver_status,
            "delta_max": dmax, "delta_rate_max": rmax, "min_decay": decay, "horizon": T,
            "filter_time_constant": tf, "intervals": N}
 

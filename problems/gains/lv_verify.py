@@ -10,6 +10,7 @@ import numpy as np
 
 from appdyn import ocp
 from appdyn.dynamics.launch_vehicle import launch_vehicle as vehicle_model
+from appdyn.ocp.status import describe, status_code
 
 from .result import STATUS_LIMITS, STATUS_UNSTABLE, GainDesign
 from .lv_data import GM_INF, LaunchVehicle
@@ -178,8 +179,9 @@ def node_peaks(model, outputs, sol, K, labels) -> list:
 
 
 #: IPOPT statuses that mean "no feasible point" (rather than a convergence failure)
-INFEASIBLE = ("Infeasible_Problem_Detected", "Restoration_Failed", "Constraint_Tol_Not_Met",
-               "Not_Enough_Degrees_Of_Freedom")
+INFEASIBLE = tuple(status_code(name) for name in (
+    "Infeasible_Problem_Detected", "Restoration_Failed", "Constraint_Tol_Not_Met",
+    "Not_Enough_Degrees_Of_Freedom"))
 
 
 def diagnose(sol, solve, lim, decay, bounds, fail, peak_of) -> GainDesign:
@@ -190,7 +192,7 @@ def diagnose(sol, solve, lim, decay, bounds, fail, peak_of) -> GainDesign:
         text = ", ".join(f"{g} in [{lo:g}, {hi:g}]" for g, (lo, hi) in bounds.items())
         return fail(STATUS_UNSTABLE, f"no gains within gain_bounds ({text}) give a closed loop "
                                      f"stable to {decay:g} 1/s, even without the limits "
-                                     f"(IPOPT: {sol.status})")
+                                     f"({describe(sol.status, sol.solver_status)})")
     alone = {k: solve((k,)) for k in lim}
     culprits = [k for k in lim if not alone[k].success]
     joint = not culprits
@@ -212,7 +214,7 @@ def diagnose(sol, solve, lim, decay, bounds, fail, peak_of) -> GainDesign:
                      f"{math.degrees(peaks[k]):.4g} {unit} in scenario {label!r})")
         parts.append(text)
     msg = (f"the limits cannot be met{' together' if joint else ''} by a loop stable to "
-           f"{decay:g} 1/s: {'; '.join(parts)} (IPOPT: {sol.status})")
+           f"{decay:g} 1/s: {'; '.join(parts)} ({describe(sol.status, sol.solver_status)})")
     return fail(STATUS_LIMITS, msg, violated=culprits)
 
 

@@ -8,13 +8,13 @@ import numpy as np
 
 from appdyn.dynamics.serialize import jsonable, text_table, to_json
 from appdyn.dynamics.results import Result
+from appdyn.ocp.status import STATUS_LIMITS, STATUS_UNSTABLE, describe
 
 __all__ = ["GainDesign", "STATUS_UNSTABLE", "STATUS_LIMITS"]
 
-#: status: the NLP converged but the designed loop is not stable (verification failed)
-STATUS_UNSTABLE = "Closed_Loop_Unstable"
-#: status: the limits (deflection, rate, torque) cannot be met by any gains of the form
-STATUS_LIMITS = "Limits_Not_Met"
+# statuses (the table of `ocp.status`): STATUS_UNSTABLE (108) the NLP converged but the
+# designed loop is not stable; STATUS_LIMITS (109) the limits (deflection, rate, torque)
+# cannot be met by any gains of the form
 
 
 # signal -> (axis label, scale to the shown unit, shown unit, verification key of its limit)
@@ -36,10 +36,11 @@ class GainDesign(Result):
     success : bool
         The NLP was solved (`ocp.Solution.success`) *and* the verification passed (a stable
         closed loop; the limits met in every scenario).
-    status : str
-        IPOPT's / `ocp.solve`'s status, or `STATUS_UNSTABLE`, `STATUS_LIMITS` (a string, as
-        the `ocp.Solution` it comes from: the documented exception to the int statuses of
-        `dynamics.results.Result`).
+    status : int
+        0 for a success; else `ocp.solve`'s status (`ocp.status.CODES`), `STATUS_UNSTABLE`
+        (108), `STATUS_LIMITS` (109) or 110 ``Simulation_Failed``; a success with a warning
+        carries 120 ``Short_Horizon`` or 121 ``Initial_States_Not_Spanning``
+        (`state_feedback_gains`).
     message : str
         What happened; on failure, which constraint or check failed.
     gains : mapping of str to float
@@ -55,10 +56,12 @@ class GainDesign(Result):
         (python-control), a reference (LQR gains, the time-optimal maneuver time), ...
     solution : ocp.Solution
         The multi-scenario solution (`ocp.scenarios`).
+    solver_status : str
+        IPOPT's return status text of ``solution`` (property; ``''`` without one).
     """
 
     success: bool
-    status: str
+    status: int
     message: str
     gains: Mapping[str, float]
     units: Mapping[str, str]
@@ -68,6 +71,11 @@ class GainDesign(Result):
     solution: object = field(repr=False, default=None)
 
     _repr_fields = ('gains', 'cost')
+
+    @property
+    def solver_status(self) -> str:
+        """IPOPT's return status text of the design's NLP (``''`` without a solution)."""
+        return str(getattr(self.solution, "solver_status", ""))
 
     @property
     def wall_time(self) -> float:
@@ -128,7 +136,7 @@ class GainDesign(Result):
         return finish_figure(fig)
 
     def __str__(self) -> str:
-        rows = [("success", f"{self.success} ({self.status})")]
+        rows = [("success", f"{self.success} ({describe(self.status, self.solver_status)})")]
         rows += [(f"{k} [{self.units.get(k, '-')}]", f"{v:.6g}") for k, v in self.gains.items()]
         rows.append(("cost", f"{self.cost:.6g}"))
         for i, sc in enumerate(self.scenarios):
@@ -144,7 +152,8 @@ class GainDesign(Result):
     def to_dict(self) -> dict:
         """Plain data (no Solution): success, status, message, gains, units, cost,
         scenarios' peaks and the verification."""
-        return jsonable({"success": self.success, "status": self.status, "message": self.message,
+        return jsonable({"success": self.success, "status": int(self.status),
+                         "solver_status": self.solver_status, "message": self.message,
                          "gains": dict(self.gains), "units": dict(self.units), "cost": self.cost,
                          "scenarios": [{"peak": dict(s.get("peak", {}))} for s in self.scenarios],
                          "verification": dict(self.verification)})

@@ -49,6 +49,7 @@ import numpy as np
 
 from appdyn import ocp
 from appdyn.dynamics.validate import finite_array, nonnegative, positive, positive_each
+from appdyn.ocp.status import STATUS_SIMULATION, status_code
 
 from .attitude_loop import (Q_SCALAR, Q_VECTOR, RATES, attitude_loop, bang_bang_time,
                             check_scenarios, error_angle, gain_names, initial_state,
@@ -64,7 +65,7 @@ DEFAULT_SETTLE_ANGLE = math.radians(1.0)
 #: default relative tolerance of the re-simulated peak torque over ``u_max``
 DEFAULT_LIMIT_TOL = 1e-3
 _DEFAULT_N = 40
-_INFEASIBLE = ("Infeasible_Problem_Detected", "Restoration_Failed")
+_INFEASIBLE = (status_code("Infeasible_Problem_Detected"), status_code("Restoration_Failed"))
 _TORQUE = "torque limit |u_i| <= u_max_i"
 
 
@@ -349,7 +350,7 @@ def attitude_gains(inertia, scenarios, *, u_max, horizon=None, per_axis: bool = 
         message = (f"the NLP converged but the loop linearized at the target is not stable "
                    f"(largest real part {np.max(poles.real):.4g} 1/s)")
     elif not sim_ok:  # before the limits: a failed run's peaks and settle times are NaN
-        success, status = False, "Simulation_Failed"
+        success, status = False, STATUS_SIMULATION
         message = f"the re-simulation of the designed loop failed: {sim_message}"
     elif not limits_met:
         success, status = False, STATUS_LIMITS

@@ -33,6 +33,8 @@ from appdyn import ocp
 from appdyn.dynamics.model import Model
 from appdyn.dynamics.validate import finite_array, positive
 
+from appdyn.ocp.status import STATUS_NOT_SPANNING, STATUS_SHORT_HORIZON
+
 from .result import STATUS_UNSTABLE, GainDesign
 
 __all__ = ["state_feedback_gains", "linear_system", "default_initial_gain", "HORIZON_RATIO_MIN", "STATUS_SHORT_HORIZON",
@@ -40,12 +42,10 @@ __all__ = ["state_feedback_gains", "linear_system", "default_initial_gain", "HOR
 
 #: a horizon shorter than this many slowest closed-loop time constants draws a warning
 HORIZON_RATIO_MIN = 10.0
-#: status (``success`` stays True): the horizon is shorter than ``HORIZON_RATIO_MIN`` time
-#: constants of the designed loop, so ``K`` is a finite-horizon compromise, not the LQR gain
-STATUS_SHORT_HORIZON = "Short_Horizon"
-#: status (``success`` stays True): the initial states do not span ``R^n``; ``K`` need not be
-#: unique (module docstring)
-STATUS_NOT_SPANNING = "Initial_States_Not_Spanning"
+# warning statuses (``success`` stays True; the table of `ocp.status`): STATUS_SHORT_HORIZON
+# (120) the horizon is shorter than ``HORIZON_RATIO_MIN`` time constants of the designed
+# loop, so ``K`` is a finite-horizon compromise, not the LQR gain; STATUS_NOT_SPANNING (121)
+# the initial states do not span ``R^n``; ``K`` need not be unique (module docstring)
 
 _DEFAULT_N = 80
 _DEFAULT_IPOPT = {"tol": 1e-10}

@@ -46,11 +46,12 @@ Every slew result says ``success=True`` only when
    (largest component of `ocp.Solution.terminal_error`). Defaults: ``pointing_tol`` =
    `POINTING_TOL` = 1e-6 rad (0.2 arcsec), ``rate_tol`` = `RATE_TOL` = 1e-6 rad/s.
 
-Otherwise ``success=False`` with ``status`` `STATUS_POINTING` (``'Pointing_Tol_Not_Met'``),
-`STATUS_REFINE` (``'Refinement_Tol_Not_Met'``) or the engine's own status. A rest-to-rest
+Otherwise ``success=False`` with ``status`` `STATUS_POINTING` (106 ``Pointing_Tol_Not_Met``),
+`STATUS_REFINE` (107 ``Refinement_Tol_Not_Met``) or the engine's own status (ints, the table
+of `ocp.status`). A rest-to-rest
 slew by a zero angle (``q0 = +/- qf``) is answered exactly without an NLP:
 `ocp.rest_solution` with ``T = 0`` (time-optimal) or zero torque over ``T`` (minimum
-effort), ``status = 'Rest_Solution'``. Tiny angles are solved in well-conditioned units: the
+effort), ``status = 0`` and ``solver_status = 'Rest_Solution'``. Tiny angles are solved in well-conditioned units: the
 horizon and the objective are scaled by the bang-bang time ``2 sqrt(angle / alpha)``, the
 target rows by the initial attitude error (`ocp.scaling`).
 

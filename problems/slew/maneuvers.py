@@ -66,7 +66,7 @@ def verify(solution: Solution, *, pointing_tol: float = POINTING_TOL, rate_tol: 
     >>> sol = slew.min_effort(np.eye(3), 2.0, angle=0.1, axis=[1, 0, 0], N=10)
     >>> strict = slew.verify(sol, pointing_tol=1e-15)  # re-simulated, graded again
     >>> strict.success, strict.status
-    (False, 'Pointing_Tol_Not_Met')
+    (False, 106)
     """
     if not isinstance(solution, Solution):
         raise TypeError(f"`solution` must be an ocp.Solution, got {type(solution).__name__}")

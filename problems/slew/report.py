@@ -7,6 +7,7 @@ from collections.abc import Mapping
 import numpy as np
 
 from appdyn.ocp import Solution, control_switches
+from appdyn.ocp.status import describe
 
 from .problem import attitude_blocks
 from .targets import ARCSEC
@@ -121,7 +122,7 @@ def polish_text(record: Mapping) -> str:
 def summary(solution: Solution, *, eigenaxis=None) -> dict:
     """JSON-ready summary of a slew solution.
 
-    Keys: success, status, message, T [s], cost, switch_times [s] (per torque axis),
+    Keys: success, status (an int, `ocp.status`), solver_status (IPOPT's text), message, T [s], cost, switch_times [s] (per torque axis),
     controls (their names, the model's: ``L1..L3`` for a body torque),
     iterations, solve_time [s], constraint_violation (NLP units, see `ocp.solve`),
     pointing_error_arcsec (final attitude error of the re-simulated control [arcsec]),
@@ -143,7 +144,7 @@ def summary(solution: Solution, *, eigenaxis=None) -> dict:
     >>> sol = slew.time_optimal(np.eye(3), angle=0.1, axis=[0, 0, 1], N=10, starts=1)
     >>> data = slew.summary(sol, eigenaxis=slew.eigenaxis_time(np.eye(3), 0.1, [0, 0, 1]))
     >>> data["success"], data["status"], round(data["T"], 6), round(data["eigenaxis_T"], 6)
-    (True, 'Solve_Succeeded', 0.632456, 0.632456)
+    (True, 0, 0.632456, 0.632456)
     >>> [np.round(s, 4).tolist() for s in data["switch_times"]]
     [[], [], [0.3162]]
     """
@@ -158,7 +159,8 @@ def summary(solution: Solution, *, eigenaxis=None) -> dict:
         rerr = float(np.max(term)) if np.all(np.isfinite(term)) else float("nan")
     out = dict(
         success=bool(solution.success),
-        status=str(solution.status),
+        status=int(solution.status),
+        solver_status=str(solution.solver_status),
         message=str(solution.message),
         T=float(solution.T),
         cost=float(solution.cost),
@@ -203,7 +205,7 @@ def format_summary(data: dict) -> str:
     >>> sol = slew.time_optimal(np.eye(3), angle=0.1, axis=[0, 0, 1], N=10, starts=1)
     >>> print(slew.format_summary(slew.summary(sol)))  # doctest: +ELLIPSIS
     Optimal slew
-      success                   True (Solve_Succeeded)
+      success                   True (status 0 Solve_Succeeded)
       maneuver time T [s]       0.632456
       cost                      0.6324555...
       switch times L1 [s]       -
@@ -217,7 +219,7 @@ def format_summary(data: dict) -> str:
     if missing:
         raise ValueError(f"`data` must be a dict from `summary`; missing keys {missing}")
     rows = [
-        ("success", f"{data['success']} ({data['status']})"),
+        ("success", f"{data['success']} ({describe(data['status'], data.get('solver_status', ''))})"),
         ("maneuver time T [s]", f"{data['T']:.6f}"),
     ]
     if "eigenaxis_T" in data:

@@ -178,8 +178,8 @@ class ManeuverTable(Result):
         The objective: [s] (time) or [N^2 m^2 s] (``1/2 integral |u|^2 dt``).
     row_success : ndarray of bool, shape (m,)
         ``Solution.success`` of each slew (verified by re-simulation).
-    row_status : tuple of str, length m
-        ``Solution.status`` of each slew.
+    row_status : tuple of int, length m
+        ``Solution.status`` of each slew (0 a success; `ocp.status`).
     messages : tuple of str, length m
     iterations : ndarray of int, shape (m,)
         IPOPT iterations of each returned solution (``Solution.iterations``).
@@ -484,7 +484,7 @@ def maneuver_table(inertia, targets, *, objective: str = "time", T=None, u_max=1
             T=np.array([s.T for s in sols], dtype=float),
             cost=np.array([s.cost for s in sols], dtype=float),
             row_success=np.array([s.success for s in sols], dtype=bool),
-            row_status=tuple(str(s.status) for s in sols),
+            row_status=tuple(int(s.status) for s in sols),
             messages=tuple("" if s.success else str(s.message) for s in sols),
             iterations=np.array([s.iterations for s in sols], dtype=int),
             wall_times=np.array([done[k][1] for k in index], dtype=float),

@@ -15,6 +15,7 @@ import numpy as np
 from appdyn.dynamics.attitude import dcm_from_quat, quat_from_axis_angle, quat_mul, quat_normalize
 from appdyn.dynamics.validate import finite_array, finite_scalar, unit_quaternion, unit_vector
 from appdyn.dynamics.validate import positive
+from appdyn.ocp.status import CODES as _CODES
 
 __all__ = ["KeepOut", "POINTING_TOL", "RATE_TOL", "MIN_REFINE_TOL", "STATUS_POINTING",
            "STATUS_REFINE", "ARCSEC", "vector3", "targets", "check_u_max", "check_angle",
@@ -23,8 +24,8 @@ __all__ = ["KeepOut", "POINTING_TOL", "RATE_TOL", "MIN_REFINE_TOL", "STATUS_POIN
 POINTING_TOL = 1e-6  # [rad] default largest re-simulated final attitude error of a success
 RATE_TOL = 1e-6  # [rad/s] default largest re-simulated final rate error of a success
 MIN_REFINE_TOL = 1e-12  # smallest refinement tol min_effort accepts (CVODES reference ~1e-13)
-STATUS_POINTING = "Pointing_Tol_Not_Met"
-STATUS_REFINE = "Refinement_Tol_Not_Met"
+STATUS_POINTING = _CODES["Pointing_Tol_Not_Met"]  # 106 (the table of `ocp.status`)
+STATUS_REFINE = _CODES["Refinement_Tol_Not_Met"]  # 107
 ARCSEC = 180.0 * 3600.0 / math.pi
 
 

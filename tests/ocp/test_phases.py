@@ -16,6 +16,7 @@ from scipy.optimize import brentq
 from appdyn import ocp
 from appdyn.dynamics.model import model_from_expressions
 from appdyn.ocp.examples import double_integrator
+from appdyn.ocp.status import STATUS_SUCCESS
 
 ENERGY = lambda x, u, p: 0.5 * u**2  # noqa: E731
 
@@ -175,7 +176,7 @@ def test_an_infeasible_event_is_a_failure_not_an_exception():
         events=[*mp.events, ocp.Constraint(lambda e: e[1]["v_f"], 2e4, np.inf)])
     sol = ocp.solve_phases(impossible, ipopt_options={"max_iter": 200})
     assert not sol.success
-    assert sol.status != "Solve_Succeeded"
+    assert sol.status != STATUS_SUCCESS
     assert sol.message
 
 

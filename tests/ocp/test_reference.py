@@ -25,6 +25,7 @@ import numpy as np
 import pytest
 
 from appdyn.ocp import solve
+from appdyn.ocp.status import STATUS_BOUND_VIOLATION
 
 from .reference import (ORDER, STRICT, TRANSCRIPTION_NAMES, bang_bang, brachistochrone,
                         bryson_denham, min_energy, observed_order, rigid_slew, static_parameter)
@@ -120,7 +121,7 @@ def test_bang_bang_minimum_time(name):
             # (below): a Bound_Violation, not a success (it was one before the dense output
             # was checked)
             sol = solve(problem, transcription=name, N=N, ipopt_options=STRICT)
-            assert not sol.success and sol.status == "Bound_Violation", sol.message
+            assert not sol.success and sol.status == STATUS_BOUND_VIOLATION, sol.message
             assert sol.bound_violation.max == pytest.approx(0.125, abs=1e-6)
             assert sol.bound_violation.name == "u" and "`u`" in sol.message
         else:

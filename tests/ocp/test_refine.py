@@ -21,6 +21,7 @@ from appdyn.dynamics import rigid_body
 from appdyn.dynamics.attitude import quat_from_axis_angle
 from appdyn.ocp import (Problem, RadauConstantControl, RefinedSolution, RefinementRound, Solution,
                  find_switches, interval_errors, polish_switches, refine, solve, solve_multistart)
+from appdyn.ocp.status import STATUS_BOUND_VIOLATION, STATUS_INFEASIBLE, STATUS_MAX_ITER
 
 from .reference import STRICT, bang_bang, brachistochrone, double_integrator, min_energy, rigid_slew
 
@@ -132,8 +133,8 @@ def test_refine_failure_returns_success_false():
                       u_bounds={"u": (-0.1, 0.1)}, lagrange=lambda x, u, p: u ** 2)
     sol = refine(problem, N=6, tol=1e-6)
     assert isinstance(sol, RefinedSolution)
-    assert sol.success is False and sol.status == "Infeasible_Problem_Detected"
-    assert "refine" in sol.message and sol.status in sol.message
+    assert sol.success is False and sol.status == STATUS_INFEASIBLE
+    assert "refine" in sol.message and sol.solver_status in sol.message
     assert len(sol.refinement) == 1 and math.isnan(sol.refinement[0].max_error)
     assert not sol.info["converged"]
 
@@ -198,7 +199,7 @@ def test_polish_switches_bilimoria_wie_from_a_tilted_start():
     start = solve(problem, N=20, guess=axis_guess(TILTED), verbose=False)
     # its Radau control polynomials overshoot |u| <= 1 between the nodes (a Bound_Violation,
     # which also lets its T sit below the polished one); a start for the polish all the same
-    assert start.status == "Bound_Violation" and 3.2428 < start.T < 3.2440
+    assert start.status == STATUS_BOUND_VIOLATION and 3.2428 < start.T < 3.2440
     sol = polish_switches(problem, start)
     elapsed = time.perf_counter() - t
     assert sol.success, sol.message
@@ -213,8 +214,8 @@ def test_polish_switches_failure_and_bad_arguments():
     problem, _ = bang_bang()
     start = solve(problem, N=7, verbose=False)
     sol = polish_switches(problem, start, ipopt_options={"max_iter": 2})
-    assert sol.success is False and sol.status == "Maximum_Iterations_Exceeded"
-    assert sol.status in sol.message
+    assert sol.success is False and sol.status == STATUS_MAX_ITER
+    assert sol.solver_status in sol.message
     with pytest.raises(ValueError, match="`stretch`"):
         polish_switches(problem, start, stretch=(2.0, 5.0))
     with pytest.raises(ValueError, match="`mesh`"):

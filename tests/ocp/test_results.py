@@ -10,7 +10,8 @@ from appdyn.ocp.examples import min_energy
 def test_solution_serializes_and_plots(tmp_path):
     sol = ocp.solve(min_energy(), N=10)
     data = json.loads(sol.to_json(), parse_constant=lambda c: (_ for _ in ()).throw(ValueError(c)))
-    assert data["success"] is True and data["status"] == "Solve_Succeeded"
+    assert data["success"] is True and data["status"] == 0
+    assert data["solver_status"] == "Solve_Succeeded"
     assert abs(data["cost"] - 6.0) < 1e-8  # Bryson & Ho: J = 6
     assert list(data["x"]) == list(sol.problem.model.states)
     np.testing.assert_array_equal(data["u"][sol.problem.model.controls[0]], sol.u[0])

@@ -9,6 +9,7 @@ import pytest
 
 from appdyn.ocp import (Constraint, HermiteSimpson, Mesh, Problem, Progress, Radau, Solution, Trapezoid,
                  solve)
+from appdyn.ocp.status import STATUS_INFEASIBLE, STATUS_MAX_ITER, STATUS_SUCCESS
 
 from .reference import (STRICT, TRANSCRIPTION_NAMES, brachistochrone, double_integrator,
                         min_energy, observed_order, rigid_slew)
@@ -24,8 +25,8 @@ def test_infeasible_problem_returns_failure_with_ipopt_status(name):
     sol = solve(problem, transcription=name, N=10, verbose=False)
     assert isinstance(sol, Solution)
     assert sol.success is False
-    assert sol.status == "Infeasible_Problem_Detected"
-    assert sol.status in sol.message
+    assert sol.status == STATUS_INFEASIBLE
+    assert sol.solver_status in sol.message
     assert sol.x.shape == (2, sol.t.size) and sol.constraint_violation > 1e-3
 
 
@@ -33,7 +34,7 @@ def test_iteration_limit_returns_failure():
     problem, truth = brachistochrone()
     sol = solve(problem, N=8, verbose=False, guess=truth["guess"], ipopt_options={"max_iter": 2})
     assert not sol.success
-    assert sol.status == "Maximum_Iterations_Exceeded" and sol.iterations == 2
+    assert sol.status == STATUS_MAX_ITER and sol.iterations == 2
 
 
 # ---------------------------------------------------------------------- progress
@@ -245,7 +246,7 @@ def test_solution_attributes():
     assert sol.p.shape == (0,)
     assert sol.transcription == Radau(2) and sol.mesh == Mesh.uniform(5)
     assert sol.solve_time > 0 and sol.build_time > 0 and sol.iterations > 0
-    assert sol.status == "Solve_Succeeded" and sol.success
+    assert sol.status == STATUS_SUCCESS and sol.success
     assert np.all(np.diff(sol.t) > 0) and sol.t[-1] == sol.T
     assert "radau" in repr(sol)
     with pytest.raises(ValueError):

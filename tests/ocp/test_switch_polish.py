@@ -11,6 +11,8 @@ from appdyn.dynamics.model import Model
 from appdyn.ocp import Problem, RadauConstantControl, find_switches, polish_switches, solve
 from appdyn.ocp.refine.switch_times import bang_arcs, optimize_switch_times
 from appdyn.problems import slew
+from appdyn.ocp.status import (STATUS_BOUND_VIOLATION, STATUS_MAX_ITER, STATUS_SUCCESS,
+                               STATUS_WALL_TIME, STATUS_WORSE)
 
 from .reference import STRICT, bang_bang, double_integrator, min_energy
 
@@ -26,9 +28,9 @@ def test_double_integrator_closed_form_in_a_few_iterations(distance, accel):
     T_star = truth["T"]
     start = solve(problem, N=7)  # odd N: the switch is smeared inside an interval
     # (its control polynomial overshoots the bound there: not a success, still a start)
-    assert start.status == "Bound_Violation" and abs(start.T - T_star) > 1e-4
+    assert start.status == STATUS_BOUND_VIOLATION and abs(start.T - T_star) > 1e-4
     sol = polish_switches(problem, start)
-    assert sol.success and sol.status == "Solve_Succeeded", sol.message
+    assert sol.success and sol.status == STATUS_SUCCESS, sol.message
     assert sol.info["method"] == "switch-times" and "fallback" not in sol.info
     assert sol.iterations <= 8
     assert abs(sol.T - T_star) < 1e-10
@@ -51,13 +53,13 @@ def test_bilimoria_wie_switch_times_under_30_iterations():
     # success as an answer, the polish's start all the same)
     start = slew.time_optimal(np.eye(3), angle=np.pi, axis=[0, 0, 1], u_max=1.0, polish=False,
                               control="polynomial")
-    assert start.status == "Bound_Violation" and abs(start.T - BW_T) < 1e-3
+    assert start.status == STATUS_BOUND_VIOLATION and abs(start.T - BW_T) < 1e-3
     problem = start.problem
     arcs, why = bang_arcs(start)
     assert why == "" and arcs.durations.size == 6 and arcs.switch_times.size == 5
     np.testing.assert_array_equal(np.abs(arcs.controls), 1.0)
     sol = polish_switches(problem, start, degree=5, ipopt_options={"tol": 1e-9})
-    assert sol.success and sol.status == "Solve_Succeeded", sol.message
+    assert sol.success and sol.status == STATUS_SUCCESS, sol.message
     assert sol.info["method"] == "switch-times"
     assert sol.iterations < 30
     assert abs(sol.T - BW_T) < 1e-6 and round(sol.T, 5) == 3.24308
@@ -81,7 +83,7 @@ def test_bilimoria_wie_switch_times_under_30_iterations():
 
 def test_time_optimal_uses_the_switch_time_polish():
     sol = slew.time_optimal(np.eye(3), angle=np.pi, axis=[0, 0, 1], u_max=1.0)
-    assert sol.success and sol.status == "Solve_Succeeded", sol.message
+    assert sol.success and sol.status == STATUS_SUCCESS, sol.message
     assert sol.info["method"] == "switch-times" and sol.info["nlp_iterations"][-1] < 30
     assert abs(sol.T - BW_T) < 1e-6 and sol.info["pointing_error"] < 1e-8
     # the eigenaxis start alone ends at the eigenaxis local optimum: x and y torques idle
@@ -110,7 +112,7 @@ def test_singular_arc_falls_back_to_moving_knots():
     problem = _singular()
     start = solve(problem, N=16, ipopt_options=STRICT)
     # the control polynomial rings on the singular arc, past |u| <= 1: not a success
-    assert start.status == "Bound_Violation"
+    assert start.status == STATUS_BOUND_VIOLATION
     arcs, why = bang_arcs(start)
     assert arcs is None and "singular" in why
     sol = polish_switches(problem, start)
@@ -139,7 +141,7 @@ def test_failed_switch_time_nlp_falls_back_or_reports():
     problem, truth = bang_bang()
     start = solve(problem, N=7)
     failed = polish_switches(problem, start, method="switch-times", ipopt_options={"max_iter": 1})
-    assert not failed.success and failed.status == "Maximum_Iterations_Exceeded"
+    assert not failed.success and failed.status == STATUS_MAX_ITER
     assert failed.info["method"] == "switch-times"
     rescued = polish_switches(problem, start, N=8, ipopt_options={"max_iter": 1})
     assert rescued.info["method"] == "moving-knots"
@@ -203,7 +205,7 @@ def test_an_arc_too_short_to_detect_is_tried_second():
     guess inserts the short arc and converges at once."""
     J, angle, axis = np.diag([1.0, 1.5, 2.0]), 2.0, [1, 2, 3]
     start = slew.time_optimal(J, angle=angle, axis=axis, polish=False, control="polynomial")
-    assert start.status == "Bound_Violation"  # the polynomial seed (see above)
+    assert start.status == STATUS_BOUND_VIOLATION  # the polynomial seed (see above)
     plain, _ = bang_arcs(start)
     more, _ = bang_arcs(start, short_arcs=True)
     assert more.durations.size > plain.durations.size
@@ -240,7 +242,7 @@ def test_another_target_reuses_the_switch_time_nlp_and_matches_a_fresh_build():
     def first_and_problem(axis):
         start = slew.time_optimal(np.eye(3), angle=2.0, axis=axis, u_max=1.0, polish=False,
                                   control="polynomial", starts=1)
-        assert start.status == "Bound_Violation"  # the polynomial seed (see above)
+        assert start.status == STATUS_BOUND_VIOLATION  # the polynomial seed (see above)
         return start.problem, start
 
     p1, s1 = first_and_problem([0.2, 1.0, 0.5])
@@ -273,7 +275,7 @@ def test_a_polish_worse_than_its_start_is_not_a_success():
     assert start.success and start.T == pytest.approx(truth["T"], rel=1e-7)
     coarse = polish_switches(problem, start, N=2)
     assert coarse.T > truth["T"] * (1 + 1e-3)  # worse than the exact optimum, by physics
-    assert not coarse.success and coarse.status == "Worse_Than_Start", coarse.message
+    assert not coarse.success and coarse.status == STATUS_WORSE, coarse.message
     assert "worse than the start" in coarse.message
     assert coarse.info["gain"] == pytest.approx(start.T - coarse.T) and coarse.info["gain"] < 0
     # as fine as the start: within the slack of the exact optimum, a success
@@ -292,7 +294,7 @@ def test_budget_stops_the_polish_and_says_so():
     assert ample.success and ample.T == pytest.approx(free.T, abs=1e-12)
     assert ample.info["wall_time"] <= 60.0
     spent = polish_switches(problem, start, budget=1e-6)  # over before IPOPT's first iteration
-    assert not spent.success and spent.status == "Maximum_WallTime_Exceeded", spent.message
+    assert not spent.success and spent.status == STATUS_WALL_TIME, spent.message
     assert "budget" in spent.message
     with pytest.raises(ValueError, match="`budget`"):
         polish_switches(problem, start, budget=0.0)
@@ -302,7 +304,7 @@ def test_budget_stops_the_polish_and_says_so():
     smooth, truth = brachistochrone()
     first = solve(smooth, N=20, guess=truth["guess"])
     cut = polish_switches(smooth, first, budget=1e-6)
-    assert not cut.success and cut.status == "Maximum_WallTime_Exceeded", cut.message
+    assert not cut.success and cut.status == STATUS_WALL_TIME, cut.message
     assert cut.info["budget_spent"] and "budget" in cut.message
 
 

@@ -6,6 +6,7 @@ import pytest
 
 from appdyn.ocp import control_switches, find_switches, interval_errors, solve
 from appdyn.ocp.refine.switch_times import bang_arcs
+from appdyn.ocp.status import STATUS_BOUND_VIOLATION
 
 from .reference import STRICT, bang_bang
 
@@ -16,7 +17,7 @@ def test_detectors_agree_on_a_bang_bang_solution(N):
     # the Radau control polynomial through the switch overshoots |u| <= 1 (N = 7): the
     # detectors read the collocated solution all the same
     sol = solve(problem, N=N, ipopt_options=STRICT, verify=False)
-    assert sol.success if N == 8 else sol.status == "Bound_Violation", sol.message
+    assert sol.success if N == 8 else sol.status == STATUS_BOUND_VIOLATION, sol.message
     per = control_switches(sol)
     merged = find_switches(sol)
     assert len(per) == 1

@@ -13,6 +13,7 @@ from appdyn.ocp import (DEFAULT_CONSTRAINT_TOL, Problem, RadauConstantControl, c
                  ipopt_option_table, rest_solution, solve)
 from appdyn.ocp.rest import STATUS_REST
 from appdyn.ocp.solve import STATUS_CONSTRAINT_TOL
+from appdyn.ocp.status import STATUS_ACCEPTABLE, STATUS_MAX_ITER, STATUS_SUCCESS
 
 from .reference import bang_bang, min_energy
 
@@ -26,7 +27,7 @@ def test_acceptable_level_is_not_success_unless_a_re_solve_reaches_tol():
     opts = {"acceptable_iter": 1, "acceptable_tol": 0.1, "acceptable_constr_viol_tol": 0.5,
             "tol": 1e-20, "max_iter": 30}
     sol = solve(problem, N=10, verbose=False, ipopt_options=opts)
-    assert sol.status == "Solved_To_Acceptable_Level"
+    assert sol.status == STATUS_ACCEPTABLE
     assert sol.success is False
     assert "acceptable" in sol.message and "re-solve" in sol.message
 
@@ -39,7 +40,7 @@ def test_acceptable_level_re_solved_to_tol_counts_as_success():
     opts = {"acceptable_iter": 1, "acceptable_tol": 0.1, "acceptable_constr_viol_tol": 0.5}
     sol = solve(problem, N=10, verbose=False, ipopt_options=opts)
     assert sol.success, sol.message
-    assert sol.status == "Solve_Succeeded" and "re-solve" in sol.message
+    assert sol.status == STATUS_SUCCESS and "re-solve" in sol.message
     assert sol.T == pytest.approx(truth["T"], rel=1e-7)
     assert sol.constraint_violation <= DEFAULT_CONSTRAINT_TOL
 
@@ -54,7 +55,7 @@ def test_constraint_violation_counts_bounds_and_gates_success():
     loose = solve(problem, N=10, verbose=False, constraint_tol=1e-300,
                   ipopt_options={"tol": 1e-2, "constr_viol_tol": 1e-2, "max_iter": 3})
     assert loose.success is False
-    assert loose.status in (STATUS_CONSTRAINT_TOL, "Maximum_Iterations_Exceeded")
+    assert loose.status in (STATUS_CONSTRAINT_TOL, STATUS_MAX_ITER)
     with pytest.raises(ValueError, match="constraint_tol"):
         solve(problem, N=4, verbose=False, constraint_tol=-1.0)
 
@@ -104,7 +105,7 @@ def _slew(qf, T=(0.0, 10.0)):
 
 def test_rest_solution_of_a_zero_slew_is_exact_and_usable():
     sol = rest_solution(_slew([0.0, 0.0, 0.0, -1.0]))  # -q0: the same attitude
-    assert sol.success and sol.status == STATUS_REST and sol.T == 0.0 and sol.cost == 0.0
+    assert sol.success and sol.status == 0 and sol.solver_status == STATUS_REST and sol.T == 0.0 and sol.cost == 0.0
     assert sol.iterations == 0 and sol.constraint_violation <= 1e-15
     x, u = sol.sample(0.0)
     np.testing.assert_array_equal(x, [0, 0, 0, 1, 0, 0, 0])

@@ -51,7 +51,8 @@ def test_negative_vector_values_are_accepted(w0, tmp_path, capsys):
 
 
 def _fake_solution(success=False, T=float("nan")):
-    return SimpleNamespace(success=success, status="Solve_Succeeded" if success
+    return SimpleNamespace(success=success, status=0 if success else 2,
+                           solver_status="Solve_Succeeded" if success
                            else "Infeasible_Problem_Detected", message="fake", T=T)
 
 

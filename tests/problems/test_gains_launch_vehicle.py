@@ -18,6 +18,7 @@ from appdyn.problems.gains import STATUS_LIMITS, GainDesign
 from appdyn.problems.gains.config import EXAMPLE_CONFIG, load_config, parse_config
 from appdyn.problems.gains.launch_vehicle import (LaunchScenario, LaunchVehicle, design_model,
                                            launch_vehicle_gains)
+from appdyn.ocp.status import STATUS_UNSTABLE
 
 F, I, L, M, V = 2.0e6, 4.0e7, 20.0, 1.0e5, 300.0
 AERO = Aero(dynamic_pressure=3.0e4, area=10.0, normal_force_slope=3.0, cp_arm=5.0)
@@ -295,5 +296,5 @@ def test_gain_bounds_that_cannot_stabilize_the_airframe_say_so():
     veh = LaunchVehicle(F, I, L, M, aero=AERO, velocity=V)
     d = launch_vehicle_gains(veh, SCENARIOS[:1], delta_max=DMAX, delta_rate_max=RMAX, N=16,
                              horizon=6.0, gain_bounds={"k_psi": (0.0, 0.05)})
-    assert not d.success and d.status == "Closed_Loop_Unstable"
+    assert not d.success and d.status == STATUS_UNSTABLE
     assert "gain_bounds" in d.message and "k_psi in [0, 0.05]" in d.message

@@ -8,6 +8,7 @@ from appdyn.dynamics import simulate
 from appdyn.problems.gains.result import STATUS_LIMITS, GainDesign
 from appdyn.problems.gains.spacecraft import (attitude_gains, attitude_loop, error_angle, initial_state,
                                        settle_time)
+from appdyn.ocp.status import STATUS_SIMULATION
 
 J_DIAG = np.diag([1.0, 2.0, 3.0])
 U_MAX = 0.5
@@ -133,7 +134,7 @@ def test_a_failed_re_simulation_is_reported_as_such(monkeypatch):
 
     monkeypatch.setattr(spacecraft, "simulate_loop", failing)
     res = attitude_gains(J_DIAG, SINGLE_AXIS[:1], u_max=U_MAX, time_optimal_reference=False)
-    assert not res.success and res.status == "Simulation_Failed"
+    assert not res.success and res.status == STATUS_SIMULATION
     assert "re-simulation of the designed loop failed" in res.message
     assert "cvodes failed near t = 1" in res.message and "nan" not in res.message
 

@@ -6,6 +6,7 @@ import pytest
 from appdyn.problems.gains.result import STATUS_UNSTABLE, GainDesign
 from appdyn.problems.gains.state_feedback import (HORIZON_RATIO_MIN, STATUS_NOT_SPANNING,
                                            STATUS_SHORT_HORIZON, state_feedback_gains)
+from appdyn.ocp.status import STATUS_SUCCESS
 
 A_DI, B_DI = np.array([[0.0, 1.0], [0.0, 0.0]]), np.array([[0.0], [1.0]])
 
@@ -15,7 +16,7 @@ def _check_against_lqr(A, B, Q, R, X0, horizon, N):
     K_lqr, _, _ = control.lqr(A, B, Q, R)
     assert isinstance(res, GainDesign)
     assert res.success, res.message
-    assert res.status == "Solve_Succeeded" and res.verification["warnings"] == []
+    assert res.status == STATUS_SUCCESS and res.verification["warnings"] == []
     assert res.verification["horizon_ratio"] >= HORIZON_RATIO_MIN
     np.testing.assert_allclose(K, K_lqr, rtol=1e-4)
     np.testing.assert_allclose(res.verification["K_lqr"], K_lqr)

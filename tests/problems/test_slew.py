@@ -6,6 +6,7 @@ import pytest
 
 from appdyn.dynamics.attitude import quat_from_axis_angle, quat_mul, rotation_angle, quat_conj
 from appdyn.problems import slew
+from appdyn.ocp.status import STATUS_SUCCESS
 
 
 def test_min_effort_single_axis_closed_form():
@@ -50,7 +51,7 @@ def test_bilimoria_wie_time_optimal_beats_eigenaxis():
     assert sol.success, sol.message
     # verified: IPOPT's tol met (it used to stop at the acceptable level and count that as
     # success) and the re-simulated control ends on the target
-    assert sol.status == "Solve_Succeeded"
+    assert sol.status == STATUS_SUCCESS
     assert sol.info["pointing_error"] <= slew.POINTING_TOL
     assert sol.constraint_violation <= 1e-6
     assert 3.2428 <= sol.T <= 3.2435

@@ -11,6 +11,7 @@ from scipy.integrate import solve_ivp
 from appdyn.dynamics.attitude import quat_conj, quat_mul
 from appdyn.problems import slew
 from appdyn.problems.slew.targets import POINTING_TOL
+from appdyn.ocp.status import STATUS_BOUND_VIOLATION
 
 INERTIA = np.array([[10.0, 1.2, -0.8], [1.2, 8.0, 0.5], [-0.8, 0.5, 6.0]])
 U_MAX = np.array([0.5, 0.5, 0.3])
@@ -57,7 +58,7 @@ def test_a_polynomial_control_is_reported_as_leaving_the_bounds():
     sol = slew.time_optimal(INERTIA, angle=np.pi / 2, axis=AXIS, u_max=U_MAX, polish=False,
                             control="polynomial")
     assert not sol.success
-    assert "Bound_Violation" in sol.message or sol.status == "Bound_Violation", sol.message
+    assert "Bound_Violation" in sol.message or sol.status == STATUS_BOUND_VIOLATION, sol.message
 
 
 def test_plots_draw_the_torque_bounds():

@@ -14,6 +14,7 @@ from scipy.integrate import solve_ivp
 
 from appdyn.problems import slew
 from appdyn.problems.slew import maneuvers
+from appdyn.ocp.status import STATUS_SUCCESS
 
 E = np.eye(3)
 
@@ -69,7 +70,7 @@ def test_tiny_time_optimal_slew_is_the_bang_bang_closed_form(angle):
     It used to come back as success with T = 1e-10 and the body never moving."""
     sol = slew.time_optimal(E, angle=angle, axis=[0, 0, 1])
     assert sol.success, sol.message
-    assert sol.status == "Solve_Succeeded"
+    assert sol.status == STATUS_SUCCESS
     assert sol.T == pytest.approx(2 * math.sqrt(angle), rel=1e-6)
     assert np.max(np.abs(sol.u[2])) == pytest.approx(1.0, abs=1e-6)
     xf = resimulate(sol, E, [0, 0, 0, 1.0], np.zeros(3))
@@ -98,7 +99,7 @@ def test_zero_slew_is_answered_exactly_and_at_once(kwargs, tmp_path):
     t = time.perf_counter()
     sol = slew.time_optimal(E, **kwargs)
     assert time.perf_counter() - t < 1.0  # no NLP (it used to take 7.8 s for T = 1.9e-9)
-    assert sol.success and sol.T == 0.0 and sol.status == "Rest_Solution"
+    assert sol.success and sol.T == 0.0 and sol.status == 0 and sol.solver_status == "Rest_Solution"
     data = slew.summary(sol)
     assert data["T"] == 0.0 and data["switch_times"] == [[], [], []]
     assert data["pointing_error_arcsec"] == 0.0 and data["constraint_violation"] < 1e-12
@@ -204,7 +205,7 @@ def test_time_optimal_success_implies_verified_accuracy(moments, axis, angle):
 
 def _check(sol, J, angle, axis):
     if not sol.success:  # a failure is allowed, but must say so
-        assert sol.status != "Solve_Succeeded" and sol.message
+        assert sol.status != STATUS_SUCCESS and sol.message
         return
     xf = resimulate(sol, J, [0, 0, 0, 1.0], np.zeros(3))
     # the stated thresholds, plus 1e-9 for DOP853's own error at rtol 1e-12
