@@ -48,8 +48,9 @@ def rest_solution(problem: Problem, *, T: float | None = None, transcription="ra
     Solution
         ``status`` 0 and ``success=True`` when the held state satisfies every constraint to
         ``constraint_tol``, else ``success=False`` and `STATUS_CONSTRAINT_TOL` (101); its
-        ``solver_status`` is `STATUS_REST` (``'Rest_Solution'``: no NLP solved). ``iterations = 0``; with ``T = 0`` every node time is
-        ``t0`` and `Solution.sample` accepts ``t0`` only.
+        ``solver_status`` is `STATUS_REST` (``'Rest_Solution'``: no NLP solved).
+        ``iterations = 0``; with ``T = 0`` every node time is ``t0`` and `Solution.sample`
+        accepts ``t0`` only.
 
     Raises
     ------

@@ -122,7 +122,7 @@ class Solution(Result):
     solver_status : str
         IPOPT's return status text (``'Solve_Succeeded'``, ``'Maximum_Iterations_Exceeded'``,
         ...; ``'Exception'`` or ``'Unknown'`` when IPOPT gave none, ``'Rest_Solution'`` from
-        `ocp.rest_solution`), kept when appdyn's verification turns a converged solve into a
+        `ocp.rest_solution`, ``''`` when no solver ran), kept when appdyn's verification turns a converged solve into a
         failure.
     nlp_point : mapping or None
         The NLP point IPOPT returned (``'key'``: the structure of the NLP it belongs to,
@@ -152,7 +152,7 @@ class Solution(Result):
     multipliers: Mapping[str, np.ndarray]
     dense: DenseOutput = field(repr=False)
     nlp_point: Mapping | None = field(default=None, repr=False)
-    solver_status: str = "Solve_Succeeded"
+    solver_status: str = ""
 
     def __getstate__(self) -> dict:
         state = dict(self.__dict__)
@@ -297,7 +297,8 @@ class Solution(Result):
                     success: bool = True, status: int = 0, message: str = "",
                     iterations: int = 0, solve_time: float = 0.0, build_time: float = 0.0,
                     constraint_violation: float = float("nan"),
-                    multipliers: Mapping[str, np.ndarray] | None = None, **extra) -> "Solution":
+                    multipliers: Mapping[str, np.ndarray] | None = None, solver_status: str = "",
+                    **extra) -> "Solution":
         """A solution of ``problem`` from the values at the transcription's nodes.
 
         Parameters
@@ -313,8 +314,9 @@ class Solution(Result):
         p : array_like, shape (np,)
         T : float [s]
         cost, success, status, message, iterations, solve_time, build_time, constraint_violation
-            As the attributes of the same name (``status`` an int; ``solver_status``, IPOPT's
-            text, defaults to ``'Solve_Succeeded'`` and may come in ``extra``).
+            As the attributes of the same name (``status`` an int).
+        solver_status : str, optional
+            IPOPT's return status text (default ``''``: no solver ran).
         multipliers : mapping of str to ndarray, optional
             By block, as `ocp.nlp.Discretization.multipliers`; costates follow from its
             ``'defect'`` entry (Radau). Default: none (empty mapping, no costates).
@@ -357,7 +359,7 @@ class Solution(Result):
                    solve_time=float(solve_time), build_time=float(build_time), costates=costates,
                    transcription=tr, mesh=mesh, problem=problem,
                    constraint_violation=float(constraint_violation), multipliers=mult,
-                   dense=dense, **extra)
+                   dense=dense, solver_status=str(solver_status), **extra)
 
     # ----------------------------------------------------------------- dense
     def sample(self, t):

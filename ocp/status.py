@@ -42,7 +42,8 @@ __all__ = ["CODES", "IPOPT_CODES", "APPDYN_CODES", "status_code", "status_name",
            "STATUS_BOUND_VIOLATION", "STATUS_RESIMULATION", "STATUS_STALLED", "STATUS_WORSE",
            "STATUS_POINTING", "STATUS_REFINE", "STATUS_UNSTABLE", "STATUS_LIMITS",
            "STATUS_SIMULATION", "STATUS_TERMINAL", "STATUS_PATH_LIMITS", "STATUS_PROPAGATION",
-           "STATUS_CHECK", "STATUS_TRACKING", "STATUS_DEFLECTION", "STATUS_SHORT_HORIZON", "STATUS_NOT_SPANNING", "STATUS_EXCEPTION",
+           "STATUS_CHECK", "STATUS_TRACKING", "STATUS_DEFLECTION", "STATUS_SHORT_HORIZON",
+           "STATUS_NOT_SPANNING", "STATUS_EXCEPTION",
            "STATUS_UNKNOWN", "SOLVER_REST", "describe"]
 
 #: IPOPT's ``ApplicationReturnStatus`` names and numbers (IPOPT's ``IpReturnCodes_inc.h``).
@@ -72,7 +73,7 @@ IPOPT_CODES = {
 #: appdyn's own statuses: verification failures (101-119), warnings of a success (120-129),
 #: failures without a solver status (-200, -201).
 APPDYN_CODES = {
-    "Constraint_Tol_Not_Met": 101,  # the solver converged, the constraint violation > constraint_tol
+    "Constraint_Tol_Not_Met": 101,  # the solver converged, the violation > constraint_tol
     "Bound_Violation": 102,  # the dense output leaves a bound between the nodes
     "Resimulation_Mismatch": 103,  # the re-simulated control disagrees with the collocation
     "Refinement_Stalled": 104,  # mesh refinement: the error estimate stopped falling

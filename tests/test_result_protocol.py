@@ -327,7 +327,8 @@ def test_every_result_class_declares_an_int_status():
         attr = inspect.getattr_static(cls, "status", None)
         if isinstance(attr, property):
             declared[cls.__qualname__] = typing.get_type_hints(attr.fget).get("return")
-        elif dataclasses.is_dataclass(cls) and "status" in {f.name for f in dataclasses.fields(cls)}:
+        elif dataclasses.is_dataclass(cls) and "status" in {f.name
+                                                             for f in dataclasses.fields(cls)}:
             declared[cls.__qualname__] = typing.get_type_hints(cls).get("status")
     expected = {name: (np.ndarray if name == BatchResult.__qualname__ else int)
                 for name in declared}
@@ -346,11 +347,10 @@ def test_optimal_control_statuses_are_one_table_of_ints():
     from tests.ocp.reference import brachistochrone
 
     # IPOPT's enum ApplicationReturnStatus (independent truth: IPOPT's header)
-    assert (st.status_code("Solve_Succeeded"), st.status_code("Solved_To_Acceptable_Level"),
-            st.status_code("Infeasible_Problem_Detected"), st.status_code("User_Requested_Stop"),
-            st.status_code("Maximum_Iterations_Exceeded"), st.status_code("Maximum_WallTime_Exceeded"),
-            st.status_code("Invalid_Number_Detected"), st.status_code("Internal_Error")) == \
-        (0, 1, 2, 5, -1, -5, -13, -199)
+    names = ("Solve_Succeeded", "Solved_To_Acceptable_Level", "Infeasible_Problem_Detected",
+             "User_Requested_Stop", "Maximum_Iterations_Exceeded", "Maximum_WallTime_Exceeded",
+             "Invalid_Number_Detected", "Internal_Error")
+    assert [st.status_code(n) for n in names] == [0, 1, 2, 5, -1, -5, -13, -199]
     codes = list(st.CODES.values())
     assert len(set(codes)) == len(codes) and all(type(c) is int for c in codes)
     assert not set(st.APPDYN_CODES.values()) & set(st.IPOPT_CODES.values())

@@ -71,7 +71,7 @@ class MultiPhaseSolution(Result):
     problem: object = field(repr=False)
     info: Mapping = field(default_factory=dict, repr=False)
     nlp_point: Mapping | None = field(default=None, repr=False)
-    solver_status: str = "Solve_Succeeded"
+    solver_status: str = ""
 
     _repr_fields = ("cost", "phases", "tf", "constraint_violation", "iterations")
 

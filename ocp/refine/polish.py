@@ -417,7 +417,8 @@ def polish_switches(problem: Problem, solution: Solution, *, N: int | None = Non
         problem, tr, phys_mesh, sa.x[:nx], sa.dense.Uo[:nu, :, 0], np.asarray(sa.p)[:np_], T,
         cost=sa.cost, success=sa.success, status=sa.status, message=sa.message,
         iterations=sa.iterations, solve_time=sa.solve_time, build_time=sa.build_time,
-        constraint_violation=sa.constraint_violation, multipliers=mult)
+        constraint_violation=sa.constraint_violation, multipliers=mult,
+        solver_status=sa.solver_status)
     v = sa.dense.Uo[nu, :, 0]
     active = np.flatnonzero((v <= lo_s * T0 * (1 + 1e-6)) | (v >= hi_s * T0 * (1 - 1e-6)))
     info = {"method": "moving-knots", "switch_times": find_switches(out),

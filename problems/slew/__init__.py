@@ -51,7 +51,8 @@ Otherwise ``success=False`` with ``status`` `STATUS_POINTING` (106 ``Pointing_To
 of `ocp.status`). A rest-to-rest
 slew by a zero angle (``q0 = +/- qf``) is answered exactly without an NLP:
 `ocp.rest_solution` with ``T = 0`` (time-optimal) or zero torque over ``T`` (minimum
-effort), ``status = 0`` and ``solver_status = 'Rest_Solution'``. Tiny angles are solved in well-conditioned units: the
+effort), ``status = 0`` and ``solver_status = 'Rest_Solution'``. Tiny angles are solved in
+well-conditioned units: the
 horizon and the objective are scaled by the bang-bang time ``2 sqrt(angle / alpha)``, the
 target rows by the initial attitude error (`ocp.scaling`).
 

@@ -122,7 +122,8 @@ def polish_text(record: Mapping) -> str:
 def summary(solution: Solution, *, eigenaxis=None) -> dict:
     """JSON-ready summary of a slew solution.
 
-    Keys: success, status (an int, `ocp.status`), solver_status (IPOPT's text), message, T [s], cost, switch_times [s] (per torque axis),
+    Keys: success, status (an int, `ocp.status`), solver_status (IPOPT's text), message,
+    T [s], cost, switch_times [s] (per torque axis),
     controls (their names, the model's: ``L1..L3`` for a body torque),
     iterations, solve_time [s], constraint_violation (NLP units, see `ocp.solve`),
     pointing_error_arcsec (final attitude error of the re-simulated control [arcsec]),
@@ -219,7 +220,8 @@ def format_summary(data: dict) -> str:
     if missing:
         raise ValueError(f"`data` must be a dict from `summary`; missing keys {missing}")
     rows = [
-        ("success", f"{data['success']} ({describe(data['status'], data.get('solver_status', ''))})"),
+        ("success",
+         f"{data['success']} ({describe(data['status'], data.get('solver_status', ''))})"),
         ("maneuver time T [s]", f"{data['T']:.6f}"),
     ]
     if "eigenaxis_T" in data:

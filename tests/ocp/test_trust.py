@@ -105,7 +105,8 @@ def _slew(qf, T=(0.0, 10.0)):
 
 def test_rest_solution_of_a_zero_slew_is_exact_and_usable():
     sol = rest_solution(_slew([0.0, 0.0, 0.0, -1.0]))  # -q0: the same attitude
-    assert sol.success and sol.status == 0 and sol.solver_status == STATUS_REST and sol.T == 0.0 and sol.cost == 0.0
+    assert sol.success and sol.status == 0 and sol.solver_status == STATUS_REST
+    assert sol.T == 0.0 and sol.cost == 0.0
     assert sol.iterations == 0 and sol.constraint_violation <= 1e-15
     x, u = sol.sample(0.0)
     np.testing.assert_array_equal(x, [0, 0, 0, 1, 0, 0, 0])
