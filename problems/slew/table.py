@@ -27,6 +27,7 @@ from appdyn.dynamics.progress import accepts_progress_bar
 from appdyn.dynamics.interrupts import check_interrupt, interruptible
 from appdyn.dynamics.serialize import jsonable, text_table, to_json
 from appdyn.dynamics.validate import check_inertia, finite_array, one_of, positive, unit_quaternion
+from appdyn.ocp.status import status_name
 from appdyn.problems.dispersion.result import ALL_FAILED, ALL_OK, SOME_FAILED
 
 from .maneuvers import min_effort, time_optimal
@@ -296,8 +297,8 @@ class ManeuverTable(Result):
         cost = "T [s]" if self.objective == "time" else "cost [N^2 m^2 s]"
         head = ["target", "angle [deg]", "axis", cost, "ok", "status", "iter", "wall [s]"]
         lines = [[n, f"{np.degrees(a):.3f}", ",".join(f"{v:.3f}" for v in e),
-                  f"{(t if self.objective == 'time' else c):.9g}", "yes" if ok else "NO", s,
-                  str(it), f"{w:.3f}"]
+                  f"{(t if self.objective == 'time' else c):.9g}", "yes" if ok else "NO",
+                  status_name(s), str(it), f"{w:.3f}"]
                  for n, a, e, t, c, ok, s, it, w in zip(
                      self.names, self.angles, self.axes, self.T, self.cost, self.row_success,
                      self.row_status, self.iterations, self.wall_times)]

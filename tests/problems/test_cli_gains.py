@@ -80,5 +80,5 @@ def test_infeasible_limits_exit_1_naming_the_limit(tmp_path, capsys):
     code = main(["gains", "launch-vehicle", "--config", path])
     assert code == 1
     captured = capsys.readouterr()
-    assert "FAILED (Limits_Not_Met)" in captured.out
+    assert "FAILED (status 109 Limits_Not_Met" in captured.out
     assert "gimbal deflection |delta| <= 0.1 deg" in captured.err
