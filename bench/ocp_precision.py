@@ -81,6 +81,7 @@ from appdyn.dynamics import wheel_spacecraft
 from appdyn.dynamics.model import Model
 from appdyn.ocp import Problem, solve
 from appdyn.ocp.examples import GODDARD_OPTIMUM, goddard_rocket, min_energy, min_time
+from appdyn.ocp.status import status_name
 from appdyn.problems import slew
 
 NAME = "ocp_precision"
@@ -164,7 +165,8 @@ def one_run(name, problem, ref, guess, label, transcription, degree, N):
     except Exception:  # noqa: BLE001 - a failed re-simulation is a number, not a crash
         prop_ok, sim_cost, prop_err, scaled = False, float("nan"), float("nan"), float("nan")
     prop_time = time.perf_counter() - t0
-    row = dict(problem=name, transcription=label, N=N, success=bool(sol.success), status=sol.status,
+    row = dict(problem=name, transcription=label, N=N, success=bool(sol.success),
+               status=status_name(sol.status),
                iterations=int(sol.iterations), build_time=float(sol.build_time),
                solve_time=float(sol.solve_time),
                time_per_iteration=float(sol.solve_time) / max(int(sol.iterations), 1),
@@ -194,7 +196,7 @@ def sweep(quick):
             wall = time.perf_counter() - t0
             guess = first
             extra.append(dict(problem=name, transcription="time_optimal (polished)", N=30,
-                              success=bool(first.success), status=first.status,
+                              success=bool(first.success), status=status_name(first.status),
                               iterations=int(first.iterations), build_time=float("nan"),
                               solve_time=wall, time_per_iteration=float("nan"),
                               cost=float(first.T), reference=ref,

@@ -20,7 +20,7 @@ from ..mesh import Mesh
 from ..problem import Problem
 from ..progress import LOGGER, stage_sink
 from ..solution import Solution
-from ..status import STATUS_STALLED
+from ..status import STATUS_STALLED, status_name
 from ..solve import solve
 from ..transcription import Radau, Transcription, get_transcription
 from .errors import IntervalErrors, interval_errors
@@ -399,7 +399,7 @@ def refine(problem: Problem, solution: Solution | None = None, *, tol: float = 1
         if not (sol.success or _refinable(sol)):
             history.append(RefinementRound(sol.mesh.N, float("nan"), sol.cost, sol.iterations,
                                            time.perf_counter() - t_round))
-            stop = f"the solve of round {rnd} failed ({sol.status})"
+            stop = f"the solve of round {rnd} failed ({status_name(sol.status)})"
             break
         itol = float(np.clip(1e-4 * tol, 1e-13, 1e-10))  # CVODES fails below ~1e-14
         est = interval_errors(sol, rtol=itol, atol=itol)
@@ -451,6 +451,6 @@ def refine(problem: Problem, solution: Solution | None = None, *, tol: float = 1
     if stop == "stalled" and (sol.success or _refinable(sol)):
         message = _stall_message(history, q, stall_rounds, sol)
         if not sol.success:  # the last round also failed a check of its dense output
-            message += f" The last round also failed ({sol.status}): {sol.message}"
+            message += f" The last round also failed ({status_name(sol.status)}): {sol.message}"
         return annotate(sol, info, success=False, status=STATUS_STALLED, message=message)
     return annotate(sol, info, message=message)
