@@ -12,11 +12,14 @@ from .nlp import Discretization
 from .problem import Problem
 from .scaling import auto_scaling
 from .solution import Solution
-from .status import SOLVER_REST as STATUS_REST
+from .status import SOLVER_REST
 from .solve import STATUS_CONSTRAINT_TOL, check_constraint_tol, make_solution
 from .transcription import get_transcription
 
 __all__ = ["rest_solution", "STATUS_REST"]
+
+#: ``solver_status`` of `rest_solution` (no NLP solved; its ``status`` is 0 on success)
+STATUS_REST = SOLVER_REST
 
 
 

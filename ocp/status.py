@@ -99,31 +99,57 @@ APPDYN_CODES = {
 CODES = {**IPOPT_CODES, **APPDYN_CODES}
 _NAMES = {code: name for name, code in CODES.items()}
 
+#: 0: IPOPT's ``Solve_Succeeded`` and every check of appdyn passed (a success).
 STATUS_SUCCESS = CODES["Solve_Succeeded"]
+#: 1: IPOPT stopped at its acceptable level (not a verified solution).
 STATUS_ACCEPTABLE = CODES["Solved_To_Acceptable_Level"]
+#: 2: IPOPT converged to a point of local infeasibility.
 STATUS_INFEASIBLE = CODES["Infeasible_Problem_Detected"]
+#: 5: stopped by a callback (a Ctrl-C, a progress callable).
 STATUS_USER_STOP = CODES["User_Requested_Stop"]
+#: -1: IPOPT reached ``max_iter``.
 STATUS_MAX_ITER = CODES["Maximum_Iterations_Exceeded"]
+#: -5: IPOPT reached ``max_wall_time`` (or a polish its ``budget``).
 STATUS_WALL_TIME = CODES["Maximum_WallTime_Exceeded"]
+#: 101: the solver converged but the constraint violation exceeds ``constraint_tol``.
 STATUS_CONSTRAINT_TOL = CODES["Constraint_Tol_Not_Met"]
+#: 102: the dense output leaves a bound by more than ``constraint_tol``.
 STATUS_BOUND_VIOLATION = CODES["Bound_Violation"]
+#: 103: the re-simulation of the control disagrees with the collocation.
 STATUS_RESIMULATION = CODES["Resimulation_Mismatch"]
+#: 104: mesh refinement stopped because its error estimate stalled.
 STATUS_STALLED = CODES["Refinement_Stalled"]
+#: 105: a polish ended with a cost worse than its start's.
 STATUS_WORSE = CODES["Worse_Than_Start"]
+#: 106: a slew's re-simulated final attitude or rate error exceeds its tolerance.
 STATUS_POINTING = CODES["Pointing_Tol_Not_Met"]
+#: 107: a slew's mesh refinement did not reach its tolerance.
 STATUS_REFINE = CODES["Refinement_Tol_Not_Met"]
+#: 108: a gain design converged but the designed loop is not stable.
 STATUS_UNSTABLE = CODES["Closed_Loop_Unstable"]
+#: 109: no gains of the designed form meet the limits.
 STATUS_LIMITS = CODES["Limits_Not_Met"]
+#: 110: the verifying simulation failed.
 STATUS_SIMULATION = CODES["Simulation_Failed"]
+#: 111: an ascent's re-propagated end misses the target.
 STATUS_TERMINAL = CODES["Terminal_Conditions_Not_Met"]
+#: 112: an ascent's re-propagation exceeds ``q_max`` or ``qalpha_max``.
 STATUS_PATH_LIMITS = CODES["Path_Limits_Exceeded"]
+#: 113: an ascent's re-propagation failed.
 STATUS_PROPAGATION = CODES["Propagation_Failed"]
+#: 114: a job's own check of the solution failed.
 STATUS_CHECK = CODES["Check_Failed"]
+#: 115: a flown pitch program left its tracking-error bound.
 STATUS_TRACKING = CODES["Tracking_Error_Exceeded"]
+#: 116: a flown pitch program asked for more deflection than allowed.
 STATUS_DEFLECTION = CODES["Deflection_Limit_Exceeded"]
+#: 120 (a success's warning): the design horizon is short.
 STATUS_SHORT_HORIZON = CODES["Short_Horizon"]
+#: 121 (a success's warning): the initial states do not span ``R^n``.
 STATUS_NOT_SPANNING = CODES["Initial_States_Not_Spanning"]
+#: -200: an evaluation error inside CasADi (no IPOPT status).
 STATUS_EXCEPTION = CODES["Exception"]
+#: -201: a status text not in `CODES`.
 STATUS_UNKNOWN = CODES["Unknown"]
 #: ``solver_status`` of `ocp.rest_solution` (no NLP solved; its ``status`` is 0 on success).
 SOLVER_REST = "Rest_Solution"

@@ -16,18 +16,21 @@ from appdyn.dynamics.figures import finish_figure, panel_axes
 from appdyn.dynamics.results import Result
 from appdyn.dynamics.serialize import text_table
 from appdyn.dynamics.validate import finite_scalar, integer, one_of, positive
-from appdyn.ocp.status import STATUS_PATH_LIMITS as STATUS_LIMITS
-from appdyn.ocp.status import STATUS_PROPAGATION, STATUS_TERMINAL, describe
+from appdyn.ocp import status as _status
+from appdyn.ocp.status import describe
 
 from .planar_model import (RHO0, SCALE_HEIGHT, STATES, AscentVehicle, check_vehicle, planar_model,
                            vertical_rise)
 
 __all__ = ["planar_ascent", "PlanarAscent", "STATUS_TERMINAL", "STATUS_LIMITS", "STATUS_PROPAGATION"]
 
-# statuses of a `PlanarAscent` (the table of `ocp.status`): STATUS_TERMINAL (111) solved, but
-# the re-propagated end misses the target; STATUS_LIMITS (112 Path_Limits_Exceeded) the
-# re-propagated trajectory exceeds q_max or qalpha_max; STATUS_PROPAGATION (113) the
-# re-propagation failed
+#: status 111 of a `PlanarAscent` (`ocp.status`): solved, but the re-propagated end misses
+#: the target
+STATUS_TERMINAL = _status.STATUS_TERMINAL
+#: status 112: solved, but the re-propagated trajectory exceeds q_max or qalpha_max
+STATUS_LIMITS = _status.STATUS_PATH_LIMITS
+#: status 113: solved, but the re-propagation failed
+STATUS_PROPAGATION = _status.STATUS_PROPAGATION
 
 
 # ------------------------------------------------------------------------ results

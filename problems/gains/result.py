@@ -8,13 +8,15 @@ import numpy as np
 
 from appdyn.dynamics.serialize import jsonable, text_table, to_json
 from appdyn.dynamics.results import Result
-from appdyn.ocp.status import STATUS_LIMITS, STATUS_UNSTABLE, describe
+from appdyn.ocp import status as _status
+from appdyn.ocp.status import describe
 
 __all__ = ["GainDesign", "STATUS_UNSTABLE", "STATUS_LIMITS"]
 
-# statuses (the table of `ocp.status`): STATUS_UNSTABLE (108) the NLP converged but the
-# designed loop is not stable; STATUS_LIMITS (109) the limits (deflection, rate, torque)
-# cannot be met by any gains of the form
+#: status 108 (`ocp.status`): the NLP converged but the designed loop is not stable
+STATUS_UNSTABLE = _status.STATUS_UNSTABLE
+#: status 109: the limits (deflection, rate, torque) cannot be met by any gains of the form
+STATUS_LIMITS = _status.STATUS_LIMITS
 
 
 # signal -> (axis label, scale to the shown unit, shown unit, verification key of its limit)

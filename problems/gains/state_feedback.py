@@ -33,7 +33,7 @@ from appdyn import ocp
 from appdyn.dynamics.model import Model
 from appdyn.dynamics.validate import finite_array, positive
 
-from appdyn.ocp.status import STATUS_NOT_SPANNING, STATUS_SHORT_HORIZON
+from appdyn.ocp import status as _status
 
 from .result import STATUS_UNSTABLE, GainDesign
 
@@ -42,10 +42,13 @@ __all__ = ["state_feedback_gains", "linear_system", "default_initial_gain", "HOR
 
 #: a horizon shorter than this many slowest closed-loop time constants draws a warning
 HORIZON_RATIO_MIN = 10.0
-# warning statuses (``success`` stays True; the table of `ocp.status`): STATUS_SHORT_HORIZON
-# (120) the horizon is shorter than ``HORIZON_RATIO_MIN`` time constants of the designed
-# loop, so ``K`` is a finite-horizon compromise, not the LQR gain; STATUS_NOT_SPANNING (121)
-# the initial states do not span ``R^n``; ``K`` need not be unique (module docstring)
+#: status 120 (``success`` stays True; `ocp.status`): the horizon is shorter than
+#: ``HORIZON_RATIO_MIN`` time constants of the designed loop, so ``K`` is a finite-horizon
+#: compromise, not the LQR gain
+STATUS_SHORT_HORIZON = _status.STATUS_SHORT_HORIZON
+#: status 121 (``success`` stays True): the initial states do not span ``R^n``; ``K`` need
+#: not be unique (module docstring)
+STATUS_NOT_SPANNING = _status.STATUS_NOT_SPANNING
 
 _DEFAULT_N = 80
 _DEFAULT_IPOPT = {"tol": 1e-10}

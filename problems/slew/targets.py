@@ -24,8 +24,8 @@ __all__ = ["KeepOut", "POINTING_TOL", "RATE_TOL", "MIN_REFINE_TOL", "STATUS_POIN
 POINTING_TOL = 1e-6  # [rad] default largest re-simulated final attitude error of a success
 RATE_TOL = 1e-6  # [rad/s] default largest re-simulated final rate error of a success
 MIN_REFINE_TOL = 1e-12  # smallest refinement tol min_effort accepts (CVODES reference ~1e-13)
-STATUS_POINTING = _CODES["Pointing_Tol_Not_Met"]  # 106 (the table of `ocp.status`)
-STATUS_REFINE = _CODES["Refinement_Tol_Not_Met"]  # 107
+STATUS_POINTING = _CODES["Pointing_Tol_Not_Met"]  #: status 106: pointing or rate error
+STATUS_REFINE = _CODES["Refinement_Tol_Not_Met"]  #: status 107: refinement tolerance not reached
 ARCSEC = 180.0 * 3600.0 / math.pi
 
 
