@@ -269,45 +269,39 @@ def test_impact_result():
 def test_every_public_result_class_follows_the_protocol():
     """Enumerated from the packages' public names: a class named like a result, report or
     solution inherits `Result` (so a new one cannot be written by hand)."""
-    import importlib
     import inspect
-    import pkgutil
 
-    import appdyn
     seen = set()
-    for pkg in ("appdyn.dynamics", "appdyn.ocp", "appdyn.problems"):
-        root = importlib.import_module(pkg)
-        mods = [root] + [importlib.import_module(m.name) for m in
-                         pkgutil.walk_packages(root.__path__, pkg + ".")
-                         if not m.name.split(".")[-1].startswith("_")
-                         and ".cli" not in m.name]
-        for mod in mods:
-            for name in getattr(mod, "__all__", ()):
-                obj = getattr(mod, name, None)
-                if inspect.isclass(obj) and name.endswith(("Result", "Report", "Solution")):
-                    seen.add(obj)
+    for mod in _library_modules():
+        for name in getattr(mod, "__all__", ()):
+            obj = getattr(mod, name, None)
+            if inspect.isclass(obj) and name.endswith(("Result", "Report", "Solution")):
+                seen.add(obj)
     assert len(seen) >= 15, seen
     outside = sorted(c.__qualname__ for c in seen if not issubclass(c, Result))
     assert not outside, outside
 
 
-def _result_classes():
-    """Every `Result` subclass defined in the library's modules (the CLI's printouts aside)."""
+def _library_modules():
+    """The public modules of appdyn.dynamics, appdyn.ocp and appdyn.problems (the CLI aside)."""
     import importlib
-    import inspect
     import pkgutil
 
-    seen = set()
+    mods = []
     for pkg in ("appdyn.dynamics", "appdyn.ocp", "appdyn.problems"):
         root = importlib.import_module(pkg)
-        mods = [root] + [importlib.import_module(m.name) for m in
-                         pkgutil.walk_packages(root.__path__, pkg + ".")
-                         if not m.name.split(".")[-1].startswith("_")
-                         and ".cli" not in m.name]
-        for mod in mods:
-            seen.update(obj for obj in vars(mod).values() if inspect.isclass(obj)
-                        and issubclass(obj, Result) and obj is not Result)
-    return seen
+        mods += [root] + [importlib.import_module(m.name) for m in
+                          pkgutil.walk_packages(root.__path__, pkg + ".")
+                          if not m.name.split(".")[-1].startswith("_") and ".cli" not in m.name]
+    return mods
+
+
+def _result_classes():
+    """Every `Result` subclass defined in the library's modules (the CLI's printouts aside)."""
+    import inspect
+
+    return {obj for mod in _library_modules() for obj in vars(mod).values()
+            if inspect.isclass(obj) and issubclass(obj, Result) and obj is not Result}
 
 
 def test_every_result_class_declares_an_int_status():
