@@ -1,7 +1,8 @@
 """The ``status`` codes of the optimal-control results: one table, ints everywhere.
 
-Every result of `appdyn.ocp` and of the jobs built on it (`Solution`, `PhasedSolution`,
-`RefinedSolution`, the slews, `GainDesign`, the ascents) carries
+Every result of `appdyn.ocp` and of the jobs built on it (`Solution`, `MultiPhaseSolution`,
+`RefinedSolution`, the slews, `GainDesign`, `PlanarAscent`, the Delta III `AscentResult`)
+carries
 
 - ``status``: an **int**, 0 for a success (what `appdyn.dynamics.results.Result` asks);
 - ``solver_status``: the text IPOPT returned (its ``ApplicationReturnStatus`` name, e.g.
@@ -10,7 +11,8 @@ Every result of `appdyn.ocp` and of the jobs built on it (`Solution`, `PhasedSol
   said when appdyn's own verification turned a converged solve into a failure;
 - ``message``: why, in words.
 
-The codes (`CODES`, `status_code`, `status_name`):
+(`PitchTracking`, which solves no NLP, takes its int codes from the same table.) The codes
+(`CODES`, `status_code`, `status_name`):
 
 - IPOPT's return statuses keep IPOPT's own numbers (``IpReturnCodes_inc.h``): 0
   ``Solve_Succeeded``; 1 to 6 a stop short of a verified optimum (1
