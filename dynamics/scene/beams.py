@@ -28,6 +28,8 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.optimize import brentq
 
+from .. import cache
+
 __all__ = ["clamped_free_roots", "ClampedFreeModes", "TabulatedModes", "gauss_legendre"]
 
 
@@ -71,7 +73,7 @@ def clamped_free_roots(modes: int, tip_mass_ratio: float = 0.0) -> np.ndarray:
     return out
 
 
-@functools.lru_cache(maxsize=16)
+@cache.memoize
 def _leggauss(n: int) -> tuple:
     return np.polynomial.legendre.leggauss(n)
 
