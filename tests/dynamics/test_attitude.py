@@ -16,8 +16,8 @@ from scipy.linalg import expm
 from scipy.spatial.transform import Rotation
 
 from appdyn.dynamics import attitude as at
+from tests.bodies import GEMINI
 
-GEMINI = np.array([[4560.7, 31.2, -43.4], [31.2, 4545.0, -270.7], [-43.4, -270.7, 1567.4]])
 
 finite = dict(allow_nan=False, allow_infinity=False)
 unit_vectors = st.tuples(*[st.floats(-1, 1, **finite)] * 3).map(np.array).filter(

@@ -24,10 +24,10 @@ from appdyn.problems.stability import (PointMassDamper, SphericalDamper, classif
 from appdyn.problems.cli.stability import add_parser as add_stability_parser
 from appdyn.problems.cli.stability import main as cli_main
 from appdyn.problems.cli.stability import run as cli_run
+from tests.bodies import GEMINI
 
 TOL = 1e-9  # eigenvalues vs closed forms, relative to the spectral radius
 G0 = 9.80665
-GEMINI = np.array([[4560.7, 31.2, -43.4], [31.2, 4545.0, -270.7], [-43.4, -270.7, 1567.4]])
 
 
 def max_pair_error(computed, expected):

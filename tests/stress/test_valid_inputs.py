@@ -936,22 +936,9 @@ def test_every_function_is_swept():
         assert set(table) <= set(FUNCTIONS), set(table) - set(FUNCTIONS)
 
 
-@pytest.fixture(scope="module", autouse=True)
-def _no_local_constants():
-    """Draws independent of the code base's literals: Hypothesis (6.1xx) mixes constants it
-    mines from every loaded local module (appdyn's own files) into its draws, so a new float
-    literal anywhere, or another set of modules loaded by earlier tests, changed every draw
-    of this file (a new DOP853 coefficient drew a new, failing cmg_slew input). Only its
-    global constants are used here; the constant cache is cleared before and after."""
-    from hypothesis.internal.conjecture import providers
-    real = providers._get_local_constants
-    providers._get_local_constants = providers.Constants
-    providers.CONSTANTS_CACHE.cache.clear()
-    yield
-    providers._get_local_constants = real
-    providers.CONSTANTS_CACHE.cache.clear()
-
-
+# Draws independent of the code base's literals (a new DOP853 coefficient once drew a new,
+# failing cmg_slew input): see the fixture in tests/conftest.py.
+@pytest.mark.usefixtures("hypothesis_global_constants")
 @pytest.mark.parametrize("func", FUNCS)
 def test_random_valid_inputs(func):
     fn = FUNCTIONS[func]
