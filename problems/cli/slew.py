@@ -231,7 +231,7 @@ def run(args) -> int:
     print(text)
     if args.plot:
         if success:
-            slew.plot_slew(sol, args.plot)
+            slew.plot_slew(sol, path=args.plot)
             print(f"plot written to {args.plot}")
         else:
             print(f"appdyn slew: --plot {args.plot} skipped: the slew failed ({why})",

@@ -259,7 +259,7 @@ def launch_vehicle_gains(vehicle, scenarios, *, delta_max, delta_rate_max, weigh
                          lambda k, other: max(node_peaks(model, outputs, other, K, labels),
                                               key=lambda item: item[1][k]))
 
-    stab, _ = stability_check(veh, sol.p, tf)
+    stab, _ = stability_check(veh, sol.p, filter_tau=tf)
     ver.update(stab)
     runs = resimulate(veh, sol.p, scs, T, points, filter_tau=tf)
     for which in ("delta", "delta_rate"):
@@ -281,7 +281,7 @@ def launch_vehicle_gains(vehicle, scenarios, *, delta_max, delta_rate_max, weigh
     return GainDesign(True, sol.status, msg, gains, units, float(sol.cost), runs, ver, sol)
 
 
-def plot_design(design: GainDesign, path=None):
+def plot_design(design: GainDesign, *, path=None):
     """Attitude, deflection and deflection rate of every scenario of a launch-vehicle design.
 
     Parameters

@@ -242,7 +242,7 @@ def format_summary(data: dict) -> str:
     return "\n".join(["Optimal slew"] + [f"  {k:<{width}}  {v}" for k, v in rows])
 
 
-def plot_slew(solution: Solution, path=None, *, fig=None, dpi: int = 110):
+def plot_slew(solution: Solution, *, path=None, fig=None, dpi: int = 110):
     """Quaternion, rates, torques (with the torque bounds ``+-u_max`` dashed) and the
     rotation path (body axes on the unit sphere).
 

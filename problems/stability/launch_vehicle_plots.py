@@ -97,7 +97,7 @@ def _margin_texts(mg):
     return gm, pm
 
 
-def bode_plot(report: StabilityReport, path=None, *, fig=None, omega=None,
+def bode_plot(report: StabilityReport, *, path=None, fig=None, omega=None,
               pole_map: bool = False):
     """Bode plot of the loop at the engine deflection with the gain and phase margins marked.
 
@@ -161,7 +161,7 @@ def bode_plot(report: StabilityReport, path=None, *, fig=None, omega=None,
     return finish_figure(fig, path)
 
 
-def nichols_plot(report: StabilityReport, path=None, *, ax=None, omega=None):
+def nichols_plot(report: StabilityReport, *, path=None, ax=None, omega=None):
     """Nichols plot of the loop at the engine deflection: the critical point (-180 deg, 0 dB),
     the gain margin (vertical) and the phase margin (horizontal) marked.
 

@@ -299,18 +299,18 @@ class StabilityReport:
             lines.append(f"{'quantities:':<{w + 2}}  {'linear model':>17}  {'closed form':>17}  "
                          f"{'unit':<9} source")
             for q in self.quantities:
-                lines.append(f"  {q.name:<{w}}  {format_number(q.value, '.10g'):>17}  "
-                             f"{format_number(q.closed_form, '.10g'):>17}  {q.unit:<9} "
+                lines.append(f"  {q.name:<{w}}  {format_number(q.value, spec='.10g'):>17}  "
+                             f"{format_number(q.closed_form, spec='.10g'):>17}  {q.unit:<9} "
                              f"{q.equation}")
         if self.margins is not None:
             mg = self.margins
             lines.append("margins:")
             lines.append(f"  gain margin   {format_number(mg.gain_margin)} "
-                         f"({format_number(mg.gain_margin_db, '.4g')} dB) at "
+                         f"({format_number(mg.gain_margin_db, spec='.4g')} dB) at "
                          f"{format_number(mg.phase_crossover)} rad/s")
-            lines.append(f"  phase margin  {format_number(mg.phase_margin, '.6g')} deg at "
+            lines.append(f"  phase margin  {format_number(mg.phase_margin, spec='.6g')} deg at "
                          f"{format_number(mg.gain_crossover)} rad/s")
-            lines.append(f"  stability margin {format_number(mg.stability_margin, '.6g')} at "
+            lines.append(f"  stability margin {format_number(mg.stability_margin, spec='.6g')} at "
                          f"{format_number(mg.stability_margin_frequency)} rad/s")
         if self.closed_form_error is not None:
             lines.append(f"closed-form check: max |lambda - closed form| / rho = "

@@ -26,11 +26,12 @@ def test_switch_times_agree_with_the_engine(bilimoria_wie):
         slew.switch_times(sol, axis=3)
 
 
+@pytest.mark.slow
 def test_plot_slew_returns_a_figure_and_saves_on_request(bilimoria_wie, tmp_path):
     fig = slew.plot_slew(bilimoria_wie)
     assert isinstance(fig, Figure) and len(fig.axes) == 4
     out = tmp_path / "slew.png"
-    fig2 = slew.plot_slew(bilimoria_wie, out)
+    fig2 = slew.plot_slew(bilimoria_wie, path=out)
     assert isinstance(fig2, Figure) and out.stat().st_size > 0
     with pytest.raises(TypeError, match="`fig`"):
         slew.plot_slew(bilimoria_wie, fig="figure")

@@ -265,6 +265,7 @@ def test_jet_damping_and_frozen_mass():
 
 
 # ---------------------------------------------------------------------- plots and I/O
+@pytest.mark.slow
 def test_bode_plot_marks_the_margins_where_python_control_puts_them(tmp_path):
     from matplotlib.figure import Figure
 
@@ -273,7 +274,7 @@ def test_bode_plot_marks_the_margins_where_python_control_puts_them(tmp_path):
                                          deflection_gimbal=0.5))
     mg = rep.margins
     assert math.isfinite(mg.phase_crossover) and math.isfinite(mg.gain_crossover)
-    fig = bode_plot(rep, tmp_path / "bode.png", pole_map=True)
+    fig = bode_plot(rep, path=tmp_path / "bode.png", pole_map=True)
     assert isinstance(fig, Figure) and len(fig.axes) == 3
     assert (tmp_path / "bode.png").read_bytes()[:4] == b"\x89PNG"
     w, mag = fig.axes[0].lines[0].get_data()
@@ -327,6 +328,7 @@ def test_loop_transfer_needs_a_launch_vehicle_report():
 
 
 # ------------------------------------------------------------------------ time response
+@pytest.mark.slow
 def test_rigid_response_follows_the_damped_oscillator():
     """Small psi0: psi = psi0 e^(-zeta wn t) (cos wd t + zeta wn / wd sin wd t); the
     nonlinearity sin(delta) - delta is (k psi0)^2 / 6 ~ 1e-6 relative."""
