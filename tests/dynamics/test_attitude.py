@@ -556,6 +556,7 @@ def test_symbolic_dcm_of_non_unit_quaternion_keeps_the_formula():
 @pytest.mark.filterwarnings("error")
 @settings(max_examples=200)
 @given(st.lists(quats, min_size=1, max_size=6), st.floats(-0.99e-6, 0.99e-6))
+@pytest.mark.slow
 def test_valid_inputs_within_tolerance_round_trip(qs, dn):
     """Quaternions off unit norm by < 1e-6 and DCMs built from them are accepted; the
     conversions agree with scipy and round-trip (batched and one at a time)."""

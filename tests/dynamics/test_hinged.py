@@ -57,6 +57,7 @@ def _relative_drift(values):
 
 # --------------------------------------------------------------- conservation
 @pytest.mark.parametrize("kind", ["ball", "revolute"])
+@pytest.mark.slow
 def test_momentum_and_energy_conserved_and_hinge_held_over_1000_s(kind):
     res = _long_run(kind, 1.0)
     assert res.success

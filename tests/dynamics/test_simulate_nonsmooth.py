@@ -61,6 +61,7 @@ def test_the_graph_scan_finds_kinks_and_only_kinks():
 
 
 @pytest.mark.parametrize("rtol", [1e-6, 1e-8])
+@pytest.mark.slow
 def test_saturated_pd_wheel_slew_is_verified(rtol, slew_reference):
     loop = saturated_pd_wheel_loop()
     assert np.max(np.abs(law_numpy(X0))) >= LMAX  # (the premise: the law starts saturated)

@@ -63,6 +63,7 @@ def test_free_flying_robot_polynomial_control_leaving_its_bounds_is_no_success()
 
 
 @pytest.mark.parametrize("control", ["linear", "constant"])
+@pytest.mark.slow
 def test_free_flying_robot_within_bounds_with_a_linear_or_constant_control(control):
     problem, truth = free_flying_robot()
     sol = solve(problem, N=80, control=control)

@@ -36,6 +36,7 @@ def printed_numbers(text, names):
     return found
 
 
+@pytest.mark.slow
 def test_ball_hinge_conserves_and_writes_plot_and_json(tmp_path, capsys):
     png, out = tmp_path / "h.png", tmp_path / "h.json"
     assert main([*BALL, "--plot", str(png), "--json", str(out)]) == 0
@@ -129,6 +130,7 @@ def test_inertia_that_is_not_positive_definite_exits_2(capsys):
 
 
 # ----------------------------------------------------------------- stability cases
+@pytest.mark.slow
 def test_shaken_pendulum_inverted_is_stabilized(tmp_path, capsys):
     out, png = tmp_path / "sp.json", tmp_path / "sp.png"
     assert main(["stability", "shaken-pendulum", *ROD, "--freq", "200", "--position",

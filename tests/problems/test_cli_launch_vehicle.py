@@ -62,6 +62,7 @@ def test_sweep_finds_the_gain_boundary(capsys):
     assert "k_psi = 0.11492936" in capsys.readouterr().out  # Routh-Hurwitz, drift included
 
 
+@pytest.mark.slow
 def test_simulate_attitude_error(tmp_path, capsys):
     out, png = tmp_path / "sim.json", tmp_path / "sim.png"
     code = main(["simulate", "launch-vehicle", *VEHICLE, "--k-psi", "2", "--k-psidot", "2",

@@ -20,6 +20,7 @@ def ascent():
     return delta3_ascent()
 
 
+@pytest.mark.slow
 def test_reproduces_the_published_optimum(ascent):
     assert ascent.success, ascent.message
     # Betts 7529.712412, yapss 7529.712268-7529.712287: the literature agrees on 7529.712
@@ -66,6 +67,7 @@ def test_table_and_json(ascent):
     assert len(data["solution"]["phases"]) == 4
 
 
+@pytest.mark.slow
 def test_cli_prints_the_phase_table(tmp_path, capsys):
     out = tmp_path / "d3.json"
     assert main(["ascent", "delta3", "--no-refine", "--json", str(out)]) == 0

@@ -301,6 +301,7 @@ def test_distribution_draws_are_seeded():
 
 
 @pytest.mark.parametrize("module_name", MODULES)
+@pytest.mark.slow
 def test_docstring_examples_run_as_written(module_name):
     module = importlib.import_module(module_name)
     result = doctest.testmod(module, optionflags=doctest.NORMALIZE_WHITESPACE | doctest.ELLIPSIS)
@@ -326,6 +327,7 @@ def _raising_flag(res, flag):
     return flag
 
 
+@pytest.mark.slow
 def test_batch_of_a_fixed_model_meets_the_closed_form_and_the_serial_run():
     """``batch=True``: all samples in one `simulate` call; each sample's transverse rate
     equals the axisymmetric closed form ``w1(t) = w1(0) cos(lambda t)``, ``lambda = (I_a -

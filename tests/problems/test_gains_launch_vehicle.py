@@ -53,6 +53,7 @@ def _loop_transfer(k, kd, tau):
 
 
 @pytest.mark.parametrize("which", ["with_actuator", "rigid_gimbal"])
+@pytest.mark.slow
 def test_margins_agree_with_python_control_on_the_closed_form_loop(which, request):
     d = request.getfixturevalue(which)
     assert isinstance(d, GainDesign) and d.success, d.message
@@ -75,6 +76,7 @@ def test_margins_agree_with_python_control_on_the_closed_form_loop(which, reques
 
 
 @pytest.mark.parametrize("which", ["with_actuator", "rigid_gimbal"])
+@pytest.mark.slow
 def test_resimulated_scenarios_are_stable_and_hold_the_limits(which, request):
     d = request.getfixturevalue(which)
     k, kd = d.gains["k_psi"], d.gains["k_psidot"]
@@ -129,6 +131,7 @@ def _solve_infeasible(**limits):
                                 horizon=6.0, N=16, **limits)
 
 
+@pytest.mark.slow
 def test_gimbal_too_weak_for_the_gust_names_the_deflection_limit():
     d = _solve_infeasible(delta_max=math.radians(0.1), delta_rate_max=RMAX)
     assert not d.success and d.status == STATUS_LIMITS
@@ -136,6 +139,7 @@ def test_gimbal_too_weak_for_the_gust_names_the_deflection_limit():
     assert d.verification["violated"] == ["delta"]
 
 
+@pytest.mark.slow
 def test_unreachable_rate_limit_names_the_rate_limit():
     d = _solve_infeasible(delta_max=DMAX, delta_rate_max=math.radians(0.01))
     assert not d.success and d.status == STATUS_LIMITS

@@ -66,6 +66,7 @@ def test_short_horizon_warns_and_is_not_lqr():
     assert res.verification["lqr_relative_difference"] > 1e-2
 
 
+@pytest.mark.slow
 def test_initial_states_not_spanning_warn_and_leave_gains_undetermined():
     """Two decoupled stable modes, both initial states on the first axis (an invariant
     subspace of every diagonal loop): the second column of K does not affect the cost and

@@ -39,6 +39,7 @@ def _pointing_error(q, qf):
 
 
 @pytest.mark.parametrize("polish", [False, True])
+@pytest.mark.slow
 def test_new_users_slew_keeps_the_torque_bounds_and_reaches_the_target(polish):
     sol = slew.time_optimal(INERTIA, angle=np.pi / 2, axis=AXIS, u_max=U_MAX, polish=polish)
     assert sol.success, sol.message

@@ -50,6 +50,7 @@ def test_effort_rows_match_the_cubic_closed_form():
     np.testing.assert_allclose(t.cost, 6 * J ** 2 * t.angles ** 2 / 2.0 ** 3, rtol=1e-6)
 
 
+@pytest.mark.slow
 def test_executors_give_the_serial_table(serial):
     calls = []
     with ThreadPoolExecutor(2) as threads, ProcessPoolExecutor(2) as processes:
@@ -142,6 +143,7 @@ def test_docstring_examples_run_as_written():
 
 
 # ------------------------------------------------------------------ CLI
+@pytest.mark.slow
 def test_cli_table_is_the_library_table(tmp_path, capsys):
     import json
 

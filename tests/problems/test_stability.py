@@ -384,6 +384,7 @@ def test_sweep_rotor_internal_damping_instability_speed():
     assert abs(res.boundaries[0].value - exact) <= 1e-8 * exact
 
 
+@pytest.mark.slow
 def test_sweep_gyrostat_boundaries():
     Ia, Ib, Ic, W = 3.0, 4.0, 5.0, 2.0
     res = sweep("gyrostat", "wheel_momentum", np.linspace(-2, 8, 6), inertia=[Ia, Ib, Ic],

@@ -136,6 +136,7 @@ def test_default_envelope_is_fast():
     assert env.max_momentum([1, 0, 0]) == pytest.approx(4 * (1 + np.cos(BETA)), abs=1e-9)
 
 
+@pytest.mark.slow
 def test_result_text_json_and_plot(env):
     text = str(env)
     assert "k=0 (saturation)" in text and "extent along x, y, z" in text and "100.0%" in text

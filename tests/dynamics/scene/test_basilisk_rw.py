@@ -235,6 +235,7 @@ def test_scene_momentum_is_basilisks_at_basilisks_states(peer):
     np.testing.assert_allclose(H, H_bsk, rtol=0, atol=1e-13 * np.abs(H_bsk).max())
 
 
+@pytest.mark.slow
 def test_trajectory_matches_basilisk_to_round_off(peer, rk4, rk8):
     cols, _ = peer
     ours, reference = blocks(rk4[0]), blocks(rk8[0])

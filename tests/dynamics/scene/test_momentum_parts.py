@@ -137,6 +137,7 @@ def test_wheel_spacecraft_equals_the_hand_written_model(data):
 
 @SETTINGS
 @given(st.data())
+@pytest.mark.slow
 def test_cmg_spacecraft_equals_the_hand_written_model(data):
     n = data.draw(st.integers(1, 4))
     I = data.draw(inertias())

@@ -36,6 +36,7 @@ def test_bilimoria_wie_through_slew(bilimoria_wie):
     assert sol.info["pointing_error"] <= pkg.POINTING_TOL
 
 
+@pytest.mark.slow
 def test_dispatch_equals_time_optimal():
     """Compared unpolished: the polish runs within a wall-time budget, so a polished T may
     depend on the machine's load (Bilimoria-Wie unpolished at N = 30: 3.24391)."""
@@ -103,6 +104,7 @@ def test_keywords_and_options_object_are_the_same_slew():
 
 
 # --------------------------------------------------------------- generic path
+@pytest.mark.slow
 def test_generic_path_reproduces_bilimoria_wie():
     """A held rotor of zero momentum adds nothing to the dynamics but no engine takes the
     scene: the generic path on the assembled model finds Bilimoria & Wie's optimum."""
@@ -137,6 +139,7 @@ def test_generic_effort_splits_the_torque_between_two_actuators():
     np.testing.assert_allclose(L3, -tau3, atol=1e-6 * np.max(np.abs(L3)))
 
 
+@pytest.mark.slow
 def test_generic_time_optimal_with_a_gyrostat_conserves_momentum():
     """Wheels on a hub with a held rotor (no external torque): a verified time-optimal slew
     within the torque bounds, the total inertial momentum (the rotor's) conserved, the wheel
@@ -203,6 +206,7 @@ def _check_damped(sol):
     assert np.abs(H).max() < 1e-10 * scale
 
 
+@pytest.mark.slow
 def test_generic_wheels_and_damper_minimum_effort():
     sol = slew(damped(2.0), objective="effort", T=12.0, angle=0.3, axis=[0, 0, 1])
     _check_damped(sol)
@@ -231,6 +235,7 @@ CONE = pkg.KeepOut(boresight=[1, 0, 0], direction=[1, 1, 0.0], half_angle=np.rad
 HELD0 = Scene(RigidHub(np.eye(3)), ExternalTorque(u_max=1.0), HeldRotor([1, 0, 0], 0.0))
 
 
+@pytest.mark.slow
 def test_generic_keep_out_equals_the_rigid_engine():
     """The same cone on the generic path (a path constraint on the hub quaternion of the
     assembled model) and in `min_effort` / `time_optimal`: the same optimum; the minimum-
@@ -355,6 +360,7 @@ def _cmg_cluster(**kw):
     return geo, scene_module.CMGCluster(geo.gimbal_axes, geo.spin_axes0, geo.h, **kw)
 
 
+@pytest.mark.slow
 def test_dispatch_equals_cmg_slew():
     """A hub with a pyramid of CMGs (rate drive): `cmg_slew`, the same result exactly
     (no wall-time budget in its pipeline: not polished), the singularity bound passed on."""
@@ -483,6 +489,7 @@ def test_readme_craft_time_optimal_slew_is_verified():
     assert np.max(np.abs(H)) < 1e-9 * wheels
 
 
+@pytest.mark.slow
 def test_cmgs_and_damper_time_optimal_slew_is_verified():
     """A pyramid of CMGs with a damper brought to rest: verified within the gimbal-rate
     bounds between the nodes; the control re-simulated by `simulate` meets the target with

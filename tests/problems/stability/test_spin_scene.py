@@ -95,6 +95,7 @@ def test_held_rotor_gyrostat_boundaries(h):
     assert wrapped.verdict == rep.verdict
 
 
+@pytest.mark.slow
 def test_held_rotor_boundaries_by_sweep_bisection():
     """The verdict boundaries of the scene spin, located by bisection on the momentum."""
     Ia, Ib, Ic, W = 3.0, 4.0, 5.0, 2.0
