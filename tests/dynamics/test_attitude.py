@@ -184,6 +184,7 @@ def test_elementary_rotations_match_scipy():
 
 @settings(max_examples=200)
 @given(quats)
+@pytest.mark.slow
 def test_euler_round_trips_from_any_attitude(q):
     A = at.dcm_from_quat(q)
     for to_euler, from_euler in (

@@ -106,6 +106,7 @@ def test_linear_system_matches_matrix_exponential(method, kwargs, tol):
     assert np.max(np.abs(res.x - expm_truth(t))) < tol
 
 
+@pytest.mark.slow
 def test_lie_matches_matrix_exponential():
     """Constant rate: the quaternion part of the Lie method is exact; y is RK4."""
     model = oscillator_with_attitude()

@@ -20,6 +20,7 @@ def strict_json(path):
     return json.loads(path.read_text(), parse_constant=lambda c: pytest.fail(f"non-strict {c}"))
 
 
+@pytest.mark.slow
 def test_rigid_report_is_verified_json_and_bode_plot(tmp_path, capsys):
     out, png = tmp_path / "lv.json", tmp_path / "lv.png"
     code = main(["stability", "launch-vehicle", *VEHICLE, "--k-psi", "2", "--k-psidot", "2",

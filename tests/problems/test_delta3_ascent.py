@@ -29,6 +29,7 @@ def test_reproduces_the_published_optimum(ascent):
     assert ascent.solution.info["converged"]
 
 
+@pytest.mark.slow
 def test_final_orbit_from_energy_and_angular_momentum(ascent):
     x = ascent.solution.phases[-1].x[:, -1]
     r, v = x[:3], x[3:6]

@@ -57,6 +57,7 @@ def spread():
 
 
 # ------------------------------------------------------------------ (a) closed form
+@pytest.mark.slow
 def test_axisymmetric_nutation_matches_closed_form_sample_by_sample(spread):
     assert spread.success and spread.status == dp.ALL_OK and spread.complete
     theta = closed_form(spread.inputs, spread.inputs["w3"])
@@ -89,6 +90,7 @@ def test_statistics_equal_numpy_statistics_of_closed_form(spread):
     assert abs(np.mean(spread.inputs["transverse_inertia"]) - 1000.0) < 4 * 20 / math.sqrt(24)
 
 
+@pytest.mark.slow
 def test_report_json_and_plot(spread):
     text = str(spread)
     assert "nutation_max [rad]" in text and "p99" in text and "24 of 24" in text
@@ -106,6 +108,7 @@ def test_report_json_and_plot(spread):
 
 
 # ------------------------------------------------------------------ (b) seeds
+@pytest.mark.slow
 def test_same_seed_same_samples_different_seed_different():
     a, b, c = spin_dispersion(), spin_dispersion(), spin_dispersion(seed=12)
     for name in SPIN:

@@ -247,6 +247,7 @@ def test_bad_arguments_name_the_argument(kwargs, error, match):
 
 @pytest.mark.parametrize("module_name", ["appdyn.problems.gains.launch_vehicle", "appdyn.problems.gains.config",
                                          "appdyn.problems.cli.gains"])
+@pytest.mark.slow
 def test_docstring_examples_run_as_written(module_name):
     module = importlib.import_module(module_name)
     runner = doctest.DocTestRunner(optionflags=doctest.NORMALIZE_WHITESPACE | doctest.ELLIPSIS)

@@ -31,6 +31,7 @@ def _sorted(z):
     return np.array(sorted(np.asarray(z, dtype=complex), key=lambda c: (round(c.real, 9), c.imag)))
 
 
+@pytest.mark.slow
 def test_single_axis_poles_are_the_closed_form(single_axis):
     """Linearized about the target, each principal axis is J_i theta'' + kd theta' + kp theta
     = 0: the reported poles (Jacobian of the nonlinear loop) agree to round-off."""
@@ -112,6 +113,7 @@ def test_settle_constraint_settles_for_good_by_the_horizon():
     assert v["settle_times"][0] > 2 * math.sqrt(math.radians(60) * 3.0 / U_MAX)  # > bang-bang
 
 
+@pytest.mark.slow
 def test_infeasible_torque_limit_fails_naming_the_constraint():
     """|u| <= 0.01 N m cannot turn J3 = 3 kg m^2 by 60 deg within 10 s (the bang-bang time
     is 35 s): with the settle constraint no gains exist; the result says which limits."""

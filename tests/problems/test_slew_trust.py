@@ -95,6 +95,7 @@ def test_tiny_min_effort_slew_is_the_cubic_closed_form():
 
 
 @pytest.mark.parametrize("kwargs", [dict(angle=0.0, axis=[0, 0, 1]), dict(qf=[0, 0, 0, -1.0])])
+@pytest.mark.slow
 def test_zero_slew_is_answered_exactly_and_at_once(kwargs, tmp_path):
     t = time.perf_counter()
     sol = slew.time_optimal(E, **kwargs)

@@ -81,6 +81,7 @@ def test_spin_full_inertia_principal_axis():
 @given(moments=hs.tuples(*[hs.floats(1.0, 10.0)] * 2), third=hs.floats(0.0, 1.0),
        angles=hs.tuples(*[hs.floats(-np.pi, np.pi)] * 3), which=hs.integers(0, 2),
        rate=hs.floats(0.1, 100.0))
+@pytest.mark.slow
 def test_spin_closed_form_for_any_body_and_principal_axis(moments, third, angles, which, rate):
     """Random principal moments (triangle inequality held) in random body axes."""
     a, b = moments
@@ -489,6 +490,7 @@ def test_report_text_is_a_table(reports):
                 assert m.zeta == pytest.approx(-m.eigenvalue.real / m.wn, rel=1e-15, abs=1e-300)
 
 
+@pytest.mark.slow
 def test_plots_write_png(tmp_path, reports):
     path = tmp_path / "poles.png"
     reports[0].plot(path)
@@ -515,6 +517,7 @@ def test_cli_spin_with_damper_json_and_plot(tmp_path, capsys):
     assert png.stat().st_size > 10_000
 
 
+@pytest.mark.slow
 def test_cli_through_an_argparse_tree_like_appdyn(capsys):
     parser = argparse.ArgumentParser(prog="appdyn")
     sub = parser.add_subparsers(dest="command", required=True)
@@ -577,6 +580,7 @@ def test_sweep_status_is_the_worst_along_the_grid():
     assert d["success"] is True and d["status"] == 0 and d["statuses"] == [0, 0]
 
 
+@pytest.mark.slow
 def test_plots_return_figures_without_pyplot(reports):
     from matplotlib.figure import Figure
 

@@ -34,6 +34,7 @@ def test_angles_reproduce_the_seed_components(v):
 
 @settings(max_examples=200, deadline=None)
 @given(velocities)
+@pytest.mark.slow
 def test_the_four_conversion_formulas(v):
     a, b = aero_angles(v)
     aT, phi = total_aoa(v)

@@ -160,6 +160,7 @@ def propeller_truth(n, yaw_rate, spin, t):
     return total, inertia
 
 
+@pytest.mark.slow
 def test_two_blade_propeller_matches_the_seed_and_oscillates_at_twice_the_spin():
     yaw_rate, spin = 0.2, 30.0
     times = np.arange(64) / 64 * 2 * np.pi / spin  # one revolution

@@ -90,6 +90,7 @@ def test_invariant_rates_along_the_flow():
 
 
 # --------------------------------------------------------------------- long-run conservation
+@pytest.mark.slow
 def test_momentum_conserved_over_100_s_with_time_varying_torques():
     model = wheel_spacecraft(HUB, AXES, J)
     t = np.linspace(0.0, 100.0, 201)

@@ -247,6 +247,7 @@ def test_trajectory_matches_basilisk_to_round_off(peer, rk4, rk8):
         np.testing.assert_allclose(ours[name], bsk, rtol=0, atol=tol, err_msg=name)
 
 
+@pytest.mark.slow
 def test_motor_torques_match_basilisk(peer, rk4):
     cols, _ = peer
     xs, taus = rk4

@@ -360,6 +360,7 @@ def test_slosh_hub_equals_an_independent_sympy_kane_model():
 
 
 @pytest.mark.parametrize("case", ["point", "point-6dof", "sphere", "slosh"])
+@pytest.mark.slow
 def test_damping_keeps_the_momenta_and_only_loses_energy(case):
     """Damping is internal: with it on, the inertial (and linear) momentum still stay put to
     1e-10 over 100 s while the energy falls (the spherical core's housing turns, its motor

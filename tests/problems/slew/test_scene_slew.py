@@ -27,6 +27,7 @@ def bilimoria_wie():
 
 
 # ------------------------------------------------------------------ dispatch
+@pytest.mark.slow
 def test_bilimoria_wie_through_slew(bilimoria_wie):
     sol = bilimoria_wie
     assert sol.success, sol.message
@@ -263,6 +264,7 @@ def test_generic_keep_out_equals_the_rigid_engine():
     "known: a time-optimal slew with a keep-out cone is re-solved with a constant control "
     "(`bounded`, RadauConstantControl) that holds the cone at the mesh points only; the "
     "result, a success, crosses it by 5.9e-4 at an interior collocation point (t = 1.27 s)"))
+@pytest.mark.slow
 def test_time_optimal_keep_out_holds_the_cone_at_every_collocation_point():
     sol = slew(rigid(), angle=np.pi / 2, axis=[0, 0, 1], keep_out=CONE)
     assert not sol.success or np.min(CONE.margin(sol.x[:4])) >= -1e-7
@@ -377,6 +379,7 @@ def test_dispatch_equals_cmg_slew():
     assert fast.success and old.success and abs(fast.T - old.T) <= 1e-9
 
 
+@pytest.mark.slow
 def test_generic_cmg_effort_equals_cmg_slew():
     """The same cluster with a zero-momentum held rotor beside it (no engine takes the
     scene): the generic path's minimum effort is `cmg_slew`'s (8e-16 relative measured)."""

@@ -62,6 +62,7 @@ def test_rigid_hub_minor_intermediate_major(which, verdict):
 @given(moments=hs.tuples(*[hs.floats(1.0, 10.0)] * 2), third=hs.floats(0.0, 1.0),
        angles=hs.tuples(*[hs.floats(-np.pi, np.pi)] * 3), which=hs.integers(0, 2),
        rate=hs.floats(0.1, 50.0))
+@pytest.mark.slow
 def test_rigid_hub_any_principal_axis_closed_form(moments, third, angles, which, rate):
     """Random principal moments (triangle inequality held) in random hub axes; the scene's
     spin equals the inertia path's (the same report machinery) and the closed form."""
