@@ -136,6 +136,7 @@ def test_ball_hinge_equals_reduced_newton_euler_model():
     assert np.ptp(res.x[4:7], axis=1).max() > 0.1  # the bodies really tumble
 
 
+@pytest.mark.slow
 def test_revolute_rotor_equals_free_wheel_spacecraft():
     """Body 2 an axisymmetric rotor on the axis through its own mass centre (r2 = 0): the
     pair is a hub with a free wheel (zero motor torque)."""

@@ -151,6 +151,7 @@ def test_smooth_callable_torque_estimate_bounds_the_true_error(rtol):
     assert ratio.max() <= res.error_estimate <= 1.0, (ratio.max(), res.error_estimate)
 
 
+@pytest.mark.slow
 def test_step_budget_on_a_non_smooth_model_is_status_3_not_a_failure():
     res = simulate(saturated_pd_wheel_loop(), X0, T, rtol=1e-6, max_steps=500)
     assert not res.success and res.status == 3, res.message

@@ -25,6 +25,7 @@ def rate_error_ratio(res, inertia, rtol, atol):
 
 
 # ------------------------------------------------------- item 3: no silent cvodes fallback
+@pytest.mark.slow
 def test_auto_on_a_dense_grid_is_rk8_and_verified():
     """1000 s on 100 001 output points at rtol 1e-8: 200 000 rk8 steps, the tolerance met
     (the old auto fell back to cvodes here and was off by 3.6e-6)."""
@@ -243,6 +244,7 @@ def test_one_compiled_chunk_serves_every_grid_and_step_count():
     assert chunks() == before and len(before) == 1
 
 
+@pytest.mark.slow
 def test_chunked_loop_matches_truth_across_chunk_boundaries():
     """Step counts that do not divide the chunk (odd substeps, padding) give the same
     accuracy as the closed form predicts for rk8."""

@@ -77,6 +77,7 @@ def test_free_flying_robot_within_bounds_with_a_linear_or_constant_control(contr
     np.testing.assert_allclose(_replay(sol), sol.propagation.x[:, -1], atol=1e-7)
 
 
+@pytest.mark.slow
 def test_the_replayed_control_is_samples_also_where_the_polynomial_overshoots():
     """`propagate` integrates exactly the interpolant `sample` returns, overshoot and all."""
     problem, _ = bang_bang()
@@ -121,6 +122,7 @@ def test_orbit_raising_with_a_bounded_angle_reaches_the_literature_optimum():
 
 
 # ------------------------------------------------------------- refine: never worse
+@pytest.mark.slow
 def test_refine_never_returns_a_worse_objective_than_an_earlier_round(monkeypatch):
     """A refinement round that lands on a worse (verified) solution -- here forced: every
     re-solve returns the coarse solution of a 10-interval mesh -- does not replace the

@@ -83,6 +83,7 @@ def test_slew_bad_input(args, message, capsys):
     assert message in capsys.readouterr().err
 
 
+@pytest.mark.slow
 def test_torque_free_report_status_plot_and_deprecated_worst_axis():
     from matplotlib.figure import Figure
 

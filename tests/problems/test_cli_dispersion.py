@@ -8,6 +8,7 @@ from appdyn.problems.cli import main
 from appdyn.problems.dispersion import nutation_spread
 
 
+@pytest.mark.slow
 def test_dispersion_spin_reports_the_closed_form_statistics(tmp_path, capsys):
     out = tmp_path / "d.json"
     assert main(["dispersion", "spin", "--samples", "8", "--seed", "4", "--duration", "10",

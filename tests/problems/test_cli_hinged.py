@@ -69,6 +69,7 @@ def test_revolute_hinge_without_stabilization(tmp_path, capsys):
 
 
 @pytest.mark.parametrize("argv", [BALL, REVOLUTE])
+@pytest.mark.slow
 def test_the_scene_run_equals_the_multiplier_model(argv, tmp_path, capsys):
     """The default run is the scene (minimal coordinates); --model multiplier integrates
     the two free bodies: the same final states (rk8, both at round-off level per step), and

@@ -45,6 +45,7 @@ def test_final_orbit_from_energy_and_angular_momentum(ascent):
     assert node == pytest.approx(TARGET_ORBIT["raan"], abs=1e-9)
 
 
+@pytest.mark.slow
 def test_links_mass_budget_and_unit_thrust(ascent):
     phases = ascent.solution.phases
     for k in range(len(phases) - 1):

@@ -72,6 +72,7 @@ def test_axisymmetric_nutation_matches_closed_form_sample_by_sample(spread):
     assert np.max(spread.outputs["momentum_inertial_drift"]) < 1e-9
 
 
+@pytest.mark.slow
 def test_statistics_equal_numpy_statistics_of_closed_form(spread):
     theta = closed_form(spread.inputs, spread.inputs["w3"])
     s = spread.statistics["nutation_max"]

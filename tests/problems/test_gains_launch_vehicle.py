@@ -257,6 +257,7 @@ def test_docstring_examples_run_as_written(module_name):
     assert result.failed == 0
 
 
+@pytest.mark.slow
 def test_integral_gain_and_command_filter_verified_on_the_closed_form_loop():
     """delta_c = -(k_psi psi + k_psidot psi' + k_i int psi) / (tau_f s + 1): the margins and
     poles of the report agree with python-control on C(s) Npsi / ((tau s + 1) D)."""

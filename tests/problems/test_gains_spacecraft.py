@@ -48,6 +48,7 @@ def test_single_axis_poles_are_the_closed_form(single_axis):
     assert np.min(np.abs(v["damping"] - zeta3)) < 1e-9
 
 
+@pytest.mark.slow
 def test_torque_limits_met_in_every_re_simulated_scenario(single_axis):
     """Re-simulated independently (CVODES) with the designed gains: the peak torque of every
     scenario is within the limit (to 1e-6 relative: IPOPT's bound relaxation), and the
@@ -87,6 +88,7 @@ def test_settling_is_slower_than_the_time_optimal_slew(single_axis):
         assert np.all(sc["angle"][after] <= v["settle_angle"] * (1 + 1e-9))
 
 
+@pytest.mark.slow
 def test_general_inertia_per_axis_gains_meet_limits():
     """Full inertia, per-axis limits and gains, three-axis scenarios with rates: stable,
     limits met, every scenario settles."""
@@ -101,6 +103,7 @@ def test_general_inertia_per_axis_gains_meet_limits():
     assert np.all(v["peak_torque"] <= np.array([0.2, 0.25, 0.2]) * (1 + 1e-3))
 
 
+@pytest.mark.slow
 def test_settle_constraint_settles_for_good_by_the_horizon():
     """With the Lyapunov settle constraint at 12 s (the free design settles in 19.9 s) the
     60 deg slew stays within 1 deg from before 12 s on (measured 9.38 s, 1.87 T_opt); the

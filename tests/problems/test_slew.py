@@ -22,6 +22,7 @@ def test_min_effort_single_axis_closed_form():
     assert sol.propagation_error < 1e-6
 
 
+@pytest.mark.slow
 def test_min_effort_target_sign_does_not_matter():
     J = [1.0, 1.5, 2.0]
     qf = quat_from_axis_angle([0.3, -0.5, 0.8], 2.0)

@@ -21,6 +21,7 @@ def test_wheel_time_optimal_reproduces_bilimoria_wie():
     assert sol.info["momentum_drift"] < 1e-9
 
 
+@pytest.mark.slow
 def test_wheel_min_effort_equals_rigid_body_min_effort_with_speed_limit_inactive():
     """Same hub: the wheel torques are the (negated) body torques, so the minimum effort is
     the rigid body's; a generous wheel-speed limit changes nothing."""

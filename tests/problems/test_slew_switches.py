@@ -38,6 +38,7 @@ def test_plot_slew_returns_a_figure_and_saves_on_request(bilimoria_wie, tmp_path
         slew.plot_slew(bilimoria_wie, fig="figure")
 
 
+@pytest.mark.slow
 def test_switch_times_component_and_the_deprecated_axis(bilimoria_wie):
     sol = bilimoria_wie
     per = slew.switch_times(sol)

@@ -24,6 +24,7 @@ def serial():
     return maneuver_table(np.eye(3), SINGLE, **FAST)
 
 
+@pytest.mark.slow
 def test_time_rows_match_the_bang_bang_closed_form(serial):
     # J = E, |u_i| <= 1, rest to rest about a principal axis: T = 2 sqrt(J theta / u)
     assert serial.success and serial.complete and serial.names == ("a0", "a1", "a2", "a3")
@@ -70,6 +71,7 @@ def test_progress_is_called_with_done_and_total():
 
 
 @pytest.mark.parametrize("threads", [False, True])
+@pytest.mark.slow
 def test_interrupt_keeps_the_finished_rows(serial, threads):
     def stop(done, total):
         if done == 2:

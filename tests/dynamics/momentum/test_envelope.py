@@ -85,6 +85,7 @@ def test_direction_along_a_gimbal_axis_is_skipped():
     assert pts.H.shape == (3, 1) and pts.delta.shape == (4, 1)
 
 
+@pytest.mark.slow
 def test_outer_surface_is_elliptic_and_internal_surfaces_have_both_kinds(env):
     assert set(env.kinds[0]) == {"elliptic"}
     for k in (1, 2):

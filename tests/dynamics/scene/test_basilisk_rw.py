@@ -261,6 +261,7 @@ def test_motor_torques_match_basilisk(peer, rk4):
     assert np.abs(applied).max() == U_MAX
 
 
+@pytest.mark.slow
 def test_inertial_momentum_is_conserved_along_our_run(rk4):
     xs, _ = rk4
     H = scene().model().invariant("momentum_inertial", xs.T)

@@ -192,6 +192,7 @@ def test_seed_example6_hub_locked_limit_gives_cantilever_frequencies():
         assert abs(md.wn / (TEXTBOOK[k - 1] ** 2 * np.sqrt(ei / (m * L ** 4))) - 1) < 1e-8
 
 
+@pytest.mark.slow
 def test_seed_example6_spinning_stiffens_and_stays_stable():
     from appdyn.dynamics.scene import flexible_antenna_satellite
     from appdyn.problems import stability
@@ -262,6 +263,7 @@ def test_seed_example6_in_plane_modes_coupled_with_the_hub():
     assert stiffer.size == n and np.all(stiffer > np.sqrt(om2))
 
 
+@pytest.mark.slow
 def test_on_a_locked_hinged_boom_it_is_the_same_beam_as_on_the_hub():
     """Parts on parts: the appendage clamped on a panel (root and direction in panel axes,
     from the hinge) that a very heavy, very stiff hinge holds at zero angle: locked, its
@@ -312,6 +314,7 @@ def test_polynomial_shape_table_gives_the_two_term_ritz_frequencies():
     assert np.max(np.abs(_freqs(lin, names) / expected - 1)) < 1e-8
 
 
+@pytest.mark.slow
 def test_a_sampled_clamped_free_table_is_the_computed_beam():
     """The library's own shapes, tabulated at 401 stations, give the same beam: frequencies
     to 1e-8 (the cubic spline's error), spinning frequencies to 1e-6."""

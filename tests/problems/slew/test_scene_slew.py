@@ -48,6 +48,7 @@ def test_dispatch_equals_time_optimal():
     assert BW_T < sol.T < BW_T + 1e-3
 
 
+@pytest.mark.slow
 def test_target_as_q_final_is_the_same_slew():
     q = [0.0, 0.0, math.sin(0.05), math.cos(0.05)]  # 0.1 rad about z
     for scene in (rigid(), HELD0):
@@ -158,6 +159,7 @@ def test_generic_time_optimal_with_a_gyrostat_conserves_momentum():
     assert sol.info["rate_tol"] == pkg.RATE_TOL and sol.info["final_rate_error"] <= pkg.RATE_TOL
 
 
+@pytest.mark.slow
 def test_generic_path_on_a_translating_hub():
     """A six-degree-of-freedom hub under a body torque only: its position and velocity are
     free and stay put; the attitude slew is the rigid body's bang-bang, 2 sqrt(0.1)."""

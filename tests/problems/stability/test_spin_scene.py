@@ -357,6 +357,7 @@ def test_the_attitude_subsystem_holds_the_mass_centre():
                        np.asarray(full.f(x, [], [])).ravel()[:7], rtol=1e-14, atol=1e-14)
 
 
+@pytest.mark.slow
 def test_sweep_over_the_rate_of_a_scene():
     """`sweep` runs spin(scene, ...) too: a held rotor h = 3 on a hub (3, 4, 5) is unstable
     while Ia + h/W lies between 4 and 5, i.e. for h/(Ic - Ia) = 1.5 < W < h/(Ib - Ia) = 3."""
