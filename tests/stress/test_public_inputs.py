@@ -167,7 +167,14 @@ VALID_CHECKED = sorted(
     if func not in SKIPPED and func not in EXPENSIVE and len(_required(fn)) >= 2)
 
 
-@pytest.mark.parametrize("func", VALID_CHECKED)
+#: the examples that take seconds (measured > 5 s on a loaded machine): marked slow
+SLOW_EXAMPLES = {"appdyn.dynamics.momentum.steer", "appdyn.problems.dispersion.nutation_history",
+                 "appdyn.problems.slew.bounded", "appdyn.problems.stability.launch_vehicle_response",
+                 "appdyn.problems.stability.shaken_pendulum"}
+
+
+@pytest.mark.parametrize("func", [pytest.param(f, marks=pytest.mark.slow) if f in SLOW_EXAMPLES
+                                  else f for f in VALID_CHECKED])
 def test_valid_examples(func):
     """The example values are accepted, so each garbage case is refused for its garbage."""
     fn = FUNCTIONS[func]

@@ -24,6 +24,7 @@ def scene_spinner(transverse_inertia, axial_inertia):
     return Scene(RigidHub([transverse_inertia, transverse_inertia, axial_inertia]))
 
 
+@pytest.mark.slow
 def test_factory_returning_a_scene_matches_the_rigid_body_factory():
     outputs = {"nutation": nutation_history, "w1_final": "w1"}
     ref = dispersion(spinner, X0, T, samples=8, seed=3, params=PARAMS, outputs=outputs)
