@@ -46,23 +46,12 @@ PRIVATE_ALLOWED = {
       for name in ("_AUTO_ACCEPT", "_EPS", "_FLOOR_ULPS", "_carried", "_floor",
                    "_initial_step", "_perturbed", "_roundoff", "_scaled_diff", "_screen",
                    "_spectrum")),
-    ("appdyn.ocp.nlp", "appdyn.ocp.assembly", "_functions"),
-    ("appdyn.ocp.phases.solve", "appdyn.ocp.refine.mesh_update", "_local_order"),
-    ("appdyn.ocp.phases.solve", "appdyn.ocp.refine.mesh_update", "_new_mesh"),
-    ("appdyn.ocp.phases.solve", "appdyn.ocp.solve", "_ipopt_options"),
-    ("appdyn.ocp.phases.solve", "appdyn.ocp.solve", "_mesh"),
-    ("appdyn.ocp.phases.solve", "appdyn.ocp.solve", "_numbers"),
-    ("appdyn.problems.ascent.pitch_tracking", "appdyn.problems.ascent.planar_model",
-     "_vehicle"),
-    ("appdyn.problems.ascent.planar", "appdyn.problems.ascent.planar_model", "_vehicle"),
 }
 
 # Strongly connected sets of modules (each closed through a function-local import). To be
 # emptied by the work on dynamics/integrate and ocp/.
 CIRCLES_ALLOWED = {
     frozenset({"appdyn.dynamics.integrate.batch", "appdyn.dynamics.integrate.batch_fixed"}),
-    frozenset({"appdyn.ocp.checks", "appdyn.ocp.propagation", "appdyn.ocp.solution"}),
-    frozenset({"appdyn.ocp.assembly", "appdyn.ocp.nlp", "appdyn.ocp.transcription"}),
 }
 
 # (module, name) of caches outside the one cache. The first two are not caches of built
@@ -77,12 +66,7 @@ CACHES_ALLOWED = {
     ("appdyn.dynamics.integrate.adaptive", "_state0"),
     ("appdyn.dynamics.integrate.estimates", "_floor_signs"),
     ("appdyn.dynamics.integrate.estimates", "_signs"),
-    ("appdyn.ocp.ipopt_options", "_available"),
-    ("appdyn.ocp.ipopt_options", "ipopt_option_table"),
     ("appdyn.ocp.refine.multistart", "_RECEIVED"),  # a worker's unpickled problems
-    ("appdyn.problems.ascent.planar_model", "_default_vehicle"),
-    ("appdyn.problems.ascent.planar_model", "pitch_model"),
-    ("appdyn.problems.ascent.planar_model", "planar_model"),
 }
 
 
