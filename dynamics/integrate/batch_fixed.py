@@ -9,21 +9,17 @@ from __future__ import annotations
 import contextlib
 import os
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
-
 import numpy as np
 
 from .. import cache
 from ..executors import run_split
 from ..interrupts import check_interrupt, deferred_interrupts
 from .evaluate import borrow_state, return_state
+from .inputs import Batch
 from .loops import BATCH_CHUNK as CHUNK
 from .loops import Progress, chunk_function, interval_ends
 from .result import Run
 from .tableaux import TABLEAUX
-
-if TYPE_CHECKING:
-    from .batch import Batch
 
 __all__ = ["fixed_batch", "run_fixed_batch", "fixed_message", "BATCH_THREADS", "PART_RUNS",
            "PART_STEPS", "PARALLEL_STEPS"]
