@@ -47,7 +47,8 @@ from appdyn.dynamics.truth import torque_free_omega
 
 from _common import Row, script_main, timed, write_csv
 
-from simulate import BATCH_TOL, INERTIA, batch_workload, numbalsoda  # noqa: E402
+from simulate import (BATCH_TOL, INERTIA, batch_workload, numbalsoda,  # noqa: E402
+                      numbalsoda_batch)
 
 REPEATS = 11
 TOLS = [10.0 ** -k for k in np.arange(4.0, 12.01, 1.0)]
@@ -215,12 +216,9 @@ def monte_carlo(quick: bool, detail: list) -> list[Row]:
                        success=True))
     peer = None
     for rtol in (1e-9, 1e-10, 1e-11):
-        ans = numbalsoda(dict(inertia=INERTIA.tolist(), t=t.tolist(), x0=x0s[0].tolist(),
-                              tols=[], repeats=3,
-                              batch=dict(x0s=x0s.tolist(), t=t.tolist(), rtol=rtol)))
-        if ans is None:
+        b = numbalsoda_batch(x0s, t, rtol)
+        if b is None:
             break
-        b = ans["batch"]
         e = float(np.max(np.abs(np.asarray(b["w"]) - truth)))
         detail.append(dict(workload=f"Monte Carlo {k} runs", target=BATCH_TOL,
                            solver="numbalsoda dop853 njit loop", rtol=rtol, error=e,
