@@ -20,7 +20,7 @@ from .inputs import Problem
 from .loops import Progress, run_fixed
 from .result import FAILED, NONSMOOTH, OK, OK_STIFF, ROUNDOFF, UNVERIFIED, Run
 from .smoothness import nonsmooth_operations
-from .stepcontrol import LOCAL_RTOL_MIN, run_dense, solve_stepped
+from .stepcontrol import LOCAL_RTOL_MIN, solve_stepped
 from .tableaux import DOP853
 
 __all__ = ["solve_auto", "auto_jit", "STIFF_STEPS", "Single", "auto_runs", "dense_pass",
@@ -380,42 +380,23 @@ def dense_pass(problem: Problem, rtol, atol, max_steps, progress):
     tolerance so near a state's rounding that 1000 ulps of it take half of the acceptance, a
     failed run, or no verdict after `dense.TRIES` answers).
 
-    Within `_PASS_MEASURED` ulps of a state's size, where the rounding the answer measured on
-    its way, carried over the horizon, is not small, `estimates.measured_floor` with a
-    repeated answer from a moved start decides.
+    Within `_PASS_MEASURED` ulps of a state's size the rounding the answer measured on its
+    way, carried over the horizon, is added; where it is not small, the floor measured by the
+    answer repeated from a moved start (as `estimates.measured_floor`), in the same call.
     """
     got = dense_auto(problem, rtol, atol, max_steps, STIFF_STEPS, progress)
-    if got is None or got.result not in (1, -1):
+    if got is None or got.result != 1:
         return None, math.nan
     estimate = got.estimate
-    if got.result == -1:
-        local = got.factor
-
-        def again(p):
-            rerun = run_dense(p, rtol * local, atol * local, max_steps, progress, STIFF_STEPS)
-            return None if rerun is None or not rerun[0].ok else rerun[0]
-
-        run = Run.new(got.x, got.answer_steps, 0, 1, True, True, "")
-        estimate = got.estimate + _dense_floor(problem, run, rtol, atol, again)
-        power = got.answer_steps / max(got.check_steps, 1) / got.ratio ** 0.125
-        if not estimate <= (AUTO_ACCEPT if 0.8 <= power <= 1.25 else 1.0):
-            return None, math.nan
     message = (f"auto: DOP853 with dense output, steps chosen by its error estimate "
                f"({got.answer_steps - got.rejected} steps, {got.rejected} rejected, "
                f"{got.interpolated} interpolated, local rtol {rtol * got.factor:.3g}), checked "
                f"against a run at a {got.ratio:.3g}x looser local tolerance ({got.check_steps} "
-               f"steps); estimated error {estimate:.2g} of tolerance")
+               f"steps); estimated error {estimate:.2g} of tolerance"
+               + (f" (a rounding floor of {got.floor:.2g} measured by a run from a moved start "
+                  "included)" if got.floor > 0 else ""))
     return Run.new(got.x, got.spent, DOP853.stages * got.spent, got.substeps, True, True,
                    message), estimate
-
-
-def _dense_floor(problem: Problem, run: Run, rtol, atol, again) -> float:
-    """`dense_pass`'s rounding floor of ``run`` near round-off where the screening bound of
-    the rounding measured on the way is not small (`estimates.measured_floor`, its check run
-    ``again(problem from the moved start)`` at the same local tolerance)."""
-    target = Single(problem)
-    return measured_floor(target, run, rtol, atol, target.spectrum(rtol, atol)[0], True, None,
-                  lambda x0: again(replace(problem, x0=x0)))[0]
 
 
 def _size_over_tolerance(problem: Problem, rtol: float, atol: np.ndarray) -> float:

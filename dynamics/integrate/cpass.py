@@ -452,12 +452,13 @@ _AUTO = r"""
 #define AU_T0 5       /* in: the start time */
 #define AU_IQ 6       /* in: index of the attitude quaternion, -1: none */
 #define AU_TRIES 7    /* in: answer-check pairs at most */
-#define AU_PHASE 8    /* 0 start, 1 check run, 2 answer, 3 done */
+#define AU_PHASE 8    /* 0 start, 1 check run, 2 answer, 4 the answer from a moved start (the
+                         rounding floor), 3 done */
 #define AU_SPENT 9    /* steps of every run (accepted and rejected) */
 #define AU_NCHK 10    /* steps of the check run */
 #define AU_NANS 11    /* steps of the answer */
-#define AU_RESULT 12  /* 1 verified, 0 not (AU_EST), -1 the rounding floor is to be measured,
-                         -2 a tolerance too near the states' rounding, -3 a run failed */
+#define AU_RESULT 12  /* 1 verified, 0 not (AU_EST), -2 a tolerance too near the states'
+                         rounding, -3 a run failed */
 #define AU_EST 13     /* the error estimate [tolerances] */
 #define AU_D 14       /* the scaled difference of the answer and the check run */
 #define AU_FLAG 15    /* `rk8_dense`'s flag of a failed run */
@@ -471,7 +472,9 @@ _AUTO = r"""
 #define AU_BOUND 23   /* the rounding bound added (0: none) */
 #define AU_NOUT 24    /* in: outputs after the start */
 #define AU_SUB 25     /* the longest output interval over the answer's smallest step */
-#define AU_HDR 26
+#define AU_GATE 26    /* the acceptance of the estimate (0.5 or 1) */
+#define AU_FLOOR 27   /* the rounding floor measured by a rerun from a moved start (0: none) */
+#define AU_HDR 28
 #define AU_ACCEPT 0.5        /* estimates.AUTO_ACCEPT */
 #define AU_FLOOR_ULPS 1000.0 /* estimates.FLOOR_ULPS */
 #define AU_MEASURED 1e6      /* auto's _PASS_MEASURED */
@@ -535,78 +538,125 @@ static casadi_real au_size(const casadi_real* w) {
   return out;
 }
 
-/* the answer X against the check XC: AU_D, AU_EST and the verdict (AU_RESULT, AU_PHASE);
-   or the next answer, tighter */
-static void au_judge(casadi_real* w, casadi_real* X, casadi_real* XC) {
-  int nout = (int) w[AU_NOUT], ld = nout + 1, i, j;
-  casadi_real rtol = w[AU_RTOL], d = 0, sc, size, smin, ulps = 0, e, emax = 0, lmin = INFINITY;
-  casadi_real ratio = w[AU_LOOSE] / w[AU_FACTOR], power, est, accept, horizon, tau, lip;
+/* the largest |X - Y| / (atol + rtol |X|) over the states and the outputs after the first
+   (inf for a non-finite one); *ulps: 1000 ulps of the largest state's size over its least
+   tolerance (`estimates.roundoff`), *lmin the least tolerance */
+static casadi_real au_diff(const casadi_real* w, const casadi_real* X, const casadi_real* Y,
+                           casadi_real* ulps, casadi_real* lmin) {
+  int ld = (int) w[AU_NOUT] + 1, i, j;
+  casadi_real rtol = w[AU_RTOL], d = 0, sc, size, smin, e;
+  *ulps = 0; *lmin = INFINITY;
   for (i = 0; i < PASS_NX; ++i) {
     size = fabs(X[i * ld]);
     smin = INFINITY;
     for (j = 1; j < ld; ++j) {
-      casadi_real xa = X[i * ld + j], xc = XC[i * ld + j];
+      casadi_real xa = X[i * ld + j];
       if (fabs(xa) > size) size = fabs(xa);
       sc = AU_ATOL(w)[i] + rtol * fabs(xa);
       if (sc < smin) smin = sc;
-      e = fabs(xa - xc);
+      e = fabs(xa - Y[i * ld + j]);
       e = sc > 0 ? e / sc : (e == 0 ? 0 : INFINITY);
       if (e != e) e = INFINITY;
       if (e > d) d = e;
     }
     e = smin > 0 ? size / smin : (size > 0 ? INFINITY : 0);
-    if (e > ulps) ulps = e;
-    /* (the carried rounding below: its largest over the states against the least scale) */
-    if (AU_NOISE(w)[i] > emax) emax = AU_NOISE(w)[i];
-    if (smin < lmin) lmin = smin;
+    if (e > *ulps) *ulps = e;
+    if (smin < *lmin) *lmin = smin;
   }
-  ulps *= AU_FLOOR_ULPS * DBL_EPSILON;
-  power = w[AU_NANS] / fmax(w[AU_NCHK], 1) / pow(ratio, 0.125);
-  if (power >= 0.8 && power <= 1.25) {
-    est = d / (pow(ratio, 0.75) - 1) + ulps;
-    accept = AU_ACCEPT;
-  } else {
-    est = d + ulps;
-    accept = 1.0;
+  *ulps *= AU_FLOOR_ULPS * DBL_EPSILON;
+  return d;
+}
+
+/* the rounding the answer measured on its way (AU_NOISE, per state), carried over the
+   horizon (`estimates.carried`), into AU_NOISE; returns its largest */
+static casadi_real au_carried(casadi_real* w) {
+  int i;
+  casadi_real horizon = AU_TS(w)[(int) w[AU_NOUT] - 1] - w[AU_T0], lip = w[AU_LIP], tau, out = 0;
+  tau = lip <= 0 ? horizon : fmin(horizon, 1.0 / lip);
+  for (i = 0; i < PASS_NX; ++i) {
+    AU_NOISE(w)[i] *= 2 * sqrt(horizon * tau);
+    if (AU_NOISE(w)[i] > out) out = AU_NOISE(w)[i];
   }
-  w[AU_D] = d; w[AU_RATIO] = ratio; w[AU_BOUND] = 0;
-  for (e = AU_TS(w)[0] - w[AU_T0], j = 1; j < nout; ++j)
-    if (AU_TS(w)[j] - AU_TS(w)[j - 1] > e) e = AU_TS(w)[j] - AU_TS(w)[j - 1];
-  w[AU_SUB] = w[AU_HMIN] < INFINITY ? ceil(e / w[AU_HMIN]) : 1;
-  if (est <= accept && au_size(w) * DBL_EPSILON * AU_MEASURED > 1.0) {
-    /* the model's rounding, measured on the way, carried over the horizon
-       (`estimates.carried`, `estimates.screen`) */
-    horizon = AU_TS(w)[nout - 1] - w[AU_T0];
-    lip = w[AU_LIP];
-    tau = lip <= 0 ? horizon : fmin(horizon, 1.0 / lip);
-    e = 2 * sqrt(horizon * tau) * emax;
-    e = lmin > 0 ? e / lmin : (e > 0 ? INFINITY : 0);
-    e *= 1 + lip * horizon;
-    if (!(e <= 0.1 * AU_ACCEPT)) {
-      w[AU_EST] = est; w[AU_RESULT] = -1; w[AU_PHASE] = 3;
-      return;
-    }
-    est += e;
-    w[AU_BOUND] = e;
-  }
+  return out;
+}
+
+/* the verdict on the estimate `est` (AU_RESULT, AU_PHASE); not accepted, the next answer,
+   tighter, or done */
+static void au_verdict(casadi_real* w, casadi_real* X, casadi_real* XC, casadi_real est) {
+  int i, n = PASS_NX * ((int) w[AU_NOUT] + 1);
+  casadi_real e;
   w[AU_EST] = est;
-  if (est <= accept) {
-    w[AU_RESULT] = 1; w[AU_PHASE] = 3;
+  w[AU_PHASE] = 3;
+  if (est <= w[AU_GATE]) {
+    w[AU_RESULT] = 1;
     return;
   }
-  w[AU_RESULT] = 0; w[AU_PHASE] = 3;
-  if (!isfinite(est) || w[AU_TRY] >= w[AU_TRIES]) return;
+  w[AU_RESULT] = 0;
+  if (!isfinite(est) || w[AU_TRY] >= w[AU_TRIES] || w[AU_FLOOR] > 0) return;
   /* aim at 0.1; a new answer at least 10x tighter is checked against this one */
   e = fmin(0.5, 0.1 / est);
   if (e <= 0.1) {
-    for (i = 0; i < PASS_NX * ld; ++i) XC[i] = X[i];
+    for (i = 0; i < n; ++i) XC[i] = X[i];
     w[AU_NCHK] = w[AU_NANS];
     w[AU_LOOSE] = w[AU_FACTOR];
   }
   w[AU_FACTOR] *= e;
-  if (rtol * w[AU_FACTOR] < AU_RTOL_MIN) return;
+  if (w[AU_RTOL] * w[AU_FACTOR] < AU_RTOL_MIN) return;
   au_begin(w, w[AU_FACTOR]);
   w[AU_PHASE] = 2;
+}
+
+/* the answer X against the check XC: AU_D, AU_EST and the verdict; near the states'
+   rounding (within 1e6 ulps) the model's rounding measured on the way, carried over the
+   horizon, is added when small (`estimates.screen`), else measured: the answer repeated
+   from x0 moved by it (phase 4, into XC, judged by `au_floor`) */
+static void au_judge(casadi_real* w, casadi_real* X, casadi_real* XC) {
+  int nout = (int) w[AU_NOUT], j;
+  casadi_real d, ulps, lmin, e, power, est, horizon, lip = w[AU_LIP];
+  casadi_real ratio = w[AU_LOOSE] / w[AU_FACTOR];
+  d = au_diff(w, X, XC, &ulps, &lmin);
+  power = w[AU_NANS] / fmax(w[AU_NCHK], 1) / pow(ratio, 0.125);
+  if (power >= 0.8 && power <= 1.25) {
+    est = d / (pow(ratio, 0.75) - 1) + ulps;
+    w[AU_GATE] = AU_ACCEPT;
+  } else {
+    est = d + ulps;
+    w[AU_GATE] = 1.0;
+  }
+  w[AU_D] = d; w[AU_RATIO] = ratio; w[AU_BOUND] = 0; w[AU_FLOOR] = 0;
+  for (e = AU_TS(w)[0] - w[AU_T0], j = 1; j < nout; ++j)
+    if (AU_TS(w)[j] - AU_TS(w)[j - 1] > e) e = AU_TS(w)[j] - AU_TS(w)[j - 1];
+  w[AU_SUB] = w[AU_HMIN] < INFINITY ? ceil(e / w[AU_HMIN]) : 1;
+  if (est <= w[AU_GATE] && au_size(w) * DBL_EPSILON * AU_MEASURED > 1.0) {
+    horizon = AU_TS(w)[nout - 1] - w[AU_T0];
+    e = au_carried(w);
+    e = lmin > 0 ? e / lmin : (e > 0 ? INFINITY : 0);
+    e *= 1 + lip * horizon;
+    if (e <= 0.1 * AU_ACCEPT) {
+      w[AU_BOUND] = e;
+      est += e;
+    } else {  /* the flow's real amplification: the answer again from x0 + s e */
+      w[AU_EST] = est;
+      au_begin(w, w[AU_FACTOR]);
+      for (j = 0; j < PASS_NX; ++j)
+        AU_XR(w)[j] += (j % 2 ? -1 : 1) * AU_NOISE(w)[j];
+      w[AU_PHASE] = 4;
+      return;
+    }
+  }
+  au_verdict(w, X, XC, est);
+}
+
+/* after the rerun from the moved start (in XC): the floor is the largest of its difference
+   from the answer, the carried rounding against the least tolerance and the ulps
+   (`estimates.measured_floor`), added to the estimate */
+static void au_floor(casadi_real* w, casadi_real* X, casadi_real* XC) {
+  casadi_real ulps, lmin, d = au_diff(w, X, XC, &ulps, &lmin), local = 0;
+  int i;
+  for (i = 0; i < PASS_NX; ++i) local = fmax(local, AU_NOISE(w)[i]);
+  local = lmin > 0 ? local / lmin : (local > 0 ? INFINITY : 0);
+  w[AU_FLOOR] = fmax(fmax(d, local), ulps);
+  au_verdict(w, X, XC, w[AU_EST] + w[AU_FLOOR]);
 }
 
 /* The whole of `dense.dense_auto` for one problem: the check run into XC, the answer into X
@@ -618,7 +668,7 @@ int rk8_auto(casadi_real* w, int nout, int budget, casadi_real* X, casadi_real* 
   w[AU_NOUT] = nout;
   if (w[AU_PHASE] == 0) {
     w[AU_SPENT] = 0; w[AU_TRY] = 0; w[AU_RESULT] = 0; w[AU_FLAG] = 0; w[AU_EST] = NAN;
-    w[AU_BOUND] = 0;
+    w[AU_BOUND] = 0; w[AU_FLOOR] = 0;
     for (i = 0; i < PASS_NX; ++i) X[i * ld] = XC[i * ld] = AU_X0(w)[i];
     if (au_size(w) * DBL_EPSILON * AU_FLOOR_ULPS > 0.5 * AU_ACCEPT) {
       w[AU_RESULT] = -2; w[AU_PHASE] = 3;  /* (the 1000-ulp floor: half the acceptance) */
@@ -627,13 +677,22 @@ int rk8_auto(casadi_real* w, int nout, int budget, casadi_real* X, casadi_real* 
     au_begin(w, w[AU_LOOSE]);
     w[AU_PHASE] = 1;
   }
-  while (budget > 0 && w[AU_PHASE] < 3) {
-    int check = w[AU_PHASE] == 1;
-    if (!au_step(w, check ? w[AU_LOOSE] : w[AU_FACTOR], check ? XC : X, &budget)) continue;
+  while (budget > 0 && w[AU_PHASE] != 3) {
+    int check = w[AU_PHASE] == 1, floor = w[AU_PHASE] == 4;
+    if (!au_step(w, check ? w[AU_LOOSE] : w[AU_FACTOR], check || floor ? XC : X, &budget))
+      continue;
     w[AU_SPENT] += count[0] + count[1];
+    if (count[2] != 0 && floor) {  /* (no floor: not verified) */
+      au_verdict(w, X, XC, INFINITY);
+      break;
+    }
     if (count[2] != 0) {
       w[AU_FLAG] = count[2]; w[AU_RESULT] = -3; w[AU_PHASE] = 3;
       break;
+    }
+    if (floor) {
+      au_floor(w, X, XC);
+      continue;
     }
     if (check) {
       w[AU_NCHK] = count[0] + count[1];

@@ -12,8 +12,12 @@ When the step counts show DOP853's tolerance power (``n_answer / n_check`` withi
 1.25 of ``ratio^(1/8)``) the estimate is ``d / (ratio^(3/4) - 1)`` plus 1000 ulps of each
 state's size, accepted at most 0.5; otherwise ``d`` plus the ulps, accepted at most 1.
 Within 1e6 ulps of a state's size the rounding of the model's formulas (measured on the
-way) is carried over the horizon and added (or, if not small, left to be measured:
-``result`` -1). Not accepted, the answer is redone aimed at 0.1 (`TRIES` answers at most).
+way) is carried over the horizon (`estimates.carried`) and its screening bound
+(`estimates.screen`) added when at most 0.05; otherwise the flow's real amplification is
+measured as `estimates.measured_floor` does: the answer is repeated from ``x0`` moved by
+that carried rounding, and the largest of its difference from the answer, the carried
+rounding and the ulps is added. Not accepted, the answer is redone aimed at 0.1 (`TRIES`
+answers at most; not after a floor was measured).
 
 Per call the Python is a look-up of the model's plan (its library and the workspace
 layout, `_plan`), a thread's reused workspace, one ``ctypes`` call and the result's array.
@@ -31,7 +35,7 @@ from ..interrupts import check_interrupt, deferred_interrupts
 from .cpass import pass_library
 from .inputs import Problem
 
-__all__ = ["HEADER", "FIRST", "CHECK", "TRIES", "DenseAuto", "dense_auto", "dense_many", "outcome_of",
+__all__ = ["FIELDS", "HEADER", "FIRST", "CHECK", "TRIES", "DenseAuto", "dense_auto", "dense_many", "outcome_of",
            "constant_control"]
 
 FIRST = 0.1     # the answer's local tolerance over the requested one
@@ -40,12 +44,16 @@ TRIES = 3       # answers (each aimed tighter) before the other paths of ``auto`
 #: Most steps of one compiled call (Ctrl-C is looked at between calls).
 BUDGET = 1 << 15
 
-# the header of the workspace (``AU_*`` of `cpass._AUTO`)
+#: The slots of a run's header (``AU_*`` of `cpass._AUTO`, in order; `HEADER` of them).
+FIELDS = ("rtol", "factor", "loose", "max_steps", "stiff_steps", "t0", "iq", "tries", "phase",
+          "spent", "check_steps", "answer_steps", "result", "estimate", "d", "flag", "try",
+          "accepted", "rejected", "hmin", "interpolated", "lipschitz", "ratio", "bound",
+          "nout", "substeps", "gate", "floor")
 (_RTOL, _FACTOR, _LOOSE, _MAXSTEPS, _STIFF, _T0, _IQ, _TRIES, _PHASE, _SPENT, _NCHK, _NANS,
  _RESULT, _EST, _D, _FLAG, _TRY, _ACC, _REJ, _HMIN, _INTERP, _LIP, _RATIO, _BOUND,
- _NOUT, _SUB) = range(26)
-#: Doubles of a run's header (``AU_HDR`` of `cpass._AUTO`).
-HEADER = 26
+ _NOUT, _SUB, _GATE, _FLOOR) = range(len(FIELDS))
+#: Doubles of a run's header.
+HEADER = len(FIELDS)
 _REASONS = ("", "a state became non-finite", "the step size underflowed",
             "more than max_steps steps", "stiff (stability alone would need too many steps)")
 
@@ -54,13 +62,13 @@ class DenseAuto(NamedTuple):
     """The outcome of `dense_auto` (one run) or of a run of `dense_many`.
 
     ``x (nx, n)`` the answer (NaN after a failure); ``result`` 1 verified, 0 not verified
-    (``estimate`` > acceptance or not finite), -1 the rounding floor must be measured (the
-    carried rounding bound was not small), -2 a tolerance too near a state's rounding (no
+    (``estimate`` > acceptance or not finite), -2 a tolerance too near a state's rounding (no
     run made), -3 a run failed (``reason``); ``estimate`` [tolerances]; ``spent`` steps of
     all runs; ``answer_steps``, ``check_steps`` (accepted and rejected), ``rejected`` of the
     answer, ``hmin`` its smallest step [s], ``interpolated`` its steps that filled outputs,
     ``ratio`` the check's local tolerance over the answer's, ``factor`` the answer's over
-    the requested, ``bound`` the rounding bound included in ``estimate``, ``substeps`` the
+    the requested, ``bound`` the rounding bound included in ``estimate`` (or ``floor``, the
+    rounding floor measured by a rerun from a moved start, when that bound was not small), ``substeps`` the
     longest output interval over ``hmin`` (equal steps of that many per interval are no
     longer than any the answer took), ``reason`` why a run failed."""
 
@@ -76,6 +84,7 @@ class DenseAuto(NamedTuple):
     ratio: float
     factor: float
     bound: float
+    floor: float
     substeps: int
     reason: str
 
@@ -167,7 +176,7 @@ def _outcome(x: np.ndarray, head) -> DenseAuto:
     result, flag = int(head[_RESULT]), int(head[_FLAG])
     return DenseAuto(x, result, head[_EST], int(head[_SPENT]), int(head[_NANS]),
                      int(head[_NCHK]), int(head[_REJ]), head[_HMIN], int(head[_INTERP]),
-                     head[_RATIO], head[_FACTOR], head[_BOUND], int(head[_SUB]),
+                     head[_RATIO], head[_FACTOR], head[_BOUND], head[_FLOOR], int(head[_SUB]),
                      _REASONS[flag] if result == -3 else "")
 
 
