@@ -479,6 +479,8 @@ _AUTO = r"""
 #define AU_FLOOR_ULPS 1000.0 /* estimates.FLOOR_ULPS */
 #define AU_MEASURED 1e6      /* auto's _PASS_MEASURED */
 #define AU_RTOL_MIN 1e-14    /* stepcontrol.LOCAL_RTOL_MIN */
+#define AU_LADDER 1e-2       /* the most a new answer's local tolerance shrinks (as
+                                stepcontrol's runs of a non-smooth right-hand side) */
 /* the workspace after the header: x0, u, p, atol, ts (AU_NOUT), then the run's x, t, h,
    count (8 + nx), local atol, the answer's noise */
 #define AU_X0(w) ((w) + AU_HDR)
@@ -593,8 +595,10 @@ static void au_verdict(casadi_real* w, casadi_real* X, casadi_real* XC, casadi_r
   }
   w[AU_RESULT] = 0;
   if (!isfinite(est) || w[AU_TRY] >= w[AU_TRIES] || w[AU_FLOOR] > 0) return;
-  /* aim at 0.1; a new answer at least 10x tighter is checked against this one */
-  e = fmin(0.5, 0.1 / est);
+  /* aim at 0.1, at most AU_LADDER tighter (beyond the method's asymptotic range, where
+     the check was taken, the estimate predicts nothing); a new answer at least 10x tighter
+     is checked against this one */
+  e = fmax(AU_LADDER, fmin(0.5, 0.1 / est));
   if (e <= 0.1) {
     for (i = 0; i < n; ++i) XC[i] = X[i];
     w[AU_NCHK] = w[AU_NANS];
