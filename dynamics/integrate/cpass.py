@@ -739,6 +739,41 @@ int rk8_auto_many(const casadi_real* w, int nout, int k0, int k1, const casadi_r
 """
 
 
+# Fixed-step rk8 over the runs of a batch, each under its constant control, in one plain C
+# loop around the generated step (`dynamics.integrate.batch_fixed`).
+_FIXED = r"""
+/* m rk8 steps per output interval (lengths H, nint of them) for the runs k0 <= k < k1:
+   x0 (K, nx), u (K, PASS_U), p (K, max(np, 1)) by run; X (K, nint + 1, nx) the states at
+   the outputs. Returns the runs done. */
+int rk8_fixed_many(int k0, int k1, int nint, int m, const casadi_real* H,
+                   const casadi_real* x0, const casadi_real* u, const casadi_real* p,
+                   casadi_real* X) {
+  pass_ctx c;
+  const casadi_real* arg[PASS_NARG + 5];
+  casadi_real* res[PASS_NRES + 1];
+  casadi_real x[PASS_NX], xn[PASS_NX], h, zero[PASS_U];
+  int k, j, s, i, np1 = PASS_NP > 0 ? PASS_NP : 1;
+  for (i = 0; i < PASS_U; ++i) zero[i] = 0;
+  arg[0] = x; arg[1] = &h; arg[3] = zero; res[0] = xn;
+  for (k = k0; k < k1; ++k) {
+    casadi_real* out = X + (size_t) k * (nint + 1) * PASS_NX;
+    arg[2] = u + (size_t) k * PASS_U;
+    arg[4] = p + (size_t) k * np1;
+    for (i = 0; i < PASS_NX; ++i) out[i] = x[i] = x0[(size_t) k * PASS_NX + i];
+    for (j = 0; j < nint; ++j) {
+      h = H[j] / m;
+      for (s = 0; s < m; ++s) {
+        rk8_step(arg, res, c.iw, c.w, 0);
+        for (i = 0; i < PASS_NX; ++i) x[i] = xn[i];
+      }
+      for (i = 0; i < PASS_NX; ++i) out[(j + 1) * PASS_NX + i] = x[i];
+    }
+  }
+  return k1 - k0;
+}
+"""
+
+
 def pass_library(model: Model) -> object | None:
     """The compiled pass of ``model`` (a ``ctypes`` function, cached); None without a C
     compiler or when the model cannot be code-generated (the pass is worth it only as C)."""
@@ -754,7 +789,7 @@ def pass_library(model: Model) -> object | None:
         steps = [_renamed(step, "rk8_step_err"),
                  _renamed(kernel(model, "rk8", "linear", compiled=True), "rk8_step"), rhs,
                  *dense]
-        return steps, _DRIVER % sizes + _STEPPER + _DENSE + _AUTO
+        return steps, _DRIVER % sizes + _STEPPER + _DENSE + _AUTO + _FIXED
 
     def job(opt):
         return cache.Job(make, opt, ctypes.CDLL, cache.recipe("rk8_pass", model.f, opt))
@@ -794,6 +829,10 @@ def pass_library(model: Model) -> object | None:
         many.argtypes = [ptr, i32, i32, i32, ptr, ptr, ptr, ptr, ptr, ptr]
         many.restype = i32
         fun.auto_many = many  # (`dynamics.integrate.dense`, a batch)
+        fixed = lib.rk8_fixed_many
+        fixed.argtypes = [i32, i32, i32, i32, ptr, ptr, ptr, ptr, ptr]
+        fixed.restype = i32
+        fun.fixed_many = fixed  # (`dynamics.integrate.batch_fixed`)
         return fun
 
     return cache.get(("rk8_pass", cache.function_key(model.f)), build, keepalive=model.f)
