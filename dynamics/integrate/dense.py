@@ -35,8 +35,8 @@ from ..interrupts import check_interrupt, deferred_interrupts
 from .cpass import pass_library
 from .inputs import Problem
 
-__all__ = ["FIELDS", "HEADER", "FIRST", "CHECK", "TRIES", "DenseAuto", "dense_auto", "dense_many", "outcome_of",
-           "constant_control"]
+__all__ = ["FIELDS", "HEADER", "FIRST", "CHECK", "TRIES", "DenseAuto", "dense_auto", "dense_many",
+           "outcome_of", "constant_control"]
 
 FIRST = 0.1     # the answer's local tolerance over the requested one
 CHECK = 100.0   # the check run's local tolerance over the answer's
@@ -90,7 +90,17 @@ class DenseAuto(NamedTuple):
 
 
 def constant_control(ctrl) -> bool:
-    """Whether the linear control ``ctrl`` is one value over the whole run."""
+    """Whether the linear control ``ctrl`` (`inputs.Control`) is one value over the whole run.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from appdyn.dynamics.integrate.dense import constant_control
+    >>> from appdyn.dynamics.integrate.inputs import check_u
+    >>> t = np.linspace(0.0, 1.0, 3)
+    >>> constant_control(check_u([0.1, 0, 0], 3, t)), constant_control(check_u(np.eye(3), 3, t))
+    (True, False)
+    """
     if ctrl.constant or ctrl.ua.size == 0:
         return True
     return bool(np.all(ctrl.ua == ctrl.ua[0]) and np.all(ctrl.ub == ctrl.ua[0]))
@@ -250,8 +260,22 @@ def dense_many(model, x0: np.ndarray, t: np.ndarray, u: np.ndarray, p: np.ndarra
                runs: slice) -> tuple[np.ndarray, np.ndarray] | None:
     """`dense_auto` for the runs ``runs`` of a batch in one compiled loop: ``x0 (K, nx)``,
     ``u (K, max(nu, 1))`` (each run's constant control), ``p (K, max(np, 1))``, all
-    C-contiguous. Returns ``(X (r, nx, n), head (r, 25))``: the answers and each run's
-    header (`outcome_of` reads it); None without a compiled pass."""
+    C-contiguous. Returns ``(X (r, nx, n), head (r, HEADER))``: the answers and each run's
+    header (`outcome_of` reads it); None without a compiled pass.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from appdyn.dynamics import rigid_body
+    >>> from appdyn.dynamics.integrate.dense import dense_many, outcome_of
+    >>> model, t = rigid_body([1.5, 2.5, 3.2]), np.linspace(0.0, 20.0, 41)
+    >>> x0 = np.array([[0, 0, 0, 1, 0.5, 0, 1.0], [0, 0, 0, 1, 0.1, 0.9, 0.2]])
+    >>> X, head = dense_many(model, x0, t, np.zeros((2, 3)), np.zeros((2, 1)), 1e-8,
+    ...                      np.full(7, 1e-10), 1e8, 1e6, slice(0, 2))
+    >>> runs = [outcome_of(X[k], head[k]) for k in range(2)]
+    >>> [r.result for r in runs]  # (each verified by its own check run)
+    [1, 1]
+    """
     plan = _plan(model)
     if plan is None:
         return None
