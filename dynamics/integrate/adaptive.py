@@ -31,10 +31,9 @@ from typing import NamedTuple
 
 import numpy as np
 
-from .. import cache
 from ..interrupts import check_interrupt, deferred_interrupts
 from .cpass import BMAX, NOISE, pass_library
-from .estimates import signs
+from .estimates import signs, table
 from .inputs import Problem
 
 __all__ = ["INTERVALS", "Pass", "run_pass"]
@@ -85,13 +84,14 @@ _STATE0 = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, math.inf, 0.0, 0.0, math.inf,
 
 def _state0(nx: int) -> np.ndarray:
     """The C `state` at the start: the accumulators, then max |x| (0), min scale (inf) and
-    rounding noise (0) of each state (read-only; kept in `dynamics.cache`)."""
-    def build():
+    rounding noise (0) of each state (read-only; kept in `estimates.table`)."""
+    known = table("pass_state0")
+    out = known.get(nx)
+    if out is None:
         out = np.concatenate([_STATE0, np.zeros(nx), np.full(nx, math.inf), np.zeros(nx)])
         out.setflags(write=False)
-        return out
-
-    return cache.get(("pass_state0", nx), build)
+        known[nx] = out
+    return out
 
 
 class _Work:

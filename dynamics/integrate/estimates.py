@@ -16,7 +16,7 @@ from .result import Run
 
 __all__ = ["AUTO_ACCEPT", "EPS", "FLOOR_ULPS", "carried", "floor_signs", "initial_step",
            "jacobian_x", "measured_floor", "perturbed", "rho_sigma", "roundoff", "scaled_diff",
-           "screen", "signs", "spectrum", "tightened"]
+           "screen", "signs", "spectrum", "table", "tightened"]
 
 EPS = np.finfo(float).eps
 AUTO_ACCEPT = 0.5     # accept a trusted estimate (truncation + round-off) below this
@@ -235,28 +235,39 @@ def perturbed(x0: np.ndarray, m: int) -> np.ndarray:
     return x0 + 2 * EPS * signs(m, x0.size) * x0
 
 
+def table(kind: str) -> dict:
+    """A table of small read-only arrays of ``kind`` (sign patterns, start states), kept as
+    ONE entry of `dynamics.cache` (so that `dynamics.clear_caches` empties it and its many
+    small arrays never evict compiled Functions); at most 256 arrays, emptied when full."""
+    got = cache.get(("arrays", kind), dict)
+    if len(got) >= 256:
+        got.clear()
+    return got
+
+
 def signs(seed: int, size: int) -> np.ndarray:
-    """A reproducible random sign pattern of ``size`` entries (read-only). Kept in
-    `dynamics.cache`: seeding a numpy generator costs about 40 us, more than an rk8 run of a
-    small model."""
-    def build():
+    """A reproducible random sign pattern of ``size`` entries (read-only). Kept (`table`):
+    seeding a numpy generator costs about 40 us, more than an rk8 run of a small model."""
+    known = table("signs")
+    out = known.get((seed, size))
+    if out is None:
         out = np.random.default_rng(seed).choice((-1.0, 1.0), size=size)
         out.setflags(write=False)
-        return out
-
-    return cache.get(("signs", seed, size), build)
+        known[seed, size] = out
+    return out
 
 
 def floor_signs(shape: tuple, n: int) -> tuple:
-    """`measured_floor`'s sign patterns (kept in `dynamics.cache`, read-only): three of
-    ``shape`` for the ulp moves of the sampled states, then ``n`` for the start of its check
-    run, drawn in that order from one generator seeded 0."""
-    def build():
+    """`measured_floor`'s sign patterns (kept, `table`; read-only): three of ``shape`` for
+    the ulp moves of the sampled states, then ``n`` for the start of its check run, drawn in
+    that order from one generator seeded 0."""
+    known = table("floor_signs")
+    out = known.get((tuple(shape), n))
+    if out is None:
         rng = np.random.default_rng(0)
         flips = [rng.choice((-1.0, 1.0), size=shape) for _ in range(3)]
         start = rng.choice((-1.0, 1.0), size=n)
         for a in (*flips, start):
             a.setflags(write=False)
-        return tuple(flips), start
-
-    return cache.get(("floor_signs", tuple(shape), n), build)
+        out = known[tuple(shape), n] = (tuple(flips), start)
+    return out
