@@ -20,9 +20,8 @@ included) and ``appdyn/``:
   (`appdyn.dynamics.cache`, emptied by `appdyn.dynamics.clear_caches`): a memoized factory
   uses ``cache.memoize``/``cache.memoize_values``, anything else ``cache.get``.
 
-The allowlists below hold what remained when these rules were written; every entry is in
-``dynamics/integrate/``, ``ocp/`` or ``problems/ascent/``, reshaped by other work in flight.
-An entry that no longer occurs fails too (so the lists only shrink): remove it.
+The allowlists below hold the exceptions, each with its reason (private imports and import
+circles: none). An entry that no longer occurs fails too (so the lists only shrink).
 """
 from __future__ import annotations
 
@@ -35,37 +34,20 @@ import pytest
 ROOT = Path(__file__).resolve().parents[1]
 FOLDERS = ("dynamics", "ocp", "problems", "appdyn")
 
-# (importing module, module the name comes from, name). To be emptied by the work on
-# dynamics/integrate (estimates' helpers get public names), ocp/ (the phase solver's and
-# the NLP's helpers) and problems/ascent/ (the shared vehicle).
-PRIVATE_ALLOWED = {
-    ("appdyn.dynamics.integrate.adaptive", "appdyn.dynamics.integrate.estimates", "_signs"),
-    ("appdyn.dynamics.integrate.stepcontrol", "appdyn.dynamics.integrate.estimates",
-     "_initial_step"),
-    *(("appdyn.dynamics.integrate.auto", "appdyn.dynamics.integrate.estimates", name)
-      for name in ("_AUTO_ACCEPT", "_EPS", "_FLOOR_ULPS", "_carried", "_floor",
-                   "_initial_step", "_perturbed", "_roundoff", "_scaled_diff", "_screen",
-                   "_spectrum")),
-}
+# (importing module, module the name comes from, name): none left.
+PRIVATE_ALLOWED: set = set()
 
-# Strongly connected sets of modules (each closed through a function-local import). To be
-# emptied by the work on dynamics/integrate and ocp/.
-CIRCLES_ALLOWED = {
-    frozenset({"appdyn.dynamics.integrate.batch", "appdyn.dynamics.integrate.batch_fixed"}),
-}
+# Strongly connected sets of modules (each closed through a function-local import): none.
+CIRCLES_ALLOWED: set = set()
 
 # (module, name) of caches outside the one cache. The first two are not caches of built
 # things: `function_key`'s identity table (weak references, part of the one cache itself)
 # and `diskcache`'s identities of this process (its code's hash, the machine, the compiler's
-# path and size: constant while the process runs, and the compile cache's key). The others
-# are to be moved into the one cache by the work on dynamics/integrate, ocp/ and
-# problems/ascent/.
+# path and size: constant while the process runs, and the compile cache's key). The third
+# holds the problems a multistart worker process received (its inputs, not a cache).
 CACHES_ALLOWED = {
     ("appdyn.dynamics.cache", "_KEYS"),
     ("appdyn.dynamics.diskcache", "_IDS"),
-    ("appdyn.dynamics.integrate.adaptive", "_state0"),
-    ("appdyn.dynamics.integrate.estimates", "_floor_signs"),
-    ("appdyn.dynamics.integrate.estimates", "_signs"),
     ("appdyn.ocp.refine.multistart", "_RECEIVED"),  # a worker's unpickled problems
 }
 

@@ -311,6 +311,8 @@ def _nonsingular_delta(draw):
 
 SPIN_RATES = st.tuples(log_floats(0.1, 10.0), floats(-0.05, 0.05), floats(-0.05, 0.05)).map(np.array)
 RANDOM_OVERRIDES = {
+    "appdyn.problems.ascent.pitch_model": {"vehicle": st.just(None), "k_theta": floats(0.5, 5.0),
+                                           "k_thetadot": floats(0.1, 2.0)},
     "appdyn.dynamics.attitude.euler321_rates": {"angles": st.tuples(
         floats(-math.pi, math.pi), floats(-1.5, 1.5), floats(-math.pi, math.pi)).map(np.array)},
     "appdyn.dynamics.attitude.euler313_rates": {"angles": st.tuples(
@@ -602,10 +604,12 @@ OPTIONAL = {
                                             "seed": st.integers(0, 1000),
                                             "duration": floats(1.0, 10.0)},
     "appdyn.problems.ascent.default_gains": {"q": floats(1e4, 5e4)},
+    "appdyn.problems.ascent.planar_model": {"vehicle": st.just(None)},
     "appdyn.problems.ascent.delta3_problem": {"N": st.integers(4, 10), "degree": st.integers(3, 5)},
 }
 NOTHING_TO_DRAW = {
     "appdyn.dynamics.clear_caches": "no parameters",
+    "appdyn.ocp.ipopt_option_table": "no parameters",
     "appdyn.problems.slew.example_targets": "no parameters",
     "appdyn.problems.ascent.initial_state": "no parameters",
     "appdyn.problems.ascent.delta3_ascent": "its only numbers are mesh sizes; one solve (about 2 s)",
@@ -621,7 +625,7 @@ NAN_FIELDS = {"error_estimate", "x_final", "x_initial", "D", "switch_time", "zet
 # that never crosses -180 deg, the period of a steady spin, a closed form that diverges
 INF_FIELDS = {"x_bounds", "u_bounds", "p_bounds", "T_bounds", "gain_margin", "gain_margin_db",
               "phase_margin", "phase_margin_deg", "stability_margin", "period", "closed_form",
-              "bounds"}
+              "bounds", "upper", "lower"}  # (lower, upper: an IPOPT option's range)
 # attributes that echo an input back (checked where that input is built), not results
 ECHOED = {"problem", "model"}
 
