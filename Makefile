@@ -1,17 +1,22 @@
 # Each target bootstraps .venv from scratch if it is missing, then runs.
 # `make demo` installs the package alone (its runtime dependencies); `make test` and
-# `make dev` add what the tests need (the `test` extra); `make docs` adds the `docs` extra and
-# builds the site (warnings are errors) into docs/_build/html; `make bench` runs the
-# benchmarks and rewrites the tables of docs/performance.md.
+# `make dev` add what the tests need (the `test` extra); `make test` runs every test (CI),
+# `make quick` all but the `slow` ones (pytest -m "not slow", a few minutes); JOBS=auto (or
+# a number) spreads either over that many processes (pytest-xdist); `make docs` adds the
+# `docs` extra and builds the site (warnings are errors) into docs/_build/html; `make bench`
+# runs the benchmarks and rewrites the tables of docs/performance.md.
 PYTHON ?= python3
 VENV := .venv
 BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed
 TEST_STAMP := $(VENV)/.installed-test
 DOCS_STAMP := $(VENV)/.installed-docs
+# pytest-xdist workers for `make test`/`make quick` (empty: one process)
+JOBS ?=
+XDIST := $(if $(JOBS),-n $(JOBS),)
 SOURCES := pyproject.toml setup.py $(wildcard */__init__.py)
 
-.PHONY: demo dev test docs bench clean
+.PHONY: demo dev test quick docs bench clean
 
 $(BIN)/python:
 	$(PYTHON) -m venv $(VENV)
@@ -35,7 +40,10 @@ demo: $(STAMP)
 dev: $(TEST_STAMP)
 
 test: $(TEST_STAMP)
-	MPLBACKEND=Agg $(BIN)/python -m pytest -q
+	MPLBACKEND=Agg $(BIN)/python -m pytest -q $(XDIST)
+
+quick: $(TEST_STAMP)
+	MPLBACKEND=Agg $(BIN)/python -m pytest -q -m "not slow" $(XDIST)
 
 docs: $(DOCS_STAMP)
 	MPLBACKEND=Agg $(BIN)/python -m sphinx -b html -W --keep-going -j 2 docs docs/_build/html

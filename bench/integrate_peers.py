@@ -16,12 +16,22 @@ is compared: ``ratio = numbalsoda time / appdyn time`` (> 1: appdyn faster). num
 runs in its own venv (``bench/peers/.venv-numbalsoda``, `bench/peers/README.md`);
 without it the appdyn columns alone are reported.
 
-Writes ``integrate_peers.csv``; returns one ratio row per workload.
-Run: ``appdyn bench integrate_peers`` or ``python bench/integrate_peers.py [--quick]``.
+Then the repeated 2-point call at the defaults (its median [us]; goal <= 20 us), and the
+Monte Carlo of issue 31, item 4: 1,000 torque-free runs (`bench/simulate.py`'s batch
+workload, every run within 1e-8 rad/s of its Jacobi truth) in one batched ``simulate`` at
+the default method and tolerances (each run verified: ``all_success``) and with fixed-step
+``rk8`` (the fewest steps meeting the error), against numbalsoda's ``dop853`` in a
+numba-jitted loop (the loosest of rtol 1e-9, 1e-10, 1e-11 meeting the error).
+
+Writes ``integrate_peers.csv``; returns the ratio rows.
+Run: ``appdyn bench integrate_peers`` or ``python bench/integrate_peers.py [--quick]``;
+``python bench/integrate_peers.py --docs`` (as ``appdyn bench integrate_peers --docs``) also
+puts its rows into ``bench/results`` and the tables of ``docs/performance.md``.
 """
 from __future__ import annotations
 
 import ctypes
+import math
 import statistics
 import subprocess
 import sys
@@ -37,7 +47,8 @@ from appdyn.dynamics.truth import torque_free_omega
 
 from _common import Row, script_main, timed, write_csv
 
-from simulate import numbalsoda  # noqa: E402  (the peer's runner)
+from simulate import (BATCH_TOL, INERTIA, batch_workload, numbalsoda,  # noqa: E402
+                      numbalsoda_batch)
 
 REPEATS = 11
 TOLS = [10.0 ** -k for k in np.arange(4.0, 12.01, 1.0)]
@@ -169,6 +180,65 @@ def cheapest(rows, target):
     return min(ok, key=lambda r: r["time"]) if ok else None
 
 
+def two_point_call(repeats: int) -> float:
+    """The median of ``repeats`` repeated 2-point ``simulate`` calls at the defaults [s]."""
+    model = rigid_body([1.0, 2.0, 3.0])
+    x0, t = np.r_[0.0, 0.0, 0.0, 1.0, 1.0, 0.1, 0.8], np.array([0.0, 10.0])
+    return median_time(lambda: simulate(model, x0, t), repeats)
+
+
+def monte_carlo(quick: bool, detail: list) -> list[Row]:
+    """The 1,000-run Monte Carlo at the defaults and fixed-step, against numbalsoda's njit
+    loop (see the module docstring); rows of the ratios."""
+    k = 100 if quick else 1000
+    x0s, t, truth = batch_workload(k)
+    model = rigid_body(INERTIA)
+
+    def error(x):  # x (7, n, K) -> the worst rate error over all runs
+        return float(np.max(np.abs(np.moveaxis(x[4:7], (0, 1, 2), (2, 1, 0)) - truth)))
+
+    def batched(**kw):
+        return simulate(model, x0s.T, t, **kw)
+
+    rows, times = [], {}
+    res = batched()
+    times["auto"] = min(timed(batched, 3)[1])
+    verified = bool(res.all_success)
+    detail.append(dict(workload=f"Monte Carlo {k} runs", target=BATCH_TOL,
+                       solver="appdyn auto batched (defaults)", rtol=1e-8, error=error(res.x),
+                       time=times["auto"], steps=res.n_steps, success=verified))
+    steps = next(n for n in range(1, 65) if error(batched(method="rk8", steps=n).x) <= BATCH_TOL)
+    fixed = lambda: batched(method="rk8", steps=steps)  # noqa: E731
+    times["rk8"] = min(timed(fixed, 3)[1])
+    detail.append(dict(workload=f"Monte Carlo {k} runs", target=BATCH_TOL,
+                       solver=f"appdyn rk8 batched ({steps} steps per interval)", rtol=math.nan,
+                       error=error(fixed().x), time=times["rk8"], steps=steps * (t.size - 1),
+                       success=True))
+    peer = None
+    for rtol in (1e-9, 1e-10, 1e-11):
+        b = numbalsoda_batch(x0s, t, rtol)
+        if b is None:
+            break
+        e = float(np.max(np.abs(np.asarray(b["w"]) - truth)))
+        detail.append(dict(workload=f"Monte Carlo {k} runs", target=BATCH_TOL,
+                           solver="numbalsoda dop853 njit loop", rtol=rtol, error=e,
+                           time=min(b["times"]), steps=-1, success=bool(b["success"])))
+        if e <= BATCH_TOL and b["success"]:
+            peer = (rtol, min(b["times"]))
+            break
+    case = f"Monte Carlo, {k} torque-free runs, error <= {BATCH_TOL:g}"
+    rows.append(Row("integrate_peers", case, "appdyn auto batched (defaults) time",
+                    times["auto"] * 1e3, "ms", f"every run verified: {verified}, error "
+                    f"{error(res.x):.2g}, {res.n_steps} steps in the costliest run"))
+    if peer:
+        for name, label in (("auto", "defaults (auto, verified per run)"),
+                            ("rk8", f"fixed-step rk8, {steps} steps per interval")):
+            rows.append(Row("integrate_peers", case, f"speed-up vs numbalsoda njit loop, "
+                            f"{label}", peer[1] / times[name], "x",
+                            f"numbalsoda rtol {peer[0]:g}, {peer[1] * 1e3:.3g} ms"))
+    return rows
+
+
 def run(quick: bool, out: Path) -> list[Row]:
     tols = TOLS[::2] if quick else TOLS
     repeats = 3 if quick else REPEATS
@@ -193,11 +263,28 @@ def run(quick: bool, out: Path) -> list[Row]:
                                    b["time"] / a["time"], "x",
                                    f"numbalsoda rtol {b['rtol']:.3g}, {b['time'] * 1e3:.3g} "
                                    f"ms, error {b['error']:.2g}"))
+            if a:  # how much more accurate than asked: the tolerance delivered, not exceeded
+                summary.append(Row("integrate_peers", w.name, "appdyn error over its rtol at "
+                                   "1e-8", _delivered(mine, 1e-8), "", "max |error| / rtol"))
+    call = two_point_call(200 if quick else 2000)
+    summary.append(Row("integrate_peers", "2-point call (10 s), defaults, repeated",
+                       "appdyn simulate time", call * 1e6, "us", "goal <= 20 us"))
+    summary += monte_carlo(quick, detail)
     write_csv(detail, out / "integrate_peers.csv")
     return summary
 
 
+def _delivered(rows, rtol) -> float:
+    """appdyn's error over the tolerance at ``rtol`` (nan when not swept)."""
+    got = [r for r in rows if abs(r["rtol"] / rtol - 1) < 1e-6]
+    return got[0]["error"] / rtol if got else math.nan
+
+
 def main(argv=()):
+    argv = list(argv)
+    if "--docs" in argv:  # as `appdyn bench integrate_peers --docs`
+        from appdyn.problems.cli import main as cli
+        return cli(["bench", "integrate_peers", *argv])
     return script_main(run, argv)
 
 

@@ -195,6 +195,16 @@ def numbalsoda(job):
     return json.loads(proc.stdout)
 
 
+def numbalsoda_batch(x0s, t, rtol, repeats=3):
+    """numbalsoda's dop853 in a numba-jitted loop over the runs ``x0s (K, 7)`` of the
+    benchmark body: its answer (``w (K, n, 3)``, ``times``, ``success``), or None."""
+    ans = numbalsoda(dict(inertia=INERTIA.tolist(), t=np.asarray(t).tolist(),
+                          x0=np.asarray(x0s[0]).tolist(), tols=[], repeats=repeats,
+                          batch=dict(x0s=np.asarray(x0s).tolist(), t=np.asarray(t).tolist(),
+                                     rtol=rtol)))
+    return None if ans is None else ans["batch"]
+
+
 def numbalsoda_rows(x0, t, tols, repeats, error):
     ans = numbalsoda(dict(inertia=INERTIA.tolist(), t=t.tolist(), x0=x0.tolist(), tols=tols,
                           repeats=repeats))
@@ -270,12 +280,9 @@ def batch(quick=False):
         print("numbalsoda batch: skipped (--quick; its process start and numba compile take "
               "several seconds)")
     for rtol in () if quick else (1e-9, 1e-10, 1e-11):
-        ans = numbalsoda(dict(inertia=INERTIA.tolist(), t=t.tolist(), x0=x0s[0].tolist(),
-                              tols=[], repeats=3,
-                              batch=dict(x0s=x0s.tolist(), t=t.tolist(), rtol=rtol)))
-        if ans is None:
+        b = numbalsoda_batch(x0s, t, rtol)
+        if b is None:
             break
-        b = ans["batch"]
         e = err(b["w"])
         rows.append(row("numbalsoda dop853 numba loop", {"rtol": rtol}, b["first"], b["times"],
                         e, b["success"]))

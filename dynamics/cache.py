@@ -302,7 +302,7 @@ class _Pool:
         self.idle: list = []
 
 
-def compile_function(fun: ca.Function, opt: str = "-O3") -> ca.Function | None:
+def compile_function(fun: ca.Function, *, opt: str = "-O3") -> ca.Function | None:
     """``fun`` compiled to C and loaded with ``casadi.external``; None without a C compiler.
 
     The code is generated into a scratch directory, compiled with ``opt`` (``-O3``; the

@@ -210,7 +210,7 @@ class FloquetResult(Result):
         return finish_figure(fig)
 
 
-def classify_multipliers(multipliers, tol: float = TOL) -> tuple[str, str]:
+def classify_multipliers(multipliers, *, tol: float = TOL) -> tuple[str, str]:
     """Verdict and reason for Floquet multipliers (the rule of the module notes).
 
     Parameters
@@ -376,7 +376,7 @@ def floquet(model, x0, period, *, u=None, p=None, tol=TOL, rtol=1e-10, atol=1e-1
     if np.all(np.isfinite(phi)):
         mu = np.linalg.eigvals(phi).astype(complex)
         mu = mu[np.argsort(-np.abs(mu), kind="stable")]
-        verdict, reason = classify_multipliers(mu, tol)
+        verdict, reason = classify_multipliers(mu, tol=tol)
     else:
         mu = np.full(len(keep), complex(math.nan, math.nan))
         verdict, reason = "unknown", "the monodromy matrix is not finite"

@@ -85,6 +85,7 @@ from typing import Mapping
 
 import numpy as np
 
+from appdyn.config import param
 from appdyn.dynamics.cache import construction_lock
 from appdyn.dynamics.interrupts import check_interrupt, interruptible
 
@@ -108,7 +109,6 @@ __all__ = ["solve", "Progress", "DEFAULT_CONSTRAINT_TOL", "STATUS_CONSTRAINT_TOL
 
 _SUCCESS = ("Solve_Succeeded",)
 _ACCEPTABLE = "Solved_To_Acceptable_Level"
-_DEFAULT_N = 20
 _RESOLVE_ITER = 200  # iteration budget of the warm re-solve after an acceptable-level stop
 DEFAULT_CONSTRAINT_TOL = 1e-6
 #: IPOPT options of a warm start with primal and dual values (`Solution` of the same structure
@@ -130,7 +130,7 @@ def default_mesh(N, mesh) -> Mesh:
     (4, 20)
     """
     if mesh is None:
-        return Mesh.uniform(_DEFAULT_N if N is None else N)
+        return Mesh.uniform(param("ocp.N", N))
     m = mesh if isinstance(mesh, Mesh) else Mesh(mesh)
     if N is not None and check_N(N) != m.N:
         raise ValueError(f"`N` = {N} conflicts with `mesh`, which has {m.N} intervals")

@@ -51,6 +51,7 @@ def test_one_guide_page_per_capability():
 
 @pytest.mark.parametrize("page", [p for p in PAGES if p.name not in PROSE],
                          ids=lambda p: p.stem)
+@pytest.mark.slow
 def test_page_python_examples_run(page, tmp_path, monkeypatch):
     """Every python block of the page runs; every ``# -> value`` line prints that value."""
     monkeypatch.chdir(tmp_path)
@@ -58,11 +59,13 @@ def test_page_python_examples_run(page, tmp_path, monkeypatch):
 
 
 @pytest.mark.parametrize("line", [line for page in PAGES for line in console_lines(page)])
+@pytest.mark.slow
 def test_page_cli_examples_run(line, tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path)
     assert main(shlex.split(line)[1:]) == 0
 
 
+@pytest.mark.slow
 def test_api_reference_lists_every_public_name(tmp_path):
     """Each name in the ``__all__`` of appdyn.dynamics, appdyn.ocp, appdyn.problems and their
     public subpackages has an autosummary entry (a constant: a ``py:data`` description) on
@@ -136,6 +139,7 @@ def test_gallery_has_the_examples_asked_for():
 
 
 @pytest.mark.parametrize("script", EXAMPLES, ids=lambda p: p.stem)
+@pytest.mark.slow
 def test_gallery_example_runs(script, tmp_path, monkeypatch):
     """Each example checks itself (``assert`` against its closed form, peer library or
     conservation law) and draws at least one figure, as sphinx-gallery will run it."""

@@ -46,6 +46,7 @@ def test_readme_links_resolve():
     assert not missing, f"README links to missing files {missing}"
 
 
+@pytest.mark.slow
 def test_readme_python_examples_run(tmp_path, monkeypatch):
     """Every python block runs; every ``# -> value`` line prints that value."""
     monkeypatch.chdir(tmp_path)
@@ -54,6 +55,7 @@ def test_readme_python_examples_run(tmp_path, monkeypatch):
 
 
 @pytest.mark.parametrize("line", console_lines(README))
+@pytest.mark.slow
 def test_readme_cli_examples_run(line, tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path)
     assert main(shlex.split(line)[1:]) == 0

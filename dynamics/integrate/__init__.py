@@ -24,7 +24,12 @@ The public entry points are `dynamics.simulate`, `dynamics.SimulationResult`,
 ``smoothness``   the non-smooth operations (kinks, jumps) of a model's expression graph
 ``stepcontrol``  DOP853 with step rejection for non-smooth right-hand sides, and stepping
                  by its error estimate alone with dense output (`stepcontrol.run_dense`)
-                 for a smooth one under a constant control (``auto``)
+``dense``        ``auto`` for a smooth right-hand side under a constant control in ONE
+                 compiled call: the dense-output answer, its check run and the verdict
+                 (`dense.dense_auto`); a batch's runs in one compiled loop, each with its
+                 own steps and check (`dense.dense_many`)
+``estimates``    the numbers ``auto`` rests on: scaled differences, round-off floors,
+                 the spectrum at ``x0``, sign patterns
 ===============  ===========================================================================
 
 Every fixed-step integration (``rk4``, ``rk8``, ``lie`` and the runs ``auto`` makes) calls
@@ -58,8 +63,10 @@ made from Python before the compiled loop runs) or at every right-hand-side eval
 
 For a smooth right-hand side under a control constant over the run, ``auto`` steps DOP853
 by its embedded error estimate alone and fills the outputs from its continuous extension of
-order 7 (`auto.dense_pass`): its work follows the solution, not the output grid; the answer
-is checked against a run at a 100x looser local tolerance. Otherwise:
+order 7 (`auto.dense_pass`): its work follows the solution, never the output grid; the answer
+is checked against a run at a 100x looser local tolerance, both runs and the comparison in
+one compiled call (`dense`), and a batch of such runs is one compiled loop over the runs,
+each run with its own steps, check and verdict. Otherwise:
 the error of a fixed-step run is controlled by the number of substeps; ``auto`` chooses it
 per output interval from DOP853's embedded error estimate in one compiled pass and checks the
 *global* error at the output times against a run with half the steps (`adaptive`), or, when

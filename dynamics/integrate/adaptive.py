@@ -25,7 +25,6 @@ about 0.1 ms (the multi-run search took 1.3 ms).
 from __future__ import annotations
 
 import contextlib
-import functools
 import math
 import threading
 from typing import NamedTuple
@@ -34,7 +33,7 @@ import numpy as np
 
 from ..interrupts import check_interrupt, deferred_interrupts
 from .cpass import BMAX, NOISE, pass_library
-from .estimates import _signs
+from .estimates import signs, table
 from .inputs import Problem
 
 __all__ = ["INTERVALS", "Pass", "run_pass"]
@@ -83,12 +82,15 @@ _ST = 13  # accumulators of the C `state` before max |x| and min scale (see `cpa
 _STATE0 = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, math.inf, 0.0, 0.0, math.inf, 0.0)
 
 
-@functools.lru_cache(maxsize=64)
 def _state0(nx: int) -> np.ndarray:
     """The C `state` at the start: the accumulators, then max |x| (0), min scale (inf) and
-    rounding noise (0) of each state (read-only)."""
-    out = np.concatenate([_STATE0, np.zeros(nx), np.full(nx, math.inf), np.zeros(nx)])
-    out.setflags(write=False)
+    rounding noise (0) of each state (read-only; kept in `estimates.table`)."""
+    known = table("pass_state0")
+    out = known.get(nx)
+    if out is None:
+        out = np.concatenate([_STATE0, np.zeros(nx), np.full(nx, math.inf), np.zeros(nx)])
+        out.setflags(write=False)
+        known[nx] = out
     return out
 
 
@@ -106,7 +108,7 @@ class _Work:
             offsets.append(offsets[-1] + size)
         work = np.zeros(offsets[-1])
         self.arrays = [work[offsets[i]:offsets[i + 1]] for i in range(len(sizes))]
-        self.arrays[9][:] = _signs(1, sizes[0])  # (`_perturbed`'s pattern for m = 1)
+        self.arrays[9][:] = signs(1, sizes[0])  # (`_perturbed`'s pattern for m = 1)
         self.base = work.ctypes.data
         self.offsets = np.array(offsets[:-1], dtype=np.int64)
         self.off_addr = self.offsets.ctypes.data

@@ -12,36 +12,32 @@ from .. import cache
 from .adaptive import run_pass
 from .cpass import BMAX, CHECK_EVERY, NOISE
 from .cvodes import run_cvodes
-from .estimates import (_AUTO_ACCEPT, _EPS, _FLOOR_ULPS, _carried, _floor, _initial_step,
-                        _perturbed, _roundoff, _scaled_diff, _screen, _spectrum, tightened)
+from .dense import dense_auto
+from .estimates import (AUTO_ACCEPT, EPS, FLOOR_ULPS, carried, initial_step, measured_floor,
+                        perturbed, roundoff, scaled_diff, screen, spectrum, tightened)
 from .evaluate import map_eval
 from .inputs import Problem
 from .loops import Progress, run_fixed
 from .result import FAILED, NONSMOOTH, OK, OK_STIFF, ROUNDOFF, UNVERIFIED, Run
 from .smoothness import nonsmooth_operations
-from .stepcontrol import LOCAL_RTOL_MIN, run_dense, solve_stepped
+from .stepcontrol import LOCAL_RTOL_MIN, solve_stepped
 from .tableaux import DOP853
 
-__all__ = ["solve_auto"]
+__all__ = ["solve_auto", "auto_jit", "STIFF_STEPS", "Single", "auto_runs", "dense_pass",
+           "one_pass", "nonsmooth_causes"]
 
 _AUTO_AIM = 0.1        # predict the step count for this estimated scaled error
 _AUTO_RUNS = 8         # give up (status 3) after this many fixed-step runs
 
 _AUTO_CONFIRM = 1024   # below this many steps a trusted triple must be confirmed by another
-_STIFF_STEPS = 1e6     # explicit steps for stability alone beyond which auto uses cvodes
+STIFF_STEPS = 1e6     # explicit steps for stability alone beyond which auto uses cvodes
 _CVODES_RTOL_MIN = 1e-14  # tightest local rtol auto asks cvodes for
 _RK8_STABILITY = 6.0   # DOP853's stability interval on the negative real axis is about [-6, 0]
 _PASS_THETA = 1.0      # the check run's embedded estimates over the horizon, in tolerances
 _PASS_TRIES = 3        # passes (each aimed tighter) before the multi-run search
 _PASS_ULPS = 10 ** 4   # the one-pass path needs the tolerance this many ulps above the state
-_PASS_MEASURED = 10 ** 6  # and below this many it measures the model's rounding (`_floor`)
+_PASS_MEASURED = 10 ** 6  # and below this many it measures the model's rounding (`measured_floor`)
 _ORDER_LOSS = 100.0    # differences this many times the modelled round-off: not round-off
-_DENSE_FIRST = 0.1     # `dense_pass`: the answer's local tolerance over the requested one
-_DENSE_CHECK = 100.0   # the check run's local tolerance over the answer's
-_DENSE_TRIES = 3       # answer-check pairs before the other paths
-_DENSE_MIN_STEPS = 4   # the fewest steps a dense run makes (its first step is cautious)
-_PASS_FLOOR = 3        # the one pass's fewest steps per output interval (2 answer + 1 check)
-_DENSE_COST = 3.0      # time of a `dense_pass` step (with its check run and calls) over a pass step
 
 
 @dataclass(frozen=True)
@@ -61,7 +57,7 @@ def _estimate(runs: dict, rtol, atol, asymptotic: bool) -> _Estimate:
     ``e_c = d_bc / ((c/b)^8 - 1)`` is the truncation error of run ``c`` if the runs are in
     the asymptotic range. That is checked: ``d_ab / d_bc`` must be within a factor 4 of
     ``(a^-8 - b^-8) / (b^-8 - c^-8)``, and ``d_bc`` must stand 4x clear of the modelled
-    round-off ``rho`` of run ``c`` (`_roundoff`, an upper bound: ``n eps max|x|``).
+    round-off ``rho`` of run ``c`` (`roundoff`, an upper bound: ``n eps max|x|``).
 
     * Trusted: accepted when ``e_c + rho <= 0.5``.
     * Untrusted: ``c >= 2 b`` with ``2 d_bc <= 1``: ``e_c <= d_bc`` for any convergent
@@ -94,11 +90,11 @@ def _estimate(runs: dict, rtol, atol, asymptotic: bool) -> _Estimate:
     c = finite[-1]
     xc = runs[c].x[:, 1:]
     scale = atol[:, None] + rtol * np.abs(xc)
-    rho = _roundoff(runs[c].x, runs[c].n_steps, scale)
+    rho = roundoff(runs[c].x, runs[c].n_steps, scale)
     if len(finite) == 1:
         return _Estimate(math.inf, False, 2 * c if c == max(runs) else 8 * max(runs))
     b = finite[-2]
-    d_bc = _scaled_diff(runs[b].x[:, 1:], xc, scale)
+    d_bc = scaled_diff(runs[b].x[:, 1:], xc, scale)
     e_c = d_bc / ((c / b) ** order - 1)
     # Accept on a two-orders-lower extrapolation: pre-asymptotic triples can look 8th order
     # (measured: runs 1, 2, 7 steps looked order 7.7, and the 8th-order estimate was 22x low).
@@ -106,7 +102,7 @@ def _estimate(runs: dict, rtol, atol, asymptotic: bool) -> _Estimate:
     trusted, d_ab = False, math.inf
     if len(finite) >= 3:
         a = finite[-3]
-        d_ab = _scaled_diff(runs[a].x[:, 1:], runs[b].x[:, 1:], scale)
+        d_ab = scaled_diff(runs[a].x[:, 1:], runs[b].x[:, 1:], scale)
         if 4 * rho < d_bc < math.inf:
             predicted = (a ** -order - b ** -order) / (b ** -order - c ** -order)
             trusted = 0.25 <= (d_ab / d_bc) / predicted <= 4.0
@@ -114,19 +110,19 @@ def _estimate(runs: dict, rtol, atol, asymptotic: bool) -> _Estimate:
     # matched the predicted ratio to 7% while the 4-step error was 12x the estimate): below
     # `_AUTO_CONFIRM` steps (cheap) a second trusted triple is asked for.
     confirmed = asymptotic or runs[c].n_steps >= _AUTO_CONFIRM
-    if trusted and confirmed and e_acc + rho <= _AUTO_ACCEPT:
+    if trusted and confirmed and e_acc + rho <= AUTO_ACCEPT:
         return _Estimate(e_acc + rho, True, c, True)
-    if trusted and e_acc + rho <= _AUTO_ACCEPT:
+    if trusted and e_acc + rho <= AUTO_ACCEPT:
         return _Estimate(e_acc + rho, False, math.ceil(1.25 * c), True)
     if c >= 2 * b and 2 * d_bc <= 1.0 and confirmed:
         return _Estimate(2 * d_bc, True, c, trusted)
-    if asymptotic and (c / b) ** (order - 2) >= 2 and 2 * d_bc <= _AUTO_ACCEPT:
+    if asymptotic and (c / b) ** (order - 2) >= 2 and 2 * d_bc <= AUTO_ACCEPT:
         return _Estimate(2 * d_bc, True, c, trusted)
-    if len(finite) == 2 and b > 1 and e_acc + rho <= _AUTO_ACCEPT:
+    if len(finite) == 2 and b > 1 and e_acc + rho <= AUTO_ACCEPT:
         return _Estimate(math.inf, False, b // 2)  # a cheap coarser run to check the order
     if d_bc <= 4 * rho and asymptotic and e_acc + rho <= 1.0:
         return _Estimate(e_acc + rho, True, c, trusted)
-    if d_bc > 0.5 * d_ab and 2 * max(d_ab, d_bc) <= _AUTO_ACCEPT:
+    if d_bc > 0.5 * d_ab and 2 * max(d_ab, d_bc) <= AUTO_ACCEPT:
         # three runs agree within the tolerance and more steps no longer shrink their
         # differences: truncation is below the rounding, which the differences show
         return _Estimate(2 * max(d_ab, d_bc), True, c, trusted)
@@ -139,7 +135,7 @@ def _estimate(runs: dict, rtol, atol, asymptotic: bool) -> _Estimate:
         # is lost: a kink or a jump of the right-hand side, see `auto_runs`)
         return _Estimate(d_bc + e_c, False, 0, trusted, d_bc > _ORDER_LOSS * rho)
     if len(finite) >= 3 and max(d_ab, d_bc) <= 4 * rho and 2 * max(d_ab, d_bc) + rho <= \
-            _AUTO_ACCEPT:
+            AUTO_ACCEPT:
         # three step counts agree to the modelled round-off: the truncation error of the
         # coarsest is below it (a solution rk8 integrates exactly, e.g. a body at rest);
         # truncation that large would differ by (b/a)^8 between the runs
@@ -171,9 +167,10 @@ class Single:
         return run_fixed(replace(self.problem, x0=x0), "rk8", m, jit, progress)
 
     def spectrum(self, rtol, atol):
-        """``(rho, sigma)`` as `_spectrum` (``(L, 0)`` from `_initial_step` when that fails)."""
-        spectrum = _spectrum(self.problem)
-        return (_initial_step(self.problem, rtol, atol, 8)[1], 0.0) if spectrum is None else spectrum
+        """``(rho, sigma)`` as `estimates.spectrum` (``(L, 0)`` from `initial_step` when that
+        fails)."""
+        found = spectrum(self.problem)
+        return (initial_step(self.problem, rtol, atol, 8)[1], 0.0) if found is None else found
 
     def rhs(self, X: np.ndarray, cols: np.ndarray) -> np.ndarray:
         """The right-hand side at the states ``X (N, c)`` taken at output times ``t[cols]``."""
@@ -202,7 +199,7 @@ def auto_runs(target, rtol, atol, max_steps, jit_pref, progress: Progress):
     horizon = float(t[-1] - t[0])
     Hmax = float(np.max(np.diff(t)))
     lipschitz, sigma = target.spectrum(rtol, atol)
-    if horizon * sigma / _RK8_STABILITY > _STIFF_STEPS:
+    if horizon * sigma / _RK8_STABILITY > STIFF_STEPS:
         return (None, math.nan, 0, f"stiff: a decay rate of {sigma:.3g}/s needs "
                 f"~{horizon * sigma / _RK8_STABILITY:.3g} explicit steps for stability alone",
                 0, 0)
@@ -229,7 +226,7 @@ def auto_runs(target, rtol, atol, max_steps, jit_pref, progress: Progress):
             reason = f"the error estimates did not settle in {len(runs)} runs"
             break
         progress.ahead = 2 * m * nint  # another run, if one is needed, takes about twice the steps
-        run = target.run(_perturbed(target.x0, m), m, _auto_jit(jit_pref), progress)
+        run = target.run(perturbed(target.x0, m), m, auto_jit(jit_pref), progress)
         run.x[:, 0] = target.x0
         runs[m] = run
         total[0] += run.n_steps
@@ -244,7 +241,7 @@ def auto_runs(target, rtol, atol, max_steps, jit_pref, progress: Progress):
         asymptotic = asymptotic or est.trusted
         if est.accept:
             best = runs[max(k for k, r in runs.items() if r.ok)]
-            floor, extra = _floor(target, best, rtol, atol, lipschitz, _auto_jit(jit_pref),
+            floor, extra = measured_floor(target, best, rtol, atol, lipschitz, auto_jit(jit_pref),
                                   progress)
             total[0] += extra
             total[1] += extra * DOP853.stages
@@ -268,7 +265,7 @@ def _first_bad(x: np.ndarray) -> int:
     return int(np.argmax(bad)) if bad.any() else x.shape[1]
 
 
-def _auto_jit(jit_pref) -> bool:
+def auto_jit(jit_pref) -> bool:
     """jit for ``auto``'s runs: `cache.should_compile` with unbounded work, as for the
     fixed-step methods (one compiled chunk per model, reused by every run and call)."""
     return cache.should_compile(jit_pref, math.inf)
@@ -310,7 +307,7 @@ def one_pass(problem: Problem, rtol, atol, max_steps, jit_pref, progress):
 
     Within `_PASS_MEASURED` ulps of a state's size, the tolerance may meet the rounding of
     the model's own formulas, which both runs share: the pass measures it (the change of
-    ``f`` when its state moves by one ulp) and `_floor`'s screening bound, carried over the
+    ``f`` when its state moves by one ulp) and `measured_floor`'s screening bound, carried over the
     horizon with the spectral radius at ``x0``, must be below 0.05 (it is added to the
     estimate); otherwise the multi-run search measures the flow's real amplification.
 
@@ -318,9 +315,9 @@ def one_pass(problem: Problem, rtol, atol, max_steps, jit_pref, progress):
     callable control, no compiled pass, a tolerance within `_PASS_ULPS` ulps of a state, a
     non-finite state or an interval that needs more than ``2 cpass.BMAX + 1`` steps.
     """
-    if problem.control.mode != "linear" or not _auto_jit(jit_pref):
+    if problem.control.mode != "linear" or not auto_jit(jit_pref):
         return None, math.nan, 0
-    if _size_over_tolerance(problem, rtol, atol) * _EPS * _PASS_ULPS > 1.0:
+    if _size_over_tolerance(problem, rtol, atol) * EPS * _PASS_ULPS > 1.0:
         return None, math.nan, 0  # (the states' sizes put the tolerance near round-off)
     horizon = float(problem.t[-1] - problem.t[0])
     theta = _PASS_THETA / horizon
@@ -332,12 +329,12 @@ def one_pass(problem: Problem, rtol, atol, max_steps, jit_pref, progress):
         spent += got.n_steps
         if not got.ok:
             return None, math.nan, spent
-        d, ulps = got.d, got.ulp * _FLOOR_ULPS
+        d, ulps = got.d, got.ulp * FLOOR_ULPS
         if got.ulp * _PASS_MEASURED > 1.0:  # near round-off: the model's rounding, measured
             lipschitz = Single(problem).spectrum(rtol, atol)[0]
-            bound = _screen(_carried(got.rounding, horizon, lipschitz), got.smin, horizon,
+            bound = screen(carried(got.rounding, horizon, lipschitz), got.smin, horizon,
                             lipschitz)
-            if not bound <= 0.1 * _AUTO_ACCEPT:
+            if not bound <= 0.1 * AUTO_ACCEPT:
                 return None, math.nan, spent  # (the multi-run search measures the flow's)
             ulps = max(ulps, bound)
         shown, measured = got.orders
@@ -345,11 +342,11 @@ def one_pass(problem: Problem, rtol, atol, max_steps, jit_pref, progress):
         if measured == 0 and got.stats.shape[0] >= 3 * CHECK_EVERY:
             # the answer's own estimates are all at the rounding level: its truncation is
             # at most that level per step, added up over its steps
-            richardson += got.answer_steps * NOISE * _EPS / rtol
+            richardson += got.answer_steps * NOISE * EPS / rtol
             trusted = True
         else:
             trusted = measured >= 3 and 2 * shown >= measured
-        if trusted and richardson + ulps <= _AUTO_ACCEPT:
+        if trusted and richardson + ulps <= AUTO_ACCEPT:
             estimate = richardson + ulps
         elif got.ec <= 1.0 and 2 * d + ulps <= 1.0:
             estimate = 2 * d + ulps
@@ -375,107 +372,32 @@ def one_pass(problem: Problem, rtol, atol, max_steps, jit_pref, progress):
 def dense_pass(problem: Problem, rtol, atol, max_steps, progress):
     """``auto`` for a smooth right-hand side under a control constant over the run: DOP853
     stepping by its error estimate alone, the outputs filled from its continuous extension
-    (`stepcontrol.run_dense`), so the work follows the solution, not the output grid.
+    (`stepcontrol.run_dense`), so the work follows the solution, not the output grid; the
+    answer, its check run at a looser local tolerance, their comparison and the verdict in
+    one compiled call (`dense.dense_auto`, whose docstring states the rules).
     Returns ``(run, estimate)`` or ``(None, nan)`` to leave the problem to `one_pass` and the
     multi-run search (stiff by the first step's Lipschitz estimate: more than
-    `_STIFF_STEPS` steps for stability alone; no compiled library, a control that varies, a tolerance so near a
-    state's rounding that 1000 ulps of it take half of the acceptance below, a failed
-    run, or no verdict after `_DENSE_TRIES` answers).
+    `STIFF_STEPS` steps for stability alone; no compiled library, a control that varies, a
+    tolerance so near a state's rounding that 1000 ulps of it take half of the acceptance, a
+    failed run, or no verdict after `dense.TRIES` answers).
 
-    The answer runs at the local tolerance ``(rtol, atol) f`` (``f`` = `_DENSE_FIRST`), a
-    check run at ``_DENSE_CHECK`` times that; ``d`` is their scaled difference (max over
-    the outputs, in units of ``atol + rtol |x|``). A step-controlled method's global error
-    is proportional to its local tolerance to the power ``q``: 7/8 for DOP853 (local error
-    per step ~ tol, step ~ tol^(1/8), steps ~ tol^(-1/8)). The runs are taken to be in that
-    range when the step counts show it: ``n_answer / n_check`` within a factor 1.25 of
-    ``_DENSE_CHECK^(1/8)``; then the estimate is ``d / (_DENSE_CHECK^(3/4) - 1)`` (one
-    order of the tolerance power low, as `one_pass` takes two orders of the step), plus
-    1000 ulps of each state, accepted when at most 0.5. Otherwise the estimate is ``d``
-    (the answer is at least twice as accurate as the check), accepted when at most 1. Not
-    accepted, ``f`` shrinks in proportion to the estimate (aimed at 0.1); a new answer at
-    least 10x tighter is checked against the previous answer (the ratio of their local
-    tolerances replaces `_DENSE_CHECK` above).
-
-    Within `_PASS_MEASURED` ulps of a state's size the rounding of the model's own
-    formulas is added: the noise the answer measured on its way (`stepcontrol.DenseRounding`)
-    carried over the horizon and screened as `one_pass` does, or where that bound is not
-    small, `estimates._floor` with a repeated answer from a moved start.
+    Within `_PASS_MEASURED` ulps of a state's size the rounding the answer measured on its
+    way, carried over the horizon, is added; where it is not small, the floor measured by the
+    answer repeated from a moved start (as `estimates.measured_floor`), in the same call.
     """
-    size = _size_over_tolerance(problem, rtol, atol)
-    if problem.control.mode != "linear" or size * _EPS * _FLOOR_ULPS > 0.5 * _AUTO_ACCEPT:
-        return None, math.nan  # (the 1000-ulp floor would take half of the acceptance)
-    spent, horizon = [0], float(problem.t[-1] - problem.t[0])
-
-    def run_at(factor, start=problem):
-        got = run_dense(start, rtol * factor, atol * factor, max_steps - spent[0], progress,
-                        _STIFF_STEPS)
-        if got is not None:
-            spent[0] += got[0].n_steps
-        return got if got is not None and got[0].ok else (None, None)
-
-    factor = _DENSE_FIRST
-    (check, _), loose = run_at(factor * _DENSE_CHECK), factor * _DENSE_CHECK
-    for _ in range(_DENSE_TRIES):
-        run, rounding = run_at(factor)
-        if check is None or run is None:
-            return None, math.nan
-        ratio = loose / factor
-        scale = atol[:, None] + rtol * np.abs(run.x[:, 1:])
-        d = _scaled_diff(check.x[:, 1:], run.x[:, 1:], scale)
-        ulps = _roundoff(run.x, _FLOOR_ULPS, scale)
-        power = run.n_steps / max(check.n_steps, 1) / ratio ** 0.125
-        if 0.8 <= power <= 1.25:
-            estimate, accept = d / (ratio ** 0.75 - 1) + ulps, _AUTO_ACCEPT
-        else:
-            estimate, accept = d + ulps, 1.0
-        if size * _EPS * _PASS_MEASURED > 1.0 and estimate <= accept:
-            # the model's rounding, measured on the way, carried over the horizon
-            bound = _screen(_carried(rounding.noise, horizon, rounding.lipschitz),
-                            np.min(scale, axis=1), horizon, rounding.lipschitz)
-            estimate += bound if bound <= 0.1 * _AUTO_ACCEPT else \
-                _dense_floor(problem, run, rtol, atol, lambda p: run_at(factor, p)[0])
-        if estimate <= accept:
-            message = (f"auto: DOP853 with dense output, steps chosen by its error estimate "
-                       f"({run.message}), checked against a run at a {ratio:.3g}x looser "
-                       f"local tolerance ({check.n_steps} steps); estimated error "
-                       f"{estimate:.2g} of tolerance")
-            return Run.new(run.x, spent[0], DOP853.stages * spent[0], run.substeps, True,
-                           True, message), estimate
-        if not math.isfinite(estimate):
-            return None, math.nan
-        # aim at 0.1; a new answer >= 10x tighter is checked against this one
-        shrink = min(0.5, 0.1 / estimate)
-        if shrink <= 0.1:
-            check, loose = run, factor
-        factor *= shrink
-        if rtol * factor < LOCAL_RTOL_MIN:
-            return None, math.nan
-    return None, math.nan
-
-
-def _grid_bound(problem: Problem, rtol, atol) -> bool:
-    """Whether the output grid, not the error, would set `one_pass`'s work: its floor of
-    `_PASS_FLOOR` steps per output interval exceeds an upper estimate of the steps DOP853
-    needs over the horizon at its own error control, ``T / h0`` (``h0`` Hairer's starting
-    step, `estimates._initial_step`, which is cautious: on the torque-free bodies of the
-    benchmarks 3-15x below the steps taken), weighted by `_DENSE_COST`. Measured (same session, matched error): where
-    the grid does not bind, the one pass is about 3x cheaper than `dense_pass` (its steps
-    cost less and it is one compiled call; 121 outputs over 60 s: 0.22 against 0.67 ms);
-    where it does, `dense_pass` is (2001 outputs over 20 s: 1.1 against 4.1 ms)."""
-    if _PASS_FLOOR * problem.nint <= 2 * _DENSE_MIN_STEPS:
-        return False  # (the dense path makes two runs of a few steps at least)
-    h0 = _initial_step(problem, rtol, atol, 8)[0]
-    horizon = float(problem.t[-1] - problem.t[0])
-    return h0 is not None and h0 > 0 and \
-        _DENSE_COST * horizon / h0 < _PASS_FLOOR * problem.nint
-
-def _dense_floor(problem: Problem, run: Run, rtol, atol, again) -> float:
-    """`dense_pass`'s rounding floor of ``run`` near round-off where the screening bound of
-    the rounding measured on the way is not small (`estimates._floor`, its check run
-    ``again(problem from the moved start)`` at the same local tolerance)."""
-    target = Single(problem)
-    return _floor(target, run, rtol, atol, target.spectrum(rtol, atol)[0], True, None,
-                  lambda x0: again(replace(problem, x0=x0)))[0]
+    got = dense_auto(problem, rtol, atol, max_steps, STIFF_STEPS, progress)
+    if got is None or got.result != 1:
+        return None, math.nan
+    estimate = got.estimate
+    message = (f"auto: DOP853 with dense output, steps chosen by its error estimate "
+               f"({got.answer_steps - got.rejected} steps, {got.rejected} rejected, "
+               f"{got.interpolated} interpolated, local rtol {rtol * got.factor:.3g}), checked "
+               f"against a run at a {got.ratio:.3g}x looser local tolerance ({got.check_steps} "
+               f"steps); estimated error {estimate:.2g} of tolerance"
+               + (f" (a rounding floor of {got.floor:.2g} measured by a run from a moved start "
+                  "included)" if got.floor > 0 else ""))
+    return Run.new(got.x, got.spent, DOP853.stages * got.spent, got.substeps, True, True,
+                   message), estimate
 
 
 def _size_over_tolerance(problem: Problem, rtol: float, atol: np.ndarray) -> float:
@@ -516,11 +438,11 @@ def _auto_stepped(problem: Problem, rtol, atol, max_steps, jit, progress, causes
     estimate)``, or None to leave it to the general path (no compiled stepper for a
     sampled control, or a stiff problem, which goes to cvodes). A callable control steps
     from Python (`stepcontrol.run_stepped_callable`)."""
-    if problem.control.mode == "linear" and not _auto_jit(jit):
+    if problem.control.mode == "linear" and not auto_jit(jit):
         return None
     lipschitz, sigma = Single(problem).spectrum(rtol, atol)
     horizon = float(problem.t[-1] - problem.t[0])
-    if horizon * sigma / _RK8_STABILITY > _STIFF_STEPS:
+    if horizon * sigma / _RK8_STABILITY > STIFF_STEPS:
         return None
     run, verdict, estimate, n_steps, n_rhs = solve_stepped(problem, rtol, atol, max_steps,
                                                            progress)
@@ -553,9 +475,9 @@ def solve_auto(problem: Problem, rtol, atol, max_steps, jit, cvodes_options, pro
 
     A right-hand side with kinks (`nonsmooth_causes`) goes to DOP853 with step rejection
     (`_auto_stepped`), which does not assume the method's order; a smooth one under a
-    constant control, where the output grid would bind the one pass (`_grid_bound`), to
-    DOP853 with dense output (`dense_pass`); then to the one-pass path, then the multi-run
-    Richardson search (`auto_runs`)."""
+    constant control to DOP853 with dense output (`dense_pass`: its steps follow the error,
+    never the output grid); then (a control that varies, or no verdict) to the one-pass
+    path, then the multi-run Richardson search (`auto_runs`)."""
     causes = nonsmooth_causes(problem)
     spent = 0
     if causes:
@@ -564,7 +486,7 @@ def solve_auto(problem: Problem, rtol, atol, max_steps, jit, cvodes_options, pro
             return got
     else:
         run, estimate = dense_pass(problem, rtol, atol, max_steps, progress) \
-            if _auto_jit(jit) and _grid_bound(problem, rtol, atol) else (None, math.nan)
+            if auto_jit(jit) else (None, math.nan)
         if run is not None:
             return run, "rk8", OK, estimate  # (DOP853's 8th-order steps, as the fixed-step rk8)
         run, estimate, spent = one_pass(problem, rtol, atol, max_steps, jit, progress)

@@ -21,14 +21,17 @@ import numpy as np
 
 from .. import cache
 from ..model import Model
-from ..validate import finite_array, integer, unit_quaternion
-from ..validate.rotations import QUAT_NORM_TOL
-from .auto import Single, auto_runs, solve_auto
+from ..validate import integer
+from ..executors import run_split
+from ..interrupts import check_interrupt, deferred_interrupts
+from .auto import STIFF_STEPS, Single, auto_jit, auto_runs, solve_auto
 from .batch_fixed import BATCH_THREADS, fixed_batch, fixed_message, run_fixed_batch
 from .cvodes import run_cvodes
+from .dense import HEADER as DENSE_HEADER
+from .dense import dense_many, outcome_of
 from .estimates import jacobian_x, rho_sigma
 from .evaluate import map_eval
-from .inputs import HOLDS, Control, Problem
+from .inputs import Batch, check_batch
 from .loops import Progress
 from ..figures import plot_signals
 from ..results import Result
@@ -37,90 +40,8 @@ from .result import (FAILED, OK, OK_STIFF, ROUNDOFF, UNVERIFIED, VIOLATED, Dense
 from .smoothness import nonsmooth_operations
 from .sanity import remedy, violations
 
-__all__ = ["Batch", "BatchResult", "check_batch", "simulate_batch", "BATCH_THREADS"]
-
-@dataclass(frozen=True)
-class Batch:
-    """K runs on one grid: ``x0 (nx, K)``, ``p (np, K)``, controls ``ua, ub (K, nint, nu)``
-    (the values at the start and end of each output interval, linear in between);
-    ``constant`` when each run's control is known to be one value throughout (``False``
-    leaves it to be found from the values); ``tail (K, nu)`` the samples at ``t[-1]`` of a
-    zero-order hold (``ub = ua``), else None."""
-
-    model: Model
-    x0: np.ndarray
-    t: np.ndarray
-    p: np.ndarray
-    ua: np.ndarray
-    ub: np.ndarray
-    constant: bool = False
-    tail: np.ndarray | None = None  # (K, nu): the samples at t[-1] of a zero-order hold
-
-    @property
-    def K(self) -> int:
-        return self.x0.shape[1]
-
-    @property
-    def nint(self) -> int:
-        return self.t.size - 1
-
-    def problem(self, k: int) -> Problem:
-        """Run ``k`` as a single-run `Problem`."""
-        return Problem(self.model, self.x0[:, k].copy(), self.t,
-                       Control("linear", self.ua[k], self.ub[k],
-                               tail=None if self.tail is None else self.tail[k]),
-                       self.p[:, k].copy())
-
-
-def check_batch(model: Model, x0, t: np.ndarray, u, p, hold: str = "linear") -> Batch:
-    """The batch of ``x0 (nx, K)`` with ``p`` ``(np,)`` or ``(np, K)`` and ``u`` None,
-    ``(nu,)``, ``(nu, n)`` (shared) or ``(nu, n, K)`` (per run), samples held as ``hold``
-    says (`dynamics.integrate.inputs.HOLDS`); raises naming the argument."""
-    if hold not in HOLDS:
-        raise ValueError(f"`hold` must be one of {HOLDS}, got {hold!r}")
-    nx, nu, n = model.nx, model.nu, t.size
-    X0 = np.array(finite_array(x0, "x0"), dtype=float)
-    if X0.ndim != 2 or X0.shape[0] != nx or X0.shape[1] < 1:
-        raise ValueError(f"`x0` must have shape ({nx},) or ({nx}, K) for a batch of K runs, "
-                         f"got {X0.shape}")
-    K = X0.shape[1]
-    if model.attitude is not None:
-        iq = model.attitude[0]
-        bad = np.abs(np.linalg.norm(X0[iq:iq + 4], axis=0) - 1.0) > QUAT_NORM_TOL
-        if bad.any():  # the message of the single-run check, naming the run
-            k = int(np.argmax(bad))
-            unit_quaternion(X0[iq:iq + 4, k], f"x0[{iq}:{iq + 4}, {k}] (the attitude quaternion)")
-    if p is None:
-        P = np.repeat(model.resolve_p(None)[:, None], K, axis=1)
-    else:
-        a = np.asarray(finite_array(p, "p"), dtype=float)
-        if a.ndim == 2 and a.shape == (model.np, K):
-            P = np.array(a)
-        elif a.ndim <= 1:
-            P = np.repeat(model.resolve_p(a)[:, None], K, axis=1)
-        else:
-            raise ValueError(f"`p` must have shape ({model.np},) or ({model.np}, {K}) for a "
-                             f"batch of {K} runs, got {a.shape}")
-    if callable(u):
-        raise ValueError("`u` must be None or an array for a batch of runs (x0 of shape "
-                         f"({nx}, K)): give samples of shape ({nu}, {n}) or ({nu}, {n}, K)")
-    if u is None:  # (zeros cost nothing until written: no copies)
-        return Batch(model, X0, t, P, np.zeros((K, n - 1, nu)), np.zeros((K, n - 1, nu)), True)
-    a = np.asarray(finite_array(u, "u"), dtype=float)
-    if a.shape == (nu,):
-        U = np.broadcast_to(a, (K, n, nu))
-    elif a.shape == (nu, n):
-        U = np.broadcast_to(a.T, (K, n, nu))
-    elif a.shape == (nu, n, K):
-        U = a.transpose(2, 1, 0)
-    else:
-        raise ValueError(f"`u` must be None, ({nu},), ({nu}, {n}) or ({nu}, {n}, {K}) for "
-                         f"a batch of {K} runs, got {a.shape}")
-    ua = np.ascontiguousarray(U[:, :-1])
-    if hold == "zoh" and a.shape != (nu,):
-        return Batch(model, X0, t, P, ua, ua, False, np.array(U[:, -1]))
-    return Batch(model, X0, t, P, ua, np.ascontiguousarray(U[:, 1:]), a.shape == (nu,))
-
+__all__ = ["Batch", "BatchResult", "check_batch", "simulate_batch", "BATCH_THREADS"]  # (Batch,
+# check_batch: `inputs`, here for the callers that import them from this module)
 
 class BatchTarget:
     """`dynamics.integrate.auto`'s view of a batch: flat states stacked run by run
@@ -180,12 +101,20 @@ def simulate_batch(batch: Batch, method: str, steps: int, rtol: float, atol: np.
             "" if ok.all() else f"; {int((~ok).sum())} failed: {runs[int(np.argmin(ok))].message}")
     else:
         target = BatchTarget(batch)
-        if target.nonsmooth:  # each run with its own step control (`stepcontrol`)
+        dense = None if target.nonsmooth else auto_dense_batch(batch, rtol, atol, max_steps,
+                                                                jit, cvodes_options, progress)
+        if dense is not None:
+            x, ok, status, estimate, used, n_steps, message = dense
+            compiled = True
+            run = None
+        elif target.nonsmooth:  # each run with its own step control (`stepcontrol`)
             run, st, reason = None, 0, "non-smooth"
         else:
             run, value, st, reason, n_steps, _ = auto_runs(target, rtol, np.tile(atol, K),
                                                        max_steps, jit, progress)
-        if run is None and reason.startswith(("stiff", "non-smooth")):
+        if dense is not None:
+            pass
+        elif run is None and reason.startswith(("stiff", "non-smooth")):
             # as single runs: auto's cvodes, or its step control, per run
             outs = [solve_auto(batch.problem(k), rtol, atol, max_steps, jit, cvodes_options,
                                progress) for k in range(K)]
@@ -219,6 +148,93 @@ def simulate_batch(batch: Batch, method: str, steps: int, rtol: float, atol: np.
                        status=status, message=message, method=used,
                        wall_time=time.perf_counter() - start, n_steps=int(n_steps),
                        error_estimate=estimate, compiled=bool(compiled), _batch=batch)
+
+
+def auto_dense_batch(batch: Batch, rtol: float, atol: np.ndarray, max_steps: int, jit,
+                     cvodes_options, progress: Progress):
+    """``auto`` on a batch of smooth runs, each under a control constant over its run: the
+    answer, check run and verdict of `dense.dense_auto` for every run in one compiled loop
+    over the runs (`dense.dense_many`; the runs in parts spread over `BATCH_THREADS`
+    threads), each run with its own steps; a run not verified there goes alone through
+    `solve_auto` (as a single call would). Returns ``(x (nx, n, K), ok, status, estimate,
+    method, n_steps, message)``, or None (no compiled pass, a control that varies within a
+    run, jit off)."""
+    if not auto_jit(jit):
+        return None
+    K, model, t = batch.K, batch.model, batch.t
+    nx, nu, np_ = model.nx, model.nu, model.np
+    ua = batch.ua
+    if not batch.constant and ua.size and not (np.all(ua == ua[:, :1]) and
+                                               np.all(batch.ub == ua[:, :1])):
+        return None
+    x0 = np.ascontiguousarray(batch.x0.T)
+    u = np.zeros((K, max(nu, 1)))
+    if nu and ua.shape[1]:
+        u[:, :nu] = ua[:, 0]
+    p = np.zeros((K, max(np_, 1)))
+    p[:, :np_] = batch.p.T
+    X = np.empty((K, nx, t.size))
+    head = np.empty((K, DENSE_HEADER))
+    parts, threads = _dense_parts(K)
+    missing = []
+
+    def work(todo):
+        for runs in iter(lambda: next(todo, None), None):
+            got = dense_many(model, x0, t, u, p, rtol, atol, max_steps, STIFF_STEPS, runs)
+            if got is None:
+                missing.append(runs)
+                return
+            X[runs], head[runs] = got
+
+    with deferred_interrupts():
+        for group in _groups(parts, threads):
+            check_interrupt()
+            run_split(work, [iter(group)] * min(threads, len(group)))
+    if missing:
+        return None
+    outs = [outcome_of(X[k], head[k]) for k in range(K)]
+    status = np.full(K, OK)
+    estimate = np.array([o.estimate for o in outs])
+    redo = [k for k, o in enumerate(outs) if o.result != 1]
+    used, steps = ({"rk8"} if len(redo) < K else set()), [o.spent for o in outs]
+    for k in redo:  # not verified in the loop: alone, by every path of `solve_auto`
+        run, method, st, est = solve_auto(batch.problem(k), rtol, atol, max_steps, jit,
+                                          cvodes_options, progress)
+        X[k] = run.x
+        status[k] = st if run.ok else FAILED
+        estimate[k] = est
+        used.add(method)
+        steps[k] = run.n_steps
+    x = X.transpose(1, 2, 0)
+    ok = np.isfinite(x).all(axis=(0, 1))
+    status = np.where(ok, status, FAILED)
+    good = [o for k, o in enumerate(outs) if o.result == 1]
+    message = (f"auto: DOP853 with dense output per run ({K} runs, each with its own steps, "
+               f"checked against its own run at a looser local tolerance): "
+               f"{min(steps)}-{max(steps)} steps per run; estimated error up to "
+               f"{max((o.estimate for o in good), default=math.nan):.2g} of tolerance")
+    if redo:
+        message += f"; {len(redo)} run(s) alone through auto's other paths"
+    return x, ok, status, estimate, ", ".join(sorted(used)), max(steps), message
+
+
+#: Runs of one compiled call of a dense batch (Ctrl-C is looked at between groups of them).
+DENSE_PART = 64
+
+
+def _dense_parts(K: int) -> tuple[list[slice], int]:
+    """The runs of a dense batch in parts of at most `DENSE_PART` runs, and the threads."""
+    threads = min(BATCH_THREADS, -(-K // DENSE_PART)) if K >= 2 * DENSE_PART else 1
+    count = max(-(-K // DENSE_PART), threads)
+    size, extra = divmod(K, count)
+    edges = np.cumsum([0] + [size + 1] * extra + [size] * (count - extra))
+    return [slice(int(a), int(b)) for a, b in zip(edges[:-1], edges[1:])], threads
+
+
+def _groups(parts: list, threads: int) -> list[list]:
+    """``parts`` in groups of about 16 parts per thread (interrupts between groups)."""
+    step = 16 * threads
+    return [parts[i:i + step] for i in range(0, len(parts), step)]
 
 
 def _sane(batch: Batch, x: np.ndarray, ok: np.ndarray, status: np.ndarray, message: str,

@@ -9,21 +9,18 @@ from __future__ import annotations
 import contextlib
 import os
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
-
 import numpy as np
 
 from .. import cache
 from ..executors import run_split
 from ..interrupts import check_interrupt, deferred_interrupts
+from .cpass import pass_library
 from .evaluate import borrow_state, return_state
+from .inputs import Batch
 from .loops import BATCH_CHUNK as CHUNK
 from .loops import Progress, chunk_function, interval_ends
 from .result import Run
 from .tableaux import TABLEAUX
-
-if TYPE_CHECKING:
-    from .batch import Batch
 
 __all__ = ["fixed_batch", "run_fixed_batch", "fixed_message", "BATCH_THREADS", "PART_RUNS",
            "PART_STEPS", "PARALLEL_STEPS"]
@@ -201,17 +198,27 @@ def fixed_batch(batch: Batch, method: str, m: int, jit: bool, x0: np.ndarray | N
                 progress: Progress | None = None) -> tuple[np.ndarray, np.ndarray, int, bool]:
     """``m`` steps of ``method`` per output interval for every run of ``batch`` (from
     ``x0 (nx, K)``, default ``batch.x0``), chunk by chunk; each chunk in one mapped call per
-    part of the runs, the parts spread over `BATCH_THREADS` threads (`run_split`).
+    part of the runs, the parts spread over `BATCH_THREADS` threads (`run_split`). Compiled
+    ``rk8`` under constant controls without a progress callback: every run in one plain C
+    loop over its steps (`cpass._FIXED`, parts of the runs spread over the threads).
 
     Returns ``(x (nx, n, K), ok (K,), steps done per run, compiled)``: a run whose state
     became non-finite has its later columns NaN and ``ok`` False.
     """
     model, K = batch.model, batch.K
-    fun, compiled = chunk_function(model, method, "linear", jit, CHUNK)
     total = m * batch.nint
     progress = Progress(None) if progress is None else progress
     progress.start(total)
     state = _FixedBatch(batch, m, batch.x0 if x0 is None else x0)
+    if method == "rk8" and jit and state.constant and progress.fun is None:
+        # (a progress callback is told after every chunk: the chunk loop below)
+        lib = pass_library(model)
+        if lib is not None:  # one plain C loop over the runs (`cpass._FIXED`)
+            _c_loop(lib.fixed_many, state, m)
+            progress.advance(total)
+            x, ok = _nan_after_failure(state.x)
+            return x, ok, total, True
+    fun, compiled = chunk_function(model, method, "linear", jit, CHUNK)
     parts, threads = _parts(K, min(CHUNK, total))
     capacity = parts[0].stop - parts[0].start
 
@@ -234,6 +241,38 @@ def fixed_batch(batch: Batch, method: str, m: int, jit: bool, x0: np.ndarray | N
     progress.abandon(total - done)
     x, ok = _nan_after_failure(state.x)
     return x, ok, done, compiled
+
+
+#: Runs of one call of the C loop of a fixed-step batch (interrupts between groups).
+C_PART = 64
+
+
+def _c_loop(fixed_many, state: "_FixedBatch", m: int) -> None:
+    """Every run of ``state`` (constant controls) by the compiled ``rk8_fixed_many`` into
+    ``state.x``, the runs in parts of `C_PART` spread over `BATCH_THREADS` threads."""
+    batch = state.batch
+    K, nu, np_ = batch.K, batch.model.nu, batch.model.np
+    H = np.ascontiguousarray(np.diff(batch.t))
+    x0 = np.ascontiguousarray(state.xk)
+    u = np.zeros((K, max(nu, 1)))
+    u[:, :nu] = state.ua0
+    p = np.zeros((K, max(np_, 1)))
+    p[:, :np_] = state.P
+    X = state.x
+    addr = (H.ctypes.data, x0.ctypes.data, u.ctypes.data, p.ctypes.data, X.ctypes.data)
+    edges = list(range(0, K, C_PART)) + [K]
+    parts = list(zip(edges[:-1], edges[1:]))
+    threads = min(BATCH_THREADS, len(parts))
+
+    def work(todo):
+        for k0, k1 in iter(lambda: next(todo, None), None):
+            fixed_many(k0, k1, batch.nint, m, *addr)
+
+    with deferred_interrupts():
+        for i in range(0, len(parts), 16 * threads):
+            check_interrupt()
+            group = iter(parts[i:i + 16 * threads])
+            run_split(work, [group] * threads)
 
 
 def _nan_after_failure(x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

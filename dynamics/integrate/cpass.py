@@ -44,6 +44,7 @@ _DRIVER = r"""
 #include <float.h>
 #define PASS_NX %(nx)d
 #define PASS_NU %(nu)d
+#define PASS_NP %(np)d
 #define PASS_NW %(nw)d
 #define PASS_NIW %(niw)d
 #define PASS_NARG %(narg)d
@@ -436,6 +437,343 @@ int rk8_dense(casadi_real* x, casadi_real* t, casadi_real* hio, int nout,
 """
 
 
+# ``auto`` for a smooth right-hand side under a constant control in ONE call: DOP853 with
+# dense output (`_DENSE`) as the answer, a check run at a looser local tolerance, their
+# comparison and the verdict, with no Python between (`dynamics.integrate.dense`, which
+# states the rules; the layout of the workspace is `dense.LAYOUT`).
+_AUTO = r"""
+#include <limits.h>
+#include <stdlib.h>
+#define AU_RTOL 0     /* in: the requested rtol */
+#define AU_FACTOR 1   /* in/out: the answer's local tolerance over the requested one */
+#define AU_LOOSE 2    /* in/out: the check run's */
+#define AU_MAXSTEPS 3 /* in: most steps of all runs */
+#define AU_STIFF 4    /* in: `rk8_dense`'s stiff_steps */
+#define AU_T0 5       /* in: the start time */
+#define AU_IQ 6       /* in: index of the attitude quaternion, -1: none */
+#define AU_TRIES 7    /* in: answer-check pairs at most */
+#define AU_PHASE 8    /* 0 start, 1 check run, 2 answer, 4 the answer from a moved start (the
+                         rounding floor), 3 done */
+#define AU_SPENT 9    /* steps of every run (accepted and rejected) */
+#define AU_NCHK 10    /* steps of the check run */
+#define AU_NANS 11    /* steps of the answer */
+#define AU_RESULT 12  /* 1 verified, 0 not (AU_EST), -2 a tolerance too near the states'
+                         rounding, -3 a run failed */
+#define AU_EST 13     /* the error estimate [tolerances] */
+#define AU_D 14       /* the scaled difference of the answer and the check run */
+#define AU_FLAG 15    /* `rk8_dense`'s flag of a failed run */
+#define AU_TRY 16     /* answers made */
+#define AU_ACC 17     /* the answer's accepted steps */
+#define AU_REJ 18     /* its rejected steps */
+#define AU_HMIN 19    /* its smallest step (a last one cut short excluded) */
+#define AU_INTERP 20  /* its steps whose continuous extension was evaluated */
+#define AU_LIP 21     /* the Lipschitz estimate of its first step */
+#define AU_RATIO 22   /* the check's local tolerance over the answer's */
+#define AU_BOUND 23   /* the rounding bound added (0: none) */
+#define AU_NOUT 24    /* in: outputs after the start */
+#define AU_SUB 25     /* the longest output interval over the answer's smallest step */
+#define AU_GATE 26    /* the acceptance of the estimate (0.5 or 1) */
+#define AU_FLOOR 27   /* the rounding floor measured by a rerun from a moved start (0: none) */
+#define AU_HDR 28
+#define AU_ACCEPT 0.5        /* estimates.AUTO_ACCEPT */
+#define AU_FLOOR_ULPS 1000.0 /* estimates.FLOOR_ULPS */
+#define AU_MEASURED 1e6      /* auto's _PASS_MEASURED */
+#define AU_RTOL_MIN 1e-14    /* stepcontrol.LOCAL_RTOL_MIN */
+#define AU_LADDER 1e-2       /* the most a new answer's local tolerance shrinks (as
+                                stepcontrol's runs of a non-smooth right-hand side) */
+/* the workspace after the header: x0, u, p, atol, ts (AU_NOUT), then the run's x, t, h,
+   count (8 + nx), local atol, the answer's noise */
+#define AU_X0(w) ((w) + AU_HDR)
+#define AU_U(w) (AU_X0(w) + PASS_NX)
+#define AU_P(w) (AU_U(w) + PASS_NU)
+#define AU_ATOL(w) (AU_P(w) + PASS_NP)
+#define AU_TS(w) (AU_ATOL(w) + PASS_NX)
+#define AU_XR(w) (AU_TS(w) + (int) (w)[AU_NOUT])
+#define AU_TT(w) (AU_XR(w) + PASS_NX)
+#define AU_H(w) (AU_TT(w) + 1)
+#define AU_COUNT(w) (AU_H(w) + 1)
+#define AU_AL(w) (AU_COUNT(w) + 8 + PASS_NX)
+#define AU_NOISE(w) (AU_AL(w) + PASS_NX)
+#define AU_SIZE(nout) (AU_HDR + 6 * PASS_NX + PASS_NU + PASS_NP + (nout) + 10)
+
+/* a run from x0 at the local tolerance (rtol, atol) factor */
+static void au_begin(casadi_real* w, casadi_real factor) {
+  casadi_real* count = AU_COUNT(w);
+  int i;
+  for (i = 0; i < PASS_NX; ++i) {
+    AU_XR(w)[i] = AU_X0(w)[i];
+    AU_AL(w)[i] = AU_ATOL(w)[i] * factor;
+  }
+  *AU_TT(w) = w[AU_T0];
+  *AU_H(w) = 0;
+  for (i = 0; i < 8 + PASS_NX; ++i) count[i] = 0;
+  count[3] = INFINITY;
+}
+
+/* `rk8_dense` on the run in progress into Y (nx, nout + 1) at local factor `factor`, at
+   most *budget steps; returns 1 when it ended (finished or failed) */
+static int au_step(casadi_real* w, casadi_real factor, casadi_real* Y, int* budget) {
+  casadi_real* count = AU_COUNT(w);
+  int nout = (int) w[AU_NOUT], j;
+  casadi_real before = count[0] + count[1];
+  j = rk8_dense(AU_XR(w), AU_TT(w), AU_H(w), nout, AU_TS(w), AU_U(w), AU_P(w),
+                w[AU_RTOL] * factor, AU_AL(w), w[AU_MAXSTEPS] - w[AU_SPENT], Y + 1, nout + 1,
+                count, *budget, w[AU_STIFF]);
+  *budget -= (int) (count[0] + count[1] - before);
+  return j >= nout || count[2] != 0;
+}
+
+/* the largest |x_i| / (atol_i + rtol |x_i|) at x0 (`auto._size_over_tolerance`) */
+static casadi_real au_size(const casadi_real* w) {
+  const casadi_real* x0 = AU_X0(w);
+  const casadi_real* at = AU_ATOL(w);
+  casadi_real rtol = w[AU_RTOL], out = 0, s, l, qn = 0;
+  int i, iq = (int) w[AU_IQ];
+  if (iq >= 0) for (i = iq; i < iq + 4; ++i) qn += x0[i] * x0[i];
+  qn = sqrt(qn);
+  for (i = 0; i < PASS_NX; ++i) {
+    int inq = iq >= 0 && i >= iq && i < iq + 4;
+    s = inq ? qn : fabs(x0[i]);
+    l = inq ? at[i] : at[i] + rtol * s;
+    if (s > 0) out = fmax(out, l > 0 ? s / l : INFINITY);
+  }
+  return out;
+}
+
+/* the largest |X - Y| / (atol + rtol |X|) over the states and the outputs after the first
+   (inf for a non-finite one); *ulps: 1000 ulps of the largest state's size over its least
+   tolerance (`estimates.roundoff`), *lmin the least tolerance */
+static casadi_real au_diff(const casadi_real* w, const casadi_real* X, const casadi_real* Y,
+                           casadi_real* ulps, casadi_real* lmin) {
+  int ld = (int) w[AU_NOUT] + 1, i, j;
+  casadi_real rtol = w[AU_RTOL], d = 0, sc, size, smin, e;
+  *ulps = 0; *lmin = INFINITY;
+  for (i = 0; i < PASS_NX; ++i) {
+    size = fabs(X[i * ld]);
+    smin = INFINITY;
+    for (j = 1; j < ld; ++j) {
+      casadi_real xa = X[i * ld + j];
+      if (fabs(xa) > size) size = fabs(xa);
+      sc = AU_ATOL(w)[i] + rtol * fabs(xa);
+      if (sc < smin) smin = sc;
+      e = fabs(xa - Y[i * ld + j]);
+      e = sc > 0 ? e / sc : (e == 0 ? 0 : INFINITY);
+      if (e != e) e = INFINITY;
+      if (e > d) d = e;
+    }
+    e = smin > 0 ? size / smin : (size > 0 ? INFINITY : 0);
+    if (e > *ulps) *ulps = e;
+    if (smin < *lmin) *lmin = smin;
+  }
+  *ulps *= AU_FLOOR_ULPS * DBL_EPSILON;
+  return d;
+}
+
+/* the rounding the answer measured on its way (AU_NOISE, per state), carried over the
+   horizon (`estimates.carried`), into AU_NOISE; returns its largest */
+static casadi_real au_carried(casadi_real* w) {
+  int i;
+  casadi_real horizon = AU_TS(w)[(int) w[AU_NOUT] - 1] - w[AU_T0], lip = w[AU_LIP], tau, out = 0;
+  tau = lip <= 0 ? horizon : fmin(horizon, 1.0 / lip);
+  for (i = 0; i < PASS_NX; ++i) {
+    AU_NOISE(w)[i] *= 2 * sqrt(horizon * tau);
+    if (AU_NOISE(w)[i] > out) out = AU_NOISE(w)[i];
+  }
+  return out;
+}
+
+/* the verdict on the estimate `est` (AU_RESULT, AU_PHASE); not accepted, the next answer,
+   tighter, or done */
+static void au_verdict(casadi_real* w, casadi_real* X, casadi_real* XC, casadi_real est) {
+  int i, n = PASS_NX * ((int) w[AU_NOUT] + 1);
+  casadi_real e;
+  w[AU_EST] = est;
+  w[AU_PHASE] = 3;
+  if (est <= w[AU_GATE]) {
+    w[AU_RESULT] = 1;
+    return;
+  }
+  w[AU_RESULT] = 0;
+  if (!isfinite(est) || w[AU_TRY] >= w[AU_TRIES] || w[AU_FLOOR] > 0) return;
+  /* aim at 0.1, at most AU_LADDER tighter (beyond the method's asymptotic range, where
+     the check was taken, the estimate predicts nothing); a new answer at least 10x tighter
+     is checked against this one */
+  e = fmax(AU_LADDER, fmin(0.5, 0.1 / est));
+  if (e <= 0.1) {
+    for (i = 0; i < n; ++i) XC[i] = X[i];
+    w[AU_NCHK] = w[AU_NANS];
+    w[AU_LOOSE] = w[AU_FACTOR];
+  }
+  w[AU_FACTOR] *= e;
+  if (w[AU_RTOL] * w[AU_FACTOR] < AU_RTOL_MIN) return;
+  au_begin(w, w[AU_FACTOR]);
+  w[AU_PHASE] = 2;
+}
+
+/* the answer X against the check XC: AU_D, AU_EST and the verdict; near the states'
+   rounding (within 1e6 ulps) the model's rounding measured on the way, carried over the
+   horizon, is added when small (`estimates.screen`), else measured: the answer repeated
+   from x0 moved by it (phase 4, into XC, judged by `au_floor`) */
+static void au_judge(casadi_real* w, casadi_real* X, casadi_real* XC) {
+  int nout = (int) w[AU_NOUT], j;
+  casadi_real d, ulps, lmin, e, power, est, horizon, lip = w[AU_LIP];
+  casadi_real ratio = w[AU_LOOSE] / w[AU_FACTOR];
+  d = au_diff(w, X, XC, &ulps, &lmin);
+  power = w[AU_NANS] / fmax(w[AU_NCHK], 1) / pow(ratio, 0.125);
+  if (power >= 0.8 && power <= 1.25) {
+    est = d / (pow(ratio, 0.75) - 1) + ulps;
+    w[AU_GATE] = AU_ACCEPT;
+  } else {
+    est = d + ulps;
+    w[AU_GATE] = 1.0;
+  }
+  w[AU_D] = d; w[AU_RATIO] = ratio; w[AU_BOUND] = 0; w[AU_FLOOR] = 0;
+  for (e = AU_TS(w)[0] - w[AU_T0], j = 1; j < nout; ++j)
+    if (AU_TS(w)[j] - AU_TS(w)[j - 1] > e) e = AU_TS(w)[j] - AU_TS(w)[j - 1];
+  w[AU_SUB] = w[AU_HMIN] < INFINITY ? ceil(e / w[AU_HMIN]) : 1;
+  if (est <= w[AU_GATE] && au_size(w) * DBL_EPSILON * AU_MEASURED > 1.0) {
+    horizon = AU_TS(w)[nout - 1] - w[AU_T0];
+    e = au_carried(w);
+    e = lmin > 0 ? e / lmin : (e > 0 ? INFINITY : 0);
+    e *= 1 + lip * horizon;
+    if (e <= 0.1 * AU_ACCEPT) {
+      w[AU_BOUND] = e;
+      est += e;
+    } else {  /* the flow's real amplification: the answer again from x0 + s e */
+      w[AU_EST] = est;
+      au_begin(w, w[AU_FACTOR]);
+      for (j = 0; j < PASS_NX; ++j)
+        AU_XR(w)[j] += (j % 2 ? -1 : 1) * AU_NOISE(w)[j];
+      w[AU_PHASE] = 4;
+      return;
+    }
+  }
+  au_verdict(w, X, XC, est);
+}
+
+/* after the rerun from the moved start (in XC): the floor is the largest of its difference
+   from the answer, the carried rounding against the least tolerance and the ulps
+   (`estimates.measured_floor`), added to the estimate */
+static void au_floor(casadi_real* w, casadi_real* X, casadi_real* XC) {
+  casadi_real ulps, lmin, d = au_diff(w, X, XC, &ulps, &lmin), local = 0;
+  int i;
+  for (i = 0; i < PASS_NX; ++i) local = fmax(local, AU_NOISE(w)[i]);
+  local = lmin > 0 ? local / lmin : (local > 0 ? INFINITY : 0);
+  w[AU_FLOOR] = fmax(fmax(d, local), ulps);
+  au_verdict(w, X, XC, w[AU_EST] + w[AU_FLOOR]);
+}
+
+/* The whole of `dense.dense_auto` for one problem: the check run into XC, the answer into X
+   (nx, nout + 1; column 0 = x0), compared; at most `budget` steps per call (interrupts
+   are looked at between calls). Returns AU_PHASE (3: done). */
+int rk8_auto(casadi_real* w, int nout, int budget, casadi_real* X, casadi_real* XC) {
+  casadi_real* count = AU_COUNT(w);
+  int i, ld = nout + 1;
+  w[AU_NOUT] = nout;
+  if (w[AU_PHASE] == 0) {
+    w[AU_SPENT] = 0; w[AU_TRY] = 0; w[AU_RESULT] = 0; w[AU_FLAG] = 0; w[AU_EST] = NAN;
+    w[AU_BOUND] = 0; w[AU_FLOOR] = 0;
+    for (i = 0; i < PASS_NX; ++i) X[i * ld] = XC[i * ld] = AU_X0(w)[i];
+    if (au_size(w) * DBL_EPSILON * AU_FLOOR_ULPS > 0.5 * AU_ACCEPT) {
+      w[AU_RESULT] = -2; w[AU_PHASE] = 3;  /* (the 1000-ulp floor: half the acceptance) */
+      return 3;
+    }
+    au_begin(w, w[AU_LOOSE]);
+    w[AU_PHASE] = 1;
+  }
+  while (budget > 0 && w[AU_PHASE] != 3) {
+    int check = w[AU_PHASE] == 1, floor = w[AU_PHASE] == 4;
+    if (!au_step(w, check ? w[AU_LOOSE] : w[AU_FACTOR], check || floor ? XC : X, &budget))
+      continue;
+    w[AU_SPENT] += count[0] + count[1];
+    if (count[2] != 0 && floor) {  /* (no floor: not verified) */
+      au_verdict(w, X, XC, INFINITY);
+      break;
+    }
+    if (count[2] != 0) {
+      w[AU_FLAG] = count[2]; w[AU_RESULT] = -3; w[AU_PHASE] = 3;
+      break;
+    }
+    if (floor) {
+      au_floor(w, X, XC);
+      continue;
+    }
+    if (check) {
+      w[AU_NCHK] = count[0] + count[1];
+      au_begin(w, w[AU_FACTOR]);
+      w[AU_PHASE] = 2;
+      continue;
+    }
+    w[AU_NANS] = count[0] + count[1];
+    w[AU_ACC] = count[0]; w[AU_REJ] = count[1]; w[AU_HMIN] = count[3];
+    w[AU_INTERP] = count[4]; w[AU_LIP] = count[7];
+    for (i = 0; i < PASS_NX; ++i) AU_NOISE(w)[i] = count[8 + i];
+    w[AU_TRY] += 1;
+    au_judge(w, X, XC);
+  }
+  return (int) w[AU_PHASE];
+}
+
+/* `rk8_auto` for the runs k0 <= k < k1 of a batch, one after another, each with its own
+   steps and verdict: x0 (K, nx), u (K, nu), p (K, np) by run; the workspace `w` (its
+   inputs but x0, u, p set) copied to `wk` for each; X (K, nx, nout + 1) the answers; XC
+   (nx, nout + 1) scratch; `res` (K, AU_HDR) each run's header. Returns the runs done. */
+int rk8_auto_many(const casadi_real* w, int nout, int k0, int k1, const casadi_real* x0,
+                  const casadi_real* u, const casadi_real* p, casadi_real* X, casadi_real* XC,
+                  casadi_real* res) {
+  int size = AU_SIZE(nout), k, i, ld = nout + 1;
+  casadi_real* wk = (casadi_real*) malloc(sizeof(casadi_real) * size);
+  if (!wk) return 0;
+  for (k = k0; k < k1; ++k) {
+    for (i = 0; i < size; ++i) wk[i] = w[i];
+    for (i = 0; i < PASS_NX; ++i) AU_X0(wk)[i] = x0[k * PASS_NX + i];
+    for (i = 0; i < PASS_NU; ++i) AU_U(wk)[i] = u[k * PASS_U + i];
+    for (i = 0; i < PASS_NP; ++i) AU_P(wk)[i] = p[k * (PASS_NP > 0 ? PASS_NP : 1) + i];
+    wk[AU_PHASE] = 0;
+    rk8_auto(wk, nout, INT_MAX, X + (size_t) k * PASS_NX * ld, XC);
+    for (i = 0; i < AU_HDR; ++i) res[(size_t) k * AU_HDR + i] = wk[i];
+  }
+  free(wk);
+  return k1 - k0;
+}
+"""
+
+
+# Fixed-step rk8 over the runs of a batch, each under its constant control, in one plain C
+# loop around the generated step (`dynamics.integrate.batch_fixed`).
+_FIXED = r"""
+/* m rk8 steps per output interval (lengths H, nint of them) for the runs k0 <= k < k1:
+   x0 (K, nx), u (K, PASS_U), p (K, max(np, 1)) by run; X (K, nint + 1, nx) the states at
+   the outputs. Returns the runs done. */
+int rk8_fixed_many(int k0, int k1, int nint, int m, const casadi_real* H,
+                   const casadi_real* x0, const casadi_real* u, const casadi_real* p,
+                   casadi_real* X) {
+  pass_ctx c;
+  const casadi_real* arg[PASS_NARG + 5];
+  casadi_real* res[PASS_NRES + 1];
+  casadi_real x[PASS_NX], xn[PASS_NX], h, zero[PASS_U];
+  int k, j, s, i, np1 = PASS_NP > 0 ? PASS_NP : 1;
+  for (i = 0; i < PASS_U; ++i) zero[i] = 0;
+  arg[0] = x; arg[1] = &h; arg[3] = zero; res[0] = xn;
+  for (k = k0; k < k1; ++k) {
+    casadi_real* out = X + (size_t) k * (nint + 1) * PASS_NX;
+    arg[2] = u + (size_t) k * PASS_U;
+    arg[4] = p + (size_t) k * np1;
+    for (i = 0; i < PASS_NX; ++i) out[i] = x[i] = x0[(size_t) k * PASS_NX + i];
+    for (j = 0; j < nint; ++j) {
+      h = H[j] / m;
+      for (s = 0; s < m; ++s) {
+        rk8_step(arg, res, c.iw, c.w, 0);
+        for (i = 0; i < PASS_NX; ++i) x[i] = xn[i];
+      }
+      for (i = 0; i < PASS_NX; ++i) out[(j + 1) * PASS_NX + i] = x[i];
+    }
+  }
+  return k1 - k0;
+}
+"""
+
+
 def pass_library(model: Model) -> object | None:
     """The compiled pass of ``model`` (a ``ctypes`` function, cached); None without a C
     compiler or when the model cannot be code-generated (the pass is worth it only as C)."""
@@ -445,13 +783,13 @@ def pass_library(model: Model) -> object | None:
         rhs = _renamed(model.f, "pass_rhs", ca.MX if calls_rhs(model, "rk8") else None)
         dense = dense_kernels(model, compiled=True)
         funs = (step, rhs) + dense  # (the plain step needs less)
-        sizes = dict(every=CHECK_EVERY, nx=model.nx, nu=model.nu,
+        sizes = dict(every=CHECK_EVERY, nx=model.nx, nu=model.nu, np=model.np,
                      nw=max(f.sz_w() for f in funs), niw=max(f.sz_iw() for f in funs),
                      narg=max(f.sz_arg() for f in funs), nres=max(f.sz_res() for f in funs))
         steps = [_renamed(step, "rk8_step_err"),
                  _renamed(kernel(model, "rk8", "linear", compiled=True), "rk8_step"), rhs,
                  *dense]
-        return steps, _DRIVER % sizes + _STEPPER + _DENSE
+        return steps, _DRIVER % sizes + _STEPPER + _DENSE + _AUTO + _FIXED
 
     def job(opt):
         return cache.Job(make, opt, ctypes.CDLL, cache.recipe("rk8_pass", model.f, opt))
@@ -483,6 +821,18 @@ def pass_library(model: Model) -> object | None:
                           f64]
         dense.restype = i32
         fun.dense = dense  # (`dynamics.integrate.stepcontrol.run_dense`)
+        auto = lib.rk8_auto
+        auto.argtypes = [ptr, i32, i32, ptr, ptr]
+        auto.restype = i32
+        fun.auto = auto  # (`dynamics.integrate.dense`)
+        many = lib.rk8_auto_many
+        many.argtypes = [ptr, i32, i32, i32, ptr, ptr, ptr, ptr, ptr, ptr]
+        many.restype = i32
+        fun.auto_many = many  # (`dynamics.integrate.dense`, a batch)
+        fixed = lib.rk8_fixed_many
+        fixed.argtypes = [i32, i32, i32, i32, ptr, ptr, ptr, ptr, ptr]
+        fixed.restype = i32
+        fun.fixed_many = fixed  # (`dynamics.integrate.batch_fixed`)
         return fun
 
     return cache.get(("rk8_pass", cache.function_key(model.f)), build, keepalive=model.f)

@@ -4,7 +4,6 @@ the spectral radius and decay rate of the Jacobian at ``x0``, and the reproducib
 patterns of the perturbations that expose rounding."""
 from __future__ import annotations
 
-import functools
 import math
 
 import casadi as ca
@@ -15,14 +14,16 @@ from .evaluate import call_buffered
 from .inputs import Problem
 from .result import Run
 
-__all__ = ["jacobian_x", "rho_sigma", "tightened"]
+__all__ = ["AUTO_ACCEPT", "EPS", "FLOOR_ULPS", "carried", "floor_signs", "initial_step",
+           "jacobian_x", "measured_floor", "perturbed", "rho_sigma", "roundoff", "scaled_diff",
+           "screen", "signs", "spectrum", "table", "tightened"]
 
-_EPS = np.finfo(float).eps
-_AUTO_ACCEPT = 0.5     # accept a trusted estimate (truncation + round-off) below this
-_FLOOR_ULPS = 1000     # least error floor of a run in ulps of a state's size (`_floor`)
+EPS = np.finfo(float).eps
+AUTO_ACCEPT = 0.5     # accept a trusted estimate (truncation + round-off) below this
+FLOOR_ULPS = 1000     # least error floor of a run in ulps of a state's size (`measured_floor`)
 
 
-def _scaled_diff(xa: np.ndarray, xb: np.ndarray, scale: np.ndarray) -> float:
+def scaled_diff(xa: np.ndarray, xb: np.ndarray, scale: np.ndarray) -> float:
     """max |xa - xb| / scale over states and output times; inf if anything is non-finite."""
     if not (np.all(np.isfinite(xa)) and np.all(np.isfinite(xb))):
         return math.inf
@@ -58,7 +59,7 @@ def tightened(run_at, rtol: float, atol: np.ndarray, first: float, ratio: float,
             return run, "failed", math.nan, *total
         if prev is not None:
             scale = atol[:, None] + rtol * np.abs(run.x[:, 1:])
-            estimate = _scaled_diff(prev.x[:, 1:], run.x[:, 1:], scale)
+            estimate = scaled_diff(prev.x[:, 1:], run.x[:, 1:], scale)
             if estimate <= 1.0:
                 return run, "met", estimate, *total
         if local <= tightest:
@@ -66,7 +67,7 @@ def tightened(run_at, rtol: float, atol: np.ndarray, first: float, ratio: float,
         prev, factor = run, factor * ratio
 
 
-def _roundoff(x: np.ndarray, n_steps: int, scale: np.ndarray) -> float:
+def roundoff(x: np.ndarray, n_steps: int, scale: np.ndarray) -> float:
     """Scaled round-off model of a fixed-step run: ``n_steps eps max_t |x_i|`` per state.
 
     Measured on a 100 s tumbling body (double against long double with the same DOP853
@@ -74,12 +75,12 @@ def _roundoff(x: np.ndarray, n_steps: int, scale: np.ndarray) -> float:
     to the state's size, growing about linearly in the number of steps.
     """
     size = np.max(np.abs(x), axis=1, keepdims=True)
-    floor = np.broadcast_to(n_steps * _EPS * size, scale.shape)
+    floor = np.broadcast_to(n_steps * EPS * size, scale.shape)
     ratio = np.divide(floor, scale, out=np.where(floor == 0, 0.0, np.inf), where=scale > 0)
     return float(ratio.max())
 
 
-def _initial_step(problem: Problem, rtol, atol, order: int) -> tuple[float | None, float]:
+def initial_step(problem: Problem, rtol, atol, order: int) -> tuple[float | None, float]:
     """Starting step and Lipschitz estimate ``(h, L)`` [s, 1/s].
 
     ``h``: Hairer's heuristic (Hairer, Norsett & Wanner I, II.4), capped at ``2 / L`` for
@@ -108,7 +109,7 @@ def _initial_step(problem: Problem, rtol, atol, order: int) -> tuple[float | Non
     return (min(h, 2.0 / lipschitz) if lipschitz > 0 else h), lipschitz
 
 
-def _spectrum(problem: Problem) -> tuple[float, float] | None:
+def spectrum(problem: Problem) -> tuple[float, float] | None:
     """``(rho, sigma)`` [1/s] from the eigenvalues ``lam`` of ``df/dx`` at ``x0``: the
     spectral radius ``max |lam|`` (what explicit stability must resolve) and the fastest
     decay that only an implicit method steps over cheaply, ``max(-Re lam)`` over the
@@ -139,7 +140,7 @@ def jacobian_x(model) -> ca.Function:
 
 
 def rho_sigma(J: np.ndarray) -> tuple[float, float] | None:
-    """`_spectrum`'s ``(rho, sigma)`` over the Jacobians ``J (K, nx, nx)`` (the largest of
+    """`spectrum`'s ``(rho, sigma)`` over the Jacobians ``J (K, nx, nx)`` (the largest of
     each over the K); None when an eigenvalue is not finite."""
     try:
         lam = np.linalg.eigvals(J)
@@ -152,7 +153,7 @@ def rho_sigma(J: np.ndarray) -> tuple[float, float] | None:
     return float(np.max(np.abs(lam), initial=0.0)), float(np.max(decay[stiff], initial=0.0))
 
 
-def _floor(target, run: Run, rtol, atol, lipschitz: float, jit: bool,
+def measured_floor(target, run: Run, rtol, atol, lipschitz: float, jit: bool,
            progress, rerun=None) -> tuple[float, int]:
     """Scaled error floor of ``run`` from rounding; returns ``(floor, extra steps made)``.
 
@@ -169,7 +170,7 @@ def _floor(target, run: Run, rtol, atol, lipschitz: float, jit: bool,
     inside the smallest tolerance of any state, that bound is the floor; otherwise the
     flow's real amplification is measured by repeating ``run`` from ``x0 + e`` (random
     signs, same steps): the floor is the scaled difference (an error injected at the start,
-    the worst time for it). The floor is never below ``_FLOOR_ULPS`` ulps of a state's size
+    the worst time for it). The floor is never below ``FLOOR_ULPS`` ulps of a state's size
     (the rounding of the state itself, shared alike: near a separatrix every run, rk8 at
     16-400 steps per interval and scipy's DOP853 alike, was off by 900 ulps of ``|w|``
     while they agreed to 90). ``rerun(x0) -> Run | None`` makes the check run of a
@@ -181,19 +182,19 @@ def _floor(target, run: Run, rtol, atol, lipschitz: float, jit: bool,
     horizon = float(target.t[-1] - target.t[0])
     cols = np.unique(np.linspace(0, x.shape[1] - 1, min(16, x.shape[1])).round().astype(int))
     X = x[:, cols]
-    flips, signs = _floor_signs(X.shape, x.shape[0])
-    pert = [X] + [X * (1 + _EPS * f) for f in flips]
+    flips, signs = floor_signs(X.shape, x.shape[0])
+    pert = [X] + [X * (1 + EPS * f) for f in flips]
     F = target.rhs(np.concatenate(pert, axis=1),
                    np.tile(cols, len(pert))).reshape(x.shape[0], len(pert), cols.size)
     if not np.all(np.isfinite(F)):
         return math.inf, 0
     noise = np.max(np.abs(F[:, 1:] - F[:, :1]), axis=(1, 2))
-    e = _carried(noise, horizon, lipschitz)
+    e = carried(noise, horizon, lipschitz)
     scale = atol[:, None] + rtol * np.abs(x[:, 1:])
-    ulps = _roundoff(x, _FLOOR_ULPS, scale)
-    local = _scaled_diff(np.broadcast_to(e[:, None], scale.shape), np.zeros(scale.shape), scale)
-    bound = _screen(e, np.min(scale, axis=1), horizon, lipschitz, target.runs)
-    if bound <= 0.1 * _AUTO_ACCEPT:
+    ulps = roundoff(x, FLOOR_ULPS, scale)
+    local = scaled_diff(np.broadcast_to(e[:, None], scale.shape), np.zeros(scale.shape), scale)
+    bound = screen(e, np.min(scale, axis=1), horizon, lipschitz, target.runs)
+    if bound <= 0.1 * AUTO_ACCEPT:
         return max(bound, ulps), 0
     if rerun is not None:
         check = rerun(target.x0 + signs * e)
@@ -201,20 +202,20 @@ def _floor(target, run: Run, rtol, atol, lipschitz: float, jit: bool,
             return math.inf, 0
     else:
         check = target.run(target.x0 + signs * e, run.substeps, jit, progress)
-    return max(local, ulps, _scaled_diff(check.x[:, 1:], x[:, 1:], scale)), check.n_steps
+    return max(local, ulps, scaled_diff(check.x[:, 1:], x[:, 1:], scale)), check.n_steps
 
 
-def _carried(noise: np.ndarray, horizon: float, lipschitz: float) -> np.ndarray:
-    """`_floor`'s rounding error ``2 sqrt(T min(T, 1 / L)) noise`` carried over the horizon
+def carried(noise: np.ndarray, horizon: float, lipschitz: float) -> np.ndarray:
+    """`measured_floor`'s rounding error ``2 sqrt(T min(T, 1 / L)) noise`` carried over the horizon
     ``T`` from the right-hand side's rounding ``noise`` per state (``L`` the spectral
     radius)."""
     tau = horizon if lipschitz <= 0 else min(horizon, 1.0 / lipschitz)
     return 2 * math.sqrt(horizon * tau) * noise
 
 
-def _screen(e: np.ndarray, smin: np.ndarray, horizon: float, lipschitz: float,
+def screen(e: np.ndarray, smin: np.ndarray, horizon: float, lipschitz: float,
             runs: int = 1) -> float:
-    """`_floor`'s screening bound of the carried rounding ``e`` against the least tolerance
+    """`measured_floor`'s screening bound of the carried rounding ``e`` against the least tolerance
     ``smin`` of each state: the flow may carry the noise of any state into any other (the
     spin-rate noise of a flat body into the phase of its transverse rates), so across the
     states of each run (the runs of a batch do not share noise), the largest over the runs,
@@ -224,33 +225,49 @@ def _screen(e: np.ndarray, smin: np.ndarray, horizon: float, lipschitz: float,
     return float(np.max(worst)) * (1 + lipschitz * horizon)
 
 
-def _perturbed(x0: np.ndarray, m: int) -> np.ndarray:
+def perturbed(x0: np.ndarray, m: int) -> np.ndarray:
     """``x0`` moved by 2 ulp in a sign pattern that differs between step
     counts ``m`` (reproducibly): the differences between ``auto``'s runs then also show how
     strongly the problem amplifies double-precision representation errors (of ``x0`` and of
     the model's constants, rounded alike). Near a separatrix this amplification put a common
     error of 3e-13 into every run at 16-400 steps per interval that step-count differences
     alone cannot see; a well-conditioned problem just carries the 2 ulp."""
-    return x0 + 2 * _EPS * _signs(m, x0.size) * x0
+    return x0 + 2 * EPS * signs(m, x0.size) * x0
 
 
-@functools.lru_cache(maxsize=256)
-def _signs(seed: int, size: int) -> np.ndarray:
-    """A reproducible random sign pattern of ``size`` entries (read-only). Cached: seeding a
-    numpy generator costs about 40 us, more than an rk8 run of a small model."""
-    out = np.random.default_rng(seed).choice((-1.0, 1.0), size=size)
-    out.setflags(write=False)
+def table(kind: str) -> dict:
+    """A table of small read-only arrays of ``kind`` (sign patterns, start states), kept as
+    ONE entry of `dynamics.cache` (so that `dynamics.clear_caches` empties it and its many
+    small arrays never evict compiled Functions); at most 256 arrays, emptied when full."""
+    got = cache.get(("arrays", kind), dict)
+    if len(got) >= 256:
+        got.clear()
+    return got
+
+
+def signs(seed: int, size: int) -> np.ndarray:
+    """A reproducible random sign pattern of ``size`` entries (read-only). Kept (`table`):
+    seeding a numpy generator costs about 40 us, more than an rk8 run of a small model."""
+    known = table("signs")
+    out = known.get((seed, size))
+    if out is None:
+        out = np.random.default_rng(seed).choice((-1.0, 1.0), size=size)
+        out.setflags(write=False)
+        known[seed, size] = out
     return out
 
 
-@functools.lru_cache(maxsize=256)
-def _floor_signs(shape: tuple, n: int) -> tuple:
-    """`_floor`'s sign patterns (cached, read-only): three of ``shape`` for the ulp moves of
-    the sampled states, then ``n`` for the start of its check run, drawn in that order from
-    one generator seeded 0."""
-    rng = np.random.default_rng(0)
-    flips = [rng.choice((-1.0, 1.0), size=shape) for _ in range(3)]
-    signs = rng.choice((-1.0, 1.0), size=n)
-    for a in (*flips, signs):
-        a.setflags(write=False)
-    return tuple(flips), signs
+def floor_signs(shape: tuple, n: int) -> tuple:
+    """`measured_floor`'s sign patterns (kept, `table`; read-only): three of ``shape`` for
+    the ulp moves of the sampled states, then ``n`` for the start of its check run, drawn in
+    that order from one generator seeded 0."""
+    known = table("floor_signs")
+    out = known.get((tuple(shape), n))
+    if out is None:
+        rng = np.random.default_rng(0)
+        flips = [rng.choice((-1.0, 1.0), size=shape) for _ in range(3)]
+        start = rng.choice((-1.0, 1.0), size=n)
+        for a in (*flips, start):
+            a.setflags(write=False)
+        out = known[tuple(shape), n] = (tuple(flips), start)
+    return out

@@ -16,9 +16,10 @@ import numpy as np
 
 from .. import cache
 from ..model import Model
-from ..validate import QUAT_NORM_TOL, check_unit_quaternion, finite_array, finite_scalar
+from ..validate import (QUAT_NORM_TOL, check_unit_quaternion, finite_array, finite_scalar,
+                        unit_quaternion)
 
-__all__ = ["HOLDS", "Control", "Problem", "check_t", "check_x0", "check_tolerances",
+__all__ = ["HOLDS", "Batch", "Control", "Problem", "check_batch", "check_t", "check_x0", "check_tolerances",
            "check_u", "check_invariants", "check_cvodes_options"]
 
 _EPS = np.finfo(float).eps
@@ -346,3 +347,86 @@ class Problem:
             p: np.ndarray) -> "Problem":
         """``Problem(model, x0, t, control, p)``, built faster (`_new`)."""
         return _new(cls, model=model, x0=x0, t=t, control=control, p=p)
+
+
+@dataclass(frozen=True)
+class Batch:
+    """K runs on one grid: ``x0 (nx, K)``, ``p (np, K)``, controls ``ua, ub (K, nint, nu)``
+    (the values at the start and end of each output interval, linear in between);
+    ``constant`` when each run's control is known to be one value throughout (``False``
+    leaves it to be found from the values); ``tail (K, nu)`` the samples at ``t[-1]`` of a
+    zero-order hold (``ub = ua``), else None."""
+
+    model: Model
+    x0: np.ndarray
+    t: np.ndarray
+    p: np.ndarray
+    ua: np.ndarray
+    ub: np.ndarray
+    constant: bool = False
+    tail: np.ndarray | None = None  # (K, nu): the samples at t[-1] of a zero-order hold
+
+    @property
+    def K(self) -> int:
+        return self.x0.shape[1]
+
+    @property
+    def nint(self) -> int:
+        return self.t.size - 1
+
+    def problem(self, k: int) -> Problem:
+        """Run ``k`` as a single-run `Problem`."""
+        return Problem(self.model, self.x0[:, k].copy(), self.t,
+                       Control("linear", self.ua[k], self.ub[k],
+                               tail=None if self.tail is None else self.tail[k]),
+                       self.p[:, k].copy())
+
+
+def check_batch(model: Model, x0, t: np.ndarray, u, p, hold: str = "linear") -> Batch:
+    """The batch of ``x0 (nx, K)`` with ``p`` ``(np,)`` or ``(np, K)`` and ``u`` None,
+    ``(nu,)``, ``(nu, n)`` (shared) or ``(nu, n, K)`` (per run), samples held as ``hold``
+    says (`dynamics.integrate.inputs.HOLDS`); raises naming the argument."""
+    if hold not in HOLDS:
+        raise ValueError(f"`hold` must be one of {HOLDS}, got {hold!r}")
+    nx, nu, n = model.nx, model.nu, t.size
+    X0 = np.array(finite_array(x0, "x0"), dtype=float)
+    if X0.ndim != 2 or X0.shape[0] != nx or X0.shape[1] < 1:
+        raise ValueError(f"`x0` must have shape ({nx},) or ({nx}, K) for a batch of K runs, "
+                         f"got {X0.shape}")
+    K = X0.shape[1]
+    if model.attitude is not None:
+        iq = model.attitude[0]
+        bad = np.abs(np.linalg.norm(X0[iq:iq + 4], axis=0) - 1.0) > QUAT_NORM_TOL
+        if bad.any():  # the message of the single-run check, naming the run
+            k = int(np.argmax(bad))
+            unit_quaternion(X0[iq:iq + 4, k], f"x0[{iq}:{iq + 4}, {k}] (the attitude quaternion)")
+    if p is None:
+        P = np.repeat(model.resolve_p(None)[:, None], K, axis=1)
+    else:
+        a = np.asarray(finite_array(p, "p"), dtype=float)
+        if a.ndim == 2 and a.shape == (model.np, K):
+            P = np.array(a)
+        elif a.ndim <= 1:
+            P = np.repeat(model.resolve_p(a)[:, None], K, axis=1)
+        else:
+            raise ValueError(f"`p` must have shape ({model.np},) or ({model.np}, {K}) for a "
+                             f"batch of {K} runs, got {a.shape}")
+    if callable(u):
+        raise ValueError("`u` must be None or an array for a batch of runs (x0 of shape "
+                         f"({nx}, K)): give samples of shape ({nu}, {n}) or ({nu}, {n}, K)")
+    if u is None:  # (zeros cost nothing until written: no copies)
+        return Batch(model, X0, t, P, np.zeros((K, n - 1, nu)), np.zeros((K, n - 1, nu)), True)
+    a = np.asarray(finite_array(u, "u"), dtype=float)
+    if a.shape == (nu,):
+        U = np.broadcast_to(a, (K, n, nu))
+    elif a.shape == (nu, n):
+        U = np.broadcast_to(a.T, (K, n, nu))
+    elif a.shape == (nu, n, K):
+        U = a.transpose(2, 1, 0)
+    else:
+        raise ValueError(f"`u` must be None, ({nu},), ({nu}, {n}) or ({nu}, {n}, {K}) for "
+                         f"a batch of {K} runs, got {a.shape}")
+    ua = np.ascontiguousarray(U[:, :-1])
+    if hold == "zoh" and a.shape != (nu,):
+        return Batch(model, X0, t, P, ua, ua, False, np.array(U[:, -1]))
+    return Batch(model, X0, t, P, ua, np.ascontiguousarray(U[:, 1:]), a.shape == (nu,))

@@ -40,7 +40,7 @@ from .. import cache
 from ..interrupts import check_interrupt, deferred_interrupts
 from .adaptive import INTERVALS
 from .cpass import pass_library
-from .estimates import _initial_step, tightened
+from .estimates import initial_step, tightened
 from .evaluate import call_buffered
 from .inputs import Problem
 from .kernels import kernel
@@ -205,9 +205,9 @@ def _constant(ctrl) -> bool:
 
 
 def _first_step(problem: Problem, rtol: float, atol: np.ndarray) -> float:
-    """The first step proposed [s]: Hairer's heuristic (`estimates._initial_step`), or a
+    """The first step proposed [s]: Hairer's heuristic (`estimates.initial_step`), or a
     hundredth of the first interval where it is degenerate."""
-    h0 = _initial_step(problem, rtol, atol, 8)[0]
+    h0 = initial_step(problem, rtol, atol, 8)[0]
     return h0 if h0 is not None and h0 > 0 else float(problem.t[1] - problem.t[0]) / 100.0
 
 

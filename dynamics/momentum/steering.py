@@ -126,7 +126,7 @@ def pseudo_inverse_steering(C, torque):
     return -np.linalg.pinv(C) @ torque
 
 
-def sr_inverse_steering(C, torque, lam0=SR_LAM0, mu=SR_MU):
+def sr_inverse_steering(C, torque, *, lam0=SR_LAM0, mu=SR_MU):
     """Singularity-robust steering ``delta_dot = -C^T (C C^T + lam I)^-1 torque``.
 
     ``lam = lam0 exp(-mu det(C C^T))``. In the singular-value basis each rate component is
@@ -161,7 +161,7 @@ def sr_inverse_steering(C, torque, lam0=SR_LAM0, mu=SR_MU):
     return _damped(C, torque, lam0, mu)
 
 
-def gsr_inverse_steering(C, torque, t=None, lam0=SR_LAM0, mu=SR_MU, eps0=GSR_EPS0,
+def gsr_inverse_steering(C, torque, t=None, *, lam0=SR_LAM0, mu=SR_MU, eps0=GSR_EPS0,
                          omega=GSR_OMEGA, phase=GSR_PHASE):
     """Generalized singularity-robust steering with off-diagonal dither (Wie).
 

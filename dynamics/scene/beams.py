@@ -28,6 +28,8 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.optimize import brentq
 
+from .. import cache
+
 __all__ = ["clamped_free_roots", "ClampedFreeModes", "TabulatedModes", "gauss_legendre"]
 
 
@@ -37,7 +39,7 @@ def _frequency_function(lam: float, mu: float) -> float:
         math.cos(lam) * math.tanh(lam) - math.sin(lam))
 
 
-def clamped_free_roots(modes: int, tip_mass_ratio: float = 0.0) -> np.ndarray:
+def clamped_free_roots(modes: int, *, tip_mass_ratio: float = 0.0) -> np.ndarray:
     """The first ``modes`` roots ``lam = beta L`` of the clamped-free frequency equation.
 
     Parameters
@@ -57,7 +59,7 @@ def clamped_free_roots(modes: int, tip_mass_ratio: float = 0.0) -> np.ndarray:
     >>> from appdyn.dynamics.scene.beams import clamped_free_roots
     >>> clamped_free_roots(4).round(4)
     array([ 1.8751,  4.6941,  7.8548, 10.9955])
-    >>> clamped_free_roots(1, 1.0).round(4)   # a tip mass equal to the beam's
+    >>> clamped_free_roots(1, tip_mass_ratio=1.0).round(4)   # a tip mass equal to the beam's
     array([1.2479])
     """
     from ..validate import integer, nonnegative
@@ -71,7 +73,7 @@ def clamped_free_roots(modes: int, tip_mass_ratio: float = 0.0) -> np.ndarray:
     return out
 
 
-@functools.lru_cache(maxsize=16)
+@cache.memoize
 def _leggauss(n: int) -> tuple:
     return np.polynomial.legendre.leggauss(n)
 
@@ -138,7 +140,7 @@ class ClampedFreeModes:
 
     @functools.cached_property
     def roots(self) -> np.ndarray:
-        return clamped_free_roots(self.modes, self.tip_mass / (self.mass_per_length * self.length))
+        return clamped_free_roots(self.modes, tip_mass_ratio=self.tip_mass / (self.mass_per_length * self.length))
 
     @functools.cached_property
     def scale(self) -> np.ndarray:

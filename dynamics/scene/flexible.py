@@ -39,13 +39,13 @@ Strain energy (Eq. 6.40): ``1/2 q^T K q`` per plane, ``K_ij = EI int phi_i'' phi
 """
 from __future__ import annotations
 
-import functools
 import math
 from dataclasses import dataclass
 
 import casadi as ca
 import numpy as np
 
+from .. import cache
 from ..validate import finite_array, integer, nonnegative, positive, positive_each
 from .beams import ClampedFreeModes, TabulatedModes
 from .contract import Body, Contribution, Load, Part, PartVariables, Variable
@@ -82,7 +82,7 @@ def _beam(length, mass_per_length, modes, tip_mass, shapes):
     return TabulatedModes(length, mass_per_length, shapes[0], shapes[1], tip_mass)
 
 
-@functools.lru_cache(maxsize=64)
+@cache.memoize
 def _body_coefficients(length, mass_per_length, modes, tip_mass, stiffening, shapes=None):
     """``(B, mu, K_unit)``: the basis coefficients of the bodies (columns of ``B``, the
     mass-centre body first), their momentum factors, and ``int phi'' phi''`` (module

@@ -69,7 +69,7 @@ def real_array(x, name: str) -> np.ndarray:
     raise ArgumentTypeError(f"`{name}` must be real numbers, got {what}: {short_repr(x)}")
 
 
-def short_repr(x, limit: int = 80) -> str:
+def short_repr(x, *, limit: int = 80) -> str:
     r = repr(x)
     return r if len(r) <= limit else r[: limit - 3] + "..."
 

@@ -34,6 +34,7 @@ from typing import Mapping
 import casadi as ca
 import numpy as np
 
+from appdyn.config import param
 from appdyn.dynamics.model import Model
 from appdyn.dynamics.interrupts import interruptible
 
@@ -56,7 +57,6 @@ __all__ = ["polish_switches", "STATUS_BUDGET"]
 
 METHODS = ("auto", "switch-times", "moving-knots")
 
-_STRICT = {"tol": 1e-10, "bound_relax_factor": 0.0, "max_iter": 3000}
 
 #: ``status`` of a polish stopped by its ``budget`` (IPOPT's -5 ``Maximum_WallTime_Exceeded``).
 STATUS_BUDGET = STATUS_WALL_TIME
@@ -302,7 +302,7 @@ def polish_switches(problem: Problem, solution: Solution, *, N: int | None = Non
     user_ipopt = kw.pop("ipopt_options", None) or {}
     if not isinstance(user_ipopt, Mapping):
         raise ValueError(f"`ipopt_options` must be a mapping, got {type(user_ipopt).__name__}")
-    ipopt = {**_STRICT, **check_ipopt_options(user_ipopt)}
+    ipopt = {**param("ocp.ipopt_strict"), **check_ipopt_options(user_ipopt)}
 
     t_start = time.perf_counter()
 

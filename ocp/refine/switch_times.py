@@ -56,6 +56,7 @@ from typing import Mapping
 import casadi as ca
 import numpy as np
 
+from appdyn.config import param
 from appdyn.dynamics.cache import construction_lock
 from appdyn.dynamics.interrupts import check_interrupt
 from appdyn.dynamics.validate import integer
@@ -76,7 +77,6 @@ from .rk8_step import step_function, step_jacobian
 
 __all__ = ["BangArcs", "bang_arcs", "optimize_switch_times"]
 
-_STRICT = {"tol": 1e-10, "bound_relax_factor": 0.0, "max_iter": 3000}
 
 
 # --------------------------------------------------------------------------- helpers
@@ -314,7 +314,7 @@ def _solve_arcs(problem: Problem, guess: Solution, arcs: BangArcs, nseg: np.ndar
     w0 = np.concatenate([D0 / sT, p0[free_p] / sp, Xg0.reshape(-1, order="F")])
 
     user = check_ipopt_options(ipopt_options)
-    ipopt = {**_STRICT, "print_level": 0, "sb": "yes", **user}
+    ipopt = {**param("ocp.ipopt_strict"), "print_level": 0, "sb": "yes", **user}
     # verbose: IPOPT's iterations through a callback to the sink (stderr), never IPOPT's own
     # printing on the C stdout
     sink = iteration_sink(verbose, None)

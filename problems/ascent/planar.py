@@ -11,6 +11,7 @@ from typing import Literal, Mapping
 import casadi as ca
 import numpy as np
 
+from appdyn.config import param
 from appdyn import ocp
 from appdyn.dynamics.figures import finish_figure, panel_axes
 from appdyn.dynamics.results import Result
@@ -165,7 +166,7 @@ def _loads(x, theta, rho0=RHO0):
 # ------------------------------------------------------------------------ the ascent
 def planar_ascent(*, target_altitude, target_gamma, q_max, qalpha_max,
                   objective: Literal["velocity", "mass"] = "velocity", target_speed=None,
-                  N: int = 40, vehicle: AscentVehicle | None = None,
+                  N: int | None = None, vehicle: AscentVehicle | None = None,
                   initial_speed: float = 50.0, kick: float = math.radians(1.0),
                   theta_bounds=(-0.2, math.pi / 2 + 0.2),
                   tolerances: Mapping | None = None, ipopt_options: Mapping | None = None,
@@ -249,7 +250,7 @@ def planar_ascent(*, target_altitude, target_gamma, q_max, qalpha_max,
     one_of(objective, "objective", ("velocity", "mass"))
     qmax = positive(q_max, "q_max")
     qamax = positive(qalpha_max, "qalpha_max")
-    N = integer(N, "N", minimum=4)
+    N = integer(param("problems.N", N), "N", minimum=4)
     kick = positive(kick, "kick")
     if not kick < math.pi / 2:
         raise ValueError(f"`kick` must be in (0, pi/2) rad, got {kick!r}")

@@ -46,7 +46,7 @@ def _num(a):
     return float(a) if a.ndim == 0 else a
 
 
-def statistics(values, percentiles=(1.0, 50.0, 99.0)) -> Statistics:
+def statistics(values, *, percentiles=(1.0, 50.0, 99.0)) -> Statistics:
     """`Statistics` of ``values`` along axis 0 (the samples); NaN everywhere when empty.
 
     Parameters
@@ -161,7 +161,7 @@ class DispersionResult(Result):
     def __post_init__(self):
         if not self.statistics:
             ok = self.sample_success
-            stats = {name: statistics(v[ok], self.percentiles) for name, v in self.outputs.items()}
+            stats = {name: statistics(v[ok], percentiles=self.percentiles) for name, v in self.outputs.items()}
             object.__setattr__(self, "statistics", stats)
 
     # ------------------------------------------------------------------ verdict

@@ -75,6 +75,7 @@ from typing import Mapping
 
 import numpy as np
 
+from appdyn.config import param
 from appdyn import ocp
 from appdyn.dynamics.validate import finite_scalar, positive
 
@@ -90,7 +91,7 @@ __all__ = ["LaunchVehicle", "LaunchScenario", "launch_vehicle_gains", "design_mo
 
 # ------------------------------------------------------------------------ the design
 def launch_vehicle_gains(vehicle, scenarios, *, delta_max, delta_rate_max, weights=None,
-                         horizon: float = 8.0, N: int = 40, gain_bounds=None,
+                         horizon: float = 8.0, N=None, gain_bounds=None,
                          min_decay: float = 0.01, integral: bool = False,
                          filter_time_constant: float | None = None, limit_tol: float = 5e-3,
                          points: int = 801, ipopt_options: Mapping | None = None) -> GainDesign:
@@ -119,8 +120,9 @@ def launch_vehicle_gains(vehicle, scenarios, *, delta_max, delta_rate_max, weigh
         keys are 0. Default ``{'psi': 1, 'delta': 1}``.
     horizon : float [s]
         Length of every scenario, ``> 0`` (several closed-loop time constants).
-    N : int
-        Collocation intervals (Radau, degree 3), ``>= 4``.
+    N : int, optional
+        Collocation intervals (Radau, degree 3), ``>= 4`` (default ``appdyn.config``
+        ``problems.N``, 40).
     gain_bounds : mapping, optional
         ``{'k_psi': (lo, hi), 'k_psidot': (lo, hi)}`` (and ``'k_i'`` with ``integral``),
         ``0 <= lo < hi``; default (0, 50) each.
@@ -182,6 +184,7 @@ def launch_vehicle_gains(vehicle, scenarios, *, delta_max, delta_rate_max, weigh
     >>> d.success, d.verification["verdict"]
     (True, 'asymptotically stable')
     """
+    N = param("problems.N", N)
     import time
 
     veh = LaunchVehicle.coerce(vehicle)
@@ -256,7 +259,7 @@ def launch_vehicle_gains(vehicle, scenarios, *, delta_max, delta_rate_max, weigh
                          lambda k, other: max(node_peaks(model, outputs, other, K, labels),
                                               key=lambda item: item[1][k]))
 
-    stab, _ = stability_check(veh, sol.p, tf)
+    stab, _ = stability_check(veh, sol.p, filter_tau=tf)
     ver.update(stab)
     runs = resimulate(veh, sol.p, scs, T, points, filter_tau=tf)
     for which in ("delta", "delta_rate"):

@@ -63,7 +63,7 @@ def compensator(gains, filter_tau):
                       outputs=["command"], name="autopilot")
 
 
-def stability_check(veh: LaunchVehicle, gains, filter_tau=None) -> tuple[dict, object]:
+def stability_check(veh: LaunchVehicle, gains, *, filter_tau=None) -> tuple[dict, object]:
     """The stability report of the designed loop: `problems.stability.launch_vehicle` for
     the PD law; for the integral/filter law its plant (recovered from that report as
     ``A = A_cl + B K C``) under the compensator, through `problems.stability.loop`."""

@@ -47,6 +47,7 @@ from typing import Mapping
 import casadi as ca
 import numpy as np
 
+from appdyn.config import param
 from appdyn import ocp
 from appdyn.dynamics.validate import finite_array, nonnegative, positive, positive_each
 from appdyn.ocp.status import STATUS_SIMULATION, status_code
@@ -64,7 +65,6 @@ __all__ = ["attitude_gains", "attitude_loop", "initial_state", "settle_time", "e
 DEFAULT_SETTLE_ANGLE = math.radians(1.0)
 #: default relative tolerance of the re-simulated peak torque over ``u_max``
 DEFAULT_LIMIT_TOL = 1e-3
-_DEFAULT_N = 40
 _INFEASIBLE = (status_code("Infeasible_Problem_Detected"), status_code("Restoration_Failed"))
 _TORQUE = "torque limit |u_i| <= u_max_i"
 
@@ -72,7 +72,7 @@ _TORQUE = "torque limit |u_i| <= u_max_i"
 def attitude_gains(inertia, scenarios, *, u_max, horizon=None, per_axis: bool = False,
                    effort_weight: float = 0.1, settle_angle: float = DEFAULT_SETTLE_ANGLE,
                    settle_by_horizon: bool = False, gains0=None, gain_bounds=None,
-                   N: int = _DEFAULT_N, transcription="radau", ipopt_options: Mapping | None = None,
+                   N=None, transcription="radau", ipopt_options: Mapping | None = None,
                    time_optimal_reference: bool = True, time_optimal_options: Mapping | None = None,
                    limit_tol: float = DEFAULT_LIMIT_TOL) -> GainDesign:
     """PD attitude gains for a rigid spacecraft under per-axis torque limits (module docstring).
@@ -118,7 +118,7 @@ def attitude_gains(inertia, scenarios, *, u_max, horizon=None, per_axis: bool = 
     gain_bounds : (lower, upper), optional
         Bounds of every gain (numbers or arrays of the gains' size); default ``(0, inf)``.
     N : int, optional
-        Collocation intervals (default 40).
+        Collocation intervals (default ``appdyn.config`` ``problems.N``, 40).
     transcription : str, optional
         Default ``'radau'``.
     ipopt_options : mapping, optional
@@ -179,6 +179,7 @@ def attitude_gains(inertia, scenarios, *, u_max, horizon=None, per_axis: bool = 
     >>> res.success, res.verification["limits_met"], res.verification["stable"]
     (True, True, True)
     """
+    N = param("problems.N", N)
     t_start = time.perf_counter()
     scene = spacecraft_scene(inertia)
     I = scene.hub.inertia_matrix

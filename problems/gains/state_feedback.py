@@ -29,6 +29,7 @@ import numpy as np
 from scipy.linalg import expm
 from scipy.signal import place_poles
 
+from appdyn.config import param
 from appdyn import ocp
 from appdyn.dynamics.model import Model
 from appdyn.dynamics.validate import finite_array, positive
@@ -50,7 +51,6 @@ STATUS_SHORT_HORIZON = _status.STATUS_SHORT_HORIZON
 #: not be unique (module docstring)
 STATUS_NOT_SPANNING = _status.STATUS_NOT_SPANNING
 
-_DEFAULT_N = 80
 _DEFAULT_IPOPT = {"tol": 1e-10}
 
 
@@ -220,7 +220,7 @@ def _is_system(value) -> bool:
     return hasattr(value, "A") and hasattr(value, "B") and not isinstance(value, np.ndarray)
 
 
-def state_feedback_gains(A, B, Q, R, initial_states, horizon=None, *, N: int = _DEFAULT_N,
+def state_feedback_gains(A, B, Q, R, initial_states, horizon=None, *, N: int | None = None,
                          transcription="radau", ipopt_options: Mapping | None = None,
                          K0=None, K_bounds=None) -> tuple[np.ndarray, GainDesign]:
     """Full-state feedback ``u = -K x`` minimizing a quadratic cost summed over initial states.
@@ -254,7 +254,8 @@ def state_feedback_gains(A, B, Q, R, initial_states, horizon=None, *, N: int = _
         cost's horizon; should be at least ``HORIZON_RATIO_MIN`` (10) times the slowest
         time constant of the designed loop (else a warning).
     N : int, optional
-        Collocation intervals (default 80; uniform mesh, Radau degree 3 by default).
+        Collocation intervals (default ``appdyn.config`` ``problems.feedback_N``, 80; uniform
+        mesh, Radau degree 3 by default).
     transcription : str, optional
         Any of ``ocp.TRANSCRIPTIONS`` (default ``'radau'``).
     ipopt_options : mapping, optional
@@ -317,6 +318,7 @@ def state_feedback_gains(A, B, Q, R, initial_states, horizon=None, *, N: int = _
     >>> res.success, np.round(K, 4), res.verification["lqr_relative_difference"] < 1e-4
     (True, array([[1.    , 1.7321]]), True)
     """
+    N = param("problems.feedback_N", N)
     t_start = time.perf_counter()
     if _is_system(A):  # (sys, Q, R, initial_states, horizon)
         if horizon is not None:

@@ -23,6 +23,7 @@ from __future__ import annotations
 import casadi as ca
 import numpy as np
 
+from appdyn.config import param
 from appdyn.dynamics import cmg_spacecraft, wheel_spacecraft
 from appdyn.dynamics.attitude import dcm_from_quat
 from appdyn.dynamics.interrupts import interruptible
@@ -155,7 +156,7 @@ def _common(objective, tol, pointing_tol, rate_tol, starts):
 @interruptible
 def wheel_slew(inertia, axes, wheel_inertia, *, objective="time", T=None, angle=None, axis=None,
                q0=None, qf=None, torque_max=1.0, speed_max=None, W0=None, Wf=None, T_max=None,
-               N=30, starts=None, seed=0, tol=1e-7, verbose=False, ipopt_options=None,
+               N=None, starts=None, seed=0, tol=1e-7, verbose=False, ipopt_options=None,
                pointing_tol=POINTING_TOL, rate_tol=RATE_TOL):
     """Time-optimal or minimum-effort rest-to-rest slew by reaction wheels.
 
@@ -212,6 +213,7 @@ def wheel_slew(inertia, axes, wheel_inertia, *, objective="time", T=None, angle=
     >>> sol.success, round(sol.T, 6), round(2 * 0.2 ** 0.5, 6)
     (True, 0.894427, 0.894427)
     """
+    N = param("problems.slew_N", N)
     objective, tol, ptol, rtol, starts = _common(objective, tol, pointing_tol, rate_tol, starts)
     I = check_inertia(inertia)
     A = unit_axes(axes, "axes")
@@ -264,7 +266,7 @@ def wheel_slew(inertia, axes, wheel_inertia, *, objective="time", T=None, angle=
 @interruptible
 def cmg_slew(inertia, geometry, *, objective="time", T=None, angle=None, axis=None, q0=None,
              qf=None, rate_max=1.0, min_measure=None, delta0=None, deltaf=None, T_max=None,
-             N=30, starts=None, seed=0, tol=1e-7, verbose=False, ipopt_options=None,
+             N=None, starts=None, seed=0, tol=1e-7, verbose=False, ipopt_options=None,
              pointing_tol=POINTING_TOL, rate_tol=RATE_TOL):
     """Time-optimal or minimum-effort rest-to-rest slew by a cluster of single-gimbal CMGs.
 
@@ -314,6 +316,7 @@ def cmg_slew(inertia, geometry, *, objective="time", T=None, angle=None, axis=No
     >>> sol.success, sol.info["min_measure"] >= 0.5 - 1e-6
     (True, True)
     """
+    N = param("problems.slew_N", N)
     objective, tol, ptol, rtol, starts = _common(objective, tol, pointing_tol, rate_tol, starts)
     if not isinstance(geometry, ClusterGeometry):
         raise TypeError(f"`geometry` must be a dynamics.momentum.ClusterGeometry, got "

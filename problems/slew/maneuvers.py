@@ -9,6 +9,7 @@ from typing import Mapping
 import casadi as ca
 import numpy as np
 
+from appdyn.config import param
 from appdyn.ocp import (CONTROLS, DEFAULT_CONSTRAINT_TOL, STATUS_BOUND_VIOLATION, STATUS_RESIMULATION,
                  Problem, Solution, annotate, bang_arcs, polish_switches, refine, rest_solution, solve,
                  solve_multistart)
@@ -120,7 +121,7 @@ def _tiny_scale(problem, T_est):
 @interruptible
 def time_optimal(inertia, *, angle=None, axis=None, q0=None, qf=None, u_max=1.0,
                  norm_bound=False, w0=None, wf=None, keep_out=None, T_max=None, guess=None,
-                 starts=None, seed=None, N=30, transcription="radau", polish=None,
+                 starts=None, seed=None, N=None, transcription="radau", polish=None,
                  verbose=False, ipopt_options=None, pointing_tol=POINTING_TOL,
                  rate_tol=RATE_TOL, control="constant") -> Solution:
     """Minimum-time rigid-body slew under torque bounds.
@@ -154,8 +155,8 @@ def time_optimal(inertia, *, angle=None, axis=None, q0=None, qf=None, u_max=1.0,
     seed : int, optional
         Seed of the tilt axes (default 0; results are reproducible).
         Ignored, with a warning, when ``guess`` is given.
-    N : int
-        Intervals of the first solve
+    N : int, optional
+        Intervals of the first solve (default ``appdyn.config`` ``problems.slew_N``, 30)
     transcription : str
         Of the first solve (any of ``ocp.TRANSCRIPTIONS``)
     control : {'constant', 'linear', 'polynomial'}
@@ -231,6 +232,7 @@ def time_optimal(inertia, *, angle=None, axis=None, q0=None, qf=None, u_max=1.0,
     >>> sol.success, round(sol.T, 6), round(slew.eigenaxis_time(np.eye(3), 0.1, [0, 0, 1]), 6)
     (True, 0.632456, 0.632456)
     """
+    N = param("problems.slew_N", N)
     ptol = check_tol("pointing_tol", pointing_tol, POINTING_TOL)
     rtol = check_tol("rate_tol", rate_tol, RATE_TOL)
     problem = slew_problem(inertia, objective="time", angle=angle, axis=axis, q0=q0, qf=qf,
@@ -542,7 +544,7 @@ def _regularized(problem, first, *, ipopt_options, scale):
 
 @interruptible
 def min_effort(inertia, T, *, angle=None, axis=None, q0=None, qf=None, u_max=None,
-               norm_bound=False, w0=None, wf=None, keep_out=None, guess=None, N=20,
+               norm_bound=False, w0=None, wf=None, keep_out=None, guess=None, N=None,
                tol=1e-7, starts=None, seed=None, verbose=False, ipopt_options=None,
                pointing_tol=POINTING_TOL, rate_tol=RATE_TOL) -> Solution:
     """Minimum-effort (``1/2 integral |u|^2 dt``) rigid-body slew over a fixed time ``T``.
@@ -562,8 +564,8 @@ def min_effort(inertia, T, *, angle=None, axis=None, q0=None, qf=None, u_max=Non
     guess : None, ocp.Solution or mapping
         Default: eigenaxis SLERP (with a keep-out cone:
         multi-start from ``starts`` seeded tilted paths, best kept)
-    N : int
-        Intervals of the first mesh
+    N : int, optional
+        Intervals of the first mesh (default ``appdyn.config`` ``problems.effort_N``, 20)
     starts : int, optional
         Seeded tilted starts with a ``keep_out`` cone and no ``guess``
         (default 4); ignored otherwise, with a warning
@@ -600,6 +602,7 @@ def min_effort(inertia, T, *, angle=None, axis=None, q0=None, qf=None, u_max=Non
     >>> sol.success, round(sol.cost, 8)
     (True, 0.0075)
     """
+    N = param("problems.effort_N", N)
     ptol = check_tol("pointing_tol", pointing_tol, POINTING_TOL)
     rtol = check_tol("rate_tol", rate_tol, RATE_TOL)
     tol = check_tol("tol", tol, 1e-7)

@@ -169,7 +169,7 @@ def eigenaxis_time(inertia, angle, axis, u_max=1.0) -> float:
 
 
 
-def rough_time(I, q0, qf, u_lim, floor=1e-3):
+def rough_time(I, q0, qf, u_lim, *, floor=1e-3):
     """Order-of-magnitude slew time: bang-bang about the error axis with the weakest axis
     (the angle taken as at least ``floor`` [rad])."""
     dq = quat_mul(qf, quat_conj(q0))

@@ -34,6 +34,7 @@ import warnings
 import casadi as ca
 import numpy as np
 
+from appdyn.config import param
 from appdyn.dynamics.attitude import dcm_from_quat
 from appdyn.dynamics.interrupts import interruptible
 from appdyn.dynamics.momentum import ClusterGeometry
@@ -49,11 +50,23 @@ from .targets import targets, vector3
 
 __all__ = ["slew", "scene_problem", "torque_map", "scene_intervals", "quaternion_blocks",
            "settling_parts", "EFFORT_HORIZON",
-           "DEFAULT_N", "INTERVALS_PER_PERIOD", "MAX_AUTO_N"]
+           "default_N", "INTERVALS_PER_PERIOD", "MAX_AUTO_N"]
 
-#: Collocation intervals of the first solve when `SlewOptions.N` is None, by objective (the
-#: defaults of `time_optimal` and `min_effort`; the device engines use 30 for both).
-DEFAULT_N = {"time": 30, "effort": 20}
+
+def default_N(objective: str) -> int:
+    """The default interval count of a slew of ``objective`` (``'time'`` or ``'effort'``).
+
+    ``appdyn.config``'s ``problems.slew_N`` (30) for a time-optimal slew, ``problems.effort_N``
+    (20) for a minimum-effort one.
+
+    Examples
+    --------
+    >>> from appdyn.problems.slew.scene_slew import default_N
+    >>> default_N("time"), default_N("effort")
+    (30, 20)
+    """
+    return param("problems.slew_N" if objective == "time" else "problems.effort_N")
+
 
 #: Least intervals per period of the fastest oscillation of a scene (`scene_intervals`): a
 #: damper on a 60 N/m spring with 0.5 kg (11.0 rad/s on its hub), 30 s of minimum effort: 20
@@ -170,7 +183,7 @@ def slew(scene, *, objective="time", angle=None, axis=None, q_final=None, T=None
     # parts the slew must bring to rest (a damper, a panel, a slosh mass): the time-optimal
     # control switches again and again to settle their modes (module docstring)
     settle = objective == "time" and bool(settling_parts(scene, problem))
-    N = opts.N or scene_intervals(problem, DEFAULT_N[objective], attitude_guess(rb, n=3)["T"])
+    N = opts.N or scene_intervals(problem, default_N(objective), attitude_guess(rb, n=3)["T"])
     run = dict(seed=opts.seed or 0, N=N, tol=opts.tol, verbose=opts.verbose,
                ipopt_options=_dict(opts.ipopt_options), ptol=opts.pointing_tol,
                rtol=opts.rate_tol, guess=opts.guess, transcription=opts.transcription,
@@ -217,7 +230,7 @@ def _from_effort(scene, problem, failed, angle, axis, q_final, w0, wf, opts, run
                                         q_final=q_final, T=T_effort, w0=w0, wf=wf,
                                         options=opts)
     warm = solve_converted(effort, rb, convert, "effort", starts=1, polish=False,
-                           **{**run, "N": max(run["N"], DEFAULT_N["effort"])})
+                           **{**run, "N": max(run["N"], default_N("effort"))})
     if not warm.success:
         return None
     rigid = scene_problem(scene, objective="time", angle=angle, axis=axis, q_final=q_final,
@@ -283,7 +296,7 @@ def _rest_to_rest(w0, wf) -> bool:
 
 def _common(opts, objective):
     """The keywords every engine takes."""
-    return dict(N=opts.N or DEFAULT_N[objective], verbose=opts.verbose,
+    return dict(N=opts.N or default_N(objective), verbose=opts.verbose,
                 ipopt_options=_dict(opts.ipopt_options), pointing_tol=opts.pointing_tol,
                 rate_tol=opts.rate_tol)
 

@@ -142,7 +142,7 @@ def spherical_damper_roots(It, Jd, c, Ha_rigid, Omega, wd_axial, Ia) -> np.ndarr
     return np.array([*with_conjugates(roots), -c * (1 / Ia + 1 / Jd)], dtype=complex)
 
 
-def method3_roots(I1, I2, kappa, rate, damping=0.0):
+def method3_roots(I1, I2, kappa, rate, *, damping=0.0):
     """Roots of ``I2 s^2 + (D - i G w0) s + K = 0`` (RP-1262, Sec. 4.6 Method III,
     Eqs. 4.122-4.127), ``G = 2 I2 - I1``, ``K = (I1 - I2) w0^2 - kappa``.
 

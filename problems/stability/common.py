@@ -76,7 +76,7 @@ def block(states, first: str, last: str) -> slice:
     return slice(i, j)
 
 
-def format_complex(z, width=13) -> str:
+def format_complex(z, *, width=13) -> str:
     """``+1.234560e+00 + 5.000000e-01j`` (``-`` for None); ``width - 7`` decimals."""
     if z is None:
         return "-"
@@ -86,7 +86,7 @@ def format_complex(z, width=13) -> str:
     return f"{z.real:+.{width - 7}e} {'+-'[z.imag < 0]} {abs(z.imag):.{width - 7}e}j"
 
 
-def format_number(v, spec=".6g") -> str:
+def format_number(v, *, spec=".6g") -> str:
     """``format(v, spec)``, with ``-`` for None and ``inf`` for an infinite float."""
     if v is None:
         return "-"

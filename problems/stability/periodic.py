@@ -176,8 +176,8 @@ class PeriodicStabilityReport(Result):
         w = max([len(q.name) for q in self.quantities] + [10])
         lines.append(f"{'quantities:':<{w + 2}}  {'computed':>17}  {'closed form':>17}  unit")
         for q in self.quantities:
-            lines.append(f"  {q.name:<{w}}  {format_number(q.value, '.10g'):>17}  "
-                         f"{format_number(q.closed_form, '.10g'):>17}  {q.unit:<7} "
+            lines.append(f"  {q.name:<{w}}  {format_number(q.value, spec='.10g'):>17}  "
+                         f"{format_number(q.closed_form, spec='.10g'):>17}  {q.unit:<7} "
                          f"{q.equation}")
         lines.append(f"status {self.status}: {self.message}")
         lines += [f"note: {n}" for n in self.notes]

@@ -300,8 +300,8 @@ class StabilityReport(Result):
             lines.append(f"{'quantities:':<{w + 2}}  {'linear model':>17}  {'closed form':>17}  "
                          f"{'unit':<9} source")
             for q in self.quantities:
-                lines.append(f"  {q.name:<{w}}  {format_number(q.value, '.10g'):>17}  "
-                             f"{format_number(q.closed_form, '.10g'):>17}  {q.unit:<9} "
+                lines.append(f"  {q.name:<{w}}  {format_number(q.value, spec='.10g'):>17}  "
+                             f"{format_number(q.closed_form, spec='.10g'):>17}  {q.unit:<9} "
                              f"{q.equation}")
         if self.margins is not None:
             mg = self.margins
@@ -309,15 +309,15 @@ class StabilityReport(Result):
             lines.append("  gain margin   " + (
                 "inf (no phase crossover: the loop gain may grow without bound)"
                 if not math.isfinite(mg.phase_crossover) else
-                f"{format_number(mg.gain_margin)} ({format_number(mg.gain_margin_db, '.4g')} "
+                f"{format_number(mg.gain_margin)} ({format_number(mg.gain_margin_db, spec='.4g')} "
                 f"dB) at {format_number(mg.phase_crossover)} rad/s"))
             lines.append("  phase margin  " + (
                 "inf (no gain crossover)" if not math.isfinite(mg.gain_crossover) else
-                f"{format_number(mg.phase_margin, '.6g')} deg at "
+                f"{format_number(mg.phase_margin, spec='.6g')} deg at "
                 f"{format_number(mg.gain_crossover)} rad/s"))
             where = (f" at {format_number(mg.stability_margin_frequency)} rad/s"
                      if math.isfinite(mg.stability_margin_frequency) else "")
-            lines.append(f"  stability margin {format_number(mg.stability_margin, '.6g')} "
+            lines.append(f"  stability margin {format_number(mg.stability_margin, spec='.6g')} "
                          f"(least |1 + L|, unitless){where}")
         if self.closed_form_error is not None:
             lines.append(f"closed-form check: max |lambda - closed form| / rho = "

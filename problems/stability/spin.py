@@ -217,7 +217,7 @@ def _scene_spin(scene: Scene, axis, rate) -> StabilityReport:
     damper, tilt = _lone_damper(scene), _upright_tilt(scene, a, sl)
     if tilt is not None:
         Ia, Ib, _ = principal_moments(scene.hub.inertia_matrix, a)
-        (r1, r2), G, K = method3_roots(Ia, Ib, tilt.overturning, W, tilt.internal_damping)
+        (r1, r2), G, K = method3_roots(Ia, Ib, tilt.overturning, W, damping=tilt.internal_damping)
         cf = with_conjugates((r1, r2))
         quantities += [Quantity("K = (I1 - I2) w0^2 - kappa", None, K, "N m/rad",
                                 "Eq. 4.122"),

@@ -238,7 +238,7 @@ def _tilt_report(case, title, I1, I2, kappa, rate, damping, params, symbol):
     scene = tilt_torque_scene(np.diag([I1, I2, I2]), kappa, internal_damping=damping)
     sl = spin_linearization(scene, np.array([1.0, 0.0, 0.0]), rate, frame="spinning")
     lin, red = sl.lin, sl.reduced
-    (r1, r2), G, K = method3_roots(I1, I2, kappa, rate, damping)
+    (r1, r2), G, K = method3_roots(I1, I2, kappa, rate, damping=damping)
     inertial_cf = sorted((complex(r) - 1j * rate for r in (r1, r2)), key=lambda z: abs(z.imag))
     inertial = _inertial_roots(red, rate)
     a = I1 * rate / (2 * I2)

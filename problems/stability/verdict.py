@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from appdyn.dynamics.floquet import VERDICTS  # the three verdicts, worst first (one tuple)
 from appdyn.dynamics.validate.base import real_array
 
 from .common import format_complex
@@ -26,8 +27,6 @@ __all__ = ["ZERO_RTOL", "VERDICTS", "classify", "least_damped", "spectral_scale"
 
 #: eigenvalues with ``|Re| <= ZERO_RTOL * rho`` count as on the imaginary axis
 ZERO_RTOL = 1e-9
-#: the three verdicts, worst first
-VERDICTS = ("unstable", "marginally stable", "asymptotically stable")
 _CLUSTER_RTOL = 1e-6
 _RANK_RTOL = 1e-5
 

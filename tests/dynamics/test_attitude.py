@@ -16,8 +16,8 @@ from scipy.linalg import expm
 from scipy.spatial.transform import Rotation
 
 from appdyn.dynamics import attitude as at
+from tests.bodies import GEMINI
 
-GEMINI = np.array([[4560.7, 31.2, -43.4], [31.2, 4545.0, -270.7], [-43.4, -270.7, 1567.4]])
 
 finite = dict(allow_nan=False, allow_infinity=False)
 unit_vectors = st.tuples(*[st.floats(-1, 1, **finite)] * 3).map(np.array).filter(
@@ -184,6 +184,7 @@ def test_elementary_rotations_match_scipy():
 
 @settings(max_examples=200)
 @given(quats)
+@pytest.mark.slow
 def test_euler_round_trips_from_any_attitude(q):
     A = at.dcm_from_quat(q)
     for to_euler, from_euler in (
@@ -561,6 +562,7 @@ def test_symbolic_dcm_of_non_unit_quaternion_keeps_the_formula():
 @pytest.mark.filterwarnings("error")
 @settings(max_examples=200)
 @given(st.lists(quats, min_size=1, max_size=6), st.floats(-0.99e-6, 0.99e-6))
+@pytest.mark.slow
 def test_valid_inputs_within_tolerance_round_trip(qs, dn):
     """Quaternions off unit norm by < 1e-6 and DCMs built from them are accepted; the
     conversions agree with scipy and round-trip (batched and one at a time)."""

@@ -61,6 +61,7 @@ def test_should_compile_depends_only_on_arguments():
     assert cache.should_compile(None, float("inf"))
 
 
+@pytest.mark.slow
 def test_identical_auto_calls_make_identical_jit_choices():
     """Four identical calls: the same `compiled` flag every time (the old policy compiled on
     the third use of a model) and the same answer."""

@@ -47,6 +47,7 @@ def random_system(seed=0, n=4, m=2):
 
 
 # ------------------------------------------------------------------------------ truths
+@pytest.mark.slow
 def test_pd_attitude_loop_matches_the_law_applied_from_python():
     model = rigid_body(INERTIA)
     loop = closed_loop(model, pd_law_casadi())

@@ -88,6 +88,7 @@ def counts():
     return np.array([info.hits, info.compiles, info.rejected, info.evicted])
 
 
+@pytest.mark.slow
 def test_a_second_process_loads_what_the_first_compiled(tmp_path):
     first = run_script(tmp_path)
     assert first["compiles"] >= 1 and first["hits"] == 0 and first["err"] < 1e-9
@@ -99,6 +100,7 @@ def test_a_second_process_loads_what_the_first_compiled(tmp_path):
     assert artifacts(tmp_path) == libraries
 
 
+@pytest.mark.slow
 def test_a_truncated_artifact_is_rebuilt_not_loaded(tmp_path):
     run_script(tmp_path)
     (library,) = artifacts(tmp_path)
@@ -110,6 +112,7 @@ def test_a_truncated_artifact_is_rebuilt_not_loaded(tmp_path):
     assert artifacts(tmp_path) == [library] and verified(library)
 
 
+@pytest.mark.slow
 def test_a_foreign_artifact_is_rebuilt_not_loaded(tmp_path):
     """The library and sidecar of another model under this model's key."""
     run_script(tmp_path, c=1.5)
@@ -136,6 +139,7 @@ def test_a_library_that_does_not_load_is_rebuilt(disk):
     assert verified(library)
 
 
+@pytest.mark.slow
 def test_two_processes_compiling_at_once_both_succeed(tmp_path):
     procs = [run_script(tmp_path, wait=False) for _ in range(2)]
     results = [finish(p) for p in procs]
@@ -179,6 +183,7 @@ def test_disabled_writes_nothing(disk, tmp_path):
 
 
 @pytest.mark.parametrize("env", [{"APPDYN_DISK_CACHE": "0"}, {"APPDYN_CACHE_DIR": ""}])
+@pytest.mark.slow
 def test_disabled_by_the_environment(tmp_path, env):
     out = run_script(tmp_path, env=env)
     assert out["directory"] is None and out["compiles"] == 1 and out["err"] < 1e-9

@@ -66,6 +66,7 @@ def run(theta, amp_y, freq, damping=0.0, **kw):
 
 # ------------------------------------------------------------- against an independent run
 @pytest.mark.parametrize("freq_ratio, damping", [(1.0, 0.0), (1.3, 0.0), (0.7, 0.004)])
+@pytest.mark.slow
 def test_multipliers_match_finite_differences_of_an_independent_integrator(freq_ratio, damping):
     freq = freq_ratio * 2 * W0
     res = run(0.0, 0.02, freq, damping)
@@ -77,6 +78,7 @@ def test_multipliers_match_finite_differences_of_an_independent_integrator(freq_
                                rtol=0, atol=1e-7)
 
 
+@pytest.mark.slow
 def test_autonomous_equilibrium_gives_the_matrix_exponential():
     """No clock: x' = A x about an equilibrium, Phi(T) = expm(A T), mu = exp(lambda T)."""
     dp = double_pendulum(mass1=1.0, mass2=0.5, length1=0.8, length2=0.6, gravity=G)

@@ -57,6 +57,7 @@ def _relative_drift(values):
 
 # --------------------------------------------------------------- conservation
 @pytest.mark.parametrize("kind", ["ball", "revolute"])
+@pytest.mark.slow
 def test_momentum_and_energy_conserved_and_hinge_held_over_1000_s(kind):
     res = _long_run(kind, 1.0)
     assert res.success
@@ -67,6 +68,7 @@ def test_momentum_and_energy_conserved_and_hinge_held_over_1000_s(kind):
         assert np.max(np.abs(res.invariants[name] - 1.0)) < 1e-12
 
 
+@pytest.mark.slow
 def test_residual_grows_without_stabilization():
     held = _long_run("ball", 1.0).invariants["constraint_residual"]
     free = _long_run("ball", None).invariants["constraint_residual"]
@@ -117,6 +119,7 @@ def _full_from_reduced(y, t, centre0, centre_rate, b):
     return np.array(out).T
 
 
+@pytest.mark.slow
 def test_ball_hinge_equals_reduced_newton_euler_model():
     model = _model("ball")
     x0 = _x0(model)
@@ -133,6 +136,7 @@ def test_ball_hinge_equals_reduced_newton_euler_model():
     assert np.ptp(res.x[4:7], axis=1).max() > 0.1  # the bodies really tumble
 
 
+@pytest.mark.slow
 def test_revolute_rotor_equals_free_wheel_spacecraft():
     """Body 2 an axisymmetric rotor on the axis through its own mass centre (r2 = 0): the
     pair is a hub with a free wheel (zero motor torque)."""
@@ -159,6 +163,7 @@ def test_revolute_rotor_equals_free_wheel_spacecraft():
     assert np.ptp(ref.x[4:7], axis=1).max() > 0.05  # the hub nutates
 
 
+@pytest.mark.slow
 def test_revolute_hinge_turns_about_the_axis_only():
     res = _long_run("revolute", 1.0)
     model = _model("revolute")

@@ -9,8 +9,8 @@ from appdyn.dynamics.attitude import (principal_axes, propagate_quat, quat_conj,
                                quat_mul, quat_rate, skew)
 from appdyn.dynamics.linearize import ANGLE_STATES, error_dynamics, linearization, linearize
 from appdyn.dynamics.spinning import PointMassDamper, gyrostat_model, tilt_torque_body
+from tests.bodies import GEMINI
 
-GEMINI = np.array([[4560.7, 31.2, -43.4], [31.2, 4545.0, -270.7], [-43.4, -270.7, 1567.4]])
 
 
 def error_rhs(model, q_ref, w_ref, xr, u, p=None):

@@ -295,6 +295,7 @@ def pole_passage(inertia):
     return (a, xa), (b, xb)
 
 
+@pytest.mark.slow
 def test_313_form_degrades_near_the_bottom_when_I_is_small_and_321_does_not():
     """Ch. 6 Ex. 1: 'for I << m l^2 these equations become almost singular for small
     theta'. Measured on a swing through the bottom (I / m l^2 = 1e-4 and 1e-6):

@@ -6,8 +6,8 @@ from scipy.spatial.transform import Rotation
 
 from appdyn.dynamics import Model, rigid_body
 from appdyn.dynamics.attitude import dcm_from_quat, principal_axes
+from tests.bodies import GEMINI
 
-GEMINI = np.array([[4560.7, 31.2, -43.4], [31.2, 4545.0, -270.7], [-43.4, -270.7, 1567.4]])
 
 
 def random_state(rng):
@@ -31,9 +31,9 @@ def test_diagonal_inertia_matches_eq_4_82():
         np.testing.assert_allclose(model.rhs(x, u)[4:], expected, rtol=1e-14)
 
 
-def test_full_inertia_equals_principal_frame_formulation():
+def test_full_inertia_equals_principal_frame_formulation(gemini):
     """Second formulation: rotate to principal axes, apply Eq. 4.82, rotate back."""
-    model = rigid_body(GEMINI)
+    model = gemini
     moments, A = principal_axes(GEMINI)
     principal = rigid_body(moments)
     rng = np.random.default_rng(1)
@@ -44,9 +44,9 @@ def test_full_inertia_equals_principal_frame_formulation():
         np.testing.assert_allclose(model.rhs(x, u)[4:], A.T @ wdot_p, rtol=1e-10, atol=1e-15)
 
 
-def test_invariant_rates_along_the_flow():
+def test_invariant_rates_along_the_flow(gemini):
     """dT/dt = w.u and d(A^T I w)/dt = A^T u (torque in inertial axes), exactly."""
-    model = rigid_body(GEMINI)
+    model = gemini
     x, u = ca.SX.sym("x", 7), ca.SX.sym("u", 3)
     xdot = model.f(x=x, u=u, p=ca.DM.zeros(0))["xdot"]
     rates = {

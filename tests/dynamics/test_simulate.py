@@ -106,6 +106,7 @@ def test_linear_system_matches_matrix_exponential(method, kwargs, tol):
     assert np.max(np.abs(res.x - expm_truth(t))) < tol
 
 
+@pytest.mark.slow
 def test_lie_matches_matrix_exponential():
     """Constant rate: the quaternion part of the Lie method is exact; y is RK4."""
     model = oscillator_with_attitude()
@@ -243,6 +244,7 @@ def axisymmetric_run(rtol, atol, t=np.linspace(0.0, 60.0, 61)):
 
 
 @pytest.mark.parametrize("rtol", [1e-5, 1e-8, 1e-10])
+@pytest.mark.slow
 def test_auto_meets_the_requested_tolerance(rtol):
     """Measured error against the closed form (axisymmetric body: rates AND attitude).
 
@@ -365,6 +367,7 @@ def test_auto_sends_a_stiff_problem_to_cvodes():
 
 
 # ----------------------------------------------------------------- results and caching
+@pytest.mark.slow
 def test_sample_is_hermite_dense_output():
     t = np.linspace(0.0, 10.0, 401)
     res = simulate(linear_model(0), X3, t, method="rk8", steps=1, jit=False)

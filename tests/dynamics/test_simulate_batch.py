@@ -252,9 +252,9 @@ def test_progress_and_ctrl_c_of_a_batch_spread_over_threads(spread):
 
 def test_an_error_in_a_part_is_raised_after_every_part_finished(spread, monkeypatch):
     model = rigid_body(INERTIA)
-    t, X0, _ = _controlled_batch(12, 5)
+    t, X0, U = _controlled_batch(12, 5)  # (a varying control: the chunk loop)
     spread(2, 3)
-    ref = simulate(model, X0, t, method="rk8", steps=2).x.copy()
+    ref = simulate(model, X0, t, u=U, method="rk8", steps=2).x.copy()
     advance = batch_module._FixedBatch.advance
     finished = []
 
@@ -266,10 +266,10 @@ def test_an_error_in_a_part_is_raised_after_every_part_finished(spread, monkeypa
 
     monkeypatch.setattr(batch_module._FixedBatch, "advance", failing)
     with pytest.raises(RuntimeError, match="part failed"):
-        simulate(model, X0, t, method="rk8", steps=2)
+        simulate(model, X0, t, u=U, method="rk8", steps=2)
     assert finished and 11 not in finished
     monkeypatch.setattr(batch_module._FixedBatch, "advance", advance)
-    np.testing.assert_array_equal(simulate(model, X0, t, method="rk8", steps=2).x, ref)
+    np.testing.assert_array_equal(simulate(model, X0, t, u=U, method="rk8", steps=2).x, ref)
 
 
 def test_run_split_runs_every_task_and_raises_the_first_error():
@@ -354,3 +354,23 @@ def test_nan_after_failure_tells_huge_finite_runs_from_non_finite_ones():
     np.testing.assert_array_equal(out[:, :, 1], x[1].T)
     assert np.all(np.isnan(out[:, 3:, 2])) and np.all(out[:, :3, 2] == 1.0)
     assert np.all(np.isnan(out[:, 1:, 3])) and np.all(out[:, 0, 3] == 1.0)
+
+
+def test_a_constant_control_rk8_batch_is_one_c_loop_matching_single_runs(monkeypatch):
+    """Compiled rk8 over a batch under constant controls runs in one plain C loop over the
+    runs (`cpass._FIXED`): each run equals its single call (the chunk loop) to rounding and
+    its Jacobi truth to the method's error."""
+    from appdyn.dynamics.truth import torque_free_omega
+    calls = []
+    real = batch_module._c_loop
+    monkeypatch.setattr(batch_module, "_c_loop", lambda *a: calls.append(1) or real(*a))
+    model, t = rigid_body(INERTIA), np.linspace(0.0, 10.0, 21)
+    rng = np.random.default_rng(3)
+    x0 = np.r_[np.zeros((3, 5)), np.ones((1, 5)), rng.uniform(-1.0, 1.0, (3, 5))]
+    res = simulate(model, x0, t, method="rk8", steps=6)
+    assert calls and res.all_success
+    for k in range(5):
+        one = simulate(model, x0[:, k], t, method="rk8", steps=6).x
+        np.testing.assert_allclose(res.x[:, :, k], one, rtol=0, atol=1e-13)
+        w = torque_free_omega(INERTIA, x0[4:, k], t)
+        assert np.max(np.abs(res.x[4:, :, k] - w)) < 1e-9

@@ -95,11 +95,16 @@ def test_auto_work_barely_grows_with_the_grid():
     assert steps[1] <= 1.3 * steps[0], steps
 
 
-def test_a_sparse_grid_keeps_the_one_pass():
-    """Where the grid does not bind (121 outputs over 60 s), the one pass is cheaper and
-    taken (`auto._grid_bound`)."""
-    res = simulate(rigid_body(INERTIA), X0, np.linspace(0.0, 60.0, 121), rtol=1e-7, atol=1e-9)
-    assert res.success and "embedded error control" in res.message, res.message
+@pytest.mark.parametrize("n", [2, 121])
+def test_a_sparse_grid_takes_the_dense_path(n):
+    """Steps chosen by the error, never by the grid, on a sparse grid too (one compiled call,
+    `dense.dense_auto`): the tolerance met against the Jacobi truth."""
+    rtol, atol = 1e-7, 1e-9
+    t = np.linspace(0.0, 60.0, n)
+    res = simulate(rigid_body(INERTIA), X0, t, rtol=rtol, atol=atol)
+    assert res.success and "dense output" in res.message, res.message
+    w = torque_free_omega(INERTIA, X0[4:], t)
+    assert np.all(np.abs(res.x[4:] - w) <= atol + rtol * np.abs(w))
 
 
 def test_varying_control_keeps_the_grid_paths():
@@ -112,3 +117,91 @@ def test_varying_control_keeps_the_grid_paths():
         model, X0, t, check_u(u, 3, t), np.zeros(0)), 1e-8, np.full(7, 1e-10), 10 ** 6) is None
     res = simulate(model, X0, t, u=u)
     assert res.success and "dense output" not in res.message
+
+
+@pytest.mark.parametrize("n", [2, 121])
+def test_the_one_call_is_the_stepper_runs(n):
+    """`dense.dense_auto` (answer, check run and verdict in one compiled call) makes the
+    runs `stepcontrol.run_dense` makes at the answer's and the check's local tolerances:
+    the answer equal to the last bit, the steps counted alike, the estimate at least the
+    Richardson bound of their difference, and the Jacobi truth within it."""
+    from appdyn.dynamics.integrate.dense import FIRST, dense_auto
+    model, t = rigid_body(INERTIA), np.linspace(0.0, 60.0, n)
+    rtol, atol = 1e-8, np.full(7, 1e-10)
+    got = dense_auto(_problem(model, X0, t), rtol, atol, 1e8, 1e6)
+    assert got.result == 1 and got.factor <= FIRST and got.ratio >= 10
+    f, g = got.factor, got.factor * got.ratio
+    answer, _ = run_dense(_problem(model, X0, t), rtol * f, atol * f, 10 ** 8)
+    check, _ = run_dense(_problem(model, X0, t), rtol * g, atol * g, 10 ** 8)
+    assert np.array_equal(got.x, answer.x)
+    assert (got.answer_steps, got.check_steps) == (answer.n_steps, check.n_steps)
+    assert got.spent >= answer.n_steps + check.n_steps
+    scale = atol[:, None] + rtol * np.abs(answer.x[:, 1:])
+    d = np.max(np.abs(answer.x[:, 1:] - check.x[:, 1:]) / scale)
+    assert got.estimate >= d / (got.ratio ** 0.75 - 1)  # (plus the ulps of the states)
+    w = torque_free_omega(INERTIA, X0[4:], t)
+    assert np.all(np.abs(got.x[4:] - w) <= got.estimate * (1e-10 + rtol * np.abs(w)))
+
+
+def _batch(K, seed=0):
+    rng = np.random.default_rng(seed)
+    w0 = np.array([0.5, 0.0, 1.0]) + rng.uniform(-0.4, 0.4, (K, 3))
+    return np.c_[np.zeros((K, 3)), np.ones(K), w0].T
+
+
+def test_a_batch_steps_each_run_by_its_own_error_and_verifies_it():
+    """Batched ``auto`` (one compiled loop over the runs, `dense.dense_many`): each run is
+    the single call's answer to the last bit (its own steps, its own check run), verified,
+    and within the tolerance of its Jacobi truth."""
+    model, t = rigid_body(INERTIA), np.linspace(0.0, 20.0, 41)
+    x0 = _batch(12)
+    res = simulate(model, x0, t)
+    assert res.all_success and "dense output per run" in res.message, res.message
+    steps = set()
+    for k in range(x0.shape[1]):
+        one = simulate(model, x0[:, k], t)
+        assert np.array_equal(res.x[:, :, k], one.x)
+        assert res.error_estimate[k] == one.error_estimate
+        steps.add(one.n_steps)
+        w = torque_free_omega(INERTIA, x0[4:, k], t)
+        assert np.all(np.abs(res.x[4:, :, k] - w) <= 1e-10 + 1e-8 * np.abs(w))
+    assert len(steps) > 1 and res.n_steps == max(steps)
+
+
+def test_a_batch_run_not_verified_in_the_loop_goes_alone(monkeypatch):
+    """A run whose check the compiled loop did not accept is run alone through every path of
+    ``auto`` (here: its verdict forced to "not verified"): its answer is the single call's."""
+    from appdyn.dynamics.integrate import batch as batch_module, dense
+    real = batch_module.dense_many
+
+    def forced(*args):
+        X, head = real(*args)
+        runs = args[-1]
+        if runs.start <= 1 < runs.stop:
+            head[1 - runs.start, dense.FIELDS.index("result")] = 0  # not verified
+        return X, head
+
+    monkeypatch.setattr(batch_module, "dense_many", forced)
+    model, t = rigid_body(INERTIA), np.linspace(0.0, 10.0, 11)
+    x0 = _batch(3, seed=1)
+    res = simulate(model, x0, t)
+    assert res.all_success and "1 run(s) alone" in res.message, res.message
+    for k in range(3):
+        assert np.array_equal(res.x[:, :, k], simulate(model, x0[:, k], t).x)
+
+
+def test_near_round_off_the_floor_is_measured_in_the_same_call():
+    """rtol 1e-10 (atol 1e-12) on issue 31's body: within 1e6 ulps of the states, the carried
+    rounding is not small against the quaternion's tolerance (1e-12 where a part crosses
+    zero), so the answer is repeated from a start moved by it in the same compiled call (its
+    steps counted); the result meets the tolerance against the Jacobi truth."""
+    from appdyn.dynamics.integrate.dense import dense_auto
+    model, t = rigid_body(INERTIA), np.linspace(0.0, 60.0, 121)
+    rtol, atol = 1e-10, 1e-12
+    got = dense_auto(_problem(model, X0, t), rtol, np.full(7, atol), 1e8, 1e6)
+    assert got.result == 1 and got.floor > 0 and got.bound == 0
+    assert got.spent >= 2 * got.answer_steps + got.check_steps
+    res = simulate(model, X0, t, rtol=rtol, atol=atol)
+    assert res.success and "rounding floor" in res.message, res.message
+    w = torque_free_omega(INERTIA, X0[4:], t)
+    assert np.all(np.abs(res.x[4:] - w) <= atol + rtol * np.abs(w))

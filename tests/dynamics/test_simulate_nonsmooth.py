@@ -61,6 +61,7 @@ def test_the_graph_scan_finds_kinks_and_only_kinks():
 
 
 @pytest.mark.parametrize("rtol", [1e-6, 1e-8])
+@pytest.mark.slow
 def test_saturated_pd_wheel_slew_is_verified(rtol, slew_reference):
     loop = saturated_pd_wheel_loop()
     assert np.max(np.abs(law_numpy(X0))) >= LMAX  # (the premise: the law starts saturated)
@@ -73,6 +74,7 @@ def test_saturated_pd_wheel_slew_is_verified(rtol, slew_reference):
     assert np.linalg.norm(quat_mul(res.x[:4, -1], quat_conj(TARGET))[:3]) < 1e-5
 
 
+@pytest.mark.slow
 def test_without_the_stepper_the_failure_names_order_loss_not_round_off(slew_reference):
     """jit=False leaves auto its Richardson search (rk8 runs of different step counts): on
     the saturated law they do not converge at order 8; the old verdict was status 2, "it
@@ -107,6 +109,7 @@ def spin_angle(t):
     return L0 / SPHERE * (n * half ** 2 + area)
 
 
+@pytest.mark.slow
 def test_bang_bang_callable_torque_is_verified_against_the_closed_form():
     res = simulate(rigid_body([SPHERE] * 3), [0, 0, 0, 1, 0, 0, 0], T, u=bang, rtol=1e-6)
     assert res.success and res.status == 0, res.message
@@ -119,6 +122,7 @@ def test_bang_bang_callable_torque_is_verified_against_the_closed_form():
     assert ratio.max() <= 1.0, ratio.max()
 
 
+@pytest.mark.slow
 def test_a_batch_of_saturated_slews_is_verified_run_by_run(slew_reference):
     """x0 of shape (nx, K): each run of the non-smooth loop gets its own step control; run 0
     is the slew above, run 1 starts at the target at rest (stays there)."""
@@ -147,6 +151,7 @@ def test_smooth_callable_torque_estimate_bounds_the_true_error(rtol):
     assert ratio.max() <= res.error_estimate <= 1.0, (ratio.max(), res.error_estimate)
 
 
+@pytest.mark.slow
 def test_step_budget_on_a_non_smooth_model_is_status_3_not_a_failure():
     res = simulate(saturated_pd_wheel_loop(), X0, T, rtol=1e-6, max_steps=500)
     assert not res.success and res.status == 3, res.message

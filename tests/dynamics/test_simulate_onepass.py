@@ -64,6 +64,7 @@ def test_one_pass_at_loose_tolerance_meets_it_in_one_pass():
     n=st.integers(2, 600),
     log_rtol=st.floats(-8.0, -2.0),
 )
+@pytest.mark.slow
 def test_one_pass_success_implies_the_tolerance_is_met(inertia, w0, t_final, n, log_rtol):
     """Random torque-free runs at tolerances where the one-pass path applies: success means
     the true rate error is within the tolerance at every output (and within the estimate
@@ -155,6 +156,7 @@ def test_max_steps_stops_the_pass_and_the_search_says_why():
     assert not res.success and res.status == 3 and "max_steps" in res.message
 
 
+@pytest.mark.slow
 def test_the_pass_is_compiled_once_per_model():
     model = rigid_body([1.0, 2.5, 3.0])
     t = np.linspace(0.0, 10.0, 11)
@@ -176,6 +178,7 @@ def test_not_accepted_passes_hand_their_steps_to_the_search():
     assert run is None and math.isnan(estimate) and spent > 0
 
 
+@pytest.mark.slow
 def test_the_first_auto_call_also_compiles_the_fallback_loop():
     """No hidden compile later: the first ``auto`` call of a model compiles the pass and,
     at the same time, the rk8 chunk loop its multi-run search runs, so a later call that

@@ -25,6 +25,7 @@ def rate_error_ratio(res, inertia, rtol, atol):
 
 
 # ------------------------------------------------------- item 3: no silent cvodes fallback
+@pytest.mark.slow
 def test_auto_on_a_dense_grid_is_rk8_and_verified():
     """1000 s on 100 001 output points at rtol 1e-8: 200 000 rk8 steps, the tolerance met
     (the old auto fell back to cvodes here and was off by 3.6e-6)."""
@@ -53,6 +54,7 @@ def test_auto_at_high_rate_is_verified_or_says_why(rtol):
         assert res.status == 2 and ratio <= 1.0, res.message
 
 
+@pytest.mark.slow
 def test_auto_never_reports_an_unverified_long_horizon_as_success():
     """1e5 s (about 2e4 periods) at rtol 1e-8: round-off of the ~5e6 steps this needs
     exceeds the tolerance. Success must imply the tolerance was met; otherwise the status
@@ -94,6 +96,7 @@ def test_auto_sends_only_stiff_problems_to_cvodes_and_estimates_their_error():
 
 
 # ---------------------------------------------------------------- item 4: false alarms
+@pytest.mark.slow
 def test_no_false_alarm_on_a_fast_spin():
     """1000 rad/s about a principal axis for 100 s: the quaternion turns 1e5 rad; the old
     round-off model (n eps |x| per run) called the default tolerance unreachable."""
@@ -123,6 +126,7 @@ def test_auto_verifies_a_solution_rk8_integrates_exactly(x0, t):
 
 
 @pytest.mark.parametrize("rtol", [1e-8, 1e-9, 1e-10])
+@pytest.mark.slow
 def test_near_symmetric_flat_body_is_verified_or_honestly_at_its_floor(rtol):
     """I = (1, 1e4, 1e4): w x (I w) cancels 800 - 800 in double, a model floor of about
     1e-10 rad/s common to every run (measured against the closed form at 1-32 rk8 steps per
@@ -240,6 +244,7 @@ def test_one_compiled_chunk_serves_every_grid_and_step_count():
     assert chunks() == before and len(before) == 1
 
 
+@pytest.mark.slow
 def test_chunked_loop_matches_truth_across_chunk_boundaries():
     """Step counts that do not divide the chunk (odd substeps, padding) give the same
     accuracy as the closed form predicts for rk8."""
@@ -296,6 +301,7 @@ def body(inertia):
     n=st.integers(2, 400),
     log_rtol=st.floats(-11.0, -5.0),
 )
+@pytest.mark.slow
 def test_auto_success_implies_the_tolerance_is_met(inertia, w0, t_final, n, log_rtol):
     """Random torque-free runs: whenever auto reports success, the true rate error against
     the Jacobi-elliptic solution is within the requested tolerance at every output time."""

@@ -75,6 +75,7 @@ def test_zoh_batch_matches_each_run_closed_form():
             np.testing.assert_allclose(res.x[:, :, k], truth, rtol=0, atol=1e-8)
 
 
+@pytest.mark.slow
 def test_rigid_body_spun_up_by_a_held_torque_matches_the_closed_form():
     """Torque about the principal axis 3 of a body at rest: w3 piecewise linear, the angle
     piecewise quadratic, q = [0, 0, sin(angle/2), cos(angle/2)]."""

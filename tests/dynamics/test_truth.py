@@ -508,6 +508,7 @@ def bodies(draw):
 
 @settings(max_examples=30, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(bodies())
+@pytest.mark.slow
 def test_property_closed_form_matches_integration(body):
     inertia, w0 = body
     rate = np.linalg.norm(w0)

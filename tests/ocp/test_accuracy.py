@@ -186,6 +186,7 @@ def test_accuracy_is_in_str_and_in_the_json():
 
 
 # ------------------------------------------------------------- (d) Goddard stalls
+@pytest.mark.slow
 def test_refine_stops_with_a_stalled_status_on_the_singular_arc(goddard_truth):
     t0 = time.perf_counter()
     sol = refine(goddard_rocket(), tol=1e-6)

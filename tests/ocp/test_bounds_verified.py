@@ -63,6 +63,7 @@ def test_free_flying_robot_polynomial_control_leaving_its_bounds_is_no_success()
 
 
 @pytest.mark.parametrize("control", ["linear", "constant"])
+@pytest.mark.slow
 def test_free_flying_robot_within_bounds_with_a_linear_or_constant_control(control):
     problem, truth = free_flying_robot()
     sol = solve(problem, N=80, control=control)
@@ -76,6 +77,7 @@ def test_free_flying_robot_within_bounds_with_a_linear_or_constant_control(contr
     np.testing.assert_allclose(_replay(sol), sol.propagation.x[:, -1], atol=1e-7)
 
 
+@pytest.mark.slow
 def test_the_replayed_control_is_samples_also_where_the_polynomial_overshoots():
     """`propagate` integrates exactly the interpolant `sample` returns, overshoot and all."""
     problem, _ = bang_bang()
@@ -120,6 +122,7 @@ def test_orbit_raising_with_a_bounded_angle_reaches_the_literature_optimum():
 
 
 # ------------------------------------------------------------- refine: never worse
+@pytest.mark.slow
 def test_refine_never_returns_a_worse_objective_than_an_earlier_round(monkeypatch):
     """A refinement round that lands on a worse (verified) solution -- here forced: every
     re-solve returns the coarse solution of a 10-interval mesh -- does not replace the

@@ -58,6 +58,7 @@ def test_executor_gives_the_serial_multistart(problem, pools, kind):
     assert all(s["time"] > 0 for s in got.info["starts"])
 
 
+@pytest.mark.slow
 def test_spawned_workers_give_the_serial_multistart(problem):
     serial = ocp.solve_multistart(problem, GUESSES[:2], N=10)
     context = multiprocessing.get_context("spawn")

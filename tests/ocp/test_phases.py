@@ -123,6 +123,7 @@ def two_stage_rocket(N=10):
                                  objective=lambda e: e[1]["v_f"], maximize=True, name="two-stage rocket")
 
 
+@pytest.mark.slow
 def test_staged_rocket_reaches_the_closed_form_optimum_with_refinement():
     p1 = optimal_split()
     sol = ocp.solve_phases(two_stage_rocket(), refine_tol=1e-10)

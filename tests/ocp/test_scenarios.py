@@ -47,6 +47,7 @@ def test_shared_gains_of_several_initial_conditions_are_the_lqr_gains():
     np.testing.assert_allclose(sol.p, K.ravel(), rtol=1e-4)
 
 
+@pytest.mark.slow
 def test_path_constraints_hold_in_every_scenario_and_weights_weigh():
     """A bound on the feedback torque binds only for the larger initial state; weighting
     that scenario by 0 removes its influence (the gains of the other one alone)."""

@@ -48,6 +48,7 @@ def test_double_integrator_closed_form_in_a_few_iterations(distance, accel):
     np.testing.assert_allclose(x, [distance, 0.0], atol=1e-12)
 
 
+@pytest.mark.slow
 def test_bilimoria_wie_switch_times_under_30_iterations():
     # the polynomial-control seed (its control overshoots |u| <= 1 between the nodes: not a
     # success as an answer, the polish's start all the same)
@@ -81,6 +82,7 @@ def test_bilimoria_wie_switch_times_under_30_iterations():
     np.testing.assert_allclose(d[4], d[1], rtol=1e-7)
 
 
+@pytest.mark.slow
 def test_time_optimal_uses_the_switch_time_polish():
     sol = slew.time_optimal(np.eye(3), angle=np.pi, axis=[0, 0, 1], u_max=1.0)
     assert sol.success and sol.status == STATUS_SUCCESS, sol.message
@@ -198,6 +200,7 @@ def test_running_cost_and_a_free_parameter():
     np.testing.assert_allclose(out[0].costates, out[1].costates, atol=1e-7)
 
 
+@pytest.mark.slow
 def test_an_arc_too_short_to_detect_is_tried_second():
     """J = diag(1, 1.5, 2), 2 rad about (1, 2, 3): the optimum ends with a 2.5e-4 s arc of
     all three torques at -1, inside the last mesh interval of the start (N = 30): the
@@ -217,6 +220,7 @@ def test_an_arc_too_short_to_detect_is_tried_second():
     assert graded.success and graded.info["pointing_error"] < 1e-8
 
 
+@pytest.mark.slow
 def test_an_arc_smeared_within_one_mesh_interval_still_gives_the_switch_structure():
     """J = diag(1, 2, 3), 1 rad about (1, 1, 1): a 0.049 s arc at the start sits inside one
     mesh interval (0.079 s) of the first solve, where the control polynomial smears it. It
@@ -233,6 +237,7 @@ def test_an_arc_smeared_within_one_mesh_interval_still_gives_the_switch_structur
     assert abs(sol.T - knots.T) < 1e-6
 
 
+@pytest.mark.slow
 def test_another_target_reuses_the_switch_time_nlp_and_matches_a_fresh_build():
     """The switch-time NLP is built once per switching structure, the target and scales
     as parameters: a slew to another target with the same arcs builds nothing, and gives

@@ -8,6 +8,7 @@ from appdyn.problems.cli import main
 from appdyn.problems.torque_free import torque_free
 
 
+@pytest.mark.slow
 def test_torque_free_summary_and_json(tmp_path, capsys):
     out = tmp_path / "tf.json"
     code = main(["simulate", "torque-free", "--inertia", "1,2,3", "--w0", "1,0.1,0.8",
@@ -21,6 +22,7 @@ def test_torque_free_summary_and_json(tmp_path, capsys):
     assert data["energy_drift"] < 1e-9 and data["momentum_drift"] < 1e-9
 
 
+@pytest.mark.slow
 def test_torque_free_plot_written(tmp_path):
     path = tmp_path / "tf.png"
     assert main(["simulate", "torque-free", "--inertia", "1,2,3", "--w0", "0.2,1,0.1",
@@ -81,6 +83,7 @@ def test_slew_bad_input(args, message, capsys):
     assert message in capsys.readouterr().err
 
 
+@pytest.mark.slow
 def test_torque_free_report_status_plot_and_deprecated_worst_axis():
     from matplotlib.figure import Figure
 
@@ -130,6 +133,7 @@ def test_bench_passes_quick_and_out_to_run(tmp_path, monkeypatch, capsys):
     assert exc.value.code == 2
 
 
+@pytest.mark.slow
 def test_slew_verbose_keeps_stdout_to_the_summary(tmp_path, capfd):
     """``appdyn slew ... --time-optimal`` (verbose: no --quiet): IPOPT's iterations go to
     stderr labelled by stage, the summary says what the polish did and the total wall time."""

@@ -22,6 +22,7 @@ def test_registered():
     assert COMMANDS["cmg"] is cmg_cli
 
 
+@pytest.mark.slow
 def test_envelope_checks_the_closed_forms(tmp_path, capsys):
     plot, out = tmp_path / "env.png", tmp_path / "env.json"
     assert main([*ENV, "--plot", str(plot), "--json", str(out)]) == 0
@@ -54,6 +55,7 @@ def test_envelope_failed_check_exits_1(monkeypatch, capsys):
     assert "check FAILED" in captured.out and "closed-form check failed" in captured.err
 
 
+@pytest.mark.slow
 def test_steer_sr_report_plot_and_json(tmp_path, capsys):
     plot, out = tmp_path / "steer.png", tmp_path / "steer.json"
     argv = [*STEER, "--torque", "0,0,0.5", "--law", "sr", "--t-final", "10", "--plot",

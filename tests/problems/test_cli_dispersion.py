@@ -8,6 +8,7 @@ from appdyn.problems.cli import main
 from appdyn.problems.dispersion import nutation_spread
 
 
+@pytest.mark.slow
 def test_dispersion_spin_reports_the_closed_form_statistics(tmp_path, capsys):
     out = tmp_path / "d.json"
     assert main(["dispersion", "spin", "--samples", "8", "--seed", "4", "--duration", "10",
@@ -20,6 +21,7 @@ def test_dispersion_spin_reports_the_closed_form_statistics(tmp_path, capsys):
     assert stats["nutation_max"]["mean"] == pytest.approx(lib.statistics["nutation_max"].mean, abs=0)
 
 
+@pytest.mark.slow
 def test_workers_give_the_serial_output(tmp_path, capsys):
     a, b = tmp_path / "a.json", tmp_path / "b.json"
     common = ["dispersion", "spin", "--samples", "6", "--duration", "5", "--quiet"]

@@ -14,6 +14,7 @@ def strict_json(path):
     return json.loads(path.read_text(), parse_constant=lambda c: pytest.fail(f"non-strict {c}"))
 
 
+@pytest.mark.slow
 def test_shipped_config_designs_prints_gains_margins_and_writes_json(tmp_path, capsys):
     assert "gains" in COMMANDS
     out, png = tmp_path / "lv.json", tmp_path / "lv.png"
@@ -74,6 +75,7 @@ def test_missing_config_and_clashing_outputs_exit_2(tmp_path, capsys):
     assert exc.value.code == 2
 
 
+@pytest.mark.slow
 def test_infeasible_limits_exit_1_naming_the_limit(tmp_path, capsys):
     path = _config(tmp_path, "delta_max_deg = 6.0", "delta_max_deg = 0.1",
                    ("intervals = 40", "intervals = 16"))

@@ -36,6 +36,7 @@ def printed_numbers(text, names):
     return found
 
 
+@pytest.mark.slow
 def test_ball_hinge_conserves_and_writes_plot_and_json(tmp_path, capsys):
     png, out = tmp_path / "h.png", tmp_path / "h.json"
     assert main([*BALL, "--plot", str(png), "--json", str(out)]) == 0
@@ -68,6 +69,7 @@ def test_revolute_hinge_without_stabilization(tmp_path, capsys):
 
 
 @pytest.mark.parametrize("argv", [BALL, REVOLUTE])
+@pytest.mark.slow
 def test_the_scene_run_equals_the_multiplier_model(argv, tmp_path, capsys):
     """The default run is the scene (minimal coordinates); --model multiplier integrates
     the two free bodies: the same final states (rk8, both at round-off level per step), and
@@ -129,6 +131,7 @@ def test_inertia_that_is_not_positive_definite_exits_2(capsys):
 
 
 # ----------------------------------------------------------------- stability cases
+@pytest.mark.slow
 def test_shaken_pendulum_inverted_is_stabilized(tmp_path, capsys):
     out, png = tmp_path / "sp.json", tmp_path / "sp.png"
     assert main(["stability", "shaken-pendulum", *ROD, "--freq", "200", "--position",

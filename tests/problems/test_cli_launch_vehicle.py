@@ -20,6 +20,7 @@ def strict_json(path):
     return json.loads(path.read_text(), parse_constant=lambda c: pytest.fail(f"non-strict {c}"))
 
 
+@pytest.mark.slow
 def test_rigid_report_is_verified_json_and_bode_plot(tmp_path, capsys):
     out, png = tmp_path / "lv.json", tmp_path / "lv.png"
     code = main(["stability", "launch-vehicle", *VEHICLE, "--k-psi", "2", "--k-psidot", "2",
@@ -62,6 +63,7 @@ def test_sweep_finds_the_gain_boundary(capsys):
     assert "k_psi = 0.11492936" in capsys.readouterr().out  # Routh-Hurwitz, drift included
 
 
+@pytest.mark.slow
 def test_simulate_attitude_error(tmp_path, capsys):
     out, png = tmp_path / "sim.json", tmp_path / "sim.png"
     code = main(["simulate", "launch-vehicle", *VEHICLE, "--k-psi", "2", "--k-psidot", "2",

@@ -28,6 +28,7 @@ def executor():
         cluster.close()
 
 
+@pytest.mark.slow
 def test_sweep_on_a_local_cluster_is_the_serial_sweep(executor):
     args = ("gyrostat", "wheel_momentum", np.linspace(-2, 8, 6))
     kw = dict(inertia=[3.0, 4.0, 5.0], axis=[1, 0, 0], rate=2.0)
@@ -38,6 +39,7 @@ def test_sweep_on_a_local_cluster_is_the_serial_sweep(executor):
     assert len(serial.boundaries) == 2
 
 
+@pytest.mark.slow
 def test_dispersion_on_a_local_cluster_is_the_serial_dispersion(executor):
     kw = dict(samples=6, seed=3, params=SPIN, outputs={"nutation": nutation_history})
     serial = dispersion(spinner, X0, T, **kw)

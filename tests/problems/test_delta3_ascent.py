@@ -20,6 +20,7 @@ def ascent():
     return delta3_ascent()
 
 
+@pytest.mark.slow
 def test_reproduces_the_published_optimum(ascent):
     assert ascent.success, ascent.message
     # Betts 7529.712412, yapss 7529.712268-7529.712287: the literature agrees on 7529.712
@@ -28,6 +29,7 @@ def test_reproduces_the_published_optimum(ascent):
     assert ascent.solution.info["converged"]
 
 
+@pytest.mark.slow
 def test_final_orbit_from_energy_and_angular_momentum(ascent):
     x = ascent.solution.phases[-1].x[:, -1]
     r, v = x[:3], x[3:6]
@@ -43,6 +45,7 @@ def test_final_orbit_from_energy_and_angular_momentum(ascent):
     assert node == pytest.approx(TARGET_ORBIT["raan"], abs=1e-9)
 
 
+@pytest.mark.slow
 def test_links_mass_budget_and_unit_thrust(ascent):
     phases = ascent.solution.phases
     for k in range(len(phases) - 1):
@@ -69,6 +72,7 @@ def test_table_and_json(ascent):
     assert len(data["solution"]["phases"]) == 4
 
 
+@pytest.mark.slow
 def test_cli_prints_the_phase_table(tmp_path, capsys):
     out = tmp_path / "d3.json"
     assert main(["ascent", "delta3", "--no-refine", "--json", str(out)]) == 0

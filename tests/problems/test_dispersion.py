@@ -57,6 +57,7 @@ def spread():
 
 
 # ------------------------------------------------------------------ (a) closed form
+@pytest.mark.slow
 def test_axisymmetric_nutation_matches_closed_form_sample_by_sample(spread):
     assert spread.success and spread.status == dp.ALL_OK and spread.complete
     theta = closed_form(spread.inputs, spread.inputs["w3"])
@@ -71,6 +72,7 @@ def test_axisymmetric_nutation_matches_closed_form_sample_by_sample(spread):
     assert np.max(spread.outputs["momentum_inertial_drift"]) < 1e-9
 
 
+@pytest.mark.slow
 def test_statistics_equal_numpy_statistics_of_closed_form(spread):
     theta = closed_form(spread.inputs, spread.inputs["w3"])
     s = spread.statistics["nutation_max"]
@@ -89,6 +91,7 @@ def test_statistics_equal_numpy_statistics_of_closed_form(spread):
     assert abs(np.mean(spread.inputs["transverse_inertia"]) - 1000.0) < 4 * 20 / math.sqrt(24)
 
 
+@pytest.mark.slow
 def test_report_json_and_plot(spread):
     text = str(spread)
     assert "nutation_max [rad]" in text and "p99" in text and "24 of 24" in text
@@ -106,6 +109,7 @@ def test_report_json_and_plot(spread):
 
 
 # ------------------------------------------------------------------ (b) seeds
+@pytest.mark.slow
 def test_same_seed_same_samples_different_seed_different():
     a, b, c = spin_dispersion(), spin_dispersion(), spin_dispersion(seed=12)
     for name in SPIN:
@@ -301,6 +305,7 @@ def test_distribution_draws_are_seeded():
 
 
 @pytest.mark.parametrize("module_name", MODULES)
+@pytest.mark.slow
 def test_docstring_examples_run_as_written(module_name):
     module = importlib.import_module(module_name)
     result = doctest.testmod(module, optionflags=doctest.NORMALIZE_WHITESPACE | doctest.ELLIPSIS)
@@ -326,6 +331,7 @@ def _raising_flag(res, flag):
     return flag
 
 
+@pytest.mark.slow
 def test_batch_of_a_fixed_model_meets_the_closed_form_and_the_serial_run():
     """``batch=True``: all samples in one `simulate` call; each sample's transverse rate
     equals the axisymmetric closed form ``w1(t) = w1(0) cos(lambda t)``, ``lambda = (I_a -

@@ -54,6 +54,7 @@ def _loop_transfer(k, kd, tau):
 
 
 @pytest.mark.parametrize("which", ["with_actuator", "rigid_gimbal"])
+@pytest.mark.slow
 def test_margins_agree_with_python_control_on_the_closed_form_loop(which, request):
     d = request.getfixturevalue(which)
     assert isinstance(d, GainDesign) and d.success, d.message
@@ -76,6 +77,7 @@ def test_margins_agree_with_python_control_on_the_closed_form_loop(which, reques
 
 
 @pytest.mark.parametrize("which", ["with_actuator", "rigid_gimbal"])
+@pytest.mark.slow
 def test_resimulated_scenarios_are_stable_and_hold_the_limits(which, request):
     d = request.getfixturevalue(which)
     k, kd = d.gains["k_psi"], d.gains["k_psidot"]
@@ -130,6 +132,7 @@ def _solve_infeasible(**limits):
                                 horizon=6.0, N=16, **limits)
 
 
+@pytest.mark.slow
 def test_gimbal_too_weak_for_the_gust_names_the_deflection_limit():
     d = _solve_infeasible(delta_max=math.radians(0.1), delta_rate_max=RMAX)
     assert not d.success and d.status == STATUS_LIMITS
@@ -137,6 +140,7 @@ def test_gimbal_too_weak_for_the_gust_names_the_deflection_limit():
     assert d.verification["violated"] == ["delta"]
 
 
+@pytest.mark.slow
 def test_unreachable_rate_limit_names_the_rate_limit():
     d = _solve_infeasible(delta_max=DMAX, delta_rate_max=math.radians(0.01))
     assert not d.success and d.status == STATUS_LIMITS
@@ -244,6 +248,7 @@ def test_bad_arguments_name_the_argument(kwargs, error, match):
 
 @pytest.mark.parametrize("module_name", ["appdyn.problems.gains.launch_vehicle", "appdyn.problems.gains.config",
                                          "appdyn.problems.cli.gains"])
+@pytest.mark.slow
 def test_docstring_examples_run_as_written(module_name):
     module = importlib.import_module(module_name)
     runner = doctest.DocTestRunner(optionflags=doctest.NORMALIZE_WHITESPACE | doctest.ELLIPSIS)
@@ -253,6 +258,7 @@ def test_docstring_examples_run_as_written(module_name):
     assert result.failed == 0
 
 
+@pytest.mark.slow
 def test_integral_gain_and_command_filter_verified_on_the_closed_form_loop():
     """delta_c = -(k_psi psi + k_psidot psi' + k_i int psi) / (tau_f s + 1): the margins and
     poles of the report agree with python-control on C(s) Npsi / ((tau s + 1) D)."""

@@ -32,6 +32,7 @@ def _sorted(z):
     return np.array(sorted(np.asarray(z, dtype=complex), key=lambda c: (round(c.real, 9), c.imag)))
 
 
+@pytest.mark.slow
 def test_single_axis_poles_are_the_closed_form(single_axis):
     """Linearized about the target, each principal axis is J_i theta'' + kd theta' + kp theta
     = 0: the reported poles (Jacobian of the nonlinear loop) agree to round-off."""
@@ -48,6 +49,7 @@ def test_single_axis_poles_are_the_closed_form(single_axis):
     assert np.min(np.abs(v["damping"] - zeta3)) < 1e-9
 
 
+@pytest.mark.slow
 def test_torque_limits_met_in_every_re_simulated_scenario(single_axis):
     """Re-simulated independently (CVODES) with the designed gains: the peak torque of every
     scenario is within the limit (to 1e-6 relative: IPOPT's bound relaxation), and the
@@ -87,6 +89,7 @@ def test_settling_is_slower_than_the_time_optimal_slew(single_axis):
         assert np.all(sc["angle"][after] <= v["settle_angle"] * (1 + 1e-9))
 
 
+@pytest.mark.slow
 def test_general_inertia_per_axis_gains_meet_limits():
     """Full inertia, per-axis limits and gains, three-axis scenarios with rates: stable,
     limits met, every scenario settles."""
@@ -101,6 +104,7 @@ def test_general_inertia_per_axis_gains_meet_limits():
     assert np.all(v["peak_torque"] <= np.array([0.2, 0.25, 0.2]) * (1 + 1e-3))
 
 
+@pytest.mark.slow
 def test_settle_constraint_settles_for_good_by_the_horizon():
     """With the Lyapunov settle constraint at 12 s (the free design settles in 19.9 s) the
     60 deg slew stays within 1 deg from before 12 s on (measured 9.38 s, 1.87 T_opt); the
@@ -113,6 +117,7 @@ def test_settle_constraint_settles_for_good_by_the_horizon():
     assert v["settle_times"][0] > 2 * math.sqrt(math.radians(60) * 3.0 / U_MAX)  # > bang-bang
 
 
+@pytest.mark.slow
 def test_infeasible_torque_limit_fails_naming_the_constraint():
     """|u| <= 0.01 N m cannot turn J3 = 3 kg m^2 by 60 deg within 10 s (the bang-bang time
     is 35 s): with the settle constraint no gains exist; the result says which limits."""

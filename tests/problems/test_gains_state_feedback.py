@@ -58,6 +58,7 @@ def test_unstable_three_state_plant_gains_are_the_lqr_gains():
     _check_against_lqr(A, B, np.diag([1.0, 0.5, 0.2]), np.array([[0.5]]), np.eye(3), 14.0, 100)
 
 
+@pytest.mark.slow
 def test_unstable_two_input_plant_gains_are_the_lqr_gains():
     """Two inputs, three states, open-loop pole at +0.70 1/s, R = diag(1, 2), four initial
     states; horizon 14 s = 15 time constants, N = 100: measured 9.8e-7 (all six entries
@@ -80,6 +81,7 @@ def test_short_horizon_warns_and_is_not_lqr():
     assert res.verification["lqr_relative_difference"] > 1e-2
 
 
+@pytest.mark.slow
 def test_initial_states_not_spanning_warn_and_leave_gains_undetermined():
     """Two decoupled stable modes, both initial states on the first axis (an invariant
     subspace of every diagonal loop): the second column of K does not affect the cost and

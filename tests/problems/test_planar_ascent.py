@@ -92,6 +92,7 @@ def test_mass_objective_reaches_target_speed_early():
 
 
 # ---------------------------------------------------------------- (c) active q limit
+@pytest.mark.slow
 def test_tightening_q_max_lowers_the_optimum(ascent):
     free = planar_ascent(**TARGET, q_max=1e6, qalpha_max=QA_MAX, N=30)
     runs = [planar_ascent(**TARGET, q_max=qm, qalpha_max=QA_MAX, N=30) for qm in (46e3, 44e3)]

@@ -23,6 +23,7 @@ def test_min_effort_single_axis_closed_form():
     assert sol.propagation_error < 1e-6
 
 
+@pytest.mark.slow
 def test_min_effort_target_sign_does_not_matter():
     J = [1.0, 1.5, 2.0]
     qf = quat_from_axis_angle([0.3, -0.5, 0.8], 2.0)
@@ -44,6 +45,7 @@ def test_time_optimal_norm_bound_is_the_eigenaxis_for_a_sphere():
     assert sol.T == pytest.approx(2 * math.sqrt(theta), rel=1e-6)
 
 
+@pytest.mark.slow
 def test_bilimoria_wie_time_optimal_beats_eigenaxis():
     """Bilimoria & Wie (1993): J = E, |u_i| <= 1, 180 deg about z: T* = 3.2430 (best known),
     the eigenaxis maneuver 2 sqrt(pi) = 3.5449 is only a local optimum."""
@@ -61,6 +63,7 @@ def test_bilimoria_wie_time_optimal_beats_eigenaxis():
     assert sol.propagation_error < 1e-4  # bang-bang: 3.7e-5 measured (polish at degree 4)
 
 
+@pytest.mark.slow
 def test_keep_out_cone_is_respected_and_active():
     """Slew 90 deg about z with the body x-axis kept 30 deg away from the inertial direction
     it passes through halfway (45 deg in the x-y plane)."""

@@ -40,6 +40,7 @@ def _pointing_error(q, qf):
 
 
 @pytest.mark.parametrize("polish", [False, True])
+@pytest.mark.slow
 def test_new_users_slew_keeps_the_torque_bounds_and_reaches_the_target(polish):
     sol = slew.time_optimal(INERTIA, angle=np.pi / 2, axis=AXIS, u_max=U_MAX, polish=polish)
     assert sol.success, sol.message
@@ -61,6 +62,7 @@ def test_a_polynomial_control_is_reported_as_leaving_the_bounds():
     assert "Bound_Violation" in sol.message or sol.status == STATUS_BOUND_VIOLATION, sol.message
 
 
+@pytest.mark.slow
 def test_plots_draw_the_torque_bounds():
     sol = slew.time_optimal(np.eye(3), angle=0.1, axis=[0, 0, 1], u_max=[0.5, 0.5, 0.3], N=10,
                             starts=1, polish=False)

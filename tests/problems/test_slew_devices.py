@@ -10,6 +10,7 @@ from appdyn.problems import slew
 BETA = np.deg2rad(54.74)
 
 
+@pytest.mark.slow
 def test_wheel_time_optimal_reproduces_bilimoria_wie():
     """A unit-inertia hub with three orthogonal wheels at zero total momentum obeys
     I w' = -tau exactly (no gyroscopic term): the rigid-body optimum, T = 3.2430833 s
@@ -20,6 +21,7 @@ def test_wheel_time_optimal_reproduces_bilimoria_wie():
     assert sol.info["momentum_drift"] < 1e-9
 
 
+@pytest.mark.slow
 def test_wheel_min_effort_equals_rigid_body_min_effort_with_speed_limit_inactive():
     """Same hub: the wheel torques are the (negated) body torques, so the minimum effort is
     the rigid body's; a generous wheel-speed limit changes nothing."""
@@ -31,6 +33,7 @@ def test_wheel_min_effort_equals_rigid_body_min_effort_with_speed_limit_inactive
     assert wheels.info["momentum_drift"] < 1e-8
 
 
+@pytest.mark.slow
 def test_wheel_speed_limit_binds_and_final_speeds_are_met():
     """The speed limit binds, and the final wheel speeds are met as the momentum balance
     guarantees. Zero total momentum (A = E): ``H_b = I w + J (w + W)`` gives at the end of
@@ -66,6 +69,7 @@ def test_wheel_speed_limit_binds_and_final_speeds_are_met():
     assert np.max(bound) <= wheel_tol
 
 
+@pytest.mark.slow
 def test_cmg_min_effort_keeps_the_singularity_measure_above_its_bound():
     geo = pyramid(BETA)
     free = slew.cmg_slew(10 * np.eye(3), geo, objective="effort", T=2.0, angle=0.1,
@@ -102,6 +106,7 @@ def test_bad_inputs_name_the_argument():
                       axis=[1, 0, 0], min_measure=0.1)
 
 
+@pytest.mark.slow
 def test_cmg_time_optimal_singular_arc_general_inertia_is_verified():
     """Regression (stress draw): a gimbal rate on a singular arc. The collocated control rings
     there, so the refinement stalls and no mesh tried (30 to 360 intervals, uniform or

@@ -12,6 +12,7 @@ def bilimoria_wie():
     return slew.time_optimal(np.eye(3), angle=np.pi, axis=[0, 0, 1], u_max=1.0)
 
 
+@pytest.mark.slow
 def test_switch_times_agree_with_the_engine(bilimoria_wie):
     sol = bilimoria_wie
     assert sol.success, sol.message
@@ -26,6 +27,7 @@ def test_switch_times_agree_with_the_engine(bilimoria_wie):
         slew.switch_times(sol, axis=3)
 
 
+@pytest.mark.slow
 def test_a_slew_plots_itself_on_the_axes_given(bilimoria_wie):
     fig = bilimoria_wie.plot()  # a slew's plot() is the slew figure (plot_slew an alias)
     assert isinstance(fig, Figure) and len(fig.axes) == 4
@@ -38,6 +40,7 @@ def test_a_slew_plots_itself_on_the_axes_given(bilimoria_wie):
         slew.plot_slew(bilimoria_wie, "figure")
 
 
+@pytest.mark.slow
 def test_switch_times_component_and_the_deprecated_axis(bilimoria_wie):
     sol = bilimoria_wie
     per = slew.switch_times(sol)
@@ -59,6 +62,7 @@ USER_SLEW = dict(angle=np.pi / 2, axis=np.array([0.0, 1.0, 1.0]) / np.sqrt(2),
                  u_max=[0.5, 0.5, 0.3])
 
 
+@pytest.mark.slow
 def test_polish_skipped_on_a_first_solution_that_is_not_bang_bang():
     """Its first solution has a singular arc (component 0 off its bounds on a stretch): the
     switch-time polish does not apply, and the moving-knot re-solve it fell back to took

@@ -24,6 +24,7 @@ def serial():
     return maneuver_table(np.eye(3), SINGLE, **FAST)
 
 
+@pytest.mark.slow
 def test_time_rows_match_the_bang_bang_closed_form(serial):
     # J = E, |u_i| <= 1, rest to rest about a principal axis: T = 2 sqrt(J theta / u)
     assert serial.success and serial.complete and serial.names == ("a0", "a1", "a2", "a3")
@@ -50,6 +51,7 @@ def test_effort_rows_match_the_cubic_closed_form():
     np.testing.assert_allclose(t.cost, 6 * J ** 2 * t.angles ** 2 / 2.0 ** 3, rtol=1e-6)
 
 
+@pytest.mark.slow
 def test_executors_give_the_serial_table(serial):
     calls = []
     with ThreadPoolExecutor(2) as threads, ProcessPoolExecutor(2) as processes:
@@ -69,6 +71,7 @@ def test_progress_is_called_with_done_and_total():
 
 
 @pytest.mark.parametrize("threads", [False, True])
+@pytest.mark.slow
 def test_interrupt_keeps_the_finished_rows(serial, threads):
     def stop(done, total):
         if done == 2:
@@ -142,6 +145,7 @@ def test_docstring_examples_run_as_written():
 
 
 # ------------------------------------------------------------------ CLI
+@pytest.mark.slow
 def test_cli_table_is_the_library_table(tmp_path, capsys):
     import json
 

@@ -65,6 +65,7 @@ def target(angle, axis):
 
 # ---------------------------------------------------------------- tiny and zero
 @pytest.mark.parametrize("angle", [1e-6, 3e-6])
+@pytest.mark.slow
 def test_tiny_time_optimal_slew_is_the_bang_bang_closed_form(angle):
     """J = E, |u_i| <= 1, rest to rest about z: T = 2 sqrt(angle) (single-axis bang-bang).
     It used to come back as success with T = 1e-10 and the body never moving."""
@@ -95,6 +96,7 @@ def test_tiny_min_effort_slew_is_the_cubic_closed_form():
 
 
 @pytest.mark.parametrize("kwargs", [dict(angle=0.0, axis=[0, 0, 1]), dict(qf=[0, 0, 0, -1.0])])
+@pytest.mark.slow
 def test_zero_slew_is_answered_exactly_and_at_once(kwargs, tmp_path):
     t = time.perf_counter()
     sol = slew.time_optimal(E, **kwargs)
@@ -112,6 +114,7 @@ def test_zero_slew_is_answered_exactly_and_at_once(kwargs, tmp_path):
 
 
 # ------------------------------------------------------------ verification gate
+@pytest.mark.slow
 def test_pointing_error_is_reported_and_gates_success():
     sol = slew.min_effort([1.0, 1.5, 2.0], 3.0, angle=1.0, axis=[1, 1, 0])
     assert sol.success, sol.message
@@ -131,6 +134,7 @@ def test_pointing_error_is_reported_and_gates_success():
         slew.min_effort(E, 1.0, angle=1.0, axis=[1, 0, 0], rate_tol="1e-6")
 
 
+@pytest.mark.slow
 def test_general_inertia_near_miss_is_verified_on_a_finer_mesh():
     """Found by the random valid-input sweep: 4 of 80 random full inertias (1 rad about z)
     ended success=False, pointing 1.0-15x over 1e-6 rad, after the polish stopped at IPOPT's
@@ -188,6 +192,7 @@ _angles = st.floats(1e-3, math.pi)
 @settings(max_examples=3, deadline=None, derandomize=True,
           suppress_health_check=[HealthCheck.too_slow])
 @given(moments=_moments, axis=_axes, angle=_angles)
+@pytest.mark.slow
 def test_min_effort_success_implies_verified_accuracy(moments, axis, angle):
     J = np.diag(moments)
     T = 4.0 * math.sqrt(angle * max(moments)) + 1.0  # about twice the bang-bang time
@@ -198,6 +203,7 @@ def test_min_effort_success_implies_verified_accuracy(moments, axis, angle):
 @settings(max_examples=2, deadline=None, derandomize=True,
           suppress_health_check=[HealthCheck.too_slow])
 @given(moments=_moments, axis=_axes, angle=_angles)
+@pytest.mark.slow
 def test_time_optimal_success_implies_verified_accuracy(moments, axis, angle):
     sol = slew.time_optimal(moments, angle=angle, axis=axis, starts=1)
     _check(sol, np.diag(moments), angle, axis)

@@ -24,10 +24,10 @@ from appdyn.problems.stability import (PointMassDamper, SphericalDamper, classif
 from appdyn.problems.cli.stability import add_parser as add_stability_parser
 from appdyn.problems.cli.stability import main as cli_main
 from appdyn.problems.cli.stability import run as cli_run
+from tests.bodies import GEMINI
 
 TOL = 1e-9  # eigenvalues vs closed forms, relative to the spectral radius
 G0 = 9.80665
-GEMINI = np.array([[4560.7, 31.2, -43.4], [31.2, 4545.0, -270.7], [-43.4, -270.7, 1567.4]])
 
 
 def max_pair_error(computed, expected):
@@ -81,6 +81,7 @@ def test_spin_full_inertia_principal_axis():
 @given(moments=hs.tuples(*[hs.floats(1.0, 10.0)] * 2), third=hs.floats(0.0, 1.0),
        angles=hs.tuples(*[hs.floats(-np.pi, np.pi)] * 3), which=hs.integers(0, 2),
        rate=hs.floats(0.1, 100.0))
+@pytest.mark.slow
 def test_spin_closed_form_for_any_body_and_principal_axis(moments, third, angles, which, rate):
     """Random principal moments (triangle inequality held) in random body axes."""
     a, b = moments
@@ -384,6 +385,7 @@ def test_sweep_rotor_internal_damping_instability_speed():
     assert abs(res.boundaries[0].value - exact) <= 1e-8 * exact
 
 
+@pytest.mark.slow
 def test_sweep_gyrostat_boundaries():
     Ia, Ib, Ic, W = 3.0, 4.0, 5.0, 2.0
     res = sweep("gyrostat", "wheel_momentum", np.linspace(-2, 8, 6), inertia=[Ia, Ib, Ic],
@@ -488,6 +490,7 @@ def test_report_text_is_a_table(reports):
                 assert m.zeta == pytest.approx(-m.eigenvalue.real / m.wn, rel=1e-15, abs=1e-300)
 
 
+@pytest.mark.slow
 def test_plots_write_png(tmp_path, reports):
     path = tmp_path / "poles.png"
     reports[0].plot().savefig(path)  # the library builds, the caller saves
@@ -514,6 +517,7 @@ def test_cli_spin_with_damper_json_and_plot(tmp_path, capsys):
     assert png.stat().st_size > 10_000
 
 
+@pytest.mark.slow
 def test_cli_through_an_argparse_tree_like_appdyn(capsys):
     parser = argparse.ArgumentParser(prog="appdyn")
     sub = parser.add_subparsers(dest="command", required=True)
@@ -576,6 +580,7 @@ def test_sweep_status_is_the_worst_along_the_grid():
     assert d["success"] is True and d["status"] == 0 and d["statuses"] == [0, 0]
 
 
+@pytest.mark.slow
 def test_plots_return_figures_without_pyplot(reports):
     from matplotlib.figure import Figure
 

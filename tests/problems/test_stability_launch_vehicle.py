@@ -265,6 +265,7 @@ def test_jet_damping_and_frozen_mass():
 
 
 # ---------------------------------------------------------------------- plots and I/O
+@pytest.mark.slow
 def test_bode_plot_marks_the_margins_where_python_control_puts_them(tmp_path):
     from matplotlib.figure import Figure
 
@@ -328,6 +329,7 @@ def test_loop_transfer_needs_a_launch_vehicle_report():
 
 
 # ------------------------------------------------------------------------ time response
+@pytest.mark.slow
 def test_rigid_response_follows_the_damped_oscillator():
     """Small psi0: psi = psi0 e^(-zeta wn t) (cos wd t + zeta wn / wd sin wd t); the
     nonlinearity sin(delta) - delta is (k psi0)^2 / 6 ~ 1e-6 relative."""
@@ -345,6 +347,7 @@ def test_rigid_response_follows_the_damped_oscillator():
     assert np.max(np.abs(res.series["delta"] + k * exact + kd * rate)) < 1e-5 * psi0
 
 
+@pytest.mark.slow
 def test_gust_response_with_limited_actuator(tmp_path):
     act = Actuator(0.05, deflection_limits=(-0.01, 0.01), rate_limit=0.2)
     res = launch_vehicle_response(**VEHICLE, k_psi=1.0, k_psidot=0.5, aero=AERO, velocity=V,
@@ -379,6 +382,7 @@ def test_response_bad_input_names_the_argument(kwargs, name):
 
 @pytest.mark.parametrize("module", ["launch_vehicle", "launch_vehicle_plots",
                                     "launch_vehicle_response"])
+@pytest.mark.slow
 def test_docstring_examples_run(module):
     mod = importlib.import_module(f"appdyn.problems.stability.{module}")
     result = doctest.testmod(mod, optionflags=doctest.NORMALIZE_WHITESPACE)

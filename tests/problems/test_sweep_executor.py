@@ -45,6 +45,7 @@ def _same(a, b):
 
 @pytest.mark.parametrize("kind", ["threads", "processes"])
 @pytest.mark.parametrize("which", sorted(SWEEPS))
+@pytest.mark.slow
 def test_executor_gives_the_serial_sweep(pools, kind, which):
     args, kw = SWEEPS[which]
     serial = st.sweep(*args, **kw)
@@ -52,6 +53,7 @@ def test_executor_gives_the_serial_sweep(pools, kind, which):
     _same(serial, st.sweep(*args, executor=pools[kind], **kw))
 
 
+@pytest.mark.slow
 def test_progress_is_called_per_grid_value(pools):
     calls = []
     args, kw = SWEEPS["gyrostat"]

@@ -464,6 +464,8 @@ OVERRIDES = {
     "appdyn.problems.ascent.orbit_residuals": {"r": _ASC_R, "v": _ASC_V},
     "appdyn.problems.ascent.orbital_elements": {"r": _ASC_R, "v": _ASC_V},
     "appdyn.problems.ascent.vertical_rise": {"vehicle": lambda: None},
+    "appdyn.problems.ascent.pitch_model": {"vehicle": lambda: None, "k_theta": lambda: 2.0,
+                                           "k_thetadot": lambda: 0.5},
     "appdyn.problems.ascent.fly_pitch_program": {"ascent": _planar_ascent},
     "appdyn.problems.dispersion.run_sample": {"task": _sample_task},
     "appdyn.problems.gains.load_config": {"path": _config_path},

@@ -79,6 +79,7 @@ def _rel_drift(values):
 @FUZZ
 @given(inertia=principal_moments(), w0=vec3, q0=unit_quats(), t=time_grids(),
        method=st.sampled_from(["auto", "rk8", "lie"]))
+@pytest.mark.slow
 def test_simulate_random_rigid_body(inertia, w0, q0, t, method):
     opts = {} if method == "auto" else {"steps": _steps(inertia, w0, t)}
     res = simulate(rigid_body(inertia), [*q0, *w0], t, method=method, invariants=True, **opts)
@@ -99,6 +100,7 @@ def test_simulate_random_rigid_body(inertia, w0, q0, t, method):
 
 @FUZZ
 @given(inertia=principal_moments(), R=rotation_matrices(), w0=vec3, t=time_grids())
+@pytest.mark.slow
 def test_simulate_full_inertia_matrix_conserves_energy_and_momentum(inertia, R, w0, t):
     J = R.T @ np.diag(inertia) @ R
     J = 0.5 * (J + J.T)

@@ -86,6 +86,7 @@ def _timed(script: str) -> str:
 
 
 @pytest.mark.parametrize("script, trial", list(CASES.values()), ids=list(CASES))
+@pytest.mark.slow
 def test_sigint_stops_a_long_run_within_a_second(script, trial):
     proc = subprocess.Popen([sys.executable, "-c", _timed(script)], cwd=ROOT, text=True,
                             stdout=subprocess.PIPE, stderr=subprocess.PIPE)
@@ -139,6 +140,7 @@ except KeyboardInterrupt as exc:
 """
 
 
+@pytest.mark.slow
 def test_interrupted_sweep_keeps_the_values_it_finished():
     proc = subprocess.Popen([sys.executable, "-c", PARTIAL], cwd=ROOT, text=True,
                             stdout=subprocess.PIPE, stderr=subprocess.PIPE)

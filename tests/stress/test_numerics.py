@@ -105,6 +105,7 @@ def test_lie_keeps_quaternion_norm_at_round_off_where_rk4_drifts():
 # --------------------------------------------------------------------------------------------
 
 
+@pytest.mark.slow
 def test_high_spin_axisymmetric_matches_closed_form_rates_and_attitude():
     inertia, w0 = [1.0, 1.0, 2.0], [1.0, 0.5, 1000.0]
     t = np.linspace(0.0, 1.0, 101)  # ~160 revolutions
@@ -121,6 +122,7 @@ def test_high_spin_axisymmetric_matches_closed_form_rates_and_attitude():
     assert np.allclose(torque_free_omega(inertia, w0, t), w_true, rtol=0, atol=1e-9)
 
 
+@pytest.mark.slow
 def test_high_spin_asymmetric_matches_jacobi():
     inertia, w0 = [1.0, 1.5, 2.0], [1.0, 0.5, 1000.0]
     t = np.linspace(0.0, 1.0, 101)
@@ -134,6 +136,7 @@ def test_high_spin_asymmetric_matches_jacobi():
 
 @pytest.mark.parametrize("w0", [[1e-3, 1.0, 1e-3], [1e-6, 1.0, 1e-6], [1e-9, 1.0, 1e-9]],
                          ids=["1e-3", "1e-6", "1e-9"])
+@pytest.mark.slow
 def test_separatrix_tumbling_reports_honestly(w0):
     """Near the intermediate axis the motion is exponentially sensitive: ``auto`` either
     verifies its tolerance (and then is right) or says it could not."""
@@ -156,6 +159,7 @@ def test_separatrix_tumbling_reports_honestly(w0):
     ([1.0, 1.0, 2.0 - 1e-9], [0.3, 0.2, 1.0]),       # near-degenerate: flat disk edge
     ([1.0, 1.0 + 1e-9, 2.0], [0.3, 0.2, 1.0]),       # near-degenerate transverse moments
 ], ids=["1:1e4-sym", "1:1e4-asym", "1:1e4-middle", "1,1,2-1e-9", "1,1+1e-9,2"])
+@pytest.mark.slow
 def test_extreme_and_degenerate_inertia(inertia, w0):
     t = np.linspace(0.0, 100.0, 201)
     rtol, atol = 1e-8, 1e-10
@@ -208,6 +212,7 @@ def _rk4(f, y0, t):
     return y
 
 
+@pytest.mark.slow
 def test_quaternions_stay_accurate_through_pitch_90_where_euler_rates_blow_up():
     w = np.array([0.0, 1.0, 1e-3])
     e0 = np.array([0.0, 1.0, 0.0])

@@ -73,6 +73,7 @@ def test_unpickled_rigid_body_simulates_bitwise(kwargs):
     assert np.array_equal(simulate(again, X0, T, **kwargs).x, a.x)
 
 
+@pytest.mark.slow
 def test_hand_built_sx_model_round_trips():
     model = _oscillator()
     loaded = _round_trip(model)
@@ -214,6 +215,7 @@ def _simulate_task(model, x0, t):
 
 
 @pytest.mark.parametrize("start", ["spawn", "fork"])
+@pytest.mark.slow
 def test_models_travel_to_process_pool(start):
     if start not in multiprocessing.get_all_start_methods():
         pytest.skip(f"no {start} start method here")

@@ -45,6 +45,7 @@ GARBAGE = {
 ALLOWED_GARBAGE = {
     ("appdyn.dynamics.launch_vehicle.rigid_part", "slosh"): {"none": "documented `Slosh or None`"},
     ("appdyn.problems.ascent.vertical_rise", "vehicle"): {"none": "documented `AscentVehicle or None`"},
+    ("appdyn.problems.ascent.pitch_model", "vehicle"): {"none": "documented `AscentVehicle or None`"},
     ("appdyn.ocp.check_ipopt_options", "options"): {"none": "documented `mapping ... or None`"},
     ("appdyn.problems.dispersion.dispersion", "seed"): {"none": "documented `int or None` (fresh entropy)"},
     ("appdyn.problems.dispersion.statistics", "values"): {
@@ -75,6 +76,7 @@ SKIPPED = {
     "appdyn.dynamics.attitude.dcm_axis": "no required parameter",
     "appdyn.dynamics.mechanisms.double_pendulum": "no required parameter",
     "appdyn.dynamics.mechanisms.accelerometer": "no required parameter",
+    "appdyn.ocp.ipopt_option_table": "no required parameter",
     "appdyn.dynamics.mechanisms.accelerometer_offset": "no required parameter",
     "appdyn.dynamics.mechanisms.foucault_pendulum": "no required parameter",
     "appdyn.dynamics.mechanisms.noninertial_particle": "no required parameter",
@@ -99,6 +101,7 @@ SKIPPED = {
     "appdyn.problems.ascent.delta3_problem": "no required parameter",
     "appdyn.problems.ascent.initial_state": "no required parameter",
     "appdyn.problems.ascent.default_gains": "no required parameter",
+    "appdyn.problems.ascent.planar_model": "no required parameter",
 }
 
 # (function, parameter, garbage) -> reason: known library bugs, strict xfail
@@ -167,7 +170,14 @@ VALID_CHECKED = sorted(
     if func not in SKIPPED and func not in EXPENSIVE and len(_required(fn)) >= 2)
 
 
-@pytest.mark.parametrize("func", VALID_CHECKED)
+#: the examples that take seconds (measured > 5 s on a loaded machine): marked slow
+SLOW_EXAMPLES = {"appdyn.dynamics.momentum.steer", "appdyn.problems.dispersion.nutation_history",
+                 "appdyn.problems.slew.bounded", "appdyn.problems.stability.launch_vehicle_response",
+                 "appdyn.problems.stability.shaken_pendulum"}
+
+
+@pytest.mark.parametrize("func", [pytest.param(f, marks=pytest.mark.slow) if f in SLOW_EXAMPLES
+                                  else f for f in VALID_CHECKED])
 def test_valid_examples(func):
     """The example values are accepted, so each garbage case is refused for its garbage."""
     fn = FUNCTIONS[func]

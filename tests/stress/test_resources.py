@@ -66,6 +66,7 @@ def run(n, nofile=0, maxsize=0, timeout=300, tmpdir=None):
     return report, done.stderr
 
 
+@pytest.mark.slow
 def test_compiles_leave_no_descriptor_and_no_files(tmp_path):
     # a temp directory of its own: other processes compiling at the same time do not count
     report, stderr = run(25, tmpdir=tmp_path)
@@ -74,6 +75,7 @@ def test_compiles_leave_no_descriptor_and_no_files(tmp_path):
     assert list(tmp_path.iterdir()) == []
 
 
+@pytest.mark.slow
 def test_evicted_loops_release_their_memory_under_a_tight_descriptor_limit():
     """60 compiles through a 10-entry cache with 256 descriptors in all: after the cache
     is full (20 compiles), resident memory stays flat (kept, 40 loops would add 3 MB)."""
@@ -82,6 +84,7 @@ def test_evicted_loops_release_their_memory_under_a_tight_descriptor_limit():
     assert report["rss"][60] - report["rss"][20] < 1.0, report["rss"]
 
 
+@pytest.mark.slow
 def test_kept_loops_do_hold_memory():
     """The measurement above can see a leak: without eviction the same run grows."""
     report, _ = run(60)

@@ -115,6 +115,7 @@ def _check(report: dict):
 
 
 @pytest.mark.parametrize("run", range(5))
+@pytest.mark.slow
 def test_threads_mixed_workload_matches_serial(run):
     _check(_run_workload())
 

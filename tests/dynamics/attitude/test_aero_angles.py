@@ -18,6 +18,7 @@ velocities = st.tuples(comp, comp, comp).filter(lambda v: np.linalg.norm(v) > 1e
 
 @settings(max_examples=200, deadline=None)
 @given(velocities)
+@pytest.mark.slow
 def test_angles_reproduce_the_seed_components(v):
     V = np.linalg.norm(v)
     a, b = aero_angles(v)
@@ -34,6 +35,7 @@ def test_angles_reproduce_the_seed_components(v):
 
 @settings(max_examples=200, deadline=None)
 @given(velocities)
+@pytest.mark.slow
 def test_the_four_conversion_formulas(v):
     a, b = aero_angles(v)
     aT, phi = total_aoa(v)

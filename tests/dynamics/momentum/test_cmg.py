@@ -187,6 +187,7 @@ def test_energy_conserved_while_the_gimbals_stand_still():
 
 
 # ------------------------------------------------------------------ exact vs torque model
+@pytest.mark.slow
 def test_torque_model_is_the_limit_of_fast_rotors():
     """At fixed rotor momentum h, rotor speed Omega = h / J over the body rate |w| grows
     tenfold per step; the trajectories' difference shrinks tenfold (first order in J)."""

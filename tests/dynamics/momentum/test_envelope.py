@@ -85,6 +85,7 @@ def test_direction_along_a_gimbal_axis_is_skipped():
     assert pts.H.shape == (3, 1) and pts.delta.shape == (4, 1)
 
 
+@pytest.mark.slow
 def test_outer_surface_is_elliptic_and_internal_surfaces_have_both_kinds(env):
     assert set(env.kinds[0]) == {"elliptic"}
     for k in (1, 2):
@@ -136,6 +137,7 @@ def test_default_envelope_is_fast():
     assert env.max_momentum([1, 0, 0]) == pytest.approx(4 * (1 + np.cos(BETA)), abs=1e-9)
 
 
+@pytest.mark.slow
 def test_result_text_json_and_plot(env):
     text = str(env)
     assert "k=0 (saturation)" in text and "extent along x, y, z" in text and "100.0%" in text

@@ -115,6 +115,7 @@ def test_cmg_torque_is_the_reaction_to_turning_the_rotor_momentum():
 
 
 # ------------------------------------------------------------------------- Eqs. 4.144-4.151
+@pytest.mark.slow
 def test_coriolis_torque_from_point_masses():
     for _ in range(4):
         masses, r0 = random_rotor()
@@ -160,6 +161,7 @@ def propeller_truth(n, yaw_rate, spin, t):
     return total, inertia
 
 
+@pytest.mark.slow
 def test_two_blade_propeller_matches_the_seed_and_oscillates_at_twice_the_spin():
     yaw_rate, spin = 0.2, 30.0
     times = np.arange(64) / 64 * 2 * np.pi / spin  # one revolution
@@ -198,6 +200,7 @@ def test_propeller_phase_shifts_time():
 
 # ------------------------------------------------------------------------- Eq. 4.152
 @pytest.mark.parametrize("ratio", [1.0, 1e-3])  # |Omega| / omega_0: exact for any ratio
+@pytest.mark.slow
 def test_symmetric_gyroscope_reaction_from_point_masses(ratio):
     axis = unit(RNG.normal(size=3))
     masses, r0 = ring(axis, 0.5, 3, mass=2.0)  # three masses: I2 = I3

@@ -88,7 +88,7 @@ def test_sr_inverse_is_damped_least_squares():
             lam = sr_gain(C, lam0, mu)
             stacked = np.vstack([C, np.sqrt(lam) * np.eye(4)])
             x = np.linalg.lstsq(stacked, np.concatenate([-tau, np.zeros(4)]), rcond=None)[0]
-            np.testing.assert_allclose(sr_inverse_steering(C, tau, lam0, mu), x, atol=1e-11)
+            np.testing.assert_allclose(sr_inverse_steering(C, tau, lam0=lam0, mu=mu), x, atol=1e-11)
 
 
 def test_sr_without_damping_is_the_pseudo_inverse():

@@ -128,8 +128,8 @@ def test_gsr_dither_moves_the_gimbals_where_sr_locks():
 def test_steering_model_is_the_numpy_law():
     rng = np.random.default_rng(3)
     for law, numpy_law in (("pinv", lambda C, T, tk: pseudo_inverse_steering(C, T)),
-                           ("sr", lambda C, T, tk: sr_inverse_steering(C, T, 0.02, 5.0)),
-                           ("gsr", lambda C, T, tk: gsr_inverse_steering(C, T, tk, 0.02, 5.0))):
+                           ("sr", lambda C, T, tk: sr_inverse_steering(C, T, lam0=0.02, mu=5.0)),
+                           ("gsr", lambda C, T, tk: gsr_inverse_steering(C, T, tk, lam0=0.02, mu=5.0))):
         opts = {} if law == "pinv" else {"lam0": 0.02, "mu": 5.0}
         model = steering_model(GEO, law, **opts)
         assert isinstance(model, Model) and model.f.is_a("SXFunction")

@@ -90,6 +90,7 @@ def test_invariant_rates_along_the_flow():
 
 
 # --------------------------------------------------------------------- long-run conservation
+@pytest.mark.slow
 def test_momentum_conserved_over_100_s_with_time_varying_torques():
     model = wheel_spacecraft(HUB, AXES, J)
     t = np.linspace(0.0, 100.0, 201)
@@ -105,6 +106,7 @@ def test_momentum_conserved_over_100_s_with_time_varying_torques():
     assert np.max(np.abs(res.x[7:] - SPEEDS0[:, None])) > 10.0
 
 
+@pytest.mark.slow
 def test_energy_changes_by_the_motor_work():
     """E(t) - E(0) = int_0^t sum_i tau_i W_i dt, the work integrated as an extra state."""
     model = wheel_spacecraft(HUB, AXES, J)
@@ -195,6 +197,7 @@ def test_gyrostat_equals_the_rotor_derivation_with_the_wheel_held():
                                    rtol=1e-13, atol=1e-13)
 
 
+@pytest.mark.slow
 def test_locking_loop_reproduces_gyrostat_and_locked_body_trajectories():
     """Closed loop with the holding torque written in CasADi: W stays put, and the motion is
     the gyrostat's (W != 0) or the locked rigid body's (W = 0)."""

@@ -235,6 +235,7 @@ def test_scene_momentum_is_basilisks_at_basilisks_states(peer):
     np.testing.assert_allclose(H, H_bsk, rtol=0, atol=1e-13 * np.abs(H_bsk).max())
 
 
+@pytest.mark.slow
 def test_trajectory_matches_basilisk_to_round_off(peer, rk4, rk8):
     cols, _ = peer
     ours, reference = blocks(rk4[0]), blocks(rk8[0])
@@ -246,6 +247,7 @@ def test_trajectory_matches_basilisk_to_round_off(peer, rk4, rk8):
         np.testing.assert_allclose(ours[name], bsk, rtol=0, atol=tol, err_msg=name)
 
 
+@pytest.mark.slow
 def test_motor_torques_match_basilisk(peer, rk4):
     cols, _ = peer
     xs, taus = rk4
@@ -259,6 +261,7 @@ def test_motor_torques_match_basilisk(peer, rk4):
     assert np.abs(applied).max() == U_MAX
 
 
+@pytest.mark.slow
 def test_inertial_momentum_is_conserved_along_our_run(rk4):
     xs, _ = rk4
     H = scene().model().invariant("momentum_inertial", xs.T)

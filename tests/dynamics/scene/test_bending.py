@@ -227,6 +227,7 @@ def test_sensed_attitude_is_the_planar_gyro_reading():
         _rel(got[[0, 2]], [-BEND.slope_sensor * e2, -BEND.slope_sensor * e2d], 1e-15)
 
 
+@pytest.mark.slow
 def test_flown_by_the_autopilot_equals_the_planar_closed_loop():
     """Slosh, actuator and the mode, the autopilot on the gyros on both axes, a yaw error,
     rate and bending at t = 0: yaw angle, slosh, mode and deflection follow the planar closed

@@ -21,10 +21,9 @@ from .registry import ALL, I_HUB, PARTS
 
 HUBS = {"attitude": lambda: RigidHub(I_HUB),
         "six_dof": lambda: RigidHub(I_HUB, mass=40.0, reference=[0.1, -0.05, 0.2])}
-#: every pair (marked slow: CI runs them, `make test` too; `-m "not slow"` skips them
-#: locally) and one scene with every example part (always)
-PAIRS = [pytest.param(pair, marks=pytest.mark.slow) for pair in itertools.combinations(PARTS, 2)
-         ] + [ALL]
+#: every pair and one scene with every example part (the simulations are slow: CI and
+#: `make test` run them, `make quick` leaves them to the energy-power tests below)
+PAIRS = list(itertools.combinations(PARTS, 2)) + [ALL]
 RTOL = 1e-10
 
 
@@ -61,6 +60,7 @@ def _conserved(names, hub):
 
 @pytest.mark.parametrize("hub", HUBS)
 @pytest.mark.parametrize("names", PAIRS, ids=lambda p: "+".join(p) if len(p) < 3 else "all")
+@pytest.mark.slow
 def test_invariants_conserved_with_controls_off(hub, names):
     scene = _scene(hub, names)
     model = scene.model()
@@ -118,8 +118,7 @@ def test_energy_changes_at_the_power_of_the_controls(hub):
 #: the parts that can carry parts, and every part that can sit on one (fields cannot)
 CARRIERS = ("panel", "ball_panel", "bending")
 MOUNTABLE = tuple(n for n in PARTS if n != "tilt")
-ON_PARTS = [pytest.param(c, (n,), marks=pytest.mark.slow) for c in CARRIERS for n in MOUNTABLE
-            ] + [("panel", tuple(n for n in ALL if n in MOUNTABLE and n != "panel"))]
+ON_PARTS = [(c, (n,)) for c in CARRIERS for n in MOUNTABLE] + [("panel", tuple(n for n in ALL if n in MOUNTABLE and n != "panel"))]
 
 
 def _mounted_scene(hub, carrier, names):
@@ -133,6 +132,7 @@ def _mounted_scene(hub, carrier, names):
 @pytest.mark.parametrize("carrier, names", ON_PARTS,
                          ids=lambda p: p if isinstance(p, str) else
                          ("+".join(p) if len(p) < 3 else "all"))
+@pytest.mark.slow
 def test_invariants_conserved_with_parts_on_a_panel(hub, carrier, names):
     scene = _mounted_scene(hub, carrier, names)
     model = scene.model()

@@ -99,6 +99,7 @@ def gyrostats(draw):
 
 @settings(max_examples=60, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(inertias(), gyrostats(), st.data())
+@pytest.mark.slow
 def test_gyrostat_wrapper_equals_the_hand_written_model(inertia, case, data):
     kw, extra_range = case
     new, old = gyrostat_model(inertia, **kw), legacy.gyrostat_model(inertia, **kw)
@@ -110,6 +111,7 @@ def test_gyrostat_wrapper_equals_the_hand_written_model(inertia, case, data):
 @settings(max_examples=40, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(inertias(), real(-10, 10), vec3, vec3, st.one_of(st.just(0.0), real(0.0, 3.0)),
        st.data())
+@pytest.mark.slow
 def test_tilt_torque_wrapper_equals_the_hand_written_model(inertia, kappa, axis, direction,
                                                           damping, data):
     kw = dict(axis=axis, direction=direction, internal_damping=damping)
@@ -328,6 +330,7 @@ def test_scene_parts_keep_the_stability_names_and_state_helpers():
 
 
 # ------------------------------------------------------- slosh: a sympy Kane model
+@pytest.mark.slow
 def test_slosh_hub_equals_an_independent_sympy_kane_model():
     """A free hub (reference point off its mass centre) with a damped pendulum hinged off
     the mass centre, a damped spring-mass and a force at a third point: the scene's
@@ -357,6 +360,7 @@ def test_slosh_hub_equals_an_independent_sympy_kane_model():
 
 
 @pytest.mark.parametrize("case", ["point", "point-6dof", "sphere", "slosh"])
+@pytest.mark.slow
 def test_damping_keeps_the_momenta_and_only_loses_energy(case):
     """Damping is internal: with it on, the inertial (and linear) momentum still stay put to
     1e-10 over 100 s while the energy falls (the spherical core's housing turns, its motor

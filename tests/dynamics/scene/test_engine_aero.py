@@ -459,6 +459,7 @@ def test_launch_vehicle_scene_with_slosh_yaw_plane_equals_the_planar_model(with_
         assert abs(xdot[idx["theta2_dot"]]) < 1e-12 and xdot[idx["dp"]] == 0.0
 
 
+@pytest.mark.slow
 def test_flown_by_the_autopilot_equals_the_planar_closed_loop():
     """Slosh and actuator, the autopilot closed on both axes, a yaw error and rate at t = 0:
     the scene stays in the yaw plane and its yaw angle, the slosh angle and the deflection

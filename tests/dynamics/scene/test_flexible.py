@@ -100,7 +100,8 @@ def _fe_rotating_beam(L, m, EI, r0, tip_mass, rate, *, elements=80, in_plane=Fal
     return float(np.sqrt(np.min(lam)))
 
 
-@pytest.mark.parametrize("tip_mass", [0.0, pytest.param(0.3, marks=pytest.mark.slow)])
+@pytest.mark.parametrize("tip_mass", [0.0, 0.3])
+@pytest.mark.slow
 def test_spinning_frequencies_match_finite_element_rotating_beam(tip_mass):
     L, m, EI, r0, n = 2.0, 0.5, 10.0, 0.7, 8  # 6 modes: 1.6e-4 at 2 omega_1
     part = FlexibleAppendage(L, m, EI, root=(r0, 0.0, 0.0), modes=n, tip_mass=tip_mass)
@@ -133,7 +134,8 @@ def test_linear_model_softens_under_spin():
 
 
 @pytest.mark.parametrize("stiffening", [True, False])
-@pytest.mark.parametrize("mass", [None, pytest.param(20.0, marks=pytest.mark.slow)])
+@pytest.mark.parametrize("mass", [None, 20.0])
+@pytest.mark.slow
 def test_momentum_and_energy_conserved(stiffening, mass):
     part = FlexibleAppendage(2.0, 0.5, (0.5, 0.8), root=(0.5, 0.1, -0.2),
                              direction=(1.0, 0.2, 0.3), modes=2, tip_mass=0.3,
@@ -169,6 +171,7 @@ def test_bad_input_names_the_argument():
         FlexibleAppendage(-1.0, 1.0, 1.0)
 
 
+@pytest.mark.slow
 def test_seed_example6_hub_locked_limit_gives_cantilever_frequencies():
     from appdyn.dynamics.scene import flexible_antenna_satellite
     from appdyn.problems import stability
@@ -189,6 +192,7 @@ def test_seed_example6_hub_locked_limit_gives_cantilever_frequencies():
         assert abs(md.wn / (TEXTBOOK[k - 1] ** 2 * np.sqrt(ei / (m * L ** 4))) - 1) < 1e-8
 
 
+@pytest.mark.slow
 def test_seed_example6_spinning_stiffens_and_stays_stable():
     from appdyn.dynamics.scene import flexible_antenna_satellite
     from appdyn.problems import stability
@@ -259,6 +263,7 @@ def test_seed_example6_in_plane_modes_coupled_with_the_hub():
     assert stiffer.size == n and np.all(stiffer > np.sqrt(om2))
 
 
+@pytest.mark.slow
 def test_on_a_locked_hinged_boom_it_is_the_same_beam_as_on_the_hub():
     """Parts on parts: the appendage clamped on a panel (root and direction in panel axes,
     from the hinge) that a very heavy, very stiff hinge holds at zero angle: locked, its
@@ -309,6 +314,7 @@ def test_polynomial_shape_table_gives_the_two_term_ritz_frequencies():
     assert np.max(np.abs(_freqs(lin, names) / expected - 1)) < 1e-8
 
 
+@pytest.mark.slow
 def test_a_sampled_clamped_free_table_is_the_computed_beam():
     """The library's own shapes, tabulated at 401 stations, give the same beam: frequencies
     to 1e-8 (the cubic spline's error), spinning frequencies to 1e-6."""
@@ -328,6 +334,7 @@ def test_a_sampled_clamped_free_table_is_the_computed_beam():
     assert np.max(np.abs(f[1] / f[0] - 1)) < 1e-6
 
 
+@pytest.mark.slow
 def test_a_shape_table_conserves_momentum_and_energy():
     x = np.linspace(0.0, 1.5, 7)
     part = FlexibleAppendage(1.5, 0.4, (0.6, 0.9), root=(0.4, 0.1, 0.0),

@@ -122,6 +122,7 @@ def test_rigid_body_equals_the_hand_written_model(I, x, u):
 
 @SETTINGS
 @given(st.data())
+@pytest.mark.slow
 def test_wheel_spacecraft_equals_the_hand_written_model(data):
     n = data.draw(st.integers(1, 4))
     I = data.draw(inertias())
@@ -137,6 +138,7 @@ def test_wheel_spacecraft_equals_the_hand_written_model(data):
 
 @SETTINGS
 @given(st.data())
+@pytest.mark.slow
 def test_cmg_spacecraft_equals_the_hand_written_model(data):
     n = data.draw(st.integers(1, 4))
     I = data.draw(inertias())

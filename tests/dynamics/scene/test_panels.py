@@ -138,6 +138,7 @@ def kane_pinned_hub_with_revolute_panel(I_hub, m, I_panel, hinge, offset, axis, 
     return rhs
 
 
+@pytest.mark.slow
 def test_revolute_panel_on_a_pinned_hub_equals_a_sympy_kane_model():
     axis, k, c = AXIS, 3.0, 0.4
     kane = kane_pinned_hub_with_revolute_panel(I1, M2, I2, R1, -R2, axis, k, c)

@@ -35,6 +35,7 @@ def kane():
     return chain_equations(I_HUB, P1, WHEEL, P2, DAMPER)
 
 
+@pytest.mark.slow
 def test_chain_of_parts_equals_an_independent_kane_model(kane):
     scene = chain_scene()
     model = scene.model()

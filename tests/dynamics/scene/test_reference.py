@@ -58,6 +58,7 @@ def test_rhs_about_a_reference_point_maps_onto_the_mass_centre_form(kind):
 
 
 @pytest.mark.parametrize("kind", ["revolute", "ball"])
+@pytest.mark.slow
 def test_trajectory_about_a_reference_point_equals_the_mass_centre_one(kind):
     at_ref, at_cm = scenes(kind)
     x = ca.SX.sym("x", at_cm.model().nx)

@@ -27,6 +27,7 @@ def bilimoria_wie():
 
 
 # ------------------------------------------------------------------ dispatch
+@pytest.mark.slow
 def test_bilimoria_wie_through_slew(bilimoria_wie):
     sol = bilimoria_wie
     assert sol.success, sol.message
@@ -36,6 +37,7 @@ def test_bilimoria_wie_through_slew(bilimoria_wie):
     assert sol.info["pointing_error"] <= pkg.POINTING_TOL
 
 
+@pytest.mark.slow
 def test_dispatch_equals_time_optimal():
     """Compared unpolished: the polish runs within a wall-time budget, so a polished T may
     depend on the machine's load (Bilimoria-Wie unpolished at N = 30: 3.24391)."""
@@ -46,6 +48,7 @@ def test_dispatch_equals_time_optimal():
     assert BW_T < sol.T < BW_T + 1e-3
 
 
+@pytest.mark.slow
 def test_target_as_q_final_is_the_same_slew():
     q = [0.0, 0.0, math.sin(0.05), math.cos(0.05)]  # 0.1 rad about z
     for scene in (rigid(), HELD0):
@@ -103,6 +106,7 @@ def test_keywords_and_options_object_are_the_same_slew():
 
 
 # --------------------------------------------------------------- generic path
+@pytest.mark.slow
 def test_generic_path_reproduces_bilimoria_wie():
     """A held rotor of zero momentum adds nothing to the dynamics but no engine takes the
     scene: the generic path on the assembled model finds Bilimoria & Wie's optimum."""
@@ -137,6 +141,7 @@ def test_generic_effort_splits_the_torque_between_two_actuators():
     np.testing.assert_allclose(L3, -tau3, atol=1e-6 * np.max(np.abs(L3)))
 
 
+@pytest.mark.slow
 def test_generic_time_optimal_with_a_gyrostat_conserves_momentum():
     """Wheels on a hub with a held rotor (no external torque): a verified time-optimal slew
     within the torque bounds, the total inertial momentum (the rotor's) conserved, the wheel
@@ -154,6 +159,7 @@ def test_generic_time_optimal_with_a_gyrostat_conserves_momentum():
     assert sol.info["rate_tol"] == pkg.RATE_TOL and sol.info["final_rate_error"] <= pkg.RATE_TOL
 
 
+@pytest.mark.slow
 def test_generic_path_on_a_translating_hub():
     """A six-degree-of-freedom hub under a body torque only: its position and velocity are
     free and stay put; the attitude slew is the rigid body's bang-bang, 2 sqrt(0.1)."""
@@ -203,6 +209,7 @@ def _check_damped(sol):
     assert np.abs(H).max() < 1e-10 * scale
 
 
+@pytest.mark.slow
 def test_generic_wheels_and_damper_minimum_effort():
     sol = slew(damped(2.0), objective="effort", T=12.0, angle=0.3, axis=[0, 0, 1])
     _check_damped(sol)
@@ -231,6 +238,7 @@ CONE = pkg.KeepOut(boresight=[1, 0, 0], direction=[1, 1, 0.0], half_angle=np.rad
 HELD0 = Scene(RigidHub(np.eye(3)), ExternalTorque(u_max=1.0), HeldRotor([1, 0, 0], 0.0))
 
 
+@pytest.mark.slow
 def test_generic_keep_out_equals_the_rigid_engine():
     """The same cone on the generic path (a path constraint on the hub quaternion of the
     assembled model) and in `min_effort` / `time_optimal`: the same optimum; the minimum-
@@ -258,6 +266,7 @@ def test_generic_keep_out_equals_the_rigid_engine():
     "known: a time-optimal slew with a keep-out cone is re-solved with a constant control "
     "(`bounded`, RadauConstantControl) that holds the cone at the mesh points only; the "
     "result, a success, crosses it by 5.9e-4 at an interior collocation point (t = 1.27 s)"))
+@pytest.mark.slow
 def test_time_optimal_keep_out_holds_the_cone_at_every_collocation_point():
     sol = slew(rigid(), angle=np.pi / 2, axis=[0, 0, 1], keep_out=CONE)
     assert not sol.success or np.min(CONE.margin(sol.x[:4])) >= -1e-7
@@ -355,6 +364,7 @@ def _cmg_cluster(**kw):
     return geo, scene_module.CMGCluster(geo.gimbal_axes, geo.spin_axes0, geo.h, **kw)
 
 
+@pytest.mark.slow
 def test_dispatch_equals_cmg_slew():
     """A hub with a pyramid of CMGs (rate drive): `cmg_slew`, the same result exactly
     (no wall-time budget in its pipeline: not polished), the singularity bound passed on."""
@@ -371,6 +381,7 @@ def test_dispatch_equals_cmg_slew():
     assert fast.success and old.success and abs(fast.T - old.T) <= 1e-9
 
 
+@pytest.mark.slow
 def test_generic_cmg_effort_equals_cmg_slew():
     """The same cluster with a zero-momentum held rotor beside it (no engine takes the
     scene): the generic path's minimum effort is `cmg_slew`'s (8e-16 relative measured)."""
@@ -483,6 +494,7 @@ def test_readme_craft_time_optimal_slew_is_verified():
     assert np.max(np.abs(H)) < 1e-9 * wheels
 
 
+@pytest.mark.slow
 def test_cmgs_and_damper_time_optimal_slew_is_verified():
     """A pyramid of CMGs with a damper brought to rest: verified within the gimbal-rate
     bounds between the nodes; the control re-simulated by `simulate` meets the target with

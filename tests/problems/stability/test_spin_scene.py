@@ -62,6 +62,7 @@ def test_rigid_hub_minor_intermediate_major(which, verdict):
 @given(moments=hs.tuples(*[hs.floats(1.0, 10.0)] * 2), third=hs.floats(0.0, 1.0),
        angles=hs.tuples(*[hs.floats(-np.pi, np.pi)] * 3), which=hs.integers(0, 2),
        rate=hs.floats(0.1, 50.0))
+@pytest.mark.slow
 def test_rigid_hub_any_principal_axis_closed_form(moments, third, angles, which, rate):
     """Random principal moments (triangle inequality held) in random hub axes; the scene's
     spin equals the inertia path's (the same report machinery) and the closed form."""
@@ -95,6 +96,7 @@ def test_held_rotor_gyrostat_boundaries(h):
     assert wrapped.verdict == rep.verdict
 
 
+@pytest.mark.slow
 def test_held_rotor_boundaries_by_sweep_bisection():
     """The verdict boundaries of the scene spin, located by bisection on the momentum."""
     Ia, Ib, Ic, W = 3.0, 4.0, 5.0, 2.0
@@ -355,6 +357,7 @@ def test_the_attitude_subsystem_holds_the_mass_centre():
                        np.asarray(full.f(x, [], [])).ravel()[:7], rtol=1e-14, atol=1e-14)
 
 
+@pytest.mark.slow
 def test_sweep_over_the_rate_of_a_scene():
     """`sweep` runs spin(scene, ...) too: a held rotor h = 3 on a hub (3, 4, 5) is unstable
     while Ia + h/W lies between 4 and 5, i.e. for h/(Ic - Ia) = 1.5 < W < h/(Ib - Ia) = 3."""

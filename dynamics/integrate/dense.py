@@ -1,0 +1,296 @@
+"""``auto`` for a smooth right-hand side under a control constant over the run, in ONE
+compiled call: DOP853 stepping by its error estimate alone with dense output of order 7
+(the answer), a check run at a looser local tolerance, their comparison and the verdict
+(`cpass._AUTO`, ``rk8_auto``), with no Python between; and the same for every run of a
+batch in one compiled loop over the runs (``rk8_auto_many``), each run with its own steps,
+check and verdict.
+
+The rules (as `dynamics.integrate.auto.dense_pass` states them): the answer runs at the
+local tolerance ``(rtol, atol) f`` (``f = FIRST``), the check run at ``CHECK`` times that;
+``d`` is their scaled difference (max over the outputs, in units of ``atol + rtol |x|``).
+When the step counts show DOP853's tolerance power (``n_answer / n_check`` within a factor
+1.25 of ``ratio^(1/8)``) the estimate is ``d / (ratio^(3/4) - 1)`` plus 1000 ulps of each
+state's size, accepted at most 0.5; otherwise ``d`` plus the ulps, accepted at most 1.
+Within 1e6 ulps of a state's size the rounding of the model's formulas (measured on the
+way) is carried over the horizon (`estimates.carried`) and its screening bound
+(`estimates.screen`) added when at most 0.05; otherwise the flow's real amplification is
+measured as `estimates.measured_floor` does: the answer is repeated from ``x0`` moved by
+that carried rounding, and the largest of its difference from the answer, the carried
+rounding and the ulps is added. Not accepted, the answer is redone aimed at 0.1 (`TRIES`
+answers at most; not after a floor was measured).
+
+Per call the Python is a look-up of the model's plan (its library and the workspace
+layout, `_plan`), a thread's reused workspace, one ``ctypes`` call and the result's array.
+"""
+from __future__ import annotations
+
+import math
+import threading
+from typing import NamedTuple
+
+import numpy as np
+
+from .. import cache
+from ..interrupts import check_interrupt, deferred_interrupts
+from .cpass import pass_library
+from .inputs import Problem
+
+__all__ = ["FIELDS", "HEADER", "FIRST", "CHECK", "TRIES", "DenseAuto", "dense_auto", "dense_many",
+           "outcome_of", "constant_control"]
+
+FIRST = 0.1     # the answer's local tolerance over the requested one
+CHECK = 100.0   # the check run's local tolerance over the answer's
+TRIES = 3       # answers (each aimed tighter) before the other paths of ``auto``
+#: Most steps of one compiled call (Ctrl-C is looked at between calls).
+BUDGET = 1 << 15
+
+#: The slots of a run's header (``AU_*`` of `cpass._AUTO`, in order; `HEADER` of them).
+FIELDS = ("rtol", "factor", "loose", "max_steps", "stiff_steps", "t0", "iq", "tries", "phase",
+          "spent", "check_steps", "answer_steps", "result", "estimate", "d", "flag", "try",
+          "accepted", "rejected", "hmin", "interpolated", "lipschitz", "ratio", "bound",
+          "nout", "substeps", "gate", "floor")
+(_RTOL, _FACTOR, _LOOSE, _MAXSTEPS, _STIFF, _T0, _IQ, _TRIES, _PHASE, _SPENT, _NCHK, _NANS,
+ _RESULT, _EST, _D, _FLAG, _TRY, _ACC, _REJ, _HMIN, _INTERP, _LIP, _RATIO, _BOUND,
+ _NOUT, _SUB, _GATE, _FLOOR) = range(len(FIELDS))
+#: Doubles of a run's header.
+HEADER = len(FIELDS)
+_REASONS = ("", "a state became non-finite", "the step size underflowed",
+            "more than max_steps steps", "stiff (stability alone would need too many steps)")
+
+
+class DenseAuto(NamedTuple):
+    """The outcome of `dense_auto` (one run) or of a run of `dense_many`.
+
+    ``x (nx, n)`` the answer (NaN after a failure); ``result`` 1 verified, 0 not verified
+    (``estimate`` > acceptance or not finite), -2 a tolerance too near a state's rounding (no
+    run made), -3 a run failed (``reason``); ``estimate`` [tolerances]; ``spent`` steps of
+    all runs; ``answer_steps``, ``check_steps`` (accepted and rejected), ``rejected`` of the
+    answer, ``hmin`` its smallest step [s], ``interpolated`` its steps that filled outputs,
+    ``ratio`` the check's local tolerance over the answer's, ``factor`` the answer's over
+    the requested, ``bound`` the rounding bound included in ``estimate`` (or ``floor``, the
+    rounding floor measured by a rerun from a moved start, when that bound was not small), ``substeps`` the
+    longest output interval over ``hmin`` (equal steps of that many per interval are no
+    longer than any the answer took), ``reason`` why a run failed."""
+
+    x: np.ndarray
+    result: int
+    estimate: float
+    spent: int
+    answer_steps: int
+    check_steps: int
+    rejected: int
+    hmin: float
+    interpolated: int
+    ratio: float
+    factor: float
+    bound: float
+    floor: float
+    substeps: int
+    reason: str
+
+
+def constant_control(ctrl) -> bool:
+    """Whether the linear control ``ctrl`` (`inputs.Control`) is one value over the whole run.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from appdyn.dynamics.integrate.dense import constant_control
+    >>> from appdyn.dynamics.integrate.inputs import check_u
+    >>> t = np.linspace(0.0, 1.0, 3)
+    >>> constant_control(check_u([0.1, 0, 0], 3, t)), constant_control(check_u(np.eye(3), 3, t))
+    (True, False)
+    """
+    if ctrl.constant or ctrl.ua.size == 0:
+        return True
+    return bool(np.all(ctrl.ua == ctrl.ua[0]) and np.all(ctrl.ub == ctrl.ua[0]))
+
+
+class _Plan(NamedTuple):
+    """What a model's calls share: the compiled functions, the sizes, the index of the
+    attitude quaternion (-1: none)."""
+
+    auto: object
+    many: object
+    nx: int
+    nu: int
+    np: int
+    iq: int
+
+
+def _plan(model) -> _Plan | None:
+    """The model's call plan (cached with its compiled pass); None without one."""
+    def build():
+        lib = pass_library(model)
+        return None if lib is None else _Plan(
+            lib.auto, lib.auto_many, model.nx, model.nu, model.np,
+            -1 if model.attitude is None else model.attitude[0])
+
+    return cache.get(("dense_plan", cache.function_key(model.f)), build, keepalive=model.f)
+
+
+def _size(plan: _Plan, nout: int) -> int:
+    """Doubles of the workspace (``AU_SIZE`` of `cpass._AUTO`)."""
+    return HEADER + 6 * plan.nx + plan.nu + plan.np + nout + 10
+
+
+_LOCAL = threading.local()
+
+
+class _Work(NamedTuple):
+    """A thread's workspace for ``nout`` outputs: ``ws`` (`_size` doubles), the check-run
+    scratch ``XC (nx, nout + 1)`` and their addresses."""
+
+    ws: np.ndarray
+    XC: np.ndarray
+    ws_addr: int
+    xc_addr: int
+
+
+def _workspace(plan: _Plan, nout: int) -> _Work:
+    """This thread's workspace for ``nout`` outputs (reused between calls; at most 8
+    shapes kept)."""
+    table = getattr(_LOCAL, "work", None)
+    if table is None:
+        table = _LOCAL.work = {}
+    key = (plan.nx, plan.nu, plan.np, nout)
+    got = table.get(key)
+    if got is None:
+        if len(table) >= 8:
+            table.clear()
+        ws, XC = np.zeros(_size(plan, nout)), np.empty((plan.nx, nout + 1))
+        ws[_TRIES], ws[_NOUT] = TRIES, nout
+        got = table[key] = _Work(ws, XC, ws.ctypes.data, XC.ctypes.data)
+    return got
+
+
+def _fill(ws: np.ndarray, plan: _Plan, t: np.ndarray, rtol: float, atol: np.ndarray,
+          max_steps: float, stiff_steps: float) -> None:
+    """The inputs shared by the runs: header, tolerances and output times (the C code
+    resets the outputs of the header)."""
+    ws[_RTOL] = rtol
+    ws[_FACTOR] = FIRST
+    ws[_LOOSE] = FIRST * CHECK
+    ws[_MAXSTEPS] = max_steps
+    ws[_STIFF] = stiff_steps
+    ws[_T0] = t[0]
+    ws[_IQ] = plan.iq
+    ws[_PHASE] = 0
+    o = HEADER + plan.nx + plan.nu + plan.np
+    ws[o:o + plan.nx] = atol
+    ws[o + plan.nx:o + plan.nx + t.size - 1] = t[1:]
+
+
+def _outcome(x: np.ndarray, head) -> DenseAuto:
+    """The `DenseAuto` of a finished run from its header ``head`` (a sequence)."""
+    result, flag = int(head[_RESULT]), int(head[_FLAG])
+    return DenseAuto(x, result, head[_EST], int(head[_SPENT]), int(head[_NANS]),
+                     int(head[_NCHK]), int(head[_REJ]), head[_HMIN], int(head[_INTERP]),
+                     head[_RATIO], head[_FACTOR], head[_BOUND], head[_FLOOR], int(head[_SUB]),
+                     _REASONS[flag] if result == -3 else "")
+
+
+def dense_auto(problem: Problem, rtol: float, atol: np.ndarray, max_steps: float,
+               stiff_steps: float, progress=None) -> DenseAuto | None:
+    """The answer, its check run and verdict for ``problem`` in one compiled call (see the
+    module docstring); None without a compiled pass or for a control that is not constant
+    over the run.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from appdyn.dynamics import rigid_body
+    >>> from appdyn.dynamics.integrate.dense import dense_auto
+    >>> from appdyn.dynamics.integrate.inputs import Problem, check_u
+    >>> from appdyn.dynamics.truth.torque_free import torque_free_omega
+    >>> model, t = rigid_body([1.5, 2.5, 3.2]), np.linspace(0.0, 60.0, 121)
+    >>> x0 = np.r_[0.0, 0.0, 0.0, 1.0, 0.5, 0.0, 1.0]
+    >>> problem = Problem.new(model, x0, t, check_u(None, 3, t), np.zeros(0))
+    >>> got = dense_auto(problem, 1e-8, np.full(7, 1e-10), 1e8, 1e6)
+    >>> w = torque_free_omega([1.5, 2.5, 3.2], x0[4:], t)
+    >>> bool(got.result == 1 and np.abs(got.x[4:] - w).max() < 1e-8)
+    True
+    """
+    ctrl = problem.control
+    if ctrl.mode != "linear" or not constant_control(ctrl):
+        return None
+    plan = _plan(problem.model)
+    if plan is None:
+        return None
+    t = problem.t
+    nout = t.size - 1
+    work = _workspace(plan, nout)
+    ws = work.ws
+    _fill(ws, plan, t, rtol, atol, max_steps, stiff_steps)
+    nx, nu = plan.nx, plan.nu
+    ws[HEADER:HEADER + nx] = problem.x0
+    if nu:
+        ws[HEADER + nx:HEADER + nx + nu] = ctrl.ua[0] if ctrl.ua.shape[0] else 0.0
+    if plan.np:
+        ws[HEADER + nx + nu:HEADER + nx + nu + plan.np] = problem.p
+    X = np.empty((nx, nout + 1))
+    args = (work.ws_addr, nout, BUDGET, X.ctypes.data, work.xc_addr)
+    if plan.auto(*args) != 3:  # a long run: interrupts looked at between calls
+        # (the steps made so far: of the runs ended, and of the run in progress)
+        count = HEADER + 3 * nx + nu + plan.np + nout + 2
+        told = 0
+        with deferred_interrupts():
+            while True:
+                check_interrupt()
+                told = _tell(progress, int(ws[_SPENT] + ws[count] + ws[count + 1]), told)
+                if plan.auto(*args) == 3:
+                    break
+        _tell(progress, int(ws[_SPENT]), told)
+    elif progress is not None:
+        _tell(progress, int(ws[_SPENT]), 0)
+    return _outcome(X, ws[:HEADER].tolist())
+
+
+def _tell(progress, steps: int, told: int) -> int:
+    """``progress`` (a `loops.Progress` or None) told of the ``steps - told`` steps made
+    since it was last told; returns ``steps``."""
+    if progress is not None and steps > told:
+        progress.start(steps - told)
+        progress.advance(steps - told)
+    return max(steps, told)
+
+
+def dense_many(model, x0: np.ndarray, t: np.ndarray, u: np.ndarray, p: np.ndarray,
+               rtol: float, atol: np.ndarray, max_steps: float, stiff_steps: float,
+               runs: slice) -> tuple[np.ndarray, np.ndarray] | None:
+    """`dense_auto` for the runs ``runs`` of a batch in one compiled loop: ``x0 (K, nx)``,
+    ``u (K, max(nu, 1))`` (each run's constant control), ``p (K, max(np, 1))``, all
+    C-contiguous. Returns ``(X (r, nx, n), head (r, HEADER))``: the answers and each run's
+    header (`outcome_of` reads it); None without a compiled pass.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from appdyn.dynamics import rigid_body
+    >>> from appdyn.dynamics.integrate.dense import dense_many, outcome_of
+    >>> model, t = rigid_body([1.5, 2.5, 3.2]), np.linspace(0.0, 20.0, 41)
+    >>> x0 = np.array([[0, 0, 0, 1, 0.5, 0, 1.0], [0, 0, 0, 1, 0.1, 0.9, 0.2]])
+    >>> X, head = dense_many(model, x0, t, np.zeros((2, 3)), np.zeros((2, 1)), 1e-8,
+    ...                      np.full(7, 1e-10), 1e8, 1e6, slice(0, 2))
+    >>> runs = [outcome_of(X[k], head[k]) for k in range(2)]
+    >>> [r.result for r in runs]  # (each verified by its own check run)
+    [1, 1]
+    """
+    plan = _plan(model)
+    if plan is None:
+        return None
+    nout = t.size - 1
+    work = _workspace(plan, nout)
+    _fill(work.ws, plan, t, rtol, atol, max_steps, stiff_steps)
+    r = runs.stop - runs.start
+    X = np.empty((r, plan.nx, nout + 1))
+    head = np.empty((r, HEADER))
+    k0 = runs.start
+    plan.many(work.ws_addr, nout, 0, r, x0[k0:].ctypes.data, u[k0:].ctypes.data,
+              p[k0:].ctypes.data, X.ctypes.data, work.xc_addr, head.ctypes.data)
+    return X, head
+
+
+def outcome_of(x: np.ndarray, head: np.ndarray) -> DenseAuto:
+    """The `DenseAuto` of one run of `dense_many` (its answer ``x (nx, n)`` and header)."""
+    return _outcome(x, head.tolist())
