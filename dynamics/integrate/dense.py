@@ -250,6 +250,9 @@ def _tell(progress, steps: int, told: int) -> int:
     """``progress`` (a `loops.Progress` or None) told of the ``steps - told`` steps made
     since it was last told; returns ``steps``."""
     if progress is not None and steps > told:
+        # the steps still ahead are unknown (the check run, maybe a retry): expect as many
+        # again, so the total is reached only at the end (`Progress.finish`)
+        progress.ahead = max(progress.ahead, steps)
         progress.start(steps - told)
         progress.advance(steps - told)
     return max(steps, told)
