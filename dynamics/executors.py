@@ -5,20 +5,50 @@ thread); `gather` runs tasks on it and hands each result back in the calling thr
 finishes, with the error and Ctrl-C behaviour of a serial loop (`dynamics.interrupts`). Used
 by `problems.stability.sweep` and `ocp.solve_multistart`. `worker_pool` is the process's own
 pool of threads for appdyn's internal parallel loops and `run_split` hands work to it (the
-runs of a batched `simulate`).
+runs of a batched `simulate`). `process_pool` makes a process pool whose workers are started
+by a fork server, not forked from this (threaded) process: forking a process that runs
+threads can leave a child waiting forever on a lock or a pipe another thread held.
 """
 from __future__ import annotations
 
+import multiprocessing
 import os
 import threading
-from concurrent.futures import FIRST_COMPLETED, Executor, ThreadPoolExecutor, wait
+from concurrent.futures import (FIRST_COMPLETED, Executor, ProcessPoolExecutor,
+                                ThreadPoolExecutor, wait)
 from typing import Callable, Sequence
 
 from .interrupts import check_interrupt
 
-__all__ = ["check_executor", "gather", "worker_pool", "run_split", "POLL"]
+__all__ = ["check_executor", "gather", "worker_pool", "run_split", "process_pool", "POLL"]
 
 POLL = 0.1  # [s] how often the wait on an executor looks for a deferred Ctrl-C
+
+
+def process_pool(max_workers: int | None = None) -> ProcessPoolExecutor:
+    """A `concurrent.futures.ProcessPoolExecutor` whose workers start from a fork server
+    (``'forkserver'``; the platform's default where there is none), safe to make in a process
+    that runs threads.
+
+    Parameters
+    ----------
+    max_workers : int, optional
+        Worker processes (default: the CPU count).
+
+    Returns
+    -------
+    concurrent.futures.ProcessPoolExecutor
+
+    Examples
+    --------
+    >>> from appdyn.dynamics.executors import process_pool
+    >>> with process_pool(2) as pool:
+    ...     print(sorted(pool.map(abs, [-2, 1])))
+    [1, 2]
+    """
+    methods = multiprocessing.get_all_start_methods()
+    context = multiprocessing.get_context("forkserver" if "forkserver" in methods else None)
+    return ProcessPoolExecutor(max_workers, mp_context=context)
 
 
 def check_executor(executor, name: str = "executor"):

@@ -273,9 +273,9 @@ def executor_from(args):
         finally:
             client.close()
     elif workers and workers > 1:
-        from concurrent.futures import ProcessPoolExecutor
+        from appdyn.dynamics.executors import process_pool
 
-        with ProcessPoolExecutor(workers) as pool:
+        with process_pool(workers) as pool:
             yield pool
     else:
         yield None

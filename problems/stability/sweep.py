@@ -115,12 +115,13 @@ def sweep(case, parameter: str, values, *, rtol: float = 1e-8, progress=None, ex
     24.256937: unstable -> marginally stable
 
     The same sweep on two threads; in a script, a process pool the same way (the case
-    travels by name, the arguments must pickle)::
+    travels by name, the arguments must pickle; `dynamics.executors.process_pool` starts
+    its workers from a fork server, safe in a process that runs threads)::
 
-        from concurrent.futures import ProcessPoolExecutor
+        from appdyn.dynamics.executors import process_pool
 
         if __name__ == "__main__":
-            with ProcessPoolExecutor(max_workers=2) as pool:
+            with process_pool(max_workers=2) as pool:
                 res = stability.sweep("heavy_top", "rate", ..., executor=pool)
 
     >>> from concurrent.futures import ThreadPoolExecutor

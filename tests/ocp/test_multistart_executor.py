@@ -15,6 +15,7 @@ import pytest
 
 from appdyn import ocp
 from appdyn.ocp.examples import min_time
+from appdyn.dynamics.executors import process_pool
 
 GUESSES = [None, {"T": 5.0}, {"T": 1.0}, {"T": 3.0}]
 # start 0 is capped before it converges; start 2 tries a capped attempt first
@@ -30,7 +31,7 @@ def problem():
 @pytest.fixture(scope="module")
 def pools():
     with concurrent.futures.ThreadPoolExecutor(2) as threads, \
-            concurrent.futures.ProcessPoolExecutor(2) as processes:
+            process_pool(2) as processes:
         yield {"threads": threads, "processes": processes}
 
 

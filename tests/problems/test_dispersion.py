@@ -13,7 +13,7 @@ import os
 import pickle
 import re
 import signal
-from concurrent.futures import ProcessPoolExecutor, ThreadPoolExecutor
+from concurrent.futures import ThreadPoolExecutor
 
 import casadi as ca
 import numpy as np
@@ -25,6 +25,7 @@ from appdyn.dynamics.truth import symmetric_precession
 from appdyn.problems import dispersion as dp
 from appdyn.problems.dispersion import (Normal, SmallRotation, Uniform, dispersion, nutation_history,
                                  nutation_spread, spinner)
+from appdyn.dynamics.executors import process_pool
 
 MODULES = ["appdyn.problems.dispersion", "appdyn.problems.dispersion.distributions",
            "appdyn.problems.dispersion.result", "appdyn.problems.dispersion.run", "appdyn.problems.dispersion.sample",
@@ -142,7 +143,7 @@ def test_thread_and_process_pools_give_the_serial_result():
     with ThreadPoolExecutor(2) as pool:
         threads = spin_dispersion(invariant_drift=["energy"], executor=pool)
         chunked = spin_dispersion(invariant_drift=["energy"], executor=pool, chunksize=4)
-    with ProcessPoolExecutor(2) as pool:
+    with process_pool(2) as pool:
         processes = spin_dispersion(invariant_drift=["energy"], executor=pool, chunksize=2)
         with pytest.raises(TypeError, match="`outputs` must be picklable"):
             spin_dispersion(outputs={"w": lambda res: res["w1"][-1]}, executor=pool)

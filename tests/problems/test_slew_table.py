@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import doctest
 import signal
-from concurrent.futures import ProcessPoolExecutor, ThreadPoolExecutor
+from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
 import pytest
@@ -12,6 +12,7 @@ import pytest
 import appdyn.problems.slew.table as table_module
 from appdyn.problems import slew
 from appdyn.problems.slew import maneuver_table
+from appdyn.dynamics.executors import process_pool
 
 FAST = dict(N=10, starts=1)
 AXES = ([1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0])
@@ -54,7 +55,7 @@ def test_effort_rows_match_the_cubic_closed_form():
 @pytest.mark.slow
 def test_executors_give_the_serial_table(serial):
     calls = []
-    with ThreadPoolExecutor(2) as threads, ProcessPoolExecutor(2) as processes:
+    with ThreadPoolExecutor(2) as threads, process_pool(2) as processes:
         for pool in (threads, processes):
             got = maneuver_table(np.eye(3), SINGLE, executor=pool,
                                  progress=lambda d, n: calls.append((d, n)), **FAST)

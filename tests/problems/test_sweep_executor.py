@@ -15,6 +15,7 @@ import pytest
 
 from appdyn.problems import stability as st
 from appdyn.problems.stability import SphericalDamper
+from appdyn.dynamics.executors import process_pool
 
 GYRO = dict(inertia=[3.0, 4.0, 5.0], axis=[1, 0, 0], rate=2.0)  # two boundaries
 DAMPED = dict(inertia=[3.0, 4.0, 4.0], axis=[1, 0, 0], rate=2.0,
@@ -30,7 +31,7 @@ SWEEPS = {
 @pytest.fixture(scope="module")
 def pools():
     with concurrent.futures.ThreadPoolExecutor(2) as threads, \
-            concurrent.futures.ProcessPoolExecutor(2) as processes:
+            process_pool(2) as processes:
         yield {"threads": threads, "processes": processes}
 
 
