@@ -95,7 +95,7 @@ def rest_solution(problem: Problem, *, T: float | None = None, transcription="ra
     p = np.asarray(problem.p, dtype=float)
     node = NodeGuess(X=np.repeat(x0[:, None], n_x, axis=1), U=np.zeros((nu, n_u)),
                      Xu=np.repeat(x0[:, None], n_u, axis=1), p=p, T=T)
-    scaling = auto_scaling(problem, node, {"T": 1.0} if T == 0 else None)
+    scaling = auto_scaling(problem, node, overrides={"T": 1.0} if T == 0 else None)
     disc = Discretization(problem, tr, mesh, scaling)
     free = problem.free_params
     sc = scaling

@@ -301,7 +301,7 @@ def solve(problem: Problem, *, transcription="radau", N: int | None = None, degr
     """
     if not isinstance(problem, Problem):
         raise TypeError(f"`problem` must be an ocp.Problem, got {type(problem).__name__}")
-    tr = get_transcription(transcription, degree, control)
+    tr = get_transcription(transcription, degree=degree, control=control)
     m = default_mesh(N, mesh)
     sink = iteration_sink(verbose, progress)
     for name, flag in (("expand", expand), ("codegen", codegen), ("verify", verify)):
@@ -313,8 +313,8 @@ def solve(problem: Problem, *, transcription="radau", N: int | None = None, degr
     opts = solver_ipopt_options(ipopt_options, ctol)
 
     t_build = time.perf_counter()
-    node_guess = initial_guess(problem, tr, m, guess)
-    scaling = auto_scaling(problem, node_guess, scale)
+    node_guess = initial_guess(problem, tr, m, guess=guess)
+    scaling = auto_scaling(problem, node_guess, overrides=scale)
     disc = Discretization(problem, tr, m, scaling, expand, codegen)  # structure from the cache
     warm = _warm_point(guess, disc)
     if warm is not None:
@@ -331,7 +331,7 @@ def solve(problem: Problem, *, transcription="radau", N: int | None = None, degr
         sol = _solve_built(problem, tr, m, node_guess, opts, ctol, disc,
                            *_build_solver(disc, nlp_opts, sink), t_build,
                            default_guess=guess is None, warm=warm)
-    return verified(sol, btol, vtol, disc.scaling.objective)
+    return verified(sol, btol, vtol, objective_scale=disc.scaling.objective)
 
 
 def _check_bound_tol(bound_tol) -> float:
@@ -343,7 +343,7 @@ def _check_bound_tol(bound_tol) -> float:
 
 
 def verified(solution: Solution, constraint_tol: float, verify_tol: float | None,
-             objective_scale: float = 1.0) -> Solution:
+             *, objective_scale: float = 1.0) -> Solution:
     """``solution`` if it is no success or passes the checks 3 and 4 of the module docstring
     (bounds of the dense output within ``constraint_tol`` (the bound tolerance, ``inf``
     skips it); re-simulation within
@@ -354,11 +354,11 @@ def verified(solution: Solution, constraint_tol: float, verify_tol: float | None
         return solution
     bv = solution.bound_violation if np.isfinite(constraint_tol) else None
     if bv is not None and not bv.max <= constraint_tol:
-        why = (f"but {bv.describe(solution.problem.model.controls)}; exceeds constraint_tol "
-               f"{constraint_tol:g}: not verified")
+        why = (f"but {bv.describe(controls=solution.problem.model.controls)}; exceeds "
+               f"constraint_tol {constraint_tol:g}: not verified")
         return _failed(solution, STATUS_BOUND_VIOLATION, why)
     if verify_tol is not None:
-        why = resimulation_mismatch(solution, verify_tol, objective_scale)
+        why = resimulation_mismatch(solution, verify_tol, objective_scale=objective_scale)
         if why is not None:
             return _failed(solution, STATUS_RESIMULATION, f"but {why}")
     return solution
@@ -376,7 +376,7 @@ def _failed(solution: Solution, status: str, why: str) -> Solution:
     return out
 
 
-def nlp_numbers(disc, bounds: bool = True) -> bytes:
+def nlp_numbers(disc, *, bounds: bool = True) -> bytes:
     """Digest of everything numeric in the NLP of ``disc`` (an `ocp.nlp.Discretization`)
     besides its structure: the parameter values, the mesh and (``bounds=True``) the variable
     and constraint bounds (physical); 16 bytes. Two NLPs with equal structure keys and equal
@@ -516,7 +516,7 @@ def _run(solver, args):
 
 
 def make_solution(problem, tr, mesh, disc, w, lam_g, g, success, status, message,
-                   iterations, solve_time, build_time, lam_x=None) -> Solution:
+                   iterations, solve_time, build_time, *, lam_x=None) -> Solution:
     """The `Solution` at the scaled NLP point ``w`` (multipliers ``lam_g``, ``lam_x``,
     constraints ``g``)."""
     phys = disc.unpack(w)

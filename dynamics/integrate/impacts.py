@@ -223,7 +223,7 @@ def simulate_impacts(simulate: Callable, model: Model, x0: np.ndarray, t: np.nda
     checked names to evaluate on the joined solution.
     """
     start = time.perf_counter()
-    control = check_u(u, model.nu, t, hold)
+    control = check_u(u, model.nu, t, hold=hold)
     nx = model.nx
     ev = Event(impact.guard, terminal=True, direction=-1, name=impact.name)
     X = np.full((nx, t.size), np.nan)

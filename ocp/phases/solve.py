@@ -55,14 +55,15 @@ def _discretize(problem: MultiPhaseProblem, meshes, guesses, expand, codegen):
     """Per phase ``(transcription, mesh, node guess, Discretization)``."""
     out = []
     for i, ph in enumerate(problem.phases):
-        tr = get_transcription(ph.transcription, ph.degree)
+        tr = get_transcription(ph.transcription, degree=ph.degree)
         m = meshes[i] if meshes is not None else default_mesh(ph.N, ph.mesh)
         pb = replace(ph.problem, t0=0.0) if ph.problem.t0 != 0.0 else ph.problem
         try:
-            ng = initial_guess(pb, tr, m, guesses[i])  # (a Solution is read in normalized time)
+            # (a Solution is read in normalized time)
+            ng = initial_guess(pb, tr, m, guess=guesses[i])
         except ValueError as exc:
             raise ValueError(f"phases[{i}]: {exc}") from exc
-        scaling = auto_scaling(pb, ng, ph.scale)
+        scaling = auto_scaling(pb, ng, overrides=ph.scale)
         out.append((tr, m, ng, Discretization(pb, tr, m, scaling, expand, codegen)))
     return out
 
