@@ -12,7 +12,7 @@ from .nlp import Discretization
 from .problem import Problem
 from .scaling import auto_scaling
 from .solution import Solution
-from .solve import STATUS_CONSTRAINT_TOL, check_constraint_tol, make_solution
+from .solve import STATUS_CONSTRAINT_TOL, NlpOutcome, check_constraint_tol, make_solution
 from .transcription import get_transcription
 
 __all__ = ["rest_solution", "STATUS_REST"]
@@ -113,5 +113,6 @@ def rest_solution(problem: Problem, *, T: float | None = None, transcription="ra
         status = STATUS_CONSTRAINT_TOL
         message = (f"the initial state held under zero control for T = {T:g} s violates the "
                    f"constraints by {viol:.3g} > constraint_tol {ctol:g}: not a solution")
-    return make_solution(problem, tr, mesh, disc, w, np.zeros(disc.g.size), g, success, status,
-                          message, 0, 0.0, time.perf_counter() - t_build)
+    return make_solution(problem, tr, mesh, disc, NlpOutcome(
+        w=w, lam_g=np.zeros(disc.g.size), g=g, success=success, status=status, message=message,
+        iterations=0, solve_time=0.0, build_time=time.perf_counter() - t_build))

@@ -100,7 +100,7 @@ from .solution import Solution
 from .transcription import get_transcription
 
 __all__ = ["solve", "Progress", "DEFAULT_CONSTRAINT_TOL", "STATUS_CONSTRAINT_TOL", "STATUS_EXCEPTION",
-           "STATUS_BOUND_VIOLATION", "STATUS_RESIMULATION", "check_constraint_tol", "verified", "make_solution", "WARM_START_OPTIONS", "run_ipopt",
+           "STATUS_BOUND_VIOLATION", "STATUS_RESIMULATION", "check_constraint_tol", "verified", "make_solution", "NlpOutcome", "WARM_START_OPTIONS", "run_ipopt",
            "read_result", "default_mesh", "solver_ipopt_options", "nlp_numbers"]
 
 _SUCCESS = ("Solve_Succeeded",)
@@ -429,8 +429,9 @@ def _solve_built(problem, tr, m, node_guess, opts, ctol, disc, solver, nlp_opts,
     if not success and default_guess:
         message += _default_guess_hint(problem, node_guess)
     LOGGER.info("solve %s (%s, N=%d): %s; %.3g s", problem.name, tr.name, m.N, message, solve_time)
-    return make_solution(problem, tr, m, disc, w, lam_g, g, success, status, message,
-                          iterations, solve_time, build_time, lam_x=lam_x)
+    return make_solution(problem, tr, m, disc, NlpOutcome(
+        w=w, lam_g=lam_g, g=g, success=success, status=status, message=message,
+        iterations=iterations, solve_time=solve_time, build_time=build_time, lam_x=lam_x))
 
 
 def run_ipopt(solver, start: dict, bounds: dict, opts: dict, resolver):
@@ -515,10 +516,60 @@ def _run(solver, args):
     return res, error, str(stats.get("return_status", "Unknown")), int(stats.get("iter_count", 0))
 
 
-def make_solution(problem, tr, mesh, disc, w, lam_g, g, success, status, message,
-                   iterations, solve_time, build_time, *, lam_x=None) -> Solution:
-    """The `Solution` at the scaled NLP point ``w`` (multipliers ``lam_g``, ``lam_x``,
-    constraints ``g``)."""
+@dataclasses.dataclass(frozen=True)
+class NlpOutcome:
+    """What one NLP solve left (an IPOPT run, or the rest point of `ocp.rest_solution`): the
+    input of `make_solution`, carried as one object instead of a long positional list.
+
+    Attributes
+    ----------
+    w : numpy.ndarray
+        The scaled NLP point, ``(n_w,)``.
+    lam_g : numpy.ndarray
+        Constraint multipliers of the scaled NLP, ``(n_g,)``.
+    g : numpy.ndarray
+        Scaled constraint values at ``w``, ``(n_g,)`` (NaN after an evaluation error).
+    success : bool
+        Whether the solve met its tests so far.
+    status : str
+        The status (IPOPT's return status or one of this module's).
+    message : str
+        What happened, with the remedy on a failure.
+    iterations : int
+        IPOPT iterations (0: no NLP solved).
+    solve_time, build_time : float
+        Seconds in IPOPT and in building the NLP and solver.
+    lam_x : numpy.ndarray or None
+        Bound multipliers ``(n_w,)``; with them the `Solution` keeps its NLP point for a
+        warm start.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from appdyn.ocp.solve import NlpOutcome
+    >>> out = NlpOutcome(w=np.zeros(3), lam_g=np.zeros(1), g=np.zeros(1), success=True,
+    ...                  status="Solve_Succeeded", message="ok", iterations=5,
+    ...                  solve_time=0.01, build_time=0.1)
+    >>> out.iterations, out.lam_x is None
+    (5, True)
+    """
+
+    w: np.ndarray
+    lam_g: np.ndarray
+    g: np.ndarray
+    success: bool
+    status: str
+    message: str
+    iterations: int
+    solve_time: float
+    build_time: float
+    lam_x: np.ndarray | None = None
+
+
+def make_solution(problem, tr, mesh, disc, outcome: NlpOutcome) -> Solution:
+    """The `Solution` of ``problem`` transcribed by ``tr`` on ``mesh`` (NLP ``disc``) at the
+    scaled point of ``outcome`` (an `NlpOutcome`)."""
+    w, lam_g, g, lam_x = outcome.w, outcome.lam_g, outcome.g, outcome.lam_x
     phys = disc.unpack(w)
     viol = disc.violation(g, w) if np.all(np.isfinite(g)) else float("nan")
     point = None
@@ -528,6 +579,7 @@ def make_solution(problem, tr, mesh, disc, w, lam_g, g, success, status, message
                  "lam_x_phys": lam_x * dJ / sw, "lam_g_phys": np.asarray(lam_g) * dJ / sg}
     return Solution.from_arrays(
         problem, tr, mesh, phys["X"], phys["U"], phys["p"], phys["T"], cost=disc.cost(w),
-        success=success, status=status, message=message, iterations=iterations,
-        solve_time=solve_time, build_time=build_time, constraint_violation=viol,
+        success=outcome.success, status=outcome.status, message=outcome.message,
+        iterations=outcome.iterations, solve_time=outcome.solve_time,
+        build_time=outcome.build_time, constraint_violation=viol,
         multipliers=disc.multipliers(lam_g), nlp_point=point)

@@ -24,8 +24,8 @@ from ..progress import LOGGER, IterationCallback, iteration_sink
 from ..refine.errors import interval_errors
 from ..refine.mesh_update import local_order, new_mesh
 from ..scaling import auto_scaling
-from ..solve import (WARM_START_OPTIONS, check_constraint_tol, default_mesh, make_solution,
-                     nlp_numbers, read_result, run_ipopt, solver_ipopt_options)
+from ..solve import (WARM_START_OPTIONS, NlpOutcome, check_constraint_tol, default_mesh,
+                     make_solution, nlp_numbers, read_result, run_ipopt, solver_ipopt_options)
 from ..transcription import get_transcription
 from .nlp import PhasedDiscretization, event_row_scales
 from .problem import MultiPhaseProblem
@@ -243,8 +243,9 @@ def _solution(problem, disc, parts, w, lam_g, lam_x, g, success, status, message
         T = float(d.unpack(wi)["T"])
         pb = replace(d.problem, t0=start)
         d_t = _Shifted(d, pb)
-        phases.append(make_solution(pb, tr, m, d_t, wi, li, gi, success, status, message,
-                                    iterations, solve_time, build_time))
+        phases.append(make_solution(pb, tr, m, d_t, NlpOutcome(
+            w=wi, lam_g=li, g=gi, success=success, status=status, message=message,
+            iterations=iterations, solve_time=solve_time, build_time=build_time)))
         t0s.append(start)
         start += T
     t0 = np.array(t0s)
