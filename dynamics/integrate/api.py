@@ -221,7 +221,8 @@ def simulate(model: Model, x0, t, *, u=None, p=None, hold: Hold = "linear", meth
             raise ValueError("`impacts` and `events` are not taken together (yet): locate the "
                              "events on the result of the run with impacts, e.g. by simulating "
                              "between its impact times with `events`")
-        return simulate_impacts(simulate, model, x0, t, impact, u, p, hold, names, dict(
+        return simulate_impacts(simulate, model, x0, t, impact, u, p, hold=hold,
+                                invariants=names, options=RunOptions(
             method=method, rtol=rtol, atol=atol, steps=steps, jit=jit, max_steps=max_steps,
             cvodes_options=cvodes_options, progress=progress))
     specs = None if events is None else check_events(events, model, t, x0, control, p)

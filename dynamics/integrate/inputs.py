@@ -67,6 +67,18 @@ class RunOptions:
     cvodes_options: Mapping | None
     progress: Callable | None
 
+    def keywords(self) -> dict:
+        """The options as `simulate`'s keyword arguments (``simulate(..., **o.keywords())``).
+
+        Examples
+        --------
+        >>> from appdyn.dynamics.integrate.inputs import RunOptions
+        >>> RunOptions(method="rk4", rtol=1e-8, atol=1e-10, steps=10, jit=False,
+        ...            max_steps=1000, cvodes_options=None, progress=None).keywords()["steps"]
+        10
+        """
+        return dict(self.__dict__)
+
 
 def check_t(t) -> np.ndarray:
     """The output grid: 1-D, at least 2 finite times, strictly increasing (read-only copy)."""
