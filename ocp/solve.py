@@ -100,7 +100,8 @@ from .solution import Solution
 from .transcription import get_transcription
 
 __all__ = ["solve", "Progress", "DEFAULT_CONSTRAINT_TOL", "STATUS_CONSTRAINT_TOL", "STATUS_EXCEPTION",
-           "STATUS_BOUND_VIOLATION", "STATUS_RESIMULATION", "check_constraint_tol", "verified", "make_solution", "NlpOutcome", "WARM_START_OPTIONS", "run_ipopt",
+           "STATUS_BOUND_VIOLATION", "STATUS_RESIMULATION", "check_constraint_tol", "verified", "make_solution",
+           "NlpOutcome", "WARM_START_OPTIONS", "run_ipopt",
            "read_result", "default_mesh", "solver_ipopt_options", "nlp_numbers"]
 
 _SUCCESS = ("Solve_Succeeded",)

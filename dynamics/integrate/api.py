@@ -18,8 +18,8 @@ from .batch import BatchResult, check_batch, simulate_batch
 from .cvodes import run_cvodes
 from .events import apply_events, check_events
 from .impacts import check_impact, simulate_impacts
-from .inputs import (Problem, RunOptions, check_cvodes_options, check_invariants, check_t, check_tolerances,
-                     check_u, check_x0, fast_x0)
+from .inputs import (Problem, RunOptions, check_cvodes_options, check_invariants, check_t,
+                     check_tolerances, check_u, check_x0, fast_x0)
 from .kernels import check_lie_model
 from .loops import Progress, run_fixed, run_short
 from .result import FAILED, OK, OK_STIFF, VIOLATED, Dense, Run, SimulationResult, new_result
@@ -221,10 +221,11 @@ def simulate(model: Model, x0, t, *, u=None, p=None, hold: Hold = "linear", meth
             raise ValueError("`impacts` and `events` are not taken together (yet): locate the "
                              "events on the result of the run with impacts, e.g. by simulating "
                              "between its impact times with `events`")
+        options = RunOptions(method=method, rtol=rtol, atol=atol, steps=steps, jit=jit,
+                             max_steps=max_steps, cvodes_options=cvodes_options,
+                             progress=progress)
         return simulate_impacts(simulate, model, x0, t, impact, u, p, hold=hold,
-                                invariants=names, options=RunOptions(
-            method=method, rtol=rtol, atol=atol, steps=steps, jit=jit, max_steps=max_steps,
-            cvodes_options=cvodes_options, progress=progress))
+                                invariants=names, options=options)
     specs = None if events is None else check_events(events, model, t, x0, control, p)
     max_steps, steps, cvodes_options, counter = _check_options(method, max_steps, jit, steps,
                                                                cvodes_options, progress)

@@ -219,8 +219,8 @@ def simulate_impacts(simulate: Callable, model: Model, x0: np.ndarray, t: np.nda
     """`simulate` with ``impacts=impact``: runs between impacts joined on the grid ``t``.
 
     ``simulate`` is `dynamics.simulate` (called without impacts for each run); ``options``
-    its options for each run (a `RunOptions`: method, tolerances, steps, jit, ...); ``invariants`` the
-    checked names to evaluate on the joined solution.
+    its options for each run (a `RunOptions`: method, tolerances, steps, jit, ...);
+    ``invariants`` the checked names to evaluate on the joined solution.
     """
     start = time.perf_counter()
     control = check_u(u, model.nu, t, hold=hold)

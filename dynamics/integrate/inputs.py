@@ -19,7 +19,8 @@ from ..model import Model
 from ..validate import (QUAT_NORM_TOL, check_unit_quaternion, finite_array, finite_scalar,
                         unit_quaternion)
 
-__all__ = ["HOLDS", "Batch", "Control", "Problem", "RunOptions", "check_batch", "check_t", "check_x0", "check_tolerances",
+__all__ = ["HOLDS", "Batch", "Control", "Problem", "RunOptions", "check_batch", "check_t",
+           "check_x0", "check_tolerances",
            "check_u", "check_invariants", "check_cvodes_options"]
 
 _EPS = np.finfo(float).eps
