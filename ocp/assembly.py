@@ -73,7 +73,7 @@ def problem_functions(problem) -> list:
             *[c.fun for c in problem.path], *[c.fun for c in problem.boundary]]
 
 
-def structure_key(problem, transcription, N: int, expand: bool, codegen: bool = False) -> tuple:
+def structure_key(problem, transcription, N: int, expand: bool, *, codegen: bool = False) -> tuple:
     """What determines a `Structure`: see the module docstring."""
     model = problem.model
     return (transcription, int(N), bool(expand), bool(codegen), content_key(model.f), content_key(problem.lagrange),
@@ -258,9 +258,9 @@ class Intervals:
         self.ends = local("ends", end_in, end_rows, end_q, v_end, lam_end)
 
 
-def intervals(problem, transcription, expand: bool = True, codegen: bool = False) -> Intervals:
+def intervals(problem, transcription, *, expand: bool = True, codegen: bool = False) -> Intervals:
     """The `Intervals` of ``problem`` transcribed by ``transcription``, from the one cache."""
-    key = structure_key(problem, transcription, 0, expand, codegen)
+    key = structure_key(problem, transcription, 0, expand, codegen=codegen)
     return cached("nlp_intervals", key, lambda: Intervals(problem, transcription, expand, codegen),
                   keepalive=tuple(f for f in problem_functions(problem) if f is not None))
 
@@ -296,7 +296,7 @@ class Structure:
     """
 
     def __init__(self, problem, transcription, N: int, expand: bool = True, codegen: bool = False):
-        loc = intervals(problem, transcription, expand, codegen)
+        loc = intervals(problem, transcription, expand=expand, codegen=codegen)
         self.N, self.transcription, self.common = N, transcription, loc.common
         self.symbolic, self.compiled = loc.symbolic, loc.compiled
         dims = loc.sizes

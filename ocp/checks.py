@@ -113,7 +113,7 @@ class BoundViolation:
     def __float__(self) -> float:
         return float(self.max)
 
-    def describe(self, controls: tuple = ()) -> str:
+    def describe(self, *, controls: tuple = ()) -> str:
         """A sentence on the worst violation and its remedy."""
         if self.name is None:
             return "within bounds"
@@ -236,7 +236,8 @@ def periodic_jumps(solution) -> list[tuple[str, float, int]]:
     return out
 
 
-def resimulation_mismatch(solution, verify_tol: float, objective_scale: float = 1.0) -> str | None:
+def resimulation_mismatch(solution, verify_tol: float, *,
+                          objective_scale: float = 1.0) -> str | None:
     """Why the re-simulation of ``solution`` disagrees with its collocation beyond
     ``verify_tol`` (module docstring), or ``None`` when it agrees.
 

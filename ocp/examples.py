@@ -95,7 +95,7 @@ def _build() -> Model:
 _DOUBLE_INTEGRATOR = _build()
 
 
-def min_energy(distance: float = 1.0, T: float = 1.0) -> Problem:
+def min_energy(*, distance: float = 1.0, T: float = 1.0) -> Problem:
     """Minimum ``integral u^2 / 2`` [m^2/s^3], rest to rest over ``distance`` [m] in ``T`` [s].
 
     Returns
@@ -108,7 +108,7 @@ def min_energy(distance: float = 1.0, T: float = 1.0) -> Problem:
                    name="double integrator, minimum energy")
 
 
-def min_time(distance: float = 1.0, u_max: float = 1.0, T_max: float = 10.0) -> Problem:
+def min_time(*, distance: float = 1.0, u_max: float = 1.0, T_max: float = 10.0) -> Problem:
     """Minimum time, rest to rest over ``distance`` [m] under ``|u| <= u_max`` [m/s^2].
 
     Returns
@@ -143,7 +143,7 @@ def _goddard_model() -> Model:
 _GODDARD = _goddard_model()
 
 
-def goddard_rocket(regularization: float = 0.0) -> Problem:
+def goddard_rocket(*, regularization: float = 0.0) -> Problem:
     """Goddard rocket, maximum final altitude (COPS 3.0 / Betts, normalized units).
 
     States ``h`` (altitude [h0]), ``v`` (velocity [sqrt(g0 h0)]), ``m`` (mass [m0]); control
@@ -368,7 +368,7 @@ def shuttle_reentry() -> Problem:
                    mayer=_latitude, maximize=True, name="shuttle reentry")
 
 
-def shuttle_reentry_guess(n: int = 21) -> dict:
+def shuttle_reentry_guess(*, n: int = 21) -> dict:
     """The start of ASSET's reentry example: over T = 1000 s, ``h``, ``v`` and ``gamma``
     straight from their initial to their final values, ``theta = 0``, ``psi = 90`` deg,
     ``alpha = beta = 0``; ``n`` samples (a guess for `shuttle_reentry`, in its units).
@@ -376,7 +376,7 @@ def shuttle_reentry_guess(n: int = 21) -> dict:
     Examples
     --------
     >>> from appdyn.ocp.examples import shuttle_reentry_guess
-    >>> shuttle_reentry_guess(5)["x"].shape
+    >>> shuttle_reentry_guess(n=5)["x"].shape
     (5, 5)
     """
     import numpy as np

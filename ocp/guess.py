@@ -263,7 +263,8 @@ def _from_mapping(problem, guess: Mapping):
                         _default_control(problem)) if "u" in guess else _default_control(problem)
         control = ("guess['u']" if "u" in guess
                    else "the default control (0 clipped into the bounds)")
-        found = _simulated_horizon(problem, lambda t: u_of_t(np.asarray(t) - t0), p, control)
+        found = _simulated_horizon(problem, lambda t: u_of_t(np.asarray(t) - t0), p,
+                                   control=control)
         if found is not None:
             T, x_fun, source = found
     if "x" in guess:
@@ -297,7 +298,7 @@ def _from_solution(problem, sol):
 
 
 
-def initial_guess(problem, transcription, mesh, guess=None) -> NodeGuess:
+def initial_guess(problem, transcription, mesh, *, guess=None) -> NodeGuess:
     """Sample a guess on the nodes of ``transcription`` on ``mesh``.
 
     Parameters

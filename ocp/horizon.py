@@ -80,7 +80,7 @@ def typical_magnitude(problem) -> np.ndarray:
     return s
 
 
-def simulate_control(problem, u: np.ndarray, t: np.ndarray, p, x0=None, **options):
+def simulate_control(problem, u: np.ndarray, t: np.ndarray, p, *, x0=None, **options):
     """`dynamics.simulate` of the model under control samples clipped into the bounds.
 
     Parameters
@@ -111,7 +111,7 @@ def simulate_control(problem, u: np.ndarray, t: np.ndarray, p, x0=None, **option
 
 
 def simulated_horizon(problem, u_of_t: Callable, p: np.ndarray,
-                      control: str = "the guessed control"):
+                      *, control: str = "the guessed control"):
     """The horizon of a free-time problem at which the model, simulated from ``x_initial``
     under the control ``u_of_t(t) -> (nu, len(t))``, comes closest to ``x_final``.
 

@@ -236,7 +236,7 @@ def _available(library: tuple) -> tuple | None:
     return tuple(n for n in LINEAR_SOLVERS if found.get(n, False))
 
 
-def available_linear_solvers(options=None) -> tuple | None:
+def available_linear_solvers(*, options=None) -> tuple | None:
     """The IPOPT linear solvers that load in this installation (probed once per process and
     library setting; about 1 s, in a subprocess).
 
@@ -266,7 +266,7 @@ def available_linear_solvers(options=None) -> tuple | None:
 def _check_linear_solver(out: dict) -> None:
     """Raise a ValueError if ``out['linear_solver']`` does not load (`available_linear_solvers`)."""
     name = str(out["linear_solver"]).lower()
-    available = available_linear_solvers(out)
+    available = available_linear_solvers(options=out)
     if available is None or name in available or name not in LINEAR_SOLVERS:
         return
     library = {k: out[k] for k in _LIBRARY_OPTIONS if k in out}

@@ -26,7 +26,7 @@ from .cached import cached
 __all__ = ["Discretization", "structure"]
 
 
-def structure(problem, transcription, N: int, expand: bool = True, codegen: bool = False, *,
+def structure(problem, transcription, N: int, *, expand: bool = True, codegen: bool = False,
               key: tuple | None = None) -> Structure:
     """The `Structure` of ``problem`` transcribed by ``transcription`` on ``N`` intervals,
     from the one cache (built on a miss; in MX when SX construction fails)."""
@@ -39,7 +39,7 @@ def structure(problem, transcription, N: int, expand: bool = True, codegen: bool
             return Structure(problem, transcription, N, False)
 
     if key is None:  # (serializing the functions for their content keys costs about 60 us each)
-        key = structure_key(problem, transcription, N, expand, codegen)
+        key = structure_key(problem, transcription, N, expand, codegen=codegen)
     return cached("nlp_structure", key, build,
                   keepalive=tuple(f for f in problem_functions(problem) if f is not None))
 
@@ -77,8 +77,9 @@ class Discretization:
 
     def __init__(self, problem, transcription, mesh, scaling, expand: bool = True, codegen: bool = False):
         self.problem, self.transcription, self.mesh, self.scaling = problem, transcription, mesh, scaling
-        self.key = structure_key(problem, transcription, mesh.N, expand, codegen)
-        st = self.structure = structure(problem, transcription, mesh.N, expand, codegen, key=self.key)
+        self.key = structure_key(problem, transcription, mesh.N, expand, codegen=codegen)
+        st = self.structure = structure(problem, transcription, mesh.N, expand=expand,
+                                        codegen=codegen, key=self.key)
         self.w, self.g, self.nlp = st.w, st.g, st.nlp
         self.P = st.params_value(problem, mesh, scaling)
         free, sc = problem.free_params, scaling
@@ -154,7 +155,7 @@ class Discretization:
                           "quat_norm": 1.0, "q_final": q})
         return sw, sg, float(sc.objective)
 
-    def multipliers(self, lam_g, objective_multiplier: float = 1.0) -> dict:
+    def multipliers(self, lam_g, *, objective_multiplier: float = 1.0) -> dict:
         """Multipliers of the unscaled constraints, by block.
 
         CasADi's ``lam_g`` belongs to the scaled NLP ``sign J / d_J + lam_g . g_scaled``; for

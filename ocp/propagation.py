@@ -84,7 +84,7 @@ def state_scale(x: np.ndarray) -> np.ndarray:
     return np.maximum(np.max(np.abs(x), axis=1), SCALE_FLOOR)
 
 
-def propagate(sol, rtol: float = 1e-12, atol: float = 1e-12) -> Propagation:
+def propagate(sol, *, rtol: float = 1e-12, atol: float = 1e-12) -> Propagation:
     """`ocp.Solution.propagate` (its docstring): re-simulate ``sol``'s dense control with
     CVODES per mesh interval, with the running cost as a quadrature."""
     for name, v in (("rtol", rtol), ("atol", atol)):

@@ -12,8 +12,8 @@ from .nlp import Discretization
 from .problem import Problem
 from .scaling import auto_scaling
 from .solution import Solution
+from .solve import STATUS_CONSTRAINT_TOL, NlpOutcome, check_constraint_tol, make_solution
 from .status import SOLVER_REST
-from .solve import STATUS_CONSTRAINT_TOL, check_constraint_tol, make_solution
 from .transcription import get_transcription
 
 __all__ = ["rest_solution", "STATUS_REST"]
@@ -98,7 +98,7 @@ def rest_solution(problem: Problem, *, T: float | None = None, transcription="ra
     p = np.asarray(problem.p, dtype=float)
     node = NodeGuess(X=np.repeat(x0[:, None], n_x, axis=1), U=np.zeros((nu, n_u)),
                      Xu=np.repeat(x0[:, None], n_u, axis=1), p=p, T=T)
-    scaling = auto_scaling(problem, node, {"T": 1.0} if T == 0 else None)
+    scaling = auto_scaling(problem, node, overrides={"T": 1.0} if T == 0 else None)
     disc = Discretization(problem, tr, mesh, scaling)
     free = problem.free_params
     sc = scaling
@@ -116,6 +116,7 @@ def rest_solution(problem: Problem, *, T: float | None = None, transcription="ra
         status = STATUS_CONSTRAINT_TOL
         message = (f"the initial state held under zero control for T = {T:g} s violates the "
                    f"constraints by {viol:.3g} > constraint_tol {ctol:g}: not a solution")
-    return make_solution(problem, tr, mesh, disc, w, np.zeros(disc.g.size), g, success, status,
-                          message, 0, 0.0, time.perf_counter() - t_build,
-                          solver_status=STATUS_REST)
+    return make_solution(problem, tr, mesh, disc, NlpOutcome(
+        w=w, lam_g=np.zeros(disc.g.size), g=g, success=success, status=status, message=message,
+        iterations=0, solve_time=0.0, build_time=time.perf_counter() - t_build,
+        solver_status=STATUS_REST))

@@ -107,7 +107,7 @@ def _concat(constraints, attr):
     return np.concatenate(parts) if parts else np.zeros(0)
 
 
-def auto_scaling(problem, guess, overrides: Mapping | None = None) -> Scaling:
+def auto_scaling(problem, guess, *, overrides: Mapping | None = None) -> Scaling:
     """Scale factors from the bounds and the initial guess, with overrides.
 
     Parameters

@@ -483,7 +483,7 @@ class Solution(Result):
         >>> prop.success, round(prop.cost, 8), bool(prop.relative_error.max() < 1e-9)
         (True, 6.0, True)
         """
-        return propagate(self, rtol, atol)
+        return propagate(self, rtol=rtol, atol=atol)
 
     @cached_property
     def propagation(self) -> Propagation:

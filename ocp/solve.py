@@ -104,7 +104,8 @@ from .status import STATUS_CONSTRAINT_TOL, STATUS_EXCEPTION, status_code
 from .transcription import get_transcription
 
 __all__ = ["solve", "Progress", "DEFAULT_CONSTRAINT_TOL", "STATUS_CONSTRAINT_TOL", "STATUS_EXCEPTION",
-           "STATUS_BOUND_VIOLATION", "STATUS_RESIMULATION", "check_constraint_tol", "verified", "make_solution", "WARM_START_OPTIONS", "run_ipopt",
+           "STATUS_BOUND_VIOLATION", "STATUS_RESIMULATION", "check_constraint_tol", "verified", "make_solution",
+           "NlpOutcome", "WARM_START_OPTIONS", "run_ipopt",
            "read_result", "default_mesh", "solver_ipopt_options", "nlp_numbers"]
 
 _SUCCESS = ("Solve_Succeeded",)
@@ -303,7 +304,7 @@ def solve(problem: Problem, *, transcription="radau", N: int | None = None, degr
     """
     if not isinstance(problem, Problem):
         raise TypeError(f"`problem` must be an ocp.Problem, got {type(problem).__name__}")
-    tr = get_transcription(transcription, degree, control)
+    tr = get_transcription(transcription, degree=degree, control=control)
     m = default_mesh(N, mesh)
     sink = iteration_sink(verbose, progress)
     for name, flag in (("expand", expand), ("codegen", codegen), ("verify", verify)):
@@ -315,8 +316,8 @@ def solve(problem: Problem, *, transcription="radau", N: int | None = None, degr
     opts = solver_ipopt_options(ipopt_options, ctol)
 
     t_build = time.perf_counter()
-    node_guess = initial_guess(problem, tr, m, guess)
-    scaling = auto_scaling(problem, node_guess, scale)
+    node_guess = initial_guess(problem, tr, m, guess=guess)
+    scaling = auto_scaling(problem, node_guess, overrides=scale)
     disc = Discretization(problem, tr, m, scaling, expand, codegen)  # structure from the cache
     warm = _warm_point(guess, disc)
     if warm is not None:
@@ -333,7 +334,7 @@ def solve(problem: Problem, *, transcription="radau", N: int | None = None, degr
         sol = _solve_built(problem, tr, m, node_guess, opts, ctol, disc,
                            *_build_solver(disc, nlp_opts, sink), t_build,
                            default_guess=guess is None, warm=warm)
-    return verified(sol, btol, vtol, disc.scaling.objective)
+    return verified(sol, btol, vtol, objective_scale=disc.scaling.objective)
 
 
 def _check_bound_tol(bound_tol) -> float:
@@ -345,7 +346,7 @@ def _check_bound_tol(bound_tol) -> float:
 
 
 def verified(solution: Solution, constraint_tol: float, verify_tol: float | None,
-             objective_scale: float = 1.0) -> Solution:
+             *, objective_scale: float = 1.0) -> Solution:
     """``solution`` if it is no success or passes the checks 3 and 4 of the module docstring
     (bounds of the dense output within ``constraint_tol`` (the bound tolerance, ``inf``
     skips it); re-simulation within
@@ -356,11 +357,11 @@ def verified(solution: Solution, constraint_tol: float, verify_tol: float | None
         return solution
     bv = solution.bound_violation if np.isfinite(constraint_tol) else None
     if bv is not None and not bv.max <= constraint_tol:
-        why = (f"but {bv.describe(solution.problem.model.controls)}; exceeds constraint_tol "
-               f"{constraint_tol:g}: not verified")
+        why = (f"but {bv.describe(controls=solution.problem.model.controls)}; exceeds "
+               f"constraint_tol {constraint_tol:g}: not verified")
         return _failed(solution, STATUS_BOUND_VIOLATION, why)
     if verify_tol is not None:
-        why = resimulation_mismatch(solution, verify_tol, objective_scale)
+        why = resimulation_mismatch(solution, verify_tol, objective_scale=objective_scale)
         if why is not None:
             return _failed(solution, STATUS_RESIMULATION, f"but {why}")
     return solution
@@ -378,7 +379,7 @@ def _failed(solution: Solution, status: int, why: str) -> Solution:
     return out
 
 
-def nlp_numbers(disc, bounds: bool = True) -> bytes:
+def nlp_numbers(disc, *, bounds: bool = True) -> bytes:
     """Digest of everything numeric in the NLP of ``disc`` (an `ocp.nlp.Discretization`)
     besides its structure: the parameter values, the mesh and (``bounds=True``) the variable
     and constraint bounds (physical); 16 bytes. Two NLPs with equal structure keys and equal
@@ -431,9 +432,10 @@ def _solve_built(problem, tr, m, node_guess, opts, ctol, disc, solver, nlp_opts,
     if not success and default_guess:
         message += _default_guess_hint(problem, node_guess)
     LOGGER.info("solve %s (%s, N=%d): %s; %.3g s", problem.name, tr.name, m.N, message, solve_time)
-    return make_solution(problem, tr, m, disc, w, lam_g, g, success, status, message,
-                          iterations, solve_time, build_time, lam_x=lam_x,
-                          solver_status=solver_status)
+    return make_solution(problem, tr, m, disc, NlpOutcome(
+        w=w, lam_g=lam_g, g=g, success=success, status=status, message=message,
+        iterations=iterations, solve_time=solve_time, build_time=build_time, lam_x=lam_x,
+        solver_status=solver_status))
 
 
 def run_ipopt(solver, start: dict, bounds: dict, opts: dict, resolver):
@@ -520,11 +522,63 @@ def _run(solver, args):
     return res, error, str(stats.get("return_status", "Unknown")), int(stats.get("iter_count", 0))
 
 
-def make_solution(problem, tr, mesh, disc, w, lam_g, g, success, status, message,
-                   iterations, solve_time, build_time, lam_x=None,
-                   solver_status: str = "Solve_Succeeded") -> Solution:
-    """The `Solution` at the scaled NLP point ``w`` (multipliers ``lam_g``, ``lam_x``,
-    constraints ``g``; ``status`` an int of `ocp.status`, ``solver_status`` IPOPT's text)."""
+@dataclasses.dataclass(frozen=True)
+class NlpOutcome:
+    """What one NLP solve left (an IPOPT run, or the rest point of `ocp.rest_solution`): the
+    input of `make_solution`, carried as one object instead of a long positional list.
+
+    Attributes
+    ----------
+    w : numpy.ndarray
+        The scaled NLP point, ``(n_w,)``.
+    lam_g : numpy.ndarray
+        Constraint multipliers of the scaled NLP, ``(n_g,)``.
+    g : numpy.ndarray
+        Scaled constraint values at ``w``, ``(n_g,)`` (NaN after an evaluation error).
+    success : bool
+        Whether the solve met its tests so far.
+    status : int
+        The status (a code of `ocp.status`).
+    message : str
+        What happened, with the remedy on a failure.
+    iterations : int
+        IPOPT iterations (0: no NLP solved).
+    solve_time, build_time : float
+        Seconds in IPOPT and in building the NLP and solver.
+    lam_x : numpy.ndarray or None
+        Bound multipliers ``(n_w,)``; with them the `Solution` keeps its NLP point for a
+        warm start.
+    solver_status : str
+        IPOPT's return status as text (``'Rest_Solution'`` when no NLP was solved).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from appdyn.ocp.solve import NlpOutcome
+    >>> out = NlpOutcome(w=np.zeros(3), lam_g=np.zeros(1), g=np.zeros(1), success=True,
+    ...                  status=0, message="ok", iterations=5,
+    ...                  solve_time=0.01, build_time=0.1)
+    >>> out.iterations, out.lam_x is None
+    (5, True)
+    """
+
+    w: np.ndarray
+    lam_g: np.ndarray
+    g: np.ndarray
+    success: bool
+    status: int
+    message: str
+    iterations: int
+    solve_time: float
+    build_time: float
+    lam_x: np.ndarray | None = None
+    solver_status: str = "Solve_Succeeded"
+
+
+def make_solution(problem, tr, mesh, disc, outcome: NlpOutcome) -> Solution:
+    """The `Solution` of ``problem`` transcribed by ``tr`` on ``mesh`` (NLP ``disc``) at the
+    scaled point of ``outcome`` (an `NlpOutcome`)."""
+    w, lam_g, g, lam_x = outcome.w, outcome.lam_g, outcome.g, outcome.lam_x
     phys = disc.unpack(w)
     viol = disc.violation(g, w) if np.all(np.isfinite(g)) else float("nan")
     point = None
@@ -534,6 +588,8 @@ def make_solution(problem, tr, mesh, disc, w, lam_g, g, success, status, message
                  "lam_x_phys": lam_x * dJ / sw, "lam_g_phys": np.asarray(lam_g) * dJ / sg}
     return Solution.from_arrays(
         problem, tr, mesh, phys["X"], phys["U"], phys["p"], phys["T"], cost=disc.cost(w),
-        success=success, status=status, message=message, iterations=iterations,
-        solve_time=solve_time, build_time=build_time, constraint_violation=viol,
-        multipliers=disc.multipliers(lam_g), nlp_point=point, solver_status=str(solver_status))
+        success=outcome.success, status=outcome.status, message=outcome.message,
+        iterations=outcome.iterations, solve_time=outcome.solve_time,
+        build_time=outcome.build_time, constraint_violation=viol,
+        multipliers=disc.multipliers(lam_g), nlp_point=point,
+        solver_status=str(outcome.solver_status))

@@ -530,7 +530,7 @@ _RADAU_BY_CONTROL = {"polynomial": Radau, "constant": RadauConstantControl,
                      "linear": RadauLinearControl}
 
 
-def get_transcription(transcription="radau", degree: int | None = None,
+def get_transcription(transcription="radau", *, degree: int | None = None,
                       control: str | None = None) -> Transcription:
     """A `Transcription` from its name (or pass an instance through).
 

@@ -19,6 +19,11 @@ included) and ``appdyn/``:
   (``{}``, ``dict()``, ``OrderedDict()``, a ``weakref`` dictionary) outside the one cache
   (`appdyn.dynamics.cache`, emptied by `appdyn.dynamics.clear_caches`): a memoized factory
   uses ``cache.memoize``/``cache.memoize_values``, anything else ``cache.get``.
+* **Options keyword-only** (in `appdyn.dynamics.integrate` and `appdyn.ocp`). A public
+  function (a name in its module's or its package's ``__all__``) and a public method of a
+  public class take its essentials (the data it is about, without defaults) positionally
+  and its options (parameters with a default) after ``*``: no positional-or-keyword
+  parameter has a default. Dataclass fields (generated ``__init__``) are not checked.
 
 The allowlists below hold the exceptions, each with its reason (private imports and import
 circles: none). An entry that no longer occurs fails too (so the lists only shrink).
@@ -49,6 +54,26 @@ CACHES_ALLOWED = {
     ("appdyn.dynamics.cache", "_KEYS"),
     ("appdyn.dynamics.diskcache", "_IDS"),
     ("appdyn.ocp.refine.multistart", "_RECEIVED"),  # a worker's unpickled problems
+}
+
+# Packages whose public functions take their options keyword-only.
+KEYWORD_ONLY_PACKAGES = ("appdyn.dynamics.integrate", "appdyn.ocp")
+# (module, qualified name, parameter) of the defaults kept positional, each with its reason.
+POSITIONAL_DEFAULTS_ALLOWED = {
+    # the axes a plot draws into: ``result.plot(ax)``, as matplotlib's own plot helpers
+    ("appdyn.dynamics.integrate.batch", "BatchResult.plot", "ax"),
+    ("appdyn.dynamics.integrate.result", "SimulationResult.plot", "ax"),
+    ("appdyn.ocp.solution", "Solution.plot", "ax"),
+    ("appdyn.ocp.phases.solution", "MultiPhaseSolution.plot", "ax"),
+    # the NLP point whose bound violation is measured besides ``g``: data, not an option
+    ("appdyn.ocp.nlp", "Discretization.violation", "w"),
+    ("appdyn.ocp.phases.nlp", "PhasedDiscretization.violation", "w"),
+    # the solution to refine from (``refine(problem, sol)``, the documented call form)
+    ("appdyn.ocp.refine.mesh_update", "refine", "solution"),
+    # the info merged into the annotated solution (``annotate(sol, {...})``): its data
+    ("appdyn.ocp.refine.result", "annotate", "info"),
+    # the transcription named: the function's one essential (``"radau"`` when omitted)
+    ("appdyn.ocp.transcription", "get_transcription", "transcription"),
 }
 
 
@@ -216,6 +241,47 @@ def caches_outside_the_one_cache() -> set:
     return found
 
 
+def _exported(module: str) -> set:
+    """The names in ``__all__`` of ``module`` and of every package above it."""
+    names, parts = set(), module.split(".")
+    for k in range(len(parts), 1, -1):
+        name = ".".join(parts[:k])
+        if name not in _modules():
+            continue
+        for node in _modules()[name][1].body:
+            if (isinstance(node, ast.Assign) and any(getattr(t, "id", None) == "__all__"
+                                                     for t in node.targets)
+                    and isinstance(node.value, (ast.List, ast.Tuple))):
+                names |= {e.value for e in node.value.elts if isinstance(e, ast.Constant)}
+    return names
+
+
+def _positional_defaults(fun: ast.FunctionDef) -> list:
+    """The positional-or-keyword parameters of ``fun`` that have a default."""
+    args = fun.args
+    return [a.arg for a in args.args[len(args.args) - len(args.defaults):]]
+
+
+def positional_defaults(packages=KEYWORD_ONLY_PACKAGES) -> set:
+    """``(module, qualified name, parameter)`` of every option (a parameter with a default)
+    a public function or method of ``packages`` takes positionally."""
+    found = set()
+    for module, (_, tree) in _modules().items():
+        if not module.startswith(packages):
+            continue
+        public = _exported(module)
+        for node in tree.body:
+            if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef)) and node.name in public:
+                found |= {(module, node.name, a) for a in _positional_defaults(node)}
+            elif isinstance(node, ast.ClassDef) and node.name in public:
+                for fun in node.body:
+                    if (isinstance(fun, (ast.FunctionDef, ast.AsyncFunctionDef))
+                            and not fun.name.startswith("_")):
+                        found |= {(module, f"{node.name}.{fun.name}", a)
+                                  for a in _positional_defaults(fun)}
+    return found
+
+
 def _check(found: set, allowed: set, what: str) -> None:
     new, gone = found - allowed, allowed - found
     assert not new, f"{what} (give the helper a public name, or merge): {sorted(new)}"
@@ -242,6 +308,13 @@ def test_every_cache_is_the_one_cache():
     _check(caches_outside_the_one_cache(), CACHES_ALLOWED, "caches outside dynamics.cache")
 
 
+def test_public_options_are_keyword_only():
+    found = positional_defaults()
+    new, gone = found - POSITIONAL_DEFAULTS_ALLOWED, POSITIONAL_DEFAULTS_ALLOWED - found
+    assert not new, f"options taken positionally (move them after `*`): {sorted(new)}"
+    assert not gone, f"no longer found; remove from the allowlist in {__file__}: {sorted(gone)}"
+
+
 @pytest.mark.parametrize("graph, expected", [
     ({"a": {"b"}, "b": {"a"}, "c": {"a"}}, {frozenset("ab")}),
     ({"a": {"b"}, "b": {"c"}, "c": {"a", "d"}, "d": set()}, {frozenset("abc")}),
@@ -260,6 +333,13 @@ def test_the_rules_catch_what_they_forbid(tmp_path, monkeypatch):
     (pkg / "a.py").write_text("import functools\nfrom .b import _helper\n_T = {}\n"
                               "@functools.lru_cache(maxsize=2)\ndef f():\n    pass\n")
     (pkg / "b.py").write_text("def _helper():\n    from . import a\n")
+    (pkg / "c.py").write_text(
+        "__all__ = ['run', 'Kept', 'ok']\n"
+        "def run(x, y=1, *, z=2):\n    pass\n"          # y: an option taken positionally
+        "def ok(x, *, y=1):\n    pass\n"
+        "def other(x, y=1):\n    pass\n"              # not public
+        "class Kept:\n    def go(self, a, b=0):\n        pass\n"
+        "    def _own(self, a=0):\n        pass\n")
     monkeypatch.setitem(globals(), "ROOT", tmp_path)
     monkeypatch.setitem(globals(), "FOLDERS", ("dynamics",))
     _modules.cache_clear()
@@ -271,6 +351,8 @@ def test_the_rules_catch_what_they_forbid(tmp_path, monkeypatch):
                                                       "appdyn.dynamics.b"})}
         assert caches_outside_the_one_cache() == {("appdyn.dynamics.a", "_T"),
                                                   ("appdyn.dynamics.a", "f")}
+        assert positional_defaults(("appdyn.dynamics",)) == {
+            ("appdyn.dynamics.c", "run", "y"), ("appdyn.dynamics.c", "Kept.go", "b")}
     finally:
         _modules.cache_clear()
         _nodes.cache_clear()

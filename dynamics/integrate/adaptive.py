@@ -136,7 +136,7 @@ def _return_work(work: _Work) -> None:
 
 
 def run_pass(problem: Problem, rtol: float, atol: np.ndarray, theta: float, max_steps: int,
-             progress, bmin: int = 1, ulps: float = math.inf) -> Pass | None:
+             progress, *, bmin: int = 1, ulps: float = math.inf) -> Pass | None:
     """The pass over ``problem`` (linear control) with the check run's embedded estimate
     aimed at ``theta`` tolerances per unit time, at least ``bmin >= 1`` check steps per
     interval; the check run starts from ``x0 (1 + 2 eps s)`` (``s`` a fixed pattern of

@@ -3,6 +3,7 @@ from __future__ import annotations
 
 import math
 import time
+from dataclasses import replace
 from types import MappingProxyType
 from typing import Callable, Literal, Mapping
 
@@ -17,8 +18,8 @@ from .batch import BatchResult, check_batch, simulate_batch
 from .cvodes import run_cvodes
 from .events import apply_events, check_events
 from .impacts import check_impact, simulate_impacts
-from .inputs import (Problem, check_cvodes_options, check_invariants, check_t, check_tolerances,
-                     check_u, check_x0, fast_x0)
+from .inputs import (Problem, RunOptions, check_cvodes_options, check_invariants, check_t,
+                     check_tolerances, check_u, check_x0, fast_x0)
 from .kernels import check_lie_model
 from .loops import Progress, run_fixed, run_short
 from .result import FAILED, OK, OK_STIFF, VIOLATED, Dense, Run, SimulationResult, new_result
@@ -200,15 +201,18 @@ def simulate(model: Model, x0, t, *, u=None, p=None, hold: Hold = "linear", meth
                 if given is not None:
                     raise ValueError(f"`{name}` are located for single runs only; simulate "
                                      "the runs of a batch (`x0` of shape (nx, K)) one by one")
-            return _simulate_batch(model, x0, t, u, p, method, rtol, atol, invariants, steps,
-                                   jit, max_steps, cvodes_options, progress, start, hold)
+            options = RunOptions(method=method, rtol=rtol, atol=atol, steps=steps, jit=jit,
+                                 max_steps=max_steps, cvodes_options=cvodes_options,
+                                 progress=progress)
+            return _simulate_batch(model, x0, t, u, p, options, invariants=invariants,
+                                   hold=hold, start=start)
         x = check_x0(x0, model)
     x0 = x
     if CLOCK_STATE in model.states:  # a time-dependent model: its clock starts at t[0]
         check_clock_start(model, x0, t[0])
     p = model.resolve_p(p)
     rtol, atol = check_tolerances(rtol, atol, model.nx)
-    control = None if u is None and hold == "linear" else check_u(u, model.nu, t, hold)
+    control = None if u is None and hold == "linear" else check_u(u, model.nu, t, hold=hold)
     # (None: zero, made if needed)
     names = check_invariants(invariants, model)
     if impacts is not None:
@@ -217,9 +221,11 @@ def simulate(model: Model, x0, t, *, u=None, p=None, hold: Hold = "linear", meth
             raise ValueError("`impacts` and `events` are not taken together (yet): locate the "
                              "events on the result of the run with impacts, e.g. by simulating "
                              "between its impact times with `events`")
-        return simulate_impacts(simulate, model, x0, t, impact, u, p, hold, names, dict(
-            method=method, rtol=rtol, atol=atol, steps=steps, jit=jit, max_steps=max_steps,
-            cvodes_options=cvodes_options, progress=progress))
+        options = RunOptions(method=method, rtol=rtol, atol=atol, steps=steps, jit=jit,
+                             max_steps=max_steps, cvodes_options=cvodes_options,
+                             progress=progress)
+        return simulate_impacts(simulate, model, x0, t, impact, u, p, hold=hold,
+                                invariants=names, options=options)
     specs = None if events is None else check_events(events, model, t, x0, control, p)
     max_steps, steps, cvodes_options, counter = _check_options(method, max_steps, jit, steps,
                                                                cvodes_options, progress)
@@ -235,7 +241,8 @@ def simulate(model: Model, x0, t, *, u=None, p=None, hold: Hold = "linear", meth
             control = check_u(None, model.nu, t)
         problem = Problem.new(model, x0, t, control, p)
         if method in _FIXED_STEP:
-            run = run_fixed(problem, method, steps, cache.should_compile(jit, math.inf), counter)
+            run = run_fixed(problem, method, steps, cache.should_compile(jit, math.inf),
+                            progress=counter)
         elif method == "cvodes":
             run = run_cvodes(problem, rtol, atol, cvodes_options)
         else:
@@ -248,12 +255,12 @@ def simulate(model: Model, x0, t, *, u=None, p=None, hold: Hold = "linear", meth
     x.setflags(write=False)
     values = _invariants(model, x, p, names) if names else {}
     success = run.ok and status in (OK, OK_STIFF)
-    result = new_result(  # (t, x, success, status, message, method, wall_time, n_steps,
-        t, x, success, status if run.ok else FAILED, run.message, used,  # n_rhs, substeps,
-        time.perf_counter() - start, run.n_steps, run.n_rhs, run.substeps,  # error_estimate,
-        estimate, run.compiled, MappingProxyType(values),  # compiled, invariants, _dense)
-        Dense(model, p, lambda: _zero_grid(t, model.nu) if control is None
-              else control.grid(t), None if control is None else control.left_grid(t)))
+    result = new_result(
+        t, x, run, success=success, status=status if run.ok else FAILED, method=used,
+        wall_time=time.perf_counter() - start, error_estimate=estimate,
+        invariants=MappingProxyType(values),
+        dense=Dense(model, p, lambda: _zero_grid(t, model.nu) if control is None
+                    else control.grid(t), None if control is None else control.left_grid(t)))
     if specs is None:
         return result
     problem = Problem.new(model, x0, t, check_u(None, model.nu, t) if control is None
@@ -262,23 +269,26 @@ def simulate(model: Model, x0, t, *, u=None, p=None, hold: Hold = "linear", meth
                         cache.should_compile(jit, math.inf))
 
 
-def _simulate_batch(model, x0, t, u, p, method, rtol, atol, invariants, steps, jit, max_steps,
-                    cvodes_options, progress, start, hold) -> BatchResult:
-    """`simulate` for ``x0`` of shape ``(nx, K)`` (`dynamics.integrate.batch`)."""
+def _simulate_batch(model, x0, t, u, p, options: RunOptions, *, invariants, hold: str,
+                    start: float) -> BatchResult:
+    """`simulate` for ``x0`` of shape ``(nx, K)`` (`dynamics.integrate.batch`); ``options``
+    as given to `simulate` (checked here), ``start`` its `time.perf_counter` at the call."""
     if clock_index(model) is not None:
         raise ValueError("`x0` of shape (nx, K) (a batch) is not supported for a model with a "
                          "clock state; simulate its runs one by one")
     if invariants not in (False, None, ()):
         raise ValueError("`invariants` are evaluated per run for a batch: use "
                          "`result.run(k).sample` or `model.invariant` on `result.x[:, :, k]`")
-    batch = check_batch(model, x0, t, u, p, hold)
-    rtol, atol = check_tolerances(rtol, atol, model.nx)
-    max_steps, steps, cvodes_options, counter = _check_options(method, max_steps, jit, steps,
-                                                               cvodes_options, progress)
-    if method == "lie":
+    batch = check_batch(model, x0, t, u, p, hold=hold)
+    rtol, atol = check_tolerances(options.rtol, options.atol, model.nx)
+    max_steps, steps, cvodes_options, counter = _check_options(
+        options.method, options.max_steps, options.jit, options.steps, options.cvodes_options,
+        options.progress)
+    if options.method == "lie":
         check_lie_model(model, batch.x0[:, 0], batch.p[:, 0])
-    result = simulate_batch(batch, method, steps, rtol, atol, max_steps, jit, cvodes_options,
-                            counter, start)
+    checked = replace(options, rtol=rtol, atol=atol, steps=steps, max_steps=max_steps,
+                      cvodes_options=cvodes_options, progress=counter)
+    result = simulate_batch(batch, checked, start=start)
     counter.finish()
     return result
 

@@ -164,7 +164,7 @@ class Single:
 
     def run(self, x0: np.ndarray, m: int, jit: bool, progress) -> Run:
         """``m`` rk8 steps per output interval from ``x0``."""
-        return run_fixed(replace(self.problem, x0=x0), "rk8", m, jit, progress)
+        return run_fixed(replace(self.problem, x0=x0), "rk8", m, jit, progress=progress)
 
     def spectrum(self, rtol, atol):
         """``(rho, sigma)`` as `estimates.spectrum` (``(L, 0)`` from `initial_step` when that
@@ -323,7 +323,8 @@ def one_pass(problem: Problem, rtol, atol, max_steps, jit_pref, progress):
     theta = _PASS_THETA / horizon
     spent, bmin = 0, 1
     for _ in range(_PASS_TRIES):
-        got = run_pass(problem, rtol, atol, theta, max_steps - spent, progress, bmin, _PASS_ULPS)
+        got = run_pass(problem, rtol, atol, theta, max_steps - spent, progress, bmin=bmin,
+                       ulps=_PASS_ULPS)
         if got is None:
             return None, math.nan, spent
         spent += got.n_steps
@@ -385,7 +386,7 @@ def dense_pass(problem: Problem, rtol, atol, max_steps, progress):
     way, carried over the horizon, is added; where it is not small, the floor measured by the
     answer repeated from a moved start (as `estimates.measured_floor`), in the same call.
     """
-    got = dense_auto(problem, rtol, atol, max_steps, STIFF_STEPS, progress)
+    got = dense_auto(problem, rtol, atol, max_steps, STIFF_STEPS, progress=progress)
     if got is None or got.result != 1:
         return None, math.nan
     estimate = got.estimate
@@ -445,7 +446,7 @@ def _auto_stepped(problem: Problem, rtol, atol, max_steps, jit, progress, causes
     if horizon * sigma / _RK8_STABILITY > STIFF_STEPS:
         return None
     run, verdict, estimate, n_steps, n_rhs = solve_stepped(problem, rtol, atol, max_steps,
-                                                           progress)
+                                                           progress=progress)
     if verdict is None:
         return None
     head = f"auto: non-smooth right-hand side ({', '.join(causes)})"

@@ -31,7 +31,7 @@ from .dense import HEADER as DENSE_HEADER
 from .dense import dense_many, outcome_of
 from .estimates import jacobian_x, rho_sigma
 from .evaluate import map_eval
-from .inputs import Batch, check_batch
+from .inputs import Batch, RunOptions, check_batch
 from .loops import Progress
 from ..figures import plot_signals
 from ..results import Result
@@ -56,7 +56,8 @@ class BatchTarget:
         return flat.reshape(self.batch.K, self.batch.model.nx).T
 
     def run(self, x0: np.ndarray, m: int, jit: bool, progress) -> Run:
-        return run_fixed_batch(self.batch, "rk8", m, jit, self._unstack(x0), progress)[2]
+        return run_fixed_batch(self.batch, "rk8", m, jit, x0=self._unstack(x0),
+                               progress=progress)[2]
 
     def spectrum(self, rtol, atol):
         b = self.batch
@@ -78,10 +79,12 @@ class BatchTarget:
         return F.reshape(nx, K, c).transpose(1, 0, 2).reshape(K * nx, c)
 
 
-def simulate_batch(batch: Batch, method: str, steps: int, rtol: float, atol: np.ndarray,
-                   max_steps: int, jit, cvodes_options, progress: Progress, start: float
-                   ) -> "BatchResult":
-    """`simulate` for a batch (see the module docstring)."""
+def simulate_batch(batch: Batch, options: RunOptions, *, start: float) -> "BatchResult":
+    """`simulate` for a batch (see the module docstring); ``options`` checked (its
+    ``progress`` a `Progress`), ``start`` the `time.perf_counter` of the call."""
+    method, steps, rtol, atol = options.method, options.steps, options.rtol, options.atol
+    max_steps, jit, cvodes_options = options.max_steps, options.jit, options.cvodes_options
+    progress: Progress = options.progress
     K, nx = batch.K, batch.model.nx
     estimate = np.full(K, math.nan)
     if method in ("rk4", "rk8", "lie"):

@@ -194,7 +194,7 @@ class _FixedBatch:
         ud[:r, n:] = 0.0
 
 
-def fixed_batch(batch: Batch, method: str, m: int, jit: bool, x0: np.ndarray | None = None,
+def fixed_batch(batch: Batch, method: str, m: int, jit: bool, *, x0: np.ndarray | None = None,
                 progress: Progress | None = None) -> tuple[np.ndarray, np.ndarray, int, bool]:
     """``m`` steps of ``method`` per output interval for every run of ``batch`` (from
     ``x0 (nx, K)``, default ``batch.x0``), chunk by chunk; each chunk in one mapped call per
@@ -218,7 +218,7 @@ def fixed_batch(batch: Batch, method: str, m: int, jit: bool, x0: np.ndarray | N
             progress.advance(total)
             x, ok = _nan_after_failure(state.x)
             return x, ok, total, True
-    fun, compiled = chunk_function(model, method, "linear", jit, CHUNK)
+    fun, compiled = chunk_function(model, method, "linear", jit, size=CHUNK)
     parts, threads = _parts(K, min(CHUNK, total))
     capacity = parts[0].stop - parts[0].start
 
@@ -295,12 +295,12 @@ def fixed_message(method: str, m: int, done: int, ok: np.ndarray) -> str:
             + ("" if ok.all() else f"; {int((~ok).sum())} run(s) became non-finite"))
 
 
-def run_fixed_batch(batch: Batch, method: str, m: int, jit: bool, x0: np.ndarray | None = None,
+def run_fixed_batch(batch: Batch, method: str, m: int, jit: bool, *, x0: np.ndarray | None = None,
                     progress: Progress | None = None) -> tuple[np.ndarray, np.ndarray, Run]:
     """`fixed_batch` with its counts as a `Run` of one run (steps per run, right-hand sides
     per run) whose ``x`` is the batch stacked run by run ``(K nx, n)``: returns
     ``(x (nx, n, K), ok (K,), run)``."""
-    x, ok, done, compiled = fixed_batch(batch, method, m, jit, x0, progress)
+    x, ok, done, compiled = fixed_batch(batch, method, m, jit, x0=x0, progress=progress)
     K, nx, n = batch.K, batch.model.nx, batch.t.size
     stages = 4 if method == "lie" else TABLEAUX[method].stages
     stacked = np.ascontiguousarray(x.transpose(2, 0, 1).reshape(K * nx, n))

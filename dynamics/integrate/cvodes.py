@@ -87,7 +87,7 @@ def integrator_options(rtol, atol, extra) -> dict:
     return opts
 
 
-def run_cvodes(problem: Problem, rtol, atol, extra, pooled: bool = True) -> Run:
+def run_cvodes(problem: Problem, rtol, atol, extra, *, pooled: bool = True) -> Run:
     """cvodes on ``problem``'s grid; ``pooled=False`` builds an integrator for this call
     alone (a grid used once, e.g. an event scan's: it is not kept in `dynamics.cache`)."""
     model, t, ctrl = problem.model, problem.t, problem.control

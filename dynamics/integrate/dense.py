@@ -191,7 +191,7 @@ def _outcome(x: np.ndarray, head) -> DenseAuto:
 
 
 def dense_auto(problem: Problem, rtol: float, atol: np.ndarray, max_steps: float,
-               stiff_steps: float, progress=None) -> DenseAuto | None:
+               stiff_steps: float, *, progress=None) -> DenseAuto | None:
     """The answer, its check run and verdict for ``problem`` in one compiled call (see the
     module docstring); None without a compiled pass or for a control that is not constant
     over the run.

@@ -154,7 +154,7 @@ def rho_sigma(J: np.ndarray) -> tuple[float, float] | None:
 
 
 def measured_floor(target, run: Run, rtol, atol, lipschitz: float, jit: bool,
-           progress, rerun=None) -> tuple[float, int]:
+           progress, *, rerun=None) -> tuple[float, int]:
     """Scaled error floor of ``run`` from rounding; returns ``(floor, extra steps made)``.
 
     Rounding that every run shares (the model's own formulas) does not show in differences
@@ -193,7 +193,7 @@ def measured_floor(target, run: Run, rtol, atol, lipschitz: float, jit: bool,
     scale = atol[:, None] + rtol * np.abs(x[:, 1:])
     ulps = roundoff(x, FLOOR_ULPS, scale)
     local = scaled_diff(np.broadcast_to(e[:, None], scale.shape), np.zeros(scale.shape), scale)
-    bound = screen(e, np.min(scale, axis=1), horizon, lipschitz, target.runs)
+    bound = screen(e, np.min(scale, axis=1), horizon, lipschitz, runs=target.runs)
     if bound <= 0.1 * AUTO_ACCEPT:
         return max(bound, ulps), 0
     if rerun is not None:
@@ -214,7 +214,7 @@ def carried(noise: np.ndarray, horizon: float, lipschitz: float) -> np.ndarray:
 
 
 def screen(e: np.ndarray, smin: np.ndarray, horizon: float, lipschitz: float,
-            runs: int = 1) -> float:
+            *, runs: int = 1) -> float:
     """`measured_floor`'s screening bound of the carried rounding ``e`` against the least tolerance
     ``smin`` of each state: the flow may carry the noise of any state into any other (the
     spin-rate noise of a flat body into the phase of its transverse rates), so across the

@@ -268,7 +268,7 @@ def _values(spec: EventSpec, ts: np.ndarray, X: np.ndarray, U: np.ndarray,
 
 
 def controls_at(control: Control | None, t: np.ndarray, ts: np.ndarray, nu: int,
-                side: str = "right") -> np.ndarray:
+                *, side: str = "right") -> np.ndarray:
     """The control of `simulate` (``None``: zero) at the times ``ts (N,)`` within the grid
     ``t``: shape (nu, N), linear between samples (or held: ``hold='zoh'``) or the callable's
     values. At a grid time, ``side='right'`` gives the value from that time on, ``'left'``

@@ -41,7 +41,7 @@ import numpy as np
 from .. import validate
 from ..model import Model
 from .events import Event, controls_at
-from .inputs import check_u
+from .inputs import RunOptions, check_u
 from .result import OK, TERMINAL_EVENT, Dense, SimulationResult, make_result
 
 __all__ = ["Impact", "ImpactRecord", "check_impact", "simulate_impacts"]
@@ -214,16 +214,16 @@ def _segment_u(u, control, t: np.ndarray, te: float, k: int, nu: int):
 
 
 def simulate_impacts(simulate: Callable, model: Model, x0: np.ndarray, t: np.ndarray,
-                     impact: Impact, u, p: np.ndarray, hold: str, invariants,
-                     options: dict) -> SimulationResult:
+                     impact: Impact, u, p: np.ndarray, *, hold: str, invariants,
+                     options: RunOptions) -> SimulationResult:
     """`simulate` with ``impacts=impact``: runs between impacts joined on the grid ``t``.
 
     ``simulate`` is `dynamics.simulate` (called without impacts for each run); ``options``
-    its keywords for each run (method, tolerances, steps, jit, ...); ``invariants`` the
-    checked names to evaluate on the joined solution.
+    its options for each run (a `RunOptions`: method, tolerances, steps, jit, ...);
+    ``invariants`` the checked names to evaluate on the joined solution.
     """
     start = time.perf_counter()
-    control = check_u(u, model.nu, t, hold)
+    control = check_u(u, model.nu, t, hold=hold)
     nx = model.nx
     ev = Event(impact.guard, terminal=True, direction=-1, name=impact.name)
     X = np.full((nx, t.size), np.nan)
@@ -238,7 +238,7 @@ def simulate_impacts(simulate: Callable, model: Model, x0: np.ndarray, t: np.nda
             ev = Event(_restarted(impact.guard, t_start, model), terminal=True, direction=-1,
                        name=impact.name)
         run = simulate(model, x_start, grid, u=_segment_u(u, control, t, t_start, k, model.nu),
-                       p=p, hold=hold, events=ev, **options)
+                       p=p, hold=hold, events=ev, **options.keywords())
         n_steps, n_rhs = n_steps + run.n_steps, n_rhs + run.n_rhs
         estimates.append(run.error_estimate)
         compiled = compiled and run.compiled

@@ -19,10 +19,66 @@ from ..model import Model
 from ..validate import (QUAT_NORM_TOL, check_unit_quaternion, finite_array, finite_scalar,
                         unit_quaternion)
 
-__all__ = ["HOLDS", "Batch", "Control", "Problem", "check_batch", "check_t", "check_x0", "check_tolerances",
+__all__ = ["HOLDS", "Batch", "Control", "Problem", "RunOptions", "check_batch", "check_t",
+           "check_x0", "check_tolerances",
            "check_u", "check_invariants", "check_cvodes_options"]
 
 _EPS = np.finfo(float).eps
+
+
+@dataclass(frozen=True)
+class RunOptions:
+    """The run options of one `simulate` call, carried as one object through its internal
+    runs (instead of a long positional list).
+
+    Attributes
+    ----------
+    method : str
+        One of `simulate`'s methods.
+    rtol : float
+        Relative tolerance.
+    atol : float or numpy.ndarray
+        Absolute tolerance, scalar or ``(nx,)`` (checked: ``(nx,)``).
+    steps : int or None
+        Substeps per output interval of a fixed-step method.
+    jit : bool or None
+        Compile the kernels (None: when worth it).
+    max_steps : int
+        Step budget of the adaptive runs.
+    cvodes_options : Mapping or None
+        Extra options of cvodes.
+    progress : callable or None
+        ``progress(done, total)`` (checked: a ``Progress``).
+
+    Examples
+    --------
+    >>> from appdyn.dynamics.integrate.inputs import RunOptions
+    >>> opts = RunOptions(method="rk4", rtol=1e-8, atol=1e-10, steps=10, jit=False,
+    ...                   max_steps=1000, cvodes_options=None, progress=None)
+    >>> opts.method, opts.steps
+    ('rk4', 10)
+    """
+
+    method: str
+    rtol: float
+    atol: float | np.ndarray
+    steps: int | None
+    jit: bool | None
+    max_steps: int
+    cvodes_options: Mapping | None
+    progress: Callable | None
+
+    def keywords(self) -> dict:
+        """The options as `simulate`'s keyword arguments (``simulate(..., **o.keywords())``).
+
+        Examples
+        --------
+        >>> from appdyn.dynamics.integrate.inputs import RunOptions
+        >>> RunOptions(method="rk4", rtol=1e-8, atol=1e-10, steps=10, jit=False,
+        ...            max_steps=1000, cvodes_options=None, progress=None).keywords()["steps"]
+        10
+        """
+        return dict(self.__dict__)
 
 
 def check_t(t) -> np.ndarray:
@@ -240,7 +296,7 @@ class Control:
 HOLDS = ("linear", "zoh")
 
 
-def check_u(u, nu: int, t: np.ndarray, hold: str = "linear") -> Control:
+def check_u(u, nu: int, t: np.ndarray, *, hold: str = "linear") -> Control:
     """``u`` (see `dynamics.simulate`) as a `Control` on the grid ``t``; ``hold`` how
     samples ``(nu, n)`` are interpolated: ``"linear"``, or ``"zoh"`` (``u[:, k]`` on
     ``[t_k, t_{k+1})``). Raises naming ``u`` or ``hold``."""
@@ -382,7 +438,7 @@ class Batch:
                        self.p[:, k].copy())
 
 
-def check_batch(model: Model, x0, t: np.ndarray, u, p, hold: str = "linear") -> Batch:
+def check_batch(model: Model, x0, t: np.ndarray, u, p, *, hold: str = "linear") -> Batch:
     """The batch of ``x0 (nx, K)`` with ``p`` ``(np,)`` or ``(np, K)`` and ``u`` None,
     ``(nu,)``, ``(nu, n)`` (shared) or ``(nu, n, K)`` (per run), samples held as ``hold``
     says (`dynamics.integrate.inputs.HOLDS`); raises naming the argument."""

@@ -99,7 +99,7 @@ def _embedded_error(x, x_next, k: list, h, rtol, atol):
     return ca.fabs(h) * e5 / ca.sqrt(x.numel() * ca.fmax(e5 + 0.01 * e3, 1e-300))
 
 
-def dense_kernels(model: Model, compiled: bool = False) -> tuple[ca.Function, ca.Function]:
+def dense_kernels(model: Model, *, compiled: bool = False) -> tuple[ca.Function, ca.Function]:
     """DOP853 with its dense output for a control constant over the run (cached):
     ``rk8_step_k (x, h, u, p, rtol, atol) -> (x_next, err, K)`` (``err`` as the ``error``
     step of `kernel`; ``K (12 nx)`` the stages, stacked) and ``rk8_cont (x, x_next, K, h,
@@ -268,7 +268,7 @@ def calls_rhs(model: Model, method: str) -> bool:
     return TABLEAUX[method].stages * model.f.n_instructions() > INLINE_MAX
 
 
-def kernel(model: Model, method: str, mode: str, error: bool = False,
+def kernel(model: Model, method: str, mode: str, *, error: bool = False,
            compiled: bool = False) -> ca.Function:
     """The step Function of ``model`` and ``method`` (cached); ``error``: with DOP853's
     embedded error estimate (``rk8``; see `_rk_kernel`); ``compiled``: the form to generate

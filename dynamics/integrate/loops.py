@@ -34,7 +34,7 @@ CHUNK = 512
 BATCH_CHUNK = 64
 
 
-def chunk_function(model: Model, method: str, mode: str, jit: bool, size: int = CHUNK):
+def chunk_function(model: Model, method: str, mode: str, jit: bool, *, size: int = CHUNK):
     """The chunk Function of ``model`` and ``method`` (cached); returns (Function, compiled).
 
     ``size`` steps per chunk (default `CHUNK`; batches use the shorter `BATCH_CHUNK`, a
@@ -302,7 +302,7 @@ class Progress:
 
 
 def run_fixed(problem: Problem, method: str, m: int, jit: bool,
-              progress: Progress | None = None) -> Run:
+              *, progress: Progress | None = None) -> Run:
     """``m`` steps of ``method`` per output interval, chunk by chunk; stops at a non-finite
     state (the columns not reached are NaN)."""
     model, nint, t = problem.model, problem.nint, problem.t

@@ -64,7 +64,7 @@ _REASONS = ("", "a state became non-finite", "the step size underflowed",
 
 
 def run_stepped(problem: Problem, rtol: float, atol: np.ndarray, max_steps: int,
-                progress=None, hmax: np.ndarray | None = None):
+                *, progress=None, hmax: np.ndarray | None = None):
     """One DOP853 run with step rejection at the local tolerances ``rtol``, ``atol``
     (linear control), no step of output interval ``k`` longer than ``hmax[k]`` [s]
     (default: the interval). Returns ``(run, longest)``, ``longest (nint,)`` [s] the longest
@@ -109,7 +109,8 @@ def run_stepped(problem: Problem, rtol: float, atol: np.ndarray, max_steps: int,
 
 
 def run_dense(problem: Problem, rtol: float, atol: np.ndarray, max_steps: int,
-              progress=None, stiff_steps: float = math.inf) -> tuple[Run, "DenseRounding"] | None:
+              *, progress=None,
+              stiff_steps: float = math.inf) -> tuple[Run, "DenseRounding"] | None:
     """One DOP853 run at the local tolerances ``rtol``, ``atol`` whose steps follow its
     error estimate alone (`cpass._DENSE`): the output grid never cuts a step, the outputs
     inside a step come from its continuous extension of order 7 (as Hairer's DOP853 with
@@ -259,7 +260,7 @@ def _callable_step(model) -> ca.Function:
 
 
 def run_stepped_callable(problem: Problem, rtol: float, atol: np.ndarray, max_steps: int,
-                         progress=None, hmax: np.ndarray | None = None):
+                         *, progress=None, hmax: np.ndarray | None = None):
     """`run_stepped` for a callable control (``problem.control.mode == 'stages'``): the same
     controller (`next_step`) stepping from Python, the control called at each step's stage
     times (a jump of the control shrinks the steps that straddle it, as a kink does)."""
@@ -312,7 +313,7 @@ def run_stepped_callable(problem: Problem, rtol: float, atol: np.ndarray, max_st
 
 
 def solve_stepped(problem: Problem, rtol: float, atol: np.ndarray, max_steps: int,
-                  progress=None):
+                  *, progress=None):
     """Step-controlled runs at local tolerances ``rtol * _FIRST``, then ``_TIGHTEN`` times
     tighter each, until two successive runs differ by at most the tolerance
     (`estimates.tightened`). No step of a run is longer than half the longest step of the
@@ -325,8 +326,8 @@ def solve_stepped(problem: Problem, rtol: float, atol: np.ndarray, max_steps: in
     state = {"spent": 0, "hmax": H}
 
     def run_at(local_rtol, local_atol):
-        got = stepped(problem, local_rtol, local_atol, max_steps - state["spent"], progress,
-                      state["hmax"])
+        got = stepped(problem, local_rtol, local_atol, max_steps - state["spent"],
+                      progress=progress, hmax=state["hmax"])
         if got is None:
             return None
         run, longest = got

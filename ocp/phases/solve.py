@@ -24,8 +24,8 @@ from ..progress import LOGGER, IterationCallback, iteration_sink
 from ..refine.errors import interval_errors
 from ..refine.mesh_update import local_order, new_mesh
 from ..scaling import auto_scaling
-from ..solve import (WARM_START_OPTIONS, check_constraint_tol, default_mesh, make_solution,
-                     nlp_numbers, read_result, run_ipopt, solver_ipopt_options)
+from ..solve import (WARM_START_OPTIONS, NlpOutcome, check_constraint_tol, default_mesh,
+                     make_solution, nlp_numbers, read_result, run_ipopt, solver_ipopt_options)
 from ..transcription import get_transcription
 from .nlp import PhasedDiscretization, event_row_scales
 from .problem import MultiPhaseProblem
@@ -55,14 +55,15 @@ def _discretize(problem: MultiPhaseProblem, meshes, guesses, expand, codegen):
     """Per phase ``(transcription, mesh, node guess, Discretization)``."""
     out = []
     for i, ph in enumerate(problem.phases):
-        tr = get_transcription(ph.transcription, ph.degree)
+        tr = get_transcription(ph.transcription, degree=ph.degree)
         m = meshes[i] if meshes is not None else default_mesh(ph.N, ph.mesh)
         pb = replace(ph.problem, t0=0.0) if ph.problem.t0 != 0.0 else ph.problem
         try:
-            ng = initial_guess(pb, tr, m, guesses[i])  # (a Solution is read in normalized time)
+            # (a Solution is read in normalized time)
+            ng = initial_guess(pb, tr, m, guess=guesses[i])
         except ValueError as exc:
             raise ValueError(f"phases[{i}]: {exc}") from exc
-        scaling = auto_scaling(pb, ng, ph.scale)
+        scaling = auto_scaling(pb, ng, overrides=ph.scale)
         out.append((tr, m, ng, Discretization(pb, tr, m, scaling, expand, codegen)))
     return out
 
@@ -242,9 +243,10 @@ def _solution(problem, disc, parts, w, lam_g, lam_x, g, success, status, message
         T = float(d.unpack(wi)["T"])
         pb = replace(d.problem, t0=start)
         d_t = _Shifted(d, pb)
-        phases.append(make_solution(pb, tr, m, d_t, wi, li, gi, success, status, message,
-                                    iterations, solve_time, build_time,
-                                    solver_status=solver_status))
+        phases.append(make_solution(pb, tr, m, d_t, NlpOutcome(
+            w=wi, lam_g=li, g=gi, success=success, status=status, message=message,
+            iterations=iterations, solve_time=solve_time, build_time=build_time,
+            solver_status=solver_status)))
         t0s.append(start)
         start += T
     t0 = np.array(t0s)

@@ -41,7 +41,7 @@ def local_order(tr: Transcription) -> int:
     --------
     >>> from appdyn.ocp.refine.mesh_update import local_order
     >>> from appdyn.ocp.transcription import get_transcription
-    >>> local_order(get_transcription("radau", 3))
+    >>> local_order(get_transcription("radau", degree=3))
     4
     """
     if isinstance(tr, Radau):
@@ -203,7 +203,7 @@ def _transcription(transcription, degree) -> Transcription:
     if isinstance(transcription, Transcription):
         return transcription
     if transcription == "radau":
-        return get_transcription("radau", degree)
+        return get_transcription("radau", degree=degree)
     return get_transcription(transcription)
 
 
@@ -379,7 +379,7 @@ def refine(problem: Problem, solution: Solution | None = None, *, tol: float = 1
                       stacklevel=2)
     N = 20 if N is None else N
     tr = get_transcription(_transcription(transcription, 3 if degree is None else degree),
-                           None, control)
+                           degree=None, control=control)
     q = local_order(tr)
 
     t_round = time.perf_counter()

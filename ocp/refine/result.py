@@ -120,7 +120,7 @@ def annotate(solution: Solution, info: Mapping | None = None, **changes) -> Refi
     return out
 
 
-def worse_than(problem, cost: float, start: float, slack: float = WORSE_SLACK) -> bool:
+def worse_than(problem, cost: float, start: float, *, slack: float = WORSE_SLACK) -> bool:
     """Whether ``cost`` is worse than ``start`` by more than ``slack |start|`` (the
     direction of `Problem.better`; a NaN ``cost`` is worse, a NaN ``start`` is not beaten).
 

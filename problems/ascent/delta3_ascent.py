@@ -402,7 +402,8 @@ def _unit_directions(sol):
     offset = 0
     for ph in sol.problem.phases:
         pb = replace(ph.problem, t0=0.0) if ph.problem.t0 != 0.0 else ph.problem
-        layout = ocp_nlp.structure(pb, get_transcription(ph.transcription, ph.degree), ph.N).w
+        tr = get_transcription(ph.transcription, degree=ph.degree)
+        layout = ocp_nlp.structure(pb, tr, ph.N).w
         cols = offset + layout.indices("U")
         x[cols] = x[cols] / np.linalg.norm(x[cols], axis=0)
         offset += layout.size

@@ -88,7 +88,7 @@ def test_goddard_truth_matches_the_literature_and_the_example(goddard_truth):
 @pytest.mark.parametrize("distance, T", [(1.0, 1.0), (2.0, 1.5)])
 def test_simulated_cost_of_min_energy_is_the_closed_form(distance, T):
     J = 6.0 * distance ** 2 / T ** 3  # Bryson & Ho
-    sol = solve(min_energy(distance, T), N=5)
+    sol = solve(min_energy(distance=distance, T=T), N=5)
     assert sol.success
     assert abs(sol.cost - J) < 1e-8 * J
     assert abs(sol.simulated_cost - J) < 1e-8 * J
@@ -226,7 +226,7 @@ def test_regularization_lets_refinement_converge_near_the_optimum(goddard_truth)
     eps = 1e-4
     # a linear thrust: the Radau polynomial overshoots [0, 3.5] at the arc junctions on
     # every mesh (a Bound_Violation); measured 3 rounds, 33 intervals
-    sol = refine(goddard_rocket(eps), tol=1e-6, control="linear")
+    sol = refine(goddard_rocket(regularization=eps), tol=1e-6, control="linear")
     H = goddard_truth["h_f"]
     assert sol.success and sol.info["converged"], sol.message
     assert sol.info["stop"] == "tolerance reached"
@@ -241,9 +241,9 @@ def test_regularization_lets_refinement_converge_near_the_optimum(goddard_truth)
 
 def test_goddard_rocket_rejects_bad_regularization():
     with pytest.raises(ValueError, match="`regularization`"):
-        goddard_rocket(-1e-4)
+        goddard_rocket(regularization=-1e-4)
     with pytest.raises(ValueError, match="`regularization`"):
-        goddard_rocket(math.inf)
+        goddard_rocket(regularization=math.inf)
     with pytest.raises(TypeError, match="`regularization`"):
-        goddard_rocket("1e-4")
-    assert goddard_rocket(np.float32(1e-4)).lagrange is not None
+        goddard_rocket(regularization="1e-4")
+    assert goddard_rocket(regularization=np.float32(1e-4)).lagrange is not None

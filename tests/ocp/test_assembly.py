@@ -53,8 +53,8 @@ def test_assembled_derivatives_equal_automatic_differentiation(name, transcripti
     rng = np.random.default_rng(7)
     tr = get_transcription(transcription)
     mesh = Mesh(np.concatenate([[0.0], np.sort(rng.uniform(size=4)), [1.0]]))
-    guess = initial_guess(problem, tr, mesh, None)
-    disc = Discretization(problem, tr, mesh, auto_scaling(problem, guess, None))
+    guess = initial_guess(problem, tr, mesh, guess=None)
+    disc = Discretization(problem, tr, mesh, auto_scaling(problem, guess, overrides=None))
     nlp = disc.nlp
     w, lam_g, lam_f = rng.normal(size=disc.w.size), rng.normal(size=disc.g.size), 0.37
     lg = ca.MX.sym("lg", disc.g.size)
@@ -80,7 +80,7 @@ def test_assembled_derivatives_equal_automatic_differentiation(name, transcripti
 def _disc(problem, N=30, transcription="radau"):
     tr = get_transcription(transcription)
     mesh = Mesh.uniform(N)
-    return Discretization(problem, tr, mesh, auto_scaling(problem, initial_guess(problem, tr, mesh, None), None))
+    return Discretization(problem, tr, mesh, auto_scaling(problem, initial_guess(problem, tr, mesh)))
 
 
 def test_problems_of_equal_structure_share_one_structure():
@@ -153,7 +153,7 @@ def test_code_generation_gives_the_same_solution():
     assert abs(built.cost - truth["J"]) < 1e-3
     tr = get_transcription("radau")
     mesh = Mesh.uniform(12)
-    disc = Discretization(problem, tr, mesh, auto_scaling(problem, initial_guess(problem, tr, mesh, None), None),
+    disc = Discretization(problem, tr, mesh, auto_scaling(problem, initial_guess(problem, tr, mesh)),
                           codegen=True)
     assert disc.structure.compiled == (compiler() is not None)
     with pytest.raises(ValueError, match="codegen"):

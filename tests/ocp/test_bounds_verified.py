@@ -157,8 +157,8 @@ def test_control_and_verify_arguments_are_checked():
         solve(problem, N=4, verify="yes")
     with pytest.raises(ValueError, match="`verify_tol`"):
         solve(problem, N=4, verify_tol=0.0)
-    assert ocp.get_transcription("radau", 4, "linear") == ocp.RadauLinearControl(4)
-    assert ocp.get_transcription("trapezoid", None, "linear") == ocp.Trapezoid()
+    assert ocp.get_transcription("radau", degree=4, control="linear") == ocp.RadauLinearControl(4)
+    assert ocp.get_transcription("trapezoid", degree=None, control="linear") == ocp.Trapezoid()
 
 
 def test_a_linear_control_is_exact_where_the_optimum_is_linear():

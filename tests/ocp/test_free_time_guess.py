@@ -19,7 +19,7 @@ RADAU, MESH = Radau(3), Mesh.uniform(10)
 
 
 def _guess(problem, guess=None, mesh=MESH):
-    return initial_guess(problem, RADAU, mesh, guess)
+    return initial_guess(problem, RADAU, mesh, guess=guess)
 
 
 def _accelerate(distance, T):

@@ -142,7 +142,7 @@ def test_solution_reads_states_and_controls_by_name():
 def _nodes(problem, guess):
     from appdyn.ocp.guess import initial_guess
     tr, mesh = ocp.Radau(3), ocp.Mesh.uniform(5)
-    return initial_guess(problem, tr, mesh, guess), tr.state_tau(mesh), tr.control_tau(mesh)
+    return initial_guess(problem, tr, mesh, guess=guess), tr.state_tau(mesh), tr.control_tau(mesh)
 
 
 @pytest.mark.parametrize("x_guess", [

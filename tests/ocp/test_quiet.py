@@ -49,7 +49,7 @@ def test_bad_progress_raises():
 
 
 def test_constant_control_transcription_is_registered_by_name():
-    tr = get_transcription("radau-constant-control", 4)
+    tr = get_transcription("radau-constant-control", degree=4)
     assert isinstance(tr, RadauConstantControl) and tr.degree == 4
     problem, _ = bang_bang()
     sol = solve(problem, N=8, transcription="radau-constant-control", ipopt_options=STRICT)
