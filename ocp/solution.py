@@ -176,7 +176,7 @@ class Solution(Result):
     def __str__(self) -> str:
         sim = self.simulated_cost
         errs = self.propagation_errors
-        rows = [("success", f"{self.success} ({describe(self.status, self.solver_status)})"),
+        rows = [("success", f"{self.success} ({describe(self.status, solver_status=self.solver_status)})"),
                 ("cost (collocated)", f"{self.cost:.10g}"),
                 ("cost (re-simulated)", f"{sim:.10g} (re-simulated - collocated: "
                                         f"{sim - self.cost:.3g})"),

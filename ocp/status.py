@@ -201,7 +201,7 @@ def status_name(code: int) -> str:
     return _NAMES.get(int(code), f"status {int(code)}")
 
 
-def describe(status: int, solver_status: str = "") -> str:
+def describe(status: int, *, solver_status: str = "") -> str:
     """``status`` for a report: the code and its name, then the solver's text when it says
     something else.
 
@@ -218,9 +218,9 @@ def describe(status: int, solver_status: str = "") -> str:
     Examples
     --------
     >>> from appdyn.ocp.status import describe
-    >>> describe(0, "Solve_Succeeded")
+    >>> describe(0, solver_status="Solve_Succeeded")
     'status 0 Solve_Succeeded'
-    >>> describe(102, "Solve_Succeeded")
+    >>> describe(102, solver_status="Solve_Succeeded")
     'status 102 Bound_Violation (solver: Solve_Succeeded)'
     """
     name = status_name(status)

@@ -125,7 +125,7 @@ class PlanarAscent(Result):
     def __str__(self) -> str:
         f = self.final
         return _rows_table("Planar ascent (" + self.objective + ")", [
-            ("success", f"{self.success} ({describe(self.status, self.solver_status)})"),
+            ("success", f"{self.success} ({describe(self.status, solver_status=self.solver_status)})"),
             ("burnout speed", f"{self.burnout_speed:.2f} m/s"),
             ("burnout mass", f"{self.burnout_mass:.1f} kg"),
             ("final altitude", f"{f['h']:.1f} m (target {self.targets['h']:.1f})"),

@@ -96,7 +96,7 @@ class DesignPrintout:
         d, v = self.design, self.design.verification
         verdict = "success" if d.success else "FAILED"
         lines = [f"Launch-vehicle autopilot gains ({self.source})",
-                 f"  status    {verdict} ({describe(d.status, d.solver_status)})"]
+                 f"  status    {verdict} ({describe(d.status, solver_status=d.solver_status)})"]
         note = "" if "verdict" in v else "  (the solver's last iterate)"
         lines += [f"  {k:<8}  {val:.6g} {d.units.get(k, '')}{note}" for k, val in d.gains.items()]
         if "verdict" in v:

@@ -208,7 +208,7 @@ def run(args) -> int:
     success = bool(data.get("success", sol.success))
     from appdyn.ocp.status import describe  # the CLI imports the engine only when it runs
 
-    why = f"{describe(data['status'], data.get('solver_status', ''))}: {data.get('message', '')}"
+    why = f"{describe(data['status'], solver_status=data.get('solver_status', ''))}: {data.get('message', '')}"
     rows = []
     if check is not None:
         data["T_lower_bound"] = check[1]

@@ -192,7 +192,7 @@ def diagnose(sol, solve, lim, decay, bounds, fail, peak_of) -> GainDesign:
         text = ", ".join(f"{g} in [{lo:g}, {hi:g}]" for g, (lo, hi) in bounds.items())
         return fail(STATUS_UNSTABLE, f"no gains within gain_bounds ({text}) give a closed loop "
                                      f"stable to {decay:g} 1/s, even without the limits "
-                                     f"({describe(sol.status, sol.solver_status)})")
+                                     f"({describe(sol.status, solver_status=sol.solver_status)})")
     alone = {k: solve((k,)) for k in lim}
     culprits = [k for k in lim if not alone[k].success]
     joint = not culprits
@@ -214,7 +214,7 @@ def diagnose(sol, solve, lim, decay, bounds, fail, peak_of) -> GainDesign:
                      f"{math.degrees(peaks[k]):.4g} {unit} in scenario {label!r})")
         parts.append(text)
     msg = (f"the limits cannot be met{' together' if joint else ''} by a loop stable to "
-           f"{decay:g} 1/s: {'; '.join(parts)} ({describe(sol.status, sol.solver_status)})")
+           f"{decay:g} 1/s: {'; '.join(parts)} ({describe(sol.status, solver_status=sol.solver_status)})")
     return fail(STATUS_LIMITS, msg, violated=culprits)
 
 

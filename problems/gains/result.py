@@ -138,7 +138,7 @@ class GainDesign(Result):
         return finish_figure(fig)
 
     def __str__(self) -> str:
-        rows = [("success", f"{self.success} ({describe(self.status, self.solver_status)})")]
+        rows = [("success", f"{self.success} ({describe(self.status, solver_status=self.solver_status)})")]
         rows += [(f"{k} [{self.units.get(k, '-')}]", f"{v:.6g}") for k, v in self.gains.items()]
         rows.append(("cost", f"{self.cost:.6g}"))
         for i, sc in enumerate(self.scenarios):

@@ -221,7 +221,7 @@ def format_summary(data: dict) -> str:
         raise ValueError(f"`data` must be a dict from `summary`; missing keys {missing}")
     rows = [
         ("success",
-         f"{data['success']} ({describe(data['status'], data.get('solver_status', ''))})"),
+         f"{data['success']} ({describe(data['status'], solver_status=data.get('solver_status', ''))})"),
         ("maneuver time T [s]", f"{data['T']:.6f}"),
     ]
     if "eigenaxis_T" in data:
