@@ -151,7 +151,13 @@ def time_optimal(inertia, *, angle=None, axis=None, q0=None, qf=None, u_max=1.0,
         A user guess (then a single start is solved). ``None``: multi-start.
     starts : int, optional
         Number of seeded starts without a user guess (eigenaxis +
-        tilted; default 3). Ignored, with a warning, when ``guess`` is given.
+        tilted; default 3). Ignored, with a warning, when ``guess`` is given. Without a
+        ``keep_out`` cone and for ``N`` above `RACE_N` = 10 the starts are raced on
+        `RACE_N` intervals, in turn until two converged ones agree on ``T`` to `RACE_AGREE`
+        (the rest skipped; ``info['race']``), and only the best goes on: polished at once
+        by switch times when bang-bang (``polish`` below; kept when verified and at most
+        1e-3 relative slower than its coarse ``T``), else re-solved on ``N`` intervals warm
+        from it.
     seed : int, optional
         Seed of the tilt axes (default 0; results are reproducible).
         Ignored, with a warning, when ``guess`` is given.
