@@ -12,6 +12,7 @@ import numpy as np
 from appdyn.ocp import (CONTROLS, DEFAULT_CONSTRAINT_TOL, STATUS_BOUND_VIOLATION, STATUS_RESIMULATION,
                  Problem, Solution, annotate, bang_arcs, polish_switches, refine, rest_solution, solve,
                  solve_multistart)
+from appdyn.ocp.refine.arcs import IDLE_TOL
 from appdyn.ocp.refine.result import WORSE_SLACK
 from appdyn.ocp.solve import verified
 from appdyn.dynamics.validate import integer
@@ -92,6 +93,15 @@ def verify(solution: Solution, *, pointing_tol: float = POINTING_TOL, rate_tol: 
         f"{solution.message}; NOT verified: the re-simulated control ends {perr:.3g} rad "
         f"({perr * ARCSEC:.3g} arcsec) from the target (pointing_tol {ptol:g}) with a final "
         f"rate error {rerr:.3g} rad/s (rate_tol {rtol:g})"))
+
+
+def _symmetric(guess, problem) -> bool:
+    """Whether a torque component of ``guess`` (an `attitude_guess`) is zero throughout
+    (within `ocp.refine.arcs.IDLE_TOL` of its bound): the eigenaxis path of a slew about a
+    body axis that is a principal axis."""
+    u = np.asarray(guess["u"], dtype=float)
+    hi = np.asarray(problem.u_bounds[1], dtype=float)[:, None]
+    return bool(np.any(np.all(np.abs(u) <= IDLE_TOL * hi, axis=1)))
 
 
 def _warn_ignored(*, why: str, **given) -> None:
@@ -272,6 +282,12 @@ def time_optimal(inertia, *, angle=None, axis=None, q0=None, qf=None, u_max=1.0,
         tries = [{"ipopt_options": {**EIGENAXIS_EXACT, **(ipopt_options or {})}},
                  {"ipopt_options": {**EIGENAXIS_START, **(ipopt_options or {})}}, {}]
         start_options = [tries] + [{}] * (len(guesses) - 1)
+        if len(guesses) >= 3 and _symmetric(guesses[0], problem):
+            # the eigenaxis start of a slew whose eigenaxis path leaves torque components
+            # idle (a body-axis slew of a principal-axis body, as Bilimoria-Wie's) keeps them
+            # idle by symmetry and converges to the eigenaxis maneuver, a local optimum; it
+            # goes last, so that two tilted starts that agree end the race before it
+            guesses, start_options = guesses[1:] + guesses[:1], start_options[1:] + start_options[:1]
     t_start = time.perf_counter()
     sol = solve_time_optimal(problem, guess, guesses, opts,
                              polish=polish and not norm_bound and keep_out is None,
