@@ -167,7 +167,9 @@ def time_optimal(inertia, *, angle=None, axis=None, q0=None, qf=None, u_max=1.0,
         (the rest skipped; ``info['race']``), and only the best goes on: polished at once
         by switch times when bang-bang (``polish`` below; kept when verified and at most
         1e-3 relative slower than its coarse ``T``), else re-solved on ``N`` intervals warm
-        from it.
+        from it. An eigenaxis path with an idle torque component (a slew about a body axis
+        that is a principal axis: the start stays on the eigenaxis maneuver by symmetry) is
+        raced last.
     seed : int, optional
         Seed of the tilt axes (default 0; results are reproducible).
         Ignored, with a warning, when ``guess`` is given.
