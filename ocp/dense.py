@@ -1,6 +1,8 @@
 """`DenseOutput`: a solution's interval data and the transcription's interpolant."""
 from __future__ import annotations
 
+import threading
+
 import casadi as ca
 import numpy as np
 
@@ -11,6 +13,7 @@ __all__ = ["DenseOutput"]
 #: samples the same counts dozens of times per solve). Bounded: the oldest entry goes first.
 _MAPS: dict = {}
 _MAPS_MAX = 256
+_MAPS_LOCK = threading.Lock()
 
 
 def _mapped(interp: ca.Function, M: int) -> ca.Function:
@@ -22,9 +25,10 @@ def _mapped(interp: ca.Function, M: int) -> ca.Function:
     if hit is not None and hit[0] is interp:
         return hit[1]
     fun = interp.map(M, [False] * 5 + [True, False], [False, False])
-    _MAPS[key] = (interp, fun)  # the interpolant kept alive: its id is not reused meanwhile
-    while len(_MAPS) > _MAPS_MAX:
-        _MAPS.pop(next(iter(_MAPS)), None)
+    with _MAPS_LOCK:  # solves may run in threads
+        _MAPS[key] = (interp, fun)  # the interpolant kept alive: its id is not reused meanwhile
+        while len(_MAPS) > _MAPS_MAX:
+            _MAPS.pop(next(iter(_MAPS)), None)
     return fun
 
 

@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import math
+import threading
 import warnings
 
 import casadi as ca
@@ -278,6 +279,7 @@ def attitude_guess(problem: Problem, *, tilt_axis=None, tilt=0.0, T=None, n=201)
 #: (guesses, time estimates), about 1 ms each.
 _INERTIA: dict = {}
 _INERTIA_MAX = 32
+_INERTIA_LOCK = threading.Lock()
 
 
 def inertia_of(model):
@@ -288,9 +290,10 @@ def inertia_of(model):
         return hit[1]
     I = _inertia_of(model)
     I.setflags(write=False)
-    _INERTIA[id(model)] = (model, I)
-    while len(_INERTIA) > _INERTIA_MAX:
-        _INERTIA.pop(next(iter(_INERTIA)), None)
+    with _INERTIA_LOCK:  # slews may run in threads (maneuver tables)
+        _INERTIA[id(model)] = (model, I)
+        while len(_INERTIA) > _INERTIA_MAX:
+            _INERTIA.pop(next(iter(_INERTIA)), None)
     return I
 
 
