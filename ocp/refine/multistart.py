@@ -28,7 +28,8 @@ _RECEIVED_LOCK = threading.Lock()
 
 @interruptible
 def solve_multistart(problem: Problem, guesses: Sequence, *, start_options: Sequence | None = None,
-                     executor=None, **solve_kwargs) -> RefinedSolution:
+                     executor=None, agree: float | None = None,
+                     **solve_kwargs) -> RefinedSolution:
     """Solve ``problem`` from each guess and keep the best converged solution.
 
     Parameters
@@ -60,6 +61,13 @@ def solve_multistart(problem: Problem, guesses: Sequence, *, start_options: Sequ
         (about a second with ``spawn``); any start method works, with ``spawn`` the calling
         script needs the usual ``if __name__ == "__main__":`` guard. A ``ThreadPoolExecutor``
         shares ``problem`` as it is (concurrent solves are safe: `ocp.solve`).
+    agree : float, optional
+        Serial runs only (ignored with an ``executor``): stop once two converged starts have
+        costs within ``agree`` relative of each other (``|a - b| <= agree max(|a|, |b|,
+        1)``): the starts after are not solved (``info['skipped']`` counts them; they have
+        no record). Two starts from different guesses reaching the same optimum is taken
+        as enough evidence that it is the best the guesses lead to. ``None`` (default):
+        every start is solved.
     **solve_kwargs
         Passed to `ocp.solve` (quiet unless ``verbose`` or ``progress`` is given).
 
@@ -70,7 +78,8 @@ def solve_multistart(problem: Problem, guesses: Sequence, *, start_options: Sequ
         `Problem.better`; ``info['best']`` is its index), or, if no start
         converged, the one of least constraint violation with ``success=False``.
         ``info['starts']`` (also ``.starts``) lists every start: ``index, success, status,
-        cost, T, constraint_violation, iterations, time``.
+        cost, T, constraint_violation, iterations, time``; ``info['skipped']`` the number
+        of starts ``agree`` left out (0 without it).
 
     Raises
     ------
@@ -131,9 +140,15 @@ def solve_multistart(problem: Problem, guesses: Sequence, *, start_options: Sequ
                      "iterations": iterations, "time": elapsed}
         LOGGER.info("multistart %d/%d: %s, cost %.12g", i + 1, len(guesses), sol.status, sol.cost)
 
+    if agree is not None and (isinstance(agree, bool) or not isinstance(agree, (int, float))
+                              or not agree >= 0):
+        raise ValueError(f"`agree` must be None or a number >= 0, got {agree!r}")
     if executor is None:
         for i, task in enumerate(tasks):
             record(i, _start(*task))
+            if agree is not None and _agreeing(sols[:i + 1], agree):
+                sols, starts = sols[:i + 1], starts[:i + 1]
+                break
     else:
         gather(executor, _start, tasks, record)
     ok = [i for i, s in enumerate(sols) if s.success and np.isfinite(s.cost)]
@@ -150,8 +165,20 @@ def solve_multistart(problem: Problem, guesses: Sequence, *, start_options: Sequ
         message = (f"none of {len(sols)} starts converged; returning start {best}, the least "
                    f"infeasible: {sols[best].message}")
     same = {} if sols[best].problem is problem else {"problem": problem}  # from a process
-    return annotate(sols[best], {"starts": starts, "best": best}, message=message,
+    return annotate(sols[best], {"starts": starts, "best": best,
+                                 "skipped": len(guesses) - len(sols)}, message=message,
                     success=bool(ok) and sols[best].success, **same)
+
+
+def _agreeing(sols, agree: float) -> bool:
+    """Whether the last of ``sols`` converged to a cost within ``agree`` (relative) of an
+    earlier converged one."""
+    last = sols[-1]
+    if not (last.success and np.isfinite(last.cost)):
+        return False
+    a = float(last.cost)
+    return any(s.success and abs(float(s.cost) - a) <= agree * max(abs(float(s.cost)), abs(a), 1.0)
+               for s in sols[:-1])
 
 
 class _Shipped:

@@ -23,8 +23,8 @@ w1..w3]``, control body torque) and return an `ocp.Solution`:
   or a norm bound ``|u| <= u_max``. Time-optimal slews have local optima (the eigenaxis
   maneuver is one, Bilimoria & Wie 1993), so without a user guess it solves from several
   seeded guesses (the eigenaxis SLERP and SLERPs tilted by a sinusoidal rotation about
-  seeded random axes), keeps the best, and polishes the bang-bang switch times
-  (`ocp.polish_switches`).
+  seeded random axes), raced on a coarse mesh until two agree, keeps the best, and polishes
+  the bang-bang switch times (`ocp.polish_switches`).
 * `min_effort` minimizes ``1/2 integral |u|^2 dt`` over a fixed time, refined until the
   re-integrated trajectory matches the collocated one (`ocp.refine`).
 

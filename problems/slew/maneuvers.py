@@ -13,6 +13,8 @@ from appdyn.config import param
 from appdyn.ocp import (CONTROLS, DEFAULT_CONSTRAINT_TOL, STATUS_BOUND_VIOLATION, STATUS_RESIMULATION,
                  Problem, Solution, annotate, bang_arcs, polish_switches, refine, rest_solution, solve,
                  solve_multistart)
+from appdyn.ocp.refine.arcs import IDLE_TOL
+from appdyn.ocp.refine.result import WORSE_SLACK
 from appdyn.ocp.solve import verified
 from appdyn.dynamics.validate import integer
 from appdyn.dynamics.interrupts import interruptible
@@ -25,7 +27,7 @@ from .targets import (ARCSEC, MIN_REFINE_TOL, POINTING_TOL, RATE_TOL, STATUS_POI
                       STATUS_REFINE, check_tol)
 
 __all__ = ["time_optimal", "min_effort", "verify", "bounded", "DEFAULT_STARTS_TIME",
-           "DEFAULT_STARTS_EFFORT", "POLISH_MIN_BUDGET", "SEED_OPTIONS"]
+           "DEFAULT_STARTS_EFFORT", "POLISH_MIN_BUDGET", "SEED_OPTIONS", "RACE_N", "RACE_AGREE"]
 
 DEFAULT_STARTS_TIME = 3  # seeded starts of time_optimal without a user guess
 DEFAULT_STARTS_EFFORT = 4  # seeded starts of min_effort with a keep-out cone
@@ -94,6 +96,15 @@ def verify(solution: Solution, *, pointing_tol: float = POINTING_TOL, rate_tol: 
         f"rate error {rerr:.3g} rad/s (rate_tol {rtol:g})"))
 
 
+def _symmetric(guess, problem) -> bool:
+    """Whether a torque component of ``guess`` (an `attitude_guess`) is zero throughout
+    (within `ocp.refine.arcs.IDLE_TOL` of its bound): the eigenaxis path of a slew about a
+    body axis that is a principal axis."""
+    u = np.asarray(guess["u"], dtype=float)
+    hi = np.asarray(problem.u_bounds[1], dtype=float)[:, None]
+    return bool(np.any(np.all(np.abs(u) <= IDLE_TOL * hi, axis=1)))
+
+
 def _warn_ignored(*, why: str, **given) -> None:
     """A `UserWarning` naming the arguments of ``given`` that are not None: ignored ``why``."""
     names = [f"`{k}`" for k, v in given.items() if v is not None]
@@ -151,7 +162,15 @@ def time_optimal(inertia, *, angle=None, axis=None, q0=None, qf=None, u_max=1.0,
         A user guess (then a single start is solved). ``None``: multi-start.
     starts : int, optional
         Number of seeded starts without a user guess (eigenaxis +
-        tilted; default 3). Ignored, with a warning, when ``guess`` is given.
+        tilted; default 3). Ignored, with a warning, when ``guess`` is given. Without a
+        ``keep_out`` cone and for ``N`` above `RACE_N` = 10 the starts are raced on
+        `RACE_N` intervals, in turn until two converged ones agree on ``T`` to `RACE_AGREE`
+        (the rest skipped; ``info['race']``), and only the best goes on: polished at once
+        by switch times when bang-bang (``polish`` below; kept when verified and at most
+        1e-3 relative slower than its coarse ``T``), else re-solved on ``N`` intervals warm
+        from it. An eigenaxis path with an idle torque component (a slew about a body axis
+        that is a principal axis: the start stays on the eigenaxis maneuver by symmetry) is
+        raced last.
     seed : int, optional
         Seed of the tilt axes (default 0; results are reproducible).
         Ignored, with a warning, when ``guess`` is given.
@@ -267,11 +286,18 @@ def time_optimal(inertia, *, angle=None, axis=None, q0=None, qf=None, u_max=1.0,
         tries = [{"ipopt_options": {**EIGENAXIS_EXACT, **(ipopt_options or {})}},
                  {"ipopt_options": {**EIGENAXIS_START, **(ipopt_options or {})}}, {}]
         start_options = [tries] + [{}] * (len(guesses) - 1)
+        if len(guesses) >= 3 and _symmetric(guesses[0], problem):
+            # the eigenaxis start of a slew whose eigenaxis path leaves torque components
+            # idle (a body-axis slew of a principal-axis body, as Bilimoria-Wie's) keeps them
+            # idle by symmetry and converges to the eigenaxis maneuver, a local optimum; it
+            # goes last, so that two tilted starts that agree end the race before it
+            guesses, start_options = guesses[1:] + guesses[:1], start_options[1:] + start_options[:1]
     t_start = time.perf_counter()
     sol = solve_time_optimal(problem, guess, guesses, opts,
                              polish=polish and not norm_bound and keep_out is None,
                              pointing_tol=ptol, rate_tol=rtol, ipopt_options=ipopt_options,
-                             verbose=verbose, start_options=start_options)
+                             verbose=verbose, start_options=start_options,
+                             race_N=RACE_N if keep_out is None else None)
     out = bounded(problem, sol, control=control, pointing_tol=ptol, rate_tol=rtol,
                   ipopt_options=ipopt_options, scale=opts["scale"])
     # the whole pipeline's wall time, a bounded re-solve included
@@ -337,7 +363,7 @@ def bounded(problem, solution, *, control="constant", pointing_tol=POINTING_TOL,
         finer = verify(finer, pointing_tol=pointing_tol, rate_tol=rate_tol)
         again = finer if finer.success else again
     keep = {k: v for k, v in getattr(sol, "info", {}).items()
-            if k in ("starts", "best", "polish", "fallback")}
+            if k in ("starts", "best", "race", "polish", "fallback")}
     bv = sol.bound_violation
     why = (f"the {sol.transcription.name} solution (T = {sol.T:.10g} s) leaves the bounds "
            f"between its nodes (`{bv.name}` by {bv.max:.3g} of its scale at t = {bv.time:.6g} "
@@ -371,6 +397,22 @@ _EXACT_SLACK = 1e-4
 #: the switch-time NLP of a new structure takes 0.1-0.5 s the first time (measured).
 POLISH_MIN_BUDGET = 0.5
 
+#: Intervals of the coarse race of `time_optimal`'s seeded starts (`_raced`): every start
+#: is solved on this mesh, only the best again on ``N`` (warm from it). Measured at N = 30
+#: (iterations of the three starts, then of the fine re-solve; the starts on the fine mesh
+#: before): Bilimoria-Wie 47 + 38 + 45, 23 (41 + 68 + 28); 2 rad about (0.2, 1, 0.5) 13 +
+#: 15 + 16, 15 (17 + 21 + 20); the new user's slew 17 + 18 + 18, 19 (18 + 21 + 21); the
+#: same best T on the fine mesh (to 5e-10 relative) in each.
+RACE_N = 10
+
+#: Relative agreement of the ``T`` of two converged starts of the coarse race (`_race`,
+#: `ocp.solve_multistart`'s ``agree``) after which the remaining starts are skipped: two
+#: starts from different guesses (the eigenaxis and a tilted one) reaching the same optimum.
+#: Where they do not (Bilimoria-Wie: the eigenaxis local optimum 3.5449 against 3.2442 on
+#: 10 intervals) every start runs. Measured: the three starts of the 2 rad slew about
+#: (0.2, 1, 0.5) and of the new user's slew each agree to 1e-9 on 10 intervals.
+RACE_AGREE = 1e-6
+
 
 def _labelled_starts(start_options, n: int, verbose):
     """``start_options`` (one entry per start: a mapping or a list of attempts) with each
@@ -398,8 +440,70 @@ def _polish_record(ran: bool, why: str, *, wall_time=0.0, budget=None, method=No
             "T_after": T_after, "gain": gain}
 
 
+def _race(problem, guesses, opts, start_options, race_N):
+    """The coarse race: the starts solved in turn on ``race_N`` intervals (`solve_multistart`;
+    about a third of the cost per iteration at N = 30) until two converged ones agree on
+    ``T`` to `RACE_AGREE` relative (the rest skipped); the best of them, or ``None`` if none
+    converged. ``info['race']`` records ``N``, the best ``T``, the ``iterations`` of all
+    starts solved and how many were ``skipped``."""
+    coarse = solve_multistart(problem, guesses, start_options=_labelled_starts(
+        start_options, len(guesses), opts.get("verbose")), agree=RACE_AGREE,
+        **{**opts, "N": race_N})
+    if not coarse.success:
+        return None
+    race = {"N": race_N, "T": float(coarse.T),
+            "iterations": int(sum(r["iterations"] for r in coarse.info["starts"])),
+            "skipped": int(coarse.info["skipped"])}
+    return annotate(coarse, {"race": race})
+
+
+def _fine(problem, coarse, opts):
+    """The best start of the race re-solved on the mesh of ``opts``, warm from it (with its
+    ``starts``, ``best`` and ``race`` records), or ``None`` if that fails."""
+    fine = solve(problem, guess=coarse, **{**opts, "verbose": stage_sink(opts.get("verbose"),
+                                                                         "slew: fine")})
+    if not fine.success:
+        return None
+    keep = {k: coarse.info[k] for k in ("starts", "best", "race")}
+    return annotate(fine, keep, message=(
+        f"best of {len(keep['starts'])} starts on {keep['race']['N']} intervals: start "
+        f"{keep['best']}, re-solved on {fine.mesh.N}; {fine.message}"))
+
+
+def _polish(problem, seed, opts, *, budget, verbose, ipopt_options, ptol, rtol,
+            method="auto"):
+    """``(polished and verified, record fields)``: `ocp.polish_switches` of ``seed`` (Radau
+    degree 5 for the moving knots; IPOPT tol 1e-9 unless ``ipopt_options`` says otherwise)
+    within ``budget`` [s]."""
+    # a bang-bang first solution: switch-time optimization (arc durations only, RK8 shooting;
+    # Bilimoria-Wie: 3 IPOPT iterations, T = 3.2430832775, re-simulated pointing error 8e-10
+    # rad). Otherwise the moving-knot fallback, at degree 5: at degree 3 the ~4 intervals per
+    # arc under-resolve the states and the free knots exploit the collocation error (T below
+    # the best known); at degree 4 the re-simulated pointing error of Bilimoria-Wie is 4e-7
+    # rad, at degree 5 3e-10 (measured)
+    polish_opts = {"tol": 1e-9, **(ipopt_options or {})}
+    pscale = None if opts["scale"] is None else {"objective": opts["scale"]["objective"],
+                                                 "t_clock": opts["scale"]["T"]}
+    t_polish = time.perf_counter()
+    polished = polish_switches(problem, seed, degree=5, verbose=verbose, ipopt_options=polish_opts,
+                               scale=pscale, budget=budget, method=method)
+    polished = verify(polished, pointing_tol=ptol, rate_tol=rtol)
+    ran = dict(wall_time=time.perf_counter() - t_polish, budget=budget,
+               method=polished.info.get("method"), T_before=float(seed.T),
+               T_polished=float(polished.T))
+    return polished, ran
+
+
+def _kept(polished, seed, ran, t_start, why):
+    """``polished`` with the seed's ``starts``, ``best`` and ``race`` records and the polish
+    record (used)."""
+    first = {k: v for k, v in getattr(seed, "info", {}).items() if k in ("starts", "best", "race")}
+    record = _polish_record(True, why, used=True, T_after=float(polished.T), **ran)
+    return _finish(annotate(polished, first), record, t_start)
+
+
 def solve_time_optimal(problem, guess, guesses, opts, *, polish, pointing_tol, rate_tol,
-                       ipopt_options, verbose, start_options=None):
+                       ipopt_options, verbose, start_options=None, race_N=None):
     """The time-optimal pipeline shared by the rigid-body and the device slews: solve from
     ``guess`` (or the best of ``guesses``), verify by re-simulation, polish the switch
     times when ``polish`` (kept only if verified and not slower), else refine the mesh
@@ -411,12 +515,34 @@ def solve_time_optimal(problem, guess, guesses, opts, *, polish, pointing_tol, r
     ``info['polish']`` (`_polish_record`: ran, used, why, method, wall_time, budget,
     T_before, T_polished, T_after, gain) and in its message (`polish_text`);
     ``info['wall_time']`` is the wall time of the whole pipeline [s]. With ``verbose`` the
-    IPOPT lines go to stderr labelled ``[slew: start i/n]`` and ``[polish]``."""
+    IPOPT lines go to stderr labelled ``[slew: start i/n]`` and ``[polish]``.
+
+    ``race_N`` (an int below ``opts['N']``, several ``guesses``): the starts are raced on
+    ``race_N`` intervals (`_race`) and only the best goes on. If it is bang-bang, its
+    switch times are polished at once (``method='switch-times'``: exact, so the coarse
+    mesh costs no accuracy) and kept when verified and at most `ocp.refine.result.WORSE_SLACK`
+    relative slower than the coarse ``T`` (that mesh's discretization error can put it
+    below the exact optimum: 1.6e-4 relative measured); otherwise the best is re-solved on
+    ``opts['N']`` intervals warm from it (`_fine`) and the pipeline goes on from there as
+    above. ``info['race']`` records the race (``N``, ``T``, ``iterations``)."""
     ptol, rtol = pointing_tol, rate_tol
     t_start = time.perf_counter()
+    sol = None
     if guess is not None:
         sol = solve(problem, guess=guess, **{**opts, "verbose": stage_sink(verbose, "slew")})
-    else:
+    elif race_N is not None and len(guesses) > 1 and race_N < opts["N"]:
+        coarse = _race(problem, guesses, opts, start_options, race_N)
+        arcs = None if not (polish and coarse is not None) else bang_arcs(coarse)[0]
+        if arcs is not None:
+            budget = max(time.perf_counter() - t_start, POLISH_MIN_BUDGET)
+            polished, ran = _polish(problem, coarse, opts, budget=budget, verbose=verbose,
+                                    ipopt_options=ipopt_options, ptol=ptol, rtol=rtol,
+                                    method="switch-times")
+            if polished.success and polished.T <= coarse.T * (1.0 + WORSE_SLACK):
+                return _kept(polished, coarse, ran, t_start,
+                             f"verified, from the best start on {race_N} intervals")
+        sol = None if coarse is None else _fine(problem, coarse, opts)
+    if sol is None:
         sol = solve_multistart(problem, guesses, start_options=_labelled_starts(
             start_options, len(guesses), opts.get("verbose")), **opts)
     t_main = time.perf_counter() - t_start
@@ -429,23 +555,8 @@ def solve_time_optimal(problem, guess, guesses, opts, *, polish, pointing_tol, r
                                 ptol, rtol, ipopt_options, opts["scale"])
         return _finish(out, _polish_record(False, why, T_before=float(first.T),
                                            T_after=float(first.T)), t_start)
-    # a bang-bang first solution: switch-time optimization (arc durations only, RK8 shooting;
-    # Bilimoria-Wie: 3 IPOPT iterations, T = 3.2430832775, re-simulated pointing error 8e-10
-    # rad). Otherwise the moving-knot fallback, at degree 5: at degree 3 the ~4 intervals per
-    # arc under-resolve the states and the free knots exploit the collocation error (T below
-    # the best known); at degree 4 the re-simulated pointing error of Bilimoria-Wie is 4e-7
-    # rad, at degree 5 3e-10 (measured)
-    polish_opts = {"tol": 1e-9, **(ipopt_options or {})}
-    pscale = None if opts["scale"] is None else {"objective": opts["scale"]["objective"],
-                                                 "t_clock": opts["scale"]["T"]}
-    budget = max(t_main, POLISH_MIN_BUDGET)
-    t_polish = time.perf_counter()
-    polished = polish_switches(problem, sol, degree=5, verbose=verbose, ipopt_options=polish_opts,
-                               scale=pscale, budget=budget)
-    polished = verify(polished, pointing_tol=ptol, rate_tol=rtol)
-    ran = dict(wall_time=time.perf_counter() - t_polish, budget=budget,
-               method=polished.info.get("method"), T_before=float(sol.T),
-               T_polished=float(polished.T))
+    polished, ran = _polish(problem, sol, opts, budget=max(t_main, POLISH_MIN_BUDGET),
+                            verbose=verbose, ipopt_options=ipopt_options, ptol=ptol, rtol=rtol)
     # switch times are integrated to ~1e-13 while a fixed-mesh T can sit below the exact
     # optimum by its discretization error (J = diag(1, 2, 3), 1 rad: 2.2075331 against
     # 2.2075385, 2.4e-6 relative), so an exact polish may come out a hair slower and is kept
@@ -454,10 +565,8 @@ def solve_time_optimal(problem, guess, guesses, opts, *, polish, pointing_tol, r
     if not (polished.success and polished.T <= sol.T + slack):  # then the first is graded
         sol = verify(sol, pointing_tol=ptol, rate_tol=rtol)
     if polished.success and (polished.T <= sol.T + slack or not sol.success):
-        first = {k: v for k, v in getattr(sol, "info", {}).items() if k in ("starts", "best")}
         why = "verified, not slower" if sol.success else "verified where the first is not"
-        record = _polish_record(True, why, used=True, T_after=float(polished.T), **ran)
-        return _finish(annotate(polished, first), record, t_start)
+        return _kept(polished, sol, ran, t_start, why)
     why = (polished.message if not polished.success else
            f"its T = {polished.T:.10g} s is not below {sol.T:.10g} s (the first kept)")
     record = _polish_record(True, why, T_after=float(sol.T), **ran)
@@ -486,7 +595,7 @@ def _refined_fallback(problem, first, verified, ptol, rtol, ipopt_options, scale
     ref = refine(problem, first, tol=1e-6, max_rounds=4, ipopt_options=ipopt_options, scale=scale,
                  transcription=first.transcription, **SEED_OPTIONS)
     ref = verify(ref, pointing_tol=ptol, rate_tol=rtol)
-    keep = {k: first.info[k] for k in ("starts", "best", "polish") if k in first.info}
+    keep = {k: first.info[k] for k in ("starts", "best", "race", "polish") if k in first.info}
     keep.update({k: verified.info[k] for k in ("polish",) if k in verified.info})
     if ref.success:
         return annotate(ref, keep)

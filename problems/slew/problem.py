@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import math
+import threading
 import warnings
 
 import casadi as ca
@@ -273,8 +274,31 @@ def attitude_guess(problem: Problem, *, tilt_axis=None, tilt=0.0, T=None, n=201)
     return dict(t=t, x=np.vstack([q, w]), u=u, T=float(T))
 
 
+#: `inertia_of` by model: ``id(model) -> (model, inertia)`` (the model kept, so that its id
+#: is not reused while it is here), the latest `_INERTIA_MAX`; a slew reads it 5-7 times
+#: (guesses, time estimates), about 1 ms each.
+_INERTIA: dict = {}
+_INERTIA_MAX = 32
+_INERTIA_LOCK = threading.Lock()
+
+
 def inertia_of(model):
-    """Recover the inertia matrix of a rigid-body model from its Jacobian (exact)."""
+    """Recover the inertia matrix of a rigid-body model from its Jacobian (exact); a
+    read-only array, computed once per model."""
+    hit = _INERTIA.get(id(model))
+    if hit is not None and hit[0] is model:
+        return hit[1]
+    I = _inertia_of(model)
+    I.setflags(write=False)
+    with _INERTIA_LOCK:  # slews may run in threads (maneuver tables)
+        _INERTIA[id(model)] = (model, I)
+        while len(_INERTIA) > _INERTIA_MAX:
+            _INERTIA.pop(next(iter(_INERTIA)), None)
+    return I
+
+
+def _inertia_of(model):
+    """`inertia_of`, computed."""
     iq, iw = attitude_blocks(model)
     x, u = ca.SX.sym("x", model.nx), ca.SX.sym("u", model.nu)
     J = ca.Function("J", [x, u], [ca.jacobian(model.f(x, u, ca.DM.zeros(0))[iw], u)])

@@ -107,3 +107,18 @@ def test_problem_is_unpickled_once_per_worker(problem):
 
     a, b = _Shipped(problem), _Shipped(problem)
     assert a.digest == b.digest and a.get() is b.get() and a.get() is not problem
+
+
+def test_agreeing_starts_stop_the_serial_multistart(problem):
+    """x'' = u, |u| <= 1 from rest to rest over a unit distance: T = 2 from every guess, so
+    with ``agree`` the second converged start ends the run; without it, every start runs."""
+    guesses = [None, {"T": 5.0}, {"T": 3.0}]
+    kw = dict(N=10, control="constant")
+    every = ocp.solve_multistart(problem, guesses, **kw)
+    short = ocp.solve_multistart(problem, guesses, agree=1e-6, **kw)
+    assert every.info["skipped"] == 0 and len(every.info["starts"]) == 3
+    assert short.info["skipped"] == 1 and len(short.info["starts"]) == 2
+    assert short.success and abs(short.T - 2.0) < 1e-6
+    assert _records(short) == _records(every)[:2]  # the same starts, the third not solved
+    with pytest.raises(ValueError, match="`agree`"):
+        ocp.solve_multistart(problem, guesses, agree=-1.0, **kw)

@@ -95,3 +95,28 @@ def test_polish_record_of_a_bang_bang_slew(bilimoria_wie):
     assert record["budget"] >= 0.5 and record["wall_time"] <= record["budget"] + 2.0
     assert sol.info["wall_time"] >= record["wall_time"]
     assert "polish (switch-times" in sol.message and "gain" in sol.message
+
+
+# ------------------------------------------------------------------ the coarse race
+def test_the_coarse_race_reaches_the_optimum_of_the_fine_starts(monkeypatch, bilimoria_wie):
+    """The starts raced on `RACE_N` intervals and the best polished at once give the T of
+    the pipeline that solves every start on N = 30 before the polish (a second formulation:
+    the race switched off), to the switch-time integration error; two agreeing starts stop
+    the race (the 2 rad slew). Bilimoria-Wie's eigenaxis start (idle x and y torques: it
+    stays on the eigenaxis local optimum 2 sqrt(pi) by symmetry) goes last and is skipped
+    once the two tilted ones agree below it."""
+    from appdyn.problems.slew import maneuvers
+
+    second = dict(angle=2.0, axis=[0.2, 1.0, 0.5], u_max=1.0)
+    raced = slew.time_optimal(np.eye(3), **second)
+    monkeypatch.setattr(maneuvers, "RACE_N", None)
+    fine = slew.time_optimal(np.eye(3), **second)
+    assert raced.success and fine.success, (raced.message, fine.message)
+    assert "race" not in fine.info and len(fine.info["starts"]) == 3
+    assert raced.info["race"]["N"] == 10
+    assert raced.info["race"]["skipped"] == 1 and len(raced.info["starts"]) == 2
+    assert raced.info["polish"]["used"] and raced.info["polish"]["method"] == "switch-times"
+    assert abs(raced.T - fine.T) <= 1e-9 * fine.T
+    bw = bilimoria_wie.info
+    assert bw["race"]["skipped"] == 1 and len(bw["starts"]) == 2
+    assert max(s["T"] for s in bw["starts"]) < 3.2443 < slew.eigenaxis_time(np.eye(3), np.pi, [0, 0, 1])
