@@ -2,13 +2,12 @@
 from __future__ import annotations
 
 import math
-import threading
 import warnings
 
 import casadi as ca
 import numpy as np
 
-from appdyn.dynamics import rigid_body
+from appdyn.dynamics import cache, rigid_body
 from appdyn.dynamics.attitude import quat_conj, quat_from_axis_angle, quat_mul, quat_normalize, rotation_angle
 from appdyn.dynamics.rigid_body import check_inertia
 from appdyn.dynamics.validate import positive, unit_vector
@@ -274,27 +273,16 @@ def attitude_guess(problem: Problem, *, tilt_axis=None, tilt=0.0, T=None, n=201)
     return dict(t=t, x=np.vstack([q, w]), u=u, T=float(T))
 
 
-#: `inertia_of` by model: ``id(model) -> (model, inertia)`` (the model kept, so that its id
-#: is not reused while it is here), the latest `_INERTIA_MAX`; a slew reads it 5-7 times
-#: (guesses, time estimates), about 1 ms each.
-_INERTIA: dict = {}
-_INERTIA_MAX = 32
-_INERTIA_LOCK = threading.Lock()
-
-
 def inertia_of(model):
     """Recover the inertia matrix of a rigid-body model from its Jacobian (exact); a
-    read-only array, computed once per model."""
-    hit = _INERTIA.get(id(model))
-    if hit is not None and hit[0] is model:
-        return hit[1]
-    I = _inertia_of(model)
-    I.setflags(write=False)
-    with _INERTIA_LOCK:  # slews may run in threads (maneuver tables)
-        _INERTIA[id(model)] = (model, I)
-        while len(_INERTIA) > _INERTIA_MAX:
-            _INERTIA.pop(next(iter(_INERTIA)), None)
-    return I
+    read-only array, computed once per model (kept in the one cache, `dynamics.cache`: a
+    slew reads it 5-7 times, about 1 ms each)."""
+    def build():
+        I = _inertia_of(model)
+        I.setflags(write=False)
+        return I
+    return cache.get(("slew.inertia_of", cache.function_key(model.f)), build,
+                     keepalive=model.f)
 
 
 def _inertia_of(model):
