@@ -38,6 +38,8 @@ Examples
 """
 from __future__ import annotations
 
+import numpy as np
+
 __all__ = ["CODES", "IPOPT_CODES", "APPDYN_CODES", "status_code", "status_name",
            "STATUS_SUCCESS", "STATUS_ACCEPTABLE", "STATUS_INFEASIBLE", "STATUS_USER_STOP",
            "STATUS_MAX_ITER", "STATUS_WALL_TIME", "STATUS_CONSTRAINT_TOL",
@@ -171,13 +173,20 @@ def status_code(name: str) -> int:
         The code in `CODES`; `STATUS_UNKNOWN` (-201) for a name not in the table (a
         solver status text is reported, never raised on).
 
+    Raises
+    ------
+    TypeError
+        If ``name`` is not a string.
+
     Examples
     --------
     >>> from appdyn.ocp.status import status_code
     >>> status_code("Infeasible_Problem_Detected"), status_code("Something_New")
     (2, -201)
     """
-    return CODES.get(str(name), STATUS_UNKNOWN)
+    if not isinstance(name, str):
+        raise TypeError(f"`name` must be a status name (a str), got {type(name).__name__}")
+    return CODES.get(name, STATUS_UNKNOWN)
 
 
 def status_name(code: int) -> str:
@@ -192,12 +201,19 @@ def status_name(code: int) -> str:
     str
         The name in `CODES`, or ``'status <code>'`` for a code not in the table.
 
+    Raises
+    ------
+    TypeError
+        If ``code`` is not an integer (a bool neither).
+
     Examples
     --------
     >>> from appdyn.ocp.status import status_name
     >>> status_name(0), status_name(-5), status_name(7)
     ('Solve_Succeeded', 'Maximum_WallTime_Exceeded', 'status 7')
     """
+    if isinstance(code, bool) or not isinstance(code, (int, np.integer)):
+        raise TypeError(f"`code` must be an int status, got {type(code).__name__}")
     return _NAMES.get(int(code), f"status {int(code)}")
 
 

@@ -24,7 +24,7 @@ from appdyn.dynamics.linearize import Linearization
 from .common import (axes_or_new_figure, finish_figure, format_number, jsonable, param_line,
                      plain)
 from .verdict import ZERO_RTOL, classify, least_damped
-from appdyn.dynamics.results import Result, clean_number, quantity
+from appdyn.dynamics.results import Result, clean_number, quantity, timed
 
 __all__ = ["Mode", "Margins", "Quantity", "StabilityReport", "build_report", "analyze",
            "STATUS_VERIFIED", "STATUS_UNCHECKED", "STATUS_MISMATCH", "CLOSED_FORM_RTOL",
@@ -496,6 +496,7 @@ def build_report(case, title, parameters, ss, *, lin=None, groups=None, labeler=
                            notes=tuple(notes), linearization=lin)
 
 
+@timed
 def analyze(sys, *, title: str = "Linear system",
             groups: Mapping[str, Sequence[str]] | None = None,
             closed_form=None) -> StabilityReport:

@@ -46,6 +46,8 @@ ALLOWED_GARBAGE = {
     ("appdyn.dynamics.launch_vehicle.rigid_part", "slosh"): {"none": "documented `Slosh or None`"},
     ("appdyn.problems.ascent.vertical_rise", "vehicle"): {"none": "documented `AscentVehicle or None`"},
     ("appdyn.problems.ascent.pitch_model", "vehicle"): {"none": "documented `AscentVehicle or None`"},
+    ("appdyn.ocp.status_code", "name"): {"str": "a name not in the table is the documented "
+                                                 "code -201 (Unknown): IPOPT may add statuses"},
     ("appdyn.ocp.check_ipopt_options", "options"): {"none": "documented `mapping ... or None`"},
     ("appdyn.problems.dispersion.dispersion", "seed"): {"none": "documented `int or None` (fresh entropy)"},
     ("appdyn.problems.dispersion.statistics", "values"): {

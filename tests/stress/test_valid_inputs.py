@@ -311,6 +311,9 @@ def _nonsingular_delta(draw):
 
 SPIN_RATES = st.tuples(log_floats(0.1, 10.0), floats(-0.05, 0.05), floats(-0.05, 0.05)).map(np.array)
 RANDOM_OVERRIDES = {
+    "appdyn.ocp.status_code": {"name": st.sampled_from(
+        sorted(__import__("appdyn.ocp.status", fromlist=["x"]).CODES) + ["Something_New"])},
+    "appdyn.ocp.status_name": {"code": st.integers(-300, 300)},
     "appdyn.problems.ascent.pitch_model": {"vehicle": st.just(None), "k_theta": floats(0.5, 5.0),
                                            "k_thetadot": floats(0.1, 2.0)},
     "appdyn.dynamics.attitude.euler321_rates": {"angles": st.tuples(
