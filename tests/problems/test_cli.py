@@ -147,7 +147,8 @@ def test_slew_verbose_keeps_stdout_to_the_summary(tmp_path, capfd):
     iteration = re.compile(r"^\s*\d+\s+[-+]?\d\.\d+e[-+]\d+")
     assert not any(iteration.match(line) for line in stdout.splitlines()), stdout
     assert "This is Ipopt" not in stdout and "objective (scaled)" not in stdout
-    assert "[slew: start 1/3]" in stderr and "[slew: start 3/3]" in stderr
+    assert "[slew: start 1/3]" in stderr and "[slew: start 2/3]" in stderr  # (the third:
+    # skipped once two starts agree, `solve_multistart(agree=)`)
     assert "[polish]" in stderr
     assert "switch-time polish" in stdout and "wall time, total [s]" in stdout
     data = json.loads(out.read_text())
