@@ -13,6 +13,7 @@ import json
 import os
 import statistics
 import sys
+import time
 
 __all__ = ["stdout_to_stderr", "repeated", "main", "asset_main"]
 
@@ -66,6 +67,19 @@ def main(doc: str, run, sizes_flag: str, default_sizes, extra=None, repeats: int
     else:
         for r in out["runs"]:
             print(r)
+
+
+def asset_solve(phase, threads: int | None, solve: str = "optimize") -> tuple:
+    """Run an ASSET phase built just before: ``(final state, solve time [s], row)`` where
+    ``row`` holds ``solve_time``, ``iterations`` and ``status`` for a runner's result."""
+    if threads:
+        phase.setThreads(threads, threads)
+    t1 = time.perf_counter()
+    flag = getattr(phase, solve)()
+    solve_time = time.perf_counter() - t1
+    last = phase.returnTraj()[-1]
+    return last, {"solve_time": solve_time, "iterations": int(phase.optimizer.LastIterNum),
+                  "status": str(getattr(flag, "name", flag))}
 
 
 def asset_main(doc: str, run_one, default_sizes) -> None:

@@ -24,7 +24,7 @@ import time
 
 import numpy as np
 
-from _runner import asset_main
+from _runner import asset_main, asset_solve
 
 THRUST, MDOT, T_FINAL = 0.1405, 0.0749, 3.32
 
@@ -61,15 +61,10 @@ def build(ast, segments: int):
 def run_one(ast, segments: int, threads: int | None) -> dict:
     t0 = time.perf_counter()
     ph = build(ast, segments)
-    if threads:
-        ph.setThreads(threads, threads)
-    t1 = time.perf_counter()
-    flag = ph.optimize()
-    t2 = time.perf_counter()
-    last = np.asarray(ph.returnTraj()[-1])
-    return {"segments": segments, "r_f": float(last[0]), "build_time": t1 - t0,
-            "solve_time": t2 - t1, "iterations": int(ph.optimizer.LastIterNum),
-            "status": str(getattr(flag, "name", flag))}
+    build_time = time.perf_counter() - t0
+    last, row = asset_solve(ph, threads)
+    return {"segments": segments, "r_f": float(np.asarray(last)[0]), "build_time": build_time,
+            **row}
 
 
 if __name__ == "__main__":

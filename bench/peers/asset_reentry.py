@@ -21,7 +21,7 @@ import time
 
 import numpy as np
 
-from _runner import asset_main
+from _runner import asset_main, asset_solve
 
 L_STAR, T_STAR = 1.0e5, 60.0
 G0, WEIGHT = 32.2, 203000.0
@@ -81,15 +81,11 @@ def build(ast, segments: int):
 def run_one(ast, segments: int, threads: int | None) -> dict:
     t0 = time.perf_counter()
     ph = build(ast, segments)
-    if threads:
-        ph.setThreads(threads, threads)
-    t1 = time.perf_counter()
-    flag = ph.solve_optimize()
-    t2 = time.perf_counter()
-    last = np.asarray(ph.returnTraj()[-1])
+    build_time = time.perf_counter() - t0
+    last, row = asset_solve(ph, threads, "solve_optimize")
+    last = np.asarray(last)
     return {"segments": segments, "theta_f_deg": float(np.rad2deg(last[1])),
-            "final_time": float(last[5] * T_STAR), "build_time": t1 - t0, "solve_time": t2 - t1,
-            "iterations": int(ph.optimizer.LastIterNum), "status": str(getattr(flag, "name", flag))}
+            "final_time": float(last[5] * T_STAR), "build_time": build_time, **row}
 
 
 if __name__ == "__main__":
