@@ -150,6 +150,26 @@ def assemble(seg_f: tuple, end_f: tuple, wsym, Psym, seg_args: list, end_args: l
     per repetition). ``nlp``: ``{'x', 'p', 'f', 'g'}`` (MX; ``p`` = ``Psym``) for
     ``casadi.nlpsol``; ``derivatives``: ``grad_f``, ``jac_g`` and ``hess_lag`` Functions for
     its options of those names; ``fg``: ``(x, p) -> (f, g)``.
+
+    Examples
+    --------
+    Two pieces ``x_k+1 - 2 x_k`` (objective ``x_k^2``) and one end row ``x_0 - 1``:
+
+    >>> import casadi as ca
+    >>> import numpy as np
+    >>> from appdyn.ocp.assembly import assemble, local_functions
+    >>> z, e = ca.SX.sym("z", 2), ca.SX.sym("e")  # a piece's (x_k, x_k+1); the end's x_0
+    >>> seg = local_functions("seg", [z], z[1] - 2 * z[0], z[0] ** 2, z)
+    >>> end = local_functions("end", [e], e - 1, 0 * e, e)
+    >>> w, P = ca.MX.sym("w", 3), ca.MX.sym("P", 0)
+    >>> cols = np.array([[0, 1], [1, 2]])  # the variables of each piece, a row per piece
+    >>> maps = (cols, np.array([[0], [1]]), np.array([0]), np.array([2]))
+    >>> Z = ca.reshape(w[cols.reshape(-1).tolist()], 2, 2)
+    >>> nlp, d, fg = assemble(seg, end, w, P, [Z], [w[0]], [False], maps)
+    >>> np.array(d["jac_g"]([1, 2, 4], [])[1]), float(fg([1, 2, 4], [])[0])
+    (array([[-2.,  1.,  0.],
+           [ 0., -2.,  1.],
+           [ 1.,  0.,  0.]]), 5.0)
     """
     seg_cols, seg_g, end_cols, end_g = maps
     N = seg_cols.shape[0]
