@@ -83,7 +83,8 @@ def solve_phases(problem: MultiPhaseProblem, *, guess=None, objective_scale: flo
     guess : None, MultiPhaseSolution or sequence, optional
         A previous solution (each phase's solution becomes that phase's guess; primal and dual
         values when it solved the same NLP up to its bounds, e.g. with a path constraint's band
-        narrowed), or one guess per phase (``None`` items take the
+        narrowed; on other meshes of Radau phases, the dual values from its costates, see
+        ``refine_tol``), or one guess per phase (``None`` items take the
         phase's own ``Phase.guess``). A phase guess is what `ocp.solve` takes, its times from
         the phase's start.
     objective_scale : float, optional
@@ -91,7 +92,10 @@ def solve_phases(problem: MultiPhaseProblem, *, guess=None, objective_scale: flo
     refine_tol : float, optional
         Refine each phase's mesh until its largest estimated interval error
         (`ocp.refine.interval_errors`) is below this (as `ocp.refine` does for one phase),
-        re-solving warm after each round; default: no refinement.
+        re-solving warm after each round: primal values interpolated onto the new meshes,
+        defect multipliers from the interpolated costates (Radau), link and event multipliers
+        carried over, IPOPT's barrier restarted where the last solve ended (``mu_init = tol /
+        10``); default: no refinement.
     max_rounds, max_intervals : int, optional
         Refinement limits (rounds; intervals per phase).
     verbose, progress, ipopt_options, constraint_tol, expand, codegen
@@ -147,23 +151,23 @@ def solve_phases(problem: MultiPhaseProblem, *, guess=None, objective_scale: flo
     rounds, totals = [], [0.0, 0.0, 0]
     for _ in range(max_rounds + 1):
         totals = [totals[0] + sol.solve_time, totals[1] + sol.build_time, totals[2] + sol.iterations]
-        errors = [interval_errors(s).max_error if sol.success else float("inf") for s in sol.phases]
+        ests = [interval_errors(s) if sol.success else None for s in sol.phases]
+        errors = [e.max_error if e is not None else float("inf") for e in ests]
         rounds.append((tuple(s.mesh.N for s in sol.phases), tuple(errors), sol.cost, sol.iterations))
         LOGGER.info("solve_phases %s: intervals %s, errors %s", problem.name,
                     rounds[-1][0], ", ".join(f"{e:.2g}" for e in errors))
         if not sol.success or max(errors) <= refine_tol or len(rounds) > max_rounds:
             break
         meshes = []
-        for s, e in zip(sol.phases, errors):
+        for s, e, est in zip(sol.phases, errors, ests):
             new = None
             if e > refine_tol:
-                est = interval_errors(s)
                 new = new_mesh(s.mesh, est, s.T, s.t0, refine_tol, local_order(s.transcription),
                                max_intervals)
             meshes.append(new or s.mesh)
         if all(m is s.mesh for m, s in zip(meshes, sol.phases)):
             break
-        sol = _solve_once(problem, meshes, list(sol.phases), None, objective_scale, opts,
+        sol = _solve_once(problem, meshes, list(sol.phases), sol, objective_scale, opts,
                           ipopt_options, ctol, sink, expand, codegen)
     converged = sol.success and max(rounds[-1][1]) <= refine_tol
     note = "" if converged or not sol.success else (
@@ -196,9 +200,16 @@ def _solve_once(problem, meshes, guesses, warm_from, objective_scale, opts, ipop
     disc = PhasedDiscretization(problem, discs, objective_scale, scale_e)
     start = {"x0": disc.pack(node_guesses)}
     warm = _warm_point(warm_from, disc)
+    cross = None
+    if warm is None:
+        warm = cross = _interpolated_duals(warm_from, disc, start["x0"])
     if warm is not None:
         start = warm
         opts = {**WARM_START_OPTIONS, **opts}
+        if cross is not None and "mu_init" not in (ipopt_options or {}):
+            # continue on the central path where the previous solve ended (its final barrier
+            # parameter: IPOPT stops near tol / 10)
+            opts["mu_init"] = 0.1 * float(opts.get("tol", 1e-8))
     nlp_opts = {"ipopt": opts, "print_time": False, "error_on_fail": False}
 
     def build(options=nlp_opts):
@@ -258,6 +269,7 @@ def _solution(problem, disc, parts, w, lam_g, lam_x, g, success, status, message
     viol = disc.violation(g, w) if np.all(np.isfinite(g)) else float("nan")
     sw, sg, dJ = _phys_scales(disc)
     point = {"key": disc.key, "numbers": _phased_numbers(disc), "x_phys": w * sw,
+             "g_sizes": tuple(d.g.size for d in disc.discs),
              "lam_x_phys": lam_x * dJ / sw, "lam_g_phys": lam_g * dJ / sg}
     return MultiPhaseSolution(
         success=bool(success), status=int(status), message=message, cost=disc.cost(w),
@@ -304,3 +316,64 @@ def _warm_point(sol, disc) -> dict | None:
     sw, sg, dJ = _phys_scales(disc)
     return {"x0": np.clip(point["x_phys"] / sw, disc.lbx, disc.ubx),
             "lam_x0": point["lam_x_phys"] * sw / dJ, "lam_g0": point["lam_g_phys"] * sg / dJ}
+
+
+def _interpolated_duals(sol, disc, x0) -> dict | None:
+    """Primal and dual start values on the meshes of ``disc`` from a `MultiPhaseSolution`
+    of the same problem on other meshes (a refinement round, a coarse-to-fine start), or
+    ``None`` when ``sol`` is not one or a phase's transcription gives no costates.
+
+    The primal values ``x0`` are the solution interpolated onto the new nodes (`ocp.guess`).
+    The defect multipliers follow from the phases' costate estimates (Radau:
+    ``lambda_i = -nu_i / w_i``, `ocp.transcription.Radau.costates`), interpolated linearly
+    in time onto the new collocation points and mapped back by ``nu_i = -w_i lambda(t_i)``;
+    the link and event rows are the same rows, their multipliers are copied; path and
+    bound multipliers start at zero (IPOPT's warm start pushes them off zero)."""
+    point = getattr(sol, "nlp_point", None)
+    if (not point or "g_sizes" not in point or len(sol.phases) != len(disc.discs)
+            or len(point["g_sizes"]) != len(disc.discs)):
+        return None
+    lam_old = np.asarray(point["lam_g_phys"], dtype=float)
+    n_e = disc.event_scale.size
+    if lam_old.size != sum(point["g_sizes"]) + n_e:
+        return None
+    nu = np.zeros(disc.lbg.size)
+    start = 0
+    for i, (d, old, size) in enumerate(zip(disc.discs, sol.phases, point["g_sizes"])):
+        tr = d.transcription
+        if type(tr) is not type(old.transcription) or old.x.shape[0] != d.problem.model.nx:
+            return None
+        rows = _old_defects(old, lam_old[start:start + size])
+        lam = old.transcription.costates(rows, old.mesh) if rows is not None else None
+        if lam is None or lam.shape[1] != old.t.size:
+            return None
+        new = _defect_multipliers(tr, d.mesh, old.t - old.t[0], old.T, lam)
+        o = disc.structure.g.offset(str(i)) + d.g.offset("defect")
+        nu[o:o + new.size] = new.reshape(-1, order="F")
+        start += size
+    if n_e:
+        nu[-n_e:] = lam_old[-n_e:]
+    sw, sg, dJ = _phys_scales(disc)
+    return {"x0": x0, "lam_g0": nu * sg / dJ, "lam_x0": np.zeros(disc.lbx.size)}
+
+
+def _old_defects(old, lam_g_phys):
+    """The defect block ``(nx, N m_d)`` of one phase's physical constraint multipliers
+    ``lam_g_phys`` (its NLP's row order), or ``None`` when the sizes disagree."""
+    from ..nlp import structure
+    pb = replace(old.problem, t0=0.0) if old.problem.t0 != 0.0 else old.problem
+    st = structure(pb, old.transcription, old.mesh.N)
+    if st.g.size != lam_g_phys.size:
+        return None
+    return st.g.split(lam_g_phys)["defect"]
+
+
+def _defect_multipliers(tr, mesh, t_old, T, lam) -> np.ndarray:
+    """``nu`` (nx, N d) on ``mesh`` (phase duration ``T``) for the costates ``lam`` (nx, n)
+    given at the phase-relative times ``t_old``: ``nu = -w lambda(t)`` at the collocation
+    points."""
+    c, w = tr.points, tr.weights
+    b, h = mesh.breaks[:-1], mesh.fractions
+    t_new = ((b[:, None] + h[:, None] * c[None, :]) * T).reshape(-1)
+    out = np.vstack([np.interp(t_new, t_old, row) for row in lam])
+    return -out * np.tile(w, mesh.N)[None, :]
