@@ -17,7 +17,7 @@ import numpy as np
 from appdyn.dynamics.cache import construction_lock
 from appdyn.dynamics.interrupts import check_interrupt, interruptible
 
-from ..cached import checkout
+from ..cached import cached, checkout
 from ..guess import initial_guess
 from ..nlp import Discretization
 from ..progress import LOGGER, IterationCallback, iteration_sink
@@ -51,19 +51,21 @@ def _phase_guesses(problem: MultiPhaseProblem, guess) -> list:
                      f"got {type(guess).__name__}")
 
 
-def _discretize(problem: MultiPhaseProblem, meshes, guesses, expand, codegen):
-    """Per phase ``(transcription, mesh, node guess, Discretization)``."""
+def _discretize(problem: MultiPhaseProblem, meshes, guesses, expand, codegen, scalings=None):
+    """Per phase ``(transcription, mesh, node guess, Discretization)``; ``scalings``: the
+    phases' `ocp.scaling.Scaling` to keep (a refinement round keeps those of its first solve:
+    the same problem in the same units), else each from its guess."""
     out = []
     for i, ph in enumerate(problem.phases):
         tr = get_transcription(ph.transcription, degree=ph.degree)
         m = meshes[i] if meshes is not None else default_mesh(ph.N, ph.mesh)
-        pb = replace(ph.problem, t0=0.0) if ph.problem.t0 != 0.0 else ph.problem
+        pb = _started_at(ph.problem, 0.0)
         try:
             # (a Solution is read in normalized time)
             ng = initial_guess(pb, tr, m, guess=guesses[i])
         except ValueError as exc:
             raise ValueError(f"phases[{i}]: {exc}") from exc
-        scaling = auto_scaling(pb, ng, overrides=ph.scale)
+        scaling = scalings[i] if scalings is not None else auto_scaling(pb, ng, overrides=ph.scale)
         out.append((tr, m, ng, Discretization(pb, tr, m, scaling, expand, codegen)))
     return out
 
@@ -168,7 +170,8 @@ def solve_phases(problem: MultiPhaseProblem, *, guess=None, objective_scale: flo
         if all(m is s.mesh for m, s in zip(meshes, sol.phases)):
             break
         sol = _solve_once(problem, meshes, list(sol.phases), sol, objective_scale, opts,
-                          ipopt_options, ctol, sink, expand, codegen)
+                          ipopt_options, ctol, sink, expand, codegen,
+                          scalings=sol.nlp_point.get("scalings") if sol.nlp_point else None)
     converged = sol.success and max(rounds[-1][1]) <= refine_tol
     note = "" if converged or not sol.success else (
         f"; mesh refinement stopped above refine_tol {refine_tol:g} (largest interval error "
@@ -176,6 +179,17 @@ def solve_phases(problem: MultiPhaseProblem, *, guess=None, objective_scale: flo
     return replace(sol, message=sol.message + note,
                    info={"rounds": tuple(rounds), "converged": converged, "solve_time": totals[0],
                          "build_time": totals[1], "iterations": totals[2]})
+
+
+def _started_at(problem, t0: float):
+    """``problem`` with its start time ``t0`` (a phase's NLP starts at 0, its solution at the
+    phase start), built once per problem object and start time in the one cache: a
+    `Problem` re-checks every argument when copied, milliseconds per phase and solve."""
+    t0 = float(t0)
+    if problem.t0 == t0:
+        return problem
+    return cached("phase_started_at", (id(problem), t0), lambda: replace(problem, t0=t0),
+                  keepalive=problem)
 
 
 def _positive(value, name: str) -> float:
@@ -189,9 +203,9 @@ def _positive(value, name: str) -> float:
 
 
 def _solve_once(problem, meshes, guesses, warm_from, objective_scale, opts, ipopt_options, ctol,
-                sink, expand, codegen) -> MultiPhaseSolution:
+                sink, expand, codegen, scalings=None) -> MultiPhaseSolution:
     t_build = time.perf_counter()
-    parts = _discretize(problem, meshes, guesses, expand, codegen)
+    parts = _discretize(problem, meshes, guesses, expand, codegen, scalings)
     discs = [p[3] for p in parts]
     node_guesses = [p[2] for p in parts]
     ends0 = np.concatenate([np.concatenate([ng.X[:, 0], ng.X[:, -1], ng.p, [ng.T]])
@@ -252,7 +266,7 @@ def _solution(problem, disc, parts, w, lam_g, lam_x, g, success, status, message
     t0s, phases, start = [], [], problem.t0
     for i, ((tr, m, _, d), wi, li, gi) in enumerate(zip(parts, ws, lgs, gs)):
         T = float(d.unpack(wi)["T"])
-        pb = replace(d.problem, t0=start)
+        pb = _started_at(d.problem, start)
         d_t = _Shifted(d, pb)
         phases.append(make_solution(pb, tr, m, d_t, NlpOutcome(
             w=wi, lam_g=li, g=gi, success=success, status=status, message=message,
@@ -270,6 +284,7 @@ def _solution(problem, disc, parts, w, lam_g, lam_x, g, success, status, message
     sw, sg, dJ = _phys_scales(disc)
     point = {"key": disc.key, "numbers": _phased_numbers(disc), "x_phys": w * sw,
              "g_sizes": tuple(d.g.size for d in disc.discs),
+             "scalings": tuple(d.scaling for d in disc.discs),
              "lam_x_phys": lam_x * dJ / sw, "lam_g_phys": lam_g * dJ / sg}
     return MultiPhaseSolution(
         success=bool(success), status=int(status), message=message, cost=disc.cost(w),
@@ -361,7 +376,7 @@ def _old_defects(old, lam_g_phys):
     """The defect block ``(nx, N m_d)`` of one phase's physical constraint multipliers
     ``lam_g_phys`` (its NLP's row order), or ``None`` when the sizes disagree."""
     from ..nlp import structure
-    pb = replace(old.problem, t0=0.0) if old.problem.t0 != 0.0 else old.problem
+    pb = _started_at(old.problem, 0.0)
     st = structure(pb, old.transcription, old.mesh.N)
     if st.g.size != lam_g_phys.size:
         return None
