@@ -18,6 +18,7 @@ from appdyn.dynamics.cache import construction_lock
 from appdyn.dynamics.interrupts import check_interrupt, interruptible
 
 from ..cached import cached, checkout
+from ..assembly import structure_key
 from ..guess import initial_guess
 from ..nlp import Discretization
 from ..progress import LOGGER, IterationCallback, iteration_sink
@@ -147,7 +148,8 @@ def solve_phases(problem: MultiPhaseProblem, *, guess=None, objective_scale: flo
     guesses = _phase_guesses(problem, guess)
 
     sol = _solve_once(problem, None, guesses, guess if isinstance(guess, MultiPhaseSolution) else None,
-                      objective_scale, opts, ipopt_options, ctol, sink, expand, codegen)
+                      objective_scale, opts, ipopt_options, ctol, sink, expand, codegen,
+                      scalings=_kept_scalings(problem, guess, expand, codegen))
     if refine_tol is None:
         return sol
     rounds, totals = [], [0.0, 0.0, 0]
@@ -179,6 +181,25 @@ def solve_phases(problem: MultiPhaseProblem, *, guess=None, objective_scale: flo
     return replace(sol, message=sol.message + note,
                    info={"rounds": tuple(rounds), "converged": converged, "solve_time": totals[0],
                          "build_time": totals[1], "iterations": totals[2]})
+
+
+def _kept_scalings(problem, guess, expand, codegen):
+    """The phases' scalings of ``guess`` when it is a `MultiPhaseSolution` of the same NLP
+    structure on the same meshes up to bounds (e.g. a relaxed path band narrowed) with the
+    same scale overrides: the same variables and rows in the same units, kept rather than
+    derived again from the guess; else ``None``."""
+    point = getattr(guess, "nlp_point", None) if isinstance(guess, MultiPhaseSolution) else None
+    if not point or "scalings" not in point or len(guess.phases) != problem.n_phases:
+        return None
+    keys = point["key"][1]
+    for i, ph in enumerate(problem.phases):
+        tr = get_transcription(ph.transcription, degree=ph.degree)
+        key = structure_key(_started_at(ph.problem, 0.0), tr, default_mesh(ph.N, ph.mesh).N,
+                            expand, codegen=codegen)
+        if (key != keys[i] or guess.phases[i].mesh != default_mesh(ph.N, ph.mesh)
+                or guess.problem.phases[i].scale != ph.scale):
+            return None
+    return point["scalings"]
 
 
 def _started_at(problem, t0: float):

@@ -170,6 +170,9 @@ def test_warm_start_carries_over_to_the_same_nlp_with_other_bounds():
     assert cold.success and warm.success
     assert warm.iterations <= 3 < cold.iterations
     assert warm.cost == pytest.approx(cold.cost, rel=1e-9)
+    # the same variables and rows in the same units: the scalings are kept, not derived again
+    assert all(a is b for a, b in zip(warm.nlp_point["scalings"], sol.nlp_point["scalings"]))
+    assert not any(a is b for a, b in zip(cold.nlp_point["scalings"], sol.nlp_point["scalings"]))
 
 
 def test_a_solution_on_other_meshes_starts_primal_and_dual():
