@@ -85,8 +85,8 @@ def solve_phases(problem: MultiPhaseProblem, *, guess=None, objective_scale: flo
     problem : MultiPhaseProblem
     guess : None, MultiPhaseSolution or sequence, optional
         A previous solution (each phase's solution becomes that phase's guess; primal and dual
-        values when it solved the same NLP up to its bounds, e.g. with a path constraint's band
-        narrowed; on other meshes of Radau phases, the dual values from its costates, see
+        values, and its scalings, when it solved the same NLP up to its bounds, e.g. with a
+        path constraint's band narrowed; on other meshes of Radau phases, the dual values from its costates, see
         ``refine_tol``), or one guess per phase (``None`` items take the
         phase's own ``Phase.guess``). A phase guess is what `ocp.solve` takes, its times from
         the phase's start.
