@@ -364,12 +364,15 @@ def _interpolated_duals(sol, disc, x0) -> dict | None:
     ``lambda_i = -nu_i / w_i``, `ocp.transcription.Radau.costates`), interpolated linearly
     in time onto the new collocation points and mapped back by ``nu_i = -w_i lambda(t_i)``;
     the link and event rows are the same rows, their multipliers are copied; path and
-    bound multipliers start at zero (IPOPT's warm start pushes them off zero)."""
+    bound multipliers start at zero (IPOPT's warm start pushes them off zero). Only from a
+    successful solve."""
     point = getattr(sol, "nlp_point", None)
-    if (not point or "g_sizes" not in point or len(sol.phases) != len(disc.discs)
-            or len(point["g_sizes"]) != len(disc.discs)):
-        return None
+    if (not point or not sol.success or "g_sizes" not in point
+            or len(sol.phases) != len(disc.discs) or len(point["g_sizes"]) != len(disc.discs)):
+        return None  # (the multipliers of a failed solve are no start)
     lam_old = np.asarray(point["lam_g_phys"], dtype=float)
+    if not np.all(np.isfinite(lam_old)):
+        return None
     n_e = disc.event_scale.size
     if lam_old.size != sum(point["g_sizes"]) + n_e:
         return None

@@ -192,6 +192,18 @@ def test_a_solution_on_other_meshes_starts_primal_and_dual():
     assert [s.mesh.N for s in warm.phases] == [7, 16]
 
 
+def test_a_stopped_solution_on_other_meshes_still_starts_the_solve():
+    """A solve stopped after 2 iterations starts the problem on 14 intervals per phase (its
+    primal values only: the multipliers of a failed solve are not taken): the answer of a
+    cold solve."""
+    stopped = ocp.solve_phases(two_stage_rocket(), ipopt_options={"max_iter": 2})
+    assert not stopped.success
+    fine = two_stage_rocket(N=14)
+    sol = ocp.solve_phases(fine, guess=stopped)
+    assert sol.success, sol.message
+    assert sol.cost == pytest.approx(ocp.solve_phases(fine).cost, rel=1e-9)
+
+
 def test_an_infeasible_event_is_a_failure_not_an_exception():
     mp = two_stage_rocket()
     impossible = ocp.MultiPhaseProblem(
