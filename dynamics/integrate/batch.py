@@ -22,10 +22,9 @@ import numpy as np
 from .. import cache
 from ..model import Model
 from ..validate import integer
-from ..executors import run_split
-from ..interrupts import check_interrupt, deferred_interrupts
 from .auto import STIFF_STEPS, Single, auto_jit, auto_runs, solve_auto
-from .batch_fixed import BATCH_THREADS, fixed_batch, fixed_message, run_fixed_batch
+from .batch_fixed import (BATCH_THREADS, batch_threads, fixed_batch, fixed_message,
+                          run_fixed_batch, spread_runs)
 from .cvodes import run_cvodes
 from .dense import HEADER as DENSE_HEADER
 from .dense import dense_many, outcome_of
@@ -47,8 +46,8 @@ class BatchTarget:
     """`dynamics.integrate.auto`'s view of a batch: flat states stacked run by run
     (``x0 (K nx,)``, a run's ``x (K nx, n)``), one step count for all runs."""
 
-    def __init__(self, batch: Batch):
-        self.batch, self.t, self.runs = batch, batch.t, batch.K
+    def __init__(self, batch: Batch, threads: int | None = None):
+        self.batch, self.t, self.runs, self.threads = batch, batch.t, batch.K, threads
         self.nonsmooth = nonsmooth_operations(batch.model.f)  # (as `Single.nonsmooth`)
         self.x0 = np.ascontiguousarray(batch.x0.T).reshape(-1)
 
@@ -57,7 +56,7 @@ class BatchTarget:
 
     def run(self, x0: np.ndarray, m: int, jit: bool, progress) -> Run:
         return run_fixed_batch(self.batch, "rk8", m, jit, x0=self._unstack(x0),
-                               progress=progress)[2]
+                               progress=progress, threads=self.threads)[2]
 
     def spectrum(self, rtol, atol):
         b = self.batch
@@ -90,7 +89,7 @@ def simulate_batch(batch: Batch, options: RunOptions, *, start: float) -> "Batch
     if method in ("rk4", "rk8", "lie"):
         x, ok, n_steps, compiled = fixed_batch(batch, method, steps,
                                                cache.should_compile(jit, math.inf),
-                                               progress=progress)
+                                               progress=progress, threads=options.threads)
         status = np.where(ok, OK, FAILED)
         used, message = method, fixed_message(method, steps, n_steps, ok)
         status, message = _sane(batch, x, ok, status, message, method)
@@ -103,9 +102,9 @@ def simulate_batch(batch: Batch, options: RunOptions, *, start: float) -> "Batch
         message = f"cvodes: {K} runs, one after another" + (
             "" if ok.all() else f"; {int((~ok).sum())} failed: {runs[int(np.argmin(ok))].message}")
     else:
-        target = BatchTarget(batch)
-        dense = None if target.nonsmooth else auto_dense_batch(batch, rtol, atol, max_steps,
-                                                                jit, cvodes_options, progress)
+        target = BatchTarget(batch, options.threads)
+        dense = None if target.nonsmooth else auto_dense_batch(
+            batch, rtol, atol, max_steps, jit, cvodes_options, progress, threads=options.threads)
         if dense is not None:
             x, ok, status, estimate, used, n_steps, message = dense
             compiled = True
@@ -154,11 +153,12 @@ def simulate_batch(batch: Batch, options: RunOptions, *, start: float) -> "Batch
 
 
 def auto_dense_batch(batch: Batch, rtol: float, atol: np.ndarray, max_steps: int, jit,
-                     cvodes_options, progress: Progress):
+                     cvodes_options, progress: Progress, *, threads: int | None = None):
     """``auto`` on a batch of smooth runs, each under a control constant over its run: the
     answer, check run and verdict of `dense.dense_auto` for every run in one compiled loop
-    over the runs (`dense.dense_many`; the runs in parts spread over `BATCH_THREADS`
-    threads), each run with its own steps; a run not verified there goes alone through
+    over the runs (`dense.dense_many`; the runs in parts of at most `DENSE_PART` spread over
+    ``threads`` threads by `batch_fixed.spread_runs`, each part filling its own slice of
+    the answers), each run with its own steps; a run not verified there goes alone through
     `solve_auto` (as a single call would). Returns ``(x (nx, n, K), ok, status, estimate,
     method, n_steps, message)``, or None (no compiled pass, a control that varies within a
     run, jit off)."""
@@ -178,21 +178,14 @@ def auto_dense_batch(batch: Batch, rtol: float, atol: np.ndarray, max_steps: int
     p[:, :np_] = batch.p.T
     X = np.empty((K, nx, t.size))
     head = np.empty((K, DENSE_HEADER))
-    parts, threads = _dense_parts(K)
     missing = []
 
-    def work(todo):
-        for runs in iter(lambda: next(todo, None), None):
-            got = dense_many(model, x0, t, u, p, rtol, atol, max_steps, STIFF_STEPS, runs)
-            if got is None:
-                missing.append(runs)
-                return
-            X[runs], head[runs] = got
+    def call(k0, k1):
+        if dense_many(model, x0, t, u, p, rtol, atol, max_steps, STIFF_STEPS, slice(k0, k1),
+                      out=(X, head)) is None:
+            missing.append(k0)
 
-    with deferred_interrupts():
-        for group in _groups(parts, threads):
-            check_interrupt()
-            run_split(work, [iter(group)] * min(threads, len(group)))
+    spread_runs(call, K, batch_threads(threads), DENSE_PART)
     if missing:
         return None
     outs = [outcome_of(X[k], head[k]) for k in range(K)]
@@ -221,23 +214,9 @@ def auto_dense_batch(batch: Batch, rtol: float, atol: np.ndarray, max_steps: int
     return x, ok, status, estimate, ", ".join(sorted(used)), max(steps), message
 
 
-#: Runs of one compiled call of a dense batch (Ctrl-C is looked at between groups of them).
+#: Most runs of one compiled call of a dense batch (Ctrl-C is looked at between groups of
+#: them, `batch_fixed.spread_runs`).
 DENSE_PART = 64
-
-
-def _dense_parts(K: int) -> tuple[list[slice], int]:
-    """The runs of a dense batch in parts of at most `DENSE_PART` runs, and the threads."""
-    threads = min(BATCH_THREADS, -(-K // DENSE_PART)) if K >= 2 * DENSE_PART else 1
-    count = max(-(-K // DENSE_PART), threads)
-    size, extra = divmod(K, count)
-    edges = np.cumsum([0] + [size + 1] * extra + [size] * (count - extra))
-    return [slice(int(a), int(b)) for a, b in zip(edges[:-1], edges[1:])], threads
-
-
-def _groups(parts: list, threads: int) -> list[list]:
-    """``parts`` in groups of about 16 parts per thread (interrupts between groups)."""
-    step = 16 * threads
-    return [parts[i:i + step] for i in range(0, len(parts), step)]
 
 
 def _sane(batch: Batch, x: np.ndarray, ok: np.ndarray, status: np.ndarray, message: str,
@@ -248,7 +227,9 @@ def _sane(batch: Batch, x: np.ndarray, ok: np.ndarray, status: np.ndarray, messa
     if good.size == 0:
         return status, message
     U = lambda: np.concatenate([batch.ua[good], batch.ub[good, -1:]], axis=1).transpose(2, 1, 0)
-    found = violations(batch.model, batch.t, x[:, :, good], U, batch.p[:, good], method)
+    every = good.size == ok.size  # (then no copy of the states)
+    found = violations(batch.model, batch.t, x if every else x[:, :, good], U,
+                       batch.p if every else batch.p[:, good], method)
     bad = [(int(k), why) for k, why in zip(good, found) if why]
     if not bad:
         return status, message

@@ -100,3 +100,7 @@ def test_a_batched_dispersion_over_a_scene_steps_each_sample_alone():
     for key in ("h", "w3"):
         np.testing.assert_array_equal(many.outputs[key], one.outputs[key])
     assert np.max(np.abs(many.outputs["h"])) < 1e-8
+    for threads in (1, 3):  # the samples spread over threads: the same bits
+        spread = dispersion(model, x0, T, batch=True, threads=threads, **kw)
+        for key in ("h", "w3"):
+            np.testing.assert_array_equal(spread.outputs[key], one.outputs[key])
