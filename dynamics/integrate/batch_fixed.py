@@ -22,6 +22,7 @@ from ..interrupts import check_interrupt, deferred_interrupts
 from .cpass import pass_library
 from .evaluate import borrow_state, return_state
 from .inputs import Batch
+from .lanes import lanes_library
 from .loops import BATCH_CHUNK as CHUNK
 from .loops import Progress, chunk_function, interval_ends
 from .result import Run
@@ -247,8 +248,10 @@ def fixed_batch(batch: Batch, method: str, m: int, jit: bool, *, x0: np.ndarray 
     if method == "rk8" and jit and state.constant and progress.fun is None:
         # (a progress callback is told after every chunk: the chunk loop below)
         lib = pass_library(model)
-        if lib is not None:  # one plain C loop over the runs (`cpass._FIXED`)
-            _c_loop(lib.fixed_many, state, m, threads)
+        if lib is not None:  # one plain C loop over the runs (`cpass._FIXED`), its runs
+            # in the lanes of the vector registers when the step allows (`lanes`)
+            lanes = lanes_library(model) if K > 1 else None
+            _c_loop(lib.fixed_many if lanes is None else lanes, state, m, threads)
             progress.advance(total)
             x, ok = _nan_after_failure(state.x)
             return x, ok, total, True
