@@ -154,22 +154,21 @@ def lanes_library(model: Model):
     model for this machine (cached; the persistent compile cache keeps it between
     processes); None when the step cannot be rewritten (`lane_source`) or without a C
     compiler."""
-    def build():
-        step = kernel(model, "rk8", "linear", compiled=True)
-        body = lane_source(step)
+    def make():  # (only when the persistent cache does not hold the library)
+        body = lane_source(kernel(model, "rk8", "linear", compiled=True))
         if body is None:
-            return None
+            raise RuntimeError("the rk8 step holds operations the lane rewrite does not take")
         functions = "\n".join(_FUNCTION % (v, c) for c, v in _FUNCTIONS.items()
-                              if c != "casadi_sq")
-        source = (_HEADER % dict(bytes=8 * LANES, lanes=LANES, nx=model.nx, nu=model.nu,
-                                 np=model.np, functions=functions)) + body + _LOOP
+                               if c != "casadi_sq")
         x = ca.SX.sym("x")
-        anchor = ca.Function("rk8_lanes", [x], [x])  # (names the library)
+        return ([ca.Function("rk8_lanes", [x], [x])],  # (names the library)
+                _HEADER % dict(bytes=8 * LANES, lanes=LANES, nx=model.nx, nu=model.nu,
+                               np=model.np, functions=functions) + body + _LOOP)
 
-        def job(opt):
-            return cache.Job(lambda: ([anchor], source), opt, ctypes.CDLL,
-                             cache.recipe("rk8_lanes", model.f, LANES, opt))
+    def job(opt):
+        return cache.Job(make, opt, ctypes.CDLL, cache.recipe("rk8_lanes", model.f, LANES, opt))
 
+    def build():
         lib = cache.compile_parallel([job(_OPTS[0])])[0]
         if isinstance(lib, RuntimeError):
             lib = cache.compile_parallel([job(_OPTS[1])])[0]
