@@ -1,14 +1,21 @@
-"""Batched simulation: K runs of one model on one output grid, chunk by chunk in mapped calls.
+"""Batched simulation: K runs of one model on one output grid, in compiled loops over the
+runs spread over the cores.
 
-`simulate` comes here when ``x0`` has shape ``(nx, K)``. Every run shares the grid, the
-method and the step count; each has its own initial state, parameters (``p`` of shape
-``(np, K)``) and control samples (``u`` of shape ``(nu, n, K)``). The fixed-step methods
-run the model's one compiled chunk loop mapped over parts of the runs, spread over the
-cores (`dynamics.integrate.batch_fixed`). ``auto`` runs the same error control as a single
-run (`dynamics.integrate.auto`) on the whole batch: one step count for all runs, chosen
-until the global error estimate of every run meets the tolerance (a stiff batch goes, run
-by run, to auto's cvodes as a single run does). ``cvodes`` (a variable-step integrator per
-run) is a loop of single runs.
+`simulate` comes here when ``x0`` has shape ``(nx, K)``. Every run shares the grid and the
+method; each has its own initial state, parameters (``p`` of shape ``(np, K)``) and control
+samples (``u`` of shape ``(nu, n, K)``). The runs are independent: they are split into
+contiguous parts that the threads of the process's pool take as they finish
+(`batch_fixed.spread_runs`; ``simulate(..., threads=)``, default the cores this process may
+use, `batch_fixed.batch_threads`), each part filling its own runs' slices of the result, so
+the answers are the same bits for every thread count. ``auto`` on a smooth model under
+controls constant over each run: every run's answer, check run and verdict in one compiled
+loop (`dense.dense_many`), each run with its own steps, the single call's answer to the
+last bit; otherwise auto's multi-run error control over the whole batch (one step count for
+all runs; a stiff or non-smooth batch goes run by run as single runs do). The fixed-step
+methods: under constant controls, compiled rk8 is a plain C loop over each run's steps
+(`lanes`: four runs per vector step where the model's step allows); otherwise the model's
+compiled chunk loop mapped over the parts (`dynamics.integrate.batch_fixed`). ``cvodes``
+(a variable-step integrator per run) is a loop of single runs.
 """
 from __future__ import annotations
 
@@ -230,9 +237,9 @@ def _sane(batch: Batch, x: np.ndarray, ok: np.ndarray, status: np.ndarray, messa
     every = good.size == ok.size  # (then no copy of the states)
     found = violations(batch.model, batch.t, x if every else x[:, :, good], U,
                        batch.p if every else batch.p[:, good], method)
-    bad = [(int(k), why) for k, why in zip(good, found) if why]
-    if not bad:
+    if not any(found):
         return status, message
+    bad = [(int(k), why) for k, why in zip(good, found) if why]
     status = status.copy()
     status[[k for k, _ in bad]] = VIOLATED
     return status, (f"{message}; {len(bad)} run(s) not a solution (run {bad[0][0]}: "
@@ -262,9 +269,9 @@ class BatchResult(Result):
     n_steps : int
         Steps per run (``auto``: summed over its runs; cvodes: the most of any run).
     error_estimate : ndarray, shape (K,)
-        ``auto``: the estimated global error in units of the tolerance, the largest over
-        the batch (one step count serves all runs; a stiff batch, run by run with cvodes:
-        each run's own); NaN for the other methods.
+        ``auto``: each run's estimated global error in units of the tolerance (the largest
+        over the batch where one step count serves all runs: auto's multi-run error
+        control); NaN for the other methods.
     compiled : bool
     """
 
