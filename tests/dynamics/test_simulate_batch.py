@@ -253,6 +253,31 @@ def test_spread_runs_calls_every_run_once_in_contiguous_parts():
             assert seen == spans  # in order, in the calling thread
 
 
+@pytest.mark.parametrize("threads", [1, 2])
+def test_a_ctrl_c_stops_the_compiled_loops_between_groups_of_parts(threads):
+    """A Ctrl-C during a part of a compiled loop over the runs is raised (KeyboardInterrupt)
+    once the parts handed out with it have finished; no later group is started."""
+    import os
+    import signal
+
+    if signal.getsignal(signal.SIGINT) is not signal.default_int_handler:
+        pytest.skip("SIGINT has a handler of its own here")
+    seen = []
+
+    def call(k0, k1):
+        if not seen:
+            os.kill(os.getpid(), signal.SIGINT)
+        seen.append(k0)
+
+    K = 4 * batch_module.GROUP * threads  # four groups of parts of one run
+    with pytest.raises(KeyboardInterrupt):
+        batch_module.spread_runs(call, K, threads, 1)
+    assert len(seen) == batch_module.GROUP * threads  # the first group only
+    model, t = rigid_body(INERTIA), np.linspace(0.0, 1.0, 5)
+    _, X0 = _rates(3)
+    assert simulate(model, X0, t, threads=threads).all_success  # (and the next call is whole)
+
+
 def test_a_run_that_blows_up_fails_alone_in_any_part(spread):
     x = ca.SX.sym("x")
     model = Model.from_expressions({"x": x}, {"x": x ** 2})
