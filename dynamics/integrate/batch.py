@@ -34,7 +34,8 @@ from .batch_fixed import (BATCH_THREADS, batch_threads, fixed_batch, fixed_messa
                           run_fixed_batch, spread_runs)
 from .cvodes import run_cvodes
 from .dense import HEADER as DENSE_HEADER
-from .dense import dense_many, outcome_of
+from .dense import FIELDS as DENSE_FIELDS
+from .dense import dense_many
 from .estimates import jacobian_x, rho_sigma
 from .evaluate import map_eval
 from .inputs import Batch, RunOptions, check_batch
@@ -195,13 +196,15 @@ def auto_dense_batch(batch: Batch, rtol: float, atol: np.ndarray, max_steps: int
     spread_runs(call, K, batch_threads(threads), DENSE_PART)
     if missing:
         return None
-    outs = [outcome_of(X[k], head[k]) for k in range(K)]
+    result = head[:, DENSE_FIELDS.index("result")]  # (each run's header read as columns)
+    estimate = head[:, DENSE_FIELDS.index("estimate")].copy()
+    steps = head[:, DENSE_FIELDS.index("spent")].astype(int)
+    worst = np.max(estimate[result == 1], initial=-math.inf)
     status = np.full(K, OK)
-    estimate = np.array([o.estimate for o in outs])
-    redo = [k for k, o in enumerate(outs) if o.result != 1]
-    used, steps = ({"rk8"} if len(redo) < K else set()), [o.spent for o in outs]
+    redo = np.flatnonzero(result != 1)
+    used = {"rk8"} if redo.size < K else set()
     for k in redo:  # not verified in the loop: alone, by every path of `solve_auto`
-        run, method, st, est = solve_auto(batch.problem(k), rtol, atol, max_steps, jit,
+        run, method, st, est = solve_auto(batch.problem(int(k)), rtol, atol, max_steps, jit,
                                           cvodes_options, progress)
         X[k] = run.x
         status[k] = st if run.ok else FAILED
@@ -211,14 +214,13 @@ def auto_dense_batch(batch: Batch, rtol: float, atol: np.ndarray, max_steps: int
     x = X.transpose(1, 2, 0)
     ok = np.isfinite(x).all(axis=(0, 1))
     status = np.where(ok, status, FAILED)
-    good = [o for k, o in enumerate(outs) if o.result == 1]
     message = (f"auto: DOP853 with dense output per run ({K} runs, each with its own steps, "
                f"checked against its own run at a looser local tolerance): "
-               f"{min(steps)}-{max(steps)} steps per run; estimated error up to "
-               f"{max((o.estimate for o in good), default=math.nan):.2g} of tolerance")
-    if redo:
-        message += f"; {len(redo)} run(s) alone through auto's other paths"
-    return x, ok, status, estimate, ", ".join(sorted(used)), max(steps), message
+               f"{steps.min()}-{steps.max()} steps per run; estimated error up to "
+               f"{worst if worst > -math.inf else math.nan:.2g} of tolerance")
+    if redo.size:
+        message += f"; {redo.size} run(s) alone through auto's other paths"
+    return x, ok, status, estimate, ", ".join(sorted(used)), int(steps.max()), message
 
 
 #: Most runs of one compiled call of a dense batch (Ctrl-C is looked at between groups of
