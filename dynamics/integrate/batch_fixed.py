@@ -285,7 +285,7 @@ def fixed_batch(batch: Batch, method: str, m: int, jit: bool, *, x0: np.ndarray 
 C_PART_STEPS = 1 << 15
 
 #: Parts of a batch per thread at least (a thread slowed by other work takes fewer).
-PARTS_PER_THREAD = 4
+PARTS_PER_THREAD = 8
 
 #: Parts per thread between two looks at Ctrl-C.
 GROUP = 16
