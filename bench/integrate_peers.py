@@ -207,6 +207,19 @@ def monte_carlo(quick: bool, detail: list) -> list[Row]:
     def batched(**kw):
         return simulate(model, x0s.T, t, **kw)
 
+    peer = None  # (numbalsoda first, then appdyn, then numbalsoda again: the VM drifts)
+    for rtol in (1e-9, 1e-10, 1e-11):
+        b = numbalsoda_batch(x0s, t, rtol)
+        if b is None:
+            break
+        e = float(np.max(np.abs(np.asarray(b["w"]) - truth)))
+        detail.append(dict(workload=f"Monte Carlo {k} runs", target=BATCH_TOL,
+                           solver="numbalsoda dop853 njit loop (one thread)", rtol=rtol,
+                           error=e, time=min(b["times"]), steps=-1,
+                           success=bool(b["success"])))
+        if e <= BATCH_TOL and b["success"]:
+            peer = (rtol, min(b["times"]))
+            break
     res = batched()
     verified = bool(res.all_success)
     steps = next(n for n in range(1, 65) if error(batched(method="rk8", steps=n).x) <= BATCH_TOL)
@@ -228,19 +241,9 @@ def monte_carlo(quick: bool, detail: list) -> list[Row]:
                            rtol=1e-8 if name == "auto" else math.nan, error=error(x),
                            time=time, steps=res.n_steps if name == "auto" else steps * (t.size - 1),
                            success=verified if name == "auto" else True))
-    peer = None
-    for rtol in (1e-9, 1e-10, 1e-11):
-        b = numbalsoda_batch(x0s, t, rtol)
-        if b is None:
-            break
-        e = float(np.max(np.abs(np.asarray(b["w"]) - truth)))
-        detail.append(dict(workload=f"Monte Carlo {k} runs", target=BATCH_TOL,
-                           solver="numbalsoda dop853 njit loop (one thread)", rtol=rtol,
-                           error=e, time=min(b["times"]), steps=-1,
-                           success=bool(b["success"])))
-        if e <= BATCH_TOL and b["success"]:
-            peer = (rtol, min(b["times"]))
-            break
+    if peer:
+        b = numbalsoda_batch(x0s, t, peer[0])
+        peer = (peer[0], min(peer[1], *b["times"])) if b else peer
     case = f"Monte Carlo, {k} torque-free runs, error <= {BATCH_TOL:g}"
     rows = [Row("integrate_peers", case, f"appdyn auto batched (defaults) time, {cores} "
                 "thread(s)", times["auto", cores] * 1e3, "ms",
