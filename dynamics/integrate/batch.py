@@ -165,8 +165,8 @@ def auto_dense_batch(batch: Batch, rtol: float, atol: np.ndarray, max_steps: int
     """``auto`` on a batch of smooth runs, each under a control constant over its run: the
     answer, check run and verdict of `dense.dense_auto` for every run in one compiled loop
     over the runs (`dense.dense_many`; the runs in parts of at most `DENSE_PART` spread over
-    ``threads`` threads by `batch_fixed.spread_runs`, each part filling its own slice of
-    the answers), each run with its own steps; a run not verified there goes alone through
+    ``threads`` threads by `batch_fixed.spread_runs` from ``2 DENSE_PART`` runs on, each
+    part filling its own slice of the answers), each run with its own steps; a run not verified there goes alone through
     `solve_auto` (as a single call would). Returns ``(x (nx, n, K), ok, status, estimate,
     method, n_steps, message)``, or None (no compiled pass, a control that varies within a
     run, jit off)."""
@@ -193,7 +193,9 @@ def auto_dense_batch(batch: Batch, rtol: float, atol: np.ndarray, max_steps: int
                       out=(X, head)) is None:
             missing.append(k0)
 
-    spread_runs(call, K, batch_threads(threads), DENSE_PART)
+    # (a small batch stays on one thread: a hand-over costs tens of microseconds on an idle
+    # machine and milliseconds on a loaded one, where the woken thread waits for a core)
+    spread_runs(call, K, batch_threads(threads) if K >= 2 * DENSE_PART else 1, DENSE_PART)
     if missing:
         return None
     result = head[:, DENSE_FIELDS.index("result")]  # (each run's header read as columns)

@@ -209,10 +209,12 @@ def test_threads_and_parts_give_the_bits_of_one_serial_call(spread, method):
 
 @pytest.mark.parametrize("kw", [{}, {"method": "rk8", "steps": 3}],
                          ids=["auto (one C loop per part)", "rk8 (one C loop per part)"])
-def test_the_compiled_loops_give_the_same_bits_on_any_number_of_threads(kw):
+def test_the_compiled_loops_give_the_same_bits_on_any_number_of_threads(kw, monkeypatch):
     """The runs are independent: 1 thread (the serial loop), 2, 3 (parts of uneven sizes)
     and more threads than parts give the same bits; ``auto``'s runs each meet their Jacobi
     truth within the tolerance."""
+    from appdyn.dynamics.integrate import batch as dense_batch
+    monkeypatch.setattr(dense_batch, "DENSE_PART", 4)  # (37 runs spread: parts of 4 runs)
     model, t = rigid_body(INERTIA), np.linspace(0.0, 10.0, 21)
     W, X0 = _rates(37, seed=5)
     ref = simulate(model, X0, t, threads=1, **kw)
