@@ -61,6 +61,11 @@ def batch_threads(threads: int | None) -> int:
     return BATCH_THREADS if value is None else integer(value, "threads", minimum=1)
 
 
+#: Run-steps of a constant-control rk8 batch from which its vector-lane loop is compiled
+#: (`lanes.lanes_library`, ~0.4 s once per model on an idle machine, then kept on disk):
+#: about 25 ms of the scalar loop, which the lanes cut 2-3x.
+LANES_BUILD = 1 << 16
+
 #: Most runs of one mapped call of the chunk Function (a part of a batch): bounds the
 #: arrays each thread keeps per model and method (`_Lane`; for 256 runs of the rigid
 #: body's 64-step chunk, 1.8 MB) and keeps a call's data in the core's cache.
@@ -250,7 +255,9 @@ def fixed_batch(batch: Batch, method: str, m: int, jit: bool, *, x0: np.ndarray 
         lib = pass_library(model)
         if lib is not None:  # one plain C loop over the runs (`cpass._FIXED`), its runs
             # in the lanes of the vector registers when the step allows (`lanes`)
-            lanes = lanes_library(model) if K > 1 else None
+            # (compiled for a batch of `LANES_BUILD` run-steps or more; a smaller one uses
+            # it once built: the same bits either way)
+            lanes = lanes_library(model, build=K * total >= LANES_BUILD) if K > 1 else None
             _c_loop(lib.fixed_many if lanes is None else lanes, state, m, threads)
             progress.advance(total)
             x, ok = _nan_after_failure(state.x)

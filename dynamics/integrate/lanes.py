@@ -148,12 +148,16 @@ def lane_source(step: ca.Function) -> str | None:
             + "\n".join(lines) + "\n}\n")
 
 
-def lanes_library(model: Model):
+def lanes_library(model: Model, *, build: bool = True):
     """``rk8_fixed_lanes(k0, k1, nint, m, H, x0, u, p, X)`` of ``model`` (a ``ctypes``
     function with the arguments of ``rk8_fixed_many``, `cpass._FIXED`), compiled once per
     model for this machine (cached; the persistent compile cache keeps it between
-    processes); None when the step cannot be rewritten (`lane_source`) or without a C
-    compiler."""
+    processes); None when the step cannot be rewritten (`lane_source`), without a C
+    compiler, or with ``build=False`` when it is not built yet in this process."""
+    key = ("rk8_lanes", cache.function_key(model.f))
+    if not build and not cache.contains(key):
+        return None
+
     def make():  # (only when the persistent cache does not hold the library)
         body = lane_source(kernel(model, "rk8", "linear", compiled=True))
         if body is None:
@@ -168,7 +172,7 @@ def lanes_library(model: Model):
     def job(opt):
         return cache.Job(make, opt, ctypes.CDLL, cache.recipe("rk8_lanes", model.f, LANES, opt))
 
-    def build():
+    def make_library():
         lib = cache.compile_parallel([job(_OPTS[0])])[0]
         if isinstance(lib, RuntimeError):
             lib = cache.compile_parallel([job(_OPTS[1])])[0]
@@ -181,4 +185,4 @@ def lanes_library(model: Model):
         fun.library = lib  # (kept alive with the function)
         return fun
 
-    return cache.get(("rk8_lanes", cache.function_key(model.f)), build, keepalive=model.f)
+    return cache.get(key, make_library, keepalive=model.f)
