@@ -18,8 +18,9 @@ The public entry points are `dynamics.simulate`, `dynamics.SimulationResult`,
                  `Event`; a terminal event truncates the result
 ``impacts``      impacts (``impacts=``): a guard's zero crossing applies a jump map and the
                  integration restarts; `Impact`, `ImpactRecord`, the Zeno guard
-``batch``        K runs at once (``x0`` of shape (nx, K)): the chunk loop mapped over the
-                 runs on threads, ``auto``'s error control over the batch; `BatchResult`
+``batch``        K runs at once (``x0`` of shape (nx, K)): compiled loops over the runs,
+                 spread over threads (``threads=``); `BatchResult`
+``lanes``        fixed-step rk8 over a batch, four runs per step in vector registers
 ``sanity``       fixed-step runs checked against the model's invariants (status 4)
 ``smoothness``   the non-smooth operations (kinks, jumps) of a model's expression graph
 ``stepcontrol``  DOP853 with step rejection for non-smooth right-hand sides, and stepping

@@ -260,11 +260,15 @@ def _tell(progress, steps: int, told: int) -> int:
 
 def dense_many(model, x0: np.ndarray, t: np.ndarray, u: np.ndarray, p: np.ndarray,
                rtol: float, atol: np.ndarray, max_steps: float, stiff_steps: float,
-               runs: slice) -> tuple[np.ndarray, np.ndarray] | None:
+               runs: slice, *, out: tuple[np.ndarray, np.ndarray] | None = None
+               ) -> tuple[np.ndarray, np.ndarray] | None:
     """`dense_auto` for the runs ``runs`` of a batch in one compiled loop: ``x0 (K, nx)``,
     ``u (K, max(nu, 1))`` (each run's constant control), ``p (K, max(np, 1))``, all
     C-contiguous. Returns ``(X (r, nx, n), head (r, HEADER))``: the answers and each run's
-    header (`outcome_of` reads it); None without a compiled pass.
+    header (`outcome_of` reads it); None without a compiled pass. ``out``: C-contiguous
+    ``(X (K, nx, n), head (K, HEADER))`` of the whole batch, whose slices ``runs`` the loop
+    fills (and returns) in place: calls on other threads (each with its own workspace) may
+    fill other slices of the same arrays at the same time.
 
     Examples
     --------
@@ -285,13 +289,21 @@ def dense_many(model, x0: np.ndarray, t: np.ndarray, u: np.ndarray, p: np.ndarra
     nout = t.size - 1
     work = _workspace(plan, nout)
     _fill(work.ws, plan, t, rtol, atol, max_steps, stiff_steps)
-    r = runs.stop - runs.start
-    X = np.empty((r, plan.nx, nout + 1))
-    head = np.empty((r, HEADER))
-    k0 = runs.start
-    plan.many(work.ws_addr, nout, 0, r, x0[k0:].ctypes.data, u[k0:].ctypes.data,
-              p[k0:].ctypes.data, X.ctypes.data, work.xc_addr, head.ctypes.data)
-    return X, head
+    r, k0 = runs.stop - runs.start, runs.start
+    if out is None:
+        X, head, at = np.empty((r, plan.nx, nout + 1)), np.empty((r, HEADER)), 0
+    else:
+        X, head = out
+        if not (X.flags.c_contiguous and head.flags.c_contiguous and X.shape[1:] == (
+                plan.nx, nout + 1) and head.shape[1:] == (HEADER,) and runs.stop <= len(X)):
+            raise ValueError("`out` must be C-contiguous (X (K, nx, n), head (K, HEADER)) "
+                             "covering `runs`")
+        at = k0
+    # (the loop runs k = at .. at + r - 1 of X and head, reading x0, u, p from row k0 - at)
+    plan.many(work.ws_addr, nout, at, at + r, x0[k0 - at:].ctypes.data,
+              u[k0 - at:].ctypes.data, p[k0 - at:].ctypes.data, X.ctypes.data, work.xc_addr,
+              head.ctypes.data)
+    return X[at:at + r], head[at:at + r]
 
 
 def outcome_of(x: np.ndarray, head: np.ndarray) -> DenseAuto:

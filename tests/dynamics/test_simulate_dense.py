@@ -174,8 +174,8 @@ def test_a_batch_run_not_verified_in_the_loop_goes_alone(monkeypatch):
     from appdyn.dynamics.integrate import batch as batch_module, dense
     real = batch_module.dense_many
 
-    def forced(*args):
-        X, head = real(*args)
+    def forced(*args, **kw):
+        X, head = real(*args, **kw)  # (``out``: slices of the batch's arrays, filled in place)
         runs = args[-1]
         if runs.start <= 1 < runs.stop:
             head[1 - runs.start, dense.FIELDS.index("result")] = 0  # not verified
