@@ -213,7 +213,7 @@ def auto_dense_batch(batch: Batch, rtol: float, atol: np.ndarray, max_steps: int
     status = np.where(ok, status, FAILED)
     good = [o for k, o in enumerate(outs) if o.result == 1]
     message = (f"auto: DOP853 with dense output per run ({K} runs, each with its own steps, "
-               f"checked against its own run at a looser local tolerance): "
+               f"checked against its own steps merged in pairs): "
                f"{min(steps)}-{max(steps)} steps per run; estimated error up to "
                f"{max((o.estimate for o in good), default=math.nan):.2g} of tolerance")
     if redo:

@@ -501,8 +501,8 @@ int rk8_dense(casadi_real* x, casadi_real* t, casadi_real* hio, int nout,
 
 
 # ``auto`` for a smooth right-hand side under a constant control in ONE call: DOP853 with
-# dense output (`_DENSE`) as the answer, a check run at a looser local tolerance, their
-# comparison and the verdict, with no Python between (`dynamics.integrate.dense`, which
+# dense output (`_DENSE`) as the answer, its check (its steps merged in pairs, alongside),
+# their comparison and the verdict, with no Python between (`dynamics.integrate.dense`, which
 # states the rules; the layout of the workspace is `dense.LAYOUT`).
 _AUTO = r"""
 #include <limits.h>
