@@ -182,6 +182,23 @@ def cheapest(rows, target):
     return min(ok, key=lambda r: r["time"]) if ok else None
 
 
+def time_at(rows, target) -> float:
+    """The time at error ``target`` on the sweep's work-precision line: log-log interpolated
+    between the loosest run meeting it and the next looser one (the sweep's decades of rtol
+    then do not decide the ratio: a run that just misses the target at one decade costs
+    1.3x the steps at the next); nan when no run meets it."""
+    pts = sorted((r["error"], r["time"]) for r in rows if r["success"] and r["error"] > 0)
+    inside = [p for p in pts if p[0] <= target]
+    if not inside:
+        return math.nan
+    (e0, t0), above = inside[-1], [p for p in pts if p[0] > target]
+    if not above:
+        return t0
+    e1, t1 = above[0]
+    w = math.log(target / e0) / math.log(e1 / e0)
+    return t0 * (t1 / t0) ** w
+
+
 def two_point_call(repeats: int) -> float:
     """The median of ``repeats`` repeated 2-point ``simulate`` calls at the defaults [s]."""
     model = rigid_body([1.0, 2.0, 3.0])
@@ -285,6 +302,12 @@ def run(quick: bool, out: Path) -> list[Row]:
                                    b["time"] / a["time"], "x",
                                    f"numbalsoda rtol {b['rtol']:.3g}, {b['time'] * 1e3:.3g} "
                                    f"ms, error {b['error']:.2g}"))
+            ta, tb = time_at(mine, w.target), time_at(peer, w.target)
+            if math.isfinite(ta) and math.isfinite(tb):
+                summary.append(Row("integrate_peers", w.name, "speed-up vs numbalsoda dop853, "
+                                   "interpolated at the target error", tb / ta, "x",
+                                   f"appdyn {ta * 1e3:.3g} ms, numbalsoda {tb * 1e3:.3g} ms "
+                                   "(log-log between the sweep's runs)"))
             if a:  # how much more accurate than asked: the tolerance delivered, not exceeded
                 summary.append(Row("integrate_peers", w.name, "appdyn error over its rtol at "
                                    "1e-8", _delivered(mine, 1e-8), "", "max |error| / rtol"))

@@ -217,7 +217,7 @@ def auto_dense_batch(batch: Batch, rtol: float, atol: np.ndarray, max_steps: int
     ok = np.isfinite(x).all(axis=(0, 1))
     status = np.where(ok, status, FAILED)
     message = (f"auto: DOP853 with dense output per run ({K} runs, each with its own steps, "
-               f"checked against its own run at a looser local tolerance): "
+               f"checked against its own steps merged in pairs): "
                f"{steps.min()}-{steps.max()} steps per run; estimated error up to "
                f"{worst if worst > -math.inf else math.nan:.2g} of tolerance")
     if redo.size:
