@@ -151,6 +151,26 @@ def test_sample_interpolates_like_the_transcription():
     assert np.allclose(x, sol.x[:, 0:4] @ np.array(basis), atol=1e-13)
 
 
+@pytest.mark.parametrize("name", TRANSCRIPTION_NAMES + ("radau-constant-control",
+                                                         "radau-linear-control"))
+def test_dense_weights_equal_the_interpolant_function(name):
+    # the numpy path of DenseOutput.eval (transcription.dense_weights) against the symbolic
+    # interpolant it replaces, at random points of random intervals, ends included
+    problem, _ = rigid_slew(theta_f=1.0, T=2.0)
+    sol = solve(problem, transcription=name, N=4, verbose=False)
+    d, rng = sol.dense, np.random.default_rng(3)
+    if sol.transcription.dense_weights(np.array([0.5])) is None:
+        assert name.startswith("hermite-simpson")  # depends on f: the Function path
+        return
+    k, s = rng.integers(0, d.N, 40), np.concatenate([[0.0, 1.0], rng.random(38)])
+    x, u = d.eval(k, s)
+    for i in range(k.size):
+        xf, uf = d.interp(d.xs[:, k[i]], d.Xo[:, k[i]], d.us[:, k[i]], d.Uo[:, k[i]], d.h[k[i]],
+                          sol.p, s[i])
+        assert np.allclose(x[:, i], np.asarray(xf).ravel(), rtol=1e-14, atol=1e-14)
+        assert np.allclose(u[:, i], np.asarray(uf).ravel(), rtol=1e-14, atol=1e-14)
+
+
 def test_sample_rejects_times_outside_horizon():
     problem, _ = min_energy()
     sol = solve(problem, N=4, verbose=False)
