@@ -83,9 +83,10 @@ class DenseOutput:
         M = k.size
         if M == 0:
             return np.zeros((self.nx, 0)), np.zeros((self.nu, 0))
-        weights = self.transcription.dense_weights(np.asarray(s, float))
+        s_at, at = np.unique(np.asarray(s, float), return_inverse=True)  # few distinct s
+        weights = self.transcription.dense_weights(s_at)
         if weights is not None:  # linear in the node values: numpy, no Function call
-            wx, wu = weights
+            wx, wu = weights[0][at.ravel()], weights[1][at.ravel()]
             x = np.einsum("imj,mj->im", self.Xo[:, k, :], wx[:, 1:]) + self.xs[:, k] * wx[:, 0]
             u = np.einsum("imj,mj->im", self.Uo[:, k, :], wu[:, 1:]) + self.us[:, k] * wu[:, 0]
             return x, u
