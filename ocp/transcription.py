@@ -79,6 +79,17 @@ def _lagrange_basis(nodes: np.ndarray, s):
     return out
 
 
+def _lagrange_matrix(nodes: np.ndarray, s: np.ndarray) -> np.ndarray:
+    """`_lagrange_basis` for numeric ``s`` (shape (M,)) in one array: ``B[i, j] = l_j(s_i)``,
+    shape (M, n) (the same factors: exact at the nodes)."""
+    n = nodes.size
+    den = nodes[:, None] - nodes[None, :]
+    np.fill_diagonal(den, 1.0)
+    factors = (s[:, None, None] - nodes[None, None, :]) / den[None, :, :]  # (M, j, m)
+    factors[:, np.arange(n), np.arange(n)] = 1.0
+    return np.prod(factors, axis=2)
+
+
 def _differentiation_matrix(nodes: np.ndarray) -> np.ndarray:
     """``D[i, j] = l_j'(nodes[i])`` by barycentric weights (accurate to a few ulp)."""
     n = nodes.size
@@ -464,10 +475,10 @@ class Radau(Transcription):
 
     def _state_weights(self, s):
         """``wx`` of `dense_weights`: the Lagrange basis through ``0, c_1, ..., c_d``."""
-        return np.stack(_lagrange_basis(np.concatenate([[0.0], self.points]), s), axis=1)
+        return _lagrange_matrix(np.concatenate([[0.0], self.points]), s)
 
     def dense_weights(self, s):
-        wu = np.stack([np.zeros_like(s), *_lagrange_basis(self.points, s)], axis=1)
+        wu = np.concatenate([np.zeros((s.size, 1)), _lagrange_matrix(self.points, s)], axis=1)
         return self._state_weights(s), wu
 
     def costates(self, defect_multipliers, mesh):
