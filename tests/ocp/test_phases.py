@@ -146,7 +146,7 @@ def test_staged_rocket_reaches_the_closed_form_optimum_with_refinement():
 
 def test_refinement_rounds_solve_the_nlp_below_refine_tol():
     # an interval's error estimate floors at the NLP's own accuracy: the rounds ask IPOPT
-    # for refine_tol / 100, unless the caller chose tol
+    # for refine_tol / 10, unless the caller chose tol
     from appdyn.ocp.phases.solve import NLP_TOL_PER_REFINE_TOL, _refinement_ipopt_options
 
     base = {"constr_viol_tol": 1e-9, "print_level": 0}
