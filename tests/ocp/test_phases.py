@@ -144,6 +144,18 @@ def test_staged_rocket_reaches_the_closed_form_optimum_with_refinement():
         np.testing.assert_allclose(prop.x[:, -1], ph.x[:, -1], rtol=1e-9)
 
 
+def test_refinement_rounds_solve_the_nlp_below_refine_tol():
+    # an interval's error estimate floors at the NLP's own accuracy: the rounds ask IPOPT
+    # for refine_tol / 10, unless the caller chose tol
+    from appdyn.ocp.phases.solve import NLP_TOL_PER_REFINE_TOL, _refinement_ipopt_options
+
+    base = {"constr_viol_tol": 1e-9, "print_level": 0}
+    tight = _refinement_ipopt_options(base, None, 1e-9)
+    assert tight == {**base, "tol": NLP_TOL_PER_REFINE_TOL * 1e-9} and "tol" not in base
+    assert _refinement_ipopt_options({**base, "tol": 1e-14}, None, 1e-9)["tol"] == 1e-14
+    assert _refinement_ipopt_options({**base, "tol": 1e-6}, {"tol": 1e-6}, 1e-9)["tol"] == 1e-6
+
+
 def test_unrefined_solve_is_close_and_warm_start_reuses_the_nlp():
     mp = two_stage_rocket()
     sol = ocp.solve_phases(mp)
