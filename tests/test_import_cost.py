@@ -26,8 +26,10 @@ def _loaded_after(statement: str) -> list[str]:
     return eval(out.stdout)  # a printed list of names
 
 
-@pytest.mark.parametrize("statement", ["import appdyn", "import appdyn.dynamics",
-                                       "import appdyn.problems.slew"])
+@pytest.mark.parametrize("statement", [
+    "import appdyn", "import appdyn.dynamics",
+    "import appdyn.problems.slew, appdyn.problems.gains, appdyn.problems.stability, "
+    "appdyn.problems.dispersion, appdyn.problems.ascent, appdyn.ocp"])
 def test_a_plain_import_pulls_no_heavy_dependency(statement):
     assert _loaded_after(statement) == []
 
