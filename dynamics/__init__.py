@@ -13,8 +13,11 @@ cache of built and compiled Functions, `dynamics.cache`), and the modules `attit
 forces, Baumgarte stabilization and projection), `mechanisms` (the seed's worked systems with
 their closed forms), `clock` (time-dependent models carry a clock state ``"t"``), `mass`
 (parallel and rotated axes, radius of gyration, specific impulse and the rocket equation), `floquet`
-(monodromy matrix and multipliers of periodic motion) and `truth` (closed forms, imported on
-first use).
+(monodromy matrix and multipliers of periodic motion) and `truth` (closed forms).
+
+Only `Model`, `rigid_body`, `launch_vehicle`, `linearize` and the cache are imported with the
+package; every other name is imported on first use, so ``import appdyn.dynamics`` costs little
+beyond casadi and numpy.
 """
 from __future__ import annotations
 
