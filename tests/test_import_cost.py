@@ -1,6 +1,7 @@
-"""A plain import pulls in no heavy dependency: scipy's submodules, matplotlib, python-control
-and sympy are imported where a call needs them, and `appdyn.dynamics` imports its heavier
-parts on first use (PEP 562) while every public name stays importable.
+"""A plain import pulls in no heavy dependency: scipy's submodules, matplotlib,
+python-control, sympy and multiprocessing are imported where a call needs them, and
+`appdyn.dynamics` imports its heavier parts on first use (PEP 562) while every public name
+stays importable.
 
 Structural, not timed: which modules a fresh process holds after the import.
 """
@@ -14,7 +15,8 @@ import appdyn.dynamics
 
 ROOT = Path(__file__).resolve().parents[1]
 HEAVY = ("scipy.optimize", "scipy.linalg", "scipy.sparse", "scipy.special", "scipy.integrate",
-         "scipy.interpolate", "scipy.signal", "matplotlib", "control", "sympy")
+         "scipy.interpolate", "scipy.signal", "matplotlib", "control", "sympy",
+         "multiprocessing")  # (the process pool's: it brings subprocess, tempfile, ...)
 
 
 def _loaded_after(statement: str) -> list[str]:
