@@ -40,7 +40,6 @@ import hashlib
 
 import casadi as ca
 import numpy as np
-import scipy.sparse as sps
 
 from appdyn.dynamics.attitude import quat_conj, quat_mul
 
@@ -238,14 +237,12 @@ class _Assembly:
 
     def __init__(self, nrow: int, ncol: int, rows: np.ndarray, cols: np.ndarray):
         n = rows.size
-        coo = sps.coo_matrix((np.arange(1, n + 1, dtype=np.float64), (rows, cols)), shape=(nrow, ncol))
-        csc = coo.tocsc()  # duplicates summed: a first look at which positions repeat
-        csc.sort_indices()
-        self.sparsity = ca.Sparsity(nrow, ncol, csc.indptr.tolist(), csc.indices.tolist())
-        # position of each contribution in the CSC nonzeros
+        # the distinct positions in column-major (CSC) order: duplicates share one nonzero
         key = cols.astype(np.int64) * nrow + rows
-        uniq = (csc.indices.astype(np.int64)
-                + np.repeat(np.arange(ncol, dtype=np.int64), np.diff(csc.indptr)) * nrow)
+        uniq = np.unique(key)
+        indptr = np.searchsorted(uniq, np.arange(ncol + 1, dtype=np.int64) * nrow)
+        self.sparsity = ca.Sparsity(nrow, ncol, indptr.tolist(), (uniq % nrow).tolist())
+        # position of each contribution in the CSC nonzeros
         pos = np.searchsorted(uniq, key)
         self.nnz = uniq.size
         if uniq.size == n:
@@ -253,10 +250,9 @@ class _Assembly:
             order[pos] = np.arange(n)
             self._perm, self._sum = order.tolist(), None
         else:
-            A = sps.csc_matrix((np.ones(n), (pos, np.arange(n))), shape=(uniq.size, n))
-            A.sort_indices()
+            # one 1 per column k, in row pos[k]: contribution k adds into nonzero pos[k]
             self._perm = None
-            self._sum = ca.DM(ca.Sparsity(uniq.size, n, A.indptr.tolist(), A.indices.tolist()), A.data)
+            self._sum = ca.DM(ca.Sparsity(uniq.size, n, list(range(n + 1)), pos.tolist()), np.ones(n))
 
     def __call__(self, values: ca.MX) -> ca.MX:
         """The sparse matrix from the stacked contributions ``values`` (MX column)."""
