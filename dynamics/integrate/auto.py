@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, replace
+from functools import partial
 
 import numpy as np
 
@@ -24,7 +25,7 @@ from .stepcontrol import LOCAL_RTOL_MIN, solve_stepped
 from .tableaux import DOP853
 
 __all__ = ["solve_auto", "auto_jit", "STIFF_STEPS", "Single", "auto_runs", "dense_pass",
-           "dense_answer", "one_pass", "nonsmooth_causes"]
+           "dense_answer", "dense_message", "one_pass", "nonsmooth_causes"]
 
 _AUTO_AIM = 0.1        # predict the step count for this estimated scaled error
 _AUTO_RUNS = 8         # give up (status 3) after this many fixed-step runs
@@ -394,17 +395,21 @@ def dense_pass(problem: Problem, rtol, atol, max_steps, progress):
 
 def dense_answer(got: DenseAuto, rtol: float) -> tuple[Run, float]:
     """``(run, estimate)`` of a verified `dense.DenseAuto` (``got.result`` 1) for the
-    requested ``rtol``: its answer, step counts and message (`dense_pass`)."""
-    estimate = got.estimate
-    message = (f"auto: DOP853 with dense output, steps chosen by its error estimate "
-               f"({got.answer_steps - got.rejected} steps, {got.rejected} rejected, "
-               f"{got.interpolated} interpolated, local rtol {rtol * got.factor:.3g}), checked "
-               f"against a run at a {got.ratio:.3g}x looser local tolerance ({got.check_steps} "
-               f"steps); estimated error {estimate:.2g} of tolerance"
-               + (f" (a rounding floor of {got.floor:.2g} measured by a run from a moved start "
-                  "included)" if got.floor > 0 else ""))
+    requested ``rtol``: its answer and step counts, its message made on first use
+    (`dense_message`)."""
     return Run.new(got.x, got.spent, DOP853.stages * got.spent, got.substeps, True, True,
-                   message), estimate
+                   partial(dense_message, got, rtol)), got.estimate
+
+
+def dense_message(got: DenseAuto, rtol: float) -> str:
+    """The message of `dense_answer`'s run: the answer's steps, its check and the estimate."""
+    return (f"auto: DOP853 with dense output, steps chosen by its error estimate "
+            f"({got.answer_steps - got.rejected} steps, {got.rejected} rejected, "
+            f"{got.interpolated} interpolated, local rtol {rtol * got.factor:.3g}), checked "
+            f"against a run at a {got.ratio:.3g}x looser local tolerance ({got.check_steps} "
+            f"steps); estimated error {got.estimate:.2g} of tolerance"
+            + (f" (a rounding floor of {got.floor:.2g} measured by a run from a moved start "
+               "included)" if got.floor > 0 else ""))
 
 
 def _size_over_tolerance(problem: Problem, rtol: float, atol: np.ndarray) -> float:

@@ -355,3 +355,27 @@ def test_bad_inputs_refused_alike_by_the_common_auto_call(body, common_calls, ba
     assert match in fast[1]
     common_calls.off()
     assert _message(lambda: dynamics.simulate(body, x0, t, **kwargs)) == fast
+
+
+@needs_compiler
+def test_dense_message_made_on_first_read_pickled_made(body, common_calls):
+    """The verified dense pass's message is made when first read (`result.Run`), once:
+    the same text every read and thread, pickled and rebuilt by `result_fields`."""
+    import pickle
+    import threading
+
+    from appdyn.dynamics.integrate.result import make_result, result_fields
+    res = dynamics.simulate(body, X0, GRID)
+    assert common_calls.answered == [res] and "message" not in res.__dict__
+    fields = make_result(**result_fields(res))
+    texts = []
+    threads = [threading.Thread(target=lambda: texts.append(res.message)) for _ in range(4)]
+    for th in threads:
+        th.start()
+    for th in threads:
+        th.join()
+    assert len(set(texts)) == 1 and texts[0].startswith("auto: DOP853 with dense output")
+    assert all(text is res.message for text in texts)
+    assert fields.message == res.message == pickle.loads(pickle.dumps(res)).message
+    common_calls.off()
+    assert dynamics.simulate(body, X0, GRID).message == res.message
