@@ -36,6 +36,11 @@ The registered values:
 ``problems.feedback_N`` = 80
     Intervals of `appdyn.problems.gains.state_feedback_gains` (its match of the Riccati
     gains needs the finer mesh).
+``dynamics.threads`` = None
+    Threads over which the runs of a batched `appdyn.dynamics.simulate` (``x0`` of shape
+    ``(nx, K)``; also `appdyn.problems.dispersion` with ``batch=True``) are spread: None is
+    the cores this process may use (``os.sched_getaffinity``), ``1`` the calling thread
+    alone. The answers are the same bits for every value.
 
 Why several ``N``: a job's interval count is set by what it must resolve (a bang-bang
 switch, a smooth effort profile, an 80-interval match of a Riccati solution); the jobs that
@@ -70,6 +75,7 @@ _INITIAL: dict[str, Any] = {
     "problems.slew_N": 30,
     "problems.effort_N": 20,
     "problems.feedback_N": 80,
+    "dynamics.threads": None,
 }
 
 #: the registry (``"<package>.<name>" -> value``)

@@ -33,17 +33,37 @@ import datetime
 import json
 import os
 import platform
+import subprocess
 import sys
 import time
 from dataclasses import asdict, dataclass
 from pathlib import Path
 
-__all__ = ["Row", "RESULTS", "machine", "write_csv", "write_rows", "save_figure", "timed",
-           "script_main", "format_rows"]
+__all__ = ["Row", "RESULTS", "PEERS", "machine", "write_csv", "write_rows", "save_figure",
+           "timed", "script_main", "format_rows", "run_peer"]
 
 #: default output folder of ``appdyn bench`` / ``make bench`` (committed: the tables of
 #: docs/performance.md are generated from ``summary.csv`` and ``machine.json`` in it)
 RESULTS = Path(__file__).resolve().parent / "results"
+
+#: the peer runners (``bench/peers/*.py``), each run in its own venv ``peers/.venv-NAME``
+PEERS = Path(__file__).resolve().parent / "peers"
+
+
+def run_peer(venv: str, script: str, args, *, timeout: float = 600.0) -> dict | None:
+    """The JSON a peer runner prints: ``peers/.venv-VENV/bin/python peers/SCRIPT --json
+    ARGS`` in a fresh process; None, with a one-line notice, when the venv is missing
+    (``bash bench/peers/setup_VENV.sh``) or the runner fails."""
+    python = PEERS / f".venv-{venv}" / "bin" / "python"
+    if not python.exists():
+        print(f"{venv}: no {python.parent.parent} (bash bench/peers/setup_{venv}.sh); skipped")
+        return None
+    proc = subprocess.run([str(python), str(PEERS / script), "--json", *map(str, args)],
+                          capture_output=True, text=True, timeout=timeout)
+    if proc.returncode:
+        print(f"{venv}: peer failed: {proc.stderr.strip().splitlines()[-1:]}; skipped")
+        return None
+    return json.loads(proc.stdout)
 
 
 @dataclass(frozen=True)

@@ -13,10 +13,11 @@ Rows (each timed: first call of the process, then the median of the repeats):
 
 * appdyn, 5 intervals of Radau degree 5 per phase (yapss's mesh: 5 x 5 LGL), no refinement, from the
   relaxed start (`delta3_ascent`'s default);
-* the solve before issue 32: 8 intervals of Radau degree 4 per phase, |u| = 1 from the guess
-  (``relaxed_start=False``);
 * appdyn, default: 5 intervals per phase refined until every interval's estimated error is
-  below 1e-9 (the converged answer: the reference for the "error" column);
+  below 1e-9 (the converged answer: the reference for the "error" column; each round
+  warm-started primal and dual from the last);
+* the formulation before issue 32: 8 intervals of Radau degree 4 per phase, |u| = 1 from the
+  guess (``relaxed_start=False``; the guess as it is now, with the last phase's duration);
 * yapss example (solve = derivative construction + IPOPT; its process import excluded);
 * ASSET, 16/32/64 segments (solve = ``solve_optimize``; build = the phases set up). Its
   error is against its own 64-segment answer (ASSET's rounded Isp values move its optimum
@@ -52,7 +53,7 @@ ASSET_PY = PEERS / ".venv-asset" / "bin" / "python"
 #: appdyn's rows: label and `delta3_ascent` keywords
 CONFIGS = (("appdyn, 5 x Radau-5 per phase", dict(refine_tol=None)),
            ("appdyn, refined to 1e-9", {}),
-           ("appdyn before: 8 x Radau-4, no relaxed start",
+           ("appdyn, 8 x Radau-4, |u| = 1 from the guess",
             dict(refine_tol=None, relaxed_start=False, N=8, degree=4)))
 
 

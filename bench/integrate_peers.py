@@ -21,7 +21,9 @@ Monte Carlo of issue 31, item 4: 1,000 torque-free runs (`bench/simulate.py`'s b
 workload, every run within 1e-8 rad/s of its Jacobi truth) in one batched ``simulate`` at
 the default method and tolerances (each run verified: ``all_success``) and with fixed-step
 ``rk8`` (the fewest steps meeting the error), against numbalsoda's ``dop853`` in a
-numba-jitted loop (the loosest of rtol 1e-9, 1e-10, 1e-11 meeting the error).
+numba-jitted loop (the loosest of rtol 1e-9, 1e-10, 1e-11 meeting the error). numbalsoda's
+loop runs on one thread; appdyn's batch is timed on the cores this process may use (its
+default ``threads``) and on one thread (``threads=1``), and both ratios are reported.
 
 Writes ``integrate_peers.csv``; returns the ratio rows.
 Run: ``appdyn bench integrate_peers`` or ``python bench/integrate_peers.py [--quick]``;
@@ -180,6 +182,23 @@ def cheapest(rows, target):
     return min(ok, key=lambda r: r["time"]) if ok else None
 
 
+def time_at(rows, target) -> float:
+    """The time at error ``target`` on the sweep's work-precision line: log-log interpolated
+    between the loosest run meeting it and the next looser one (the sweep's decades of rtol
+    then do not decide the ratio: a run that just misses the target at one decade costs
+    1.3x the steps at the next); nan when no run meets it."""
+    pts = sorted((r["error"], r["time"]) for r in rows if r["success"] and r["error"] > 0)
+    inside = [p for p in pts if p[0] <= target]
+    if not inside:
+        return math.nan
+    (e0, t0), above = inside[-1], [p for p in pts if p[0] > target]
+    if not above:
+        return t0
+    e1, t1 = above[0]
+    w = math.log(target / e0) / math.log(e1 / e0)
+    return t0 * (t1 / t0) ** w
+
+
 def two_point_call(repeats: int) -> float:
     """The median of ``repeats`` repeated 2-point ``simulate`` calls at the defaults [s]."""
     model = rigid_body([1.0, 2.0, 3.0])
@@ -189,10 +208,15 @@ def two_point_call(repeats: int) -> float:
 
 def monte_carlo(quick: bool, detail: list) -> list[Row]:
     """The 1,000-run Monte Carlo at the defaults and fixed-step, against numbalsoda's njit
-    loop (see the module docstring); rows of the ratios."""
+    loop (see the module docstring); rows of the ratios. numbalsoda's loop runs on one
+    thread; appdyn's batch on the cores this process may use (``threads`` default) and on
+    one thread (``threads=1``): both ratios are reported."""
+    from appdyn.dynamics.integrate.batch_fixed import batch_threads
+
     k = 100 if quick else 1000
     x0s, t, truth = batch_workload(k)
     model = rigid_body(INERTIA)
+    cores = batch_threads(None)
 
     def error(x):  # x (7, n, K) -> the worst rate error over all runs
         return float(np.max(np.abs(np.moveaxis(x[4:7], (0, 1, 2), (2, 1, 0)) - truth)))
@@ -200,42 +224,57 @@ def monte_carlo(quick: bool, detail: list) -> list[Row]:
     def batched(**kw):
         return simulate(model, x0s.T, t, **kw)
 
-    rows, times = [], {}
-    res = batched()
-    times["auto"] = min(timed(batched, 3)[1])
-    verified = bool(res.all_success)
-    detail.append(dict(workload=f"Monte Carlo {k} runs", target=BATCH_TOL,
-                       solver="appdyn auto batched (defaults)", rtol=1e-8, error=error(res.x),
-                       time=times["auto"], steps=res.n_steps, success=verified))
-    steps = next(n for n in range(1, 65) if error(batched(method="rk8", steps=n).x) <= BATCH_TOL)
-    fixed = lambda: batched(method="rk8", steps=steps)  # noqa: E731
-    times["rk8"] = min(timed(fixed, 3)[1])
-    detail.append(dict(workload=f"Monte Carlo {k} runs", target=BATCH_TOL,
-                       solver=f"appdyn rk8 batched ({steps} steps per interval)", rtol=math.nan,
-                       error=error(fixed().x), time=times["rk8"], steps=steps * (t.size - 1),
-                       success=True))
-    peer = None
+    peer = None  # (numbalsoda first, then appdyn, then numbalsoda again: the VM drifts)
     for rtol in (1e-9, 1e-10, 1e-11):
         b = numbalsoda_batch(x0s, t, rtol)
         if b is None:
             break
         e = float(np.max(np.abs(np.asarray(b["w"]) - truth)))
         detail.append(dict(workload=f"Monte Carlo {k} runs", target=BATCH_TOL,
-                           solver="numbalsoda dop853 njit loop", rtol=rtol, error=e,
-                           time=min(b["times"]), steps=-1, success=bool(b["success"])))
+                           solver="numbalsoda dop853 njit loop (one thread)", rtol=rtol,
+                           error=e, time=min(b["times"]), steps=-1,
+                           success=bool(b["success"])))
         if e <= BATCH_TOL and b["success"]:
             peer = (rtol, min(b["times"]))
             break
+    res = batched()
+    verified = bool(res.all_success)
+    steps = next(n for n in range(1, 65) if error(batched(method="rk8", steps=n).x) <= BATCH_TOL)
+    jobs = {"auto": {}, "rk8": dict(method="rk8", steps=steps)}
+    times = {}
+    for name, kw in jobs.items():  # (1 thread and the default, interleaved: the VM drifts)
+        runs = {1: [], cores: []}
+        for _ in range(5):
+            for threads in runs:
+                runs[threads] += timed(lambda: batched(threads=threads, **kw), 1)[1]
+        for threads, got in runs.items():
+            times[name, threads] = min(got)
+    labels = {"auto": "appdyn auto batched (defaults)",
+              "rk8": f"appdyn rk8 batched ({steps} steps per interval)"}
+    for (name, threads), time in times.items():
+        x = res.x if name == "auto" else batched(**jobs["rk8"]).x
+        detail.append(dict(workload=f"Monte Carlo {k} runs", target=BATCH_TOL,
+                           solver=f"{labels[name]}, {threads} thread(s)",
+                           rtol=1e-8 if name == "auto" else math.nan, error=error(x),
+                           time=time, steps=res.n_steps if name == "auto" else steps * (t.size - 1),
+                           success=verified if name == "auto" else True))
+    if peer:
+        b = numbalsoda_batch(x0s, t, peer[0])
+        peer = (peer[0], min(peer[1], *b["times"])) if b else peer
     case = f"Monte Carlo, {k} torque-free runs, error <= {BATCH_TOL:g}"
-    rows.append(Row("integrate_peers", case, "appdyn auto batched (defaults) time",
-                    times["auto"] * 1e3, "ms", f"every run verified: {verified}, error "
-                    f"{error(res.x):.2g}, {res.n_steps} steps in the costliest run"))
+    rows = [Row("integrate_peers", case, f"appdyn auto batched (defaults) time, {cores} "
+                "thread(s)", times["auto", cores] * 1e3, "ms",
+                f"every run verified: {verified}, error {error(res.x):.2g}, {res.n_steps} "
+                "steps in the costliest run")]
     if peer:
         for name, label in (("auto", "defaults (auto, verified per run)"),
                             ("rk8", f"fixed-step rk8, {steps} steps per interval")):
-            rows.append(Row("integrate_peers", case, f"speed-up vs numbalsoda njit loop, "
-                            f"{label}", peer[1] / times[name], "x",
-                            f"numbalsoda rtol {peer[0]:g}, {peer[1] * 1e3:.3g} ms"))
+            for threads in sorted({1, cores}):
+                rows.append(Row("integrate_peers", case, f"speed-up vs numbalsoda njit loop "
+                                f"(one thread), {label}, appdyn on {threads} thread(s)",
+                                peer[1] / times[name, threads], "x",
+                                f"numbalsoda rtol {peer[0]:g}, {peer[1] * 1e3:.3g} ms; appdyn "
+                                f"{times[name, threads] * 1e3:.3g} ms"))
     return rows
 
 
@@ -263,6 +302,12 @@ def run(quick: bool, out: Path) -> list[Row]:
                                    b["time"] / a["time"], "x",
                                    f"numbalsoda rtol {b['rtol']:.3g}, {b['time'] * 1e3:.3g} "
                                    f"ms, error {b['error']:.2g}"))
+            ta, tb = time_at(mine, w.target), time_at(peer, w.target)
+            if math.isfinite(ta) and math.isfinite(tb):
+                summary.append(Row("integrate_peers", w.name, "speed-up vs numbalsoda dop853, "
+                                   "interpolated at the target error", tb / ta, "x",
+                                   f"appdyn {ta * 1e3:.3g} ms, numbalsoda {tb * 1e3:.3g} ms "
+                                   "(log-log between the sweep's runs)"))
             if a:  # how much more accurate than asked: the tolerance delivered, not exceeded
                 summary.append(Row("integrate_peers", w.name, "appdyn error over its rtol at "
                                    "1e-8", _delivered(mine, 1e-8), "", "max |error| / rtol"))

@@ -20,9 +20,7 @@ Run: ``appdyn bench literature`` (``--quick``: one round, no ASSET).
 """
 from __future__ import annotations
 
-import json
 import math
-import subprocess
 import sys
 import time
 from dataclasses import dataclass
@@ -36,11 +34,8 @@ from appdyn.ocp import solve
 from appdyn.ocp.examples import (ORBIT_RAISING_OPTIMUM, SHUTTLE_REENTRY_OPTIMUM, orbit_raising,
                                  shuttle_reentry, shuttle_reentry_guess)
 
-from _common import Row, script_main, write_csv
+from _common import Row, run_peer, script_main, write_csv
 
-PEERS = Path(__file__).resolve().parent / "peers"
-ASSET_PY = PEERS / ".venv-asset" / "bin" / "python"
-ROCKIT_PY = PEERS / ".venv-rockit" / "bin" / "python"
 
 
 @dataclass(frozen=True)
@@ -88,16 +83,10 @@ def appdyn_round(case: Case) -> dict:
 
 
 def asset_round(case: Case) -> dict:
-    if not ASSET_PY.exists():
-        print(f"ASSET: no {ASSET_PY.parent.parent} (bash bench/peers/setup_asset.sh); skipped")
+    a = run_peer("asset", case.asset_script, ["--threads", 1, "--repeats", 1, "--segments",
+                                               *case.asset_segments])
+    if a is None:
         return {}
-    proc = subprocess.run([str(ASSET_PY), str(PEERS / case.asset_script), "--json", "--threads", "1",
-                           "--repeats", "1", "--segments", *map(str, case.asset_segments)],
-                          capture_output=True, text=True, timeout=600)
-    if proc.returncode:
-        print(f"ASSET: peer failed: {proc.stderr.strip().splitlines()[-1:]}; skipped")
-        return {}
-    a = json.loads(proc.stdout)
     out = {}
     for r in a["runs"]:
         label = f"ASSET {a['asset']}, {r['segments']} x LGL3"
@@ -112,16 +101,9 @@ def rockit_round(case: Case) -> dict:
     """rockit (DirectCollocation, N = 20) in a fresh process of its own venv, or nothing."""
     if case.rockit is None:
         return {}
-    if not ROCKIT_PY.exists():
-        print(f"rockit: no {ROCKIT_PY.parent.parent} (bash bench/peers/setup_rockit.sh); skipped")
+    a = run_peer("rockit", "rockit_literature.py", ["--case", case.rockit, "--N", 20])
+    if a is None:
         return {}
-    proc = subprocess.run([str(ROCKIT_PY), str(PEERS / "rockit_literature.py"), "--json",
-                           "--case", case.rockit, "--N", "20"],
-                          capture_output=True, text=True, timeout=600)
-    if proc.returncode:
-        print(f"rockit: peer failed: {proc.stderr.strip().splitlines()[-1:]}; skipped")
-        return {}
-    a = json.loads(proc.stdout)
     out = {}
     for r in a["runs"]:
         label = f"rockit {a['rockit']}, {r['N']} x Radau-4"

@@ -13,22 +13,37 @@ cache of built and compiled Functions, `dynamics.cache`), and the modules `attit
 forces, Baumgarte stabilization and projection), `mechanisms` (the seed's worked systems with
 their closed forms), `clock` (time-dependent models carry a clock state ``"t"``), `mass`
 (parallel and rotated axes, radius of gyration, specific impulse and the rocket equation), `floquet`
-(monodromy matrix and multipliers of periodic motion) and `truth` (closed forms, imported on
-first use).
+(monodromy matrix and multipliers of periodic motion) and `truth` (closed forms).
+
+Only `Model`, `rigid_body`, `launch_vehicle`, `linearize` and the cache are imported with the
+package; every other name is imported on first use, so ``import appdyn.dynamics`` costs little
+beyond casadi and numpy.
 """
 from __future__ import annotations
 
 import importlib
 
-from . import attitude, cache, clock, constrained, floquet, mass, mechanisms, momentum
-from .feedback import closed_loop
-from .hinged import hinged_bodies
-from .integrate import METHODS, BatchResult, Event, Impact, ImpactRecord, SimulationResult, simulate
+from . import cache
+# `launch_vehicle`, `linearize` and `rigid_body` are both a submodule and a function: bound
+# here, before anything imports the submodule (which would bind the module under the name)
 from .launch_vehicle import launch_vehicle
 from .linearize import Linearization, linearization, linearize
 from .model import Model
-from .momentum import cmg_spacecraft, wheel_spacecraft
 from .rigid_body import rigid_body
+
+# every other public name, imported on first use (PEP 562): name -> (module, attribute or
+# None for the module itself); ``import appdyn.dynamics`` then stays cheap
+_LAZY = {
+    "attitude": (".attitude", None), "clock": (".clock", None),
+    "constrained": (".constrained", None), "floquet": (".floquet", None),
+    "mass": (".mass", None), "mechanisms": (".mechanisms", None),
+    "momentum": (".momentum", None), "truth": (".truth", None),
+    "closed_loop": (".feedback", "closed_loop"), "hinged_bodies": (".hinged", "hinged_bodies"),
+    "cmg_spacecraft": (".momentum", "cmg_spacecraft"),
+    "wheel_spacecraft": (".momentum", "wheel_spacecraft"),
+    **{name: (".integrate", name) for name in ("METHODS", "BatchResult", "Event", "Impact",
+                                              "ImpactRecord", "SimulationResult", "simulate")},
+}
 
 __all__ = ["METHODS", "BatchResult", "Event", "Impact", "ImpactRecord", "Linearization", "Model", "SimulationResult", "attitude", "clear_caches",
            "clock", "closed_loop", "cmg_spacecraft", "constrained", "floquet", "hinged_bodies",
@@ -55,6 +70,15 @@ def clear_caches() -> None:
 
 
 def __getattr__(name):
-    if name == "truth":
-        return importlib.import_module("appdyn.dynamics.truth")
-    raise AttributeError(f"module 'appdyn.dynamics' has no attribute {name!r}")
+    if name not in _LAZY:
+        raise AttributeError(f"module 'appdyn.dynamics' has no attribute {name!r}")
+    module, attribute = _LAZY[name]
+    value = importlib.import_module(module, __name__)
+    if attribute is not None:
+        value = getattr(value, attribute)
+    globals()[name] = value
+    return value
+
+
+def __dir__():
+    return sorted(set(globals()) | set(__all__))

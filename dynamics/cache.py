@@ -138,9 +138,6 @@ from __future__ import annotations
 import contextlib
 import functools
 import os
-import shutil
-import subprocess
-import tempfile
 import threading
 import weakref
 from collections import Counter, OrderedDict
@@ -288,6 +285,8 @@ class FunctionCache:
             return self._compiler
         with self._lock:
             if not self._compiler_checked:
+                import shutil  # (stdlib, imported when first compiling)
+
                 self._compiler_checked = True
                 self._compiler = shutil.which("gcc") or shutil.which("cc")
             return self._compiler
@@ -396,6 +395,8 @@ def compile_parallel(jobs: list) -> list:
                 if _load_cached(key, job, results, i):
                     continue
             if work is None:
+                import tempfile  # (stdlib, imported when first compiling)
+
                 work = stack.enter_context(tempfile.TemporaryDirectory(prefix="appdyn-cc-"))
             try:
                 functions, extra = job.make()
@@ -411,6 +412,8 @@ def compile_parallel(jobs: list) -> list:
                     continue
             library = os.path.join(work, f"{name}.so")
             diskcache.compiled()
+            import subprocess  # (stdlib, imported when first compiling)
+
             procs.append((i, name, key, library, subprocess.Popen(
                 [compiler, *flags, os.path.basename(source), "-o", library, "-lm"], cwd=work,
                 stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)))

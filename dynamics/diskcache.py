@@ -53,7 +53,6 @@ import hashlib
 import json
 import os
 import platform
-import tempfile
 import threading
 import time
 from pathlib import Path
@@ -373,6 +372,8 @@ def _unlink(path: Path) -> None:
 
 
 def _atomic_write(path: Path, data: bytes) -> None:
+    import tempfile  # (stdlib, imported on the first store)
+
     fd, tmp = tempfile.mkstemp(prefix=f".tmp-{path.stem[:16]}-", suffix=path.suffix,
                                dir=path.parent)
     try:

@@ -11,14 +11,15 @@ threads can leave a child waiting forever on a lock or a pipe another thread hel
 """
 from __future__ import annotations
 
-import multiprocessing
 import os
 import threading
-from concurrent.futures import (FIRST_COMPLETED, Executor, ProcessPoolExecutor,
-                                ThreadPoolExecutor, wait)
-from typing import Callable, Sequence
+from concurrent.futures import FIRST_COMPLETED, Executor, ThreadPoolExecutor, wait
+from typing import TYPE_CHECKING, Callable, Sequence
 
 from .interrupts import check_interrupt
+
+if TYPE_CHECKING:
+    from concurrent.futures import ProcessPoolExecutor
 
 __all__ = ["check_executor", "gather", "worker_pool", "run_split", "process_pool", "POLL"]
 
@@ -46,6 +47,9 @@ def process_pool(max_workers: int | None = None) -> ProcessPoolExecutor:
     ...     print(sorted(pool.map(abs, [-2, 1])))
     [1, 2]
     """
+    import multiprocessing  # with the process pool (it brings subprocess, tempfile, ...)
+    from concurrent.futures import ProcessPoolExecutor
+
     methods = multiprocessing.get_all_start_methods()
     context = multiprocessing.get_context("forkserver" if "forkserver" in methods else None)
     return ProcessPoolExecutor(max_workers, mp_context=context)

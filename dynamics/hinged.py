@@ -70,7 +70,6 @@ from dataclasses import dataclass
 
 import casadi as ca
 import numpy as np
-from scipy import linalg
 
 from . import cache
 from .attitude import dcm_from_quat, propagate_quat, quat_from_axis_angle, quat_mul, quat_rate, skew
@@ -114,6 +113,8 @@ class Hinge:
 
     def mass_matrix(self) -> np.ndarray:
         """``M = diag(m1 E, I1, m2 E, I2)``, shape (12, 12), for ``nu = (v1, w1, v2, w2)``."""
+        from scipy import linalg  # a heavy import, only here
+
         return linalg.block_diag(self.m1 * np.eye(3), np.reshape(self.I1, (3, 3)),
                                  self.m2 * np.eye(3), np.reshape(self.I2, (3, 3)))
 

@@ -40,7 +40,6 @@ import hashlib
 
 import casadi as ca
 import numpy as np
-import scipy.sparse as sps
 
 from appdyn.dynamics.attitude import quat_conj, quat_mul
 
@@ -51,6 +50,7 @@ from .layout import Layout
 from .functions import sx_compatible
 
 __all__ = ["Structure", "Intervals", "intervals", "structure_key", "content_key",
+           "local_functions", "assemble",
            "problem_functions"]
 
 
@@ -102,6 +102,132 @@ def _triplets(M) -> tuple[np.ndarray, np.ndarray]:
     return np.asarray(r, dtype=np.int64), np.asarray(c, dtype=np.int64)
 
 
+def local_functions(name: str, ins: list, rows, q, v, *, compiled: bool = False) -> tuple:
+    """The derivative Functions of one piece of an NLP (an interval, the ends, a segment):
+    ``(values, gradient, jacobian, hessian, jac triplets, grad triplets, hess triplets)``.
+
+    ``ins`` are the piece's symbolic inputs, ``rows`` its constraint rows and ``q`` its
+    share of the objective, ``v`` the variables (among ``ins``) they are differentiated by.
+    ``values(*ins) -> (rows, q)``, ``gradient(*ins) -> (q, nonzeros of dq/dv)``,
+    ``jacobian(*ins) -> (rows, nonzeros of d rows/dv)``, ``hessian(*ins, lam, lam_f) ->
+    nonzeros of the upper triangle of d^2 (lam_f q + lam . rows) / dv^2``; the triplets are
+    the ``(rows, cols)`` of those nonzeros in ``v``. ``compiled``: the derivatives compiled
+    to C (`dynamics.cache.compile_function`).
+
+    Examples
+    --------
+    >>> import casadi as ca
+    >>> from appdyn.ocp.assembly import local_functions
+    >>> x = ca.SX.sym("x", 2)
+    >>> val, grad, jac, hess, jt, gt, ht = local_functions("f", [x], x[0] * x[1], x[0] ** 2, x)
+    >>> float(hess([1, 2], [3], 1)[0]), jt[1].tolist(), ht[0].tolist()
+    (2.0, [0, 1], [0, 0])
+    """
+    sym = ca.SX if isinstance(v, ca.SX) else ca.MX
+    lam, lam_f = sym.sym("lam", rows.numel()), sym.sym("lam_f")
+    J = ca.jacobian(rows, v)
+    gq = ca.jacobian(q, v)
+    H = ca.triu(ca.hessian(lam_f * q + ca.dot(lam, rows), v)[0])
+    funs = (ca.Function(f"{name}_val", ins, [rows, q]),
+            ca.Function(f"{name}_grad", ins, [q, _nonzeros(gq)]),
+            ca.Function(f"{name}_jac", ins, [rows, _nonzeros(J)]),
+            ca.Function(f"{name}_hess", ins + [lam, lam_f], [_nonzeros(H)]))
+    if compiled:  # the derivatives; the values stay SX (IPOPT's nlp_grad differentiates them)
+        funs = (funs[0], *(compile_function(fn) for fn in funs[1:]))
+    return (*funs, _triplets(J), _triplets(gq), _triplets(H))
+
+
+def assemble(seg_f: tuple, end_f: tuple, wsym, Psym, seg_args: list, end_args: list,
+             rep_in: list, maps: tuple) -> tuple:
+    """The NLP and its derivatives from pieces: ``(nlp, derivatives, fg)``.
+
+    ``seg_f`` and ``end_f`` are `local_functions` of a repeated piece (mapped over the
+    columns of its arguments ``seg_args``; ``rep_in`` says which are the same for every
+    repetition) and of the single piece ``end_f(*end_args)``; ``maps = (seg_cols, seg_g,
+    end_cols, end_g)`` are the positions in the NLP variables ``wsym`` of each repetition's
+    and the single piece's variables, and in the constraints of their rows (numpy, one row
+    per repetition). ``nlp``: ``{'x', 'p', 'f', 'g'}`` (MX; ``p`` = ``Psym``) for
+    ``casadi.nlpsol``; ``derivatives``: ``grad_f``, ``jac_g`` and ``hess_lag`` Functions for
+    its options of those names; ``fg``: ``(x, p) -> (f, g)``.
+
+    Examples
+    --------
+    Two pieces ``x_k+1 - 2 x_k`` (objective ``x_k^2``) and one end row ``x_0 - 1``:
+
+    >>> import casadi as ca
+    >>> import numpy as np
+    >>> from appdyn.ocp.assembly import assemble, local_functions
+    >>> z, e = ca.SX.sym("z", 2), ca.SX.sym("e")  # a piece's (x_k, x_k+1); the end's x_0
+    >>> seg = local_functions("seg", [z], z[1] - 2 * z[0], z[0] ** 2, z)
+    >>> end = local_functions("end", [e], e - 1, 0 * e, e)
+    >>> w, P = ca.MX.sym("w", 3), ca.MX.sym("P", 0)
+    >>> cols = np.array([[0, 1], [1, 2]])  # the variables of each piece, a row per piece
+    >>> maps = (cols, np.array([[0], [1]]), np.array([0]), np.array([2]))
+    >>> Z = ca.reshape(w[cols.reshape(-1).tolist()], 2, 2)
+    >>> nlp, d, fg = assemble(seg, end, w, P, [Z], [w[0]], [False], maps)
+    >>> np.array(d["jac_g"]([1, 2, 4], [])[1]), float(fg([1, 2, 4], [])[0])
+    (array([[-2.,  1.,  0.],
+           [ 0., -2.,  1.],
+           [ 1.,  0.,  0.]]), 5.0)
+    """
+    seg_cols, seg_g, end_cols, end_g = maps
+    N = seg_cols.shape[0]
+    n_seg, n_end = seg_g.shape[1], end_g.size
+    n_w, n_g = wsym.numel(), N * n_seg + n_end
+
+    def mapped(fun, reduce_out):
+        return fun.map(N, rep_in, reduce_out)
+
+    order = np.empty(n_g, dtype=np.int64)
+    order[seg_g.reshape(-1)] = np.arange(N * n_seg)
+    order[end_g] = N * n_seg + np.arange(n_end)
+    order = order.tolist()
+
+    def g_of(rows_seg, rows_end):
+        return ca.vertcat(ca.vec(rows_seg), rows_end)[order] if order else ca.MX(0, 1)
+
+    # values
+    R, q = mapped(seg_f[0], [False, True])(*seg_args)
+    Re, qe = end_f[0](*end_args)
+    f, g = q + qe, g_of(R, Re)
+    nlp = {"x": wsym, "p": Psym, "f": f, "g": g}
+
+    # gradient of f
+    q2, Gq = mapped(seg_f[1], [True, False])(*seg_args)
+    qe2, Gqe = end_f[1](*end_args)
+    cs, ce = seg_f[5][1], end_f[5][1]
+    grad_rows = np.concatenate([seg_cols[:, cs].reshape(-1), end_cols[ce]])
+    grad = _Assembly(n_w, 1, grad_rows, np.zeros(grad_rows.size, dtype=np.int64))
+    gvec = ca.densify(grad(ca.vertcat(ca.vec(Gq), Gqe)))
+    # Jacobian of g
+    R3, Jz = mapped(seg_f[2], [False, False])(*seg_args)
+    Re3, Je = end_f[2](*end_args)
+    (rs, cs), (re, ce) = seg_f[4], end_f[4]
+    jac = _Assembly(n_g, n_w, np.concatenate([seg_g[:, rs].reshape(-1), end_g[re]]),
+                    np.concatenate([seg_cols[:, cs].reshape(-1), end_cols[ce]]))
+    J = jac(ca.vertcat(ca.vec(Jz), Je))
+    # Hessian of the Lagrangian (upper triangle)
+    lf = ca.MX.sym("lam_f")
+    lg = ca.MX.sym("lam_g", n_g)
+    Lseg = ca.reshape(lg[seg_g.reshape(-1).tolist()], n_seg, N) if n_seg else ca.MX(0, N)
+    Lend = lg[end_g.tolist()] if n_end else ca.MX(0, 1)
+    Hz = seg_f[3].map(N, rep_in + [False, True], [False])(*seg_args, Lseg, lf)
+    He = end_f[3](*end_args, Lend, lf)
+    (rs, cs), (re, ce) = seg_f[6], end_f[6]
+    hr = np.concatenate([seg_cols[:, rs].reshape(-1), end_cols[re]])
+    hc = np.concatenate([seg_cols[:, cs].reshape(-1), end_cols[ce]])
+    hess = _Assembly(n_w, n_w, np.minimum(hr, hc), np.maximum(hr, hc))
+    H = hess(ca.vertcat(ca.vec(Hz), He))
+    derivatives = {
+        "grad_f": ca.Function("nlp_grad_f", [wsym, Psym], [q2 + qe2, gvec], ["x", "p"], ["f", "grad_f_x"]),
+        "jac_g": ca.Function("nlp_jac_g", [wsym, Psym], [g_of(R3, Re3), J],
+                             ["x", "p"], ["g", "jac_g_x"]),
+        "hess_lag": ca.Function("nlp_hess_l", [wsym, Psym, lf, lg], [H],
+                                ["x", "p", "lam_f", "lam_g"], ["hess_gamma_x_x"]),
+    }
+    return nlp, derivatives, ca.Function("nlp_fg", [wsym, Psym], [f, g], ["x", "p"], ["f", "g"])
+
+
 class _Assembly:
     """Sum of value contributions into the nonzeros of a fixed sparse matrix.
 
@@ -111,14 +237,12 @@ class _Assembly:
 
     def __init__(self, nrow: int, ncol: int, rows: np.ndarray, cols: np.ndarray):
         n = rows.size
-        coo = sps.coo_matrix((np.arange(1, n + 1, dtype=np.float64), (rows, cols)), shape=(nrow, ncol))
-        csc = coo.tocsc()  # duplicates summed: a first look at which positions repeat
-        csc.sort_indices()
-        self.sparsity = ca.Sparsity(nrow, ncol, csc.indptr.tolist(), csc.indices.tolist())
-        # position of each contribution in the CSC nonzeros
+        # the distinct positions in column-major (CSC) order: duplicates share one nonzero
         key = cols.astype(np.int64) * nrow + rows
-        uniq = (csc.indices.astype(np.int64)
-                + np.repeat(np.arange(ncol, dtype=np.int64), np.diff(csc.indptr)) * nrow)
+        uniq = np.unique(key)
+        indptr = np.searchsorted(uniq, np.arange(ncol + 1, dtype=np.int64) * nrow)
+        self.sparsity = ca.Sparsity(nrow, ncol, indptr.tolist(), (uniq % nrow).tolist())
+        # position of each contribution in the CSC nonzeros
         pos = np.searchsorted(uniq, key)
         self.nnz = uniq.size
         if uniq.size == n:
@@ -126,10 +250,9 @@ class _Assembly:
             order[pos] = np.arange(n)
             self._perm, self._sum = order.tolist(), None
         else:
-            A = sps.csc_matrix((np.ones(n), (pos, np.arange(n))), shape=(uniq.size, n))
-            A.sort_indices()
+            # one 1 per column k, in row pos[k]: contribution k adds into nonzero pos[k]
             self._perm = None
-            self._sum = ca.DM(ca.Sparsity(uniq.size, n, A.indptr.tolist(), A.indices.tolist()), A.data)
+            self._sum = ca.DM(ca.Sparsity(uniq.size, n, list(range(n + 1)), pos.tolist()), np.ones(n))
 
     def __call__(self, values: ca.MX) -> ca.MX:
         """The sparse matrix from the stacked contributions ``values`` (MX column)."""
@@ -238,24 +361,9 @@ class Intervals:
         n_seg, n_end = seg_rows.numel(), end_rows.numel()
         self.sizes.update(n_z=n_z, n_s=n_s, n_seg=n_seg, n_end=n_end)
         v_seg, v_end = ca.vertcat(z, s), ca.vertcat(e, s)
-        lam_seg, lam_end, lam_f = sym.sym("lam", n_seg), sym.sym("lam", n_end), sym.sym("lam_f")
-
         self.compiled = bool(codegen and sx_ok and compiler() is not None)
-
-        def local(name, ins, rows_, q, v, lam):
-            J = ca.jacobian(rows_, v)
-            gq = ca.jacobian(q, v)
-            H = ca.triu(ca.hessian(lam_f * q + ca.dot(lam, rows_), v)[0])
-            funs = (ca.Function(f"{name}_val", ins, [rows_, q]),
-                    ca.Function(f"{name}_grad", ins, [q, _nonzeros(gq)]),
-                    ca.Function(f"{name}_jac", ins, [rows_, _nonzeros(J)]),
-                    ca.Function(f"{name}_hess", ins + [lam, lam_f], [_nonzeros(H)]))
-            if self.compiled:  # the derivatives; the values stay SX (IPOPT's nlp_grad differentiates them)
-                funs = (funs[0], *(compile_function(fn) for fn in funs[1:]))
-            return (*funs, _triplets(J), _triplets(gq), _triplets(H))
-
-        self.seg = local("seg", seg_in, seg_rows, seg_q, v_seg, lam_seg)
-        self.ends = local("ends", end_in, end_rows, end_q, v_end, lam_end)
+        self.seg = local_functions("seg", seg_in, seg_rows, seg_q, v_seg, compiled=self.compiled)
+        self.ends = local_functions("ends", end_in, end_rows, end_q, v_end, compiled=self.compiled)
 
 
 def intervals(problem, transcription, *, expand: bool = True, codegen: bool = False) -> Intervals:
@@ -340,59 +448,8 @@ class Structure:
         Ee = wsym[end_cols[:end_cols.size - shared.size].tolist()]
         seg_args, end_args = [Z, S, cP, fr], [Ee, S, cP]
         rep_in = [False, True, True, False]
-
-        def mapped(fun, reduce_out):
-            return fun.map(N, rep_in, reduce_out)
-
-        order = np.empty(self.g.size, dtype=np.int64)
-        order[seg_g.reshape(-1)] = np.arange(N * n_seg)
-        order[end_g] = N * n_seg + np.arange(n_end)
-        order = order.tolist()
-
-        def g_of(rows_seg, rows_end):
-            return ca.vertcat(ca.vec(rows_seg), rows_end)[order] if order else ca.MX(0, 1)
-
-        # values
-        R, q = mapped(seg_f[0], [False, True])(*seg_args)
-        Re, qe = end_f[0](*end_args)
-        f, g = q + qe, g_of(R, Re)
-        self.nlp = {"x": wsym, "p": Psym, "f": f, "g": g}
-
-        # gradient of f
-        q2, Gq = mapped(seg_f[1], [True, False])(*seg_args)
-        qe2, Gqe = end_f[1](*end_args)
-        cs, ce = seg_f[5][1], end_f[5][1]
-        grad_rows = np.concatenate([seg_cols[:, cs].reshape(-1), end_cols[ce]])
-        grad = _Assembly(self.w.size, 1, grad_rows, np.zeros(grad_rows.size, dtype=np.int64))
-        gvec = ca.densify(grad(ca.vertcat(ca.vec(Gq), Gqe)))
-        # Jacobian of g
-        R3, Jz = mapped(seg_f[2], [False, False])(*seg_args)
-        Re3, Je = end_f[2](*end_args)
-        (rs, cs), (re, ce) = seg_f[4], end_f[4]
-        jac = _Assembly(self.g.size, self.w.size,
-                        np.concatenate([seg_g[:, rs].reshape(-1), end_g[re]]),
-                        np.concatenate([seg_cols[:, cs].reshape(-1), end_cols[ce]]))
-        J = jac(ca.vertcat(ca.vec(Jz), Je))
-        # Hessian of the Lagrangian (upper triangle)
-        lf = ca.MX.sym("lam_f")
-        lg = ca.MX.sym("lam_g", self.g.size)
-        Lseg = ca.reshape(lg[seg_g.reshape(-1).tolist()], n_seg, N) if n_seg else ca.MX(0, N)
-        Lend = lg[end_g.tolist()] if n_end else ca.MX(0, 1)
-        Hz = seg_f[3].map(N, rep_in + [False, True], [False])(*seg_args, Lseg, lf)
-        He = end_f[3](*end_args, Lend, lf)
-        (rs, cs), (re, ce) = seg_f[6], end_f[6]
-        hr = np.concatenate([seg_cols[:, rs].reshape(-1), end_cols[re]])
-        hc = np.concatenate([seg_cols[:, cs].reshape(-1), end_cols[ce]])
-        hess = _Assembly(self.w.size, self.w.size, np.minimum(hr, hc), np.maximum(hr, hc))
-        H = hess(ca.vertcat(ca.vec(Hz), He))
-        self.derivatives = {
-            "grad_f": ca.Function("nlp_grad_f", [wsym, Psym], [q2 + qe2, gvec], ["x", "p"], ["f", "grad_f_x"]),
-            "jac_g": ca.Function("nlp_jac_g", [wsym, Psym], [g_of(R3, Re3), J],
-                                 ["x", "p"], ["g", "jac_g_x"]),
-            "hess_lag": ca.Function("nlp_hess_l", [wsym, Psym, lf, lg], [H],
-                                    ["x", "p", "lam_f", "lam_g"], ["hess_gamma_x_x"]),
-        }
-        self._fg = ca.Function("nlp_fg", [wsym, Psym], [f, g], ["x", "p"], ["f", "g"])
+        self.nlp, self.derivatives, self._fg = assemble(
+            seg_f, end_f, wsym, Psym, seg_args, end_args, rep_in, self._maps)
 
     # ---------------------------------------------------------------- use
     def params_value(self, problem, mesh, scaling) -> np.ndarray:

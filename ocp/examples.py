@@ -65,6 +65,7 @@ from types import MappingProxyType
 
 import casadi as ca
 
+from appdyn.dynamics import cache
 from appdyn.dynamics.model import Model
 
 from .problem import Constraint, Problem
@@ -82,17 +83,15 @@ def double_integrator() -> Model:
     dynamics.Model
         States ``('x', 'v')``, control ``('u',)``, no parameters.
     """
-    return _DOUBLE_INTEGRATOR
+    return _build()
 
 
+@cache.memoize  # built on first use, once per process (until `clear_caches`)
 def _build() -> Model:
     x, u, p = ca.SX.sym("x", 2), ca.SX.sym("u"), ca.SX.sym("p", 0)
     f = ca.Function("double_integrator", [x, u, p], [ca.vertcat(x[1], u)],
                     ["x", "u", "p"], ["xdot"])
     return Model(f, ("x", "v"), ("u",), name="double_integrator")
-
-
-_DOUBLE_INTEGRATOR = _build()
 
 
 def min_energy(*, distance: float = 1.0, T: float = 1.0) -> Problem:
@@ -127,6 +126,7 @@ def min_time(*, distance: float = 1.0, u_max: float = 1.0, T_max: float = 10.0) 
 GODDARD_OPTIMUM = MappingProxyType({"h_f": 1.0128369183, "T": 0.1988562621})
 
 
+@cache.memoize  # built on first use, once per process (until `clear_caches`)
 def _goddard_model() -> Model:
     h0, g0, m0, c = 1.0, 1.0, 1.0, 0.5  # c = 0.5 sqrt(g0 h0)
     Dc, hc = 0.5 * 620.0 * m0 / g0, 500.0  # Dc = 0.5 vc m0 / g0, vc = 620
@@ -138,9 +138,6 @@ def _goddard_model() -> Model:
                     [ca.vertcat(v, (u - drag) / m - gravity, -u / c)], ["x", "u", "p"], ["xdot"])
     return Model(f, ("h", "v", "m"), ("thrust",), name="goddard_rocket",
                  units={"h": "h0", "v": "sqrt(g0 h0)", "m": "m0", "thrust": "g0 m0"})
-
-
-_GODDARD = _goddard_model()
 
 
 def goddard_rocket(*, regularization: float = 0.0) -> Problem:
@@ -203,7 +200,7 @@ def goddard_rocket(*, regularization: float = 0.0) -> Problem:
     if eps > 0.0:
         kw["lagrange"] = lambda x, u, p: -eps * u[0] ** 2
     name = "Goddard rocket, maximum altitude" + (f", regularized {eps:g}" if eps > 0.0 else "")
-    return Problem(_GODDARD, T=(0.1, 1.0), x_initial=[1.0, 0.0, 1.0], x_final={"m": 0.6},
+    return Problem(_goddard_model(), T=(0.1, 1.0), x_initial=[1.0, 0.0, 1.0], x_final={"m": 0.6},
                    x_bounds={"h": (1.0, None), "v": (0.0, None), "m": (0.6, 1.0)},
                    u_bounds={"thrust": (0.0, 3.5)}, mayer=lambda xf, p, T: xf[0],
                    maximize=True, name=name, **kw)
@@ -215,6 +212,7 @@ def goddard_rocket(*, regularization: float = 0.0) -> Problem:
 ORBIT_RAISING_OPTIMUM = MappingProxyType({"r_f": 1.5253})
 
 
+@cache.memoize  # built on first use, once per process (until `clear_caches`)
 def _orbit_raising_model() -> Model:
     thrust, mdot = 0.1405, 0.0749
     x, u, p = ca.SX.sym("x", 4), ca.SX.sym("u", 2), ca.SX.sym("p", 0)
@@ -226,9 +224,6 @@ def _orbit_raising_model() -> Model:
     return Model(f, ("r", "vr", "vt", "m"), ("ur", "ut"), name="orbit_raising",
                  units={"r": "r0", "vr": "sqrt(mu/r0)", "vt": "sqrt(mu/r0)", "m": "m0",
                         "ur": "-", "ut": "-"})
-
-
-_ORBIT_RAISING = _orbit_raising_model()
 
 
 def _unit(ur, ut):
@@ -270,7 +265,7 @@ def orbit_raising() -> Problem:
     >>> sol.success, round(sol.cost, 4), round(sol.simulated_cost, 4)
     (True, 1.5253, 1.5253)
     """
-    return Problem(_ORBIT_RAISING, T=3.32, x_initial=[1.0, 0.0, 1.0, 1.0], x_final={"vr": 0.0},
+    return Problem(_orbit_raising_model(), T=3.32, x_initial=[1.0, 0.0, 1.0, 1.0], x_final={"vr": 0.0},
                    x_bounds={"r": (0.5, 5.0), "m": (0.1, 1.0)},
                    path=Constraint(_unit, 1.0, 1.0, name="|u| = 1"),
                    boundary=Constraint(_circular, 0.0, 0.0, name="circular"),
@@ -288,6 +283,7 @@ _REENTRY_START = (260000.0 / _L, 0.0, 25600.0 / (_L / _T), math.radians(-1.0), m
 _REENTRY_END = {"h": 80000.0 / _L, "v": 2500.0 / (_L / _T), "gamma": math.radians(-5.0)}
 
 
+@cache.memoize  # built on first use, once per process (until `clear_caches`)
 def _reentry_model() -> Model:
     g0, weight = 32.2, 203000.0
     m_star = weight / g0
@@ -315,9 +311,6 @@ def _reentry_model() -> Model:
                  name="shuttle_reentry",
                  units={"h": "1e5 ft", "theta": "rad", "v": "1e5 ft / 60 s", "gamma": "rad",
                         "psi": "rad", "alpha": "rad", "beta": "rad"})
-
-
-_REENTRY = _reentry_model()
 
 
 def _latitude(theta_f):
@@ -359,7 +352,7 @@ def shuttle_reentry() -> Problem:
     verification tolerance: not verified.)
     """
     lim = math.radians(89.0)
-    return Problem(_REENTRY, T=(0.1, 2500.0 / _T), x_initial=list(_REENTRY_START),
+    return Problem(_reentry_model(), T=(0.1, 2500.0 / _T), x_initial=list(_REENTRY_START),
                    x_final=dict(_REENTRY_END),
                    x_bounds={"h": (0.0, 3.0), "theta": (-lim, lim), "v": (0.01, 20.0),
                              "gamma": (-lim, lim), "psi": (-math.pi, 2 * math.pi)},

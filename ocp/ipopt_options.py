@@ -29,7 +29,6 @@ import difflib
 import json
 import math
 import re
-import subprocess
 import sys
 from dataclasses import dataclass
 from typing import Mapping
@@ -191,6 +190,8 @@ def ipopt_option_table() -> Mapping[str, IpoptOption] | None:
     -------
     mapping of str to IpoptOption, or None
     """
+    import subprocess  # (stdlib, with the capture)
+
     try:
         out = subprocess.run([sys.executable, "-c", _CAPTURE], capture_output=True, text=True,
                              timeout=60, check=False)
@@ -208,6 +209,8 @@ def _probe(names, library: tuple) -> dict:
     """``{name: loads?}`` for ``names``, each solved in the subprocess of `_PROBE`; a name
     that ended the subprocess without a report counts as unavailable and the rest are
     probed in a new one. A failed capture (no subprocess) leaves the names unreported."""
+    import subprocess  # (stdlib, with the probe)
+
     names, found = list(names), {}
     while names:
         try:

@@ -116,6 +116,8 @@ class Layout:
         out = np.empty(self.size)
         for name, (r, c) in self.shapes.items():
             o = self._offsets[name]
-            m = np.broadcast_to(np.asarray(parts[name], dtype=float), (r, c))
+            m = np.asarray(parts[name], dtype=float)
+            if m.shape != (r, c):  # a scalar or a broadcastable block
+                m = np.broadcast_to(m, (r, c))
             out[o:o + r * c] = m.reshape(-1, order="F")
         return out

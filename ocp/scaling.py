@@ -38,6 +38,7 @@ from typing import Mapping
 import casadi as ca
 import numpy as np
 
+from .cached import cached, function_key
 from .functions import sx_compatible
 
 __all__ = ["Scaling", "auto_scaling"]
@@ -214,17 +215,30 @@ def _boundary_scales(problem, guess, dx, dp_free) -> np.ndarray:
 def _auto_rows(funs, args, n_nodes) -> np.ndarray:
     """Row scales of the stacked ``funs`` from gradients w.r.t. scaled arguments."""
     rows = []
+    d = np.concatenate([np.asarray(s, float) for _, _, s in args])
+    vals = [np.broadcast_to(v, (v.shape[0], n_nodes)) if v.shape[1] == 1 else v for _, v, _ in args]
     for fun in funs:
-        syms = [ca.SX.sym(name, fun.size_in(i)) if sx_compatible(fun) else ca.MX.sym(name, fun.size_in(i))
-                for i, (name, _, _) in enumerate(args)]
-        out = fun(*syms)
-        cols = [ca.jacobian(out, s) @ ca.diag(ca.DM(d)) for s, (_, _, d) in zip(syms, args)]
-        jf = ca.Function("row_gradients", syms, [ca.horzcat(*cols)])
-        vals = [np.broadcast_to(v, (v.shape[0], n_nodes)) if v.shape[1] == 1 else v for _, v, _ in args]
-        J = np.asarray(jf.map(n_nodes)(*vals)) if n_nodes > 1 else np.asarray(jf(*vals))
+        J = np.asarray(_row_gradients(fun, tuple(name for name, _, _ in args), n_nodes)(*vals))
         m = fun.numel_out(0)
-        rows.append(_row_scale(J.reshape(m, -1, n_nodes, order="F")))
+        J = J.reshape(m, -1, n_nodes, order="F")
+        # scaled arguments; a fixed parameter (scale 0) contributes nothing, not 0 * inf
+        rows.append(_row_scale(np.where(d[None, :, None] == 0, 0.0, J * d[None, :, None])))
     return np.concatenate(rows)
+
+
+def _row_gradients(fun: ca.Function, names: tuple, n_nodes: int) -> ca.Function:
+    """``(args...) -> [d fun / d arg_1, ...]`` (shape (m, n_args_total)), mapped over
+    ``n_nodes`` points, built once per Function, argument names and count in the one cache
+    (`ocp.cached`): a round of refinement scales the same constraints again."""
+    def build():
+        sym = ca.SX if sx_compatible(fun) else ca.MX
+        syms = [sym.sym(name, fun.size_in(i)) for i, name in enumerate(names)]
+        out = fun(*syms)
+        jf = ca.Function("row_gradients", syms, [ca.horzcat(*[ca.jacobian(out, s) for s in syms])])
+        return jf.map(n_nodes) if n_nodes > 1 else jf
+
+    return cached("row_gradients", (function_key(fun), tuple(names), int(n_nodes)), build,
+                  keepalive=fun)
 
 
 def _merge(cons, auto: np.ndarray) -> np.ndarray:

@@ -79,6 +79,17 @@ def _lagrange_basis(nodes: np.ndarray, s):
     return out
 
 
+def _lagrange_matrix(nodes: np.ndarray, s: np.ndarray) -> np.ndarray:
+    """`_lagrange_basis` for numeric ``s`` (shape (M,)) in one array: ``B[i, j] = l_j(s_i)``,
+    shape (M, n) (the same factors: exact at the nodes)."""
+    n = nodes.size
+    den = nodes[:, None] - nodes[None, :]
+    np.fill_diagonal(den, 1.0)
+    factors = (s[:, None, None] - nodes[None, None, :]) / den[None, :, :]  # (M, j, m)
+    factors[:, np.arange(n), np.arange(n)] = 1.0
+    return np.prod(factors, axis=2)
+
+
 def _differentiation_matrix(nodes: np.ndarray) -> np.ndarray:
     """``D[i, j] = l_j'(nodes[i])`` by barycentric weights (accurate to a few ulp)."""
     n = nodes.size
@@ -145,6 +156,24 @@ class Transcription(abc.ABC):
     @abc.abstractmethod
     def _interpolate(self, f, xs, X, us, U, h, p, s):
         """Symbolic ``(x (nx, 1), u (nu, 1))`` at ``sigma = s`` inside one interval."""
+
+    def dense_weights(self, s: np.ndarray):
+        """Weights of the dense output where it is linear in the node values, or ``None``.
+
+        Parameters
+        ----------
+        s : ndarray, shape (M,)
+            Fractions of the interval.
+
+        Returns
+        -------
+        (wx, wu) or None
+            ``wx`` (M, 1 + m_x) and ``wu`` (M, 1 + m_u) with ``x(s) = [xs, X] @ wx[i]`` and
+            ``u(s) = [us, U] @ wu[i]`` (``us`` the control at the interval start, zero when
+            the transcription has none there); ``None`` when the interpolant depends on the
+            dynamics (Hermite-Simpson): use `interpolant`.
+        """
+        return None
 
     def costates(self, defect_multipliers: np.ndarray, mesh: Mesh):
         """Costate estimates at the state nodes from the defect multipliers, or ``None``.
@@ -295,6 +324,10 @@ class Trapezoid(Transcription):
     def _interpolate(self, f, xs, X, us, U, h, p, s):
         return xs + s * (X[:, 0] - xs), us + s * (U[:, 0] - us)
 
+    def dense_weights(self, s):
+        w = np.stack([1.0 - s, s], axis=1)
+        return w, w
+
 
 # ========================================================================= Hermite-Simpson
 @dataclass(frozen=True)
@@ -440,6 +473,14 @@ class Radau(Transcription):
             u = u + bu[j] * U[:, j]
         return x, u
 
+    def _state_weights(self, s):
+        """``wx`` of `dense_weights`: the Lagrange basis through ``0, c_1, ..., c_d``."""
+        return _lagrange_matrix(np.concatenate([[0.0], self.points]), s)
+
+    def dense_weights(self, s):
+        wu = np.concatenate([np.zeros((s.size, 1)), _lagrange_matrix(self.points, s)], axis=1)
+        return self._state_weights(s), wu
+
     def costates(self, defect_multipliers, mesh):
         nu = np.asarray(defect_multipliers)
         nx, d, N = nu.shape[0], self.degree, mesh.N
@@ -477,6 +518,9 @@ class RadauConstantControl(Radau):
     def _interpolate(self, f, xs, X, us, U, h, p, s):
         x, _ = super()._interpolate(f, xs, X, us, ca.repmat(U[:, 0], 1, self.degree), h, p, s)
         return x, U[:, 0]
+
+    def dense_weights(self, s):
+        return self._state_weights(s), np.stack([np.zeros_like(s), np.ones_like(s)], axis=1)
 
 
 @dataclass(frozen=True)
@@ -518,6 +562,9 @@ class RadauLinearControl(Radau):
     def _interpolate(self, f, xs, X, us, U, h, p, s):
         x, _ = super()._interpolate(f, xs, X, us, self._controls(us, U), h, p, s)
         return x, us + s * (U[:, 0] - us)
+
+    def dense_weights(self, s):
+        return self._state_weights(s), np.stack([1.0 - s, s], axis=1)
 
 
 TRANSCRIPTIONS = ("trapezoid", "hermite-simpson", "hermite-simpson-compressed", "radau",

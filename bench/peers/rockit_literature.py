@@ -5,12 +5,16 @@ The problems as `appdyn.ocp.examples.orbit_raising`, `shuttle_reentry` and bench
 Bilimoria-Wie slew state them, written in rockit (rockit-meco; our code): DirectCollocation
 (rockit's default, Radau degree 4 per interval) with ``N`` intervals, IPOPT with MUMPS, the
 same starts as appdyn (orbit raising: rockit's own, zeros, with ``ut = 1``; reentry: ASSET's
-straight line over 1000 s; slew: rockit's own with ``T = 3.5``).
+straight line over 1000 s). The slew: ``bilimoria_wie`` from the start a rockit user writes
+(``set_initial``: a constant-rate turn about z over ``T = 3.5`` s), ``bilimoria_wie_own``
+from rockit's own (zeros, ``T = 3.5``: on a loaded machine 1601 IPOPT iterations, 225 s at
+N = 40), ``bilimoria_wie_tilted`` from the user's start times a turn about x by
+``sin(pi t / 3.5)`` rad (as appdyn's tilted starts: off the eigenaxis local optimum).
 
 Usage (from the project root)::
 
     bench/peers/.venv-rockit/bin/python bench/peers/rockit_literature.py --json
-        --case orbit_raising|reentry|bilimoria_wie [--N 20 40] [--repeats 1]
+        --case orbit_raising|reentry|bilimoria_wie[_own|_tilted] [--N 20 40] [--repeats 1]
 
 prints ``{"rockit", "casadi", "case", "runs": [...]}``, one run per ``N`` with
 ``objective`` (orbit raising: r_f; reentry: theta_f [deg]; slew: T [s]), ``build_time``
@@ -89,7 +93,7 @@ def reentry(ca, rk, N):
     return ocp, lambda sol: float(np.degrees(sol.value(ocp.at_tf(theta))))
 
 
-def bilimoria_wie(ca, rk, N):
+def bilimoria_wie(ca, rk, N, start="eigenaxis"):
     ocp = rk.Ocp(T=rk.FreeTime(3.5))
     q, w, u = ocp.state(4), ocp.state(3), ocp.control(3)
     qv, q4 = q[:3], q[3]
@@ -100,11 +104,33 @@ def bilimoria_wie(ca, rk, N):
     ocp.subject_to(ocp.at_t0(w) == 0)
     ocp.subject_to(ocp.at_tf(q) == ca.vertcat(0, 0, 1, 0))
     ocp.subject_to(ocp.at_tf(w) == 0)
+    if start != "own":
+        # what a rockit user writes (rockit's set_initial with an expression of ocp.t): the
+        # attitude turning at a constant rate about z over the guessed T = 3.5 s
+        angle = np.pi * ocp.t / 3.5
+        qz = ca.vertcat(0, 0, ca.sin(angle / 2), ca.cos(angle / 2))
+        if start == "tilted":  # times a turn about x by sin(pi t / T) rad, 0 at both ends
+            b = ca.sin(np.pi * ocp.t / 3.5) / 2
+            qz = ca.vertcat(qz[3] * ca.sin(b), qz[2] * ca.sin(b), qz[2] * ca.cos(b),
+                            qz[3] * ca.cos(b))
+        ocp.set_initial(q, qz)
+        ocp.set_initial(w, ca.vertcat(0, 0, np.pi / 3.5))
     ocp.add_objective(ocp.T)
     return ocp, lambda sol: float(sol.value(ocp.T))
 
 
-CASES = {"orbit_raising": orbit_raising, "reentry": reentry, "bilimoria_wie": bilimoria_wie}
+def bilimoria_wie_own(ca, rk, N):
+    """The slew from rockit's own start (zeros; T = 3.5 s)."""
+    return bilimoria_wie(ca, rk, N, start="own")
+
+
+def bilimoria_wie_tilted(ca, rk, N):
+    """The slew from the user's start tilted off the eigenaxis (as appdyn's seeded starts)."""
+    return bilimoria_wie(ca, rk, N, start="tilted")
+
+
+CASES = {"orbit_raising": orbit_raising, "reentry": reentry, "bilimoria_wie": bilimoria_wie,
+         "bilimoria_wie_own": bilimoria_wie_own, "bilimoria_wie_tilted": bilimoria_wie_tilted}
 
 
 def run_one(case: str, N: int) -> dict:

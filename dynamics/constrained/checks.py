@@ -8,7 +8,6 @@ from __future__ import annotations
 
 import casadi as ca
 import numpy as np
-from scipy import linalg
 
 from ..validate import finite_array
 
@@ -60,6 +59,8 @@ def factor_mass(M):
     if M.size == 0 or not eig[0] > M.shape[0] * np.finfo(float).eps * max(eig[-1], 0.0):
         raise ValueError("`M` must be symmetric positive definite (a singular mass matrix, or "
                          f"a zero or negative mass or inertia), got eigenvalues {tuple(eig)}")
+    from scipy import linalg  # on first numeric solve (a heavy import)
+
     return linalg.cho_factor(M, lower=True)
 
 

@@ -7,7 +7,6 @@ from typing import NamedTuple
 
 import casadi as ca
 import numpy as np
-from scipy import linalg
 
 from ..validate import ArgumentTypeError, finite_array, is_symbolic
 from .checks import CASADI_TYPES, check_constraints, column, factor_mass, is_casadi, matrix, vector
@@ -30,6 +29,8 @@ def _numeric(M, Q, B, c):
     Q, B = vector(Q, "Q", n), matrix(B, "B", n)
     c = vector(c, "c", B.shape[0])
     check_constraints(B, c)
+    from scipy import linalg  # on first numeric solve (a heavy import)
+
     a0 = linalg.cho_solve(chol, Q)
     if B.shape[0] == 0:
         return a0, np.zeros(0), np.zeros(n)

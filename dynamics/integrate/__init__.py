@@ -18,14 +18,15 @@ The public entry points are `dynamics.simulate`, `dynamics.SimulationResult`,
                  `Event`; a terminal event truncates the result
 ``impacts``      impacts (``impacts=``): a guard's zero crossing applies a jump map and the
                  integration restarts; `Impact`, `ImpactRecord`, the Zeno guard
-``batch``        K runs at once (``x0`` of shape (nx, K)): the chunk loop mapped over the
-                 runs on threads, ``auto``'s error control over the batch; `BatchResult`
+``batch``        K runs at once (``x0`` of shape (nx, K)): compiled loops over the runs,
+                 spread over threads (``threads=``); `BatchResult`
+``lanes``        fixed-step rk8 over a batch, four runs per step in vector registers
 ``sanity``       fixed-step runs checked against the model's invariants (status 4)
 ``smoothness``   the non-smooth operations (kinks, jumps) of a model's expression graph
 ``stepcontrol``  DOP853 with step rejection for non-smooth right-hand sides, and stepping
                  by its error estimate alone with dense output (`stepcontrol.run_dense`)
 ``dense``        ``auto`` for a smooth right-hand side under a constant control in ONE
-                 compiled call: the dense-output answer, its check run and the verdict
+                 compiled call: the dense-output answer, its check and the verdict
                  (`dense.dense_auto`); a batch's runs in one compiled loop, each with its
                  own steps and check (`dense.dense_many`)
 ``estimates``    the numbers ``auto`` rests on: scaled differences, round-off floors,
@@ -64,8 +65,8 @@ made from Python before the compiled loop runs) or at every right-hand-side eval
 For a smooth right-hand side under a control constant over the run, ``auto`` steps DOP853
 by its embedded error estimate alone and fills the outputs from its continuous extension of
 order 7 (`auto.dense_pass`): its work follows the solution, never the output grid; the answer
-is checked against a run at a 100x looser local tolerance, both runs and the comparison in
-one compiled call (`dense`), and a batch of such runs is one compiled loop over the runs,
+is checked against its own steps merged in pairs (Richardson: that run's error is 2^8 times
+the answer's), both runs and the comparison in one compiled call (`dense`), and a batch of such runs is one compiled loop over the runs,
 each run with its own steps, check and verdict. Otherwise:
 the error of a fixed-step run is controlled by the number of substeps; ``auto`` chooses it
 per output interval from DOP853's embedded error estimate in one compiled pass and checks the

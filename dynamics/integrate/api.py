@@ -15,6 +15,7 @@ from ..model import Model, check_model
 from ..progress import progress_reporter
 from .auto import STIFF_STEPS, dense_answer, solve_auto
 from .batch import BatchResult, check_batch, simulate_batch
+from .batch_fixed import batch_threads
 from .cvodes import run_cvodes
 from .dense import dense_run
 from .events import apply_events, check_events
@@ -40,7 +41,8 @@ def simulate(model: Model, x0, t, *, u=None, p=None, hold: Hold = "linear", meth
              jit: bool | None = None, max_steps: int = 100_000_000,
              cvodes_options: Mapping | None = None,
              progress: bool | Callable[[int, int], None] | None = None,
-             events=None, impacts=None) -> SimulationResult | BatchResult:
+             events=None, impacts=None,
+             threads: int | None = None) -> SimulationResult | BatchResult:
     """Integrate ``xdot = f(x, u, p)`` of ``model`` from ``x0`` over the grid ``t``.
 
     Parameters
@@ -138,6 +140,12 @@ def simulate(model: Model, x0, t, *, u=None, p=None, hold: Hold = "linear", meth
         restarts from the new state (`dynamics.integrate.impacts`); every impact is listed in
         ``impacts`` of the result, and a contact that comes to rest (the Zeno guard
         ``rest_speed``) stops the solution (status 6). Single runs only, not with ``events``.
+    threads : int, optional
+        A batch (``x0`` of shape ``(nx, K)``): the threads its runs are spread over (the
+        runs are independent; each is computed alone, so the answers are the same bits for
+        every thread count). Default: ``appdyn.config`` ``"dynamics.threads"``, else the
+        cores this process may use (``os.sched_getaffinity``); ``1`` runs the batch in the
+        calling thread. A single run uses one thread whatever ``threads`` says.
 
     Returns
     -------
@@ -190,11 +198,12 @@ def simulate(model: Model, x0, t, *, u=None, p=None, hold: Hold = "linear", meth
             return simulate(model, x0, t, u=u, p=p, hold=hold, method=method, rtol=rtol,
                             atol=atol, invariants=invariants, steps=steps, jit=jit,
                             max_steps=max_steps, cvodes_options=cvodes_options,
-                            progress=bar, events=events, impacts=impacts)
+                            progress=bar, events=events, impacts=impacts, threads=threads)
     start = time.perf_counter()
     if (method == "auto" and u is None and p is None and hold == "linear" and events is None
             and impacts is None and invariants is False and steps is None
-            and (jit is None or jit is True) and cvodes_options is None and progress is None):
+            and (jit is None or jit is True) and cvodes_options is None and progress is None
+            and threads is None):
         result = _common_call(model, x0, t, rtol, atol, max_steps, start)
         if result is not None:
             return result
@@ -202,6 +211,8 @@ def simulate(model: Model, x0, t, *, u=None, p=None, hold: Hold = "linear", meth
     if method not in METHODS:
         raise ValueError(f"`method` must be one of {METHODS}, got {method!r}")
     t = check_t(t)
+    if threads is not None:  # (checked for a single run too, which has one thread)
+        batch_threads(threads)
     x = fast_x0(x0, model)  # the common x0 at once (shape (nx,): no batch); else in full
     if x is None:
         if np.ndim(x0) == 2 and np.shape(x0)[1] >= 2:
@@ -211,7 +222,7 @@ def simulate(model: Model, x0, t, *, u=None, p=None, hold: Hold = "linear", meth
                                      "the runs of a batch (`x0` of shape (nx, K)) one by one")
             options = RunOptions(method=method, rtol=rtol, atol=atol, steps=steps, jit=jit,
                                  max_steps=max_steps, cvodes_options=cvodes_options,
-                                 progress=progress)
+                                 progress=progress, threads=threads)
             return _simulate_batch(model, x0, t, u, p, options, invariants=invariants,
                                    hold=hold, start=start)
         x = check_x0(x0, model)
@@ -367,7 +378,8 @@ def _simulate_batch(model, x0, t, u, p, options: RunOptions, *, invariants, hold
     if options.method == "lie":
         check_lie_model(model, batch.x0[:, 0], batch.p[:, 0])
     checked = replace(options, rtol=rtol, atol=atol, steps=steps, max_steps=max_steps,
-                      cvodes_options=cvodes_options, progress=counter)
+                      cvodes_options=cvodes_options, progress=counter,
+                      threads=batch_threads(options.threads))
     result = simulate_batch(batch, checked, start=start)
     counter.finish()
     return result

@@ -375,7 +375,7 @@ def dense_pass(problem: Problem, rtol, atol, max_steps, progress):
     """``auto`` for a smooth right-hand side under a control constant over the run: DOP853
     stepping by its error estimate alone, the outputs filled from its continuous extension
     (`stepcontrol.run_dense`), so the work follows the solution, not the output grid; the
-    answer, its check run at a looser local tolerance, their comparison and the verdict in
+    answer, its check (its steps merged in pairs), their comparison and the verdict in
     one compiled call (`dense.dense_auto`, whose docstring states the rules).
     Returns ``(run, estimate)`` or ``(None, nan)`` to leave the problem to `one_pass` and the
     multi-run search (stiff by the first step's Lipschitz estimate: more than
@@ -406,8 +406,8 @@ def dense_message(got: DenseAuto, rtol: float) -> str:
     return (f"auto: DOP853 with dense output, steps chosen by its error estimate "
             f"({got.answer_steps - got.rejected} steps, {got.rejected} rejected, "
             f"{got.interpolated} interpolated, local rtol {rtol * got.factor:.3g}), checked "
-            f"against a run at a {got.ratio:.3g}x looser local tolerance ({got.check_steps} "
-            f"steps); estimated error {got.estimate:.2g} of tolerance"
+            f"against its steps merged in pairs ({got.check_steps} steps); estimated error "
+            f"{got.estimate:.2g} of tolerance"
             + (f" (a rounding floor of {got.floor:.2g} measured by a run from a moved start "
                "included)" if got.floor > 0 else ""))
 

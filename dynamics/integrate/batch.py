@@ -1,14 +1,21 @@
-"""Batched simulation: K runs of one model on one output grid, chunk by chunk in mapped calls.
+"""Batched simulation: K runs of one model on one output grid, in compiled loops over the
+runs spread over the cores.
 
-`simulate` comes here when ``x0`` has shape ``(nx, K)``. Every run shares the grid, the
-method and the step count; each has its own initial state, parameters (``p`` of shape
-``(np, K)``) and control samples (``u`` of shape ``(nu, n, K)``). The fixed-step methods
-run the model's one compiled chunk loop mapped over parts of the runs, spread over the
-cores (`dynamics.integrate.batch_fixed`). ``auto`` runs the same error control as a single
-run (`dynamics.integrate.auto`) on the whole batch: one step count for all runs, chosen
-until the global error estimate of every run meets the tolerance (a stiff batch goes, run
-by run, to auto's cvodes as a single run does). ``cvodes`` (a variable-step integrator per
-run) is a loop of single runs.
+`simulate` comes here when ``x0`` has shape ``(nx, K)``. Every run shares the grid and the
+method; each has its own initial state, parameters (``p`` of shape ``(np, K)``) and control
+samples (``u`` of shape ``(nu, n, K)``). The runs are independent: they are split into
+contiguous parts that the threads of the process's pool take as they finish
+(`batch_fixed.spread_runs`; ``simulate(..., threads=)``, default the cores this process may
+use, `batch_fixed.batch_threads`), each part filling its own runs' slices of the result, so
+the answers are the same bits for every thread count. ``auto`` on a smooth model under
+controls constant over each run: every run's answer, check run and verdict in one compiled
+loop (`dense.dense_many`), each run with its own steps, the single call's answer to the
+last bit; otherwise auto's multi-run error control over the whole batch (one step count for
+all runs; a stiff or non-smooth batch goes run by run as single runs do). The fixed-step
+methods: under constant controls, compiled rk8 is a plain C loop over each run's steps
+(`lanes`: four runs per vector step where the model's step allows); otherwise the model's
+compiled chunk loop mapped over the parts (`dynamics.integrate.batch_fixed`). ``cvodes``
+(a variable-step integrator per run) is a loop of single runs.
 """
 from __future__ import annotations
 
@@ -22,13 +29,13 @@ import numpy as np
 from .. import cache
 from ..model import Model
 from ..validate import integer
-from ..executors import run_split
-from ..interrupts import check_interrupt, deferred_interrupts
 from .auto import STIFF_STEPS, Single, auto_jit, auto_runs, solve_auto
-from .batch_fixed import BATCH_THREADS, fixed_batch, fixed_message, run_fixed_batch
+from .batch_fixed import (BATCH_THREADS, batch_threads, fixed_batch, fixed_message,
+                          run_fixed_batch, spread_runs)
 from .cvodes import run_cvodes
 from .dense import HEADER as DENSE_HEADER
-from .dense import dense_many, outcome_of
+from .dense import FIELDS as DENSE_FIELDS
+from .dense import dense_many
 from .estimates import jacobian_x, rho_sigma
 from .evaluate import map_eval
 from .inputs import Batch, RunOptions, check_batch
@@ -47,8 +54,8 @@ class BatchTarget:
     """`dynamics.integrate.auto`'s view of a batch: flat states stacked run by run
     (``x0 (K nx,)``, a run's ``x (K nx, n)``), one step count for all runs."""
 
-    def __init__(self, batch: Batch):
-        self.batch, self.t, self.runs = batch, batch.t, batch.K
+    def __init__(self, batch: Batch, threads: int | None = None):
+        self.batch, self.t, self.runs, self.threads = batch, batch.t, batch.K, threads
         self.nonsmooth = nonsmooth_operations(batch.model.f)  # (as `Single.nonsmooth`)
         self.x0 = np.ascontiguousarray(batch.x0.T).reshape(-1)
 
@@ -57,7 +64,7 @@ class BatchTarget:
 
     def run(self, x0: np.ndarray, m: int, jit: bool, progress) -> Run:
         return run_fixed_batch(self.batch, "rk8", m, jit, x0=self._unstack(x0),
-                               progress=progress)[2]
+                               progress=progress, threads=self.threads)[2]
 
     def spectrum(self, rtol, atol):
         b = self.batch
@@ -90,7 +97,7 @@ def simulate_batch(batch: Batch, options: RunOptions, *, start: float) -> "Batch
     if method in ("rk4", "rk8", "lie"):
         x, ok, n_steps, compiled = fixed_batch(batch, method, steps,
                                                cache.should_compile(jit, math.inf),
-                                               progress=progress)
+                                               progress=progress, threads=options.threads)
         status = np.where(ok, OK, FAILED)
         used, message = method, fixed_message(method, steps, n_steps, ok)
         status, message = _sane(batch, x, ok, status, message, method)
@@ -103,9 +110,9 @@ def simulate_batch(batch: Batch, options: RunOptions, *, start: float) -> "Batch
         message = f"cvodes: {K} runs, one after another" + (
             "" if ok.all() else f"; {int((~ok).sum())} failed: {runs[int(np.argmin(ok))].message}")
     else:
-        target = BatchTarget(batch)
-        dense = None if target.nonsmooth else auto_dense_batch(batch, rtol, atol, max_steps,
-                                                                jit, cvodes_options, progress)
+        target = BatchTarget(batch, options.threads)
+        dense = None if target.nonsmooth else auto_dense_batch(
+            batch, rtol, atol, max_steps, jit, cvodes_options, progress, threads=options.threads)
         if dense is not None:
             x, ok, status, estimate, used, n_steps, message = dense
             compiled = True
@@ -154,11 +161,12 @@ def simulate_batch(batch: Batch, options: RunOptions, *, start: float) -> "Batch
 
 
 def auto_dense_batch(batch: Batch, rtol: float, atol: np.ndarray, max_steps: int, jit,
-                     cvodes_options, progress: Progress):
+                     cvodes_options, progress: Progress, *, threads: int | None = None):
     """``auto`` on a batch of smooth runs, each under a control constant over its run: the
     answer, check run and verdict of `dense.dense_auto` for every run in one compiled loop
-    over the runs (`dense.dense_many`; the runs in parts spread over `BATCH_THREADS`
-    threads), each run with its own steps; a run not verified there goes alone through
+    over the runs (`dense.dense_many`; the runs in parts of at most `DENSE_PART` spread over
+    ``threads`` threads by `batch_fixed.spread_runs` from ``2 DENSE_PART`` runs on, each
+    part filling its own slice of the answers), each run with its own steps; a run not verified there goes alone through
     `solve_auto` (as a single call would). Returns ``(x (nx, n, K), ok, status, estimate,
     method, n_steps, message)``, or None (no compiled pass, a control that varies within a
     run, jit off)."""
@@ -178,30 +186,27 @@ def auto_dense_batch(batch: Batch, rtol: float, atol: np.ndarray, max_steps: int
     p[:, :np_] = batch.p.T
     X = np.empty((K, nx, t.size))
     head = np.empty((K, DENSE_HEADER))
-    parts, threads = _dense_parts(K)
     missing = []
 
-    def work(todo):
-        for runs in iter(lambda: next(todo, None), None):
-            got = dense_many(model, x0, t, u, p, rtol, atol, max_steps, STIFF_STEPS, runs)
-            if got is None:
-                missing.append(runs)
-                return
-            X[runs], head[runs] = got
+    def call(k0, k1):
+        if dense_many(model, x0, t, u, p, rtol, atol, max_steps, STIFF_STEPS, slice(k0, k1),
+                      out=(X, head)) is None:
+            missing.append(k0)
 
-    with deferred_interrupts():
-        for group in _groups(parts, threads):
-            check_interrupt()
-            run_split(work, [iter(group)] * min(threads, len(group)))
+    # (a small batch stays on one thread: a hand-over costs tens of microseconds on an idle
+    # machine and milliseconds on a loaded one, where the woken thread waits for a core)
+    spread_runs(call, K, batch_threads(threads) if K >= 2 * DENSE_PART else 1, DENSE_PART)
     if missing:
         return None
-    outs = [outcome_of(X[k], head[k]) for k in range(K)]
+    result = head[:, DENSE_FIELDS.index("result")]  # (each run's header read as columns)
+    estimate = head[:, DENSE_FIELDS.index("estimate")].copy()
+    steps = head[:, DENSE_FIELDS.index("spent")].astype(int)
+    worst = np.max(estimate[result == 1], initial=-math.inf)
     status = np.full(K, OK)
-    estimate = np.array([o.estimate for o in outs])
-    redo = [k for k, o in enumerate(outs) if o.result != 1]
-    used, steps = ({"rk8"} if len(redo) < K else set()), [o.spent for o in outs]
+    redo = np.flatnonzero(result != 1)
+    used = {"rk8"} if redo.size < K else set()
     for k in redo:  # not verified in the loop: alone, by every path of `solve_auto`
-        run, method, st, est = solve_auto(batch.problem(k), rtol, atol, max_steps, jit,
+        run, method, st, est = solve_auto(batch.problem(int(k)), rtol, atol, max_steps, jit,
                                           cvodes_options, progress)
         X[k] = run.x
         status[k] = st if run.ok else FAILED
@@ -211,33 +216,18 @@ def auto_dense_batch(batch: Batch, rtol: float, atol: np.ndarray, max_steps: int
     x = X.transpose(1, 2, 0)
     ok = np.isfinite(x).all(axis=(0, 1))
     status = np.where(ok, status, FAILED)
-    good = [o for k, o in enumerate(outs) if o.result == 1]
     message = (f"auto: DOP853 with dense output per run ({K} runs, each with its own steps, "
-               f"checked against its own run at a looser local tolerance): "
-               f"{min(steps)}-{max(steps)} steps per run; estimated error up to "
-               f"{max((o.estimate for o in good), default=math.nan):.2g} of tolerance")
-    if redo:
-        message += f"; {len(redo)} run(s) alone through auto's other paths"
-    return x, ok, status, estimate, ", ".join(sorted(used)), max(steps), message
+               f"checked against its own steps merged in pairs): "
+               f"{steps.min()}-{steps.max()} steps per run; estimated error up to "
+               f"{worst if worst > -math.inf else math.nan:.2g} of tolerance")
+    if redo.size:
+        message += f"; {redo.size} run(s) alone through auto's other paths"
+    return x, ok, status, estimate, ", ".join(sorted(used)), int(steps.max()), message
 
 
-#: Runs of one compiled call of a dense batch (Ctrl-C is looked at between groups of them).
+#: Most runs of one compiled call of a dense batch (Ctrl-C is looked at between groups of
+#: them, `batch_fixed.spread_runs`).
 DENSE_PART = 64
-
-
-def _dense_parts(K: int) -> tuple[list[slice], int]:
-    """The runs of a dense batch in parts of at most `DENSE_PART` runs, and the threads."""
-    threads = min(BATCH_THREADS, -(-K // DENSE_PART)) if K >= 2 * DENSE_PART else 1
-    count = max(-(-K // DENSE_PART), threads)
-    size, extra = divmod(K, count)
-    edges = np.cumsum([0] + [size + 1] * extra + [size] * (count - extra))
-    return [slice(int(a), int(b)) for a, b in zip(edges[:-1], edges[1:])], threads
-
-
-def _groups(parts: list, threads: int) -> list[list]:
-    """``parts`` in groups of about 16 parts per thread (interrupts between groups)."""
-    step = 16 * threads
-    return [parts[i:i + step] for i in range(0, len(parts), step)]
 
 
 def _sane(batch: Batch, x: np.ndarray, ok: np.ndarray, status: np.ndarray, message: str,
@@ -248,10 +238,12 @@ def _sane(batch: Batch, x: np.ndarray, ok: np.ndarray, status: np.ndarray, messa
     if good.size == 0:
         return status, message
     U = lambda: np.concatenate([batch.ua[good], batch.ub[good, -1:]], axis=1).transpose(2, 1, 0)
-    found = violations(batch.model, batch.t, x[:, :, good], U, batch.p[:, good], method)
-    bad = [(int(k), why) for k, why in zip(good, found) if why]
-    if not bad:
+    every = good.size == ok.size  # (then no copy of the states)
+    found = violations(batch.model, batch.t, x if every else x[:, :, good], U,
+                       batch.p if every else batch.p[:, good], method)
+    if not any(found):
         return status, message
+    bad = [(int(k), why) for k, why in zip(good, found) if why]
     status = status.copy()
     status[[k for k, _ in bad]] = VIOLATED
     return status, (f"{message}; {len(bad)} run(s) not a solution (run {bad[0][0]}: "
@@ -281,9 +273,9 @@ class BatchResult(Result):
     n_steps : int
         Steps per run (``auto``: summed over its runs; cvodes: the most of any run).
     error_estimate : ndarray, shape (K,)
-        ``auto``: the estimated global error in units of the tolerance, the largest over
-        the batch (one step count serves all runs; a stiff batch, run by run with cvodes:
-        each run's own); NaN for the other methods.
+        ``auto``: each run's estimated global error in units of the tolerance (the largest
+        over the batch where one step count serves all runs: auto's multi-run error
+        control); NaN for the other methods.
     compiled : bool
     """
 

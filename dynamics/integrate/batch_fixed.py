@@ -1,9 +1,11 @@
 """The fixed-step engine of a batch (`dynamics.integrate.batch`): the runs of each chunk of
 steps in contiguous parts, each part one call of the model's compiled chunk loop of
 ``loops.BATCH_CHUNK`` steps mapped serially over its runs, the parts spread over the
-machine's cores (`BATCH_THREADS` threads, `dynamics.executors.run_split`; a compiled call
+machine's cores (`batch_threads` threads, `dynamics.executors.run_split`; a compiled call
 releases the GIL), each thread taking the next part as it finishes, through arrays it keeps
-bound to the mapped call between chunks and calls (`_Lane`)."""
+bound to the mapped call between chunks and calls (`_Lane`). The runs are independent and
+each is computed alone whatever part or thread takes it: the answers are the same bits for
+every thread count."""
 from __future__ import annotations
 
 import contextlib
@@ -11,24 +13,58 @@ import os
 from dataclasses import dataclass
 import numpy as np
 
+from appdyn.config import param
+
 from .. import cache
+from ..validate import integer
 from ..executors import run_split
 from ..interrupts import check_interrupt, deferred_interrupts
 from .cpass import pass_library
 from .evaluate import borrow_state, return_state
 from .inputs import Batch
+from .lanes import lanes_library
 from .loops import BATCH_CHUNK as CHUNK
 from .loops import Progress, chunk_function, interval_ends
 from .result import Run
 from .tableaux import TABLEAUX
 
-__all__ = ["fixed_batch", "run_fixed_batch", "fixed_message", "BATCH_THREADS", "PART_RUNS",
-           "PART_STEPS", "PARALLEL_STEPS"]
+__all__ = ["fixed_batch", "run_fixed_batch", "fixed_message", "batch_threads", "spread_runs",
+           "BATCH_THREADS", "PART_RUNS", "PART_STEPS", "PARALLEL_STEPS"]
 
-#: Threads over which the runs of a batch are spread (the cores this process may use, at
-#: most 8).
-BATCH_THREADS = max(1, min(8, len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity")
-                           else os.cpu_count() or 1))
+#: The cores this process may use (``os.sched_getaffinity``; the CPU count where there is
+#: none): the threads of a batch unless told otherwise (`batch_threads`).
+BATCH_THREADS = max(1, len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity")
+                    else os.cpu_count() or 1)
+
+
+def batch_threads(threads: int | None) -> int:
+    """The threads a batch of runs is spread over: ``threads`` if given, else the registered
+    default ``appdyn.config`` ``"dynamics.threads"``, else `BATCH_THREADS` (the cores this
+    process may use). ``1`` runs the batch in the calling thread alone.
+
+    Raises
+    ------
+    TypeError, ValueError
+        Naming ``threads`` when it is not an integer ``>= 1`` (nor None).
+
+    Examples
+    --------
+    >>> from appdyn import config
+    >>> from appdyn.dynamics.integrate.batch_fixed import batch_threads
+    >>> batch_threads(3)
+    3
+    >>> with config.using("dynamics", threads=1):
+    ...     batch_threads(None)
+    1
+    """
+    value = param("dynamics.threads", threads)
+    return BATCH_THREADS if value is None else integer(value, "threads", minimum=1)
+
+
+#: Run-steps of a constant-control rk8 batch from which its vector-lane loop is compiled
+#: (`lanes.lanes_library`, ~0.4 s once per model on an idle machine, then kept on disk):
+#: about 25 ms of the scalar loop, which the lanes cut 2-3x.
+LANES_BUILD = 1 << 16
 
 #: Most runs of one mapped call of the chunk Function (a part of a batch): bounds the
 #: arrays each thread keeps per model and method (`_Lane`; for 256 runs of the rigid
@@ -50,12 +86,13 @@ def _mapped(fun, runs: int):
     return cache.get(key, lambda: fun.map(runs, "serial"), keepalive=fun)
 
 
-def _parts(K: int, steps: int) -> tuple[list[slice], int]:
+def _parts(K: int, steps: int, threads: int) -> tuple[list[slice], int]:
     """The runs of a batch in contiguous parts (sizes differing by at most one run) of about
     `PART_STEPS` run-steps of a chunk of ``steps`` steps, and at most `PART_RUNS` runs; and
-    the threads that take them one after another as they finish (a thread slowed by other
-    work on the machine takes fewer): one below `PARALLEL_STEPS` run-steps per chunk."""
-    threads = min(BATCH_THREADS, K) if K * steps >= PARALLEL_STEPS else 1
+    the threads (at most ``threads``) that take them one after another as they finish (a
+    thread slowed by other work on the machine takes fewer): one below `PARALLEL_STEPS`
+    run-steps per chunk."""
+    threads = min(threads, K) if K * steps >= PARALLEL_STEPS else 1
     count = max(-(-K // PART_RUNS), threads if threads > 1 else 1,
                 min(K, K * steps // PART_STEPS) if threads > 1 else 1)
     size, extra = divmod(K, count)
@@ -195,17 +232,20 @@ class _FixedBatch:
 
 
 def fixed_batch(batch: Batch, method: str, m: int, jit: bool, *, x0: np.ndarray | None = None,
-                progress: Progress | None = None) -> tuple[np.ndarray, np.ndarray, int, bool]:
+                progress: Progress | None = None,
+                threads: int | None = None) -> tuple[np.ndarray, np.ndarray, int, bool]:
     """``m`` steps of ``method`` per output interval for every run of ``batch`` (from
     ``x0 (nx, K)``, default ``batch.x0``), chunk by chunk; each chunk in one mapped call per
-    part of the runs, the parts spread over `BATCH_THREADS` threads (`run_split`). Compiled
-    ``rk8`` under constant controls without a progress callback: every run in one plain C
-    loop over its steps (`cpass._FIXED`, parts of the runs spread over the threads).
+    part of the runs, the parts spread over ``threads`` threads (`batch_threads`,
+    `run_split`). Compiled ``rk8`` under constant controls without a progress callback:
+    every run in one plain C loop over its steps (`cpass._FIXED`, parts of the runs spread
+    over the threads by `spread_runs`).
 
     Returns ``(x (nx, n, K), ok (K,), steps done per run, compiled)``: a run whose state
     became non-finite has its later columns NaN and ``ok`` False.
     """
     model, K = batch.model, batch.K
+    threads = batch_threads(threads)
     total = m * batch.nint
     progress = Progress(None) if progress is None else progress
     progress.start(total)
@@ -213,13 +253,17 @@ def fixed_batch(batch: Batch, method: str, m: int, jit: bool, *, x0: np.ndarray 
     if method == "rk8" and jit and state.constant and progress.fun is None:
         # (a progress callback is told after every chunk: the chunk loop below)
         lib = pass_library(model)
-        if lib is not None:  # one plain C loop over the runs (`cpass._FIXED`)
-            _c_loop(lib.fixed_many, state, m)
+        if lib is not None:  # one plain C loop over the runs (`cpass._FIXED`), its runs
+            # in the lanes of the vector registers when the step allows (`lanes`)
+            # (compiled for a batch of `LANES_BUILD` run-steps or more; a smaller one uses
+            # it once built: the same bits either way)
+            lanes = lanes_library(model, build=K * total >= LANES_BUILD) if K > 1 else None
+            _c_loop(lib.fixed_many if lanes is None else lanes, state, m, threads)
             progress.advance(total)
             x, ok = _nan_after_failure(state.x)
             return x, ok, total, True
     fun, compiled = chunk_function(model, method, "linear", jit, size=CHUNK)
-    parts, threads = _parts(K, min(CHUNK, total))
+    parts, threads = _parts(K, min(CHUNK, total), threads)
     capacity = parts[0].stop - parts[0].start
 
     def work(task):  # a thread's share of a chunk: the parts left, one at a time
@@ -243,13 +287,48 @@ def fixed_batch(batch: Batch, method: str, m: int, jit: bool, *, x0: np.ndarray 
     return x, ok, done, compiled
 
 
-#: Runs of one call of the C loop of a fixed-step batch (interrupts between groups).
-C_PART = 64
+#: Most run-steps of one call of a compiled loop over the runs (`spread_runs`: ~10 ms on
+#: the rigid body, so that a Ctrl-C is seen within a second on two threads).
+C_PART_STEPS = 1 << 15
+
+#: Parts of a batch per thread at least (a thread slowed by other work takes fewer).
+PARTS_PER_THREAD = 8
+
+#: Parts per thread between two looks at Ctrl-C.
+GROUP = 16
 
 
-def _c_loop(fixed_many, state: "_FixedBatch", m: int) -> None:
+def spread_runs(call, K: int, threads: int, part: int) -> None:
+    """``call(k0, k1)`` (a compiled loop over the runs ``k0 <= k < k1`` that releases the
+    GIL and writes only those runs' slices of its outputs) for every run of a batch of
+    ``K``: the runs in contiguous parts of at most ``part`` runs, and at most ``K / (threads
+    PARTS_PER_THREAD)`` when spread, taken one after another by ``threads`` threads of the
+    process's pool as they finish (`run_split`); Ctrl-C is looked at between groups of
+    `GROUP` parts per thread (`deferred_interrupts`). ``threads=1``: every part in the
+    calling thread, in order."""
+    if threads > 1:
+        part = min(part, -(-K // (threads * PARTS_PER_THREAD)))
+    part = max(1, part)
+    edges = list(range(0, K, part)) + [K]
+    parts = list(zip(edges[:-1], edges[1:]))
+    threads = min(threads, len(parts))
+
+    def work(todo):
+        for k0, k1 in iter(lambda: next(todo, None), None):
+            call(k0, k1)
+
+    with deferred_interrupts():
+        for i in range(0, len(parts), GROUP * threads):
+            check_interrupt()
+            group = iter(parts[i:i + GROUP * threads])  # (its `next` is atomic)
+            run_split(work, [group] * threads)
+
+
+def _c_loop(fixed_many, state: "_FixedBatch", m: int, threads: int) -> None:
     """Every run of ``state`` (constant controls) by the compiled ``rk8_fixed_many`` into
-    ``state.x``, the runs in parts of `C_PART` spread over `BATCH_THREADS` threads."""
+    ``state.x``, the runs in parts of at most `C_PART_STEPS` run-steps spread over
+    ``threads`` threads (`spread_runs`; one when the batch has fewer than
+    `PARALLEL_STEPS` run-steps)."""
     batch = state.batch
     K, nu, np_ = batch.K, batch.model.nu, batch.model.np
     H = np.ascontiguousarray(np.diff(batch.t))
@@ -260,19 +339,9 @@ def _c_loop(fixed_many, state: "_FixedBatch", m: int) -> None:
     p[:, :np_] = state.P
     X = state.x
     addr = (H.ctypes.data, x0.ctypes.data, u.ctypes.data, p.ctypes.data, X.ctypes.data)
-    edges = list(range(0, K, C_PART)) + [K]
-    parts = list(zip(edges[:-1], edges[1:]))
-    threads = min(BATCH_THREADS, len(parts))
-
-    def work(todo):
-        for k0, k1 in iter(lambda: next(todo, None), None):
-            fixed_many(k0, k1, batch.nint, m, *addr)
-
-    with deferred_interrupts():
-        for i in range(0, len(parts), 16 * threads):
-            check_interrupt()
-            group = iter(parts[i:i + 16 * threads])
-            run_split(work, [group] * threads)
+    steps = m * batch.nint
+    spread_runs(lambda k0, k1: fixed_many(k0, k1, batch.nint, m, *addr), K,
+                threads if K * steps >= PARALLEL_STEPS else 1, C_PART_STEPS // steps)
 
 
 def _nan_after_failure(x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -296,11 +365,13 @@ def fixed_message(method: str, m: int, done: int, ok: np.ndarray) -> str:
 
 
 def run_fixed_batch(batch: Batch, method: str, m: int, jit: bool, *, x0: np.ndarray | None = None,
-                    progress: Progress | None = None) -> tuple[np.ndarray, np.ndarray, Run]:
+                    progress: Progress | None = None,
+                    threads: int | None = None) -> tuple[np.ndarray, np.ndarray, Run]:
     """`fixed_batch` with its counts as a `Run` of one run (steps per run, right-hand sides
     per run) whose ``x`` is the batch stacked run by run ``(K nx, n)``: returns
     ``(x (nx, n, K), ok (K,), run)``."""
-    x, ok, done, compiled = fixed_batch(batch, method, m, jit, x0=x0, progress=progress)
+    x, ok, done, compiled = fixed_batch(batch, method, m, jit, x0=x0, progress=progress,
+                                        threads=threads)
     K, nx, n = batch.K, batch.model.nx, batch.t.size
     stages = 4 if method == "lie" else TABLEAUX[method].stages
     stacked = np.ascontiguousarray(x.transpose(2, 0, 1).reshape(K * nx, n))

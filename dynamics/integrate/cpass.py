@@ -42,6 +42,7 @@ _N, _E, _EC, _S = range(4)
 # and `rk8_step` (x, h, ua, ud, p) -> x+ called from a plain C loop over the output intervals.
 _DRIVER = r"""
 #include <float.h>
+#include <stddef.h>
 #define PASS_NX %(nx)d
 #define PASS_NU %(nu)d
 #define PASS_NP %(np)d
@@ -345,6 +346,75 @@ static casadi_real dense_first_step(pass_ctx* c, const casadi_real* x, const cas
   return isfinite(h1) && h1 > 0 ? fmin(h1, tend - t) : tend - t;
 }
 
+/* The outputs ts[*j] ... in the step of `hs` from (t, x) to (tn, xn) (stages K) into X
+   (nx, ldx): those inside from the step's continuous extension of order 7 (`rk8_cont`,
+   evaluated only for a step that holds one: *have 1 then), those on its end from xn. */
+static void dense_outputs(pass_ctx* c, const casadi_real* x, const casadi_real* xn,
+                          const casadi_real* K, casadi_real hs, const casadi_real* u,
+                          const casadi_real* p, casadi_real t, casadi_real tn, int nout,
+                          const casadi_real* ts, int* j, casadi_real* X, int ldx, int* have) {
+  const casadi_real* arg[PASS_NARG + 7];
+  casadi_real* res[PASS_NRES + 3];
+  casadi_real F[7 * PASS_NX], s, r;
+  int i;
+  *have = 0;
+  while (*j < nout && ts[*j] < tn) {
+    if (!*have) {
+      arg[0] = x; arg[1] = xn; arg[2] = K; arg[3] = &hs; arg[4] = u; arg[5] = p;
+      res[0] = F;
+      rk8_cont(arg, res, c->iw, c->w, 0);
+      *have = 1;
+    }
+    s = (ts[*j] - t) / hs;
+    for (i = 0; i < PASS_NX; ++i) {
+      r = F[5 * PASS_NX + i] + s * F[6 * PASS_NX + i];
+      r = F[4 * PASS_NX + i] + (1 - s) * r;
+      r = F[3 * PASS_NX + i] + s * r;
+      r = F[2 * PASS_NX + i] + (1 - s) * r;
+      r = F[PASS_NX + i] + s * r;
+      r = F[i] + (1 - s) * r;
+      X[i * ldx + *j] = x[i] + s * r;
+    }
+    ++*j;
+  }
+  while (*j < nout && ts[*j] == tn) {  /* an output on the step's end */
+    for (i = 0; i < PASS_NX; ++i) X[i * ldx + *j] = xn[i];
+    ++*j;
+  }
+}
+
+/* The check of merged step pairs (Richardson on the answer's own steps): its state `rich`
+   is RI_T its time, RI_PEND the answer's step not yet merged (0: none), RI_J its outputs
+   filled, RI_STEPS its steps, RI_E the sum of the answer's embedded estimates over its
+   accepted steps, RI_EC the sum of the check's over its steps, then its x (nx). */
+#define RI_T 0
+#define RI_PEND 1
+#define RI_J 2
+#define RI_STEPS 3
+#define RI_E 4
+#define RI_EC 5
+#define RI_X 6
+#define RI_SIZE (RI_X + PASS_NX)
+
+/* one step of the check from its time to `tn` (two of the answer's steps merged, or its
+   lone last step), its outputs into XC (nx, ldx) */
+static void rich_step(pass_ctx* c, casadi_real* rich, casadi_real tn, const casadi_real* u,
+                      const casadi_real* p, const casadi_real* atol, int nout,
+                      const casadi_real* ts, casadi_real* XC, int ldx) {
+  const casadi_real* arg[PASS_NARG + 7];
+  casadi_real* res[PASS_NRES + 3];
+  casadi_real xn[PASS_NX], K[12 * PASS_NX], err, H = tn - rich[RI_T];
+  casadi_real* xc = rich + RI_X;
+  int j = (int) rich[RI_J], i, have;
+  arg[0] = xc; arg[1] = &H; arg[2] = u; arg[3] = p; arg[4] = &c->rtol; arg[5] = atol;
+  res[0] = xn; res[1] = &err; res[2] = K;
+  rk8_step_k(arg, res, c->iw, c->w, 0);
+  dense_outputs(c, xc, xn, K, H, u, p, rich[RI_T], tn, nout, ts, &j, XC, ldx, &have);
+  for (i = 0; i < PASS_NX; ++i) xc[i] = xn[i];
+  rich[RI_T] = tn; rich[RI_PEND] = 0; rich[RI_J] = j; rich[RI_STEPS] += 1;
+  rich[RI_EC] += isfinite(err) ? err : INFINITY;
+}
+
 /* Steps of x (in/out) from time *t (in/out) towards ts[nout - 1], the outputs at the times
    ts (increasing, after the start) in X (nx, ldx); control u throughout; `hio` (in/out) the
    controller's proposed step (<= 0: `dense_first_step`); `count` (in/out): accepted steps,
@@ -355,17 +425,18 @@ static casadi_real dense_first_step(pass_ctx* c, const casadi_real* x, const cas
    the right-hand side at every DENSE_NOISE_EVERY-th accepted state (s = +-1 alternating
    over the states and the samples). At most `budget` steps per
    call (the caller checks for interrupts between calls). Returns the outputs filled. The
-   controller is `rk8_adaptive`'s; the last step lands on ts[nout - 1]. */
-int rk8_dense(casadi_real* x, casadi_real* t, casadi_real* hio, int nout,
-              const casadi_real* ts, const casadi_real* u, const casadi_real* p,
-              casadi_real rtol, const casadi_real* atol, casadi_real max_steps,
-              casadi_real* X, int ldx, casadi_real* count, int budget,
-              casadi_real stiff_steps) {
+   controller is `rk8_adaptive`'s; the last step lands on ts[nout - 1]. With `rich` (not
+   NULL) the check of merged step pairs runs alongside (`rich_step`, outputs into XC). */
+static int dense_run(casadi_real* x, casadi_real* t, casadi_real* hio, int nout,
+                     const casadi_real* ts, const casadi_real* u, const casadi_real* p,
+                     casadi_real rtol, const casadi_real* atol, casadi_real max_steps,
+                     casadi_real* X, int ldx, casadi_real* count, int budget,
+                     casadi_real stiff_steps, casadi_real* rich, casadi_real* XC) {
   pass_ctx c;
   const casadi_real* arg[PASS_NARG + 7];
   casadi_real* res[PASS_NRES + 3];
-  casadi_real xn[PASS_NX], K[12 * PASS_NX], F[7 * PASS_NX];
-  casadi_real h = *hio, hp, hs, err, fac, s, r, tend = ts[nout - 1], tn;
+  casadi_real xn[PASS_NX], K[12 * PASS_NX];
+  casadi_real h = *hio, hp, hs, err, fac, tend = ts[nout - 1], tn;
   int j = (int) count[5], i, last, rejected = count[6] > 0, finite, have;
   c.p = p; c.atol = atol; c.rtol = rtol;
   if (!(h > 0)) {
@@ -387,34 +458,16 @@ int rk8_dense(casadi_real* x, casadi_real* t, casadi_real* hio, int nout,
     fac = finite ? pow(err, 0.125) / 0.9 : 3.0;
     if (finite && err <= 1.0) {
       tn = last ? tend : *t + hs;
-      have = 0;
-      while (j < nout && ts[j] < tn) {
-        if (!have) {
-          arg[0] = x; arg[1] = xn; arg[2] = K; arg[3] = &hs; arg[4] = u; arg[5] = p;
-          res[0] = F;
-          rk8_cont(arg, res, c.iw, c.w, 0);
-          have = 1;
-          count[4] += 1;
-        }
-        s = (ts[j] - *t) / hs;
-        for (i = 0; i < PASS_NX; ++i) {
-          r = F[5 * PASS_NX + i] + s * F[6 * PASS_NX + i];
-          r = F[4 * PASS_NX + i] + (1 - s) * r;
-          r = F[3 * PASS_NX + i] + s * r;
-          r = F[2 * PASS_NX + i] + (1 - s) * r;
-          r = F[PASS_NX + i] + s * r;
-          r = F[i] + (1 - s) * r;
-          X[i * ldx + j] = x[i] + s * r;
-        }
-        ++j;
-      }
+      dense_outputs(&c, x, xn, K, hs, u, p, *t, tn, nout, ts, &j, X, ldx, &have);
+      count[4] += have;
       for (i = 0; i < PASS_NX; ++i) x[i] = xn[i];
       *t = tn;
-      while (j < nout && ts[j] == tn) {  /* an output on the step's end */
-        for (i = 0; i < PASS_NX; ++i) X[i * ldx + j] = x[i];
-        ++j;
-      }
       count[0] += 1;
+      if (rich) {
+        rich[RI_E] += err;
+        if (rich[RI_PEND] > 0 || last) rich_step(&c, rich, tn, u, p, atol, nout, ts, XC, ldx);
+        else rich[RI_PEND] = hs;
+      }
       if (((int) count[0]) % DENSE_NOISE_EVERY == 1) {
         casadi_real f0[PASS_NX], f1[PASS_NX], sg = ((int) count[0] / DENSE_NOISE_EVERY) % 2
                                                     ? -DBL_EPSILON : DBL_EPSILON;
@@ -434,12 +487,22 @@ int rk8_dense(casadi_real* x, casadi_real* t, casadi_real* hio, int nout,
   count[6] = rejected;
   return j;
 }
+
+/* `dense_run` without the check (`stepcontrol.run_dense`) */
+int rk8_dense(casadi_real* x, casadi_real* t, casadi_real* hio, int nout,
+              const casadi_real* ts, const casadi_real* u, const casadi_real* p,
+              casadi_real rtol, const casadi_real* atol, casadi_real max_steps,
+              casadi_real* X, int ldx, casadi_real* count, int budget,
+              casadi_real stiff_steps) {
+  return dense_run(x, t, hio, nout, ts, u, p, rtol, atol, max_steps, X, ldx, count, budget,
+                   stiff_steps, NULL, NULL);
+}
 """
 
 
 # ``auto`` for a smooth right-hand side under a constant control in ONE call: DOP853 with
-# dense output (`_DENSE`) as the answer, a check run at a looser local tolerance, their
-# comparison and the verdict, with no Python between (`dynamics.integrate.dense`, which
+# dense output (`_DENSE`) as the answer, its check (its steps merged in pairs, alongside),
+# their comparison and the verdict, with no Python between (`dynamics.integrate.dense`, which
 # states the rules; the layout of the workspace is `dense.LAYOUT`).
 _AUTO = r"""
 #include <limits.h>
@@ -474,15 +537,26 @@ _AUTO = r"""
 #define AU_SUB 25     /* the longest output interval over the answer's smallest step */
 #define AU_GATE 26    /* the acceptance of the estimate (0.5 or 1) */
 #define AU_FLOOR 27   /* the rounding floor measured by a rerun from a moved start (0: none) */
-#define AU_HDR 28
+#define AU_ORDER 28   /* the order shown by the embedded estimates of the check's merged
+                         steps against the answer's (`au_order`; NaN: not measured) */
+#define AU_HDR 29
 #define AU_ACCEPT 0.5        /* estimates.AUTO_ACCEPT */
 #define AU_FLOOR_ULPS 1000.0 /* estimates.FLOOR_ULPS */
 #define AU_MEASURED 1e6      /* auto's _PASS_MEASURED */
 #define AU_RTOL_MIN 1e-14    /* stepcontrol.LOCAL_RTOL_MIN */
 #define AU_LADDER 1e-2       /* the most a new answer's local tolerance shrinks (as
                                 stepcontrol's runs of a non-smooth right-hand side) */
+#define AU_NOISE_EPS 30.0    /* NOISE: an embedded estimate at most this many eps / rtol
+                                is rounding */
+#define AU_AIM 0.2           /* a new answer's aim [tolerances] */
+#define AU_ORDER_LO 5.0      /* the least order of the estimates that shows the method's
+                                asymptotic range (DOP853's estimate: 6-8 there) */
+#define AU_ORDER_HI 11.0     /* the most */
+#define AU_RICHARDSON 127.0  /* |answer - check| over this is the answer's error in that
+                                range: 2^p - 1 for the check's merged steps, p = 7 (the
+                                method's order is 8: 2x conservative) */
 /* the workspace after the header: x0, u, p, atol, ts (AU_NOUT), then the run's x, t, h,
-   count (8 + nx), local atol, the answer's noise */
+   count (8 + nx), local atol, the answer's noise, the check's state (`RI_SIZE`) */
 #define AU_X0(w) ((w) + AU_HDR)
 #define AU_U(w) (AU_X0(w) + PASS_NX)
 #define AU_P(w) (AU_U(w) + PASS_NU)
@@ -494,31 +568,38 @@ _AUTO = r"""
 #define AU_COUNT(w) (AU_H(w) + 1)
 #define AU_AL(w) (AU_COUNT(w) + 8 + PASS_NX)
 #define AU_NOISE(w) (AU_AL(w) + PASS_NX)
-#define AU_SIZE(nout) (AU_HDR + 6 * PASS_NX + PASS_NU + PASS_NP + (nout) + 10)
+#define AU_RICH(w) (AU_NOISE(w) + PASS_NX)
+#define AU_SIZE(nout) (AU_HDR + 7 * PASS_NX + PASS_NU + PASS_NP + (nout) + 16)
 
-/* a run from x0 at the local tolerance (rtol, atol) factor */
+/* a run from x0 at the local tolerance (rtol, atol) factor (the check's state reset) */
 static void au_begin(casadi_real* w, casadi_real factor) {
   casadi_real* count = AU_COUNT(w);
+  casadi_real* rich = AU_RICH(w);
   int i;
   for (i = 0; i < PASS_NX; ++i) {
     AU_XR(w)[i] = AU_X0(w)[i];
     AU_AL(w)[i] = AU_ATOL(w)[i] * factor;
+    rich[RI_X + i] = AU_X0(w)[i];
   }
+  for (i = 0; i < RI_X; ++i) rich[i] = 0;
+  rich[RI_T] = w[AU_T0];
   *AU_TT(w) = w[AU_T0];
   *AU_H(w) = 0;
   for (i = 0; i < 8 + PASS_NX; ++i) count[i] = 0;
   count[3] = INFINITY;
 }
 
-/* `rk8_dense` on the run in progress into Y (nx, nout + 1) at local factor `factor`, at
-   most *budget steps; returns 1 when it ended (finished or failed) */
-static int au_step(casadi_real* w, casadi_real factor, casadi_real* Y, int* budget) {
+/* `dense_run` on the run in progress into Y (nx, nout + 1) at local factor `factor`, at
+   most *budget steps, with the check of merged step pairs into XC when `check`; returns 1
+   when it ended (finished or failed) */
+static int au_step(casadi_real* w, casadi_real factor, casadi_real* Y, int* budget,
+                   int check, casadi_real* XC) {
   casadi_real* count = AU_COUNT(w);
   int nout = (int) w[AU_NOUT], j;
   casadi_real before = count[0] + count[1];
-  j = rk8_dense(AU_XR(w), AU_TT(w), AU_H(w), nout, AU_TS(w), AU_U(w), AU_P(w),
+  j = dense_run(AU_XR(w), AU_TT(w), AU_H(w), nout, AU_TS(w), AU_U(w), AU_P(w),
                 w[AU_RTOL] * factor, AU_AL(w), w[AU_MAXSTEPS] - w[AU_SPENT], Y + 1, nout + 1,
-                count, *budget, w[AU_STIFF]);
+                count, *budget, w[AU_STIFF], check ? AU_RICH(w) : NULL, XC + 1);
   *budget -= (int) (count[0] + count[1] - before);
   return j >= nout || count[2] != 0;
 }
@@ -584,8 +665,7 @@ static casadi_real au_carried(casadi_real* w) {
 
 /* the verdict on the estimate `est` (AU_RESULT, AU_PHASE); not accepted, the next answer,
    tighter, or done */
-static void au_verdict(casadi_real* w, casadi_real* X, casadi_real* XC, casadi_real est) {
-  int i, n = PASS_NX * ((int) w[AU_NOUT] + 1);
+static void au_verdict(casadi_real* w, casadi_real est) {
   casadi_real e;
   w[AU_EST] = est;
   w[AU_PHASE] = 3;
@@ -595,39 +675,46 @@ static void au_verdict(casadi_real* w, casadi_real* X, casadi_real* XC, casadi_r
   }
   w[AU_RESULT] = 0;
   if (!isfinite(est) || w[AU_TRY] >= w[AU_TRIES] || w[AU_FLOOR] > 0) return;
-  /* aim at 0.1, at most AU_LADDER tighter (beyond the method's asymptotic range, where
-     the check was taken, the estimate predicts nothing); a new answer at least 10x tighter
-     is checked against this one */
-  e = fmax(AU_LADDER, fmin(0.5, 0.1 / est));
-  if (e <= 0.1) {
-    for (i = 0; i < n; ++i) XC[i] = X[i];
-    w[AU_NCHK] = w[AU_NANS];
-    w[AU_LOOSE] = w[AU_FACTOR];
-  }
+  /* aim at AU_AIM (the error follows the local tolerance about linearly: measured over
+     1e-3..10 of rtol on torque-free bodies), at most AU_LADDER tighter (beyond the
+     method's asymptotic range the estimate predicts nothing) */
+  e = fmax(AU_LADDER, fmin(0.5, AU_AIM / est));
   w[AU_FACTOR] *= e;
+  w[AU_LOOSE] = w[AU_FACTOR];
   if (w[AU_RTOL] * w[AU_FACTOR] < AU_RTOL_MIN) return;
   au_begin(w, w[AU_FACTOR]);
   w[AU_PHASE] = 2;
 }
 
-/* the answer X against the check XC: AU_D, AU_EST and the verdict; near the states'
-   rounding (within 1e6 ulps) the model's rounding measured on the way, carried over the
-   horizon, is added when small (`estimates.screen`), else measured: the answer repeated
-   from x0 moved by it (phase 4, into XC, judged by `au_floor`) */
+/* the order the check's merged steps show: log2 of 2 x the sum of their embedded estimates
+   over the answer's sum (twice the steps; a step of 2h has 2^p the estimate of one of h);
+   NaN when the answer's are rounding (at most NOISE eps / rtol) or a sum is not finite */
+static casadi_real au_order(const casadi_real* w, const casadi_real* rich) {
+  casadi_real e = rich[RI_E], ec = rich[RI_EC];
+  casadi_real noise = AU_NOISE_EPS * DBL_EPSILON / (w[AU_RTOL] * w[AU_FACTOR]);
+  if (!(e > noise * w[AU_ACC]) || !isfinite(ec) || !(ec > 0)) return NAN;
+  return log2(2 * ec / e);
+}
+
+/* the answer X against the check XC (its steps merged in pairs): AU_D, AU_EST and the
+   verdict; near the states' rounding (within 1e6 ulps) the model's rounding measured on
+   the way, carried over the horizon, is added when small (`estimates.screen`), else
+   measured: the answer repeated from x0 moved by it (phase 4, into XC, judged by
+   `au_floor`) */
 static void au_judge(casadi_real* w, casadi_real* X, casadi_real* XC) {
   int nout = (int) w[AU_NOUT], j;
-  casadi_real d, ulps, lmin, e, power, est, horizon, lip = w[AU_LIP];
-  casadi_real ratio = w[AU_LOOSE] / w[AU_FACTOR];
+  casadi_real d, ulps, lmin, e, est, horizon, lip = w[AU_LIP], order;
   d = au_diff(w, X, XC, &ulps, &lmin);
-  power = w[AU_NANS] / fmax(w[AU_NCHK], 1) / pow(ratio, 0.125);
-  if (power >= 0.8 && power <= 1.25) {
-    est = d / (pow(ratio, 0.75) - 1) + ulps;
+  order = au_order(w, AU_RICH(w));
+  w[AU_ORDER] = order;
+  if (order >= AU_ORDER_LO && order <= AU_ORDER_HI) {  /* Richardson */
+    est = d / AU_RICHARDSON + ulps;
     w[AU_GATE] = AU_ACCEPT;
-  } else {
+  } else {  /* (no order shown: the difference itself) */
     est = d + ulps;
     w[AU_GATE] = 1.0;
   }
-  w[AU_D] = d; w[AU_RATIO] = ratio; w[AU_BOUND] = 0; w[AU_FLOOR] = 0;
+  w[AU_D] = d; w[AU_RATIO] = 2; w[AU_BOUND] = 0; w[AU_FLOOR] = 0;
   for (e = AU_TS(w)[0] - w[AU_T0], j = 1; j < nout; ++j)
     if (AU_TS(w)[j] - AU_TS(w)[j - 1] > e) e = AU_TS(w)[j] - AU_TS(w)[j - 1];
   w[AU_SUB] = w[AU_HMIN] < INFINITY ? ceil(e / w[AU_HMIN]) : 1;
@@ -648,7 +735,7 @@ static void au_judge(casadi_real* w, casadi_real* X, casadi_real* XC) {
       return;
     }
   }
-  au_verdict(w, X, XC, est);
+  au_verdict(w, est);
 }
 
 /* after the rerun from the moved start (in XC): the floor is the largest of its difference
@@ -660,11 +747,11 @@ static void au_floor(casadi_real* w, casadi_real* X, casadi_real* XC) {
   for (i = 0; i < PASS_NX; ++i) local = fmax(local, AU_NOISE(w)[i]);
   local = lmin > 0 ? local / lmin : (local > 0 ? INFINITY : 0);
   w[AU_FLOOR] = fmax(fmax(d, local), ulps);
-  au_verdict(w, X, XC, w[AU_EST] + w[AU_FLOOR]);
+  au_verdict(w, w[AU_EST] + w[AU_FLOOR]);
 }
 
-/* The whole of `dense.dense_auto` for one problem: the check run into XC, the answer into X
-   (nx, nout + 1; column 0 = x0), compared; at most `budget` steps per call (interrupts
+/* The whole of `dense.dense_auto` for one problem: the answer into X (nx, nout + 1; column
+   0 = x0) and, alongside, its check (its steps merged in pairs) into XC, compared; at most `budget` steps per call (interrupts
    are looked at between calls). Returns AU_PHASE (3: done). */
 int rk8_auto(casadi_real* w, int nout, int budget, casadi_real* X, casadi_real* XC) {
   casadi_real* count = AU_COUNT(w);
@@ -678,16 +765,17 @@ int rk8_auto(casadi_real* w, int nout, int budget, casadi_real* X, casadi_real* 
       w[AU_RESULT] = -2; w[AU_PHASE] = 3;  /* (the 1000-ulp floor: half the acceptance) */
       return 3;
     }
-    au_begin(w, w[AU_LOOSE]);
-    w[AU_PHASE] = 1;
+    w[AU_LOOSE] = w[AU_FACTOR];
+    au_begin(w, w[AU_FACTOR]);
+    w[AU_PHASE] = 2;
   }
   while (budget > 0 && w[AU_PHASE] != 3) {
-    int check = w[AU_PHASE] == 1, floor = w[AU_PHASE] == 4;
-    if (!au_step(w, check ? w[AU_LOOSE] : w[AU_FACTOR], check || floor ? XC : X, &budget))
+    int floor = w[AU_PHASE] == 4;
+    if (!au_step(w, w[AU_FACTOR], floor ? XC : X, &budget, !floor, XC))
       continue;
-    w[AU_SPENT] += count[0] + count[1];
+    w[AU_SPENT] += count[0] + count[1] + (floor ? 0 : AU_RICH(w)[RI_STEPS]);
     if (count[2] != 0 && floor) {  /* (no floor: not verified) */
-      au_verdict(w, X, XC, INFINITY);
+      au_verdict(w, INFINITY);
       break;
     }
     if (count[2] != 0) {
@@ -698,12 +786,7 @@ int rk8_auto(casadi_real* w, int nout, int budget, casadi_real* X, casadi_real* 
       au_floor(w, X, XC);
       continue;
     }
-    if (check) {
-      w[AU_NCHK] = count[0] + count[1];
-      au_begin(w, w[AU_FACTOR]);
-      w[AU_PHASE] = 2;
-      continue;
-    }
+    w[AU_NCHK] = AU_RICH(w)[RI_STEPS];
     w[AU_NANS] = count[0] + count[1];
     w[AU_ACC] = count[0]; w[AU_REJ] = count[1]; w[AU_HMIN] = count[3];
     w[AU_INTERP] = count[4]; w[AU_LIP] = count[7];

@@ -1,23 +1,29 @@
 """``auto`` for a smooth right-hand side under a control constant over the run, in ONE
 compiled call: DOP853 stepping by its error estimate alone with dense output of order 7
-(the answer), a check run at a looser local tolerance, their comparison and the verdict
+(the answer), its check (the answer's steps merged in pairs), their comparison and the verdict
 (`cpass._AUTO`, ``rk8_auto``), with no Python between; and the same for every run of a
 batch in one compiled loop over the runs (``rk8_auto_many``), each run with its own steps,
 check and verdict.
 
 The rules (as `dynamics.integrate.auto.dense_pass` states them): the answer runs at the
-local tolerance ``(rtol, atol) f`` (``f = FIRST``), the check run at ``CHECK`` times that;
-``d`` is their scaled difference (max over the outputs, in units of ``atol + rtol |x|``).
-When the step counts show DOP853's tolerance power (``n_answer / n_check`` within a factor
-1.25 of ``ratio^(1/8)``) the estimate is ``d / (ratio^(3/4) - 1)`` plus 1000 ulps of each
-state's size, accepted at most 0.5; otherwise ``d`` plus the ulps, accepted at most 1.
-Within 1e6 ulps of a state's size the rounding of the model's formulas (measured on the
-way) is carried over the horizon (`estimates.carried`) and its screening bound
-(`estimates.screen`) added when at most 0.05; otherwise the flow's real amplification is
-measured as `estimates.measured_floor` does: the answer is repeated from ``x0`` moved by
-that carried rounding, and the largest of its difference from the answer, the carried
-rounding and the ulps is added. Not accepted, the answer is redone aimed at 0.1 (`TRIES`
-answers at most; not after a floor was measured).
+local tolerance ``(rtol, atol) f`` (``f = FIRST``); its check is Richardson's on the answer's
+own steps: alongside the answer, each pair of its accepted steps is taken again as one
+step of their sum (a lone last step alone), no step rejected, the outputs from that step's
+continuous extension (about half the answer's steps). ``d`` is their scaled difference (max
+over the outputs, in units of ``atol + rtol |x|``). In the method's asymptotic range the
+check's error is 2^8 times the answer's (order 8); the range is shown by the embedded
+estimates: the sum of the check's over the answer's, doubled, is ``2^p`` with ``p``
+between 5 and 11 (6-8 measured on smooth problems). Then the estimate is ``d / (2^7 - 1)``
+(2x conservative) plus 1000 ulps of each state's size, accepted at most 0.5; otherwise ``d``
+plus the ulps, accepted at most 1. Within 1e6 ulps of a state's size the rounding of the
+model's formulas (measured on the way) is carried over the horizon (`estimates.carried`)
+and its screening bound (`estimates.screen`) added when at most 0.05; otherwise the flow's
+real amplification is measured as `estimates.measured_floor` does: the answer is repeated
+from ``x0`` moved by that carried rounding, and the largest of its difference from the
+answer, the carried rounding and the ulps is added. Not accepted, the answer is redone
+with its local tolerance scaled by ``0.2 / estimate`` (the error follows the local
+tolerance about linearly), at most 100x tighter (`TRIES` answers at most; not after a
+floor was measured).
 
 Per call the Python is a look-up of the model's plan (its library and the workspace
 layout, `_plan`), a thread's reused workspace, one ``ctypes`` call and the result's array.
@@ -40,8 +46,15 @@ __all__ = ["FIELDS", "HEADER", "FIRST", "CHECK", "TRIES", "DenseAuto", "dense_au
            "dense_many",
            "outcome_of", "constant_control"]
 
-FIRST = 0.1     # the answer's local tolerance over the requested one
-CHECK = 100.0   # the check run's local tolerance over the answer's
+#: The first answer's local tolerance over the requested one. Its global error, in units
+#: of the requested tolerance, was 10-1500 times this on the torque-free bodies and 300 on
+#: the wheel spacecraft of ``bench/integrate_peers.py`` (rtol 1e-4..1e-8; the most near a
+#: separatrix): 0.003 meets the tolerance at once on most of them, and a
+#: retry aims at 0.2 from the estimate.
+FIRST = 0.003
+#: The check's local tolerance over the answer's (it steps the answer's steps merged in
+#: pairs, with the answer's error norm).
+CHECK = 1.0
 TRIES = 3       # answers (each aimed tighter) before the other paths of ``auto``
 #: Most steps of one compiled call (Ctrl-C is looked at between calls).
 BUDGET = 1 << 15
@@ -50,10 +63,10 @@ BUDGET = 1 << 15
 FIELDS = ("rtol", "factor", "loose", "max_steps", "stiff_steps", "t0", "iq", "tries", "phase",
           "spent", "check_steps", "answer_steps", "result", "estimate", "d", "flag", "try",
           "accepted", "rejected", "hmin", "interpolated", "lipschitz", "ratio", "bound",
-          "nout", "substeps", "gate", "floor")
+          "nout", "substeps", "gate", "floor", "order")
 (_RTOL, _FACTOR, _LOOSE, _MAXSTEPS, _STIFF, _T0, _IQ, _TRIES, _PHASE, _SPENT, _NCHK, _NANS,
  _RESULT, _EST, _D, _FLAG, _TRY, _ACC, _REJ, _HMIN, _INTERP, _LIP, _RATIO, _BOUND,
- _NOUT, _SUB, _GATE, _FLOOR) = range(len(FIELDS))
+ _NOUT, _SUB, _GATE, _FLOOR, _ORDER) = range(len(FIELDS))
 #: Doubles of a run's header.
 HEADER = len(FIELDS)
 _REASONS = ("", "a state became non-finite", "the step size underflowed",
@@ -68,8 +81,8 @@ class DenseAuto(NamedTuple):
     run made), -3 a run failed (``reason``); ``estimate`` [tolerances]; ``spent`` steps of
     all runs; ``answer_steps``, ``check_steps`` (accepted and rejected), ``rejected`` of the
     answer, ``hmin`` its smallest step [s], ``interpolated`` its steps that filled outputs,
-    ``ratio`` the check's local tolerance over the answer's, ``factor`` the answer's over
-    the requested, ``bound`` the rounding bound included in ``estimate`` (or ``floor``, the
+    ``ratio`` the check's steps over the answer's (2: merged in pairs), ``factor`` the
+    answer's local tolerance over the requested, ``bound`` the rounding bound included in ``estimate`` (or ``floor``, the
     rounding floor measured by a rerun from a moved start, when that bound was not small), ``substeps`` the
     longest output interval over ``hmin`` (equal steps of that many per interval are no
     longer than any the answer took), ``reason`` why a run failed."""
@@ -133,7 +146,7 @@ def _plan(model) -> _Plan | None:
 
 def _size(plan: _Plan, nout: int) -> int:
     """Doubles of the workspace (``AU_SIZE`` of `cpass._AUTO`)."""
-    return HEADER + 6 * plan.nx + plan.nu + plan.np + nout + 10
+    return HEADER + 7 * plan.nx + plan.nu + plan.np + nout + 16
 
 
 _LOCAL = threading.local()
@@ -294,11 +307,15 @@ def _tell(progress, steps: int, told: int) -> int:
 
 def dense_many(model, x0: np.ndarray, t: np.ndarray, u: np.ndarray, p: np.ndarray,
                rtol: float, atol: np.ndarray, max_steps: float, stiff_steps: float,
-               runs: slice) -> tuple[np.ndarray, np.ndarray] | None:
+               runs: slice, *, out: tuple[np.ndarray, np.ndarray] | None = None
+               ) -> tuple[np.ndarray, np.ndarray] | None:
     """`dense_auto` for the runs ``runs`` of a batch in one compiled loop: ``x0 (K, nx)``,
     ``u (K, max(nu, 1))`` (each run's constant control), ``p (K, max(np, 1))``, all
     C-contiguous. Returns ``(X (r, nx, n), head (r, HEADER))``: the answers and each run's
-    header (`outcome_of` reads it); None without a compiled pass.
+    header (`outcome_of` reads it); None without a compiled pass. ``out``: C-contiguous
+    ``(X (K, nx, n), head (K, HEADER))`` of the whole batch, whose slices ``runs`` the loop
+    fills (and returns) in place: calls on other threads (each with its own workspace) may
+    fill other slices of the same arrays at the same time.
 
     Examples
     --------
@@ -319,13 +336,21 @@ def dense_many(model, x0: np.ndarray, t: np.ndarray, u: np.ndarray, p: np.ndarra
     nout = t.size - 1
     work = _workspace(plan, nout)
     _fill(work.ws, plan, t, rtol, atol, max_steps, stiff_steps)
-    r = runs.stop - runs.start
-    X = np.empty((r, plan.nx, nout + 1))
-    head = np.empty((r, HEADER))
-    k0 = runs.start
-    plan.many(work.ws_addr, nout, 0, r, x0[k0:].ctypes.data, u[k0:].ctypes.data,
-              p[k0:].ctypes.data, X.ctypes.data, work.xc_addr, head.ctypes.data)
-    return X, head
+    r, k0 = runs.stop - runs.start, runs.start
+    if out is None:
+        X, head, at = np.empty((r, plan.nx, nout + 1)), np.empty((r, HEADER)), 0
+    else:
+        X, head = out
+        if not (X.flags.c_contiguous and head.flags.c_contiguous and X.shape[1:] == (
+                plan.nx, nout + 1) and head.shape[1:] == (HEADER,) and runs.stop <= len(X)):
+            raise ValueError("`out` must be C-contiguous (X (K, nx, n), head (K, HEADER)) "
+                             "covering `runs`")
+        at = k0
+    # (the loop runs k = at .. at + r - 1 of X and head, reading x0, u, p from row k0 - at)
+    plan.many(work.ws_addr, nout, at, at + r, x0[k0 - at:].ctypes.data,
+              u[k0 - at:].ctypes.data, p[k0 - at:].ctypes.data, X.ctypes.data, work.xc_addr,
+              head.ctypes.data)
+    return X[at:at + r], head[at:at + r]
 
 
 def outcome_of(x: np.ndarray, head: np.ndarray) -> DenseAuto:

@@ -57,7 +57,6 @@ from types import MappingProxyType
 
 import casadi as ca
 import numpy as np
-from scipy.optimize import brentq
 
 from .. import cache
 from ..model import Model
@@ -520,6 +519,8 @@ def _locate(spec: EventSpec, stepper, problem: Problem, ta: float, tb: float, ga
             raise _LocationFailed(f"`{spec.label}` ({spec.name}) is not finite at t = {tau:.15g}"
                                   " on the solution between the points")
         return value
+
+    from scipy.optimize import brentq  # only when an event is located (a heavy import)
 
     try:
         te = brentq(g, ta, tb, xtol=4 * _EPS * max(abs(ta), abs(tb)) + 1e-300, rtol=4 * _EPS,

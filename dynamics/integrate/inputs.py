@@ -51,6 +51,8 @@ class RunOptions:
         Extra options of cvodes.
     progress : callable or None
         ``progress(done, total)`` (checked: a ``Progress``).
+    threads : int or None
+        Threads of a batch (None: `batch_fixed.batch_threads`' default).
 
     Examples
     --------
@@ -69,6 +71,7 @@ class RunOptions:
     max_steps: int
     cvodes_options: Mapping | None
     progress: Callable | None
+    threads: int | None = None
 
     def keywords(self) -> dict:
         """The options as `simulate`'s keyword arguments (``simulate(..., **o.keywords())``).

@@ -9,7 +9,6 @@ from __future__ import annotations
 
 import casadi as ca
 import numpy as np
-from scipy.special import ellipj, ellipk
 
 from .. import cache, validate
 from ..model import Model
@@ -273,6 +272,8 @@ def pendulum_swing(t, theta0, *, length=1.0, gravity=GRAVITY) -> np.ndarray:
     if t.ndim > 1:
         raise ValueError(f"`t` must be a scalar or have shape (n,), got {t.shape}")
     k, w0 = _swing_constants(theta0, length, gravity)
+    from scipy.special import ellipj  # a heavy import, only here
+
     sn, cn, dn, _ = ellipj(w0 * t, k * k)
     return 2.0 * np.arcsin(np.clip(k * cn / dn, -1.0, 1.0))
 
@@ -290,6 +291,8 @@ def pendulum_period(theta0, *, length=1.0, gravity=GRAVITY) -> float:
     1.0
     """
     k, w0 = _swing_constants(theta0, length, gravity)
+    from scipy.special import ellipk  # a heavy import, only here
+
     return float(4.0 * ellipk(k * k) / w0)
 
 

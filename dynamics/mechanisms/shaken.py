@@ -12,7 +12,6 @@ from __future__ import annotations
 
 import casadi as ca
 import numpy as np
-from scipy.special import mathieu_a, mathieu_b
 
 from .. import cache, validate
 from ..model import Model
@@ -215,6 +214,8 @@ def kapitza_frequency(amp_y, *, mass=_D["mass"], inertia=_D["inertia"], length=_
     q = _mathieu_q(amp_y, l_eff)
     if not exact:
         return float(np.sqrt(2.0 * gravity * l_eff) / amp_y)
+    from scipy.special import mathieu_a  # a heavy import, only here
+
     return float(2.0 * w0 / np.sqrt(-mathieu_a(0, q)))
 
 
@@ -251,4 +252,6 @@ def resonance_tongue(amp_y, *, mass=_D["mass"], inertia=_D["inertia"], length=_D
     """
     w0, l_eff = _constants(mass, inertia, length, gravity)
     q = _mathieu_q(amp_y, l_eff)
+    from scipy.special import mathieu_a, mathieu_b  # a heavy import, only here
+
     return float(2.0 * w0 / np.sqrt(mathieu_a(1, q))), float(2.0 * w0 / np.sqrt(mathieu_b(1, q)))

@@ -26,7 +26,6 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.optimize import brentq
 
 from .. import cache
 
@@ -62,6 +61,8 @@ def clamped_free_roots(modes: int, *, tip_mass_ratio: float = 0.0) -> np.ndarray
     >>> clamped_free_roots(1, tip_mass_ratio=1.0).round(4)   # a tip mass equal to the beam's
     array([1.2479])
     """
+    from scipy.optimize import brentq  # a heavy import, only here
+
     from ..validate import integer, nonnegative
     n = integer(modes, "modes", minimum=1)
     mu = nonnegative(tip_mass_ratio, "tip_mass_ratio")

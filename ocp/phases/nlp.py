@@ -207,9 +207,8 @@ def event_row_scales(problem, ends: np.ndarray, discs) -> np.ndarray:
     """Row scales of the link and event rows: the largest entry of each row of their Jacobian
     with respect to the phase ends in units of the phases' scales, at the guess ``ends``
     (a power of 2, clamped to [1e-6, 1e6]); an event's own ``scale`` where given."""
-    E = ca.SX.sym("E", ends.size)
-    e = problem.ends_function(E)[1]
-    n_e = e.numel()
+    jac = _ends_jacobian(problem.ends_function, ends.size)
+    n_e = jac.size1_out(0)
     if n_e == 0:
         return np.zeros(0)
     units = []
@@ -219,7 +218,7 @@ def event_row_scales(problem, ends: np.ndarray, discs) -> np.ndarray:
         sp[pb.free_params] = sc.p[pb.free_params]
         units += [sc.x, sc.x, sp, [sc.T if pb.free_time else 1.0]]
     unit = np.concatenate([np.asarray(u, dtype=float).reshape(-1) for u in units])
-    J = np.abs(np.asarray(ca.Function("je", [E], [ca.jacobian(e, E)])(ends))) * unit[None, :]
+    J = np.abs(np.asarray(jac(ends))) * unit[None, :]
     g = J.max(axis=1)
     out = np.ones(n_e)
     ok = g > 0
@@ -231,6 +230,18 @@ def event_row_scales(problem, ends: np.ndarray, discs) -> np.ndarray:
             out[k:k + m] = ev.scale
         k += m
     return out
+
+
+def _ends_jacobian(ends_function: ca.Function, n: int) -> ca.Function:
+    """``E -> d e / d E`` of the link and event rows ``e`` of ``ends_function`` (``n`` phase
+    ends), built once per ends function in the one cache."""
+    def build():
+        E = ca.SX.sym("E", n)
+        e = ends_function(E)[1]
+        return ca.Function("event_rows_jacobian", [E], [ca.jacobian(e, E)])
+
+    return cached("event_rows_jacobian", (content_key(ends_function), n), build,
+                  keepalive=ends_function)
 
 
 __all__ += ["event_row_scales"]

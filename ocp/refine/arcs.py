@@ -129,18 +129,24 @@ def _bang_arcs(solution: Solution, samples: int, short_arcs: bool):
     tb, hmesh = solution.dense.t_breaks, solution.dense.h
     own = []  # per component: (edges, sides) of its own arcs
     idle = _idle(solution, per, lo, hi)
-    for j in range(nu):
-        edges = np.concatenate([[t0], per[j], [t0 + T]])
+    all_edges = [np.concatenate([[t0], per[j], [t0 + T]]) for j in range(nu)]
+    for j, edges in enumerate(all_edges):
+        if np.any(np.diff(edges) <= 0):
+            return None, f"component {j}: switches out of order"
+    # every arc's 41 samples of its central 80 %, read at once (one interpolation)
+    frac = np.linspace(0.1, 0.9, 41)
+    ts = np.concatenate([(e[:-1, None] + np.diff(e)[:, None] * frac).reshape(-1)
+                         for e in all_edges])
+    u_all = solution.sample(ts)[1]
+    first = np.cumsum([0] + [41 * (e.size - 1) for e in all_edges])
+    for j, edges in enumerate(all_edges):
         if idle[j]:
             own.append((edges, None))
             continue
         sides = []
-        for a, b in zip(edges[:-1], edges[1:]):
+        zj = ((u_all[j, first[j]:first[j + 1]] - mid[j]) / half[j]).reshape(-1, 41)
+        for (a, b), z in zip(zip(edges[:-1], edges[1:]), zj):
             L = b - a
-            if L <= 0:
-                return None, f"component {j}: switches out of order"
-            ts = a + L * np.linspace(0.1, 0.9, 41)
-            z = (solution.sample(ts)[1][j] - mid[j]) / half[j]
             s = 1.0 if np.median(z) >= 0 else -1.0
             # an arc within two mesh intervals is smeared by the collocation (the control
             # polynomial of the interval holding a switch): its side is that of its median,

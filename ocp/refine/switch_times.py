@@ -22,7 +22,8 @@ direct multiple shooting with exact sensitivities:
 The decision variables are the durations, the free parameters and the segment-end states:
 no control variables, no singular directions (the free-mesh polish of `polish_switches`
 carries one dilation per interval, most of which the objective does not see). IPOPT
-(``casadi.nlpsol``, the NLP in MX around the mapped SX step) then converges in a handful of iterations to
+(``casadi.nlpsol``, the derivatives assembled per segment: `ocp.refine.arc_nlp`) then
+converges in a handful of iterations to
 ``Solve_Succeeded`` (Bilimoria & Wie's slew: 3 iterations, 0.03 s of IPOPT, ``T =
 3.2430832775``); the answer carries only the integration error of the RK8 steps
 (``O(h^8)``, estimated by step doubling: ``info['integration_error']``, about 3e-13 on
@@ -322,7 +323,8 @@ def _solve_arcs(problem: Problem, guess: Solution, arcs: BangArcs, nseg: np.ndar
     # equalities (fixed variables included) against variables would print a warning for the
     # structurally over-determined end conditions of a symmetric slew, which IPOPT solves
     # (a quiet library)
-    nlp_opts = {"ipopt": ipopt, "print_time": False, "error_on_fail": False, "inputs_check": False}
+    nlp_opts = {"ipopt": ipopt, "print_time": False, "error_on_fail": False, "inputs_check": False,
+                **(nlp.derivatives or {})}  # assembled derivatives (`arc_nlp`) where built
     if sink is None:  # pooled with its (data-less) callback, which carries the deadline
         def build():
             callback = IterationCallback(0, 0)

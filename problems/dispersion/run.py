@@ -14,8 +14,9 @@ import inspect
 import math
 import os
 import pickle
+import sys
 import time
-from concurrent.futures import Executor, ProcessPoolExecutor
+from concurrent.futures import Executor
 from typing import Callable, Mapping
 
 import numpy as np
@@ -40,6 +41,13 @@ _OWN = ("model", "x0", "t", "progress")  # simulate's arguments that dispersion 
 
 
 # ---------------------------------------------------------------------------- checks
+def _is_process_pool(executor) -> bool:
+    """Whether ``executor`` is a ``ProcessPoolExecutor`` (there is none unless its module, heavy
+    to import, was imported)."""
+    module = sys.modules.get("concurrent.futures.process")
+    return module is not None and isinstance(executor, module.ProcessPoolExecutor)
+
+
 def _check_outputs(outputs) -> dict:
     if not isinstance(outputs, Mapping):
         raise TypeError(f"`outputs` must be a mapping of names to callables (res, **draws) or "
@@ -258,7 +266,7 @@ def dispersion(model, x0, t, *, samples: int, seed: int | None, outputs: Mapping
     units = {} if units is None else {str(k): str(v) for k, v in dict(units).items()}
     if chunksize is None:
         chunksize = math.ceil(samples / (4 * (os.cpu_count() or 1))) \
-            if isinstance(executor, ProcessPoolExecutor) else 1
+            if _is_process_pool(executor) else 1
     chunksize = validate.integer(chunksize, "chunksize", minimum=1)
     factory = not isinstance(model, Model)
     kwargs = _check_simulate_kwargs(dict(simulate_kwargs), factory)
@@ -286,7 +294,7 @@ def dispersion(model, x0, t, *, samples: int, seed: int | None, outputs: Mapping
         _check_model_names(probe, applied, outputs, drift)
         if not callable(x0) and x0.shape != (probe.nx,):
             raise ValueError(f"`x0` must have shape ({probe.nx},), got {x0.shape}")
-    if isinstance(executor, ProcessPoolExecutor):
+    if _is_process_pool(executor):
         _check_picklable({"model": model, "x0": x0, "outputs": outputs, "simulate_kwargs": kwargs})
     tasks = [SampleTask(i, draws[i], model, x0, t, outputs, applied, drift, kwargs)
              for i in range(samples)]

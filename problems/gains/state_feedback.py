@@ -26,8 +26,6 @@ from typing import Mapping
 
 import casadi as ca
 import numpy as np
-from scipy.linalg import expm
-from scipy.signal import place_poles
 
 from appdyn.config import param
 from appdyn import ocp
@@ -154,6 +152,8 @@ def default_initial_gain(A, B, Q, R) -> np.ndarray:
     band = (np.linalg.norm(Q, 2) * np.linalg.norm(B, 2) ** 2 / np.linalg.eigvalsh(R)[0]) ** (0.5 / n)
     w = max(rho, float(band), 1e-3)
     poles = -w * (1.0 + 0.25 * np.arange(n))
+    from scipy.signal import place_poles  # a heavy import, only here
+
     try:
         K = np.asarray(place_poles(A, B, poles).gain_matrix, dtype=float)
     except Exception:  # noqa: BLE001 -- uncontrollable pair, numerical failure: no placement
@@ -164,6 +164,8 @@ def default_initial_gain(A, B, Q, R) -> np.ndarray:
 def _guess(A, B, K0, X0, horizon: float, samples: int) -> dict:
     """The closed loop under ``K0`` from every initial state, exactly (matrix exponential)."""
     t = np.linspace(0.0, horizon, samples)
+    from scipy.linalg import expm  # a heavy import, only here
+
     step = expm((A - B @ K0) * (t[1] - t[0]))
     x = np.empty((X0.shape[0], samples, X0.shape[1]))
     x[:, 0, :] = X0

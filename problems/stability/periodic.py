@@ -31,7 +31,6 @@ import time
 from dataclasses import asdict, dataclass, field
 
 import numpy as np
-from scipy.special import mathieu_a, mathieu_b
 
 from appdyn.dynamics.floquet import TOL, classify_multipliers, floquet, variational_model
 from appdyn.dynamics.integrate import simulate
@@ -234,6 +233,8 @@ def mathieu_region(a: float, q: float):
     >>> mathieu_region(-0.5, 0.2)[0], mathieu_region(1.0, 0.2)[0], mathieu_region(2.0, 0.2)[0]
     (False, False, True)
     """
+    from scipy.special import mathieu_a, mathieu_b  # a heavy import, only here
+
     def rel(e):
         return abs(a - e) / max(abs(a), abs(e), 1e-300)
 

@@ -139,6 +139,7 @@ def test_a_stiff_batch_goes_to_cvodes_run_by_run_as_single_runs_do():
 
 
 # ------------------------------------------------ parts of a batch spread over threads
+from appdyn import config  # noqa: E402
 from appdyn.dynamics import executors  # noqa: E402
 from appdyn.dynamics.integrate import batch_fixed as batch_module  # noqa: E402
 
@@ -148,7 +149,7 @@ def spread(monkeypatch):
     """``spread(threads, part_runs)``: every chunk split into parts of at most ``part_runs``
     runs on ``threads`` threads, however small the batch."""
     def use(threads, part_runs):
-        monkeypatch.setattr(batch_module, "BATCH_THREADS", threads)
+        monkeypatch.setitem(config.defaults, "dynamics.threads", threads)
         monkeypatch.setattr(batch_module, "PART_RUNS", part_runs)
         monkeypatch.setattr(batch_module, "PARALLEL_STEPS", 0)
     return use
@@ -157,7 +158,7 @@ def spread(monkeypatch):
 @pytest.mark.parametrize("K, steps", [(1000, 64), (23, 64), (3, 5), (1, 64), (5, 1)])
 def test_parts_cover_the_runs_in_near_equal_contiguous_slices(spread, K, steps):
     spread(2, 8)
-    parts, threads = batch_module._parts(K, steps)
+    parts, threads = batch_module._parts(K, steps, 2)
     assert threads == min(2, K)
     assert parts[0].start == 0 and parts[-1].stop == K
     assert all(a.stop == b.start for a, b in zip(parts[:-1], parts[1:]))
@@ -166,14 +167,13 @@ def test_parts_cover_the_runs_in_near_equal_contiguous_slices(spread, K, steps):
     assert len(parts) >= min(K, K * steps // batch_module.PART_STEPS) and len(parts) >= threads
 
 
-def test_parts_of_a_large_batch_are_small_enough_to_balance_the_threads(monkeypatch):
-    monkeypatch.setattr(batch_module, "BATCH_THREADS", 2)
-    parts, threads = batch_module._parts(1000, 64)
+def test_parts_of_a_large_batch_are_small_enough_to_balance_the_threads():
+    parts, threads = batch_module._parts(1000, 64, 2)
     assert threads == 2 and len(parts) == 1000 * 64 // batch_module.PART_STEPS
 
 
 def test_a_small_chunk_stays_on_one_thread():
-    parts, threads = batch_module._parts(3, 10)  # 30 run-steps: not worth a hand-over
+    parts, threads = batch_module._parts(3, 10, 2)  # 30 run-steps: not worth a hand-over
     assert threads == 1 and parts == [slice(0, 3)]
 
 
@@ -205,6 +205,79 @@ def test_threads_and_parts_give_the_bits_of_one_serial_call(spread, method):
                 simulate(model, X0, t, u=U, method=method, steps=9).x, ref[1])
             np.testing.assert_array_equal(
                 simulate(model, X0[:, :7], t, method=method, steps=2).x, ref[2])
+
+
+@pytest.mark.parametrize("kw", [{}, {"method": "rk8", "steps": 3}],
+                         ids=["auto (one C loop per part)", "rk8 (one C loop per part)"])
+def test_the_compiled_loops_give_the_same_bits_on_any_number_of_threads(kw, monkeypatch):
+    """The runs are independent: 1 thread (the serial loop), 2, 3 (parts of uneven sizes)
+    and more threads than parts give the same bits; ``auto``'s runs each meet their Jacobi
+    truth within the tolerance."""
+    from appdyn.dynamics.integrate import batch as dense_batch
+    monkeypatch.setattr(dense_batch, "DENSE_PART", 4)  # (37 runs spread: parts of 4 runs)
+    model, t = rigid_body(INERTIA), np.linspace(0.0, 10.0, 21)
+    W, X0 = _rates(37, seed=5)
+    ref = simulate(model, X0, t, threads=1, **kw)
+    assert ref.all_success
+    for threads in (2, 3, 64):
+        got = simulate(model, X0, t, threads=threads, **kw)
+        np.testing.assert_array_equal(got.x, ref.x)
+        np.testing.assert_array_equal(got.error_estimate, ref.error_estimate)
+    with config.using("dynamics", threads=2):  # the registered default
+        np.testing.assert_array_equal(simulate(model, X0, t, **kw).x, ref.x)
+    w = _truth(W, t)
+    assert np.all(np.abs(ref.x[4:] - w) <= 1e-9 + 1e-7 * np.abs(w))
+
+
+@pytest.mark.parametrize("threads, error", [(0, ValueError), (-2, ValueError),
+                                            (1.5, TypeError), ("2", TypeError),
+                                            (True, TypeError)])
+def test_threads_must_be_a_positive_integer(threads, error):
+    model, t = rigid_body(INERTIA), np.linspace(0.0, 1.0, 3)
+    _, X0 = _rates(2)
+    for x0 in (X0, X0[:, 0]):  # a batch, and a single run (one thread, checked too)
+        with pytest.raises(error, match="`threads`"):
+            simulate(model, x0, t, threads=threads)
+    with config.using("dynamics", threads=threads), pytest.raises(error, match="`threads`"):
+        simulate(model, X0, t)
+
+
+def test_spread_runs_calls_every_run_once_in_contiguous_parts():
+    seen = []
+    for threads, part in [(1, 5), (2, 5), (3, 64), (4, 1)]:
+        seen.clear()
+        batch_module.spread_runs(lambda k0, k1: seen.append((k0, k1)), 23, threads, part)
+        spans = sorted(seen)
+        assert spans[0][0] == 0 and spans[-1][1] == 23
+        assert all(a[1] == b[0] and a[0] < a[1] for a, b in zip(spans[:-1], spans[1:]))
+        assert max(b - a for a, b in spans) <= part
+        if threads == 1:
+            assert seen == spans  # in order, in the calling thread
+
+
+@pytest.mark.parametrize("threads", [1, 2])
+def test_a_ctrl_c_stops_the_compiled_loops_between_groups_of_parts(threads):
+    """A Ctrl-C during a part of a compiled loop over the runs is raised (KeyboardInterrupt)
+    once the parts handed out with it have finished; no later group is started."""
+    import os
+    import signal
+
+    if signal.getsignal(signal.SIGINT) is not signal.default_int_handler:
+        pytest.skip("SIGINT has a handler of its own here")
+    seen = []
+
+    def call(k0, k1):
+        if not seen:
+            os.kill(os.getpid(), signal.SIGINT)
+        seen.append(k0)
+
+    K = 4 * batch_module.GROUP * threads  # four groups of parts of one run
+    with pytest.raises(KeyboardInterrupt):
+        batch_module.spread_runs(call, K, threads, 1)
+    assert len(seen) == batch_module.GROUP * threads  # the first group only
+    model, t = rigid_body(INERTIA), np.linspace(0.0, 1.0, 5)
+    _, X0 = _rates(3)
+    assert simulate(model, X0, t, threads=threads).all_success  # (and the next call is whole)
 
 
 def test_a_run_that_blows_up_fails_alone_in_any_part(spread):

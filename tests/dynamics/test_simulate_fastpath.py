@@ -312,7 +312,7 @@ def test_common_auto_call_is_the_general_path(body, common_calls, case):
 @needs_compiler
 @pytest.mark.parametrize("kwargs", [dict(rtol=np.float64(1e-6)), dict(atol=[1e-9] * 7),
                                     dict(max_steps=np.int64(10 ** 6)), dict(jit=False),
-                                    dict(invariants=True), dict(p=[])])
+                                    dict(invariants=True), dict(p=[]), dict(threads=1)])
 def test_common_auto_call_declines_the_rest_alike(body, common_calls, kwargs):
     """What the common path does not take (other types, options) goes the general way,
     unchanged."""

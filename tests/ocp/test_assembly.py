@@ -158,3 +158,37 @@ def test_code_generation_gives_the_same_solution():
     assert disc.structure.compiled == (compiler() is not None)
     with pytest.raises(ValueError, match="codegen"):
         solve(problem, N=12, codegen="yes")
+
+
+@pytest.mark.parametrize("name", ["loaded", "rigid_slew", "pointing"])
+def test_switch_time_nlp_assembled_equals_the_whole_nlp_differentiated_by_casadi(name):
+    """The switch-time NLP of `ocp.refine.arc_nlp`, assembled per segment, against the same
+    NLP stated whole in MX around the mapped RK8 step (`_whole`) and differentiated by
+    casadi: constraint blocks, values, gradient, Jacobian, Lagrangian Hessian (upper
+    triangle) and cost at a random point, on arcs of unequal segment counts."""
+    from appdyn.ocp.refine.arc_nlp import _whole, arc_nlp
+    from appdyn.ocp.refine.rk8_step import step_function
+
+    problem = PROBLEMS[name]()
+    step = step_function(problem.model, problem.lagrange)
+    nseg = np.array([3, 1, 4])
+    mine, whole = arc_nlp(problem, step, 3, nseg), _whole(problem, step, 3, nseg, None)
+    assert mine.derivatives is not None and mine.blocks == whole.blocks
+    x, p = whole.nlp["x"], whole.nlp["p"]
+    rng = np.random.default_rng(3)
+    w, par = rng.uniform(0.5, 1.5, x.numel()), rng.uniform(0.5, 1.5, p.numel())
+    lam_g, lam_f = rng.normal(size=whole.nlp["g"].numel()), 0.37
+    lg = ca.MX.sym("lg", lam_g.size)
+    ad = ca.Function("ad", [x, p, lg], [
+        whole.nlp["f"], whole.nlp["g"], ca.gradient(whole.nlp["f"], x),
+        ca.jacobian(whole.nlp["g"], x),
+        ca.triu(ca.hessian(lam_f * whole.nlp["f"] + ca.dot(lg, whole.nlp["g"]), x)[0])])
+    f0, g0, G0, J0, H0 = (np.asarray(ca.densify(v)) for v in ad(w, par, lam_g))
+    d = mine.derivatives
+    f1, G1 = (np.asarray(ca.densify(v)) for v in d["grad_f"](w, par))
+    g1, J1 = (np.asarray(ca.densify(v)) for v in d["jac_g"](w, par))
+    H1 = np.asarray(ca.densify(d["hess_lag"](w, par, lam_f, lam_g)))
+    for ref, got in ((f0, f1), (g0, g1), (G0, G1.reshape(G0.shape)), (J0, J1), (H0, H1)):
+        np.testing.assert_allclose(got, ref, rtol=1e-12, atol=1e-12 * max(1.0, np.abs(ref).max()))
+    assert abs(float(mine.cost(w, par)) - float(whole.cost(w, par))) <= 1e-12 * max(
+        1.0, abs(float(whole.cost(w, par))))

@@ -135,11 +135,25 @@ def test_staged_rocket_reaches_the_closed_form_optimum_with_refinement():
     # the refinement record: error estimates fall below refine_tol on finer meshes
     rounds = sol.info["rounds"]
     assert max(rounds[-1][1]) <= 1e-10 < max(rounds[0][1])
+    # each round after the first starts from the previous one, primal and dual: few iterations
+    assert all(r[3] <= 5 for r in rounds[1:]) and rounds[0][3] > 5, rounds
     # the collocated cost equals the propagated one (rocket equation in each phase)
     for ph in sol.phases:
         prop = ph.propagate()
         assert prop.success
         np.testing.assert_allclose(prop.x[:, -1], ph.x[:, -1], rtol=1e-9)
+
+
+def test_refinement_rounds_solve_the_nlp_below_refine_tol():
+    # an interval's error estimate floors at the NLP's own accuracy: the rounds ask IPOPT
+    # for refine_tol / 10, unless the caller chose tol
+    from appdyn.ocp.phases.solve import NLP_TOL_PER_REFINE_TOL, _refinement_ipopt_options
+
+    base = {"constr_viol_tol": 1e-9, "print_level": 0}
+    tight = _refinement_ipopt_options(base, None, 1e-9)
+    assert tight == {**base, "tol": NLP_TOL_PER_REFINE_TOL * 1e-9} and "tol" not in base
+    assert _refinement_ipopt_options({**base, "tol": 1e-14}, None, 1e-9)["tol"] == 1e-14
+    assert _refinement_ipopt_options({**base, "tol": 1e-6}, {"tol": 1e-6}, 1e-9)["tol"] == 1e-6
 
 
 def test_unrefined_solve_is_close_and_warm_start_reuses_the_nlp():
@@ -168,6 +182,38 @@ def test_warm_start_carries_over_to_the_same_nlp_with_other_bounds():
     assert cold.success and warm.success
     assert warm.iterations <= 3 < cold.iterations
     assert warm.cost == pytest.approx(cold.cost, rel=1e-9)
+    # the same variables and rows in the same units: the scalings are kept, not derived again
+    assert all(a is b for a, b in zip(warm.nlp_point["scalings"], sol.nlp_point["scalings"]))
+    assert not any(a is b for a, b in zip(cold.nlp_point["scalings"], sol.nlp_point["scalings"]))
+
+
+def test_a_solution_on_other_meshes_starts_primal_and_dual():
+    """A solution on 10 intervals per phase starts the same problem on 7 and 16 (costates
+    interpolated into the defect multipliers, links and events copied): the answer of a
+    cold solve on those meshes in a few iterations."""
+    coarse = ocp.solve_phases(two_stage_rocket())
+    fine = two_stage_rocket()
+    fine = ocp.MultiPhaseProblem([replace(fine.phases[0], N=7), replace(fine.phases[1], N=16)],
+                                 links=fine.links, events=fine.events, objective=fine.objective,
+                                 maximize=True)
+    cold = ocp.solve_phases(fine)
+    warm = ocp.solve_phases(fine, guess=coarse)
+    assert coarse.success and cold.success and warm.success, (cold.message, warm.message)
+    assert warm.iterations <= 3 < cold.iterations
+    assert warm.cost == pytest.approx(cold.cost, rel=1e-9)
+    assert [s.mesh.N for s in warm.phases] == [7, 16]
+
+
+def test_a_stopped_solution_on_other_meshes_still_starts_the_solve():
+    """A solve stopped after 2 iterations starts the problem on 14 intervals per phase (its
+    primal values only: the multipliers of a failed solve are not taken): the answer of a
+    cold solve."""
+    stopped = ocp.solve_phases(two_stage_rocket(), ipopt_options={"max_iter": 2})
+    assert not stopped.success
+    fine = two_stage_rocket(N=14)
+    sol = ocp.solve_phases(fine, guess=stopped)
+    assert sol.success, sol.message
+    assert sol.cost == pytest.approx(ocp.solve_phases(fine).cost, rel=1e-9)
 
 
 def test_an_infeasible_event_is_a_failure_not_an_exception():

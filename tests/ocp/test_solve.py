@@ -151,6 +151,26 @@ def test_sample_interpolates_like_the_transcription():
     assert np.allclose(x, sol.x[:, 0:4] @ np.array(basis), atol=1e-13)
 
 
+@pytest.mark.parametrize("name", TRANSCRIPTION_NAMES + ("radau-constant-control",
+                                                         "radau-linear-control"))
+def test_dense_weights_equal_the_interpolant_function(name):
+    # the numpy path of DenseOutput.eval (transcription.dense_weights) against the symbolic
+    # interpolant it replaces, at random points of random intervals, ends included
+    problem, _ = rigid_slew(theta_f=1.0, T=2.0)
+    sol = solve(problem, transcription=name, N=4, verbose=False)
+    d, rng = sol.dense, np.random.default_rng(3)
+    if sol.transcription.dense_weights(np.array([0.5])) is None:
+        assert name.startswith("hermite-simpson")  # depends on f: the Function path
+        return
+    k, s = rng.integers(0, d.N, 40), np.concatenate([[0.0, 1.0], rng.random(38)])
+    x, u = d.eval(k, s)
+    for i in range(k.size):
+        xf, uf = d.interp(d.xs[:, k[i]], d.Xo[:, k[i]], d.us[:, k[i]], d.Uo[:, k[i]], d.h[k[i]],
+                          sol.p, s[i])
+        assert np.allclose(x[:, i], np.asarray(xf).ravel(), rtol=1e-14, atol=1e-14)
+        assert np.allclose(u[:, i], np.asarray(uf).ravel(), rtol=1e-14, atol=1e-14)
+
+
 def test_sample_rejects_times_outside_horizon():
     problem, _ = min_energy()
     sol = solve(problem, N=4, verbose=False)
@@ -251,6 +271,28 @@ def test_solution_attributes():
     assert "radau" in repr(sol)
     with pytest.raises(ValueError):
         sol.x[0, 0] = 1.0
+
+
+def test_constraint_row_scales_follow_the_gradient_rule_on_every_guess():
+    """Path and boundary row scales: the largest |gradient| over the nodes w.r.t. the scaled
+    variables, rounded to a power of two, computed here by hand; the gradient Functions are
+    built once (one cache), so a second guess must still give its own scales."""
+    from dataclasses import replace
+
+    from appdyn.ocp.guess import initial_guess
+    from appdyn.ocp.scaling import auto_scaling
+    problem = Problem(double_integrator(), T=1.0, x_initial=[0.1, 0.3], x_final=[2.9, -0.7],
+                      path=[Constraint(lambda x, u, p: 3 * x[0] * u + x[1], upper=50.0)],
+                      boundary=[Constraint(lambda x0, xf, p: 5 * xf[0] ** 2, upper=100.0)],
+                      lagrange=lambda x, u, p: 0.5 * u ** 2)
+    g = initial_guess(problem, Radau(3), Mesh.uniform(3))
+    pow2 = lambda v: np.exp2(np.round(np.log2(v)))  # noqa: E731
+    for guess in (g, replace(g, X=4 * g.X, Xu=4 * g.Xu, U=g.U + 3.0)):
+        sc = auto_scaling(problem, guess)
+        x, u = guess.Xu, guess.U
+        grad = np.stack([3 * u[0] * sc.x[0], np.full_like(u[0], sc.x[1]), 3 * x[0] * sc.u[0]])
+        assert sc.path[0] == pow2(np.max(np.abs(grad)))
+        assert sc.boundary[0] == pow2(10 * abs(guess.X[0, -1]) * sc.x[0])
 
 
 def test_automatic_scales_are_powers_of_two_so_boundary_values_are_exact():

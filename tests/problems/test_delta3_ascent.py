@@ -110,6 +110,29 @@ def test_relaxed_start_reaches_the_same_optimum(ascent):
     assert ascent.iterations >= ascent.solution.info["iterations"] > 0
 
 
+def test_guess_of_the_free_last_phase_runs_to_the_target_orbit():
+    """The last phase's guess spans its 700 s burn and ends at the target's perigee; the
+    engine samples all of it (not the first half, the middle of the free duration's range):
+    the sampled final state has the target's elements (`orbital_elements`, not the NLP rows)."""
+    from dataclasses import replace as dc_replace
+
+    from appdyn.ocp.guess import initial_guess
+    from appdyn.ocp.mesh import Mesh
+    from appdyn.ocp.transcription import get_transcription
+    from appdyn.problems.ascent.delta3 import orbital_elements
+
+    ph = delta3_problem().phases[3]
+    pb = dc_replace(ph.problem, t0=0.0)
+    ng = initial_guess(pb, get_transcription(ph.transcription, degree=ph.degree),
+                       Mesh.uniform(ph.N), guess=ph.guess)
+    assert ng.T == pytest.approx(PHASES[3].t_end_max - PHASES[3].t_start, rel=1e-12)
+    el = orbital_elements(ng.X[:3, -1], ng.X[3:6, -1])
+    assert el.a == pytest.approx(TARGET_ORBIT["a"], rel=1e-9)
+    assert el.e == pytest.approx(TARGET_ORBIT["e"], abs=1e-9)
+    for k in ("i", "raan", "argp"):
+        assert math.remainder(getattr(el, k) - TARGET_ORBIT[k], 2 * math.pi) == pytest.approx(0.0, abs=1e-9)
+
+
 def test_bad_guess_samples():
     with pytest.raises(ValueError, match="`guess_samples`"):
         delta3_ascent(guess_samples=(1,))

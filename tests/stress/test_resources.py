@@ -9,6 +9,7 @@ Each compiled loop kept in the cache holds about 75 kB; evicted, it is unloaded.
 import json
 import os
 import shutil
+import statistics
 import subprocess
 import sys
 from pathlib import Path
@@ -76,19 +77,31 @@ def test_compiles_leave_no_descriptor_and_no_files(tmp_path):
 
 
 @pytest.mark.slow
+def steady_growth(rss: dict, start: int) -> float:
+    """The median growth per 10 compiles after ``start`` compiles [MB]: a leak grows by
+    the same step every 10 compiles, while a one-off step (the allocator taking a new arena
+    while another process loads the machine) moves one increment only."""
+    keys = sorted(k for k in rss if k >= start)
+    return statistics.median(rss[b] - rss[a] for a, b in zip(keys, keys[1:]))
+
+
 def test_evicted_loops_release_their_memory_under_a_tight_descriptor_limit():
     """60 compiles through a 10-entry cache with 256 descriptors in all: after the cache
-    is full (20 compiles), resident memory stays flat (kept, 40 loops would add 3 MB)."""
+    is full (20 compiles), resident memory stays flat (kept, 40 loops would add 3 MB,
+    about 0.75 MB per 10 compiles)."""
     report, _ = run(60, nofile=256, maxsize=10)
     assert report["fds"] <= 5 and report["entries"] <= 10
-    assert report["rss"][60] - report["rss"][20] < 1.0, report["rss"]
+    assert steady_growth(report["rss"], 20) < 0.25, report["rss"]
+    assert report["rss"][60] - report["rss"][20] < 3.0, report["rss"]
 
 
 @pytest.mark.slow
 def test_kept_loops_do_hold_memory():
-    """The measurement above can see a leak: without eviction the same run grows."""
+    """The measurement above can see a leak: without eviction the same run grows, by
+    about the same step every 10 compiles."""
     report, _ = run(60)
     assert report["rss"][60] - report["rss"][20] > 1.5, report["rss"]
+    assert steady_growth(report["rss"], 20) > 0.25, report["rss"]
 
 
 @pytest.mark.skipif(os.environ.get("APPDYN_SOAK") != "1", reason="soak: set APPDYN_SOAK=1")

@@ -80,7 +80,7 @@ def test_nutation_history_reads_the_hub_states_by_name():
         nutation_history(fake, 1000.0, 1500.0)
 
 
-def test_a_batched_dispersion_over_a_scene_steps_each_sample_alone():
+def test_a_batched_dispersion_over_a_scene_steps_each_sample_alone(monkeypatch):
     """``batch=True`` over a wheel scene: one batched ``simulate`` (``auto`` per run in one
     compiled loop) gives every sample the answer of its own single call, to the last bit;
     the wheel momenta stay conserved."""
@@ -100,3 +100,9 @@ def test_a_batched_dispersion_over_a_scene_steps_each_sample_alone():
     for key in ("h", "w3"):
         np.testing.assert_array_equal(many.outputs[key], one.outputs[key])
     assert np.max(np.abs(many.outputs["h"])) < 1e-8
+    from appdyn.dynamics.integrate import batch as dense_batch
+    monkeypatch.setattr(dense_batch, "DENSE_PART", 1)  # (6 samples spread: parts of 1)
+    for threads in (1, 3):  # the samples spread over threads: the same bits
+        spread = dispersion(model, x0, T, batch=True, threads=threads, **kw)
+        for key in ("h", "w3"):
+            np.testing.assert_array_equal(spread.outputs[key], one.outputs[key])
