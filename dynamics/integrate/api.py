@@ -5,7 +5,7 @@ import math
 import time
 from dataclasses import replace
 from types import MappingProxyType
-from typing import Callable, Literal, Mapping
+from typing import Callable, Literal, Mapping, NamedTuple
 
 import numpy as np
 
@@ -13,20 +13,22 @@ from .. import cache, validate
 from ..clock import CLOCK_STATE, check_clock_start, clock_index
 from ..model import Model, check_model
 from ..progress import progress_reporter
-from .auto import solve_auto
+from .auto import STIFF_STEPS, dense_answer, solve_auto
 from .batch import BatchResult, check_batch, simulate_batch
 from .batch_fixed import batch_threads
 from .cvodes import run_cvodes
+from .dense import dense_run
 from .events import apply_events, check_events
 from .impacts import check_impact, simulate_impacts
-from .inputs import (Problem, RunOptions, check_cvodes_options, check_invariants, check_t,
-                     check_tolerances, check_u, check_x0, fast_x0)
+from .inputs import (RTOL_MIN, Problem, RunOptions, check_cvodes_options, check_invariants,
+                     check_t, check_tolerances, check_u, check_x0, fast_x0)
 from .kernels import check_lie_model
 from .loops import Progress, run_fixed, run_short
 from .result import FAILED, OK, OK_STIFF, VIOLATED, Dense, Run, SimulationResult, new_result
 from .sanity import remedy, violation
+from .smoothness import nonsmooth_operations
 
-__all__ = ["simulate", "METHODS", "Method", "Hold"]
+__all__ = ["simulate", "METHODS", "Method", "Hold", "CallPlan", "call_plan"]
 
 Method = Literal["auto", "cvodes", "rk4", "rk8", "lie"]
 Hold = Literal["linear", "zoh"]
@@ -198,6 +200,13 @@ def simulate(model: Model, x0, t, *, u=None, p=None, hold: Hold = "linear", meth
                             max_steps=max_steps, cvodes_options=cvodes_options,
                             progress=bar, events=events, impacts=impacts, threads=threads)
     start = time.perf_counter()
+    if (method == "auto" and u is None and p is None and hold == "linear" and events is None
+            and impacts is None and invariants is False and steps is None
+            and (jit is None or jit is True) and cvodes_options is None and progress is None
+            and threads is None):
+        result = _common_call(model, x0, t, rtol, atol, max_steps, start)
+        if result is not None:
+            return result
     model = check_model(model)
     if method not in METHODS:
         raise ValueError(f"`method` must be one of {METHODS}, got {method!r}")
@@ -218,13 +227,14 @@ def simulate(model: Model, x0, t, *, u=None, p=None, hold: Hold = "linear", meth
                                    hold=hold, start=start)
         x = check_x0(x0, model)
     x0 = x
-    if CLOCK_STATE in model.states:  # a time-dependent model: its clock starts at t[0]
+    plan = call_plan(model)
+    if plan.clock:  # a time-dependent model: its clock starts at t[0]
         check_clock_start(model, x0, t[0])
-    p = model.resolve_p(p)
+    p = model.p_default if p is None else model.resolve_p(p)  # (read-only defaults)
     rtol, atol = check_tolerances(rtol, atol, model.nx)
     control = None if u is None and hold == "linear" else check_u(u, model.nu, t, hold=hold)
     # (None: zero, made if needed)
-    names = check_invariants(invariants, model)
+    names = () if invariants is False else check_invariants(invariants, model)
     if impacts is not None:
         impact = check_impact(impacts)
         if events is not None:
@@ -257,26 +267,97 @@ def simulate(model: Model, x0, t, *, u=None, p=None, hold: Hold = "linear", meth
             run = run_cvodes(problem, rtol, atol, cvodes_options)
         else:
             run, used, status, estimate = solve_auto(problem, rtol, atol, max_steps, jit,
-                                                     cvodes_options, counter)
+                                                     cvodes_options, counter,
+                                                     nonsmooth=plan.nonsmooth)
         counter.finish()
     if method in _FIXED_STEP and run.ok:
         run, status = _sane(model, t, run, control, p, method)
-    x = run.x
-    x.setflags(write=False)
-    values = _invariants(model, x, p, names) if names else {}
-    success = run.ok and status in (OK, OK_STIFF)
-    result = new_result(
-        t, x, run, success=success, status=status if run.ok else FAILED, method=used,
-        wall_time=time.perf_counter() - start, error_estimate=estimate,
-        invariants=MappingProxyType(values),
-        dense=Dense(model, p, lambda: _zero_grid(t, model.nu) if control is None
-                    else control.grid(t), None if control is None else control.left_grid(t)))
+    result = _result(model, t, run, used, status, estimate, control, p, names, start)
     if specs is None:
         return result
     problem = Problem.new(model, x0, t, check_u(None, model.nu, t) if control is None
                           else control, p)
     return apply_events(result, specs, problem, method, rtol, atol, cvodes_options,
                         cache.should_compile(jit, math.inf))
+
+
+def _common_call(model, x0, t, rtol, atol, max_steps, start: float):
+    """`simulate` of the common call, ``method='auto'`` at the model's parameters without a
+    control or options (a `Model` with no clock state and a smooth right-hand side, ``x0`` of
+    shape ``(nx,)`` that `fast_x0` takes, float tolerances, an int ``max_steps``): the
+    verified answer of the compiled dense pass (`dense.dense_run`) at once, ``start`` the
+    call's `time.perf_counter`. None for anything else, or when the pass gives no verified
+    answer: the general path then decides (and words any error)."""
+    if type(model) is not Model or not call_plan(model).common:
+        return None
+    if (type(rtol) is not float or type(atol) is not float or type(max_steps) is not int
+            or not (RTOL_MIN <= rtol < 1 and 0 <= atol < math.inf and max_steps >= 1)):
+        return None
+    t = check_t(t)
+    x0 = fast_x0(x0, model)
+    if x0 is None:
+        return None
+    got = dense_run(model, x0, t, rtol, atol, max_steps, STIFF_STEPS, p=model.p_default)
+    if got is None or got.result != 1:
+        return None
+    run, estimate = dense_answer(got, rtol)
+    return _result(model, t, run, "rk8", OK, estimate, None, model.p_default, (), start)
+
+
+def _result(model: Model, t: np.ndarray, run: Run, used: str, status: int, estimate: float,
+            control, p: np.ndarray, names: tuple, start: float) -> SimulationResult:
+    """The `SimulationResult` of ``run`` (its ``x`` made read-only) by the method ``used``,
+    with the invariants ``names`` evaluated; ``control`` None for zero."""
+    x = run.x
+    x.setflags(write=False)
+    values = MappingProxyType(_invariants(model, x, p, names)) if names else _NO_INVARIANTS
+    return new_result(
+        t, x, run, success=run.ok and status in (OK, OK_STIFF),
+        status=status if run.ok else FAILED, method=used,
+        wall_time=time.perf_counter() - start, error_estimate=estimate, invariants=values,
+        dense=Dense(model, p, lambda: _zero_grid(t, model.nu) if control is None
+                    else control.grid(t), None if control is None else control.left_grid(t)))
+
+
+#: The ``invariants`` of a result that asked for none (read-only, shared).
+_NO_INVARIANTS = MappingProxyType({})
+
+
+class CallPlan(NamedTuple):
+    """What every `simulate` call with one model shares, found once (`call_plan`).
+
+    Attributes
+    ----------
+    clock : bool
+        The model has a clock state (`dynamics.clock`), started at ``t[0]``.
+    nonsmooth : tuple of str
+        The non-smooth operations of its right-hand side
+        (`dynamics.integrate.smoothness.nonsmooth_operations`).
+    common : bool
+        Neither: the common call (``auto`` at the defaults) may take the compiled dense
+        pass at once.
+    """
+
+    clock: bool
+    nonsmooth: tuple
+    common: bool
+
+
+def call_plan(model: Model) -> CallPlan:
+    """The `CallPlan` of ``model`` (cached in the one cache with the model: `dynamics.cache`).
+
+    Examples
+    --------
+    >>> from appdyn.dynamics import rigid_body
+    >>> from appdyn.dynamics.integrate.api import call_plan
+    >>> call_plan(rigid_body([1.0, 2.0, 3.0]))
+    CallPlan(clock=False, nonsmooth=(), common=True)
+    """
+    def build():
+        clock, nonsmooth = CLOCK_STATE in model.states, nonsmooth_operations(model.f)
+        return CallPlan(clock, nonsmooth, not clock and not nonsmooth)
+
+    return cache.get(("simulate_plan", id(model)), build, keepalive=model)
 
 
 def _simulate_batch(model, x0, t, u, p, options: RunOptions, *, invariants, hold: str,
@@ -306,7 +387,8 @@ def _simulate_batch(model, x0, t, u, p, options: RunOptions, *, invariants, hold
 
 def _check_options(method, max_steps, jit, steps, cvodes_options, progress):
     """`simulate`'s run options checked: ``(max_steps, steps, cvodes_options, Progress)``."""
-    max_steps = validate.integer(max_steps, "max_steps", minimum=1)
+    if type(max_steps) is not int or max_steps < 1:  # (an int >= 1 at once: the common case)
+        max_steps = validate.integer(max_steps, "max_steps", minimum=1)
     if jit not in (None, True, False):
         raise ValueError(f"`jit` must be None, True or False, got {jit!r}")
     if method in _FIXED_STEP:

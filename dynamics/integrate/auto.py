@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, replace
+from functools import partial
 
 import numpy as np
 
@@ -12,7 +13,7 @@ from .. import cache
 from .adaptive import run_pass
 from .cpass import BMAX, CHECK_EVERY, NOISE
 from .cvodes import run_cvodes
-from .dense import dense_auto
+from .dense import DenseAuto, dense_auto
 from .estimates import (AUTO_ACCEPT, EPS, FLOOR_ULPS, carried, initial_step, measured_floor,
                         perturbed, roundoff, scaled_diff, screen, spectrum, tightened)
 from .evaluate import map_eval
@@ -24,7 +25,7 @@ from .stepcontrol import LOCAL_RTOL_MIN, solve_stepped
 from .tableaux import DOP853
 
 __all__ = ["solve_auto", "auto_jit", "STIFF_STEPS", "Single", "auto_runs", "dense_pass",
-           "one_pass", "nonsmooth_causes"]
+           "dense_answer", "dense_message", "one_pass", "nonsmooth_causes"]
 
 _AUTO_AIM = 0.1        # predict the step count for this estimated scaled error
 _AUTO_RUNS = 8         # give up (status 3) after this many fixed-step runs
@@ -389,16 +390,26 @@ def dense_pass(problem: Problem, rtol, atol, max_steps, progress):
     got = dense_auto(problem, rtol, atol, max_steps, STIFF_STEPS, progress=progress)
     if got is None or got.result != 1:
         return None, math.nan
-    estimate = got.estimate
-    message = (f"auto: DOP853 with dense output, steps chosen by its error estimate "
-               f"({got.answer_steps - got.rejected} steps, {got.rejected} rejected, "
-               f"{got.interpolated} interpolated, local rtol {rtol * got.factor:.3g}), checked "
-               f"against its steps merged in pairs ({got.check_steps} steps); estimated error "
-               f"{estimate:.2g} of tolerance"
-               + (f" (a rounding floor of {got.floor:.2g} measured by a run from a moved start "
-                  "included)" if got.floor > 0 else ""))
+    return dense_answer(got, rtol)
+
+
+def dense_answer(got: DenseAuto, rtol: float) -> tuple[Run, float]:
+    """``(run, estimate)`` of a verified `dense.DenseAuto` (``got.result`` 1) for the
+    requested ``rtol``: its answer and step counts, its message made on first use
+    (`dense_message`)."""
     return Run.new(got.x, got.spent, DOP853.stages * got.spent, got.substeps, True, True,
-                   message), estimate
+                   partial(dense_message, got, rtol)), got.estimate
+
+
+def dense_message(got: DenseAuto, rtol: float) -> str:
+    """The message of `dense_answer`'s run: the answer's steps, its check and the estimate."""
+    return (f"auto: DOP853 with dense output, steps chosen by its error estimate "
+            f"({got.answer_steps - got.rejected} steps, {got.rejected} rejected, "
+            f"{got.interpolated} interpolated, local rtol {rtol * got.factor:.3g}), checked "
+            f"against its steps merged in pairs ({got.check_steps} steps); estimated error "
+            f"{got.estimate:.2g} of tolerance"
+            + (f" (a rounding floor of {got.floor:.2g} measured by a run from a moved start "
+               "included)" if got.floor > 0 else ""))
 
 
 def _size_over_tolerance(problem: Problem, rtol: float, atol: np.ndarray) -> float:
@@ -417,11 +428,12 @@ def _size_over_tolerance(problem: Problem, rtol: float, atol: np.ndarray) -> flo
                default=0.0)
 
 
-def nonsmooth_causes(problem: Problem) -> tuple[str, ...]:
+def nonsmooth_causes(problem: Problem, *, operations: tuple | None = None) -> tuple[str, ...]:
     """Why ``problem``'s right-hand side may be non-smooth: the non-smooth operations of
-    the model (`smoothness.nonsmooth_operations`), and ``"callable u"`` for a control
-    that is a Python callable (it may jump); ``()`` when it is smooth."""
-    found = nonsmooth_operations(problem.model.f)
+    the model (`smoothness.nonsmooth_operations`, or ``operations`` when they are known),
+    and ``"callable u"`` for a control that is a Python callable (it may jump); ``()`` when
+    it is smooth."""
+    found = nonsmooth_operations(problem.model.f) if operations is None else operations
     return found + (("callable u",) if problem.control.mode == "stages" else ())
 
 
@@ -471,15 +483,17 @@ def _auto_stepped(problem: Problem, rtol, atol, max_steps, jit, progress, causes
             estimate)
 
 
-def solve_auto(problem: Problem, rtol, atol, max_steps, jit, cvodes_options, progress):
-    """``auto``: -> (run, method used, status, error estimate); counters cover every run.
+def solve_auto(problem: Problem, rtol, atol, max_steps, jit, cvodes_options, progress, *,
+               nonsmooth: tuple | None = None):
+    """``auto``: -> (run, method used, status, error estimate); counters cover every run;
+    ``nonsmooth`` the model's non-smooth operations when known (`nonsmooth_causes`).
 
     A right-hand side with kinks (`nonsmooth_causes`) goes to DOP853 with step rejection
     (`_auto_stepped`), which does not assume the method's order; a smooth one under a
     constant control to DOP853 with dense output (`dense_pass`: its steps follow the error,
     never the output grid); then (a control that varies, or no verdict) to the one-pass
     path, then the multi-run Richardson search (`auto_runs`)."""
-    causes = nonsmooth_causes(problem)
+    causes = nonsmooth_causes(problem, operations=nonsmooth)
     spent = 0
     if causes:
         got = _auto_stepped(problem, rtol, atol, max_steps, jit, progress, causes)

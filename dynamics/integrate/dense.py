@@ -31,6 +31,7 @@ layout, `_plan`), a thread's reused workspace, one ``ctypes`` call and the resul
 from __future__ import annotations
 
 import math
+import struct
 import threading
 from typing import NamedTuple
 
@@ -41,7 +42,8 @@ from ..interrupts import check_interrupt, deferred_interrupts
 from .cpass import pass_library
 from .inputs import Problem
 
-__all__ = ["FIELDS", "HEADER", "FIRST", "CHECK", "TRIES", "DenseAuto", "dense_auto", "dense_many",
+__all__ = ["FIELDS", "HEADER", "FIRST", "CHECK", "TRIES", "DenseAuto", "dense_auto", "dense_run",
+           "dense_many",
            "outcome_of", "constant_control"]
 
 #: The first answer's local tolerance over the requested one. Its global error, in units
@@ -152,12 +154,15 @@ _LOCAL = threading.local()
 
 class _Work(NamedTuple):
     """A thread's workspace for ``nout`` outputs: ``ws`` (`_size` doubles), the check-run
-    scratch ``XC (nx, nout + 1)`` and their addresses."""
+    scratch ``XC (nx, nout + 1)``, the answer's buffer ``X (nx, nout + 1)`` (copied out after
+    a call), their addresses and the arguments of the single run's call ``args``."""
 
     ws: np.ndarray
     XC: np.ndarray
     ws_addr: int
     xc_addr: int
+    X: np.ndarray
+    args: tuple
 
 
 def _workspace(plan: _Plan, nout: int) -> _Work:
@@ -171,24 +176,25 @@ def _workspace(plan: _Plan, nout: int) -> _Work:
     if got is None:
         if len(table) >= 8:
             table.clear()
-        ws, XC = np.zeros(_size(plan, nout)), np.empty((plan.nx, nout + 1))
+        ws, XC, X = np.zeros(_size(plan, nout)), np.empty((plan.nx, nout + 1)), \
+            np.empty((plan.nx, nout + 1))
         ws[_TRIES], ws[_NOUT] = TRIES, nout
-        got = table[key] = _Work(ws, XC, ws.ctypes.data, XC.ctypes.data)
+        got = table[key] = _Work(ws, XC, ws.ctypes.data, XC.ctypes.data, X,
+                                 (ws.ctypes.data, nout, BUDGET, X.ctypes.data, XC.ctypes.data))
     return got
 
 
-def _fill(ws: np.ndarray, plan: _Plan, t: np.ndarray, rtol: float, atol: np.ndarray,
+#: The header's inputs (its first slots, `FIELDS` from ``rtol`` to ``phase``), written by
+#: one `struct` call (about a tenth of the cost of nine numpy item assignments).
+_INPUTS = struct.Struct(f"{_PHASE + 1}d")
+
+
+def _fill(ws: np.ndarray, plan: _Plan, t: np.ndarray, rtol: float, atol,
           max_steps: float, stiff_steps: float) -> None:
-    """The inputs shared by the runs: header, tolerances and output times (the C code
-    resets the outputs of the header)."""
-    ws[_RTOL] = rtol
-    ws[_FACTOR] = FIRST
-    ws[_LOOSE] = FIRST * CHECK
-    ws[_MAXSTEPS] = max_steps
-    ws[_STIFF] = stiff_steps
-    ws[_T0] = t[0]
-    ws[_IQ] = plan.iq
-    ws[_PHASE] = 0
+    """The inputs shared by the runs: header, tolerances (``atol`` a float or ``(nx,)``)
+    and output times (the C code resets the outputs of the header)."""
+    _INPUTS.pack_into(ws, 0, rtol, FIRST, FIRST * CHECK, max_steps, stiff_steps, t[0], plan.iq,
+                      TRIES, 0.0)
     o = HEADER + plan.nx + plan.nu + plan.np
     ws[o:o + plan.nx] = atol
     ws[o + plan.nx:o + plan.nx + t.size - 1] = t[1:]
@@ -196,11 +202,16 @@ def _fill(ws: np.ndarray, plan: _Plan, t: np.ndarray, rtol: float, atol: np.ndar
 
 def _outcome(x: np.ndarray, head) -> DenseAuto:
     """The `DenseAuto` of a finished run from its header ``head`` (a sequence)."""
-    result, flag = int(head[_RESULT]), int(head[_FLAG])
-    return DenseAuto(x, result, head[_EST], int(head[_SPENT]), int(head[_NANS]),
-                     int(head[_NCHK]), int(head[_REJ]), head[_HMIN], int(head[_INTERP]),
-                     head[_RATIO], head[_FACTOR], head[_BOUND], head[_FLOOR], int(head[_SUB]),
-                     _REASONS[flag] if result == -3 else "")
+    result = int(head[_RESULT])
+    return _NEW(DenseAuto, (x, result, head[_EST], int(head[_SPENT]), int(head[_NANS]),
+                            int(head[_NCHK]), int(head[_REJ]), head[_HMIN],
+                            int(head[_INTERP]), head[_RATIO], head[_FACTOR], head[_BOUND],
+                            head[_FLOOR], int(head[_SUB]),
+                            _REASONS[int(head[_FLAG])] if result == -3 else ""))
+
+
+#: ``DenseAuto`` from a tuple of every field, without its ``__new__``'s argument parsing.
+_NEW = tuple.__new__
 
 
 def dense_auto(problem: Problem, rtol: float, atol: np.ndarray, max_steps: float,
@@ -227,23 +238,46 @@ def dense_auto(problem: Problem, rtol: float, atol: np.ndarray, max_steps: float
     ctrl = problem.control
     if ctrl.mode != "linear" or not constant_control(ctrl):
         return None
-    plan = _plan(problem.model)
+    u = ctrl.ua[0] if ctrl.ua.shape[0] else None
+    return dense_run(problem.model, problem.x0, problem.t, rtol, atol, max_steps, stiff_steps,
+                     u=u, p=problem.p, progress=progress)
+
+
+def dense_run(model, x0: np.ndarray, t: np.ndarray, rtol: float, atol, max_steps: float,
+              stiff_steps: float, *, u=None, p=None, progress=None) -> DenseAuto | None:
+    """`dense_auto` of checked inputs: ``x0 (nx,)``, the grid ``t (n,)``, ``atol`` a float or
+    ``(nx,)``, the constant control ``u (nu,)`` (None: zero) and ``p (np,)``; None without a
+    compiled pass. Per call: the model's plan looked up, the thread's workspace filled, one
+    ``ctypes`` call with arguments built with the workspace, the answer copied out.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from appdyn.dynamics import rigid_body
+    >>> from appdyn.dynamics.integrate.dense import dense_run
+    >>> model = rigid_body([1.5, 2.5, 3.2])
+    >>> got = dense_run(model, np.r_[0.0, 0.0, 0.0, 1.0, 0.5, 0.0, 1.0],
+    ...                 np.array([0.0, 10.0]), 1e-8, 1e-10, 1e8, 1e6)
+    >>> got.result, got.x.shape
+    (1, (7, 2))
+    """
+    plan = _plan(model)
     if plan is None:
         return None
-    t = problem.t
     nout = t.size - 1
     work = _workspace(plan, nout)
     ws = work.ws
     _fill(ws, plan, t, rtol, atol, max_steps, stiff_steps)
     nx, nu = plan.nx, plan.nu
-    ws[HEADER:HEADER + nx] = problem.x0
+    ws[HEADER:HEADER + nx] = x0
     if nu:
-        ws[HEADER + nx:HEADER + nx + nu] = ctrl.ua[0] if ctrl.ua.shape[0] else 0.0
+        ws[HEADER + nx:HEADER + nx + nu] = 0.0 if u is None else u
     if plan.np:
-        ws[HEADER + nx + nu:HEADER + nx + nu + plan.np] = problem.p
-    X = np.empty((nx, nout + 1))
-    args = (work.ws_addr, nout, BUDGET, X.ctypes.data, work.xc_addr)
-    if plan.auto(*args) != 3:  # a long run: interrupts looked at between calls
+        ws[HEADER + nx + nu:HEADER + nx + nu + plan.np] = p
+    if progress is not None and progress.fun is None:
+        progress = None  # (nobody is told: no counting)
+    auto, args = plan.auto, work.args
+    if auto(*args) != 3:  # a long run: interrupts looked at between calls
         # (the steps made so far: of the runs ended, and of the run in progress)
         count = HEADER + 3 * nx + nu + plan.np + nout + 2
         told = 0
@@ -251,12 +285,12 @@ def dense_auto(problem: Problem, rtol: float, atol: np.ndarray, max_steps: float
             while True:
                 check_interrupt()
                 told = _tell(progress, int(ws[_SPENT] + ws[count] + ws[count + 1]), told)
-                if plan.auto(*args) == 3:
+                if auto(*args) == 3:
                     break
         _tell(progress, int(ws[_SPENT]), told)
     elif progress is not None:
         _tell(progress, int(ws[_SPENT]), 0)
-    return _outcome(X, ws[:HEADER].tolist())
+    return _outcome(work.X.copy(), ws[:HEADER].tolist())
 
 
 def _tell(progress, steps: int, told: int) -> int:

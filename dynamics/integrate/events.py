@@ -64,7 +64,8 @@ from .cvodes import ControlCallback, integrator_options, run_cvodes
 from .evaluate import call_buffered, map_eval
 from .inputs import Control, Problem
 from .loops import run_fixed
-from .result import FAILED, OK, OK_STIFF, TERMINAL_EVENT, Dense, SimulationResult, make_result
+from .result import (FAILED, OK, OK_STIFF, TERMINAL_EVENT, Dense, SimulationResult, make_result,
+                     result_fields)
 from .stepcontrol import LOCAL_RTOL_MIN, run_stepped, run_stepped_callable
 from .tableaux import TABLEAUX
 
@@ -594,7 +595,7 @@ def apply_events(result: SimulationResult, specs: tuple[EventSpec, ...], problem
     t_events = [_frozen(np.array(times, dtype=float)) for times in found.times]
     x_events = [_frozen(np.array(states, dtype=float).reshape(len(states), nx))
                 for states in found.states]
-    values = dict(result.__dict__, t_events=t_events, x_events=x_events,
+    values = dict(result_fields(result), t_events=t_events, x_events=x_events,
                   n_steps=result.n_steps + stepper.n_steps, n_rhs=result.n_rhs + stepper.n_rhs)
     if found.failure:
         values.update(success=False, status=FAILED,

@@ -19,11 +19,13 @@ from ..model import Model
 from ..validate import (QUAT_NORM_TOL, check_unit_quaternion, finite_array, finite_scalar,
                         unit_quaternion)
 
-__all__ = ["HOLDS", "Batch", "Control", "Problem", "RunOptions", "check_batch", "check_t",
-           "check_x0", "check_tolerances",
+__all__ = ["HOLDS", "RTOL_MIN", "Batch", "Control", "Problem", "RunOptions", "check_batch",
+           "check_t", "check_x0", "check_tolerances",
            "check_u", "check_invariants", "check_cvodes_options"]
 
 _EPS = np.finfo(float).eps
+#: The least ``rtol`` taken (100 ulps of 1).
+RTOL_MIN = 100 * _EPS
 
 
 @dataclass(frozen=True)
@@ -221,12 +223,14 @@ def _cvodes_option_names() -> frozenset:
 
 def check_tolerances(rtol, atol, nx: int) -> tuple[float, np.ndarray]:
     """``rtol`` in ``[100 eps, 1)``; ``atol`` a scalar or (nx,), finite and >= 0 -> (nx,)."""
-    if (type(rtol) is float and type(atol) is float and 100 * _EPS <= rtol < 1
+    if (type(rtol) is float and type(atol) is float and RTOL_MIN <= rtol < 1
             and 0 <= atol < math.inf):  # fast path: the common case, every check passed
-        return rtol, np.full(nx, atol)
+        a = np.empty(nx)  # (`numpy.full` costs twice as much)
+        a.fill(atol)
+        return rtol, a
     rtol_f = finite_scalar(rtol, "rtol")
-    if not 100 * _EPS <= rtol_f < 1:
-        raise ValueError(f"`rtol` must be in [{100 * _EPS:.3g}, 1), got {rtol!r}")
+    if not RTOL_MIN <= rtol_f < 1:
+        raise ValueError(f"`rtol` must be in [{RTOL_MIN:.3g}, 1), got {rtol!r}")
     if type(atol) is float and 0 <= atol < math.inf:  # fast path: the common case
         return rtol_f, np.full(nx, atol)
     a = finite_array(atol, "atol")

@@ -16,8 +16,9 @@ from ..results import Result
 from ..serialize import text_table
 from .evaluate import map_eval
 
-__all__ = ["SimulationResult", "make_result", "new_result", "Dense", "Run", "OK", "OK_STIFF", "ROUNDOFF",
-           "UNVERIFIED", "VIOLATED", "NONSMOOTH", "FAILED", "TERMINAL_EVENT"]
+__all__ = ["SimulationResult", "make_result", "result_fields", "new_result", "Dense", "Run", "OK",
+           "OK_STIFF", "ROUNDOFF", "UNVERIFIED", "VIOLATED", "NONSMOOTH", "FAILED",
+           "TERMINAL_EVENT"]
 
 # status codes of SimulationResult (documented in its docstring)
 OK, OK_STIFF, ROUNDOFF, UNVERIFIED, VIOLATED, NONSMOOTH, FAILED = 0, 1, 2, 3, 4, 5, -1
@@ -188,8 +189,16 @@ class SimulationResult(Result):
 
     _repr_fields = ("method", "t", "x", "n_steps", "error_estimate")
 
+    def __getattr__(self, name: str):
+        # (reached only for an attribute not set: a ``message`` made on first use, from the
+        # ``_message`` callable `new_result` was given; the first thread's text is kept)
+        lazy = self.__dict__.get("_message") if name == "message" else None
+        if lazy is None:
+            raise AttributeError(f"{type(self).__name__!r} object has no attribute {name!r}")
+        return self.__dict__.setdefault("message", lazy())
+
     def __getstate__(self) -> dict:
-        state = dict(self.__dict__)
+        state = result_fields(self)
         state["invariants"] = dict(self.invariants)
         return state
 
@@ -365,16 +374,41 @@ def make_result(**values) -> SimulationResult:
     return result
 
 
+def result_fields(result: SimulationResult) -> dict:
+    """Every field of ``result`` by name, the keywords of `make_result` (a ``message`` made
+    on first use is made now).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from appdyn.dynamics import rigid_body, simulate
+    >>> from appdyn.dynamics.integrate.result import make_result, result_fields
+    >>> res = simulate(rigid_body([1.0, 2.0, 3.0]), [0, 0, 0, 1, 1.0, 0.1, 0.8], [0.0, 1.0])
+    >>> make_result(**result_fields(res)).message == res.message
+    True
+    """
+    values = dict(result.__dict__)
+    if values.pop("_message", None) is not None:
+        values["message"] = result.message
+    return values
+
+
 def new_result(t, x, run: "Run", *, success, status, method, wall_time, error_estimate,
                invariants, dense) -> SimulationResult:
     """`make_result` of the states ``x`` on ``t`` of ``run`` (its message and counts), without
-    the check of the keyword names (`simulate`'s one call site; about 0.3 us less)."""
+    the check of the keyword names (`simulate`'s one call site; about 0.3 us less). A
+    ``run.message`` that is a callable makes the result's ``message`` on first use."""
     result = object.__new__(SimulationResult)
+    message = run.message
     result.__dict__.update(
-        t=t, x=x, success=success, status=status, message=run.message, method=method,
+        t=t, x=x, success=success, status=status, method=method,
         wall_time=wall_time, n_steps=run.n_steps, n_rhs=run.n_rhs, substeps=run.substeps,
         error_estimate=error_estimate, compiled=run.compiled, invariants=invariants,
         _dense=dense, t_events=None, x_events=None, impacts=None)
+    if type(message) is str:
+        result.__dict__["message"] = message
+    else:
+        result.__dict__["_message"] = message
     return result
 
 
@@ -392,13 +426,17 @@ def _hermite(t, x, xdot, xdot_left, tq):
 
 @dataclass(frozen=True)
 class Run:
+    """One integration run inside a call: ``x (nx, n)``, its counts, whether it ran compiled
+    and reached the end, and its ``message`` (a str, or a callable making it: the verified
+    dense pass's, made only when the result's ``message`` is read)."""
+
     x: np.ndarray  # (nx, n)
     n_steps: int
     n_rhs: int
     substeps: int
     compiled: bool
     ok: bool
-    message: str
+    message: str | Callable[[], str]
 
     @classmethod
     def new(cls, x, n_steps, n_rhs, substeps, compiled, ok, message) -> "Run":

@@ -265,3 +265,11 @@ def test_near_round_off_the_floor_is_measured_in_the_same_call():
     assert res.success and "rounding floor" in res.message, res.message
     w = torque_free_omega(INERTIA, X0[4:], t)
     assert np.all(np.abs(res.x[4:] - w) <= atol + rtol * np.abs(w))
+
+
+def test_header_inputs_are_the_first_slots():
+    """`dense._fill` writes the header's inputs in one `struct` call in this order: the
+    C code's ``AU_*`` slots (`dense.FIELDS`) must start with them."""
+    from appdyn.dynamics.integrate.dense import FIELDS
+    assert FIELDS[:9] == ("rtol", "factor", "loose", "max_steps", "stiff_steps", "t0", "iq",
+                          "tries", "phase")

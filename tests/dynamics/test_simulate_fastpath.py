@@ -12,6 +12,9 @@ from appdyn import dynamics
 from appdyn.dynamics import cache
 from appdyn.dynamics.integrate import api, evaluate, inputs
 from appdyn.dynamics.integrate.inputs import check_t
+from appdyn.dynamics.truth import torque_free_omega
+
+needs_compiler = pytest.mark.skipif(cache.compiler() is None, reason="needs a C compiler")
 
 INERTIA = [1.5, 2.0, 3.25]  # a body of its own: other tests count the chunks of theirs
 X0 = [0, 0, 0, 1, 1.0, 0.1, 0.8]
@@ -244,3 +247,135 @@ def test_short_run_with_invariants_and_a_non_finite_state(body, monkeypatch):
         assert a.invariants.keys() == b.invariants.keys()
         for k in a.invariants:
             np.testing.assert_array_equal(a.invariants[k], b.invariants[k])
+
+
+# ------------------------------------------------------------ the common `auto` call
+# `simulate(model, x0, t)` at the defaults goes to the compiled dense pass at once
+# (`api._common_call`: a per-model call plan, a thread's reused workspace, one ctypes call);
+# it must give what the general path gives, bit for bit, and refuse what it refuses.
+
+
+@pytest.fixture
+def common_calls(monkeypatch):
+    """Count the calls the common path answered; ``off()`` switches it off."""
+    answered = []
+    take = api._common_call
+
+    def counted(*args):
+        result = take(*args)
+        if result is not None:
+            answered.append(result)
+        return result
+
+    monkeypatch.setattr(api, "_common_call", counted)
+    counted.answered = answered
+    counted.off = lambda: monkeypatch.setattr(api, "_common_call", lambda *args: None)
+    return counted
+
+
+def _oscillator():
+    """A smooth model with a parameter and a control: ``y'' = -k y + u``."""
+    y, v, u, k = (ca.SX.sym(n) for n in "yvuk")
+    return dynamics.Model.from_expressions({"y": y, "v": v}, {"y": v, "v": -k * y + u},
+                                           {"u": u}, {"k": k}, p_default=[4.0])
+
+
+def _same_auto(a, b):
+    _same(a, b)
+    assert a.error_estimate == b.error_estimate
+    np.testing.assert_array_equal(a.xdot, b.xdot)
+    np.testing.assert_array_equal(a.sample(0.3), b.sample(0.3))
+
+
+@needs_compiler
+@pytest.mark.parametrize("case", ["2-point", "list grid", "41 outputs", "x0 list", "oscillator"])
+def test_common_auto_call_is_the_general_path(body, common_calls, case):
+    model, x0, t = body, np.array(X0, dtype=float), np.array([0.0, 10.0])
+    if case == "list grid":
+        t = [0.0, 0.5, 2.0]
+    elif case == "41 outputs":
+        t = np.linspace(0.0, 20.0, 41)
+    elif case == "x0 list":
+        x0 = list(X0)
+    elif case == "oscillator":
+        model, x0 = _oscillator(), [1.0, 0.0]
+    fast = dynamics.simulate(model, x0, t)
+    assert len(common_calls.answered) == 1 and fast.success and fast.status == 0
+    common_calls.off()
+    slow = dynamics.simulate(model, x0, t)
+    _same_auto(fast, slow)
+    if model is body:  # the torque-free truth, to the tolerance
+        w = torque_free_omega(INERTIA, fast.x[4:, 0], fast.t)
+        assert np.all(np.abs(fast.x[4:] - w) <= 1e-10 + 1e-8 * np.abs(w))
+
+
+@needs_compiler
+@pytest.mark.parametrize("kwargs", [dict(rtol=np.float64(1e-6)), dict(atol=[1e-9] * 7),
+                                    dict(max_steps=np.int64(10 ** 6)), dict(jit=False),
+                                    dict(invariants=True), dict(p=[]), dict(threads=1)])
+def test_common_auto_call_declines_the_rest_alike(body, common_calls, kwargs):
+    """What the common path does not take (other types, options) goes the general way,
+    unchanged."""
+    fast = dynamics.simulate(body, X0, GRID, **kwargs)
+    assert common_calls.answered == []
+    common_calls.off()
+    _same(fast, dynamics.simulate(body, X0, GRID, **kwargs))
+
+
+@needs_compiler
+def test_common_auto_call_declines_a_nonsmooth_model(common_calls):
+    x = ca.SX.sym("x")
+    model = dynamics.Model.from_expressions({"x": x}, {"x": -ca.fabs(x)})
+    res = dynamics.simulate(model, [1.0], np.array([0.0, 1.0]))
+    assert common_calls.answered == [] and res.method == "dop853"
+    assert abs(res.x[0, -1] - np.exp(-1.0)) <= 1e-8 * np.exp(-1.0) + 1e-10  # x = exp(-t)
+
+
+@needs_compiler
+def test_common_auto_call_results_share_no_memory(body):
+    """The answer is copied out of the thread's reused buffer: an earlier result keeps its
+    states when the same call is made again from another start."""
+    first = dynamics.simulate(body, X0, GRID)
+    kept = first.x.copy()
+    other = dynamics.simulate(body, [0, 0, 0, 1, 0.2, -0.5, 0.3], GRID)
+    np.testing.assert_array_equal(first.x, kept)
+    assert not np.shares_memory(first.x, other.x)
+    assert not first.x.flags.writeable
+
+
+AUTO_BAD = [(bad, match) for bad, match in BAD if "steps" not in bad]
+
+
+@pytest.mark.parametrize("bad, match", AUTO_BAD, ids=[m for _, m in AUTO_BAD])
+def test_bad_inputs_refused_alike_by_the_common_auto_call(body, common_calls, bad, match):
+    kwargs = dict(x0=X0, t=GRID)
+    kwargs.update(bad)
+    x0, t = kwargs.pop("x0"), kwargs.pop("t")
+    fast = _message(lambda: dynamics.simulate(body, x0, t, **kwargs))
+    assert match in fast[1]
+    common_calls.off()
+    assert _message(lambda: dynamics.simulate(body, x0, t, **kwargs)) == fast
+
+
+@needs_compiler
+def test_dense_message_made_on_first_read_pickled_made(body, common_calls):
+    """The verified dense pass's message is made when first read (`result.Run`), once:
+    the same text every read and thread, pickled and rebuilt by `result_fields`."""
+    import pickle
+    import threading
+
+    from appdyn.dynamics.integrate.result import make_result, result_fields
+    res = dynamics.simulate(body, X0, GRID)
+    assert common_calls.answered == [res] and "message" not in res.__dict__
+    fields = make_result(**result_fields(res))
+    texts = []
+    threads = [threading.Thread(target=lambda: texts.append(res.message)) for _ in range(4)]
+    for th in threads:
+        th.start()
+    for th in threads:
+        th.join()
+    assert len(set(texts)) == 1 and texts[0].startswith("auto: DOP853 with dense output")
+    assert all(text is res.message for text in texts)
+    assert fields.message == res.message == pickle.loads(pickle.dumps(res)).message
+    common_calls.off()
+    assert dynamics.simulate(body, X0, GRID).message == res.message

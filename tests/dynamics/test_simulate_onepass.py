@@ -26,11 +26,13 @@ pytestmark = pytest.mark.skipif(cache.compiler() is None, reason="needs a C comp
 @pytest.fixture(autouse=True)
 def _no_dense_path(monkeypatch):
     """The one-pass path as ``auto`` takes it where DOP853 with dense output
-    (`auto.dense_pass`, tested in test_simulate_dense.py) does not apply, e.g. under a
+    (`auto.dense_pass`, `dense.dense_run`, tested in test_simulate_dense.py) does not apply, e.g. under a
     control that varies: here with that path switched off, so that the same closed forms
     judge the pass."""
     monkeypatch.setattr("appdyn.dynamics.integrate.auto.dense_pass",
                         lambda *args: (None, math.nan))
+    # (and the common call's way to the same pass: `simulate` at the defaults)
+    monkeypatch.setattr("appdyn.dynamics.integrate.api.dense_run", lambda *args, **kw: None)
 
 
 def ratio(res, inertia, rtol, atol):
