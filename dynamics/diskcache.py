@@ -226,6 +226,11 @@ def code_version() -> bytes:
     this module, `dynamics.attitude`): part of the key of a `dynamics.cache.Job` looked up
     by its recipe, so that an upgrade of appdyn never loads a library built by older code.
 
+    Taken once per process, when `dynamics.integrate` is imported (the code the process
+    runs), not at the first compile: files replaced on disk after the import (an upgrade
+    while a kernel runs) would otherwise key this process's libraries, built by the old
+    code, as the new code's, and later processes would load them.
+
     Examples
     --------
     >>> from appdyn.dynamics.diskcache import code_version

@@ -108,5 +108,11 @@ from .batch import BatchResult
 from .events import Event
 from .impacts import Impact, ImpactRecord
 from .result import SimulationResult
+from .. import diskcache
+
+# The hash of the code that turns a model into C is taken now, as that code is imported:
+# a library this process compiles later is keyed by the code it runs, even when the files
+# on disk change in between (an upgrade or a checkout while a kernel keeps running).
+diskcache.code_version()
 
 __all__ = ["METHODS", "BatchResult", "Event", "Impact", "ImpactRecord", "Method", "SimulationResult", "simulate"]

@@ -218,3 +218,36 @@ def test_cli_info_and_clear(disk, capsys):
     assert str(disk) in out and "entries:   1" in out
     assert main(["cache", "clear"]) == 0
     assert "removed 1 entries" in capsys.readouterr().out and artifacts(disk) == []
+
+
+UPGRADED_WHILE_RUNNING = """
+import hashlib, sys
+from pathlib import Path
+import appdyn.dynamics.integrate  # the code this process runs
+from appdyn.dynamics import diskcache
+here = Path(diskcache.__file__).parent
+assert here.is_relative_to(Path.cwd()), here  # (the copy, never the project's own files)
+before = hashlib.sha256()
+for path in sorted([*(here / "integrate").glob("*.py"), here / "cache.py",
+                    here / "diskcache.py", *(here / "attitude").glob("*.py")]):
+    before.update(path.name.encode())
+    before.update(path.read_bytes())
+dense = here / "integrate" / "dense.py"
+dense.write_text(dense.read_text() + "\\n# upgraded on disk after the import\\n")
+print(diskcache.code_version() == before.digest())
+"""
+
+
+def test_the_code_hash_is_the_imported_code_not_files_changed_later(tmp_path):
+    # a copy of the package whose integrate code changes on disk after this process
+    # imported it (an upgrade while a kernel runs): the key keeps the imported code's hash
+    root = Path(__file__).resolve().parents[2]
+    for name in ("appdyn", "dynamics", "ocp", "problems"):
+        shutil.copytree(root / name, tmp_path / name,
+                        ignore=shutil.ignore_patterns("__pycache__"))
+    shutil.copy(root / "pyproject.toml", tmp_path)  # (appdyn finds its packages beside it)
+    env = dict(os.environ, PYTHONPATH=str(tmp_path), APPDYN_CACHE_DIR=str(tmp_path / "cache"))
+    done = subprocess.run([sys.executable, "-c", UPGRADED_WHILE_RUNNING], cwd=tmp_path,
+                          env=env, capture_output=True, text=True, timeout=120)
+    assert done.returncode == 0, done.stderr[-2000:]
+    assert done.stdout.split() == ["True"]
