@@ -74,7 +74,7 @@ from ..transcription import RadauConstantControl
 from .arc_nlp import arc_nlp, constraint_bounds
 from .arcs import BangArcs, bang_arcs
 from .result import RefinedSolution, annotate, graded
-from .rk8_step import step_function, step_jacobian
+from .rk8_step import step_adjoint, step_function
 
 __all__ = ["BangArcs", "bang_arcs", "optimize_switch_times"]
 
@@ -396,7 +396,7 @@ def _solve_arcs(problem: Problem, guess: Solution, arcs: BangArcs, nseg: np.ndar
     tt = np.tile(taus, N_out)
     with construction_lock():
         step_S, step_nodes = step.map(S), step.map(js.size)
-        jac_nodes = step_jacobian(step).map(js.size + 1)
+        adjoint_nodes = step_adjoint(step).map(js.size + 1)
     half = np.asarray(step_S(Xopt[:, :-1], Ucols, P[:, :S], hseg[None, :] / 2)[0], float).reshape(nx, S)
     two = np.asarray(step_S(half, Ucols, P[:, :S], hseg[None, :] / 2)[0], float).reshape(nx, S)
     full = np.asarray(step_S(Xopt[:, :-1], Ucols, P[:, :S], hseg[None, :])[0], float).reshape(nx, S)
@@ -424,11 +424,9 @@ def _solve_arcs(problem: Problem, guess: Solution, arcs: BangArcs, nseg: np.ndar
         xs_in = np.hstack([Xnodes, Xopt[:, segs[:1]]])
         hs_in = np.concatenate([hseg[js] * (1.0 - tt), hseg[segs[:1]]])
         u_in = np.hstack([Ucols[:, js], Ucols[:, segs[:1]]])
-        Jx, Jq = jac_nodes(xs_in, u_in, Pn, hs_in[None, :])
-        Jx = np.asarray(Jx, float).reshape(nx, n_in, nx)  # [row, node, column]
-        Jq = np.asarray(Jq, float).reshape(n_in, nx)
         ends = np.concatenate([js, segs[:1]])
-        lam = np.einsum("rnc,rn->cn", Jx, lam_end[:, ends]) + sign * Jq.T
+        lam = np.asarray(adjoint_nodes(xs_in, u_in, Pn, hs_in[None, :], lam_end[:, ends],
+                                       np.full((1, n_in), float(sign))), float).reshape(nx, n_in)
         costates = _read_only(np.hstack([lam[:, -1:], lam[:, :-1]]))
 
     message = (f"switch-time optimization ({n_arcs} arcs, {S} RK8 segments): IPOPT {status} "

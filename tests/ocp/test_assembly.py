@@ -192,3 +192,30 @@ def test_switch_time_nlp_assembled_equals_the_whole_nlp_differentiated_by_casadi
         np.testing.assert_allclose(got, ref, rtol=1e-12, atol=1e-12 * max(1.0, np.abs(ref).max()))
     assert abs(float(mine.cost(w, par)) - float(whole.cost(w, par))) <= 1e-12 * max(
         1.0, abs(float(whole.cost(w, par))))
+
+
+@pytest.mark.parametrize("name", ["loaded", "rigid_slew", "pointing"])
+def test_step_adjoint_is_the_transposed_jacobian_of_the_step(name):
+    """`ocp.refine.rk8_step.step_adjoint` (one reverse sweep: the switch-time costates)
+    against casadi's whole state Jacobian of the RK8 step and of its running-cost integral,
+    transposed and applied to random seeds, at random points, batched by `map`."""
+    from appdyn.ocp.refine.rk8_step import step_adjoint, step_function
+
+    problem = PROBLEMS[name]()
+    step = step_function(problem.model, problem.lagrange)
+    sym = ca.SX if step.is_a("SXFunction") else ca.MX
+    x, u, p, h = (sym.sym(n, step.sparsity_in(i)) for i, n in enumerate("xuph"))
+    xn, qn = step(x, u, p, h)
+    jac = ca.Function("step_jac", [x, u, p, h], [ca.jacobian(xn, x), ca.jacobian(qn, x)])
+    rng = np.random.default_rng(5)
+    n = 4
+    X, U = rng.uniform(-1, 1, (x.numel(), n)), rng.uniform(-1, 1, (u.numel(), n))
+    P, H = rng.uniform(0.5, 1.5, (p.numel(), n)), rng.uniform(0.01, 0.2, (1, n))
+    L, S = rng.normal(size=(x.numel(), n)), rng.normal(size=(1, n))
+    got = np.asarray(step_adjoint(step).map(n)(X, U, P, H, L, S), float)
+    for k in range(n):
+        Jx, Jq = (np.asarray(ca.densify(v), float) for v in jac(X[:, k], U[:, k], P[:, k], H[0, k]))
+        ref = Jx.T @ L[:, k] + S[0, k] * Jq.reshape(-1)
+        np.testing.assert_allclose(got[:, k], ref, rtol=1e-12, atol=1e-12 * max(1.0, np.abs(ref).max()))
+    if name == "loaded":  # L = u^2 (1 + x1^2) / 2: the running cost's part is there (not zero)
+        assert np.abs(np.asarray(ca.densify(jac(X[:, 0], U[:, 0], P[:, 0], H[0, 0])[1]))).max() > 0
