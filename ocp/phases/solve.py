@@ -307,11 +307,13 @@ def _solution(problem, disc, parts, w, lam_g, lam_x, g, success, status, message
     lgs, _ = disc.split_g(lam_g)
     gs, ge = disc.split_g(g)
     ends = disc.ends(w)
+    finite = bool(np.all(np.isfinite(g)))
+    phase_viols, _ = disc.violations(g, w) if finite else ([None] * len(parts), 0.0)
     t0s, phases, start = [], [], problem.t0
     for i, ((tr, m, _, d), wi, li, gi) in enumerate(zip(parts, ws, lgs, gs)):
         T = float(d.unpack(wi)["T"])
         pb = _started_at(d.problem, start)
-        d_t = _Shifted(d, pb)
+        d_t = _Shifted(d, pb, phase_viols[i])
         phases.append(make_solution(pb, tr, m, d_t, NlpOutcome(
             w=wi, lam_g=li, g=gi, success=success, status=status, message=message,
             iterations=iterations, solve_time=solve_time, build_time=build_time,
@@ -324,7 +326,7 @@ def _solution(problem, disc, parts, w, lam_g, lam_x, g, success, status, message
     ev = ge * disc.event_scale
     ev_viol = float(np.max(np.maximum(0.0, np.maximum(lo - ev, ev - hi)), initial=0.0)) \
         if np.all(np.isfinite(ev)) else float("nan")
-    viol = disc.violation(g, w) if np.all(np.isfinite(g)) else float("nan")
+    viol = disc.violation(g, w) if finite else float("nan")
     sw, sg, dJ = _phys_scales(disc)
     point = {"key": disc.key, "numbers": _phased_numbers(disc), "x_phys": w * sw,
              "g_sizes": tuple(d.g.size for d in disc.discs),
@@ -340,10 +342,16 @@ def _solution(problem, disc, parts, w, lam_g, lam_x, g, success, status, message
 
 class _Shifted:
     """A phase `Discretization` seen with its problem's ``t0`` set to the phase start (for
-    `make_solution`; the NLP is that of the phase started at 0)."""
+    `make_solution`; the NLP is that of the phase started at 0), its violation at the
+    solve's end point already measured (`PhasedDiscretization.violations`; ``None``: not
+    measured, the phase's own `violation` measures it)."""
 
-    def __init__(self, disc, problem):
-        self._disc, self.problem = disc, problem
+    def __init__(self, disc, problem, violation: float | None = None):
+        self._disc, self.problem, self._violation = disc, problem, violation
+
+    def violation(self, g, w=None) -> float:
+        """The phase's violation at the end point (``g``, ``w`` are that point's)."""
+        return self._disc.violation(g, w) if self._violation is None else self._violation
 
     def __getattr__(self, name):
         return getattr(self._disc, name)

@@ -5,6 +5,7 @@ import numpy as np
 import pytest
 
 from appdyn import ocp
+from appdyn.dynamics import clear_caches
 from appdyn.ocp import Constraint, Mesh, Problem, solve
 from appdyn.ocp.assembly import content_key
 from appdyn.ocp.guess import initial_guess
@@ -108,6 +109,11 @@ def test_content_key_is_equal_for_equal_functions_and_differs_otherwise():
     f3 = ca.Function("f", [x], [x ** 3])
     assert content_key(f1) == content_key(f2) != content_key(f3)
     assert content_key(None) is None
+    # kept per Function object: the same answer again, and the same as computed afresh
+    assert content_key(f1) is content_key(f1)
+    kept = content_key(f3)
+    clear_caches()
+    assert content_key(f3) == kept and content_key(f3) != content_key(ca.Function("g", [x], [x ** 3]))
 
 
 def test_warm_start_with_multipliers_converges_at_once():

@@ -294,3 +294,39 @@ def test_phase_parameters_shared_by_an_event():
     assert sol.cost == pytest.approx(1.25, rel=1e-9)
     for ph in sol.phases:
         assert ph.p[0] == pytest.approx(0.5, rel=1e-8)
+
+
+def test_violations_measure_each_point_and_the_phases_as_their_own_discretizations():
+    """`PhasedDiscretization.violations` keeps its last point's answer: a new point is
+    measured again (not the kept answer), and every phase's share is what that phase's own
+    `Discretization.violation` gives on its slice; the link rows by hand."""
+    from appdyn.ocp.guess import initial_guess
+    from appdyn.ocp.nlp import Discretization
+    from appdyn.ocp.phases.nlp import PhasedDiscretization
+    from appdyn.ocp.scaling import auto_scaling
+    from appdyn.ocp.solve import default_mesh
+    from appdyn.ocp.transcription import get_transcription
+
+    problem = split_energy(N=4)
+    discs = []
+    for ph in problem.phases:
+        tr, mesh = get_transcription(ph.transcription, degree=ph.degree), default_mesh(ph.N, ph.mesh)
+        pb = replace(ph.problem, t0=0.0)
+        discs.append(Discretization(pb, tr, mesh, auto_scaling(pb, initial_guess(pb, tr, mesh))))
+    n_e = problem.event_bounds()[0].size
+    disc = PhasedDiscretization(problem, discs, 1.0, np.ones(n_e))
+    rng = np.random.default_rng(3)
+    w = np.clip(rng.normal(size=disc.lbx.size), disc.lbx, disc.ubx)  # the rows decide
+    points = [rng.normal(size=disc.lbg.size) * s for s in (1.0, 3.0, 1.0)]
+    points[2] = points[0].copy()
+    for g in points:
+        phases, events = disc.violations(g, w)
+        gs, ge = disc.split_g(g)
+        ws = disc.split_w(w)
+        assert phases == tuple(d.violation(gi, wi) for d, gi, wi in zip(discs, gs, ws))
+        lo, hi = problem.event_bounds()
+        assert events == pytest.approx(max(0.0, np.max(np.maximum(lo - ge, ge - hi))), abs=0)
+        assert disc.violation(g, w) == max(*phases, events)
+    for g in points:  # without the variables
+        gs, _ = disc.split_g(g)
+        assert disc.violations(g, None)[0] == tuple(d.violation(gi) for d, gi in zip(discs, gs))
