@@ -96,7 +96,9 @@ def compiled_model(name, case, n, target, build: Path) -> Workload:
 
 def peer_library(model, path: Path) -> Path:
     """A shared library with ``void peer_rhs(double t, double* x, double* dx, void* p)``
-    calling the casadi-generated C of ``model.f`` at zero control and default parameters."""
+    calling the casadi-generated C of ``model.f`` at zero control and default parameters,
+    and ``long long peer_calls(void)``: its calls since the last ``peer_calls`` (the peer's
+    right-hand-side evaluations, `bench/step_cost.py`)."""
     f = model.f
     gen = ca.CodeGenerator(path.stem + ".c", {"with_header": False})
     ins = [f.mx_in(i) for i in range(3)]
@@ -112,8 +114,11 @@ def peer_library(model, path: Path) -> Path:
         f"static const casadi_real P[{max(p.size, 1)}] = {{{', '.join(map(repr, p)) or '0'}}};\n"
         f"static casadi_int IW[{max(f.sz_iw(), 1) + 8}];\n"
         f"static casadi_real W[{max(f.sz_w(), 1) + 64}];\n"
+        "static long long CALLS;\n"
+        "long long peer_calls(void) { long long n = CALLS; CALLS = 0; return n; }\n"
         "void peer_rhs(double t, double* x, double* dx, void* p) {\n"
         "  const casadi_real* arg[16] = {x, U, P}; casadi_real* res[8] = {dx};\n"
+        "  ++CALLS;\n"
         "  peer_f(arg, res, IW, W, 0);\n}\n")
     subprocess.run(["cc", "-O1", "-march=native", "-shared", "-fPIC", "-o", str(path),
                     str(shim)], check=True, cwd=path.parent)
