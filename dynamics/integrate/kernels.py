@@ -50,12 +50,12 @@ def _stage_control(mode, ins, nu, nodes_unique, linear_u):
 
 
 def _rk_kernel(f: ca.Function, method: str, mode: str, error: bool = False,
-               sym=None) -> ca.Function:
+               call: bool = False) -> ca.Function:
     """One explicit Runge-Kutta step ``(x, h, u-data, p) -> x_next`` as a Function.
 
-    ``sym`` (``casadi.SX`` or ``casadi.MX``) forces the symbol type: on MX the step calls
-    ``f`` (generated once as its own C function) and combines the stages as vectors;
-    default SX where ``f`` allows (``f`` inlined in every stage).
+    ``call``: the step calls ``f`` (an SX call node: ``f`` generated once as its own C
+    function, the stages' sums scalar C); default SX where ``f`` allows (``f`` inlined in
+    every stage), else MX.
 
     ``error`` (``rk8`` only): inputs ``rtol`` (scalar) and ``atol (nx)`` follow, and a
     second output is DOP853's embedded error estimate of the step (`DOP853_E5`), in units
@@ -64,11 +64,11 @@ def _rk_kernel(f: ca.Function, method: str, mode: str, error: bool = False,
     tab = TABLEAUX[method]
     nx, nu, np_ = f.numel_in(0), f.numel_in(1), f.numel_in(2)
     nodes = unique_nodes(method)
-    sym = sym or _sym(f)
+    sym = ca.SX if call else _sym(f)
     ins, linear_u = _kernel_inputs(sym, nx, nu, np_, mode, len(nodes))
     u_at = _stage_control(mode, ins, nu, nodes, linear_u)
     x, h, p = ins[0], ins[1], ins[-1]
-    k = _stages(f, tab.a, tab.c, x, h, u_at, p, [])
+    k = _stages(f, tab.a, tab.c, x, h, u_at, p, [], call=call)
     x_next = x + h * _combine(tab.b, k)
     if not error:
         return ca.Function(f"{method}_step", ins, [x_next])
@@ -285,6 +285,6 @@ def kernel(model: Model, method: str, mode: str, *, error: bool = False,
     def build():
         if method == "lie":
             return _lie_kernel(model.f, model.attitude, mode)
-        return _rk_kernel(model.f, method, mode, error, ca.MX if call else None)
+        return _rk_kernel(model.f, method, mode, error, call)
 
     return cache.get(key, build, keepalive=model.f)
