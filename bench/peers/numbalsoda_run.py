@@ -4,11 +4,13 @@ Reads a JSON job from stdin, prints JSON to stdout. Job: ``inertia``, ``t`` (out
 ``x0`` (7,), ``tols`` (rtol list; atol = rtol/100), ``repeats``, and optionally ``batch``:
 ``{"x0s": (K, 7), "t": grid, "rtol": r}`` for the numba-jitted loop of dop853 runs.
 Answers carry body rates (the main process computes errors against the Jacobi truth).
+``mxstep`` (optional, default numbalsoda's 10,000): most steps of a run.
 
 A job with ``library`` (path of a shared library exporting ``peer_rhs(t, x, dx, p)``, the
 signature of numbalsoda's ``lsoda_sig``: the right-hand side of any appdyn model compiled
 from the same casadi-generated C as appdyn's own, see bench/integrate_peers.py) instead of
-``inertia`` integrates that model; its answers carry the whole state (``x``).
+``inertia`` integrates that model; its answers carry the whole state (``x``) and, when the library exports ``peer_calls``
+(the right-hand-side calls since its last call), ``rhs_calls`` of one run.
 """
 import json
 import sys
@@ -42,23 +44,32 @@ def main():
         import ctypes
         lib = ctypes.CDLL(job["library"])
         ptr = ctypes.cast(lib.peer_rhs, ctypes.c_void_p).value
+        calls = getattr(lib, "peer_calls", None)
+        if calls is not None:
+            calls.restype = ctypes.c_longlong
     else:
+        calls = None
         ptr = make_rhs(job["inertia"])
     t = np.asarray(job["t"], float)
     x0 = np.asarray(job["x0"], float)
     out = {"runs": []}
+    mxstep = int(job.get("mxstep", 10000))
     for name, solver in (("lsoda", lsoda), ("dop853", dop853)):
         if name not in job.get("solvers", ("lsoda", "dop853")):
             continue
         for rtol in job["tols"]:
-            times = []
+            times, extra = [], {}
             for k in range(job["repeats"] + 1):
+                if calls is not None and k == 1:
+                    calls()
                 t0 = time.perf_counter()
-                usol, ok = solver(ptr, x0, t, rtol=rtol, atol=rtol * 1e-2)
+                usol, ok = solver(ptr, x0, t, rtol=rtol, atol=rtol * 1e-2, mxstep=mxstep)
                 times.append(time.perf_counter() - t0)
+                if calls is not None and k == 1:
+                    extra["rhs_calls"] = int(calls())
             answer = dict(x=usol.tolist()) if job.get("library") else dict(w=usol[:, 4:7].tolist())
             out["runs"].append(dict(solver=name, rtol=rtol, first=times[0], times=times[1:],
-                                    success=bool(ok), **answer))
+                                    success=bool(ok), **answer, **extra))
     if job.get("batch"):
         b = job["batch"]
         x0s, tb, rtol = np.asarray(b["x0s"], float), np.asarray(b["t"], float), b["rtol"]

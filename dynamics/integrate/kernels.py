@@ -50,12 +50,12 @@ def _stage_control(mode, ins, nu, nodes_unique, linear_u):
 
 
 def _rk_kernel(f: ca.Function, method: str, mode: str, error: bool = False,
-               sym=None) -> ca.Function:
+               call: bool = False) -> ca.Function:
     """One explicit Runge-Kutta step ``(x, h, u-data, p) -> x_next`` as a Function.
 
-    ``sym`` (``casadi.SX`` or ``casadi.MX``) forces the symbol type: on MX the step calls
-    ``f`` (generated once as its own C function) and combines the stages as vectors;
-    default SX where ``f`` allows (``f`` inlined in every stage).
+    ``call``: the step calls ``f`` (an SX call node: ``f`` generated once as its own C
+    function, the stages' sums scalar C); default SX where ``f`` allows (``f`` inlined in
+    every stage), else MX.
 
     ``error`` (``rk8`` only): inputs ``rtol`` (scalar) and ``atol (nx)`` follow, and a
     second output is DOP853's embedded error estimate of the step (`DOP853_E5`), in units
@@ -64,11 +64,11 @@ def _rk_kernel(f: ca.Function, method: str, mode: str, error: bool = False,
     tab = TABLEAUX[method]
     nx, nu, np_ = f.numel_in(0), f.numel_in(1), f.numel_in(2)
     nodes = unique_nodes(method)
-    sym = sym or _sym(f)
+    sym = ca.SX if call else _sym(f)
     ins, linear_u = _kernel_inputs(sym, nx, nu, np_, mode, len(nodes))
     u_at = _stage_control(mode, ins, nu, nodes, linear_u)
     x, h, p = ins[0], ins[1], ins[-1]
-    k = _stages(f, tab.a, tab.c, x, h, u_at, p, [])
+    k = _stages(f, tab.a, tab.c, x, h, u_at, p, [], call=call)
     x_next = x + h * _combine(tab.b, k)
     if not error:
         return ca.Function(f"{method}_step", ins, [x_next])
@@ -77,15 +77,16 @@ def _rk_kernel(f: ca.Function, method: str, mode: str, error: bool = False,
     return ca.Function(f"{method}_step_err", ins + [rtol, atol], [x_next, err])
 
 
-def _stages(f: ca.Function, a, c, x, h, u_at, p, k: list) -> list:
+def _stages(f: ca.Function, a, c, x, h, u_at, p, k: list, *, call=False) -> list:
     """The stages ``k_i = f(x + h sum_j a_ij k_j, u(c_i h), p)`` of the rows ``a`` (nodes
-    ``c``) appended to the stages ``k`` already known; returns ``k``."""
+    ``c``) appended to the stages ``k`` already known; returns ``k``. ``call``: ``f`` is
+    called (an SX call node, generated as a C call) rather than inlined."""
     for ai, ci in zip(a, c):
         xi = x
         for j, aij in enumerate(ai):
             if aij != 0.0:
                 xi = xi + (aij * h) * k[j]
-        k.append(f.call([xi, u_at(ci), p])[0])
+        k.append(f.call([xi, u_at(ci), p], not call, call)[0])
     return k
 
 
@@ -124,23 +125,27 @@ def dense_kernels(model: Model, *, compiled: bool = False) -> tuple[ca.Function,
         (("compiled",) if compiled else ())
 
     def build():
+        # a called rhs is an SX call node: the stages' sums stay scalar C code (an MX step
+        # copies every vector through its work array: 1.9x numbalsoda's time per step on
+        # the wheel spacecraft, bench/step_cost.py)
         f, tab = model.f, TABLEAUX["rk8"]
-        sym = ca.MX if call else _sym(f)
+        sym = ca.SX if call else _sym(f)
         nx, nu, np_ = model.nx, model.nu, f.numel_in(2)
         x, h, u, p = sym.sym("x", nx), sym.sym("h"), sym.sym("u", nu), sym.sym("p", np_)
         rtol, atol = sym.sym("rtol"), sym.sym("atol", nx)
-        k = _stages(f, tab.a, tab.c, x, h, lambda c: u, p, [])
+        k = _stages(f, tab.a, tab.c, x, h, lambda c: u, p, [], call=call)
         x_next = x + h * _combine(tab.b, k)
         step = ca.Function("rk8_step_k", [x, h, u, p, rtol, atol],
                            [x_next, _embedded_error(x, x_next, k, h, rtol, atol),
                             ca.vertcat(*k)])
         # the extension's 4 rhs inline unless they too exceed `INLINE_MAX` (as `calls_rhs`)
-        sym = ca.MX if compiled and 4 * f.n_instructions() > INLINE_MAX else _sym(f)
+        extra = compiled and 4 * f.n_instructions() > INLINE_MAX
+        sym = ca.SX if extra else _sym(f)
         x, h, u, p = sym.sym("x", nx), sym.sym("h"), sym.sym("u", nu), sym.sym("p", np_)
         xn, K = sym.sym("x_next", nx), sym.sym("K", tab.stages * nx)
         k = [K[i * nx:(i + 1) * nx] for i in range(tab.stages)]
-        k = _stages(f, ((),), (1.0,), xn, h, lambda c: u, p, k)  # k13 = f(x_next)
-        k = _stages(f, DOP853_DENSE_A, DOP853_DENSE_C, x, h, lambda c: u, p, k)
+        k = _stages(f, ((),), (1.0,), xn, h, lambda c: u, p, k, call=extra)  # k13 = f(x_next)
+        k = _stages(f, DOP853_DENSE_A, DOP853_DENSE_C, x, h, lambda c: u, p, k, call=extra)
         dx = xn - x
         F = [dx, h * k[0] - dx, 2 * dx - h * (k[12] + k[0])] + \
             [h * _combine(row, k) for row in DOP853_DENSE_D]
@@ -280,6 +285,6 @@ def kernel(model: Model, method: str, mode: str, *, error: bool = False,
     def build():
         if method == "lie":
             return _lie_kernel(model.f, model.attitude, mode)
-        return _rk_kernel(model.f, method, mode, error, ca.MX if call else None)
+        return _rk_kernel(model.f, method, mode, error, call)
 
     return cache.get(key, build, keepalive=model.f)

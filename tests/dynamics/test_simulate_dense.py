@@ -273,3 +273,29 @@ def test_header_inputs_are_the_first_slots():
     from appdyn.dynamics.integrate.dense import FIELDS
     assert FIELDS[:9] == ("rtol", "factor", "loose", "max_steps", "stiff_steps", "t0", "iq",
                           "tries", "phase")
+
+
+def test_a_called_rhs_step_is_the_inlined_step():
+    """A right-hand side too large to inline (the wheel spacecraft) is called from the
+    compiled steps as an SX call node (scalar sums around one C function, not an MX step):
+    the dense step, its extension and the pass's error step equal the inlined forms."""
+    from appdyn.dynamics import wheel_spacecraft
+    from appdyn.dynamics.integrate.kernels import calls_rhs
+
+    hub = np.array([[10.0, 0.2, -0.1], [0.2, 12.0, 0.3], [-0.1, 0.3, 8.0]])
+    model = wheel_spacecraft(hub, np.c_[np.eye(3), np.ones(3) / np.sqrt(3.0)], 0.05)
+    assert calls_rhs(model, "rk8")
+    x0 = np.r_[0.0, 0.0, 0.0, 1.0, 0.3, -0.2, 0.4, 100.0, -50.0, 80.0, 30.0]
+    u, p, atol = np.zeros(model.nu), np.zeros(model.f.numel_in(2)), np.full(11, 1e-10)
+    (step, cont), (cstep, ccont) = dense_kernels(model), dense_kernels(model, compiled=True)
+    assert cstep.is_a("SXFunction")
+    assert cstep.n_instructions() < 12 * model.f.n_instructions()  # (called, not inlined)
+    a, b = step(x0, 0.7, u, p, 1e-8, atol), cstep(x0, 0.7, u, p, 1e-8, atol)
+    for ai, bi in zip(a, b):
+        assert np.allclose(np.ravel(bi), np.ravel(ai), rtol=1e-14, atol=1e-14)
+    F, G = cont(x0, a[0], a[2], 0.7, u, p), ccont(x0, a[0], a[2], 0.7, u, p)
+    assert np.allclose(np.ravel(G), np.ravel(F), rtol=1e-13, atol=1e-13)
+    e, ce = (kernel(model, "rk8", "linear", error=True, compiled=c) for c in (False, True))
+    assert ce.is_a("SXFunction")
+    for ai, bi in zip(e(x0, 0.7, u, u, p, 1e-8, atol), ce(x0, 0.7, u, u, p, 1e-8, atol)):
+        assert np.allclose(np.ravel(bi), np.ravel(ai), rtol=1e-14, atol=1e-14)
