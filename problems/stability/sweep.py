@@ -1,6 +1,7 @@
 """`sweep`: run a case along one parameter and locate each verdict boundary by bisection."""
 from __future__ import annotations
 
+import functools
 import inspect
 
 import numpy as np
@@ -20,8 +21,20 @@ _STABLE_UNSTABLE = {"asymptotically stable", "unstable"}
 _BAND_RTOL = 1e-4  # a "marginally stable" stretch this narrow between the two is a zero band
 
 
+def _control_first(fun):
+    """``fun`` with python-control imported before it runs: the analyses of a sweep import it
+    on first use, and inside `interruptible`'s deferred region its ~1 s import (scipy,
+    matplotlib) would hold a Ctrl-C back until the import ends."""
+    @functools.wraps(fun)
+    def wrapper(*args, **kwargs):
+        import control  # noqa: F401  (a Ctrl-C here is a plain KeyboardInterrupt)
+        return fun(*args, **kwargs)
+    return wrapper
+
+
 @timed
 @accepts_progress_bar("sweep")
+@_control_first
 @interruptible
 def sweep(case, parameter: str, values, *, rtol: float = 1e-8, progress=None, executor=None,
           **case_kwargs) -> SweepResult:
