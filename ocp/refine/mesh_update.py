@@ -16,7 +16,7 @@ from appdyn.dynamics.interrupts import interruptible
 from appdyn.dynamics.progress import accepts_round_bar
 from ..checks import (STATUS_BOUND_VIOLATION, STATUS_RESIMULATION, interval_bound_violation,
                       periodic_jumps)
-from ..mesh import Mesh
+from ..mesh import Mesh, sorted_union
 from ..problem import Problem
 from ..progress import LOGGER, stage_sink
 from ..solution import Solution
@@ -122,7 +122,7 @@ def new_mesh(mesh: Mesh, est: IntervalErrors, T: float, t0: float, tol: float, q
     for k in range(N):
         if cuts[k].size:
             pieces.append(b[k] + cuts[k] * h[k])
-    new = np.unique(np.concatenate(pieces + [[1.0]]))
+    new = sorted_union(*pieces, [1.0])
     new[0], new[-1] = 0.0, 1.0
     new = new[np.concatenate([[True], np.diff(new) > 1e-14])]
     new[-1] = 1.0
