@@ -58,15 +58,13 @@ from functools import cached_property
 import casadi as ca
 import numpy as np
 
-from appdyn.dynamics.validate import integer
-
 from .cached import cached, function_key
 from .functions import sx_compatible
 from .mesh import Mesh, sorted_union
 
 __all__ = ["Transcription", "Trapezoid", "HermiteSimpson", "Radau", "RadauConstantControl",
            "RadauLinearControl", "TRANSCRIPTIONS", "CONTROLS", "f_columns", "lagrange_columns", "sx_compatible",
-           "get_transcription", "gauss_legendre"]
+           "get_transcription"]
 
 
 def _lagrange_basis(nodes: np.ndarray, s):
@@ -107,45 +105,9 @@ def _differentiation_matrix(nodes: np.ndarray) -> np.ndarray:
     return D
 
 
-def gauss_legendre(n: int) -> tuple[np.ndarray, np.ndarray]:
-    """Gauss-Legendre nodes and weights on [-1, 1] (``numpy.polynomial.legendre.leggauss``)
-    by Golub-Welsch: the eigenvalues of the Legendre Jacobi matrix and the squared first
-    components of its eigenvectors. Written out because importing ``numpy.polynomial``
-    costs about 9 ms in a fresh process (paid by its first solve).
-
-    Parameters
-    ----------
-    n : int
-        Number of nodes (>= 1); exact for polynomials of degree ``2 n - 1``.
-
-    Returns
-    -------
-    nodes : ndarray, shape (n,)
-        Ascending, in (-1, 1).
-    weights : ndarray, shape (n,)
-        Positive, summing to 2.
-
-    Raises
-    ------
-    TypeError, ValueError
-        If ``n`` is not an integer >= 1.
-
-    Examples
-    --------
-    >>> from appdyn.ocp.transcription import gauss_legendre
-    >>> x, w = gauss_legendre(2)
-    >>> print(np.round(x * 3 ** 0.5, 12), w)
-    [-1.  1.] [1. 1.]
-    """
-    k = np.arange(1, integer(n, "n", minimum=1))
-    off = k / np.sqrt(4.0 * k * k - 1.0)
-    nodes, vec = np.linalg.eigh(np.diag(off, 1) + np.diag(off, -1))
-    return nodes, 2.0 * vec[0] ** 2
-
-
 def _quadrature_weights(nodes: np.ndarray) -> np.ndarray:
     """``w_i = integral_0^1 l_i(s) ds`` for the Lagrange basis through ``nodes``."""
-    g, gw = gauss_legendre(nodes.size + 1)
+    g, gw = np.polynomial.legendre.leggauss(nodes.size + 1)
     s, gw = 0.5 * (g + 1.0), 0.5 * gw
     return gw @ _lagrange_matrix(nodes, s)
 
