@@ -182,6 +182,22 @@ def _better_round(problem: Problem, best, current, tol: float):
     return current
 
 
+def _overshoot_message(history: list, window: int, tol: float, sol: Solution) -> str:
+    """The message of a refinement that met ``tol`` while the dense output of its last round
+    still leaves a bound (where a bound is active, the interpolant between the nodes
+    overshoots by an amount that refining barely changes: a wheel-speed bound of
+    `slew.wheel_slew`, 1e-5 of its scale on 123, 234 and 400 intervals)."""
+    bv = sol.bound_violation
+    sizes = ", ".join(str(r.n_intervals) for r in history[-(window + 1):])
+    return (f"refine: the error estimate meets tol ({history[-1].max_error:.2e} <= {tol:g}), "
+            f"but on {sizes} intervals the dense output still leaves a bound: `{bv.name}` by "
+            f"{bv.max:.3g} of its scale at t = {bv.time:.6g} s. Where a bound is active the "
+            f"interpolant overshoots it between the nodes by about the same amount on finer "
+            f"meshes. Remedy: accept an overshoot of this size (bound_tol of ocp.solve and "
+            f"ocp.refine, e.g. {2 * bv.max:.1g}), with the bound tightened by as much where the "
+            f"original must hold. {sol.message}")
+
+
 def _stall_message(history: list, q: int, window: int, sol: Solution) -> str:
     errors = ", ".join(f"{r.max_error:.2e}" for r in history[-(window + 1):])
     sizes = ", ".join(str(r.n_intervals) for r in history[-(window + 1):])
@@ -449,8 +465,12 @@ def refine(problem: Problem, solution: Solution | None = None, *, tol: float = 1
         info.update(converged=bool(est_b.max_error <= tol), errors=est_b, returned_round=rnd)
         return annotate(earlier, info, message=note)
     if stop == "stalled" and (sol.success or _refinable(sol)):
-        message = _stall_message(history, q, stall_rounds, sol)
-        if not sol.success:  # the last round also failed a check of its dense output
-            message += f" The last round also failed ({status_name(sol.status)}): {sol.message}"
+        if est.max_error <= tol and sol.status == STATUS_BOUND_VIOLATION:
+            message = _overshoot_message(history, stall_rounds, tol, sol)
+        else:
+            message = _stall_message(history, q, stall_rounds, sol)
+            if not sol.success:  # the last round also failed a check of its dense output
+                message += (f" The last round also failed ({status_name(sol.status)}): "
+                            f"{sol.message}")
         return annotate(sol, info, success=False, status=STATUS_STALLED, message=message)
     return annotate(sol, info, message=message)
