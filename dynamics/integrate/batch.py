@@ -35,7 +35,7 @@ from .batch_fixed import (BATCH_THREADS, batch_threads, fixed_batch, fixed_messa
 from .cvodes import run_cvodes
 from .dense import HEADER as DENSE_HEADER
 from .dense import FIELDS as DENSE_FIELDS
-from .dense import dense_many
+from .dense import FIRST, TRIES, dense_many
 from .estimates import jacobian_x, rho_sigma
 from .evaluate import map_eval
 from .inputs import Batch, RunOptions, check_batch
@@ -46,8 +46,10 @@ from .result import (FAILED, OK, OK_STIFF, ROUNDOFF, UNVERIFIED, VIOLATED, Dense
                      Run, SimulationResult)
 from .smoothness import nonsmooth_operations
 from .sanity import remedy, violations
+from .stepcontrol import LOCAL_RTOL_MIN
 
-__all__ = ["Batch", "BatchResult", "check_batch", "simulate_batch", "BATCH_THREADS"]  # (Batch,
+__all__ = ["Batch", "BatchResult", "check_batch", "simulate_batch", "BATCH_THREADS",
+           "first_factor", "dense_rounds"]  # (Batch,
 # check_batch: `inputs`, here for the callers that import them from this module)
 
 class BatchTarget:
@@ -188,16 +190,22 @@ def auto_dense_batch(batch: Batch, rtol: float, atol: np.ndarray, max_steps: int
     head = np.empty((K, DENSE_HEADER))
     missing = []
 
-    def call(k0, k1):
+    def call(k0, k1, factor):
         if dense_many(model, x0, t, u, p, rtol, atol, max_steps, STIFF_STEPS, slice(k0, k1),
-                      out=(X, head)) is None:
+                      out=(X, head), factor=factor) is None:
             missing.append(k0)
 
     # (a small batch stays on one thread: a hand-over costs tens of microseconds on an idle
     # machine and milliseconds on a loaded one, where the woken thread waits for a core)
-    spread_runs(call, K, batch_threads(threads) if K >= 2 * DENSE_PART else 1, DENSE_PART)
-    if missing:
-        return None
+    spread = batch_threads(threads) if K >= 2 * DENSE_PART else 1
+    factor, factors = FIRST, []
+    for k0, k1 in dense_rounds(K):  # (the rounds do not depend on `threads`: same bits)
+        if k0:
+            factor = _learned(head[:k0], factor, rtol)
+        factors.append(factor)
+        spread_runs(lambda a, b: call(k0 + a, k0 + b, factor), k1 - k0, spread, DENSE_PART)
+        if missing:
+            return None
     result = head[:, DENSE_FIELDS.index("result")]  # (each run's header read as columns)
     estimate = head[:, DENSE_FIELDS.index("estimate")].copy()
     steps = head[:, DENSE_FIELDS.index("spent")].astype(int)
@@ -220,6 +228,10 @@ def auto_dense_batch(batch: Batch, rtol: float, atol: np.ndarray, max_steps: int
                f"checked against its own steps merged in pairs): "
                f"{steps.min()}-{steps.max()} steps per run; estimated error up to "
                f"{worst if worst > -math.inf else math.nan:.2g} of tolerance")
+    if len(factors) > 1:
+        message += (f"; first answers at {factors[0]:.2g} of the tolerance, then at "
+                    + ", ".join(f"{f:.2g}" for f in factors[1:]) + " (learned from the runs "
+                    "before: `first_factor`)")
     if redo.size:
         message += f"; {redo.size} run(s) alone through auto's other paths"
     return x, ok, status, estimate, ", ".join(sorted(used)), int(steps.max()), message
@@ -228,6 +240,149 @@ def auto_dense_batch(batch: Batch, rtol: float, atol: np.ndarray, max_steps: int
 #: Most runs of one compiled call of a dense batch (Ctrl-C is looked at between groups of
 #: them, `batch_fixed.spread_runs`).
 DENSE_PART = 64
+#: A dense batch runs in rounds (`dense_rounds`): its first `PILOT` runs answer first at
+#: `dense.FIRST` of the tolerance, as single calls do; each later round, `ROUND_GROWTH`
+#: times the runs before it (the last takes the rest), at the factor `first_factor` learns
+#: from every run before it.
+PILOT = 16
+ROUND_GROWTH = 4
+#: DOP853's order: a run's steps grow as its local tolerance to the power -1/8 (measured:
+#: -0.10..-0.12 per run on `bench/simulate.py`'s torque-free batch, factors 1e-4..0.3).
+ORDER = 8
+#: A retry of `cpass._AUTO` (``AU_AIM``, ``AU_LADDER``): the next answer's local tolerance
+#: aims at 0.2 tolerances from the estimate, scaled by at most 0.5 and at least 1e-2.
+RETRY_AIM, RETRY_LADDER = 0.2, 1e-2
+#: How far from the factors the runs done were measured at a later round's factor may go,
+#: either way: the estimate's proportionality to the factor (slope 0.35-1.8 per run over
+#: 3x, median 1.0, measured on the batch above) is not carried further than a decade.
+REACH = 10.0
+#: How far a run's error per unit of factor moves when its factor changes: 2x either way
+#: (the slope above over 3x of factor), so each run done counts as three, at its ratio
+#: (weight 1/2) and at 2x either side (1/4 each).
+SPREAD = 2.0
+
+
+def dense_rounds(K: int) -> list[tuple[int, int]]:
+    """The rounds ``(k0, k1)`` of a dense batch of ``K`` runs: the first `PILOT` runs, then
+    rounds ending at `ROUND_GROWTH` times the runs before (the last one up to ``K``).
+
+    Examples
+    --------
+    >>> from appdyn.dynamics.integrate.batch import dense_rounds
+    >>> dense_rounds(1000)
+    [(0, 16), (16, 64), (64, 256), (256, 1000)]
+    >>> dense_rounds(12)
+    [(0, 12)]
+    """
+    edges, end = [0], PILOT
+    while end < K:
+        edges.append(end)
+        end *= ROUND_GROWTH
+    edges.append(K)
+    return list(zip(edges[:-1], edges[1:]))
+
+
+def first_factor(estimate, factor, steps, gate, *, current: float, rtol: float) -> float:
+    """The first answer's local tolerance over the requested one (the factor) for the next
+    runs of a batch: the one that minimises their expected steps under what the runs done
+    showed, on a grid of 8 per decade through ``current`` within `REACH` of the factors the
+    runs were measured at (at most 1, at least ``LOCAL_RTOL_MIN / rtol``).
+
+    Each run done is a draw of how the batch behaves: its global error per unit of local
+    factor (``estimate / factor``: the error follows the local tolerance about linearly,
+    within `SPREAD`) and its steps (answer and check, growing as factor^(-1/`ORDER`)). At a
+    candidate factor a run is accepted at once when its predicted estimate is within its
+    ``gate``; otherwise it pays a retry as ``cpass._AUTO`` makes one (`RETRY_AIM`, `RETRY_LADDER`, at most
+    `dense.TRIES` answers; a run still not accepted counts double, for auto's other paths).
+    Too tight a factor over-delivers on every run, too loose one pays retries: the sum
+    weighs both, so a lone chaotic run retries alone rather than tightening all. Every run
+    is still verified by its own check.
+
+    Parameters
+    ----------
+    estimate, factor, steps, gate : array_like, shape (m,)
+        Of each verified run done: its estimate [tolerances], its accepted answer's factor,
+        that answer's and its check's steps, its acceptance [tolerances] (0.5 or 1).
+        Entries not finite or not positive are left out.
+    current : float
+        The factor of the last round.
+    rtol : float
+        The requested relative tolerance.
+
+    Returns
+    -------
+    float
+        ``current`` when no run is usable.
+
+    Examples
+    --------
+    >>> from appdyn.dynamics.integrate.batch import first_factor
+    >>> f = first_factor([0.01] * 4, [0.003] * 4, [150] * 4, [0.5] * 4, current=0.003,
+    ...                  rtol=1e-8)
+    >>> round(f, 4)  # (runs 50x inside the gate: a decade looser)
+    0.03
+    >>> round(first_factor([0.01] * 9 + [40.0], [0.003] * 10, [150] * 10, [0.5] * 10,
+    ...                    current=0.003, rtol=1e-8), 4)  # (one run 4000x worse: still looser)
+    0.03
+    >>> round(first_factor([2.0] * 4, [0.003] * 4, [150] * 4, [0.5] * 4, current=0.003,
+    ...                    rtol=1e-8), 5)  # (every run would retry: tighter, with a margin)
+    0.0003
+    """
+    e, f, n, g = (np.asarray(a, float).ravel() for a in (estimate, factor, steps, gate))
+    use = np.isfinite(e) & np.isfinite(f) & np.isfinite(n) & np.isfinite(g) & (e > 0) & \
+        (f > 0) & (n > 0) & (g > 0)
+    if not use.any():
+        return float(current)
+    e, f, n, g = e[use], f[use], n[use], g[use]
+    # (8 per decade through `current`, within `REACH` of the factors the runs were measured at)
+    low, high = max(f.min() / REACH, LOCAL_RTOL_MIN / rtol), min(f.max() * REACH, 1.0)
+    if low > high:  # (measured below the floor: at the floor)
+        return float(min(LOCAL_RTOL_MIN / rtol, 1.0))
+    j = np.arange(math.floor(8 * math.log10(low / current)),
+                  math.ceil(8 * math.log10(high / current)) + 1)
+    grid = current * 10.0 ** (j / 8.0)
+    grid = grid[(grid >= low * (1 - 1e-12)) & (grid <= high * (1 + 1e-12))]
+    if grid.size == 0:
+        return float(current)
+    # each run's steps scale as factor^(-1/ORDER) from its own; its ratio spread by `SPREAD`
+    # (what it would be at another factor); the runs binned by ratio (1/32 decade) and gate
+    scale = n * f ** (1.0 / ORDER)
+    ratio = np.concatenate([e / f / SPREAD, e / f, e / f * SPREAD])
+    weight = np.concatenate([0.25 * scale, 0.5 * scale, 0.25 * scale])
+    cost = np.zeros(grid.size)
+    gates = np.tile(g, 3)
+    for gate in np.unique(g):
+        key = np.round(32 * np.log10(ratio[gates == gate])).astype(int)
+        lo = key.min()
+        w = np.bincount(key - lo, weights=weight[gates == gate])
+        used = np.flatnonzero(w)
+        cost += _expected_steps(grid, 10.0 ** ((used + lo) / 32), gate) @ w[used]
+    return float(grid[int(np.argmin(cost))])
+
+
+def _expected_steps(grid: np.ndarray, ratio: np.ndarray, gate: float) -> np.ndarray:
+    """The steps ``(c, m)`` of runs of unit steps at factor 1 (steps ``factor^(-1/ORDER)``),
+    of estimates ``ratio (m,)`` per unit factor and acceptance ``gate``, had their first
+    answer been at each factor of ``grid (c,)``: the answers until one is accepted (a
+    retry as `cpass._AUTO` makes one), double when none of `dense.TRIES` is."""
+    at = np.repeat(grid[:, None], ratio.size, axis=1)
+    total = np.zeros_like(at)
+    live = np.ones(at.shape, bool)
+    for _ in range(TRIES):
+        total += np.where(live, at ** (-1.0 / ORDER), 0.0)
+        est = ratio * at
+        live &= est > gate
+        at = np.where(live, at * np.clip(RETRY_AIM / est, RETRY_LADDER, 0.5), at)
+    return np.where(live, 2 * total, total)
+
+
+def _learned(head: np.ndarray, current: float, rtol: float) -> float:
+    """`first_factor` from the headers ``head (m, HEADER)`` of the runs done."""
+    col = lambda name: head[:, DENSE_FIELDS.index(name)]
+    ok = col("result") == 1
+    return first_factor(col("estimate")[ok], col("factor")[ok],
+                        (col("answer_steps") + col("check_steps"))[ok], col("gate")[ok],
+                        current=current, rtol=rtol)
 
 
 def _sane(batch: Batch, x: np.ndarray, ok: np.ndarray, status: np.ndarray, message: str,
