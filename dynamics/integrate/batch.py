@@ -9,8 +9,11 @@ contiguous parts that the threads of the process's pool take as they finish
 use, `batch_fixed.batch_threads`), each part filling its own runs' slices of the result, so
 the answers are the same bits for every thread count. ``auto`` on a smooth model under
 controls constant over each run: every run's answer, check run and verdict in one compiled
-loop (`dense.dense_many`), each run with its own steps, the single call's answer to the
-last bit; otherwise auto's multi-run error control over the whole batch (one step count for
+loop (`dense.dense_many`), each run with its own steps and its own check; the runs in
+rounds (`dense_rounds`), the first round's runs the single call's answers to the last bit,
+each later round's first answers at the local tolerance the runs before show to cost the
+fewest steps (`first_factor`: over-delivery weighed against retries), each of its runs the
+single call's answer at that first tolerance; otherwise auto's multi-run error control over the whole batch (one step count for
 all runs; a stiff or non-smooth batch goes run by run as single runs do). The fixed-step
 methods: under constant controls, compiled rk8 is a plain C loop over each run's steps
 (`lanes`: four runs per vector step where the model's step allows); otherwise the model's
@@ -168,8 +171,10 @@ def auto_dense_batch(batch: Batch, rtol: float, atol: np.ndarray, max_steps: int
     answer, check run and verdict of `dense.dense_auto` for every run in one compiled loop
     over the runs (`dense.dense_many`; the runs in parts of at most `DENSE_PART` spread over
     ``threads`` threads by `batch_fixed.spread_runs` from ``2 DENSE_PART`` runs on, each
-    part filling its own slice of the answers), each run with its own steps; a run not verified there goes alone through
-    `solve_auto` (as a single call would). Returns ``(x (nx, n, K), ok, status, estimate,
+    part filling its own slice of the answers), each run with its own steps; round by round
+    (`dense_rounds`), each later round's first answers at the factor `first_factor` learns
+    from the runs before. A run not verified there goes alone through `solve_auto` (as a
+    single call would). Returns ``(x (nx, n, K), ok, status, estimate,
     method, n_steps, message)``, or None (no compiled pass, a control that varies within a
     run, jit off)."""
     if not auto_jit(jit):
