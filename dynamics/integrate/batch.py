@@ -10,7 +10,7 @@ use, `batch_fixed.batch_threads`), each part filling its own runs' slices of the
 the answers are the same bits for every thread count. ``auto`` on a smooth model under
 controls constant over each run: every run's answer, check run and verdict in one compiled
 loop (`dense.dense_many`), each run with its own steps and its own check; the runs in
-rounds (`dense_rounds`), the first round's runs the single call's answers to the last bit,
+rounds (`dense_rounds`, each a sample spread over the batch: `dense_order`), the first round's runs the single call's answers to the last bit,
 each later round's first answers at the local tolerance the runs before show to cost the
 fewest steps (`first_factor`: over-delivery weighed against retries), each of its runs the
 single call's answer at that first tolerance; otherwise auto's multi-run error control over the whole batch (one step count for
@@ -52,7 +52,7 @@ from .sanity import remedy, violations
 from .stepcontrol import LOCAL_RTOL_MIN
 
 __all__ = ["Batch", "BatchResult", "check_batch", "simulate_batch", "BATCH_THREADS",
-           "first_factor", "dense_rounds"]  # (Batch,
+           "first_factor", "dense_order", "dense_rounds"]  # (Batch,
 # check_batch: `inputs`, here for the callers that import them from this module)
 
 class BatchTarget:
@@ -172,7 +172,7 @@ def auto_dense_batch(batch: Batch, rtol: float, atol: np.ndarray, max_steps: int
     over the runs (`dense.dense_many`; the runs in parts of at most `DENSE_PART` spread over
     ``threads`` threads by `batch_fixed.spread_runs` from ``2 DENSE_PART`` runs on, each
     part filling its own slice of the answers), each run with its own steps; round by round
-    (`dense_rounds`), each later round's first answers at the factor `first_factor` learns
+    (`dense_rounds` of the runs in `dense_order`), each later round's first answers at the factor `first_factor` learns
     from the runs before. A run not verified there goes alone through `solve_auto` (as a
     single call would). Returns ``(x (nx, n, K), ok, status, estimate,
     method, n_steps, message)``, or None (no compiled pass, a control that varies within a
@@ -185,19 +185,20 @@ def auto_dense_batch(batch: Batch, rtol: float, atol: np.ndarray, max_steps: int
     if not batch.constant and ua.size and not (np.all(ua == ua[:, :1]) and
                                                np.all(batch.ub == ua[:, :1])):
         return None
-    x0 = np.ascontiguousarray(batch.x0.T)
+    order = dense_order(K)  # (the runs in this order: each round a sample spread over all)
+    x0 = np.ascontiguousarray(batch.x0.T[order])
     u = np.zeros((K, max(nu, 1)))
     if nu and ua.shape[1]:
-        u[:, :nu] = ua[:, 0]
+        u[:, :nu] = ua[order, 0]
     p = np.zeros((K, max(np_, 1)))
-    p[:, :np_] = batch.p.T
-    X = np.empty((K, nx, t.size))
-    head = np.empty((K, DENSE_HEADER))
+    p[:, :np_] = batch.p.T[order]
+    Xo = np.empty((K, nx, t.size))
+    ho = np.empty((K, DENSE_HEADER))
     missing = []
 
     def call(k0, k1, factor):
         if dense_many(model, x0, t, u, p, rtol, atol, max_steps, STIFF_STEPS, slice(k0, k1),
-                      out=(X, head), factor=factor) is None:
+                      out=(Xo, ho), factor=factor) is None:
             missing.append(k0)
 
     # (a small batch stays on one thread: a hand-over costs tens of microseconds on an idle
@@ -206,11 +207,13 @@ def auto_dense_batch(batch: Batch, rtol: float, atol: np.ndarray, max_steps: int
     factor, factors = FIRST, []
     for k0, k1 in dense_rounds(K):  # (the rounds do not depend on `threads`: same bits)
         if k0:
-            factor = _learned(head[:k0], factor, rtol)
+            factor = _learned(ho[:k0], factor, rtol)
         factors.append(factor)
         spread_runs(lambda a, b: call(k0 + a, k0 + b, factor), k1 - k0, spread, DENSE_PART)
         if missing:
             return None
+    X, head = np.empty_like(Xo), np.empty_like(ho)
+    X[order], head[order] = Xo, ho
     result = head[:, DENSE_FIELDS.index("result")]  # (each run's header read as columns)
     estimate = head[:, DENSE_FIELDS.index("estimate")].copy()
     steps = head[:, DENSE_FIELDS.index("spent")].astype(int)
@@ -265,6 +268,28 @@ REACH = 10.0
 #: (the slope above over 3x of factor), so each run done counts as three, at its ratio
 #: (weight 1/2) and at 2x either side (1/4 each).
 SPREAD = 2.0
+
+
+def dense_order(K: int) -> np.ndarray:
+    """The order in which a dense batch of ``K`` runs goes (`dense_rounds` of it): by the
+    bit-reversed run index, so that every round's runs, and the runs before it, are a
+    sample spread over the whole batch (a batch sorted by a parameter, easy runs first,
+    would otherwise teach its first rounds the wrong first tolerance).
+
+    Examples
+    --------
+    >>> from appdyn.dynamics.integrate.batch import dense_order
+    >>> dense_order(8).tolist()
+    [0, 4, 2, 6, 1, 5, 3, 7]
+    >>> dense_order(6).tolist()
+    [0, 4, 2, 1, 5, 3]
+    """
+    bits = max(1, (K - 1).bit_length())
+    k = np.arange(K)
+    reversed_ = np.zeros(K, dtype=np.int64)
+    for b in range(bits):
+        reversed_ |= ((k >> b) & 1) << (bits - 1 - b)
+    return np.argsort(reversed_, kind="stable")
 
 
 def dense_rounds(K: int) -> list[tuple[int, int]]:
