@@ -10,7 +10,7 @@ use, `batch_fixed.batch_threads`), each part filling its own runs' slices of the
 the answers are the same bits for every thread count. ``auto`` on a smooth model under
 controls constant over each run: every run's answer, check run and verdict in one compiled
 loop (`dense.dense_many`), each run with its own steps and its own check; the runs in
-rounds (`dense_rounds`, each a sample spread over the batch: `dense_order`), the first round's runs the single call's answers to the last bit,
+rounds (`dense_rounds`, each spread over the batch), the first round's runs the single call's answers to the last bit,
 each later round's first answers at the local tolerance the runs before show to cost the
 fewest steps (`first_factor`: over-delivery weighed against retries), each of its runs the
 single call's answer at that first tolerance; otherwise auto's multi-run error control over the whole batch (one step count for
@@ -52,7 +52,7 @@ from .sanity import remedy, violations
 from .stepcontrol import LOCAL_RTOL_MIN
 
 __all__ = ["Batch", "BatchResult", "check_batch", "simulate_batch", "BATCH_THREADS",
-           "first_factor", "dense_order", "dense_rounds"]  # (Batch,
+           "first_factor", "dense_rounds"]  # (Batch,
 # check_batch: `inputs`, here for the callers that import them from this module)
 
 class BatchTarget:
@@ -172,7 +172,7 @@ def auto_dense_batch(batch: Batch, rtol: float, atol: np.ndarray, max_steps: int
     over the runs (`dense.dense_many`; the runs in parts of at most `DENSE_PART` spread over
     ``threads`` threads by `batch_fixed.spread_runs` from ``2 DENSE_PART`` runs on, each
     part filling its own slice of the answers), each run with its own steps; round by round
-    (`dense_rounds` of the runs in `dense_order`), each later round's first answers at the factor `first_factor` learns
+    (`dense_rounds`, each spread over the batch), each later round's first answers at the factor `first_factor` learns
     from the runs before. A run not verified there goes alone through `solve_auto` (as a
     single call would). Returns ``(x (nx, n, K), ok, status, estimate,
     method, n_steps, message)``, or None (no compiled pass, a control that varies within a
@@ -185,35 +185,39 @@ def auto_dense_batch(batch: Batch, rtol: float, atol: np.ndarray, max_steps: int
     if not batch.constant and ua.size and not (np.all(ua == ua[:, :1]) and
                                                np.all(batch.ub == ua[:, :1])):
         return None
-    order = dense_order(K)  # (the runs in this order: each round a sample spread over all)
-    x0 = np.ascontiguousarray(batch.x0.T[order])
+    x0 = np.ascontiguousarray(batch.x0.T)
     u = np.zeros((K, max(nu, 1)))
     if nu and ua.shape[1]:
-        u[:, :nu] = ua[order, 0]
+        u[:, :nu] = ua[:, 0]
     p = np.zeros((K, max(np_, 1)))
-    p[:, :np_] = batch.p.T[order]
-    Xo = np.empty((K, nx, t.size))
-    ho = np.empty((K, DENSE_HEADER))
+    p[:, :np_] = batch.p.T
+    X = np.empty((K, nx, t.size))
+    head = np.empty((K, DENSE_HEADER))
     missing = []
-
-    def call(k0, k1, factor):
-        if dense_many(model, x0, t, u, p, rtol, atol, max_steps, STIFF_STEPS, slice(k0, k1),
-                      out=(Xo, ho), factor=factor) is None:
-            missing.append(k0)
 
     # (a small batch stays on one thread: a hand-over costs tens of microseconds on an idle
     # machine and milliseconds on a loaded one, where the woken thread waits for a core)
     spread = batch_threads(threads) if K >= 2 * DENSE_PART else 1
-    factor, factors = FIRST, []
-    for k0, k1 in dense_rounds(K):  # (the rounds do not depend on `threads`: same bits)
-        if k0:
-            factor = _learned(ho[:k0], factor, rtol)
+    factor, factors, done = FIRST, [], []
+    for pieces in dense_rounds(K):  # (the rounds do not depend on `threads`: same bits)
+        if done:
+            factor = _learned(head[np.concatenate(done)], factor, rtol)
         factors.append(factor)
-        spread_runs(lambda a, b: call(k0 + a, k0 + b, factor), k1 - k0, spread, DENSE_PART)
+        starts = np.cumsum([0] + [k1 - k0 for k0, k1 in pieces])
+
+        def call(a, b, pieces=pieces, starts=starts, factor=factor):
+            # the round's runs a <= i < b, its pieces laid end to end: each piece's share
+            for (k0, _), s0, s1 in zip(pieces, starts[:-1], starts[1:]):
+                lo, hi = max(a, s0), min(b, s1)
+                if lo < hi and dense_many(model, x0, t, u, p, rtol, atol, max_steps,
+                                          STIFF_STEPS, slice(k0 + lo - s0, k0 + hi - s0),
+                                          out=(X, head), factor=factor) is None:
+                    missing.append(k0)
+
+        spread_runs(call, int(starts[-1]), spread, DENSE_PART)
         if missing:
             return None
-    X, head = np.empty_like(Xo), np.empty_like(ho)
-    X[order], head[order] = Xo, ho
+        done += [np.arange(k0, k1) for k0, k1 in pieces]
     result = head[:, DENSE_FIELDS.index("result")]  # (each run's header read as columns)
     estimate = head[:, DENSE_FIELDS.index("estimate")].copy()
     steps = head[:, DENSE_FIELDS.index("spent")].astype(int)
@@ -248,8 +252,8 @@ def auto_dense_batch(batch: Batch, rtol: float, atol: np.ndarray, max_steps: int
 #: Most runs of one compiled call of a dense batch (Ctrl-C is looked at between groups of
 #: them, `batch_fixed.spread_runs`).
 DENSE_PART = 64
-#: A dense batch runs in rounds (`dense_rounds`): its first `PILOT` runs answer first at
-#: `dense.FIRST` of the tolerance, as single calls do; each later round, `ROUND_GROWTH`
+#: A dense batch runs in rounds (`dense_rounds`): `PILOT` runs spread over it answer first
+#: at `dense.FIRST` of the tolerance, as single calls do; each later round, `ROUND_GROWTH`
 #: times the runs before it (the last takes the rest), at the factor `first_factor` learns
 #: from every run before it.
 PILOT = 16
@@ -270,46 +274,36 @@ REACH = 10.0
 SPREAD = 2.0
 
 
-def dense_order(K: int) -> np.ndarray:
-    """The order in which a dense batch of ``K`` runs goes (`dense_rounds` of it): by the
-    bit-reversed run index, so that every round's runs, and the runs before it, are a
-    sample spread over the whole batch (a batch sorted by a parameter, easy runs first,
-    would otherwise teach its first rounds the wrong first tolerance).
-
-    Examples
-    --------
-    >>> from appdyn.dynamics.integrate.batch import dense_order
-    >>> dense_order(8).tolist()
-    [0, 4, 2, 6, 1, 5, 3, 7]
-    >>> dense_order(6).tolist()
-    [0, 4, 2, 1, 5, 3]
-    """
-    bits = max(1, (K - 1).bit_length())
-    k = np.arange(K)
-    reversed_ = np.zeros(K, dtype=np.int64)
-    for b in range(bits):
-        reversed_ |= ((k >> b) & 1) << (bits - 1 - b)
-    return np.argsort(reversed_, kind="stable")
-
-
-def dense_rounds(K: int) -> list[tuple[int, int]]:
-    """The rounds ``(k0, k1)`` of a dense batch of ``K`` runs: the first `PILOT` runs, then
-    rounds ending at `ROUND_GROWTH` times the runs before (the last one up to ``K``).
+def dense_rounds(K: int) -> list[tuple[tuple[int, int], ...]]:
+    """The rounds of a dense batch of ``K`` runs, each a tuple of slices ``(k0, k1)``: the
+    batch cut into `PILOT` near-equal contiguous strata, round 0 takes the first run of
+    each, every later round `ROUND_GROWTH` times the runs before from each stratum (the
+    last one the rest). The runs done before a round are thus spread over the whole batch
+    (a batch sorted by a parameter, easy runs first, would otherwise teach the first
+    rounds the wrong first tolerance), and every round writes its slices in place. One
+    round for a batch under ``2 PILOT`` runs.
 
     Examples
     --------
     >>> from appdyn.dynamics.integrate.batch import dense_rounds
-    >>> dense_rounds(1000)
-    [(0, 16), (16, 64), (64, 256), (256, 1000)]
+    >>> [sum(k1 - k0 for k0, k1 in r) for r in dense_rounds(1000)]
+    [16, 48, 192, 744]
+    >>> dense_rounds(1000)[0][:3]
+    ((0, 1), (62, 63), (125, 126))
     >>> dense_rounds(12)
-    [(0, 12)]
+    [((0, 12),)]
     """
-    edges, end = [0], PILOT
-    while end < K:
-        edges.append(end)
-        end *= ROUND_GROWTH
-    edges.append(K)
-    return list(zip(edges[:-1], edges[1:]))
+    if K < 2 * PILOT:
+        return [((0, K),)]
+    edges = [K * i // PILOT for i in range(PILOT + 1)]
+    counts, c = [0], 1
+    while c < max(b - a for a, b in zip(edges[:-1], edges[1:])):
+        counts.append(c)
+        c *= ROUND_GROWTH
+    counts.append(K)
+    return [tuple((a + min(c0, b - a), a + min(c1, b - a))
+                  for a, b in zip(edges[:-1], edges[1:]) if min(c0, b - a) < min(c1, b - a))
+            for c0, c1 in zip(counts[:-1], counts[1:])]
 
 
 def first_factor(estimate, factor, steps, gate, *, current: float, rtol: float) -> float:

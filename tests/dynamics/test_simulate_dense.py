@@ -251,11 +251,10 @@ def test_a_batch_run_not_verified_in_the_loop_goes_alone(monkeypatch):
 
 
 def test_later_rounds_of_a_batch_answer_first_at_the_factor_learned_before(monkeypatch):
-    """A batch of 80 runs goes in rounds (`batch.dense_rounds` of the runs in
-    `batch.dense_order`): the first round's runs are their single calls to the last bit;
-    each later round's runs are the single call with its first answer at the factor the
-    runs before chose (`batch.first_factor`), each verified by its own check and within the
-    tolerance of its Jacobi truth."""
+    """A batch of 80 runs goes in rounds (`batch.dense_rounds`): the first round's runs are
+    their single calls to the last bit; each later round's runs are the single call with
+    its first answer at the factor the runs before chose (`batch.first_factor`), each
+    verified by its own check and within the tolerance of its Jacobi truth."""
     from appdyn.dynamics.integrate import batch as batch_module, dense
     seen = []
     real = batch_module.dense_many
@@ -270,32 +269,39 @@ def test_later_rounds_of_a_batch_answer_first_at_the_factor_learned_before(monke
     res = simulate(model, x0, t, threads=1)
     assert res.all_success and "learned from the runs before" in res.message, res.message
     rounds = batch_module.dense_rounds(80)
-    assert len(rounds) == 3 and [s for s, _ in seen] == [slice(*r) for r in rounds]
-    assert seen[0][1] == dense.FIRST and seen[1][1] != dense.FIRST
+    assert len(rounds) == 3
+    covered = sorted(k for runs, _ in seen for k in range(runs.start, runs.stop))
+    assert covered == list(range(80))
+    first = {k0 for k0, _ in rounds[0]}
+    assert all((f == dense.FIRST) == (runs.start in first) for runs, f in seen)
     w = np.stack([torque_free_omega(INERTIA, x0[4:, k], t) for k in range(80)], axis=2)
     assert np.all(np.abs(res.x[4:] - w) <= 1e-10 + 1e-8 * np.abs(w))
-    order = batch_module.dense_order(80)
-    assert sorted(order.tolist()) == list(range(80))
-    for runs, factor in seen:
+    for runs, factor in seen[::4]:
         monkeypatch.setattr(dense, "FIRST", factor)
-        for k in order[[runs.start, runs.stop - 1]]:
+        for k in (runs.start, runs.stop - 1):
             one = simulate(model, x0[:, k], t)
             assert np.array_equal(res.x[:, :, k], one.x)
             assert res.error_estimate[k] == one.error_estimate
 
 
-def test_each_round_of_a_batch_is_a_sample_spread_over_it():
-    """`batch.dense_order`: the runs done before each round (`batch.dense_rounds`) are spread
-    over the whole batch (no gap wider than about twice the even one), so a batch sorted
-    by a parameter (easy runs first) does not teach its first rounds the wrong tolerance."""
-    from appdyn.dynamics.integrate.batch import dense_order, dense_rounds
-    for K in (5, 80, 1000, 1024):
-        order = dense_order(K)
-        assert sorted(order.tolist()) == list(range(K))
-        for _, k1 in dense_rounds(K):
-            done = np.sort(order[:k1])
-            gaps = np.diff(np.r_[done, K + done[0]])  # (around the end too)
-            assert gaps.max() <= 2 * K / k1 + 1, (K, k1, gaps.max())
+def test_each_round_of_a_batch_draws_from_every_part_of_it():
+    """`batch.dense_rounds`: the rounds cover every run once, in slices; the first takes
+    one run from each sixteenth of the batch and every later round but the last takes
+    from each sixteenth alike, so a batch sorted by a parameter (easy runs first) does not
+    teach its first rounds the wrong tolerance."""
+    from appdyn.dynamics.integrate.batch import PILOT, dense_rounds
+    for K in (33, 80, 1000, 1024, 5000):
+        rounds = dense_rounds(K)
+        runs = [k for r in rounds for k0, k1 in r for k in range(k0, k1)]
+        assert sorted(runs) == list(range(K))
+        strata = np.array([K * i // PILOT for i in range(PILOT + 1)])
+        part = lambda k: int(np.searchsorted(strata, k, side="right")) - 1
+        assert sorted(part(k0) for k0, _ in rounds[0]) == list(range(PILOT))
+        assert all(k1 - k0 == 1 for k0, k1 in rounds[0])
+        for r in rounds[1:-1]:
+            assert sorted(part(k0) for k0, _ in r) == list(range(PILOT))
+            assert len({k1 - k0 for k0, k1 in r}) == 1
+    assert dense_rounds(31) == [((0, 31),)]
 
 
 def test_first_factor_weighs_over_delivery_against_retries():
