@@ -10,11 +10,12 @@ use, `batch_fixed.batch_threads`), each part filling its own runs' slices of the
 the answers are the same bits for every thread count. ``auto`` on a smooth model under
 controls constant over each run: every run's answer, check run and verdict in one compiled
 loop (`dense.dense_many`), each run with its own steps and its own check; the runs in
-rounds (`dense_rounds`, each spread over the batch), the first round's runs the single call's answers to the last bit,
-each later round's first answers at the local tolerance the runs before show to cost the
-fewest steps (`first_factor`: over-delivery weighed against retries), each of its runs the
-single call's answer at that first tolerance; otherwise auto's multi-run error control over the whole batch (one step count for
-all runs; a stiff or non-smooth batch goes run by run as single runs do). The fixed-step
+rounds (`dense_rounds`, each spread over the batch), the first round's runs the single
+call's answers to the last bit, each later round's first answers at the local tolerance
+the runs before show to cost the fewest steps (`first_factor`: over-delivery weighed
+against retries), each of its runs the single call's answer at that first tolerance;
+otherwise auto's multi-run error control over the whole batch (one step count for all
+runs; a stiff or non-smooth batch goes run by run as single runs do). The fixed-step
 methods: under constant controls, compiled rk8 is a plain C loop over each run's steps
 (`lanes`: four runs per vector step where the model's step allows); otherwise the model's
 compiled chunk loop mapped over the parts (`dynamics.integrate.batch_fixed`). ``cvodes``
@@ -172,11 +173,11 @@ def auto_dense_batch(batch: Batch, rtol: float, atol: np.ndarray, max_steps: int
     over the runs (`dense.dense_many`; the runs in parts of at most `DENSE_PART` spread over
     ``threads`` threads by `batch_fixed.spread_runs` from ``2 DENSE_PART`` runs on, each
     part filling its own slice of the answers), each run with its own steps; round by round
-    (`dense_rounds`, each spread over the batch), each later round's first answers at the factor `first_factor` learns
-    from the runs before. A run not verified there goes alone through `solve_auto` (as a
-    single call would). Returns ``(x (nx, n, K), ok, status, estimate,
-    method, n_steps, message)``, or None (no compiled pass, a control that varies within a
-    run, jit off)."""
+    (`dense_rounds`, each spread over the batch), each later round's first answers at the
+    factor `first_factor` learns from the runs before. A run not verified there goes alone
+    through `solve_auto` (as a single call would). Returns ``(x (nx, n, K), ok, status,
+    estimate, method, n_steps, message)``, or None (no compiled pass, a control that varies
+    within a run, jit off)."""
     if not auto_jit(jit):
         return None
     K, model, t = batch.K, batch.model, batch.t
@@ -316,8 +317,9 @@ def first_factor(estimate, factor, steps, gate, *, current: float, rtol: float) 
     factor (``estimate / factor``: the error follows the local tolerance about linearly,
     within `SPREAD`) and its steps (answer and check, growing as factor^(-1/`ORDER`)). At a
     candidate factor a run is accepted at once when its predicted estimate is within its
-    ``gate``; otherwise it pays a retry as ``cpass._AUTO`` makes one (`RETRY_AIM`, `RETRY_LADDER`, at most
-    `dense.TRIES` answers; a run still not accepted counts double, for auto's other paths).
+    ``gate``; otherwise it pays a retry as ``cpass._AUTO`` makes one (`RETRY_AIM`,
+    `RETRY_LADDER`, at most `dense.TRIES` answers; a run still not accepted counts double,
+    for auto's other paths).
     Too tight a factor over-delivers on every run, too loose one pays retries: the sum
     weighs both, so a lone chaotic run retries alone rather than tightening all. Every run
     is still verified by its own check.
