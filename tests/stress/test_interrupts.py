@@ -122,7 +122,8 @@ def test_deferral_raises_at_the_check_and_restores_the_handler():
 PARTIAL = """
 import json
 import numpy as np
-from appdyn.problems import stability
+import control  # the sweep's first analysis imports it (~1-3 s on a loaded machine): before
+from appdyn.problems import stability  # the signal, so that it lands in the sweep itself
 values = np.linspace(0.1, 10.0, 200000)
 print("start", flush=True)
 try:
