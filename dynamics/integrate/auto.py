@@ -25,7 +25,7 @@ from .stepcontrol import LOCAL_RTOL_MIN, solve_stepped
 from .tableaux import DOP853
 
 __all__ = ["solve_auto", "auto_jit", "STIFF_STEPS", "Single", "auto_runs", "dense_pass",
-           "dense_answer", "dense_message", "floor_message", "one_pass", "nonsmooth_causes"]
+           "dense_answer", "dense_message", "one_pass", "nonsmooth_causes"]
 
 _AUTO_AIM = 0.1        # predict the step count for this estimated scaled error
 _AUTO_RUNS = 8         # give up (status 3) after this many fixed-step runs
@@ -380,7 +380,7 @@ def dense_pass(problem: Problem, rtol, atol, max_steps, progress):
     Returns ``(run, estimate, status, spent)``: status ``OK`` (verified), ``ROUNDOFF`` (not
     verified because the tolerance lies below the rounding floor of double precision: 1000
     ulps of a state's size, with the carried rounding, exceed it at the outputs, so no path
-    of ``auto`` can verify it; the answer is returned at once with its estimate, `floor_message`
+    of ``auto`` can verify it; the answer is returned at once with its estimate, `_floor_message`
     words it), or ``(None, nan, None, spent)`` to leave the problem to `one_pass` and the multi-run
     search (stiff by the first step's Lipschitz estimate: more than `STIFF_STEPS` steps for
     stability alone; no compiled library, a control that varies, a requested tolerance below
@@ -400,11 +400,11 @@ def dense_pass(problem: Problem, rtol, atol, max_steps, progress):
         # (every path accepts at most a floor of the tolerance: `auto_runs`' estimate plus
         # its floor, which is at least these ulps, within 1)
         return (Run.new(got.x, got.spent, DOP853.stages * got.spent, got.substeps, True, True,
-                        floor_message(got, rtol)), got.estimate, ROUNDOFF, got.spent)
+                        _floor_message(got, rtol)), got.estimate, ROUNDOFF, got.spent)
     return None, math.nan, None, got.spent
 
 
-def floor_message(got: DenseAuto, rtol: float) -> str:
+def _floor_message(got: DenseAuto, rtol: float) -> str:
     """The message of `dense_pass`'s answer below the rounding floor: what was asked, what
     the floor is, the answer's estimate and the remedy."""
     return (f"auto: tolerance not verified: it lies below the round-off floor of double "
