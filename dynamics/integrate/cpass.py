@@ -549,6 +549,12 @@ _AUTO = r"""
 #define AU_ACCEPT 0.5        /* estimates.AUTO_ACCEPT */
 #define AU_FLOOR_ULPS 1000.0 /* estimates.FLOOR_ULPS */
 #define AU_MEASURED 1e6      /* auto's _PASS_MEASURED */
+#define AU_DEEP 1e4          /* a retry whose local tolerance lies within this many ulps of
+                                the states' size measures the rounding floor: per step the
+                                rounding is an ulp against the truncation's AU_DEEP, so it is
+                                a part of the difference over N steps only below ~10 sqrt(N)
+                                ulps (300 at N = 1000); the near-separatrix tumble that showed
+                                it ran at 80 */
 #define AU_RTOL_MIN 1e-14    /* stepcontrol.LOCAL_RTOL_MIN */
 #define AU_LADDER 1e-3       /* the most a new answer's local tolerance shrinks */
 #define AU_LOCAL_ULPS 1.0    /* a local tolerance below this many ulps of a state's size
@@ -742,11 +748,11 @@ static void au_judge(casadi_real* w, casadi_real* X, casadi_real* XC) {
   for (e = AU_TS(w)[0] - w[AU_T0], j = 1; j < nout; ++j)
     if (AU_TS(w)[j] - AU_TS(w)[j - 1] > e) e = AU_TS(w)[j] - AU_TS(w)[j - 1];
   w[AU_SUB] = w[AU_HMIN] < INFINITY ? ceil(e / w[AU_HMIN]) : 1;
-  /* a retry whose local tolerance lies within AU_MEASURED ulps of the states' size: the
+  /* a retry whose local tolerance lies within AU_DEEP ulps of the states' size: the
      difference of the answer and its check may be rounding the flow amplified, which the
      Richardson division would hide (near a separatrix: 20 tolerances estimated at 0.18):
      the floor is measured, not modelled */
-  deep = w[AU_TRY] > 1 && au_size(w) / w[AU_FACTOR] * DBL_EPSILON * AU_MEASURED > 1.0;
+  deep = w[AU_TRY] > 1 && au_size(w) / w[AU_FACTOR] * DBL_EPSILON * AU_DEEP > 1.0;
   if (est <= w[AU_GATE] && (deep || au_size(w) * DBL_EPSILON * AU_MEASURED > 1.0)) {
     horizon = AU_TS(w)[nout - 1] - w[AU_T0];
     e = au_carried(w);
