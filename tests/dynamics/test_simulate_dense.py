@@ -305,6 +305,24 @@ def test_below_the_rounding_floor_answers_at_once_and_says_so():
     assert np.max(np.abs(res.x[4:] - w)) < 1e-13
 
 
+def test_a_retry_far_above_the_rounding_makes_no_floor_run():
+    """The bench body near a separatrix (100 s) at rtol 1e-5: its first answer (at 0.003 of
+    the tolerance) is refused and the retry, predicted from the estimate, lands about 30x
+    tighter, 1e5 ulps above the states' size, where rounding is no part of the difference of
+    the answer and its check (the floors measured there were 3e-6 of the tolerance): no
+    rerun from a moved start, two answers and their checks in all, verified and within the
+    estimate of Jacobi's rates."""
+    from appdyn.dynamics.integrate.dense import FIRST, dense_auto
+    inertia, w0 = _JACOBI[1]
+    model, t = rigid_body(inertia), np.linspace(0.0, 100.0, 101)
+    x0, rtol, atol = np.r_[0.0, 0.0, 0.0, 1.0, w0], 1e-5, 1e-7
+    got = dense_auto(_problem(model, x0, t), rtol, np.full(7, atol), 1e8, 1e6)
+    assert got.result == 1 and got.factor < FIRST / 10 and got.floor == 0
+    assert got.spent < 2 * (got.answer_steps + got.check_steps)
+    w = torque_free_omega(inertia, w0, t)
+    assert np.all(np.abs(got.x[4:] - w) <= got.estimate * (atol + rtol * np.abs(w)))
+
+
 def test_header_inputs_are_the_first_slots():
     """`dense._fill` writes the header's inputs in one `struct` call in this order: the
     C code's ``AU_*`` slots (`dense.FIELDS`) must start with them."""
