@@ -16,8 +16,9 @@ is compared: ``ratio = numbalsoda time / appdyn time`` (> 1: appdyn faster). num
 runs in its own venv (``bench/peers/.venv-numbalsoda``, `bench/peers/README.md`);
 without it the appdyn columns alone are reported.
 
-Then the repeated 2-point call at the defaults (its median [us]; goal <= 20 us), and the
-Monte Carlo of issue 31, item 4: 1,000 torque-free runs (`bench/simulate.py`'s batch
+Then the repeated 2-point call at the defaults (goal <= 20 us): medians of interleaved
+rounds of the call and of its compiled pass alone, and the Python around it
+(`two_point_call`); and the Monte Carlo of issue 31, item 4: 1,000 torque-free runs (`bench/simulate.py`'s batch
 workload, every run within 1e-8 rad/s of its Jacobi truth) in one batched ``simulate`` at
 the default method and tolerances (each run verified: ``all_success``) and with fixed-step
 ``rk8`` (the fewest steps meeting the error), against numbalsoda's ``dop853`` in a
@@ -49,6 +50,7 @@ from appdyn.dynamics.truth import torque_free_omega
 
 from _common import Row, script_main, timed, write_csv
 
+from overhead import dense_pass_call, paired_per_call  # noqa: E402
 from simulate import (BATCH_TOL, INERTIA, batch_workload, numbalsoda,  # noqa: E402
                       numbalsoda_batch)
 
@@ -223,11 +225,21 @@ def time_at(rows, target) -> float:
     return t0 * (t1 / t0) ** w
 
 
-def two_point_call(repeats: int) -> float:
-    """The median of ``repeats`` repeated 2-point ``simulate`` calls at the defaults [s]."""
+def two_point_call(calls: int, rounds: int) -> tuple[float, float, float]:
+    """The repeated 2-point ``simulate`` call at the defaults, timed as `bench/overhead.py`
+    times calls: ``rounds`` rounds of ``calls`` calls, each round followed by as many calls
+    of the compiled pass alone (`overhead.dense_pass_call`, the same C call with the same
+    workspace). Returns the medians ``(call, compiled pass, Python around it)`` [s], the
+    last the median of the rounds' differences.
+
+    Why paired: this VM's two cores are shared, and one round's median alone moved between
+    57 and 130 us for the same call in the same process (a busy neighbour on the other
+    core); the code's cost is the same (callgrind: 396k instructions per call, 255k of them
+    in the compiled pass)."""
     model = rigid_body([1.0, 2.0, 3.0])
     x0, t = np.r_[0.0, 0.0, 0.0, 1.0, 1.0, 0.1, 0.8], np.array([0.0, 10.0])
-    return median_time(lambda: simulate(model, x0, t), repeats)
+    floor, _ = dense_pass_call(model, x0, t)
+    return paired_per_call(lambda: simulate(model, x0, t), floor, calls, rounds)
 
 
 def monte_carlo(quick: bool, detail: list) -> list[Row]:
@@ -336,9 +348,13 @@ def run(quick: bool, out: Path) -> list[Row]:
                 summary.append(Row("integrate_peers", w.name, "appdyn error over its tolerance "
                                    "at rtol 1e-8, every state", _delivered(mine, 1e-8), "",
                                    "max |x - reference| / (atol + rtol |reference|)"))
-    call = two_point_call(200 if quick else 2000)
+    rounds = 3 if quick else 15
+    call, floor, around = two_point_call(1000, rounds)
     summary.append(Row("integrate_peers", "2-point call (10 s), defaults, repeated",
-                       "appdyn simulate time", call * 1e6, "us", "goal <= 20 us"))
+                       "appdyn simulate time", call * 1e6, "us",
+                       f"goal <= 20 us; its compiled pass alone {floor * 1e6:.3g} us, Python "
+                       f"around it {around * 1e6:.3g} us (medians of {rounds} interleaved "
+                       "rounds of 1,000 calls)"))
     summary += monte_carlo(quick, detail)
     write_csv(detail, out / "integrate_peers.csv")
     return summary

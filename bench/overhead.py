@@ -4,8 +4,8 @@ A repeated short call on a cached model (the torque-free rigid body, J = diag(1,
 2-point grid ``[0, 1]`` s, ``x0`` a list) for ``rk8`` and ``rk4`` with ``steps=1`` and for
 ``auto``. For each: the time per `simulate` call, the time of the compiled call alone (the
 chunk's buffer triggered with the same inputs already in place; for ``auto``, the call of its
-compiled pass, `dynamics.integrate.adaptive`, replayed with the arguments `simulate` gave
-it: the floor no Python wrapper can go under), and their difference, the overhead; for the
+compiled dense pass, `dynamics.integrate.dense`, replayed with the workspace `simulate`
+filled: the floor no Python wrapper can go under), and their difference, the overhead; for the
 fixed-step methods also the Python time before the compiled call starts (`before_compiled`,
 what the per-call target of issue "Simulation at compiled-C speed" counts). The two
 are timed in 15 interleaved rounds of 2,000 calls each (3 of 1,000 with ``--quick``); each
@@ -24,7 +24,7 @@ from pathlib import Path
 import numpy as np
 
 from appdyn.dynamics import rigid_body, simulate
-from appdyn.dynamics.integrate import adaptive, evaluate
+from appdyn.dynamics.integrate import dense, evaluate
 from appdyn.dynamics.integrate.loops import CHUNK, _chunk_shapes, chunk_function
 
 from _common import Row, script_main, write_csv
@@ -79,25 +79,34 @@ def compiled_call(model, method: str):
     return trigger, compiled
 
 
-def compiled_pass_call(model):
-    """The call of ``auto``'s compiled pass that `simulate` makes over ``GRID``, captured
-    and replayed (the workspace it points into is kept alive)."""
-    lib = adaptive.pass_library(model)
-    captured = []
+def dense_pass_call(model, x0, t):
+    """The call of ``auto``'s compiled dense pass (`dynamics.integrate.dense`, ``rk8_auto``)
+    that ``simulate(model, x0, t)`` at the defaults makes, captured and replayed with the
+    workspace as `simulate` filled it (restored before each call: one copy of ~100 doubles):
+    the floor no Python wrapper can go under. Returns ``(call, True)``."""
+    plan = dense._plan(model)
+    work = dense._workspace(plan, len(t) - 1)  # (this thread's: the one `simulate` fills)
+    seen = []
 
     def spy(*args):
-        captured.append(args)
-        return lib(*args)
+        seen.append((args, work.ws.copy()))
+        return plan.auto(*args)
 
-    real = adaptive.pass_library
-    adaptive.pass_library = lambda _model: spy
+    real = dense._plan
+    dense._plan = lambda m: plan._replace(auto=spy) if m is model else real(m)
     try:
-        res = simulate(model, X0, GRID)
+        res = simulate(model, x0, t)
     finally:
-        adaptive.pass_library = real
-    _KEEP.append((res, captured))
-    args = captured[-1]
-    return (lambda: lib(*args)), True
+        dense._plan = real
+    args, filled = seen[-1]
+    ws = work.ws
+
+    def call():
+        ws[:] = filled
+        return plan.auto(*args)
+
+    _KEEP.append((res, work, filled))
+    return call, True
 
 
 def before_compiled(model, kwargs, calls: int, batches: int) -> float:
@@ -138,7 +147,7 @@ def run(quick: bool, out: Path) -> list[Row]:
     for name, kwargs in CASES:
         res = simulate(model, X0, GRID, **kwargs)  # warm: compiles once
         n = calls
-        trigger, compiled = (compiled_pass_call(model) if "embedded" in res.message
+        trigger, compiled = (dense_pass_call(model, X0, GRID) if name == "auto"
                              else compiled_call(model, res.method))
         trigger()
         total, chunk, over = paired_per_call(lambda: simulate(model, X0, GRID, **kwargs),

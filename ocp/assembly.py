@@ -248,11 +248,10 @@ class _Assembly:
         n = rows.size
         # the distinct positions in column-major (CSC) order: duplicates share one nonzero
         key = cols.astype(np.int64) * nrow + rows
-        uniq = np.unique(key)
+        # pos: the position of each contribution in the CSC nonzeros
+        uniq, pos = np.unique(key, return_inverse=True)
         indptr = np.searchsorted(uniq, np.arange(ncol + 1, dtype=np.int64) * nrow)
         self.sparsity = ca.Sparsity(nrow, ncol, indptr.tolist(), (uniq % nrow).tolist())
-        # position of each contribution in the CSC nonzeros
-        pos = np.searchsorted(uniq, key)
         self.nnz = uniq.size
         if uniq.size == n:
             order = np.empty(n, dtype=np.int64)

@@ -34,6 +34,7 @@ from typing import Mapping
 
 import numpy as np
 
+from .mesh import sorted_union
 from .propagation import SCALE_FLOOR
 from .status import STATUS_BOUND_VIOLATION, STATUS_RESIMULATION
 
@@ -139,7 +140,7 @@ def bound_grid(dense) -> tuple[np.ndarray, np.ndarray]:
     ``dense`` (`ocp.DenseOutput`): in every interval ``sigma = j / BOUND_SAMPLES``, ``j = 0
     .. BOUND_SAMPLES``, and the transcription's owned nodes."""
     tr = dense.transcription
-    sig = np.union1d(np.linspace(0.0, 1.0, BOUND_SAMPLES + 1), tr.node_sigma)
+    sig = sorted_union(np.linspace(0.0, 1.0, BOUND_SAMPLES + 1), tr.node_sigma)
     return np.repeat(np.arange(dense.N), sig.size), np.tile(sig, dense.N)
 
 

@@ -60,7 +60,7 @@ import numpy as np
 
 from .cached import cached, function_key
 from .functions import sx_compatible
-from .mesh import Mesh
+from .mesh import Mesh, sorted_union
 
 __all__ = ["Transcription", "Trapezoid", "HermiteSimpson", "Radau", "RadauConstantControl",
            "RadauLinearControl", "TRANSCRIPTIONS", "CONTROLS", "f_columns", "lagrange_columns", "sx_compatible",
@@ -109,7 +109,7 @@ def _quadrature_weights(nodes: np.ndarray) -> np.ndarray:
     """``w_i = integral_0^1 l_i(s) ds`` for the Lagrange basis through ``nodes``."""
     g, gw = np.polynomial.legendre.leggauss(nodes.size + 1)
     s, gw = 0.5 * (g + 1.0), 0.5 * gw
-    return np.array([np.dot(gw, b) for b in _lagrange_basis(nodes, s)])
+    return gw @ _lagrange_matrix(nodes, s)
 
 
 @dataclass(frozen=True)
@@ -255,7 +255,7 @@ class Transcription(abc.ABC):
     @property
     def node_sigma(self) -> np.ndarray:
         """Owned output nodes of an interval: union of state and control nodes."""
-        return np.union1d(self.x_sigma, self.u_sigma)
+        return sorted_union(self.x_sigma, self.u_sigma)
 
     def node_tau(self, mesh: Mesh) -> np.ndarray:
         """Normalized times of all output nodes (``t0`` plus the owned nodes)."""

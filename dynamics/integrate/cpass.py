@@ -556,7 +556,7 @@ _AUTO = r"""
                                 ulps (300 at N = 1000); the near-separatrix tumble that showed
                                 it ran at 80 */
 #define AU_RTOL_MIN 1e-14    /* stepcontrol.LOCAL_RTOL_MIN */
-#define AU_LADDER 1e-3       /* the most a new answer's local tolerance shrinks */
+#define AU_LADDER 1e-2       /* the most a new answer's local tolerance shrinks */
 #define AU_LOCAL_ULPS 1.0    /* a local tolerance below this many ulps of a state's size
                                 asks DOP853 for less than the state's own rounding */
 #define AU_FLOOR_GATE 1.0    /* the acceptance of the estimate with a measured floor on top

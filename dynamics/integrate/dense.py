@@ -28,7 +28,7 @@ estimate it controls (the estimate less the ulps and the carried rounding, which
 tighter tolerance lowers): DOP853's global error follows its local tolerance about
 linearly, so the first retry scales it by ``aim / part`` and a later one by the slope
 measured between the last two answers; the aim is 0.2 (less where the rounding takes more
-of the acceptance), at most 1000x tighter per answer, never below the factor that keeps
+of the acceptance), at most 100x tighter per answer, never below the factor that keeps
 the local tolerance an ulp above the states' size (`TRIES` answers at most; none after a
 floor was measured, nor when the rounding alone takes 90 % of the acceptance: the
 tolerance then lies at the rounding floor, and `dynamics.integrate.auto.dense_pass` answers
@@ -203,11 +203,13 @@ _INPUTS = struct.Struct(f"{_PHASE + 1}d")
 
 
 def _fill(ws: np.ndarray, plan: _Plan, t: np.ndarray, rtol: float, atol,
-          max_steps: float, stiff_steps: float) -> None:
-    """The inputs shared by the runs: header, tolerances (``atol`` a float or ``(nx,)``)
-    and output times (the C code resets the outputs of the header)."""
-    _INPUTS.pack_into(ws, 0, rtol, FIRST, FIRST * CHECK, max_steps, stiff_steps, t[0], plan.iq,
-                      TRIES, 0.0)
+          max_steps: float, stiff_steps: float, factor: float | None = None) -> None:
+    """The inputs shared by the runs: header (the first answer at local tolerance ``factor``
+    times the requested one), tolerances (``atol`` a float or ``(nx,)``) and output times
+    (the C code resets the outputs of the header); ``factor`` None: `FIRST`."""
+    factor = FIRST if factor is None else factor
+    _INPUTS.pack_into(ws, 0, rtol, factor, factor * CHECK, max_steps, stiff_steps, t[0],
+                      plan.iq, TRIES, 0.0)
     o = HEADER + plan.nx + plan.nu + plan.np
     ws[o:o + plan.nx] = atol
     ws[o + plan.nx:o + plan.nx + t.size - 1] = t[1:]
@@ -320,15 +322,18 @@ def _tell(progress, steps: int, told: int) -> int:
 
 def dense_many(model, x0: np.ndarray, t: np.ndarray, u: np.ndarray, p: np.ndarray,
                rtol: float, atol: np.ndarray, max_steps: float, stiff_steps: float,
-               runs: slice, *, out: tuple[np.ndarray, np.ndarray] | None = None
-               ) -> tuple[np.ndarray, np.ndarray] | None:
+               runs: slice, *, out: tuple[np.ndarray, np.ndarray] | None = None,
+               factor: float | None = None) -> tuple[np.ndarray, np.ndarray] | None:
     """`dense_auto` for the runs ``runs`` of a batch in one compiled loop: ``x0 (K, nx)``,
     ``u (K, max(nu, 1))`` (each run's constant control), ``p (K, max(np, 1))``, all
-    C-contiguous. Returns ``(X (r, nx, n), head (r, HEADER))``: the answers and each run's
-    header (`outcome_of` reads it); None without a compiled pass. ``out``: C-contiguous
-    ``(X (K, nx, n), head (K, HEADER))`` of the whole batch, whose slices ``runs`` the loop
-    fills (and returns) in place: calls on other threads (each with its own workspace) may
-    fill other slices of the same arrays at the same time.
+    C-contiguous; each run's first answer at local tolerance ``factor`` times the requested
+    one (None: `FIRST`, as a single call; a batch learns its own,
+    `dynamics.integrate.batch.first_factor`), a retry as in a single call. Returns
+    ``(X (r, nx, n), head (r, HEADER))``: the answers and each run's header (`outcome_of`
+    reads it); None without a compiled pass. ``out``: C-contiguous ``(X (K, nx, n),
+    head (K, HEADER))`` of the whole batch, whose slices ``runs`` the loop fills (and
+    returns) in place: calls on other threads (each with its own workspace) may fill other
+    slices of the same arrays at the same time.
 
     Examples
     --------
@@ -348,7 +353,7 @@ def dense_many(model, x0: np.ndarray, t: np.ndarray, u: np.ndarray, p: np.ndarra
         return None
     nout = t.size - 1
     work = _workspace(plan, nout)
-    _fill(work.ws, plan, t, rtol, atol, max_steps, stiff_steps)
+    _fill(work.ws, plan, t, rtol, atol, max_steps, stiff_steps, factor)
     r, k0 = runs.stop - runs.start, runs.start
     if out is None:
         X, head, at = np.empty((r, plan.nx, nout + 1)), np.empty((r, HEADER)), 0

@@ -86,20 +86,25 @@ class RunOptions:
         return dict(self.__dict__)
 
 
+#: numpy's float64 dtype object (native byte order): an array's ``dtype is _FLOAT64`` is the
+#: cheap test of the fast paths (another float64 dtype object takes the general path).
+_FLOAT64 = np.dtype(np.float64)
+
+
 def check_t(t) -> np.ndarray:
     """The output grid: 1-D, at least 2 finite times, strictly increasing (read-only copy)."""
     tp = type(t)
     if tp is np.ndarray:  # fast path: a short float64 grid that passes every check
-        if t.dtype == np.float64 and t.ndim == 1 and 2 <= t.size <= 16:
+        if t.dtype is _FLOAT64 and t.ndim == 1 and 2 <= t.size <= 16:
             v = t.tolist()
             if _finite_increasing(v):
                 t = t.copy()
-                t.setflags(write=False)
+                t.setflags(False)  # (read-only; positional: a third of the keyword's cost)
                 return t
     elif (tp is list or tp is tuple) and 2 <= len(t) <= 16 and all(
             type(e) is float for e in t) and _finite_increasing(t):
         t = np.array(t)
-        t.setflags(write=False)
+        t.setflags(False)
         return t
     t = np.array(finite_array(t, "t"), dtype=float)
     if t.ndim != 1 or t.size < 2:
@@ -163,8 +168,8 @@ def fast_x0(x0, model: Model) -> np.ndarray | None:
         return None
     if a.shape != (model.nx,) or a.dtype.kind not in "fiu":
         return None
-    if a is not x0 and a.dtype == np.float64:
-        x = a  # made here from the list: already the copy
+    if a.dtype is _FLOAT64:  # (the common dtype object: a cheaper test than ``==``)
+        x = a if a is not x0 else a.copy()  # (made here from a list: already the copy)
     else:
         x = np.array(a, dtype=float)
     v = x.tolist()

@@ -11,6 +11,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..mesh import sorted_union
 from ..solution import Solution
 from .switches import control_switches
 
@@ -147,7 +148,7 @@ def _bang_arcs(solution: Solution, samples: int, short_arcs: bool):
         zj = ((u_all[j, first[j]:first[j + 1]] - mid[j]) / half[j]).reshape(-1, 41)
         for (a, b), z in zip(zip(edges[:-1], edges[1:]), zj):
             L = b - a
-            s = 1.0 if np.median(z) >= 0 else -1.0
+            s = 1.0 if np.count_nonzero(z >= 0) > z.size / 2 else -1.0  # median's sign (41: odd)
             # an arc within two mesh intervals is smeared by the collocation (the control
             # polynomial of the interval holding a switch): its side is that of its median,
             # and the switch-time NLP checks the guess
@@ -162,7 +163,7 @@ def _bang_arcs(solution: Solution, samples: int, short_arcs: bool):
         if short_arcs:
             edges, sides = _with_short_arcs(solution, j, edges, sides, mid[j], half[j])
         own.append((edges, np.asarray(sides)))
-    merged = np.unique(np.concatenate([e[1:-1] for e, _ in own]))
+    merged = sorted_union(*[e[1:-1] for e, _ in own])
     if merged.size > 1:
         merged = merged[np.concatenate([[True], np.diff(merged) > 1e-9 * max(T, 1.0)])]
     merged = merged[(merged > t0) & (merged < t0 + T)]

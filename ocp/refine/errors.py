@@ -11,6 +11,7 @@ import numpy as np
 from ..cached import cached, function_key
 from appdyn.dynamics.validate import integer
 from ..solution import Solution, interval_integrator, stack_interval_controls
+from ..mesh import sorted_union
 from ..transcription import Transcription
 from .switches import control_switches
 
@@ -57,7 +58,7 @@ def _check_sigma(tr: Transcription) -> np.ndarray:
     quarter points (the dense output between nodes counts too: for the trapezoid its linear
     interpolant is only second-order accurate, while its mesh points are third-order
     locally)."""
-    return np.union1d(tr.node_sigma, [0.25, 0.5, 0.75])
+    return sorted_union(tr.node_sigma, [0.25, 0.5, 0.75])
 
 
 def _interval_integrator(sol: Solution, rtol: float, atol: float) -> ca.Function:

@@ -42,7 +42,7 @@ from ..cached import cached, function_key
 from ..ipopt_options import check_ipopt_options
 from ..progress import stage_sink
 from appdyn.dynamics.validate import integer
-from ..mesh import Mesh
+from ..mesh import Mesh, sorted_union
 from ..problem import Constraint, Problem
 from ..solution import Solution
 from ..status import STATUS_WALL_TIME
@@ -380,7 +380,7 @@ def polish_switches(problem: Problem, solution: Solution, *, N: int | None = Non
     aug = _free_mesh_problem(problem, T0, (lo_s, hi_s))
     # guess in pseudo time sigma (= t / T0 initially): states and clock at the nodes, the
     # interval-mean control of `solution`, v = T0
-    sig = np.unique(np.concatenate([tr.state_tau(mesh), b]))
+    sig = sorted_union(tr.state_tau(mesh), b)
     xg = np.vstack([solution.sample(solution.t0 + T0 * sig)[0], T0 * sig])
     m = 16
     tm = (b[:-1, None] + (np.arange(m)[None, :] + 0.5) / m * np.diff(b)[:, None]).reshape(-1)

@@ -28,7 +28,7 @@ from .targets import (ARCSEC, MIN_REFINE_TOL, POINTING_TOL, RATE_TOL, STATUS_POI
 
 __all__ = ["time_optimal", "min_effort", "verify", "bounded", "DEFAULT_STARTS_TIME",
            "DEFAULT_STARTS_EFFORT", "POLISH_MIN_BUDGET", "SEED_OPTIONS", "RACE_N", "RACE_AGREE",
-           "RACE_IPOPT"]
+           "RACE_IPOPT", "BOUNDED_ITER_FACTOR", "BOUNDED_MIN_ITER"]
 
 DEFAULT_STARTS_TIME = 3  # seeded starts of time_optimal without a user guess
 DEFAULT_STARTS_EFFORT = 4  # seeded starts of min_effort with a keep-out cone
@@ -312,12 +312,19 @@ def time_optimal(inertia, *, angle=None, axis=None, q0=None, qf=None, u_max=1.0,
 SEED_OPTIONS = {"bound_tol": math.inf, "verify": False}
 
 
+#: IPOPT iteration budget of `bounded`'s re-solve: this many times the iterations of the
+#: solution it starts from, and at least `BOUNDED_MIN_ITER`
+BOUNDED_ITER_FACTOR = 10
+BOUNDED_MIN_ITER = 200
+
+
 def bounded(problem, solution, *, control="constant", pointing_tol=POINTING_TOL,
             rate_tol=RATE_TOL, ipopt_options=None, scale=None):
     """``solution`` if its dense output keeps the bounds (`ocp.Solution.bound_violation`
     within `ocp.DEFAULT_CONSTRAINT_TOL`) or it is no success; else re-solved with ``control``
-    (``'constant'`` or ``'linear'``) on its mesh, warm from it, and graded (`verify`; a
-    miss is mesh-refined once more, `ocp.refine` tol 1e-6, 4 rounds).
+    (``'constant'`` or ``'linear'``) on its mesh, warm from it, within
+    `BOUNDED_ITER_FACTOR` times its IPOPT iterations (at least `BOUNDED_MIN_ITER`), and
+    graded (`verify`; a miss is mesh-refined once more, `ocp.refine` tol 1e-6, 4 rounds).
 
     Parameters
     ----------
@@ -356,7 +363,14 @@ def bounded(problem, solution, *, control="constant", pointing_tol=POINTING_TOL,
     if control == "polynomial":
         return failed
     kw = dict(ipopt_options=ipopt_options, scale=scale)
-    again = solve(problem, transcription="radau", control=control, mesh=sol.mesh, guess=sol, **kw)
+    # warm from a converged neighbour: the re-solves of the tests take 8-44 IPOPT iterations;
+    # a CMG slew's took 1861 (35 s) to end in Restoration_Failed, so the budget is
+    # `BOUNDED_ITER_FACTOR` times the first solve's iterations, at least `BOUNDED_MIN_ITER`
+    # (the user's ``max_iter`` wins)
+    budget = (ipopt_options or {}).get(
+        "max_iter", max(BOUNDED_MIN_ITER, BOUNDED_ITER_FACTOR * int(sol.iterations)))
+    again = solve(problem, transcription="radau", control=control, mesh=sol.mesh, guess=sol,
+                  ipopt_options={**(ipopt_options or {}), "max_iter": budget}, scale=scale)
     again = verify(again, pointing_tol=pointing_tol, rate_tol=rate_tol)
     if not again.success and again.status != STATUS_BOUND_VIOLATION and np.isfinite(again.T):
         finer = refine(problem, again, tol=1e-6, max_rounds=4, transcription=again.transcription,
@@ -372,6 +386,7 @@ def bounded(problem, solution, *, control="constant", pointing_tol=POINTING_TOL,
     if again.success:
         said = f"; {polish_text(keep['polish'])}" if "polish" in keep else ""
         return annotate(again, {**keep, "bounded": why}, message=f"{again.message}; {why}{said}")
+    why = f"{why} (a budget of {budget} IPOPT iterations; ipopt_options max_iter sets it)"
     return annotate(failed, {"bounded": f"{why}, which failed: {again.message[:300]}"},
                     message=f"{failed.message}; {why}, which failed: {again.message[:300]}")
 

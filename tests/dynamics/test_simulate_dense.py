@@ -250,6 +250,101 @@ def test_a_batch_run_not_verified_in_the_loop_goes_alone(monkeypatch):
         assert np.array_equal(res.x[:, :, k], simulate(model, x0[:, k], t).x)
 
 
+def test_later_rounds_of_a_batch_answer_first_at_the_factor_learned_before(monkeypatch):
+    """A batch of 80 runs goes in rounds (`batch.dense_rounds`): the first round's runs are
+    their single calls to the last bit; each later round's runs are the single call with
+    its first answer at the factor the runs before chose (`batch.first_factor`), each
+    verified by its own check and within the tolerance of its Jacobi truth."""
+    from appdyn.dynamics.integrate import batch as batch_module, dense
+    seen = []
+    real = batch_module.dense_many
+
+    def spy(*args, factor=None, **kw):
+        seen.append((args[-1], factor))
+        return real(*args, factor=factor, **kw)
+
+    monkeypatch.setattr(batch_module, "dense_many", spy)
+    model, t = rigid_body(INERTIA), np.linspace(0.0, 20.0, 41)
+    x0 = _batch(80, seed=3)
+    res = simulate(model, x0, t, threads=1)
+    assert res.all_success and "learned from the runs before" in res.message, res.message
+    rounds = batch_module.dense_rounds(80)
+    assert len(rounds) == 3
+    covered = sorted(k for runs, _ in seen for k in range(runs.start, runs.stop))
+    assert covered == list(range(80))
+    first = {k0 for k0, _ in rounds[0]}
+    assert all((f == dense.FIRST) == (runs.start in first) for runs, f in seen)
+    w = np.stack([torque_free_omega(INERTIA, x0[4:, k], t) for k in range(80)], axis=2)
+    assert np.all(np.abs(res.x[4:] - w) <= 1e-10 + 1e-8 * np.abs(w))
+    for runs, factor in seen[::4]:
+        monkeypatch.setattr(dense, "FIRST", factor)
+        for k in (runs.start, runs.stop - 1):
+            one = simulate(model, x0[:, k], t)
+            assert np.array_equal(res.x[:, :, k], one.x)
+            assert res.error_estimate[k] == one.error_estimate
+
+
+def test_each_round_of_a_batch_draws_from_every_part_of_it():
+    """`batch.dense_rounds`: the rounds cover every run once, in slices; the first takes
+    one run from each sixteenth of the batch and every later round but the last takes
+    from each sixteenth alike, so a batch sorted by a parameter (easy runs first) does not
+    teach its first rounds the wrong tolerance."""
+    from appdyn.dynamics.integrate.batch import PILOT, dense_rounds
+    for K in (33, 80, 1000, 1024, 5000):
+        rounds = dense_rounds(K)
+        runs = [k for r in rounds for k0, k1 in r for k in range(k0, k1)]
+        assert sorted(runs) == list(range(K))
+        strata = np.array([K * i // PILOT for i in range(PILOT + 1)])
+        part = lambda k: int(np.searchsorted(strata, k, side="right")) - 1
+        assert sorted(part(k0) for k0, _ in rounds[0]) == list(range(PILOT))
+        assert all(k1 - k0 == 1 for k0, k1 in rounds[0])
+        for r in rounds[1:-1]:
+            assert sorted(part(k0) for k0, _ in r) == list(range(PILOT))
+            assert len({k1 - k0 for k0, k1 in r}) == 1
+    assert dense_rounds(31) == [((0, 31),)]
+
+
+def test_first_factor_weighs_over_delivery_against_retries():
+    """`batch.first_factor`: runs far inside their acceptance loosen the factor (at most
+    `REACH` beyond where they were measured, never past 1), runs accepted only at a tighter
+    factor bring it there (never below the local rtol floor), a lone chaotic run among regular ones retries alone
+    (the factor is the regular runs'), while a tail of hard runs tightens it."""
+    from appdyn.dynamics.integrate.batch import REACH, first_factor
+    from appdyn.dynamics.integrate.stepcontrol import LOCAL_RTOL_MIN
+
+    def choose(est, current=0.003, rtol=1e-8, at=None):
+        m = len(est)
+        at = [current] * m if at is None else np.broadcast_to(at, m)
+        return first_factor(est, at, [150.0] * m, [0.5] * m, current=current, rtol=rtol)
+
+    regular = list(np.geomspace(0.05, 0.3, 20))  # (estimates at 0.003: 170-1000 per unit)
+    base = choose(regular)
+    assert np.isclose(10.0 ** (np.arange(-8, 9) / 8.0), base / 0.003).any()  # (on the grid)
+    assert 0.003 / REACH <= base <= 0.003 * REACH
+    assert choose([1e-4] * 20) == pytest.approx(0.003 * REACH)  # (no further than measured)
+    assert 0.5 < choose([1e-4] * 20, current=0.5) <= 1.0
+    # runs accepted only after retries, at 1e-5 with estimates 0.4: there, with a margin
+    assert 0.3e-5 <= choose([0.4] * 20, at=1e-5) <= 1e-5
+    assert choose([0.4] * 20, at=2e-5, rtol=1e-10) >= LOCAL_RTOL_MIN / 1e-10  # (the floor)
+    # one chaotic run (accepted at 3e-6 after retries): it retries alone, the rest not tighter
+    assert choose(regular + [0.3], at=[0.003] * 20 + [3e-6]) >= base
+    assert choose(regular + [3.0] * 10) < base  # (a third of the runs 10x harder)
+    nothing = [np.nan, 0.0, -1.0]
+    assert first_factor(nothing, [0.003] * 3, [150.0] * 3, [0.5] * 3, current=0.003,
+                        rtol=1e-8) == 0.003
+
+
+def test_the_learned_factor_models_the_compiled_retry():
+    """`batch.first_factor`'s model of a retry is the compiled one's (``AU_AIM``,
+    ``AU_LADDER`` of `cpass`'s C)."""
+    import re
+    from pathlib import Path
+    from appdyn.dynamics.integrate import batch, cpass
+    source = Path(cpass.__file__).read_text()
+    define = lambda name: float(re.search(rf"#define {name} ([0-9.e-]+)", source).group(1))
+    assert (batch.RETRY_AIM, batch.RETRY_LADDER) == (define("AU_AIM"), define("AU_LADDER"))
+
+
 def test_near_round_off_the_floor_is_measured_in_the_same_call():
     """rtol 1e-10 (atol 1e-12) on issue 31's body: within 1e6 ulps of the states, the carried
     rounding is not small against the quaternion's tolerance (1e-12 where a part crosses

@@ -128,3 +128,32 @@ def test_cmg_time_optimal_singular_arc_general_inertia_is_verified():
     # per interval on its mesh (`slew.bounded`), measured T = 2.6895478
     assert "bounded" in sol.info and abs(sol.T - 2.6895478) < 1e-6
     assert sol.info["momentum_drift"] < 1e-5
+
+
+@pytest.mark.slow
+def test_an_overshoot_at_an_active_speed_bound_is_diagnosed_and_its_remedy_works():
+    """At 0.85 of the free slew's peak wheel speed the refinement meets its tolerance but the
+    dense wheel speed overshoots the active bound between the nodes by 1.6e-5 of its scale
+    on 30, 43 and 65 intervals alike: a failure that says so (not "a singular arc"), and its
+    remedy, ``bound_tol`` of about twice the overshoot, verifies the same problem."""
+    from appdyn import ocp
+    from appdyn.problems.slew.targets import RATE_TOL
+
+    I, J = np.diag([1.0, 2.0, 3.0]), 0.05
+    free = slew.wheel_slew(I, np.eye(3), J, objective="effort", T=4.0, angle=1.0,
+                           axis=[0, 0, 1], torque_max=None)
+    speeds = free.problem.model.layout["wheels"].speeds
+    limit = 0.85 * float(np.max(np.abs(free.x[speeds])))
+    held = slew.wheel_slew(I, np.eye(3), J, objective="effort", T=4.0, angle=1.0,
+                           axis=[0, 0, 1], torque_max=None, speed_max=limit,
+                           Wf=[0.0, 0.0, 0.0], rate_tol=RATE_TOL * (3.0 / J + 1.0))
+    assert not held.success and held.status == ocp.STATUS_STALLED
+    assert "meets tol" in held.message and "leaves a bound: `W" in held.message
+    assert "singular arc" not in held.message.split(". IPOPT")[0]
+    overshoot = held.bound_violation.max
+    assert 1e-6 < overshoot < 1e-4
+    first = ocp.solve(held.problem, mesh=held.info["meshes"][0], guess=held,
+                      bound_tol=2 * overshoot)
+    again = ocp.refine(held.problem, first, tol=1e-7, bound_tol=2 * overshoot)
+    assert again.success, again.message
+    assert again.bound_violation.max <= 2 * overshoot

@@ -386,6 +386,8 @@ def test_dispatch_equals_cmg_slew():
     assert (fast.success, fast.status) == (old.success, old.status)
     assert abs(fast.T - old.T) <= 1e-9
     assert fast.success or "which failed" in fast.message, fast.message
+    # a failed re-solve ends within its iteration budget (it once took 1861 iterations, 35 s)
+    assert fast.success or "a budget of 200 IPOPT iterations" in fast.message, fast.message
 
 
 @pytest.mark.slow
