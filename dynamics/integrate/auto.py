@@ -377,20 +377,43 @@ def dense_pass(problem: Problem, rtol, atol, max_steps, progress):
     (`stepcontrol.run_dense`), so the work follows the solution, not the output grid; the
     answer, its check (its steps merged in pairs), their comparison and the verdict in
     one compiled call (`dense.dense_auto`, whose docstring states the rules).
-    Returns ``(run, estimate)`` or ``(None, nan)`` to leave the problem to `one_pass` and the
-    multi-run search (stiff by the first step's Lipschitz estimate: more than
-    `STIFF_STEPS` steps for stability alone; no compiled library, a control that varies, a
-    tolerance so near a state's rounding that 1000 ulps of it take half of the acceptance, a
-    failed run, or no verdict after `dense.TRIES` answers).
+    Returns ``(run, estimate, status, spent)``: status ``OK`` (verified), ``ROUNDOFF`` (not
+    verified because the tolerance lies below the rounding floor of double precision: 1000
+    ulps of a state's size, with the carried rounding, exceed it at the outputs, so no path
+    of ``auto`` can verify it; the answer is returned at once with its estimate, `_floor_message`
+    words it), or ``(None, nan, None, spent)`` to leave the problem to `one_pass` and the multi-run
+    search (stiff by the first step's Lipschitz estimate: more than `STIFF_STEPS` steps for
+    stability alone; no compiled library, a control that varies, a requested tolerance below
+    one ulp of a state's size, a failed run, or no verdict after `dense.TRIES` answers).
 
     Within `_PASS_MEASURED` ulps of a state's size the rounding the answer measured on its
     way, carried over the horizon, is added; where it is not small, the floor measured by the
     answer repeated from a moved start (as `estimates.measured_floor`), in the same call.
+    ``spent``: the steps of its runs (counted in the result whichever path answers).
     """
     got = dense_auto(problem, rtol, atol, max_steps, STIFF_STEPS, progress=progress)
-    if got is None or got.result != 1:
-        return None, math.nan
-    return dense_answer(got, rtol)
+    if got is None:
+        return None, math.nan, None, 0
+    if got.result == 1:
+        return *dense_answer(got, rtol), OK, got.spent
+    if got.result == 0 and got.ulps + got.bound > 1.0:
+        # (every path accepts at most a floor of the tolerance: `auto_runs`' estimate plus
+        # its floor, which is at least these ulps, within 1)
+        return (Run.new(got.x, got.spent, DOP853.stages * got.spent, got.substeps, True, True,
+                        _floor_message(got, rtol)), got.estimate, ROUNDOFF, got.spent)
+    return None, math.nan, None, got.spent
+
+
+def _floor_message(got: DenseAuto, rtol: float) -> str:
+    """The message of `dense_pass`'s answer below the rounding floor: what was asked, what
+    the floor is, the answer's estimate and the remedy."""
+    return (f"auto: tolerance not verified: it lies below the round-off floor of double "
+            f"precision for these states (1000 ulps of the largest state's size are "
+            f"{got.ulps:.2g} of its least tolerance at the outputs"
+            + (f", the rounding carried over the horizon {got.bound:.2g} more" if got.bound
+               else "")
+            + f"); {dense_message(got, rtol)[len('auto: '):]}; x is the best solution found; "
+            f"remedy: rtol and atol at least {4 * (got.ulps + got.bound):.2g}x looser")
 
 
 def dense_answer(got: DenseAuto, rtol: float) -> tuple[Run, float]:
@@ -494,21 +517,23 @@ def solve_auto(problem: Problem, rtol, atol, max_steps, jit, cvodes_options, pro
     never the output grid); then (a control that varies, or no verdict) to the one-pass
     path, then the multi-run Richardson search (`auto_runs`)."""
     causes = nonsmooth_causes(problem, operations=nonsmooth)
-    spent = 0
+    spent = tried = 0
     if causes:
         got = _auto_stepped(problem, rtol, atol, max_steps, jit, progress, causes)
         if got is not None:
             return got
     else:
-        run, estimate = dense_pass(problem, rtol, atol, max_steps, progress) \
-            if auto_jit(jit) else (None, math.nan)
-        if run is not None:
-            return run, "rk8", OK, estimate  # (DOP853's 8th-order steps, as the fixed-step rk8)
+        run, estimate, status, tried = dense_pass(problem, rtol, atol, max_steps, progress) \
+            if auto_jit(jit) else (None, math.nan, None, 0)
+        if run is not None:  # (DOP853's 8th-order steps, as the fixed-step rk8)
+            return run, "rk8", status, estimate
         run, estimate, spent = one_pass(problem, rtol, atol, max_steps, jit, progress)
-        if run is not None:
-            return run, "rk8", OK, estimate
+        if run is not None:  # (the steps of every path tried are counted)
+            return replace(run, n_steps=run.n_steps + tried,
+                           n_rhs=run.n_rhs + DOP853.stages * tried), "rk8", OK, estimate
     run, estimate, status, reason, n_steps, n_rhs = auto_runs(Single(problem), rtol, atol,
                                                           max_steps - spent, jit, progress)
+    spent += tried
     n_steps, n_rhs = n_steps + spent, n_rhs + DOP853.stages * spent
     if run is None and reason.startswith("stiff"):
         crun, estimate, status, cs, cr = _auto_cvodes(problem, rtol, atol, cvodes_options)

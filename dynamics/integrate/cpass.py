@@ -520,8 +520,8 @@ _AUTO = r"""
 #define AU_SPENT 9    /* steps of every run (accepted and rejected) */
 #define AU_NCHK 10    /* steps of the check run */
 #define AU_NANS 11    /* steps of the answer */
-#define AU_RESULT 12  /* 1 verified, 0 not (AU_EST), -2 a tolerance too near the states'
-                         rounding, -3 a run failed */
+#define AU_RESULT 12  /* 1 verified, 0 not (AU_EST), -2 a tolerance below an ulp of the
+                         states' size (AU_FMIN > 1), -3 a run failed */
 #define AU_EST 13     /* the error estimate [tolerances] */
 #define AU_D 14       /* the scaled difference of the answer and the check run */
 #define AU_FLAG 15    /* `rk8_dense`'s flag of a failed run */
@@ -539,13 +539,29 @@ _AUTO = r"""
 #define AU_FLOOR 27   /* the rounding floor measured by a rerun from a moved start (0: none) */
 #define AU_ORDER 28   /* the order shown by the embedded estimates of the check's merged
                          steps against the answer's (`au_order`; NaN: not measured) */
-#define AU_HDR 29
+#define AU_ULPS 29    /* FLOOR_ULPS ulps of the largest state's size over its least tolerance
+                         at the outputs (`au_diff`): the rounding no answer is verified below */
+#define AU_PFAC 30    /* the previous answer's local factor (0: none) ... */
+#define AU_PEST 31    /* ... and the part of its estimate that the local tolerance controls */
+#define AU_FMIN 32    /* the least local factor: the answer's local tolerance kept
+                         AU_LOCAL_ULPS ulps above the states' size and at least AU_RTOL_MIN */
+#define AU_HDR 33
 #define AU_ACCEPT 0.5        /* estimates.AUTO_ACCEPT */
 #define AU_FLOOR_ULPS 1000.0 /* estimates.FLOOR_ULPS */
 #define AU_MEASURED 1e6      /* auto's _PASS_MEASURED */
+#define AU_DEEP 1e4          /* a retry whose local tolerance lies within this many ulps of
+                                the states' size measures the rounding floor: per step the
+                                rounding is an ulp against the truncation's AU_DEEP, so it is
+                                a part of the difference over N steps only below ~10 sqrt(N)
+                                ulps (300 at N = 1000); the near-separatrix tumble that showed
+                                it ran at 80 */
 #define AU_RTOL_MIN 1e-14    /* stepcontrol.LOCAL_RTOL_MIN */
-#define AU_LADDER 1e-2       /* the most a new answer's local tolerance shrinks (as
-                                stepcontrol's runs of a non-smooth right-hand side) */
+#define AU_LADDER 1e-2       /* the most a new answer's local tolerance shrinks */
+#define AU_LOCAL_ULPS 1.0    /* a local tolerance below this many ulps of a state's size
+                                asks DOP853 for less than the state's own rounding */
+#define AU_FLOOR_GATE 1.0    /* the acceptance of the estimate with a measured floor on top
+                                (as `auto.auto_runs`: truncation within AU_ACCEPT, floor
+                                included within the tolerance) */
 #define AU_NOISE_EPS 30.0    /* NOISE: an embedded estimate at most this many eps / rtol
                                 is rounding */
 #define AU_AIM 0.2           /* a new answer's aim [tolerances] */
@@ -664,9 +680,18 @@ static casadi_real au_carried(casadi_real* w) {
 }
 
 /* the verdict on the estimate `est` (AU_RESULT, AU_PHASE); not accepted, the next answer,
-   tighter, or done */
+   tighter, or done. The next local factor is predicted from the part of the estimate the
+   local tolerance controls (`est` less the rounding AU_ULPS and AU_BOUND, which no tighter
+   tolerance lowers): DOP853's global error follows its local tolerance about linearly
+   (tolerance proportionality: its error estimate is of the step's order, measured slope
+   0.9-1.1 over 1e-5..1 of rtol on torque-free bodies and the hinged scene), so the first
+   retry scales the factor by aim / part; a later one by the slope measured between the last
+   two answers (within [0.5, 2]). The aim is AU_AIM, less where the rounding takes more of
+   the acceptance (half what it leaves); at most AU_LADDER tighter per answer, never below
+   AU_FMIN. No answer is made when the rounding alone takes 90 % of the acceptance, or the
+   factor cannot shrink by 1.5 (at AU_FMIN): the tolerance lies at the rounding floor. */
 static void au_verdict(casadi_real* w, casadi_real est) {
-  casadi_real e;
+  casadi_real e, part, aim, slope = 1, rounding = w[AU_ULPS] + w[AU_BOUND];
   w[AU_EST] = est;
   w[AU_PHASE] = 3;
   if (est <= w[AU_GATE]) {
@@ -675,13 +700,17 @@ static void au_verdict(casadi_real* w, casadi_real est) {
   }
   w[AU_RESULT] = 0;
   if (!isfinite(est) || w[AU_TRY] >= w[AU_TRIES] || w[AU_FLOOR] > 0) return;
-  /* aim at AU_AIM (the error follows the local tolerance about linearly: measured over
-     1e-3..10 of rtol on torque-free bodies), at most AU_LADDER tighter (beyond the
-     method's asymptotic range the estimate predicts nothing) */
-  e = fmax(AU_LADDER, fmin(0.5, AU_AIM / est));
+  part = est - rounding;
+  aim = fmin(AU_AIM, 0.5 * (AU_ACCEPT - rounding));
+  if (!(aim > 0.05 * AU_ACCEPT) || !(part > 0)) return;
+  if (w[AU_PFAC] > w[AU_FACTOR] && w[AU_PEST] > part)
+    slope = fmin(2.0, fmax(0.5, log(w[AU_PEST] / part) / log(w[AU_PFAC] / w[AU_FACTOR])));
+  e = fmax(AU_LADDER, fmin(0.5, pow(aim / part, 1.0 / slope)));
+  e = fmax(e, w[AU_FMIN] / w[AU_FACTOR]);
+  if (!(e <= 1.0 / 1.5)) return;
+  w[AU_PFAC] = w[AU_FACTOR]; w[AU_PEST] = part;
   w[AU_FACTOR] *= e;
   w[AU_LOOSE] = w[AU_FACTOR];
-  if (w[AU_RTOL] * w[AU_FACTOR] < AU_RTOL_MIN) return;
   au_begin(w, w[AU_FACTOR]);
   w[AU_PHASE] = 2;
 }
@@ -705,6 +734,7 @@ static void au_judge(casadi_real* w, casadi_real* X, casadi_real* XC) {
   int nout = (int) w[AU_NOUT], j, deep;
   casadi_real d, ulps, lmin, e, est, horizon, lip = w[AU_LIP], order;
   d = au_diff(w, X, XC, &ulps, &lmin);
+  w[AU_ULPS] = ulps;
   order = au_order(w, AU_RICH(w));
   w[AU_ORDER] = order;
   if (order >= AU_ORDER_LO && order <= AU_ORDER_HI) {  /* Richardson */
@@ -718,11 +748,11 @@ static void au_judge(casadi_real* w, casadi_real* X, casadi_real* XC) {
   for (e = AU_TS(w)[0] - w[AU_T0], j = 1; j < nout; ++j)
     if (AU_TS(w)[j] - AU_TS(w)[j - 1] > e) e = AU_TS(w)[j] - AU_TS(w)[j - 1];
   w[AU_SUB] = w[AU_HMIN] < INFINITY ? ceil(e / w[AU_HMIN]) : 1;
-  /* a retry whose local tolerance lies within AU_MEASURED ulps of the states' size: the
+  /* a retry whose local tolerance lies within AU_DEEP ulps of the states' size: the
      difference of the answer and its check may be rounding the flow amplified, which the
      Richardson division would hide (near a separatrix: 20 tolerances estimated at 0.18):
      the floor is measured, not modelled */
-  deep = w[AU_TRY] > 1 && au_size(w) / w[AU_FACTOR] * DBL_EPSILON * AU_MEASURED > 1.0;
+  deep = w[AU_TRY] > 1 && au_size(w) / w[AU_FACTOR] * DBL_EPSILON * AU_DEEP > 1.0;
   if (est <= w[AU_GATE] && (deep || au_size(w) * DBL_EPSILON * AU_MEASURED > 1.0)) {
     horizon = AU_TS(w)[nout - 1] - w[AU_T0];
     e = au_carried(w);
@@ -745,14 +775,18 @@ static void au_judge(casadi_real* w, casadi_real* X, casadi_real* XC) {
 
 /* after the rerun from the moved start (in XC): the floor is the largest of its difference
    from the answer, the carried rounding against the least tolerance and the ulps
-   (`estimates.measured_floor`), added to the estimate */
+   (`estimates.measured_floor`), in the estimate in place of the ulps; accepted within
+   AU_FLOOR_GATE (the truncation estimate was within the acceptance: the rerun is made only
+   then) */
 static void au_floor(casadi_real* w, casadi_real* X, casadi_real* XC) {
   casadi_real ulps, lmin, d = au_diff(w, X, XC, &ulps, &lmin), local = 0;
   int i;
   for (i = 0; i < PASS_NX; ++i) local = fmax(local, AU_NOISE(w)[i]);
   local = lmin > 0 ? local / lmin : (local > 0 ? INFINITY : 0);
   w[AU_FLOOR] = fmax(fmax(d, local), ulps);
-  au_verdict(w, w[AU_EST] + w[AU_FLOOR]);
+  /* (the floor replaces the ulps in the estimate: it is at least them) */
+  w[AU_GATE] = AU_FLOOR_GATE;
+  au_verdict(w, w[AU_EST] - ulps + w[AU_FLOOR]);
 }
 
 /* The whole of `dense.dense_auto` for one problem: the answer into X (nx, nout + 1; column
@@ -764,12 +798,17 @@ int rk8_auto(casadi_real* w, int nout, int budget, casadi_real* X, casadi_real* 
   w[AU_NOUT] = nout;
   if (w[AU_PHASE] == 0) {
     w[AU_SPENT] = 0; w[AU_TRY] = 0; w[AU_RESULT] = 0; w[AU_FLAG] = 0; w[AU_EST] = NAN;
-    w[AU_BOUND] = 0; w[AU_FLOOR] = 0;
+    w[AU_BOUND] = 0; w[AU_FLOOR] = 0; w[AU_ULPS] = 0; w[AU_PFAC] = 0; w[AU_PEST] = 0;
     for (i = 0; i < PASS_NX; ++i) X[i * ld] = XC[i * ld] = AU_X0(w)[i];
-    if (au_size(w) * DBL_EPSILON * AU_FLOOR_ULPS > 0.5 * AU_ACCEPT) {
-      w[AU_RESULT] = -2; w[AU_PHASE] = 3;  /* (the 1000-ulp floor: half the acceptance) */
+    /* the local tolerance kept AU_LOCAL_ULPS ulps above the states' size (a tighter one asks
+       for less than DOP853's rounding) and at least AU_RTOL_MIN; a requested tolerance
+       itself below that: no run (-2) */
+    w[AU_FMIN] = fmax(au_size(w) * DBL_EPSILON * AU_LOCAL_ULPS, AU_RTOL_MIN / w[AU_RTOL]);
+    if (w[AU_FMIN] > 1.0) {
+      w[AU_RESULT] = -2; w[AU_PHASE] = 3;
       return 3;
     }
+    if (w[AU_FACTOR] < w[AU_FMIN]) w[AU_FACTOR] = w[AU_FMIN];
     w[AU_LOOSE] = w[AU_FACTOR];
     au_begin(w, w[AU_FACTOR]);
     w[AU_PHASE] = 2;

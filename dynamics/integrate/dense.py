@@ -6,7 +6,8 @@ batch in one compiled loop over the runs (``rk8_auto_many``), each run with its 
 check and verdict.
 
 The rules (as `dynamics.integrate.auto.dense_pass` states them): the answer runs at the
-local tolerance ``(rtol, atol) f`` (``f = FIRST``); its check is Richardson's on the answer's
+local tolerance ``(rtol, atol) f`` (``f = FIRST``, at least the factor that keeps it one ulp
+above the states' size); its check is Richardson's on the answer's
 own steps: alongside the answer, each pair of its accepted steps is taken again as one
 step of their sum (a lone last step alone), no step rejected, the outputs from that step's
 continuous extension (about half the answer's steps). ``d`` is their scaled difference (max
@@ -20,10 +21,18 @@ model's formulas (measured on the way) is carried over the horizon (`estimates.c
 and its screening bound (`estimates.screen`) added when at most 0.05; otherwise the flow's
 real amplification is measured as `estimates.measured_floor` does: the answer is repeated
 from ``x0`` moved by that carried rounding, and the largest of its difference from the
-answer, the carried rounding and the ulps is added. Not accepted, the answer is redone
-with its local tolerance scaled by ``0.2 / estimate`` (the error follows the local
-tolerance about linearly), at most 100x tighter (`TRIES` answers at most; not after a
-floor was measured).
+answer, the carried rounding and the ulps replaces the ulps; the estimate is then accepted
+at most 1 (as the multi-run search accepts its estimate with its floor on top). Not
+accepted, the answer is redone with its local tolerance predicted from the part of the
+estimate it controls (the estimate less the ulps and the carried rounding, which no
+tighter tolerance lowers): DOP853's global error follows its local tolerance about
+linearly, so the first retry scales it by ``aim / part`` and a later one by the slope
+measured between the last two answers; the aim is 0.2 (less where the rounding takes more
+of the acceptance), at most 100x tighter per answer, never below the factor that keeps
+the local tolerance an ulp above the states' size (`TRIES` answers at most; none after a
+floor was measured, nor when the rounding alone takes 90 % of the acceptance: the
+tolerance then lies at the rounding floor, and `dynamics.integrate.auto.dense_pass` answers
+with ``ROUNDOFF`` when those ulps exceed the tolerance).
 
 Per call the Python is a look-up of the model's plan (its library and the workspace
 layout, `_plan`), a thread's reused workspace, one ``ctypes`` call and the result's array.
@@ -63,10 +72,11 @@ BUDGET = 1 << 15
 FIELDS = ("rtol", "factor", "loose", "max_steps", "stiff_steps", "t0", "iq", "tries", "phase",
           "spent", "check_steps", "answer_steps", "result", "estimate", "d", "flag", "try",
           "accepted", "rejected", "hmin", "interpolated", "lipschitz", "ratio", "bound",
-          "nout", "substeps", "gate", "floor", "order")
+          "nout", "substeps", "gate", "floor", "order", "ulps", "prev_factor", "prev_part",
+          "factor_min")
 (_RTOL, _FACTOR, _LOOSE, _MAXSTEPS, _STIFF, _T0, _IQ, _TRIES, _PHASE, _SPENT, _NCHK, _NANS,
  _RESULT, _EST, _D, _FLAG, _TRY, _ACC, _REJ, _HMIN, _INTERP, _LIP, _RATIO, _BOUND,
- _NOUT, _SUB, _GATE, _FLOOR, _ORDER) = range(len(FIELDS))
+ _NOUT, _SUB, _GATE, _FLOOR, _ORDER, _ULPS) = range(len(FIELDS) - 3)
 #: Doubles of a run's header.
 HEADER = len(FIELDS)
 _REASONS = ("", "a state became non-finite", "the step size underflowed",
@@ -77,15 +87,17 @@ class DenseAuto(NamedTuple):
     """The outcome of `dense_auto` (one run) or of a run of `dense_many`.
 
     ``x (nx, n)`` the answer (NaN after a failure); ``result`` 1 verified, 0 not verified
-    (``estimate`` > acceptance or not finite), -2 a tolerance too near a state's rounding (no
-    run made), -3 a run failed (``reason``); ``estimate`` [tolerances]; ``spent`` steps of
+    (``estimate`` > acceptance or not finite), -2 a requested tolerance below one ulp of a
+    state's size (no run made), -3 a run failed (``reason``); ``estimate`` [tolerances]; ``spent`` steps of
     all runs; ``answer_steps``, ``check_steps`` (accepted and rejected), ``rejected`` of the
     answer, ``hmin`` its smallest step [s], ``interpolated`` its steps that filled outputs,
     ``ratio`` the check's steps over the answer's (2: merged in pairs), ``factor`` the
     answer's local tolerance over the requested, ``bound`` the rounding bound included in ``estimate`` (or ``floor``, the
     rounding floor measured by a rerun from a moved start, when that bound was not small), ``substeps`` the
     longest output interval over ``hmin`` (equal steps of that many per interval are no
-    longer than any the answer took), ``reason`` why a run failed."""
+    longer than any the answer took), ``reason`` why a run failed, ``ulps`` 1000 ulps of the
+    largest state's size over its least tolerance at the outputs (part of ``estimate``: the
+    rounding no answer is verified below)."""
 
     x: np.ndarray
     result: int
@@ -102,6 +114,7 @@ class DenseAuto(NamedTuple):
     floor: float
     substeps: int
     reason: str
+    ulps: float
 
 
 def constant_control(ctrl) -> bool:
@@ -209,7 +222,7 @@ def _outcome(x: np.ndarray, head) -> DenseAuto:
                             int(head[_NCHK]), int(head[_REJ]), head[_HMIN],
                             int(head[_INTERP]), head[_RATIO], head[_FACTOR], head[_BOUND],
                             head[_FLOOR], int(head[_SUB]),
-                            _REASONS[int(head[_FLAG])] if result == -3 else ""))
+                            _REASONS[int(head[_FLAG])] if result == -3 else "", head[_ULPS]))
 
 
 #: ``DenseAuto`` from a tuple of every field, without its ``__new__``'s argument parsing.

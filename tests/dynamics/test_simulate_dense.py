@@ -362,6 +362,62 @@ def test_near_round_off_the_floor_is_measured_in_the_same_call():
     assert np.all(np.abs(res.x[4:] - w) <= atol + rtol * np.abs(w))
 
 
+@pytest.mark.slow  # (a body of its own: its first compile)
+def test_no_cliff_between_tolerances_near_the_rounding_floor():
+    """A fast flat body on a dense grid (20 s, 2001 outputs) at rtol 1e-9 and 1e-10 (atol
+    rtol/100, 4500 ulps of the quaternion's size at 1e-10): both verified on the dense path,
+    the decade costing what the method's order says (steps ~ tol^(-1/8): 1.33x, a measured
+    rounding floor included: at most 5x; it took 46x on the multi-run search before), each
+    within its tolerance against Jacobi's closed form."""
+    inertia, w0 = [10.0, 12.0, 21.0], [2.0, -1.0, 0.5]
+    model, t = rigid_body(inertia), np.linspace(0.0, 20.0, 2001)
+    x0, w = np.r_[0.0, 0.0, 0.0, 1.0, w0], torque_free_omega(inertia, w0, t)
+    steps = {}
+    for rtol in (1e-9, 1e-10):
+        res = simulate(model, x0, t, rtol=rtol, atol=rtol / 100)
+        assert res.success and "dense output" in res.message, res.message
+        assert np.all(np.abs(res.x[4:] - w) <= rtol / 100 + rtol * np.abs(w))
+        steps[rtol] = res.n_steps
+    assert steps[1e-10] <= 5 * steps[1e-9], steps
+
+
+def test_below_the_rounding_floor_answers_at_once_and_says_so():
+    """rtol 1e-12, atol 1e-14 on issue 31's body: 1000 ulps of the quaternion's size (which
+    crosses zero, where its tolerance is atol) are 22 tolerances, so no path of ``auto``
+    can verify the answer: it comes at once from the dense path (one answer and its check,
+    not the multi-run search: 3480 steps before), not called a success, with the floor and
+    the remedy in its message; it is as good as double precision gives (rates within 1e-13
+    of Jacobi's closed form)."""
+    from appdyn.dynamics.integrate.result import ROUNDOFF
+    model, t = rigid_body(INERTIA), np.linspace(0.0, 60.0, 121)
+    loose = simulate(model, X0, t, rtol=1e-9, atol=1e-11)
+    res = simulate(model, X0, t, rtol=1e-12, atol=1e-14)
+    assert not res.success and res.status == ROUNDOFF
+    assert "below the round-off floor" in res.message and "remedy" in res.message, res.message
+    assert res.error_estimate > 1.0
+    assert res.n_steps <= 2 * loose.n_steps, (res.n_steps, loose.n_steps)
+    w = torque_free_omega(INERTIA, X0[4:], t)
+    assert np.max(np.abs(res.x[4:] - w)) < 1e-13
+
+
+def test_a_retry_far_above_the_rounding_makes_no_floor_run():
+    """The bench body near a separatrix (100 s) at rtol 1e-5: its first answer (at 0.003 of
+    the tolerance) is refused and the retry, predicted from the estimate, lands about 30x
+    tighter, 1e5 ulps above the states' size, where rounding is no part of the difference of
+    the answer and its check (the floors measured there were 3e-6 of the tolerance): no
+    rerun from a moved start, two answers and their checks in all, verified and within the
+    estimate of Jacobi's rates."""
+    from appdyn.dynamics.integrate.dense import FIRST, dense_auto
+    inertia, w0 = _JACOBI[1]
+    model, t = rigid_body(inertia), np.linspace(0.0, 100.0, 101)
+    x0, rtol, atol = np.r_[0.0, 0.0, 0.0, 1.0, w0], 1e-5, 1e-7
+    got = dense_auto(_problem(model, x0, t), rtol, np.full(7, atol), 1e8, 1e6)
+    assert got.result == 1 and got.factor < FIRST / 10 and got.floor == 0
+    assert got.spent < 2 * (got.answer_steps + got.check_steps)
+    w = torque_free_omega(inertia, w0, t)
+    assert np.all(np.abs(got.x[4:] - w) <= got.estimate * (atol + rtol * np.abs(w)))
+
+
 def test_header_inputs_are_the_first_slots():
     """`dense._fill` writes the header's inputs in one `struct` call in this order: the
     C code's ``AU_*`` slots (`dense.FIELDS`) must start with them."""

@@ -30,7 +30,7 @@ def _no_dense_path(monkeypatch):
     control that varies: here with that path switched off, so that the same closed forms
     judge the pass."""
     monkeypatch.setattr("appdyn.dynamics.integrate.auto.dense_pass",
-                        lambda *args: (None, math.nan))
+                        lambda *args: (None, math.nan, None, 0))
     # (and the common call's way to the same pass: `simulate` at the defaults)
     monkeypatch.setattr("appdyn.dynamics.integrate.api.dense_run", lambda *args, **kw: None)
 
