@@ -111,7 +111,7 @@ def rockit_round(case: Case) -> dict:
     if case.rockit is None:
         return {}
     if case.rockit in _ROCKIT_FAILED:
-        return _ROCKIT_FAILED[case.rockit]
+        return {k: dict(v, reused=True) for k, v in _ROCKIT_FAILED[case.rockit].items()}
     a = run_peer("rockit", "rockit_literature.py", ["--case", case.rockit, "--N", 20])
     if a is None:
         return {}
@@ -158,8 +158,9 @@ def run_case(case: Case, quick: bool, repeats: int) -> list:
         ok = "" if r["success"] else "; NOT successful"
         summary.append(Row("literature", case.name, f"error, {r['solver']}", r["error"], case.unit,
                            f"objective {r['objective']:.7f}{ok}"))
+        once = "one run (failed: not repeated)" if r.get("reused") else how
         summary.append(Row("literature", case.name, f"wall time, {r['solver']}", r["wall"], "s",
-                           f"{how}; build {r['build']:.3g} s, solve {r['solve']:.3g} s; "
+                           f"{once}; build {r['build']:.3g} s, solve {r['solve']:.3g} s; "
                            f"{r['iterations']} iterations{ok}"))
     for a, _ in case.appdyn:
         for p in (k for k in rounds[-1] if not k.startswith("appdyn")):
