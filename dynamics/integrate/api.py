@@ -13,7 +13,7 @@ from .. import cache, validate
 from ..clock import CLOCK_STATE, check_clock_start, clock_index
 from ..model import Model, check_model
 from ..progress import progress_reporter
-from .auto import STIFF_STEPS, dense_answer, solve_auto
+from .auto import STIFF_STEPS, dense_outcome, solve_auto
 from .batch import BatchResult, check_batch, simulate_batch
 from .batch_fixed import batch_threads
 from .cvodes import run_cvodes
@@ -285,9 +285,10 @@ def _common_call(model, x0, t, rtol, atol, max_steps, start: float):
     """`simulate` of the common call, ``method='auto'`` at the model's parameters without a
     control or options (a `Model` with no clock state and a smooth right-hand side, ``x0`` of
     shape ``(nx,)`` that `fast_x0` takes, float tolerances, an int ``max_steps``): the
-    verified answer of the compiled dense pass (`dense.dense_run`) at once, ``start`` the
-    call's `time.perf_counter`. None for anything else, or when the pass gives no verified
-    answer: the general path then decides (and words any error)."""
+    answer of the compiled dense pass (`dense.dense_run`) at once when it answers
+    (`auto.dense_outcome`: verified, or below the rounding floor), ``start`` the call's
+    `time.perf_counter`. None for anything else, or when the pass leaves the run to auto's
+    other paths: the general path then decides (and words any error)."""
     if type(model) is not Model or not call_plan(model).common:
         return None
     if (type(rtol) is not float or type(atol) is not float or type(max_steps) is not int
@@ -298,10 +299,11 @@ def _common_call(model, x0, t, rtol, atol, max_steps, start: float):
     if x0 is None:
         return None
     got = dense_run(model, x0, t, rtol, atol, max_steps, STIFF_STEPS, p=model.p_default)
-    if got is None or got.result != 1:
+    out = None if got is None else dense_outcome(got, rtol)
+    if out is None:
         return None
-    run, estimate = dense_answer(got, rtol)
-    return _result(model, t, run, "rk8", OK, estimate, None, model.p_default, (), start)
+    run, estimate, status = out
+    return _result(model, t, run, "rk8", status, estimate, None, model.p_default, (), start)
 
 
 def _result(model: Model, t: np.ndarray, run: Run, used: str, status: int, estimate: float,

@@ -25,7 +25,7 @@ from .stepcontrol import LOCAL_RTOL_MIN, solve_stepped
 from .tableaux import DOP853
 
 __all__ = ["solve_auto", "auto_jit", "STIFF_STEPS", "Single", "auto_runs", "dense_pass",
-           "dense_answer", "dense_message", "one_pass", "nonsmooth_causes"]
+           "dense_outcome", "dense_answer", "dense_message", "one_pass", "nonsmooth_causes"]
 
 _AUTO_AIM = 0.1        # predict the step count for this estimated scaled error
 _AUTO_RUNS = 8         # give up (status 3) after this many fixed-step runs
@@ -394,14 +394,23 @@ def dense_pass(problem: Problem, rtol, atol, max_steps, progress):
     got = dense_auto(problem, rtol, atol, max_steps, STIFF_STEPS, progress=progress)
     if got is None:
         return None, math.nan, None, 0
+    out = dense_outcome(got, rtol)
+    return (*out, got.spent) if out is not None else (None, math.nan, None, got.spent)
+
+
+def dense_outcome(got: DenseAuto, rtol: float) -> tuple[Run, float, int] | None:
+    """``(run, estimate, status)`` of a dense pass's outcome ``got`` that answers: ``OK``
+    (verified) or ``ROUNDOFF`` (not verified below the rounding floor, `dense_pass`); None
+    for one left to auto's other paths. Shared by `dense_pass` and `simulate`'s common
+    call (which would otherwise run the same pass again on the general path)."""
     if got.result == 1:
-        return *dense_answer(got, rtol), OK, got.spent
+        return *dense_answer(got, rtol), OK
     if got.result == 0 and got.ulps + got.bound > 1.0:
         # (every path accepts at most a floor of the tolerance: `auto_runs`' estimate plus
         # its floor, which is at least these ulps, within 1)
         return (Run.new(got.x, got.spent, DOP853.stages * got.spent, got.substeps, True, True,
-                        _floor_message(got, rtol)), got.estimate, ROUNDOFF, got.spent)
-    return None, math.nan, None, got.spent
+                        _floor_message(got, rtol)), got.estimate, ROUNDOFF)
+    return None
 
 
 def _floor_message(got: DenseAuto, rtol: float) -> str:

@@ -398,6 +398,12 @@ def test_below_the_rounding_floor_answers_at_once_and_says_so():
     assert res.n_steps <= 2 * loose.n_steps, (res.n_steps, loose.n_steps)
     w = torque_free_omega(INERTIA, X0[4:], t)
     assert np.max(np.abs(res.x[4:] - w)) < 1e-13
+    # the common call answers it from its one pass (it ran the pass again on the general
+    # path): the same result as the general path (taken with a numpy int max_steps)
+    general = simulate(model, X0, t, rtol=1e-12, atol=1e-14, max_steps=np.int64(10**6))
+    assert (general.status, general.n_steps, general.message) == (res.status, res.n_steps,
+                                                                  res.message)
+    assert np.array_equal(general.x, res.x)
 
 
 def test_a_retry_far_above_the_rounding_makes_no_floor_run():
