@@ -8,7 +8,7 @@ import numpy as np
 
 from appdyn.dynamics.executors import check_executor, gather
 from appdyn.dynamics.progress import accepts_progress_bar
-from appdyn.dynamics.interrupts import check_interrupt, interruptible
+from appdyn.dynamics.interrupts import check_interrupt, deferred_interrupts, interruptible
 from appdyn.dynamics.results import timed
 
 from .cases import resolve_case
@@ -22,12 +22,19 @@ _BAND_RTOL = 1e-4  # a "marginally stable" stretch this narrow between the two i
 
 
 def _control_first(fun):
-    """``fun`` with python-control imported before it runs: the analyses of a sweep import it
-    on first use, and inside `interruptible`'s deferred region its ~1 s import (scipy,
-    matplotlib) would hold a Ctrl-C back until the import ends."""
+    """``fun`` with python-control imported before it runs, a Ctrl-C during the import held
+    until the import ends.
+
+    The analyses of a sweep import python-control on first use (~1 s: scipy, matplotlib). A
+    SIGINT landing inside those third-party imports is not reliably a ``KeyboardInterrupt``:
+    it can be swallowed (the sweep runs on) or turned into ``RuntimeError: Error calling
+    __set_name__`` in ``matplotlib.ticker``, leaving matplotlib half-imported. Deferred, it is
+    raised as a plain ``KeyboardInterrupt`` right after the import, with the modules whole.
+    """
     @functools.wraps(fun)
     def wrapper(*args, **kwargs):
-        import control  # noqa: F401  (a Ctrl-C here is a plain KeyboardInterrupt)
+        with deferred_interrupts():
+            import control  # noqa: F401
         return fun(*args, **kwargs)
     return wrapper
 
