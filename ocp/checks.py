@@ -38,7 +38,7 @@ from .mesh import sorted_union
 from .propagation import SCALE_FLOOR
 from .status import STATUS_BOUND_VIOLATION, STATUS_RESIMULATION
 
-__all__ = ["BoundViolation", "bound_grid", "bound_scale", "bound_violation",
+__all__ = ["BoundViolation", "bound_excess", "bound_grid", "bound_scale", "bound_violation",
            "interval_bound_violation", "periodic_jumps",
            "resimulation_mismatch", "BOUND_SAMPLES", "DEFAULT_VERIFY_TOL",
            "DEFAULT_VERIFY_TOL_LOW_ORDER", "default_verify_tol",
@@ -177,6 +177,14 @@ def _excess(dense, problem, x_nodes, u_nodes):
     excess = np.maximum(np.maximum(lo - values, values - hi), 0.0) / scale[:, None]
     excess[~np.isfinite(values)] = np.inf
     return bounds, scale, k, s, values, excess
+
+
+def bound_excess(solution) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
+    """``(bounds, scale, values)`` of ``solution``'s states and controls (in that order) on
+    `bound_grid`: their bounds, shape (2, n), scales (`bound_scale`), shape (n,), and dense
+    values, shape (n, M) [variable units]; ``None`` without finite bounds."""
+    out = _excess(solution.dense, solution.problem, solution.x, solution.u)
+    return None if out is None else (out[0], out[1], out[4])
 
 
 def interval_bound_violation(solution) -> np.ndarray:

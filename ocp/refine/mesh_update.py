@@ -23,6 +23,7 @@ from ..solution import Solution
 from ..status import STATUS_STALLED, status_name
 from ..solve import solve
 from ..transcription import Radau, Transcription, get_transcription
+from .backoff import back_off
 from .errors import IntervalErrors, interval_errors
 from .result import RefinedSolution, RefinementRound, annotate
 
@@ -198,6 +199,34 @@ def _overshoot_message(history: list, window: int, tol: float, sol: Solution) ->
             f"original must hold. {sol.message}")
 
 
+def _backed_off(sol: Solution, backed: Solution, moved: dict, tries: int, info: dict,
+                tol: float, verbose, progress, t_round: float, history: list) -> RefinedSolution:
+    """The result of a refinement whose last round overshot an active bound and was re-solved
+    on the same mesh with the bound moved inwards (`back_off`)."""
+    itol = float(np.clip(1e-4 * tol, 1e-13, 1e-10))
+    est = interval_errors(backed, rtol=itol, atol=itol)
+    history.append(RefinementRound(backed.mesh.N, est.max_error, backed.cost, backed.iterations,
+                                   time.perf_counter() - t_round))
+    _report(len(history) - 1, history[-1], verbose, progress)
+    bv = sol.bound_violation
+    margins = "; ".join(
+        f"`{name}` " + " and ".join(f"{side} by {m:.3g}" for side, m in zip(("lower", "upper"), lm) if m > 0)
+        for name, lm in moved.items())
+    converged = bool(est.max_error <= tol)
+    message = (f"refine: the dense output overshot an active bound between the nodes (`{bv.name}` "
+               f"by {bv.max:.3g} of its scale at t = {bv.time:.6g} s on {sol.mesh.N} intervals; "
+               f"refining barely changes such an overshoot); re-solved on the same "
+               f"mesh with the bound moved inwards ({margins}; {tries} re-solve"
+               f"{'s' if tries > 1 else ''}): the dense output is within the original bounds, "
+               f"the objective {backed.cost:.10g} against {sol.cost:.10g} without the margin; "
+               f"estimated error {est.max_error:.2e} {'<=' if converged else '>'} tol {tol:g}; "
+               f"{backed.message}")
+    info = dict(info, refinement=history, errors=est, converged=converged,
+                backoff={"margins": moved, "tries": tries, "overshoot": bv.max,
+                         "cost_without": float(sol.cost)})
+    return annotate(backed, info, message=message)
+
+
 def _stall_message(history: list, q: int, window: int, sol: Solution) -> str:
     errors = ", ".join(f"{r.max_error:.2e}" for r in history[-(window + 1):])
     sizes = ", ".join(str(r.n_intervals) for r in history[-(window + 1):])
@@ -238,7 +267,7 @@ def _report(rnd: int, r: RefinementRound, verbose, progress) -> None:
 def refine(problem: Problem, solution: Solution | None = None, *, tol: float = 1e-6,
            max_rounds: int = 6, max_intervals: int = 400, transcription="radau",
            N: int | None = None, degree: int | None = None, verbose=False, progress=None,
-           stall_rounds: int | None = 2, **solve_kwargs) -> RefinedSolution:
+           stall_rounds: int | None = 2, backoff: bool = True, **solve_kwargs) -> RefinedSolution:
     """Solve ``problem`` and refine the mesh until the estimated error is below ``tol``.
 
     Each round estimates the error of every interval (`interval_errors`: re-integration of
@@ -323,6 +352,15 @@ def refine(problem: Problem, solution: Solution | None = None, *, tol: float = 1
         stall (a pre-asymptotic plateau can end late: unregularized Goddard, given
         ``max_rounds=9``, reaches 1e-6 after 9 rounds on 304 intervals, its estimate
         erratic on the way: 1.5e-3, 1.2e-4, 9.0e-4, 8.3e-7 in the last four).
+    backoff : bool
+        When the last round meets ``tol`` but its dense output leaves a bound by at most
+        `ocp.refine.backoff.BACKOFF_MAX` of the variable's scale (the interpolant bulging past
+        an *active* bound between the nodes, which refining barely changes): re-solve on the
+        same mesh with that bound moved inwards by twice the overshoot (up to 3 times), graded
+        against the original bounds (`ocp.refine.backoff.back_off`; default True). The
+        objective pays for the margin to first order in its size; ``info['backoff']`` gives
+        the margins and the objective without them. ``False`` returns the overshooting
+        round as a failure that names the overshoot (status `STATUS_STALLED` after a stall).
     **solve_kwargs
         Passed to `ocp.solve` (``ipopt_options``, ``scale``, ``expand``; ``guess`` and
         ``mesh`` for the initial solve only).
@@ -345,8 +383,8 @@ def refine(problem: Problem, solution: Solution | None = None, *, tol: float = 1
     Raises
     ------
     TypeError
-        If ``problem`` is not a `Problem`, ``solution`` not a `Solution`, or ``progress``
-        not callable.
+        If ``problem`` is not a `Problem`, ``solution`` not a `Solution`, ``progress``
+        not callable, or ``backoff`` not a bool.
     ValueError
         Naming the argument: ``tol`` not positive, ``max_rounds`` < 0, ``max_intervals`` or
         ``stall_rounds`` < 1.
@@ -380,6 +418,8 @@ def refine(problem: Problem, solution: Solution | None = None, *, tol: float = 1
     max_intervals = integer(max_intervals, "max_intervals", minimum=1)
     if stall_rounds is not None:
         stall_rounds = integer(stall_rounds, "stall_rounds", minimum=1)
+    if not isinstance(backoff, (bool, np.bool_)):
+        raise TypeError(f"`backoff` must be True or False, got {type(backoff).__name__}")
     if progress is not None and not callable(progress):
         raise TypeError(f"`progress` must be a callable or None, got {type(progress).__name__}")
     kw = dict(solve_kwargs)
@@ -464,6 +504,11 @@ def refine(problem: Problem, solution: Solution | None = None, *, tol: float = 1
                 f"{est_b.max_error:.2e}); {earlier.message}")
         info.update(converged=bool(est_b.max_error <= tol), errors=est_b, returned_round=rnd)
         return annotate(earlier, info, message=note)
+    if backoff and est is not None and est.max_error <= tol and sol.status == STATUS_BOUND_VIOLATION:
+        backed = back_off(problem, sol, kw, transcription=tr,
+                          verbose=stage_sink(verbose, "refine back-off"))
+        if backed is not None:
+            return _backed_off(sol, *backed, info, tol, verbose, progress, t_round, history)
     if stop == "stalled" and (sol.success or _refinable(sol)):
         if est.max_error <= tol and sol.status == STATUS_BOUND_VIOLATION:
             message = _overshoot_message(history, stall_rounds, tol, sol)

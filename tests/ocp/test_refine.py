@@ -149,6 +149,36 @@ def test_refine_rejects_bad_arguments():
         refine(problem, max_intervals=0)
     with pytest.raises(TypeError, match="`problem`"):
         refine("problem")
+    with pytest.raises(TypeError, match="`backoff`"):
+        refine(problem, backoff="yes")
+
+
+@pytest.mark.parametrize("l", [1 / 9, 1 / 12])
+def test_an_overshoot_at_an_active_state_bound_is_backed_off_to_the_closed_form(l):
+    """Bryson-Denham with x <= l a state bound, checked to 1e-10 of its scale: the
+    position interpolant bulges past l between the nodes at the ends of the boundary arc
+    (1e-8 of its scale, on 20 to 43 intervals alike) while the error estimate meets tol.
+    Without the back-off that is a stalled failure naming the overshoot; with it, the bound
+    moved in by twice the overshoot gives a success whose dense position never exceeds l
+    (sampled on a grid of its own), at the closed-form cost J = 4 / (9 l) of the tightened
+    bound (to the collocation's accuracy) and above the untightened round's."""
+    from .reference import bryson_denham
+    problem, truth = bryson_denham(l, as_bound=True)
+    kw = dict(tol=1e-7, bound_tol=1e-10, ipopt_options={"tol": 1e-12})
+    stalled = refine(problem, backoff=False, **kw)
+    assert not stalled.success and "meets tol" in stalled.message
+    assert "leaves a bound: `x`" in stalled.message and stalled.bound_violation.max > 1e-9
+    sol = refine(problem, **kw)
+    assert sol.success, sol.message
+    assert sol.problem is problem and sol.bound_violation.max == 0.0
+    x, _ = sol.sample(np.linspace(0.0, 1.0, 100001))
+    assert np.max(x[0]) <= l
+    bo = sol.info["backoff"]
+    margin = bo["margins"]["x"][1]
+    assert bo["margins"]["x"][0] == 0.0 and 0 < margin < 1e-3 * l
+    assert bo["cost_without"] < sol.cost
+    assert abs(sol.cost - 4.0 / (9.0 * (l - margin))) < 1e-6
+    assert "moved inwards" in sol.message and sol.info["converged"]
 
 
 # ===================================================================== error estimate
