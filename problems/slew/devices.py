@@ -33,7 +33,8 @@ from appdyn.dynamics.validate import (check_inertia, finite_array, integer, one_
                                positive_each, unit_axes)
 from appdyn.ocp import Constraint, Problem, annotate, solve, solve_multistart
 
-from .maneuvers import SEED_OPTIONS, bounded, refine_and_verify, solve_time_optimal
+from .maneuvers import (START_BUDGET, SEED_OPTIONS, bounded, refine_and_verify,
+                        solve_time_optimal)
 from .problem import attitude_guess, rough_time, seeded_guesses, slew_problem
 from .targets import POINTING_TOL, RATE_TOL, check_tol, targets
 
@@ -140,7 +141,7 @@ def solve_converted(problem, rb_problem, convert, objective, *, starts, seed, N,
             first = solve(problem, guess=convert(attitude_guess(rb_problem)), **opts)
         else:
             first = solve_multistart(problem, [convert(g) for g in seeded_guesses(
-                rb_problem, starts, seed, eigenaxis=False)], **opts)
+                rb_problem, starts, seed, eigenaxis=False)], start_budget=START_BUDGET, **opts)
         sol = refine_and_verify(problem, first, tol=tol, scale=None, pointing_tol=ptol,
                                 rate_tol=rtol, ipopt_options=ipopt_options, verbose=verbose)
     return sol if scale is None else annotate(sol, _momentum_info(sol, scale))

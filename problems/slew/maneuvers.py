@@ -16,6 +16,7 @@ from appdyn.ocp import (CONTROLS, DEFAULT_CONSTRAINT_TOL, STATUS_BOUND_VIOLATION
 from appdyn.ocp.refine.arcs import IDLE_TOL
 from appdyn.ocp.refine.result import WORSE_SLACK
 from appdyn.ocp.solve import verified
+from appdyn.ocp.ipopt_options import iteration_budget
 from appdyn.dynamics.validate import integer
 from appdyn.dynamics.interrupts import interruptible
 from appdyn.ocp.progress import stage_sink
@@ -28,7 +29,7 @@ from .targets import (ARCSEC, MIN_REFINE_TOL, POINTING_TOL, RATE_TOL, STATUS_POI
 
 __all__ = ["time_optimal", "min_effort", "verify", "bounded", "DEFAULT_STARTS_TIME",
            "DEFAULT_STARTS_EFFORT", "POLISH_MIN_BUDGET", "SEED_OPTIONS", "RACE_N", "RACE_AGREE",
-           "RACE_IPOPT", "BOUNDED_ITER_FACTOR", "BOUNDED_MIN_ITER"]
+           "RACE_IPOPT", "BOUNDED_ITER_FACTOR", "BOUNDED_MIN_ITER", "START_BUDGET"]
 
 DEFAULT_STARTS_TIME = 3  # seeded starts of time_optimal without a user guess
 DEFAULT_STARTS_EFFORT = 4  # seeded starts of min_effort with a keep-out cone
@@ -317,6 +318,13 @@ SEED_OPTIONS = {"bound_tol": math.inf, "verify": False}
 BOUNDED_ITER_FACTOR = 10
 BOUNDED_MIN_ITER = 200
 
+#: IPOPT iteration budget of the seeded starts after one has converged
+#: (`ocp.solve_multistart`'s ``start_budget``): this many times the converged start's
+#: iterations, at least `ocp.ipopt_options.BUDGET_MIN_ITER`. A CMG slew's (pyramid, 0.3 rad
+#: about z) two other starts ran 1,053 and 3,000 iterations, 117 s, to no solution, where
+#: the converged one took 16 (0.18 s).
+START_BUDGET = 10
+
 
 def bounded(problem, solution, *, control="constant", pointing_tol=POINTING_TOL,
             rate_tol=RATE_TOL, ipopt_options=None, scale=None):
@@ -367,10 +375,10 @@ def bounded(problem, solution, *, control="constant", pointing_tol=POINTING_TOL,
     # a CMG slew's took 1861 (35 s) to end in Restoration_Failed, so the budget is
     # `BOUNDED_ITER_FACTOR` times the first solve's iterations, at least `BOUNDED_MIN_ITER`
     # (the user's ``max_iter`` wins)
-    budget = (ipopt_options or {}).get(
-        "max_iter", max(BOUNDED_MIN_ITER, BOUNDED_ITER_FACTOR * int(sol.iterations)))
+    limited, budget = iteration_budget(ipopt_options, sol.iterations, BOUNDED_ITER_FACTOR,
+                                       BOUNDED_MIN_ITER)
     again = solve(problem, transcription="radau", control=control, mesh=sol.mesh, guess=sol,
-                  ipopt_options={**(ipopt_options or {}), "max_iter": budget}, scale=scale)
+                  ipopt_options=limited, scale=scale)
     again = verify(again, pointing_tol=pointing_tol, rate_tol=rate_tol)
     if not again.success and again.status != STATUS_BOUND_VIOLATION and np.isfinite(again.T):
         finer = refine(problem, again, tol=1e-6, max_rounds=4, transcription=again.transcription,
@@ -473,7 +481,7 @@ def _race(problem, guesses, opts, start_options, race_N):
     ipopt = {**RACE_IPOPT, **(opts.get("ipopt_options") or {})}
     coarse = solve_multistart(problem, guesses, start_options=_labelled_starts(
         start_options, len(guesses), opts.get("verbose")), agree=RACE_AGREE,
-        **{**opts, "N": race_N, "ipopt_options": ipopt})
+        start_budget=START_BUDGET, **{**opts, "N": race_N, "ipopt_options": ipopt})
     if not coarse.success:
         return None
     race = {"N": race_N, "T": float(coarse.T),
@@ -569,7 +577,8 @@ def solve_time_optimal(problem, guess, guesses, opts, *, polish, pointing_tol, r
         sol = None if coarse is None else _fine(problem, coarse, opts)
     if sol is None:
         sol = solve_multistart(problem, guesses, start_options=_labelled_starts(
-            start_options, len(guesses), opts.get("verbose")), **opts)
+            start_options, len(guesses), opts.get("verbose")), start_budget=START_BUDGET,
+            **opts)
     t_main = time.perf_counter() - t_start
     first = sol
     arcs, not_bang = (None, "") if not (polish and first.success) else bang_arcs(first)
@@ -769,7 +778,7 @@ def min_effort(inertia, T, *, angle=None, axis=None, q0=None, qf=None, u_max=Non
         # ways around: start from seeded tilted paths instead and keep the best
         starts = integer(DEFAULT_STARTS_EFFORT if starts is None else starts, "starts", minimum=1)
         guesses = seeded_guesses(problem, starts, 0 if seed is None else seed, eigenaxis=False)
-        first = solve_multistart(problem, guesses, **opts)
+        first = solve_multistart(problem, guesses, start_budget=START_BUDGET, **opts)
     return refine_and_verify(problem, first, tol=tol, scale=scale, pointing_tol=ptol,
                              rate_tol=rtol, ipopt_options=ipopt_options, verbose=verbose)
 

@@ -279,6 +279,36 @@ def test_multistart_picks_the_better_local_optimum():
     assert all(s["time"] > 0 and s["iterations"] > 0 for s in starts)
 
 
+def test_multistart_start_budget_limits_the_starts_after_a_converged_one():
+    """After start 0 converges in k iterations, each later start may take max(200, 10 k)
+    (`iteration_budget`); a ``max_iter`` of a start's own options wins (start 1: 3, too few
+    to converge: stopped at its budget, and said so); starts that converge within it are
+    the unbudgeted ones, bit for bit; with an executor there is no budget."""
+    from concurrent.futures import ThreadPoolExecutor
+    from appdyn.ocp.ipopt_options import BUDGET_MIN_ITER, iteration_budget
+
+    problem = bilimoria_wie()
+    guesses = [None, axis_guess(TILTED), axis_guess(TILTED)]
+    tries = [{}, {"ipopt_options": {"max_iter": 3}}, {}]
+    kw = dict(N=20, control="constant", start_options=tries)
+    sol = solve_multistart(problem, guesses, start_budget=10, **kw)
+    free = solve_multistart(problem, guesses, **kw)
+    k = sol.starts[0]["iterations"]
+    assert sol.starts[0]["success"] and sol.starts[0]["budget"] is None
+    assert sol.starts[1]["budget"] == 3 and not sol.starts[1]["success"]
+    assert sol.starts[1]["iterations"] == 3 and "start 1 stopped at its iteration budget" in sol.message
+    assert sol.starts[2]["budget"] == max(BUDGET_MIN_ITER, 10 * k) == iteration_budget(None, k, 10)[1]
+    assert sol.starts[2]["success"] and sol.starts[2]["iterations"] < sol.starts[2]["budget"]
+    assert sol.T == free.T and sol.info["best"] == free.info["best"] == 2
+    assert all(st["budget"] is None for st in free.starts)
+    with ThreadPoolExecutor(max_workers=2) as pool:
+        par = solve_multistart(problem, guesses, start_budget=10, executor=pool, **kw)
+    assert [st["budget"] for st in par.starts] == [None, None, None] and par.T == free.T
+    for bad in (0.5, True, float("inf"), "10"):
+        with pytest.raises(ValueError, match="`start_budget`"):
+            solve_multistart(problem, guesses, start_budget=bad, **kw)
+
+
 def test_multistart_without_success_returns_least_infeasible():
     problem = Problem(double_integrator(), T=1.0, x_initial=[0, 0], x_final=[1, 0],
                       u_bounds={"u": (-0.1, 0.1)}, lagrange=lambda x, u, p: u ** 2)

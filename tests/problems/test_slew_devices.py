@@ -178,3 +178,22 @@ def test_an_overshoot_at_an_active_speed_bound_is_backed_off_within_the_bound(fr
     again = ocp.refine(held.problem, first, tol=1e-7, bound_tol=2 * overshoot, backoff=False)
     assert again.success, again.message
     assert again.bound_violation.max <= 2 * overshoot
+
+
+@pytest.mark.slow
+def test_cmg_time_optimal_starts_after_a_converged_one_run_on_a_budget():
+    """Pyramid CMGs, 0.3 rad about z: start 0 converges in 16 iterations; starts 1 and 2
+    (tilted seeds) wandered for 1,053 and 3,000 iterations (117 s, T drifting to 68 s) to no
+    solution. They now stop at their budget (`slew.maneuvers.START_BUDGET` x 16, at least
+    200 iterations) and the slew is the same: start 0's, bounded and verified."""
+    from appdyn.ocp.ipopt_options import BUDGET_MIN_ITER
+    from appdyn.problems.slew.maneuvers import START_BUDGET
+
+    sol = slew.cmg_slew(10 * np.eye(3), pyramid(BETA), angle=0.3, axis=[0, 0, 1])
+    assert sol.success, sol.message
+    st = sol.info["starts"]
+    assert st[0]["success"] and st[0]["budget"] is None and sol.info["best"] == 0
+    for later in st[1:]:
+        assert later["budget"] == max(BUDGET_MIN_ITER, START_BUDGET * st[0]["iterations"])
+        assert later["success"] or later["iterations"] <= later["budget"]
+    assert sol.pointing_error <= slew.POINTING_TOL and sol.info["momentum_drift"] < 1e-6
