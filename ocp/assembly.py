@@ -26,8 +26,10 @@ Pieces
 * ``seg(z, s, c, frac) -> (rows, quad)``: one interval. ``z`` its own scaled variables
   (start state, own state nodes, start control, own control nodes), ``s`` the shared
   ones (free parameters, ``T``), ``c`` the common parameters, ``frac`` its mesh fraction.
-  ``rows``: its defects (divided by the state scales) and path rows at its own control
-  nodes (divided by their scales); ``quad``: its share of ``sign J / d_J``.
+  ``rows``: its defects (divided by the state scales) and path rows at its own path
+  points (`ocp.Transcription.path_sigma`: the control nodes, every collocation point for a
+  constant or linear Radau control; divided by their scales); ``quad``: its share of
+  ``sign J / d_J``.
 * ``ends(e, s, c) -> (rows, mayer)``: the first and last state (and first control): the
   path rows at a start control node, boundary rows, ``|q(t0)|^2 - 1``, the attitude target
   rows, and the Mayer term.
@@ -287,7 +289,7 @@ class Intervals:
     common : Layout
         The parameters shared by every interval (scales, fixed values, horizon, target).
     sizes : dict
-        Dimensions (``nx, nu, m_x, m_u, ua, m_d, n_path, n_bound, n_q, qn, nf, ft, n_z,
+        Dimensions (``nx, nu, m_x, m_u, m_p, ua, m_d, n_path, n_bound, n_q, qn, nf, ft, n_z,
         n_s, n_seg, n_end``).
     symbolic : str
         ``'SX'`` or ``'MX'``.
@@ -298,7 +300,7 @@ class Intervals:
     def __init__(self, problem, transcription, expand: bool = True, codegen: bool = False):
         model, tr = problem.model, transcription
         nx, nu, np_ = model.nx, model.nu, model.np
-        m_x, m_u = tr.x_sigma.size, tr.u_sigma.size
+        m_x, m_u, m_p = tr.x_sigma.size, tr.u_sigma.size, tr.path_sigma.size
         ua = int(tr.u_at_start)
         free = problem.free_params
         nf, ft = free.size, int(problem.free_time)
@@ -308,7 +310,7 @@ class Intervals:
         n_bound = sum(c.size for c in problem.boundary)
         n_q = _target_kind(problem)
         qn = int(problem.quaternion_norm_at_t0)
-        self.sizes = dict(nx=nx, nu=nu, m_x=m_x, m_u=m_u, ua=ua, m_d=m_d, n_path=n_path,
+        self.sizes = dict(nx=nx, nu=nu, m_x=m_x, m_u=m_u, m_p=m_p, ua=ua, m_d=m_d, n_path=n_path,
                           n_bound=n_bound, n_q=n_q, qn=qn, nf=nf, ft=ft)
         self.common = Layout({"sx": (nx, 1), "su": (nu, 1), "sp": (np_, 1), "sT": (1, 1), "sJ": (1, 1),
                               "spath": (n_path, 1), "sb": (n_bound, 1), "sq": (1, 1), "pval": (np_, 1),
@@ -337,11 +339,11 @@ class Intervals:
         X = ca.reshape(z[o:o + nx * m_x], nx, m_x) * ca.repmat(C["sx"], 1, m_x); o += nx * m_x
         us = C["su"] * z[o:o + nu] if ua else sym.zeros(nu, 1); o += nu * ua
         U = ca.reshape(z[o:o + nu * m_u], nu, m_u) * ca.repmat(C["su"], 1, m_u)
-        defect, xu, quad = kernel(xs, X, us, U, T * frac, p)
+        defect, xp, up, quad = kernel(xs, X, us, U, T * frac, p)
         rows = [ca.vec(defect / ca.repmat(C["sx"], 1, m_d))]
         if n_path:
-            rows += [ca.vertcat(*[cons.fun(xu[:, j], U[:, j], p) for cons in problem.path]) / C["spath"]
-                     for j in range(m_u)]
+            rows += [ca.vertcat(*[cons.fun(xp[:, j], up[:, j], p) for cons in problem.path]) / C["spath"]
+                     for j in range(m_p)]
         seg_rows = ca.vertcat(*rows)
         seg_q = sign * quad / C["sJ"]
         seg_in = [z, s, c, frac]
@@ -418,9 +420,10 @@ class Structure:
         dims = loc.sizes
         nx, nu, m_x, m_u, ua, m_d = (dims[k] for k in ("nx", "nu", "m_x", "m_u", "ua", "m_d"))
         n_path, n_z, n_seg, n_end = dims["n_path"], dims["n_z"], dims["n_seg"], dims["n_end"]
+        m_p = dims["m_p"]
         n_x, n_u = 1 + N * m_x, N * m_u + ua
         self.w = Layout({"X": (nx, n_x), "U": (nu, n_u), "P": (dims["nf"], 1), "T": (dims["ft"], 1)})
-        self.g = Layout({"defect": (nx, N * m_d), "path": (n_path, n_u), "boundary": (dims["n_bound"], 1),
+        self.g = Layout({"defect": (nx, N * m_d), "path": (n_path, N * m_p + ua), "boundary": (dims["n_bound"], 1),
                          "quat_norm": (dims["qn"], 1), "q_final": (dims["n_q"], 1)})
         self.params = Layout({**self.common.shapes, "frac": (N, 1)})
         seg_f, end_f = loc.seg, loc.ends
@@ -439,8 +442,9 @@ class Structure:
         end_cols = np.concatenate([Xi[:, 0], Xi[:, -1], Ui[:, 0] if ua else np.zeros(0, int), shared])
         Gd, Gp = self.g.indices("defect"), self.g.indices("path")
         seg_g = [Gd[:, k[:, None] * m_d + np.arange(m_d)[None, :]].transpose(1, 2, 0).reshape(N, nx * m_d)]
-        if n_path:
-            seg_g.append(Gp[:, own_u.reshape(-1)].T.reshape(N, m_u * n_path))
+        if n_path:  # path rows at the interval's own path points (`path_sigma`)
+            own_p = ua + k[:, None] * m_p + np.arange(m_p)[None, :]
+            seg_g.append(Gp[:, own_p.reshape(-1)].T.reshape(N, m_p * n_path))
         seg_g = np.concatenate(seg_g, axis=1)
         end_g = np.concatenate([Gp[:, 0] if (ua and n_path) else np.zeros(0, int),
                                 *[self.g.indices(b).reshape(-1) for b in ("boundary", "quat_norm", "q_final")]])

@@ -3,7 +3,8 @@ bounds held by the dense output, and the agreement of the re-simulation with the
 
 Bounds (`bound_violation`)
 --------------------------
-The NLP imposes state and control bounds at the nodes only. The dense output the user gets
+The NLP imposes state and control bounds at the nodes only, path constraints at the
+transcription's path points only (`ocp.Transcription.path_sigma`). The dense output the user gets
 (`ocp.Solution.sample`) and that the re-simulation replays (`ocp.Solution.propagate`) is the
 transcription's interpolant, which can leave the bounds between the nodes: the degree
 ``d - 1`` Radau control polynomial on a bang-bang or singular arc overshoots (measured up to
@@ -11,7 +12,10 @@ transcription's interpolant, which can leave the bounds between the nodes: the d
 output on `bound_grid` -- in every mesh interval ``BOUND_SAMPLES + 1`` equally spaced points
 ``sigma = 0, 1/16, ..., 1`` (both ends: the one-sided limits at each mesh point, where a
 Radau control may jump) and the transcription's own nodes -- and measures every violation of
-a finite bound in units of the variable's scale (`bound_scale`).
+a finite bound in units of the variable's scale (`bound_scale`), and of every inequality
+path constraint ``lower <= g(x, u, p) <= upper`` evaluated there (a keep-out cone held at the
+mesh points by a piecewise-constant control was crossed by 5.9e-4 at a collocation point
+in between, and reported a success).
 
 Re-simulation (`resimulation_mismatch`)
 ---------------------------------------
@@ -39,7 +43,7 @@ from .propagation import SCALE_FLOOR
 from .status import STATUS_BOUND_VIOLATION, STATUS_RESIMULATION
 
 __all__ = ["BoundViolation", "bound_excess", "bound_grid", "bound_scale", "bound_violation",
-           "interval_bound_violation", "periodic_jumps",
+           "interval_bound_violation", "periodic_jumps", "row_names",
            "resimulation_mismatch", "BOUND_SAMPLES", "DEFAULT_VERIFY_TOL",
            "DEFAULT_VERIFY_TOL_LOW_ORDER", "default_verify_tol",
            "STATUS_BOUND_VIOLATION", "STATUS_RESIMULATION", "check_verify_tol"]
@@ -100,6 +104,10 @@ class BoundViolation:
         Where it is worst (NaN when nothing is violated).
     value, lower, upper, scale : float
         Its value there, its bounds and its scale [variable units].
+    kind : str
+        ``'state'``, ``'control'`` or ``'path'`` (a path-constraint row, named by its
+        constraint's name, ``name[i]`` for row ``i`` of several); ``''`` when nothing is
+        violated.
     """
 
     by_name: Mapping[str, float] = field(default_factory=dict)
@@ -110,6 +118,7 @@ class BoundViolation:
     lower: float = float("nan")
     upper: float = float("nan")
     scale: float = float("nan")
+    kind: str = ""
 
     def __float__(self) -> float:
         return float(self.max)
@@ -118,10 +127,16 @@ class BoundViolation:
         """A sentence on the worst violation and its remedy."""
         if self.name is None:
             return "within bounds"
-        kind = "control" if self.name in controls else "state"
-        text = (f"the dense {kind} `{self.name}` leaves its bounds [{self.lower:g}, {self.upper:g}] "
+        kind = self.kind or ("control" if self.name in controls else "state")
+        what = "path constraint" if kind == "path" else kind
+        text = (f"the dense {what} `{self.name}` leaves its bounds [{self.lower:g}, {self.upper:g}] "
                 f"at t = {self.time:.6g} s: {self.value:.10g} ({self.max:.3g} in units of its "
                 f"scale {self.scale:g})")
+        if kind == "path":
+            return text + ("; the NLP imposes it at the collocation points (the control "
+                           "nodes of the trapezoid and Hermite-Simpson), the state "
+                           "interpolant crosses it between them: refine the mesh "
+                           "(ocp.refine, which also backs off a small overshoot)")
         if kind == "control" and self.max < 1e-3:
             return text + ("; a small overshoot of the interpolant through nodes that IPOPT's "
                            "interior point keeps a hair inside the bound next to a switch: "
@@ -163,36 +178,84 @@ def bound_scale(bounds: np.ndarray, nodes: np.ndarray) -> np.ndarray:
     return np.maximum(np.maximum(b, np.where(np.isfinite(v), v, 0.0)), SCALE_FLOOR)
 
 
-def _excess(dense, problem, x_nodes, u_nodes):
-    """``(bounds (2, n), scale (n,), k, s, values (n, M), excess (n, M))`` of the states and
-    controls on `bound_grid`, or ``None`` without finite bounds."""
+def row_names(con) -> list[str]:
+    """The names of the rows of the path constraint ``con`` in `BoundViolation`: its name,
+    or ``name[i]`` for row ``i`` of several."""
+    return [con.name] if con.size == 1 else [f"{con.name}[{i}]" for i in range(con.size)]
+
+
+def _path_rows(problem, x: np.ndarray, u: np.ndarray, p) -> tuple | None:
+    """``(bounds (2, m), values (m, M), names)`` of ``problem``'s inequality path constraints
+    at the states ``x`` (nx, M) and controls ``u`` (nu, M), ``p`` the parameters; ``None``
+    without any. Rows of a constraint of several rows are named ``name[i]``.
+
+    Equality rows (``lower == upper``) are left out: they hold at the collocation points,
+    and no interpolant keeps them in between (the Radau control of orbit raising through
+    unit vectors has ``|u|^2 = 1.72`` between two nodes at N = 20); the re-simulation check
+    (`resimulation_mismatch`) judges what that deviation does to the trajectory."""
+    if not any(np.any(np.asarray(c.lower) < np.asarray(c.upper)) for c in problem.path):
+        return None
+    pv = np.zeros((0, 1)) if p is None or np.size(p) == 0 else np.asarray(p, float).reshape(-1, 1)
+    M = x.shape[1]
+    vals, lo, hi, names = [], [], [], []
+    for con in problem.path:
+        a, b = con.fun.size_out(0)
+        g = np.asarray(con.fun(x, u, pv), dtype=float).reshape(a, M, b)  # implicit map
+        vals.append(g.transpose(1, 2, 0).reshape(M, a * b).T)  # column-major rows per point
+        lo.append(np.broadcast_to(con.lower, (con.size,)))
+        hi.append(np.broadcast_to(con.upper, (con.size,)))
+        names += row_names(con)
+    bounds, values = np.stack([np.concatenate(lo), np.concatenate(hi)]), np.concatenate(vals)
+    keep = bounds[0] < bounds[1]
+    return bounds[:, keep], values[keep], [n for n, k in zip(names, keep) if k]
+
+
+def _excess(dense, problem, x_nodes, u_nodes, p=None):
+    """``(bounds (2, n), scale (n,), k, s, values (n, M), excess (n, M), names, kinds)`` of
+    the states, controls and path-constraint rows (in that order) on `bound_grid`, or
+    ``None`` without finite bounds. A path row's scale is ``max(|finite bounds|, max |g|
+    on the grid, SCALE_FLOOR)``."""
+    model = problem.model
     bounds = np.concatenate([problem.x_bounds, problem.u_bounds], axis=1)
-    if not np.any(np.isfinite(bounds)) or dense.N == 0:
+    if dense.N == 0 or not (np.any(np.isfinite(bounds)) or problem.path):
         return None
     k, s = bound_grid(dense)
     x, u = dense.eval(k, s)
     values = np.concatenate([x, u], axis=0)
     scale = bound_scale(bounds, np.concatenate([x_nodes, u_nodes], axis=0))
+    names = list(model.states) + list(model.controls)
+    kinds = ["state"] * len(model.states) + ["control"] * len(model.controls)
+    path = _path_rows(problem, x, u, problem.p if p is None else p)
+    if path is not None:
+        pb, pv, pn = path
+        bounds = np.concatenate([bounds, pb], axis=1)
+        values = np.concatenate([values, pv], axis=0)
+        scale = np.concatenate([scale, bound_scale(pb, pv)])
+        names += pn
+        kinds += ["path"] * len(pn)
+    if not np.any(np.isfinite(bounds)):
+        return None
     lo, hi = bounds[0][:, None], bounds[1][:, None]
     excess = np.maximum(np.maximum(lo - values, values - hi), 0.0) / scale[:, None]
     excess[~np.isfinite(values)] = np.inf
-    return bounds, scale, k, s, values, excess
+    return bounds, scale, k, s, values, excess, names, kinds
 
 
-def bound_excess(solution) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
-    """``(bounds, scale, values)`` of ``solution``'s states and controls (in that order) on
-    `bound_grid`: their bounds, shape (2, n), scales (`bound_scale`), shape (n,), and dense
-    values, shape (n, M) [variable units]; ``None`` without finite bounds."""
-    out = _excess(solution.dense, solution.problem, solution.x, solution.u)
-    return None if out is None else (out[0], out[1], out[4])
+def bound_excess(solution) -> tuple | None:
+    """``(bounds, scale, values, names)`` of ``solution``'s states, controls and path
+    constraint rows (in that order) on `bound_grid`: their bounds, shape (2, n), scales
+    (`bound_scale`), shape (n,), dense values, shape (n, M) [their units], and names;
+    ``None`` without finite bounds."""
+    out = _excess(solution.dense, solution.problem, solution.x, solution.u, solution.p)
+    return None if out is None else (out[0], out[1], out[4], out[6])
 
 
 def interval_bound_violation(solution) -> np.ndarray:
     """Largest scaled bound violation of ``solution``'s dense output in each mesh interval
-    (`bound_violation` per interval), shape (N,) [-]: where `ocp.refine` splits a mesh
-    whose dense output leaves a bound."""
+    (`bound_violation` per interval, path constraints included), shape (N,) [-]: where
+    `ocp.refine` splits a mesh whose dense output leaves a bound."""
     d = solution.dense
-    out = _excess(d, solution.problem, solution.x, solution.u)
+    out = _excess(d, solution.problem, solution.x, solution.u, solution.p)
     if out is None:
         return np.zeros(d.N)
     k, excess = out[2], out[5]
@@ -201,15 +264,15 @@ def interval_bound_violation(solution) -> np.ndarray:
     return per
 
 
-def bound_violation(dense, problem, x_nodes: np.ndarray, u_nodes: np.ndarray) -> BoundViolation:
+def bound_violation(dense, problem, x_nodes: np.ndarray, u_nodes: np.ndarray, *,
+                    p=None) -> BoundViolation:
     """The `BoundViolation` of the dense output ``dense`` of a solution of ``problem`` on
-    `bound_grid` (``x_nodes``, ``u_nodes``: the solution's ``x`` and ``u``, for the scales)."""
-    model = problem.model
-    names = tuple(model.states) + tuple(model.controls)
-    out = _excess(dense, problem, x_nodes, u_nodes)
+    `bound_grid`, its path constraints included (``x_nodes``, ``u_nodes``: the solution's
+    ``x`` and ``u``, for the scales; ``p``: its parameters, default ``problem.p``)."""
+    out = _excess(dense, problem, x_nodes, u_nodes, p)
     if out is None:
         return BoundViolation()
-    bounds, scale, k, s, values, excess = out
+    bounds, scale, k, s, values, excess, names, kinds = out
     finite = np.any(np.isfinite(bounds), axis=0)
     worst = np.max(excess, axis=1)
     by_name = {n: float(worst[i]) for i, n in enumerate(names) if finite[i]}
@@ -219,7 +282,7 @@ def bound_violation(dense, problem, x_nodes: np.ndarray, u_nodes: np.ndarray) ->
     j = int(np.argmax(excess[i]))
     t = float(dense.t_breaks[k[j]] + s[j] * dense.h[k[j]])
     return BoundViolation(by_name, float(worst[i]), names[i], t, float(values[i, j]),
-                          float(bounds[0, i]), float(bounds[1, i]), float(scale[i]))
+                          float(bounds[0, i]), float(bounds[1, i]), float(scale[i]), kinds[i])
 
 
 def periodic_jumps(solution) -> list[tuple[str, float, int]]:

@@ -384,7 +384,7 @@ def check_ipopt_options(options) -> dict:
     return out
 
 
-def iteration_budget(ipopt_options: Mapping | None, iterations: int, factor: float,
+def iteration_budget(ipopt_options: Mapping | None, iterations: int, factor: float, *,
                      minimum: int = BUDGET_MIN_ITER) -> tuple[dict, int]:
     """``(options, budget)``: ``ipopt_options`` with ``max_iter`` set to ``max(minimum,
     factor * iterations)`` -- the budget of a solve that a converged neighbour needed

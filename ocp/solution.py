@@ -124,6 +124,11 @@ class Solution(Result):
         ...; ``'Exception'`` or ``'Unknown'`` when IPOPT gave none, ``'Rest_Solution'`` from
         `ocp.rest_solution`, ``''`` when no solver ran), kept when appdyn's verification turns a converged solve into a
         failure.
+    backoff : mapping or None
+        When `ocp.solve` (or `ocp.refine`) backed off an overshoot of its dense output
+        (`ocp.solve.back_off`): ``{'margins': {name: (lower, upper)}, 'tries',
+        'overshoot', 'cost_without'}`` -- the bounds moved in [their units], the re-solves,
+        the overshoot that was backed off [scaled] and the objective before; else ``None``.
     nlp_point : mapping or None
         The NLP point IPOPT returned (``'key'``: the structure of the NLP it belongs to,
         ``'x'``, ``'lam_x'``, ``'lam_g'``: scaled primal and dual values), used by `ocp.solve`
@@ -153,6 +158,7 @@ class Solution(Result):
     dense: DenseOutput = field(repr=False)
     nlp_point: Mapping | None = field(default=None, repr=False)
     solver_status: str = ""
+    backoff: Mapping | None = field(default=None, repr=False)
 
     def __getstate__(self) -> dict:
         state = dict(self.__dict__)
@@ -413,13 +419,15 @@ class Solution(Result):
     # ----------------------------------------------------------- diagnostics
     @cached_property
     def bound_violation(self) -> BoundViolation:
-        """Largest violation of the state and control bounds by the dense output, per
-        variable in units of its scale, and where it is worst (`ocp.checks.BoundViolation`).
+        """Largest violation of the state and control bounds and of the path constraints by
+        the dense output, per variable (path-constraint row) in units of its scale, and where
+        it is worst (`ocp.checks.BoundViolation`).
 
         Evaluated on `ocp.checks.bound_grid`: in every mesh interval 17 equally spaced points
         (``sigma = 0, 1/16, ..., 1``; both one-sided limits at a mesh point) and the
         transcription's nodes -- the interpolant `sample` returns and `propagate` replays.
-        The scale of a variable is ``max(|finite bounds|, max_n |v(t_n)|, 1e-6)``. `ocp.solve`
+        The scale of a variable is ``max(|finite bounds|, max_n |v(t_n)|, 1e-6)``, of a path
+        row ``max(|finite bounds|, its largest |g| on the grid, 1e-6)``. `ocp.solve`
         requires ``bound_violation.max <= constraint_tol`` for a success. Computed on first
         use and cached.
 
@@ -431,7 +439,7 @@ class Solution(Result):
         >>> sol.bound_violation.max, sorted(sol.bound_violation.by_name)
         (0.0, ['u'])
         """
-        return bound_violation(self.dense, self.problem, self.x, self.u)
+        return bound_violation(self.dense, self.problem, self.x, self.u, p=self.p)
 
     @property
     def quaternion_norm_error(self) -> float | None:

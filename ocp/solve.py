@@ -89,8 +89,9 @@ from appdyn.config import param
 from appdyn.dynamics.cache import construction_lock
 from appdyn.dynamics.interrupts import check_interrupt, interruptible
 
+from .backoff import BACKOFF_MAX, BACKOFF_TRIES, MARGIN, backoff_note, overshoots, tightened
 from .cached import checkout
-from .checks import (STATUS_BOUND_VIOLATION, STATUS_RESIMULATION, check_verify_tol,
+from .checks import (STATUS_BOUND_VIOLATION, STATUS_RESIMULATION, bound_excess, check_verify_tol,
                      resimulation_mismatch)
 from .guess import initial_guess
 from .ipopt_options import check_ipopt_options
@@ -106,7 +107,7 @@ from .transcription import get_transcription
 __all__ = ["solve", "Progress", "DEFAULT_CONSTRAINT_TOL", "STATUS_CONSTRAINT_TOL", "STATUS_EXCEPTION",
            "STATUS_BOUND_VIOLATION", "STATUS_RESIMULATION", "check_constraint_tol", "verified", "make_solution",
            "NlpOutcome", "WARM_START_OPTIONS", "run_ipopt",
-           "read_result", "default_mesh", "solver_ipopt_options", "nlp_numbers"]
+           "read_result", "default_mesh", "solver_ipopt_options", "nlp_numbers", "back_off"]
 
 _SUCCESS = ("Solve_Succeeded",)
 _ACCEPTABLE = "Solved_To_Acceptable_Level"
@@ -199,7 +200,7 @@ def solve(problem: Problem, *, transcription="radau", N: int | None = None, degr
           progress=None, ipopt_options: Mapping | None = None, expand: bool = True,
           constraint_tol: float | None = None, codegen: bool = False, control: str | None = None,
           verify: bool = True, verify_tol: float | None = None,
-          bound_tol: float | None = None) -> Solution:
+          bound_tol: float | None = None, backoff: bool = True) -> Solution:
     """Solve ``problem`` by direct collocation and IPOPT.
 
     Parameters
@@ -271,6 +272,15 @@ def solve(problem: Problem, *, transcription="radau", N: int | None = None, degr
         `ocp.checks.default_verify_tol` (3e-3; 0.1 for the trapezoid).
     bound_tol : float, optional
         Largest `Solution.bound_violation` of a success; default ``constraint_tol``.
+    backoff : bool
+        When the dense output leaves a bound (or a path constraint) between the nodes by more
+        than ``bound_tol`` but at most `ocp.backoff.BACKOFF_MAX` of its scale -- the
+        interpolant bulging past an *active* bound, e.g. a dynamic-pressure limit of
+        `problems.ascent.planar_ascent` by 2e-5 of its scale -- re-solve on the same mesh with
+        that bound moved in by twice the overshoot (up to 3 times), graded against the
+        original bounds (`back_off`; default True). The result's
+        `Solution.backoff` records the margins and the objective without them; its message
+        says so. ``False``: the ``'Bound_Violation'`` failure.
         ``math.inf`` skips the check: for a seed that another solve will replace (the
         time-optimal slews solve a polynomial-control seed for the switch detection of
         their polish, then return a solution within the bounds).
@@ -307,7 +317,8 @@ def solve(problem: Problem, *, transcription="radau", N: int | None = None, degr
     tr = get_transcription(transcription, degree=degree, control=control)
     m = default_mesh(N, mesh)
     sink = iteration_sink(verbose, progress)
-    for name, flag in (("expand", expand), ("codegen", codegen), ("verify", verify)):
+    for name, flag in (("expand", expand), ("codegen", codegen), ("verify", verify),
+                       ("backoff", backoff)):
         if flag not in (True, False):
             raise ValueError(f"`{name}` must be True or False, got {flag!r}")
     ctol = check_constraint_tol(constraint_tol)
@@ -334,7 +345,87 @@ def solve(problem: Problem, *, transcription="radau", N: int | None = None, degr
         sol = _solve_built(problem, tr, m, node_guess, opts, ctol, disc,
                            *_build_solver(disc, nlp_opts, sink), t_build,
                            default_guess=guess is None, warm=warm)
-    return verified(sol, btol, vtol, objective_scale=disc.scaling.objective)
+    out = verified(sol, btol, vtol, objective_scale=disc.scaling.objective)
+    if backoff and out.status == STATUS_BOUND_VIOLATION:
+        kw = dict(scale=scale, verbose=verbose, progress=progress, ipopt_options=ipopt_options,
+                  expand=expand, constraint_tol=constraint_tol, codegen=codegen, verify=verify,
+                  verify_tol=verify_tol, bound_tol=bound_tol)
+        backed = back_off(problem, out, kw, transcription=tr)
+        if backed is not None:
+            done = dataclasses.replace(backed[0], message=f"{backed[0].message}; "
+                                                          f"{backoff_note(out, backed[0])}")
+            for name in ("bound_violation", "propagation"):  # checked: carried over
+                if name in vars(backed[0]):
+                    vars(done)[name] = vars(backed[0])[name]
+            return done
+    return out
+
+
+def back_off(problem, sol, solve_kwargs: dict, *, transcription, verbose=False):
+    """``(solution, margins, tries)`` of ``problem`` on ``sol``'s mesh with the dense output
+    within the bounds, or ``None`` when backing off does not apply or does not succeed.
+
+    Parameters
+    ----------
+    problem : ocp.Problem
+        The user's problem: the result is graded against its bounds.
+    sol : ocp.Solution
+        A solution of ``problem`` whose only fault is `STATUS_BOUND_VIOLATION`: states,
+        controls or path-constraint rows past their bounds by at most `BACKOFF_MAX` of
+        their scale each (in all, over the re-solves).
+    solve_kwargs : dict
+        The options of `ocp.solve` used for ``sol`` (``bound_tol``/``constraint_tol`` give
+        the grading tolerance).
+    transcription : ocp.Transcription
+
+    Returns
+    -------
+    tuple or None
+        The verified `Solution` (its ``problem`` is ``problem``; its ``backoff`` the record
+        ``{'margins', 'tries', 'overshoot', 'cost_without'}``), a dict ``{name: (lower
+        margin, upper margin)}`` of the bounds moved [their units; path rows by their
+        names, `ocp.checks.BoundViolation`], and the number of re-solves.
+    """
+    if sol.status != STATUS_BOUND_VIOLATION or not np.isfinite(sol.cost):
+        return None
+    kw = dict(solve_kwargs, backoff=False)
+    verbose = kw.pop("verbose", verbose)
+    btol = check_constraint_tol(kw.get("constraint_tol"))
+    btol = btol if kw.pop("bound_tol", None) is None else float(solve_kwargs["bound_tol"])
+    bounds = bound_excess(sol)[0]
+    margin = np.zeros_like(bounds)
+    current = sol
+    for tries in range(1, BACKOFF_TRIES + 1):
+        found = overshoots(current, btol)
+        if found is None:
+            return None
+        over, scale, names = found
+        margin = margin + MARGIN * over
+        if (np.any(margin > MARGIN * BACKOFF_MAX * scale)
+                or np.any(bounds[0] + margin[0] > bounds[1] - margin[1])):
+            return None
+        try:
+            shifted = tightened(problem, np.stack([bounds[0] + margin[0], bounds[1] - margin[1]]),
+                                 names)
+        except ValueError:  # a fixed boundary value on the bound: no room to back off
+            return None
+        # the tightened problem's own bound check is the original's, done below
+        trial = solve(shifted, transcription=transcription, mesh=sol.mesh, guess=current,
+                      verbose=verbose, bound_tol=np.inf, **kw)
+        if not trial.success:
+            return None
+        regraded = dataclasses.replace(trial, problem=problem)
+        if "propagation" in vars(trial):  # verified by the solve: same model, same trajectory
+            vars(regraded)["propagation"] = trial.propagation
+        graded = verified(regraded, btol, None)
+        if graded.success:
+            moved = {names[i]: (float(margin[0, i]), float(margin[1, i]))
+                     for i in np.flatnonzero(np.any(margin > 0, axis=0))}
+            record = {"margins": moved, "tries": tries, "overshoot": float(sol.bound_violation.max),
+                      "cost_without": float(sol.cost)}
+            return dataclasses.replace(graded, backoff=record), moved, tries
+        current = graded
+    return None
 
 
 def _check_bound_tol(bound_tol) -> float:

@@ -153,6 +153,17 @@ class Transcription(abc.ABC):
     def _kernel(self, f, L, xs, X, us, U, h, p):
         """Symbolic ``(defect (nx, m_d), xu (nx, m_u), quad (1, 1))`` of one interval."""
 
+    @property
+    def path_sigma(self) -> np.ndarray:
+        """Where in an interval the path constraints are imposed, shape (m_p,): the control
+        nodes ``u_sigma`` (a constant or linear Radau control: every collocation point)."""
+        return self.u_sigma
+
+    def _path_points(self, xs, X, us, U, xu):
+        """Symbolic ``(x (nx, m_p), u (nu, m_p))`` at `path_sigma` of one interval, given
+        ``xu`` (the states at the control nodes, from `_kernel`)."""
+        return xu, U
+
     @abc.abstractmethod
     def _interpolate(self, f, xs, X, us, U, h, p, s):
         """Symbolic ``(x (nx, 1), u (nu, 1))`` at ``sigma = s`` inside one interval."""
@@ -189,7 +200,8 @@ class Transcription(abc.ABC):
 
     # ------------------------------------------------------------ common part
     def kernel(self, f: ca.Function, L: ca.Function | None) -> ca.Function:
-        """The interval Function ``(xs, X, us, U, h, p) -> (defect, xu, quad)``.
+        """The interval Function ``(xs, X, us, U, h, p) -> (defect, xp, up, quad)``: the
+        defects, the states and controls at `path_sigma`, the running cost's quadrature.
 
         Parameters
         ----------
@@ -212,10 +224,11 @@ class Transcription(abc.ABC):
         nx, nu, np_ = f.numel_in(0), f.numel_in(1), f.numel_in(2)
         ins = self._symbols(sym, nx, nu, np_)
         defect, xu, quad = self._kernel(f, L, *ins)
+        xp, up = self._path_points(ins[0], ins[1], ins[2], ins[3], xu)
         if not isinstance(quad, (ca.SX, ca.MX)):
             quad = sym.zeros(1, 1)
-        return ca.Function(f"{self.name.replace('-', '_')}_interval", list(ins), [defect, xu, quad],
-                           ["xs", "X", "us", "U", "h", "p"], ["defect", "xu", "quad"])
+        return ca.Function(f"{self.name.replace('-', '_')}_interval", list(ins), [defect, xp, up, quad],
+                           ["xs", "X", "us", "U", "h", "p"], ["defect", "xp", "up", "quad"])
 
     def interpolant(self, f: ca.Function) -> ca.Function:
         """The interval Function ``(xs, X, us, U, h, p, s) -> (x, u)`` (dense solution),
@@ -496,7 +509,9 @@ class RadauConstantControl(Radau):
 
     The state is collocated exactly as in `Radau`; the control is a single value per
     interval (``u_sigma = [1]``), held at every collocation point, so a bang-bang control
-    can only switch at mesh points. Path constraints are imposed at the interval ends.
+    can only switch at mesh points. Path constraints are imposed at every collocation point
+    (`path_sigma`; before, at the interval ends only: a keep-out cone was crossed by 5.9e-4
+    at a collocation point in between).
     Use it with ``solve(..., transcription="radau-constant-control", degree=3)`` (or an
     instance); `ocp.polish_switches` uses it on a free mesh.
     """
@@ -519,6 +534,13 @@ class RadauConstantControl(Radau):
         x, _ = super()._interpolate(f, xs, X, us, ca.repmat(U[:, 0], 1, self.degree), h, p, s)
         return x, U[:, 0]
 
+    @property
+    def path_sigma(self):
+        return self.points
+
+    def _path_points(self, xs, X, us, U, xu):
+        return X, ca.repmat(U[:, 0], 1, self.degree)
+
     def dense_weights(self, s):
         return self._state_weights(s), np.stack([np.zeros_like(s), np.ones_like(s)], axis=1)
 
@@ -533,10 +555,9 @@ class RadauLinearControl(Radau):
     collocation points. A linear interpolant between values within box bounds stays within
     them, so unlike `Radau` the dense control cannot overshoot a bound on a bang-bang or
     singular arc; a switch is smeared over one interval (refine the mesh, or
-    `ocp.polish_switches`, to sharpen it). Path constraints are imposed at the mesh points
-    only (not at the collocation points in between, as `Radau` does): a path-constrained
-    state may cross its limit between them (measured 2.3e-5 relative on a CMG singularity
-    measure at 28 intervals).
+    `ocp.polish_switches`, to sharpen it). Path constraints are imposed at every collocation
+    point and at the start (`path_sigma`; before, at the mesh points only: a CMG singularity
+    measure crossed its limit by 2.3e-5 relative in between at 28 intervals).
     Use it with ``solve(..., control="linear")`` (or ``transcription="radau-linear-control"``).
     """
 
@@ -562,6 +583,13 @@ class RadauLinearControl(Radau):
     def _interpolate(self, f, xs, X, us, U, h, p, s):
         x, _ = super()._interpolate(f, xs, X, us, self._controls(us, U), h, p, s)
         return x, us + s * (U[:, 0] - us)
+
+    @property
+    def path_sigma(self):
+        return self.points
+
+    def _path_points(self, xs, X, us, U, xu):
+        return X, self._controls(us, U)
 
     def dense_weights(self, s):
         return self._state_weights(s), np.stack([1.0 - s, s], axis=1)

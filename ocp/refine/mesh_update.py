@@ -21,9 +21,9 @@ from ..problem import Problem
 from ..progress import LOGGER, stage_sink
 from ..solution import Solution
 from ..status import STATUS_STALLED, status_name
-from ..solve import solve
+from ..solve import back_off, solve
 from ..transcription import Radau, Transcription, get_transcription
-from .backoff import back_off
+from ..backoff import backoff_note
 from .errors import IntervalErrors, interval_errors
 from .result import RefinedSolution, RefinementRound, annotate
 
@@ -208,22 +208,12 @@ def _backed_off(sol: Solution, backed: Solution, moved: dict, tries: int, info: 
     history.append(RefinementRound(backed.mesh.N, est.max_error, backed.cost, backed.iterations,
                                    time.perf_counter() - t_round))
     _report(len(history) - 1, history[-1], verbose, progress)
-    bv = sol.bound_violation
-    margins = "; ".join(
-        f"`{name}` " + " and ".join(f"{side} by {m:.3g}" for side, m in zip(("lower", "upper"), lm) if m > 0)
-        for name, lm in moved.items())
     converged = bool(est.max_error <= tol)
-    message = (f"refine: the dense output overshot an active bound between the nodes (`{bv.name}` "
-               f"by {bv.max:.3g} of its scale at t = {bv.time:.6g} s on {sol.mesh.N} intervals; "
-               f"refining barely changes such an overshoot); re-solved on the same "
-               f"mesh with the bound moved inwards ({margins}; {tries} re-solve"
-               f"{'s' if tries > 1 else ''}): the dense output is within the original bounds, "
-               f"the objective {backed.cost:.10g} against {sol.cost:.10g} without the margin; "
-               f"estimated error {est.max_error:.2e} {'<=' if converged else '>'} tol {tol:g}; "
-               f"{backed.message}")
+    message = (f"refine: {backoff_note(sol, backed)} (refining barely changes such an "
+               f"overshoot); estimated error {est.max_error:.2e} {'<=' if converged else '>'} "
+               f"tol {tol:g}; {backed.message}")
     info = dict(info, refinement=history, errors=est, converged=converged,
-                backoff={"margins": moved, "tries": tries, "overshoot": bv.max,
-                         "cost_without": float(sol.cost)})
+                backoff=backed.backoff)
     return annotate(backed, info, message=message)
 
 
@@ -354,10 +344,10 @@ def refine(problem: Problem, solution: Solution | None = None, *, tol: float = 1
         erratic on the way: 1.5e-3, 1.2e-4, 9.0e-4, 8.3e-7 in the last four).
     backoff : bool
         When the last round meets ``tol`` but its dense output leaves a bound by at most
-        `ocp.refine.backoff.BACKOFF_MAX` of the variable's scale (the interpolant bulging past
+        `ocp.backoff.BACKOFF_MAX` of the variable's scale (the interpolant bulging past
         an *active* bound between the nodes, which refining barely changes): re-solve on the
         same mesh with that bound moved inwards by twice the overshoot (up to 3 times), graded
-        against the original bounds (`ocp.refine.backoff.back_off`; default True). The
+        against the original bounds (`ocp.solve.back_off`; default True). The
         objective pays for the margin to first order in its size; ``info['backoff']`` gives
         the margins and the objective without them. ``False`` returns the overshooting
         round as a failure that names the overshoot (status `STATUS_STALLED` after a stall).
@@ -422,7 +412,7 @@ def refine(problem: Problem, solution: Solution | None = None, *, tol: float = 1
         raise TypeError(f"`backoff` must be True or False, got {type(backoff).__name__}")
     if progress is not None and not callable(progress):
         raise TypeError(f"`progress` must be a callable or None, got {type(progress).__name__}")
-    kw = dict(solve_kwargs)
+    kw = dict(solve_kwargs, backoff=False)  # the rounds: backed off once at the end
     guess0 = kw.pop("guess", None)
     mesh0 = kw.pop("mesh", None)
     control = kw.pop("control", None)

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import math
 import time
+import dataclasses
 from dataclasses import dataclass, field
 from typing import Literal, Mapping
 
@@ -18,6 +19,7 @@ from appdyn.dynamics.results import Result
 from appdyn.dynamics.serialize import text_table
 from appdyn.dynamics.validate import finite_scalar, integer, one_of, positive
 from appdyn.ocp import status as _status
+from appdyn.ocp.checks import bound_violation
 from appdyn.ocp.status import describe
 
 from .planar_model import (RHO0, SCALE_HEIGHT, STATES, AscentVehicle, check_vehicle, planar_model,
@@ -305,7 +307,15 @@ def planar_ascent(*, target_altitude, target_gamma, q_max, qalpha_max,
                          ipopt_options=ipopt_options)
         if free.success:
             guess = free
-    sol = ocp.solve(problem, N=N, guess=guess, scale=scale, ipopt_options=ipopt_options)
+    # the loads are graded by `_verify` against the limits with ``limit_tol`` (the dense
+    # trajectory and the re-propagation); the bounds of the states and the control here
+    sol = ocp.solve(problem, N=N, guess=guess, scale=scale, ipopt_options=ipopt_options,
+                    bound_tol=math.inf)
+    plain = bound_violation(sol.dense, problem.replace(path=()), sol.x, sol.u, p=sol.p)
+    if sol.success and plain.max > ocp.DEFAULT_CONSTRAINT_TOL:
+        sol = dataclasses.replace(
+            sol, success=False, status=ocp.STATUS_BOUND_VIOLATION,
+            message=f"{sol.message}; but {plain.describe(controls=problem.model.controls)}")
     return _verify(sol, veh, objective, x_final, qmax, qamax, tol, start,
                    {"t": t0, "h": h0, "V": V0, "gamma": gamma0, "m": m0})
 

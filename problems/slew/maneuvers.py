@@ -376,11 +376,15 @@ def bounded(problem, solution, *, control="constant", pointing_tol=POINTING_TOL,
     # `BOUNDED_ITER_FACTOR` times the first solve's iterations, at least `BOUNDED_MIN_ITER`
     # (the user's ``max_iter`` wins)
     limited, budget = iteration_budget(ipopt_options, sol.iterations, BOUNDED_ITER_FACTOR,
-                                       BOUNDED_MIN_ITER)
+                                       minimum=BOUNDED_MIN_ITER)
     again = solve(problem, transcription="radau", control=control, mesh=sol.mesh, guess=sol,
                   ipopt_options=limited, scale=scale)
     again = verify(again, pointing_tol=pointing_tol, rate_tol=rate_tol)
-    if not again.success and again.status != STATUS_BOUND_VIOLATION and np.isfinite(again.T):
+    if not again.success and np.isfinite(again.T) and (
+            again.status != STATUS_BOUND_VIOLATION or again.bound_violation.kind != "control"):
+        # a state or a path constraint (a keep-out cone) crossed between the collocation
+        # points by more than `ocp.solve` backs off: a finer mesh there is the remedy
+        # (`ocp.refine` splits those intervals)
         finer = refine(problem, again, tol=1e-6, max_rounds=4, transcription=again.transcription,
                        **kw)
         finer = verify(finer, pointing_tol=pointing_tol, rate_tol=rate_tol)
@@ -791,16 +795,14 @@ def refine_and_verify(problem, first, *, tol, scale, pointing_tol, rate_tol, ipo
     dense output is refined too (the remedy); a result whose control polynomial still
     leaves a bound the optimum rides (a torque or gimbal-rate limit: a kink the polynomial
     overshoots however fine the mesh) is refined again with a piecewise-linear control
-    (``control='linear'``) -- unless the problem has path constraints (a keep-out cone, a
-    singularity measure), which `ocp.RadauLinearControl` imposes at the mesh points only:
-    then the failure stands."""
+    (``control='linear'``; path constraints, a keep-out cone or a singularity measure, are
+    imposed at its collocation points and checked on its dense output like the bounds)."""
     if not (first.success or first.status in (STATUS_BOUND_VIOLATION, STATUS_RESIMULATION)):
         return verify(first, pointing_tol=pointing_tol, rate_tol=rate_tol)
     kw = dict(tol=tol, verbose=verbose, ipopt_options=ipopt_options, scale=scale)
     sol = refine(problem, first, transcription=first.transcription, **kw)
     bv = sol.bound_violation
-    if (not sol.success and bv.name in problem.model.controls and bv.max > DEFAULT_CONSTRAINT_TOL
-            and not problem.path):  # (a linear control has its path rows at the mesh points only)
+    if not sol.success and bv.name in problem.model.controls and bv.max > DEFAULT_CONSTRAINT_TOL:
         sol = refine(problem, sol, control="linear", **kw)
     checks = (STATUS_BOUND_VIOLATION, STATUS_RESIMULATION)
     if (sol.success or sol.status in checks) and not sol.info.get("converged", False):

@@ -11,7 +11,7 @@ from appdyn.dynamics import cache, rigid_body
 from appdyn.dynamics.attitude import quat_conj, quat_from_axis_angle, quat_mul, quat_normalize, rotation_angle
 from appdyn.dynamics.rigid_body import check_inertia
 from appdyn.dynamics.validate import positive, unit_vector
-from appdyn.ocp import Problem
+from appdyn.ocp import Constraint, Problem
 from appdyn.ocp.attitude import slerp
 
 from .targets import KeepOut, check_angle, check_u_max, targets, vector3
@@ -81,8 +81,8 @@ def slew_problem(inertia, *, objective, T=None, angle=None, axis=None, q0=None, 
         if u_max is None or np.ptp(u_lim) != 0:
             raise ValueError("`norm_bound=True` needs a scalar `u_max`")
         x, u, p = ca.SX.sym("x", 7), ca.SX.sym("u", 3), ca.SX.sym("p", 0)
-        path.append(ca.Function("torque_norm", [x, u, p], [ca.sumsqr(u) - u_lim[0] ** 2],
-                                ["x", "u", "p"], ["g"]))
+        path.append(Constraint(ca.Function("torque_norm", [x, u, p], [ca.sumsqr(u) - u_lim[0] ** 2],
+                                           ["x", "u", "p"], ["g"]), name="torque_norm"))
     if keep_out is not None:
         if not isinstance(keep_out, KeepOut):
             raise TypeError(f"`keep_out` must be a KeepOut, got {type(keep_out).__name__}")
@@ -90,7 +90,7 @@ def slew_problem(inertia, *, objective, T=None, angle=None, axis=None, q0=None, 
             if keep_out.margin(qq) < 0:
                 raise ValueError(f"the {name} attitude already violates the keep-out cone "
                                  f"(margin {keep_out.margin(qq):.3g})")
-        path.append(keep_out.function())
+        path.append(Constraint(keep_out.function(), name="keep_out"))
     model = rigid_body(I)
     if objective == "time":
         T_ref = rough_time(I, q0, qf, u_lim)

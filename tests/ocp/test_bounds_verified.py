@@ -53,7 +53,10 @@ def test_free_flying_robot_polynomial_control_leaving_its_bounds_is_no_success()
     assert u.max() > 1.0 + 1e-2 or u.min() < -1e-2  # the polynomial overshoots [0, 1]
     assert not sol.success and sol.status == ocp.STATUS_BOUND_VIOLATION
     bv = sol.bound_violation
-    assert set(bv.by_name) == {"u1", "u2", "u3", "u4"} and bv.max > 1e-2
+    # the four thrusts, and the two rows of its path constraint (thrust pairs, checked on the
+    # same dense output)
+    assert set(bv.by_name) == {"u1", "u2", "u3", "u4", "path[0]", "path[1]"} and bv.max > 1e-2
+    assert bv.kind == "control"
     assert bv.max == pytest.approx(max(bv.by_name.values()))
     assert f"`{bv.name}`" in sol.message and "control='linear'" in sol.message
     assert f"t = {bv.time:.6g} s" in sol.message

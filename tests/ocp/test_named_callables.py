@@ -66,8 +66,18 @@ def test_named_path_constraint_is_bryson_denham():
     base, truth = bryson_denham()
     prob = base.replace(path=lambda x: x - truth["l"])
     _same(prob.path[0].fun, base.path[0].fun)
-    sol = solve(prob, N=40)
+    sol = solve(prob, N=40, bound_tol=1e-5)
     assert sol.success and sol.cost == pytest.approx(truth["J"], rel=2e-3)
+    # the dense position crosses l between the collocation points (6.4e-6 of its scale at
+    # N = 40): checked on the path row as on the same bound stated as a state bound
+    as_bound = solve(bryson_denham(as_bound=True)[0], N=40, bound_tol=1e-5)
+    assert sol.bound_violation.kind == "path" and sol.bound_violation.by_name["path"] > 1e-6
+    assert sol.bound_violation.by_name["path"] == pytest.approx(
+        as_bound.bound_violation.by_name["x"], rel=1e-6)
+    assert not solve(prob, N=40, backoff=False).success  # beyond the default 1e-6
+    backed = solve(prob, N=40)  # x <= l moved in by twice the overshoot: within it
+    assert backed.success and backed.bound_violation.max == 0.0
+    assert backed.backoff["margins"]["path"][1] > 0 and backed.cost > sol.cost
 
 
 def test_named_boundary_constraints_replace_the_boundary_values():

@@ -112,7 +112,7 @@ def _singular():
 
 def test_singular_arc_falls_back_to_moving_knots():
     problem = _singular()
-    start = solve(problem, N=16, ipopt_options=STRICT)
+    start = solve(problem, N=16, ipopt_options=STRICT, backoff=False)
     # the control polynomial rings on the singular arc, past |u| <= 1: not a success
     assert start.status == STATUS_BOUND_VIOLATION
     arcs, why = bang_arcs(start)
