@@ -38,10 +38,13 @@ import numpy as np
 from appdyn.dynamics import cache
 
 __all__ = ["IpoptOption", "ipopt_option_table", "check_ipopt_options", "parse_documentation",
-           "available_linear_solvers", "iteration_budget", "LINEAR_SOLVERS", "BUDGET_MIN_ITER"]
+           "available_linear_solvers", "iteration_budget", "LINEAR_SOLVERS", "BUDGET_MIN_ITER",
+           "IPOPT_MAX_ITER"]
 
 #: The least IPOPT iteration budget `iteration_budget` gives.
 BUDGET_MIN_ITER = 200
+#: IPOPT's default ``max_iter``.
+IPOPT_MAX_ITER = 3000
 
 #: The linear solvers IPOPT may be built with or load at run time, probed by
 #: `available_linear_solvers` (in this order).

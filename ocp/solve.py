@@ -94,7 +94,7 @@ from .cached import checkout
 from .checks import (STATUS_BOUND_VIOLATION, STATUS_RESIMULATION, bound_excess, check_verify_tol,
                      resimulation_mismatch)
 from .guess import initial_guess
-from .ipopt_options import check_ipopt_options
+from .ipopt_options import IPOPT_MAX_ITER, check_ipopt_options
 from .mesh import Mesh, check_N
 from .nlp import Discretization
 from .problem import Problem
@@ -272,18 +272,18 @@ def solve(problem: Problem, *, transcription="radau", N: int | None = None, degr
         `ocp.checks.default_verify_tol` (3e-3; 0.1 for the trapezoid).
     bound_tol : float, optional
         Largest `Solution.bound_violation` of a success; default ``constraint_tol``.
-    backoff : bool
-        When the dense output leaves a bound (or a path constraint) between the nodes by more
-        than ``bound_tol`` but at most `ocp.backoff.BACKOFF_MAX` of its scale -- the
-        interpolant bulging past an *active* bound, e.g. a dynamic-pressure limit of
-        `problems.ascent.planar_ascent` by 2e-5 of its scale -- re-solve on the same mesh with
-        that bound moved in by twice the overshoot (up to 3 times), graded against the
-        original bounds (`back_off`; default True). The result's
-        `Solution.backoff` records the margins and the objective without them; its message
-        says so. ``False``: the ``'Bound_Violation'`` failure.
         ``math.inf`` skips the check: for a seed that another solve will replace (the
         time-optimal slews solve a polynomial-control seed for the switch detection of
         their polish, then return a solution within the bounds).
+    backoff : bool
+        When the dense output leaves a bound (or an inequality path constraint) between the
+        nodes by more than ``bound_tol`` but at most `ocp.backoff.BACKOFF_MAX` of its scale --
+        the interpolant bulging past an *active* bound, e.g. a keep-out cone crossed by 5e-4
+        of its scale between the collocation points of a piecewise-constant torque -- re-solve
+        on the same mesh with that bound moved in by twice the overshoot (up to 3 times),
+        graded against the original bounds (`back_off`; default True). The result's
+        `Solution.backoff` records the margins and the objective without them; its message
+        says so. ``False``: the ``'Bound_Violation'`` failure.
 
     Returns
     -------
@@ -352,18 +352,13 @@ def solve(problem: Problem, *, transcription="radau", N: int | None = None, degr
                   verify_tol=verify_tol, bound_tol=bound_tol)
         backed = back_off(problem, out, kw, transcription=tr)
         if backed is not None:
-            done = dataclasses.replace(backed[0], message=f"{backed[0].message}; "
-                                                          f"{backoff_note(out, backed[0])}")
-            for name in ("bound_violation", "propagation"):  # checked: carried over
-                if name in vars(backed[0]):
-                    vars(done)[name] = vars(backed[0])[name]
-            return done
+            return _replaced(backed, message=f"{backed.message}; {backoff_note(out, backed)}")
     return out
 
 
 def back_off(problem, sol, solve_kwargs: dict, *, transcription, verbose=False):
-    """``(solution, margins, tries)`` of ``problem`` on ``sol``'s mesh with the dense output
-    within the bounds, or ``None`` when backing off does not apply or does not succeed.
+    """The solution of ``problem`` on ``sol``'s mesh with the dense output within the bounds,
+    or ``None`` when backing off does not apply or does not succeed.
 
     Parameters
     ----------
@@ -380,11 +375,12 @@ def back_off(problem, sol, solve_kwargs: dict, *, transcription, verbose=False):
 
     Returns
     -------
-    tuple or None
-        The verified `Solution` (its ``problem`` is ``problem``; its ``backoff`` the record
-        ``{'margins', 'tries', 'overshoot', 'cost_without'}``), a dict ``{name: (lower
-        margin, upper margin)}`` of the bounds moved [their units; path rows by their
-        names, `ocp.checks.BoundViolation`], and the number of re-solves.
+    Solution or None
+        Verified against ``problem``'s bounds (its ``problem`` is ``problem``); its
+        ``backoff`` is the record ``{'margins': {name: (lower, upper)}, 'tries',
+        'overshoot', 'cost_without'}``: the bounds moved in [their units; path rows by
+        their names, `ocp.checks.BoundViolation`], the re-solves, the overshoot backed off
+        [scaled] and the objective before.
     """
     if sol.status != STATUS_BOUND_VIOLATION or not np.isfinite(sol.cost):
         return None
@@ -414,18 +410,29 @@ def back_off(problem, sol, solve_kwargs: dict, *, transcription, verbose=False):
                       verbose=verbose, bound_tol=np.inf, **kw)
         if not trial.success:
             return None
-        regraded = dataclasses.replace(trial, problem=problem)
-        if "propagation" in vars(trial):  # verified by the solve: same model, same trajectory
-            vars(regraded)["propagation"] = trial.propagation
-        graded = verified(regraded, btol, None)
+        # the re-simulation verified by the solve is the same (same model and trajectory);
+        # the bounds are graded again against the original problem
+        graded = verified(_replaced(trial, ("propagation",), problem=problem), btol, None)
         if graded.success:
             moved = {names[i]: (float(margin[0, i]), float(margin[1, i]))
                      for i in np.flatnonzero(np.any(margin > 0, axis=0))}
-            record = {"margins": moved, "tries": tries, "overshoot": float(sol.bound_violation.max),
-                      "cost_without": float(sol.cost)}
-            return dataclasses.replace(graded, backoff=record), moved, tries
+            return _replaced(graded, backoff={"margins": moved, "tries": tries,
+                                              "overshoot": float(sol.bound_violation.max),
+                                              "cost_without": float(sol.cost)})
         current = graded
     return None
+
+
+def _replaced(solution: Solution, carried=("bound_violation", "propagation"),
+              **changes) -> Solution:
+    """``dataclasses.replace(solution, **changes)`` with the cached checks named in
+    ``carried`` (`Solution.bound_violation`, `Solution.propagation`) carried over when
+    computed: for changes that leave what they measure as it was."""
+    out = dataclasses.replace(solution, **changes)
+    for name in carried:
+        if name in vars(solution):
+            vars(out)[name] = vars(solution)[name]
+    return out
 
 
 def _check_bound_tol(bound_tol) -> float:
@@ -461,11 +468,7 @@ def verified(solution: Solution, constraint_tol: float, verify_tol: float | None
 def _failed(solution: Solution, status: int, why: str) -> Solution:
     """A copy of ``solution`` with ``success=False``, ``status`` and ``why`` appended to the
     message; its cached checks (bounds, re-simulation) carried over."""
-    out = dataclasses.replace(solution, success=False, status=status,
-                              message=f"{solution.message}; {why}")
-    for name in ("bound_violation", "propagation"):
-        if name in vars(solution):
-            vars(out)[name] = vars(solution)[name]
+    out = _replaced(solution, success=False, status=status, message=f"{solution.message}; {why}")
     LOGGER.info("solve %s: %s", solution.problem.name, why)
     return out
 
@@ -540,7 +543,7 @@ def run_ipopt(solver, start: dict, bounds: dict, opts: dict, resolver):
     note, t_build = "", 0.0
     if res is not None and status == _ACCEPTABLE:
         # not verified: one warm re-solve from the acceptable point, acceptable exit disabled
-        budget = min(max(int(opts.get("max_iter", 3000)) - iterations, 0), _RESOLVE_ITER)
+        budget = min(max(int(opts.get("max_iter", IPOPT_MAX_ITER)) - iterations, 0), _RESOLVE_ITER)
         if budget > 0:
             t_re = time.perf_counter()
             again = {**opts, "acceptable_iter": 0, "max_iter": budget,

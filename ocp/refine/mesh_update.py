@@ -199,12 +199,18 @@ def _overshoot_message(history: list, window: int, tol: float, sol: Solution) ->
             f"original must hold. {sol.message}")
 
 
-def _backed_off(sol: Solution, backed: Solution, moved: dict, tries: int, info: dict,
-                tol: float, verbose, progress, t_round: float, history: list) -> RefinedSolution:
+def _estimate(sol: Solution, tol: float) -> IntervalErrors:
+    """`interval_errors` of ``sol`` for a refinement to ``tol``: re-integrated at
+    ``1e-4 tol``, within [1e-13, 1e-10] (CVODES fails below ~1e-14)."""
+    itol = float(np.clip(1e-4 * tol, 1e-13, 1e-10))
+    return interval_errors(sol, rtol=itol, atol=itol)
+
+
+def _backed_off(sol: Solution, backed: Solution, info: dict, tol: float, verbose, progress,
+                t_round: float, history: list) -> RefinedSolution:
     """The result of a refinement whose last round overshot an active bound and was re-solved
     on the same mesh with the bound moved inwards (`back_off`)."""
-    itol = float(np.clip(1e-4 * tol, 1e-13, 1e-10))
-    est = interval_errors(backed, rtol=itol, atol=itol)
+    est = _estimate(backed, tol)
     history.append(RefinementRound(backed.mesh.N, est.max_error, backed.cost, backed.iterations,
                                    time.perf_counter() - t_round))
     _report(len(history) - 1, history[-1], verbose, progress)
@@ -447,8 +453,7 @@ def refine(problem: Problem, solution: Solution | None = None, *, tol: float = 1
                                            time.perf_counter() - t_round))
             stop = f"the solve of round {rnd} failed ({status_name(sol.status)})"
             break
-        itol = float(np.clip(1e-4 * tol, 1e-13, 1e-10))  # CVODES fails below ~1e-14
-        est = interval_errors(sol, rtol=itol, atol=itol)
+        est = _estimate(sol, tol)
         history.append(RefinementRound(sol.mesh.N, est.max_error, sol.cost, sol.iterations,
                                        time.perf_counter() - t_round))
         _report(rnd, history[-1], verbose, progress)
@@ -498,7 +503,7 @@ def refine(problem: Problem, solution: Solution | None = None, *, tol: float = 1
         backed = back_off(problem, sol, kw, transcription=tr,
                           verbose=stage_sink(verbose, "refine back-off"))
         if backed is not None:
-            return _backed_off(sol, *backed, info, tol, verbose, progress, t_round, history)
+            return _backed_off(sol, backed, info, tol, verbose, progress, t_round, history)
     if stop == "stalled" and (sol.success or _refinable(sol)):
         if est.max_error <= tol and sol.status == STATUS_BOUND_VIOLATION:
             message = _overshoot_message(history, stall_rounds, tol, sol)

@@ -13,7 +13,7 @@ import numpy as np
 
 from appdyn.dynamics.executors import check_executor, gather
 from appdyn.dynamics.interrupts import interruptible
-from ..ipopt_options import iteration_budget
+from ..ipopt_options import IPOPT_MAX_ITER, iteration_budget
 from ..problem import Problem
 from ..progress import LOGGER
 from ..solution import Solution
@@ -25,7 +25,6 @@ __all__ = ["solve_multistart"]
 _RECEIVED: OrderedDict = OrderedDict()  # in a worker: digest -> Problem, the latest few
 _RECEIVED_MAX = 4
 _RECEIVED_LOCK = threading.Lock()
-_MAX_ITER = 3000  # IPOPT's default max_iter: a budgeted start continued goes no further
 
 
 @interruptible
@@ -225,7 +224,7 @@ def _cap(task) -> int:
     _, _, tries, kw = task
     last = tries[-1] if not isinstance(tries, Mapping) else tries
     options = {**(kw.get("ipopt_options") or {}), **(last.get("ipopt_options") or {})}
-    return int(options.get("max_iter", _MAX_ITER))
+    return int(options.get("max_iter", IPOPT_MAX_ITER))
 
 
 def _best_cost(problem, sols) -> float:
