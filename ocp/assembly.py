@@ -50,6 +50,7 @@ from appdyn.dynamics.cache import compile_function, compiler
 from .cached import cached, function_key
 from .layout import Layout
 from .functions import sx_compatible
+from .ipopt_options import ipopt_solver
 
 __all__ = ["Structure", "Intervals", "intervals", "structure_key", "content_key",
            "local_functions", "assemble",
@@ -490,4 +491,4 @@ class Structure:
         opts = {k: v for k, v in options.items() if k != "expand"}
         opts.update(self.derivatives)
         opts.setdefault("calc_lam_p", False)
-        return ca.nlpsol(name, "ipopt", self.nlp, opts)
+        return ipopt_solver(name, self.nlp, opts)

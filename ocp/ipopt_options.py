@@ -22,24 +22,45 @@ probes which of `LINEAR_SOLVERS` load -- a one-variable NLP per name, solved in 
 subprocess (a missing Pardiso library can crash the process that tries it) -- once per
 process and library setting; `check_ipopt_options` then rejects an unavailable one before
 anything is built.
+
+BLAS threads
+------------
+IPOPT's linear algebra (MUMPS) runs on the OpenBLAS that CasADi ships, which starts a
+thread per core when it is loaded (with the IPOPT plugin, at the first solver of a process).
+Those threads spin about 0.1 s after each wake-up before sleeping, and the KKT systems of
+this package's NLPs are too small for a threaded BLAS call to pay: on 2 cores a spinning
+thread took 0.10 s of CPU during the first Bilimoria-Wie slew of a process (0.33 s CPU for
+0.23 s wall), and on a busy machine that CPU is taken from the solve. `ipopt_solver` (every
+IPOPT solver of this package is built by it) therefore loads the plugin with
+`IPOPT_BLAS_THREADS` BLAS threads unless ``OPENBLAS_NUM_THREADS`` is set in the
+environment, which then decides (`load_ipopt`). Measured with one thread against the
+default, whole processes alternated: the first slew of a process 0.24-0.31 s against
+0.29-0.35 s; Delta III and a minimum-effort slew at N = 2000 unchanged within their
+run-to-run spread.
 """
 from __future__ import annotations
 
 import difflib
 import json
 import math
+import os
 import re
 import sys
 from dataclasses import dataclass
 from typing import Mapping
 
+import casadi as ca
 import numpy as np
 
 from appdyn.dynamics import cache
 
 __all__ = ["IpoptOption", "ipopt_option_table", "check_ipopt_options", "parse_documentation",
            "available_linear_solvers", "iteration_budget", "LINEAR_SOLVERS", "BUDGET_MIN_ITER",
-           "IPOPT_MAX_ITER"]
+           "IPOPT_MAX_ITER", "IPOPT_BLAS_THREADS", "load_ipopt", "ipopt_solver"]
+
+#: BLAS threads CasADi's OpenBLAS (IPOPT's linear algebra) is loaded with when
+#: ``OPENBLAS_NUM_THREADS`` is not set (module docstring, "BLAS threads").
+IPOPT_BLAS_THREADS = 1
 
 #: The least IPOPT iteration budget `iteration_budget` gives.
 BUDGET_MIN_ITER = 200
@@ -125,6 +146,75 @@ class IpoptOption:
         hi = ")" if self.upper_strict else "]"
         what = "an integer" if self.kind == "Integer" else "a number"
         return f"{what} in {lo}{self.lower:g}, {self.upper:g}{hi}"
+
+
+def load_ipopt() -> bool:
+    """Load CasADi's IPOPT plugin once per process, with `IPOPT_BLAS_THREADS` BLAS threads
+    unless ``OPENBLAS_NUM_THREADS`` is set (module docstring, "BLAS threads").
+
+    The variable is set only while the plugin loads (OpenBLAS reads it when loaded) and
+    restored at once, under `dynamics.cache.construction_lock`. A library loaded earlier by
+    another CasADi plugin keeps its own setting.
+
+    Returns
+    -------
+    bool
+        True once the plugin is loaded (False when this CasADi has no IPOPT).
+
+    Examples
+    --------
+    >>> from appdyn.ocp.ipopt_options import load_ipopt
+    >>> load_ipopt()
+    True
+    """
+    return cache.get(("ocp.ipopt-plugin",), _load_plugin)
+
+
+def _load_plugin() -> bool:
+    with cache.construction_lock():
+        unset = "OPENBLAS_NUM_THREADS" not in os.environ
+        if unset:
+            os.environ["OPENBLAS_NUM_THREADS"] = str(IPOPT_BLAS_THREADS)
+        try:
+            ca.load_nlpsol("ipopt")
+            return True
+        except RuntimeError:  # no IPOPT in this CasADi: the solver's own error says so
+            return False
+        finally:
+            if unset:
+                del os.environ["OPENBLAS_NUM_THREADS"]
+
+
+def ipopt_solver(name: str, nlp: dict, options: dict) -> ca.Function:
+    """``casadi.nlpsol(name, 'ipopt', nlp, options)`` with the plugin loaded by `load_ipopt`:
+    every IPOPT solver of this package is built here.
+
+    Parameters
+    ----------
+    name : str
+        The solver Function's name.
+    nlp : dict or casadi.Function
+        CasADi's NLP (``x``, ``p``, ``f``, ``g``).
+    options : dict
+        nlpsol options (IPOPT's own under ``'ipopt'``).
+
+    Returns
+    -------
+    casadi.Function
+        The solver.
+
+    Examples
+    --------
+    >>> import casadi as ca
+    >>> from appdyn.ocp.ipopt_options import ipopt_solver
+    >>> x = ca.SX.sym("x")
+    >>> s = ipopt_solver("s", {"x": x, "f": (x - 2) ** 2},
+    ...                  {"print_time": False, "ipopt": {"print_level": 0, "sb": "yes"}})
+    >>> round(float(s(x0=0)["x"]), 6)
+    2.0
+    """
+    load_ipopt()
+    return ca.nlpsol(name, "ipopt", nlp, options)
 
 
 def _number(text: str) -> float:

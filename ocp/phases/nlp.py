@@ -24,6 +24,7 @@ import numpy as np
 
 from ..assembly import content_key
 from ..cached import cached
+from ..ipopt_options import ipopt_solver
 from ..layout import Layout
 from ..nlp import Discretization
 
@@ -124,7 +125,7 @@ class PhasedStructure:
         opts = {k: v for k, v in options.items() if k != "expand"}
         opts.update(self.derivatives)
         opts.setdefault("calc_lam_p", False)
-        return ca.nlpsol(name, "ipopt", self.nlp, opts)
+        return ipopt_solver(name, self.nlp, opts)
 
 
 def phased_structure(problem, discs) -> PhasedStructure:

@@ -64,7 +64,7 @@ from appdyn.dynamics.validate import integer
 
 from ..attitude import attitude_error
 from ..cached import checkout
-from ..ipopt_options import check_ipopt_options
+from ..ipopt_options import check_ipopt_options, ipopt_solver
 from ..progress import IterationCallback, iteration_sink
 from ..mesh import Mesh
 from ..problem import Problem
@@ -328,8 +328,8 @@ def _solve_arcs(problem: Problem, guess: Solution, arcs: BangArcs, nseg: np.ndar
     if sink is None:  # pooled with its (data-less) callback, which carries the deadline
         def build():
             callback = IterationCallback(0, 0)
-            return ca.nlpsol("switch_times", "ipopt", nlp.nlp,
-                             {**nlp_opts, "iteration_callback": callback}), callback
+            return ipopt_solver("switch_times", nlp.nlp,
+                                {**nlp_opts, "iteration_callback": callback}), callback
 
         lend = checkout("switch_times_nlpsol", (nlp.key, repr(sorted(ipopt.items()))), build,
                         keepalive=nlp)
@@ -339,8 +339,8 @@ def _solve_arcs(problem: Problem, guess: Solution, arcs: BangArcs, nseg: np.ndar
 
         callback = IterationCallback(w0.size, lbg.size, violation, sink)
         with construction_lock():
-            lend = contextlib.nullcontext((ca.nlpsol(
-                "switch_times", "ipopt", nlp.nlp, {**nlp_opts, "iteration_callback": callback}),
+            lend = contextlib.nullcontext((ipopt_solver(
+                "switch_times", nlp.nlp, {**nlp_opts, "iteration_callback": callback}),
                 callback))
     with lend as (solver, callback):
         build_time = time.perf_counter() - t_build
