@@ -56,7 +56,7 @@ from appdyn.dynamics import cache
 
 __all__ = ["IpoptOption", "ipopt_option_table", "check_ipopt_options", "parse_documentation",
            "available_linear_solvers", "iteration_budget", "LINEAR_SOLVERS", "BUDGET_MIN_ITER",
-           "IPOPT_MAX_ITER", "IPOPT_BLAS_THREADS", "load_ipopt", "ipopt_solver"]
+           "IPOPT_MAX_ITER", "IPOPT_TOL", "IPOPT_BLAS_THREADS", "load_ipopt", "ipopt_solver"]
 
 #: BLAS threads CasADi's OpenBLAS (IPOPT's linear algebra) is loaded with when
 #: ``OPENBLAS_NUM_THREADS`` is not set (module docstring, "BLAS threads").
@@ -66,6 +66,8 @@ IPOPT_BLAS_THREADS = 1
 BUDGET_MIN_ITER = 200
 #: IPOPT's default ``max_iter``.
 IPOPT_MAX_ITER = 3000
+#: IPOPT's default ``tol``.
+IPOPT_TOL = 1e-8
 
 #: The linear solvers IPOPT may be built with or load at run time, probed by
 #: `available_linear_solvers` (in this order).

@@ -15,8 +15,9 @@ from appdyn.ocp import (CONTROLS, DEFAULT_CONSTRAINT_TOL, STATUS_BOUND_VIOLATION
                  solve_multistart)
 from appdyn.ocp.refine.arcs import IDLE_TOL
 from appdyn.ocp.refine.result import WORSE_SLACK
+from appdyn.ocp.backoff import BACKOFF_MAX
 from appdyn.ocp.solve import verified
-from appdyn.ocp.ipopt_options import iteration_budget
+from appdyn.ocp.ipopt_options import IPOPT_TOL, iteration_budget
 from appdyn.dynamics.validate import integer
 from appdyn.dynamics.interrupts import interruptible
 from appdyn.ocp.progress import stage_sink
@@ -29,7 +30,8 @@ from .targets import (ARCSEC, MIN_REFINE_TOL, POINTING_TOL, RATE_TOL, STATUS_POI
 
 __all__ = ["time_optimal", "min_effort", "verify", "bounded", "DEFAULT_STARTS_TIME",
            "DEFAULT_STARTS_EFFORT", "POLISH_MIN_BUDGET", "SEED_OPTIONS", "RACE_N", "RACE_AGREE",
-           "RACE_IPOPT", "BOUNDED_ITER_FACTOR", "BOUNDED_MIN_ITER", "START_BUDGET"]
+           "RACE_IPOPT", "BOUNDED_ITER_FACTOR", "BOUNDED_MIN_ITER", "START_BUDGET",
+           "BOUNDED_TOL_FACTOR"]
 
 DEFAULT_STARTS_TIME = 3  # seeded starts of time_optimal without a user guess
 DEFAULT_STARTS_EFFORT = 4  # seeded starts of min_effort with a keep-out cone
@@ -313,6 +315,10 @@ def time_optimal(inertia, *, angle=None, axis=None, q0=None, qf=None, u_max=1.0,
 SEED_OPTIONS = {"bound_tol": math.inf, "verify": False}
 
 
+#: Factor on IPOPT's ``tol`` (the user's or IPOPT's 1e-8, the tighter) of `bounded`'s warm
+#: re-solve of a small control overshoot, before any change of the control.
+BOUNDED_TOL_FACTOR = 1e-2
+
 #: IPOPT iteration budget of `bounded`'s re-solve: this many times the iterations of the
 #: solution it starts from, and at least `BOUNDED_MIN_ITER`
 BOUNDED_ITER_FACTOR = 10
@@ -333,6 +339,10 @@ def bounded(problem, solution, *, control="constant", pointing_tol=POINTING_TOL,
     (``'constant'`` or ``'linear'``) on its mesh, warm from it, within
     `BOUNDED_ITER_FACTOR` times its IPOPT iterations (at least `BOUNDED_MIN_ITER`), and
     graded (`verify`; a miss is mesh-refined once more, `ocp.refine` tol 1e-6, 4 rounds).
+    A control that overshoots by at most `ocp.backoff.BACKOFF_MAX` of its scale is first
+    re-solved warm with its own control on its mesh at IPOPT's ``tol`` times
+    `BOUNDED_TOL_FACTOR` (an interior-point iterate a hair inside a bound next to a switch),
+    and returned when graded a success.
 
     Parameters
     ----------
@@ -371,6 +381,28 @@ def bounded(problem, solution, *, control="constant", pointing_tol=POINTING_TOL,
     if control == "polynomial":
         return failed
     kw = dict(ipopt_options=ipopt_options, scale=scale)
+    keep = {k: v for k, v in getattr(sol, "info", {}).items()
+            if k in ("starts", "best", "race", "polish", "fallback")}
+    bv = sol.bound_violation
+    why = (f"the {sol.transcription.name} solution (T = {sol.T:.10g} s) leaves the bounds "
+           f"between its nodes (`{bv.name}` by {bv.max:.3g} of its scale at t = {bv.time:.6g} "
+           f"s)")
+    said = f"; {polish_text(keep['polish'])}" if "polish" in keep else ""
+    # a small control overshoot (at most `ocp.backoff.BACKOFF_MAX` of its scale) comes from
+    # IPOPT's iterate a hair inside a bound next to a switch and shrinks with the barrier
+    # parameter: first a warm re-solve on the same mesh and control at a tighter tol
+    # (`BOUNDED_TOL_FACTOR`; `ocp.solve` backs off what overshoot remains). J = E, 1 rad
+    # about (1, 1, 0): 2.3e-5 at IPOPT's tol 1e-8 (9.5e-6 after a warm re-solve at 1e-8),
+    # 1e-7 after 2 iterations at 1e-10 (0.04 s), where the constant-control re-solve ran out
+    # of its 200 iterations (1.9 s, a failure)
+    if bv.kind == "control" and bv.max <= BACKOFF_MAX:
+        tol = min(float((ipopt_options or {}).get("tol", IPOPT_TOL)), IPOPT_TOL) * BOUNDED_TOL_FACTOR
+        tight = solve(problem, transcription=sol.transcription, mesh=sol.mesh, guess=sol,
+                      ipopt_options={**(ipopt_options or {}), "tol": tol}, scale=scale)
+        tight = verify(tight, pointing_tol=pointing_tol, rate_tol=rate_tol)
+        if tight.success:
+            why = f"{why}: re-solved warm on its mesh at IPOPT tol {tol:g}"
+            return annotate(tight, {**keep, "bounded": why}, message=f"{tight.message}; {why}{said}")
     # warm from a converged neighbour: the re-solves of the tests take 8-44 IPOPT iterations;
     # a CMG slew's took 1861 (35 s) to end in Restoration_Failed, so the budget is
     # `BOUNDED_ITER_FACTOR` times the first solve's iterations, at least `BOUNDED_MIN_ITER`
@@ -389,14 +421,8 @@ def bounded(problem, solution, *, control="constant", pointing_tol=POINTING_TOL,
                        **kw)
         finer = verify(finer, pointing_tol=pointing_tol, rate_tol=rate_tol)
         again = finer if finer.success else again
-    keep = {k: v for k, v in getattr(sol, "info", {}).items()
-            if k in ("starts", "best", "race", "polish", "fallback")}
-    bv = sol.bound_violation
-    why = (f"the {sol.transcription.name} solution (T = {sol.T:.10g} s) leaves the bounds "
-           f"between its nodes (`{bv.name}` by {bv.max:.3g} of its scale at t = {bv.time:.6g} "
-           f"s): re-solved with control={control!r}")
+    why = f"{why}: re-solved with control={control!r}"
     if again.success:
-        said = f"; {polish_text(keep['polish'])}" if "polish" in keep else ""
         return annotate(again, {**keep, "bounded": why}, message=f"{again.message}; {why}{said}")
     why = f"{why} (a budget of {budget} IPOPT iterations; ipopt_options max_iter sets it)"
     return annotate(failed, {"bounded": f"{why}, which failed: {again.message[:300]}"},
