@@ -388,6 +388,12 @@ def bounded(problem, solution, *, control="constant", pointing_tol=POINTING_TOL,
            f"between its nodes (`{bv.name}` by {bv.max:.3g} of its scale at t = {bv.time:.6g} "
            f"s)")
     said = f"; {polish_text(keep['polish'])}" if "polish" in keep else ""
+    # warm from a converged neighbour: the re-solves of the tests take 8-44 IPOPT iterations;
+    # a CMG slew's took 1861 (35 s) to end in Restoration_Failed, so the budget of each
+    # re-solve is `BOUNDED_ITER_FACTOR` times the first solve's iterations, at least
+    # `BOUNDED_MIN_ITER` (the user's ``max_iter`` wins)
+    limited, budget = iteration_budget(ipopt_options, sol.iterations, BOUNDED_ITER_FACTOR,
+                                       minimum=BOUNDED_MIN_ITER)
     # a small control overshoot (at most `ocp.backoff.BACKOFF_MAX` of its scale) comes from
     # IPOPT's iterate a hair inside a bound next to a switch and shrinks with the barrier
     # parameter: first a warm re-solve on the same mesh and control at a tighter tol
@@ -398,17 +404,11 @@ def bounded(problem, solution, *, control="constant", pointing_tol=POINTING_TOL,
     if bv.kind == "control" and bv.max <= BACKOFF_MAX:
         tol = min(float((ipopt_options or {}).get("tol", IPOPT_TOL)), IPOPT_TOL) * BOUNDED_TOL_FACTOR
         tight = solve(problem, transcription=sol.transcription, mesh=sol.mesh, guess=sol,
-                      ipopt_options={**(ipopt_options or {}), "tol": tol}, scale=scale)
+                      ipopt_options={**limited, "tol": tol}, scale=scale)
         tight = verify(tight, pointing_tol=pointing_tol, rate_tol=rate_tol)
         if tight.success:
             why = f"{why}: re-solved warm on its mesh at IPOPT tol {tol:g}"
             return annotate(tight, {**keep, "bounded": why}, message=f"{tight.message}; {why}{said}")
-    # warm from a converged neighbour: the re-solves of the tests take 8-44 IPOPT iterations;
-    # a CMG slew's took 1861 (35 s) to end in Restoration_Failed, so the budget is
-    # `BOUNDED_ITER_FACTOR` times the first solve's iterations, at least `BOUNDED_MIN_ITER`
-    # (the user's ``max_iter`` wins)
-    limited, budget = iteration_budget(ipopt_options, sol.iterations, BOUNDED_ITER_FACTOR,
-                                       minimum=BOUNDED_MIN_ITER)
     again = solve(problem, transcription="radau", control=control, mesh=sol.mesh, guess=sol,
                   ipopt_options=limited, scale=scale)
     again = verify(again, pointing_tol=pointing_tol, rate_tol=rate_tol)
