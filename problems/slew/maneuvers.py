@@ -14,6 +14,7 @@ from appdyn.ocp import (CONTROLS, DEFAULT_CONSTRAINT_TOL, STATUS_BOUND_VIOLATION
                  Problem, Solution, annotate, bang_arcs, polish_switches, refine, rest_solution, solve,
                  solve_multistart)
 from appdyn.ocp.refine.arcs import IDLE_TOL
+from appdyn.ocp.status import STATUS_INFEASIBLE
 from appdyn.ocp.refine.result import WORSE_SLACK
 from appdyn.ocp.backoff import BACKOFF_MAX
 from appdyn.ocp.solve import verified
@@ -31,7 +32,7 @@ from .targets import (ARCSEC, MIN_REFINE_TOL, POINTING_TOL, RATE_TOL, STATUS_POI
 __all__ = ["time_optimal", "min_effort", "verify", "bounded", "DEFAULT_STARTS_TIME",
            "DEFAULT_STARTS_EFFORT", "POLISH_MIN_BUDGET", "SEED_OPTIONS", "RACE_N", "RACE_AGREE",
            "RACE_IPOPT", "BOUNDED_ITER_FACTOR", "BOUNDED_MIN_ITER", "START_BUDGET",
-           "BOUNDED_TOL_FACTOR"]
+           "BOUNDED_TOL_FACTOR", "minimum_time_text"]
 
 DEFAULT_STARTS_TIME = 3  # seeded starts of time_optimal without a user guess
 DEFAULT_STARTS_EFFORT = 4  # seeded starts of min_effort with a keep-out cone
@@ -757,7 +758,13 @@ def min_effort(inertia, T, *, angle=None, axis=None, q0=None, qf=None, u_max=Non
         ``cost`` in [N^2 m^2 s]; ``success`` as in the module docstring (``status``
         `STATUS_REFINE` when the refinement stopped above ``tol``). For a rest-to-rest
         rotation by ``theta`` about a principal axis with moment ``J`` and no active bound:
-        ``u = J theta (6/T^2 - 12 t/T^3)``, cost ``6 J^2 theta^2 / T^3``.
+        ``u = J theta (6/T^2 - 12 t/T^3)``, cost ``6 J^2 theta^2 / T^3``. With ``u_max``,
+        a first solve that IPOPT finds infeasible is checked against the time-optimal slew
+        of the same scene (`time_optimal`; ``info['minimum_time']`` [s], None if it failed):
+        ``T`` below that minimum time is a failure that says so; otherwise the slew is
+        re-solved from the time-optimal one, stretched to ``T`` (its torque times
+        ``(T_min / T)^2``: feasible), as for Bilimoria-Wie at ``T`` between 3.243 s and the
+        eigenaxis start's 3.545 s.
 
     Raises
     ------
@@ -809,8 +816,38 @@ def min_effort(inertia, T, *, angle=None, axis=None, q0=None, qf=None, u_max=Non
         starts = integer(DEFAULT_STARTS_EFFORT if starts is None else starts, "starts", minimum=1)
         guesses = seeded_guesses(problem, starts, 0 if seed is None else seed, eigenaxis=False)
         first = solve_multistart(problem, guesses, start_budget=START_BUDGET, **opts)
-    return refine_and_verify(problem, first, tol=tol, scale=scale, pointing_tol=ptol,
-                             rate_tol=rtol, ipopt_options=ipopt_options, verbose=verbose)
+    fastest = None
+    if first.status == STATUS_INFEASIBLE and u_max is not None:
+        # under a torque bound, IPOPT's "local infeasibility" is a T below the slew's minimum
+        # time, or a start path too slow for T (the eigenaxis path of Bilimoria-Wie needs
+        # 3.545 s where 3.243 s is the minimum): the time-optimal slew of the same scene says
+        # which, and stretched to T it is feasible (the torque scales by (T_min / T)^2)
+        fastest = time_optimal(inertia, angle=angle, axis=axis, q0=q0, qf=qf, u_max=u_max,
+                               norm_bound=norm_bound, w0=w0, wf=wf, keep_out=keep_out,
+                               pointing_tol=ptol, rate_tol=rtol, ipopt_options=ipopt_options)
+        if fastest.success and fastest.T <= problem.T:
+            first = solve(problem, guess=fastest, **opts)
+    sol = refine_and_verify(problem, first, tol=tol, scale=scale, pointing_tol=ptol,
+                            rate_tol=rtol, ipopt_options=ipopt_options, verbose=verbose)
+    if fastest is None:
+        return sol
+    return annotate(sol, {"minimum_time": float(fastest.T) if fastest.success else None},
+                    message=f"{sol.message}; {minimum_time_text(problem.T, fastest)}")
+
+
+def minimum_time_text(T: float, fastest: Solution) -> str:
+    """The sentence on a minimum-effort slew over ``T`` [s] whose first solve IPOPT found
+    infeasible, given ``fastest``, the time-optimal slew of the same scene (`time_optimal`)."""
+    if not fastest.success:
+        return (f"its first solve was infeasible and the time-optimal slew of the same scene "
+                f"did not converge either ({fastest.message[:200]}): check the torque bound "
+                f"and the target")
+    if fastest.T > T:
+        return (f"T = {T:.6g} s is below this slew's minimum time {fastest.T:.6g} s under "
+                f"u_max (`slew.time_optimal`, verified): no torque within the bounds reaches "
+                f"the target in T; ask T >= {fastest.T:.6g} s")
+    return (f"its first solve was infeasible from its start path; re-solved from the "
+            f"time-optimal slew (minimum time {fastest.T:.6g} s, stretched to T = {T:.6g} s)")
 
 
 def refine_and_verify(problem, first, *, tol, scale, pointing_tol, rate_tol, ipopt_options,

@@ -97,3 +97,31 @@ def test_bad_input_raises(kwargs, match):
 def test_eigenaxis_time_needs_a_principal_axis():
     with pytest.raises(ValueError, match="principal axis"):
         slew.eigenaxis_time(np.diag([1.0, 2.0, 2.5]), 1.0, [1, 1, 0])
+
+
+#: Bilimoria & Wie's minimum time of the 180 deg slew about z, J = E, |u_i| <= 1 [s]
+BW_T_MIN = 3.2430
+
+
+def test_min_effort_below_the_minimum_time_says_so():
+    """T = 3.2 s is below Bilimoria & Wie's 3.2430 s: no bounded torque reaches the target.
+    Before, the message was IPOPT's "the problem may be infeasible" alone."""
+    sol = slew.min_effort(np.eye(3), 3.2, angle=np.pi, axis=[0, 0, 1.0], u_max=1.0)
+    assert not sol.success
+    assert sol.info["minimum_time"] == pytest.approx(BW_T_MIN, abs=1e-4)
+    assert "below this slew's minimum time 3.2430" in sol.message
+
+
+@pytest.mark.slow
+def test_min_effort_faster_than_the_eigenaxis_starts_from_the_time_optimal_slew():
+    """T = 3.4 s lies between the minimum time (3.2430 s) and the eigenaxis maneuver's
+    2 sqrt(pi) = 3.545 s: the eigenaxis start is locally infeasible (a failure before). The
+    time-optimal torque (|u_i| = 1 on every axis) stretched to T, u(t k) k^2 with k = T_min / T,
+    is feasible and costs 1/2 * 3 k^3 T_min: the optimum can only cost less."""
+    T = 3.4
+    sol = slew.min_effort(np.eye(3), T, angle=np.pi, axis=[0, 0, 1.0], u_max=1.0)
+    assert sol.success, sol.message
+    k = BW_T_MIN / T
+    assert sol.cost <= 0.5 * 3 * k ** 3 * BW_T_MIN
+    _, u = sol.sample(np.linspace(sol.t0, sol.t0 + T, 20001))
+    assert np.max(np.abs(u)) <= 1.0 + 1e-6
