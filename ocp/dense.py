@@ -57,12 +57,12 @@ class DenseOutput:
         self.h = T * mesh.fractions
         self.t_breaks = t0 + T * mesh.breaks
         self.t_breaks[-1] = t0 + T
-        self._interp = tr.interpolant(model.f)
+        self._interp = None  # built on first use: Radau's dense output needs none (`eval`)
 
     @property
     def interp(self) -> ca.Function:
-        """The transcription's interpolant Function (`Transcription.interpolant`; rebuilt on
-        first use after unpickling, from the cache when present)."""
+        """The transcription's interpolant Function (`Transcription.interpolant`; built on
+        first use, from the cache when present)."""
         fun = self._interp
         if fun is None:
             fun = self._interp = self.transcription.interpolant(self.model.f)

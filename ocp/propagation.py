@@ -10,6 +10,7 @@ import numpy as np
 from appdyn.dynamics.validate.base import real_array
 
 from .cached import cached, function_key
+from .functions import sx_compatible
 
 __all__ = ["Propagation", "propagate", "interval_integrator", "stack_interval_controls",
            "state_scale", "SCALE_FLOOR"]
@@ -142,12 +143,12 @@ def _build_interval_integrator(sol, grid, rtol, atol, lagrange=None):
     d = sol.dense
     model = sol.problem.model
     nx, nu = model.nx, model.nu
-    sx = d.interp.is_a("SXFunction") and (lagrange is None or lagrange.is_a("SXFunction"))
+    sx = sx_compatible(model.f) and (lagrange is None or lagrange.is_a("SXFunction"))
     sym = ca.SX if sx else ca.MX
     x, s = sym.sym("x", nx), sym.sym("s")
     us, U = sym.sym("us", nu), sym.sym("U", nu, d.m_u)
     h, p = sym.sym("h"), sym.sym("p", model.np)
-    _, u = d.interp(sym.zeros(nx), sym.zeros(nx, d.m_x), us, U, h, p, s)
+    u = sol.transcription.control_at(us, U, s)  # the interpolant's control, without its states
     data = ca.vertcat(us, ca.vec(U), h, p)
     dae = {"x": x, "p": data, "t": s, "ode": h * model.f(x, u, p)}
     opts = {"abstol": atol, "reltol": rtol, "max_num_steps": 100000}

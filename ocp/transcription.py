@@ -70,6 +70,7 @@ __all__ = ["Transcription", "Trapezoid", "HermiteSimpson", "Radau", "RadauConsta
 def _lagrange_basis(nodes: np.ndarray, s):
     """Lagrange basis polynomials through ``nodes`` at ``s`` (product form: exact at nodes)."""
     out = []
+    nodes = [float(v) for v in nodes]  # Python floats: an SX op with a numpy scalar is ~5x slower
     for j, tj in enumerate(nodes):
         b = 1
         for m, tm in enumerate(nodes):
@@ -166,7 +167,36 @@ class Transcription(abc.ABC):
 
     @abc.abstractmethod
     def _interpolate(self, f, xs, X, us, U, h, p, s):
-        """Symbolic ``(x (nx, 1), u (nu, 1))`` at ``sigma = s`` inside one interval."""
+        """Symbolic ``(x (nx, 1), u (nu, 1))`` at ``sigma = s`` inside one interval (its
+        ``u`` is `control_at`'s)."""
+
+    @abc.abstractmethod
+    def control_at(self, us, U, s):
+        """The control polynomial of one interval at ``sigma = s``, symbolic (SX or MX).
+
+        Parameters
+        ----------
+        us : casadi.SX or casadi.MX, shape (nu, 1)
+            The control at the interval start (unused where the transcription has none).
+        U : casadi.SX or casadi.MX, shape (nu, m_u)
+            The interval's own control nodes.
+        s : casadi.SX or casadi.MX, scalar
+            The fraction of the interval.
+
+        Returns
+        -------
+        casadi.SX or casadi.MX, shape (nu, 1)
+            The same expression as the ``u`` of the interpolant (`interpolant`), built
+            without its state part (re-simulations need the control alone).
+
+        Examples
+        --------
+        >>> import casadi as ca
+        >>> from appdyn.ocp.transcription import RadauLinearControl
+        >>> us, U, s = ca.SX.sym("us"), ca.SX.sym("U", 1, 1), ca.SX.sym("s")
+        >>> ca.Function("u", [us, U, s], [RadauLinearControl(3).control_at(us, U, s)])(1, 3, 0.5)
+        DM(2)
+        """
 
     def dense_weights(self, s: np.ndarray):
         """Weights of the dense output where it is linear in the node values, or ``None``.
@@ -335,7 +365,10 @@ class Trapezoid(Transcription):
         return defect, xe, quad
 
     def _interpolate(self, f, xs, X, us, U, h, p, s):
-        return xs + s * (X[:, 0] - xs), us + s * (U[:, 0] - us)
+        return xs + s * (X[:, 0] - xs), self.control_at(us, U, s)
+
+    def control_at(self, us, U, s):
+        return us + s * (U[:, 0] - us)
 
     def dense_weights(self, s):
         w = np.stack([1.0 - s, s], axis=1)
@@ -398,8 +431,11 @@ class HermiteSimpson(Transcription):
         s2, s3 = s * s, s * s * s
         x = ((2 * s3 - 3 * s2 + 1) * xs + (s3 - 2 * s2 + s) * h * fs
              + (-2 * s3 + 3 * s2) * xe + (s3 - s2) * h * fe)
+        return x, self.control_at(us, U, s)
+
+    def control_at(self, us, U, s):
         b0, bc, be = _lagrange_basis(np.array([0.0, 0.5, 1.0]), s)
-        return x, b0 * us + bc * uc + be * ue
+        return b0 * us + bc * U[:, 0] + be * U[:, 1]
 
 
 # ================================================================================== Radau
@@ -475,16 +511,18 @@ class Radau(Transcription):
         return defect, X, quad
 
     def _interpolate(self, f, xs, X, us, U, h, p, s):
-        nodes = np.concatenate([[0.0], self.points])
-        bx = _lagrange_basis(nodes, s)
-        bu = _lagrange_basis(self.points, s)
+        bx = _lagrange_basis(np.concatenate([[0.0], self.points]), s)
         x = bx[0] * xs
         for j in range(self.degree):
             x = x + bx[j + 1] * X[:, j]
+        return x, self.control_at(us, U, s)
+
+    def control_at(self, us, U, s):
+        bu = _lagrange_basis(self.points, s)
         u = 0
         for j in range(self.degree):
             u = u + bu[j] * U[:, j]
-        return x, u
+        return u
 
     def _state_weights(self, s):
         """``wx`` of `dense_weights`: the Lagrange basis through ``0, c_1, ..., c_d``."""
@@ -532,7 +570,10 @@ class RadauConstantControl(Radau):
 
     def _interpolate(self, f, xs, X, us, U, h, p, s):
         x, _ = super()._interpolate(f, xs, X, us, ca.repmat(U[:, 0], 1, self.degree), h, p, s)
-        return x, U[:, 0]
+        return x, self.control_at(us, U, s)
+
+    def control_at(self, us, U, s):
+        return U[:, 0]
 
     @property
     def path_sigma(self):
@@ -582,7 +623,10 @@ class RadauLinearControl(Radau):
 
     def _interpolate(self, f, xs, X, us, U, h, p, s):
         x, _ = super()._interpolate(f, xs, X, us, self._controls(us, U), h, p, s)
-        return x, us + s * (U[:, 0] - us)
+        return x, self.control_at(us, U, s)
+
+    def control_at(self, us, U, s):
+        return us + s * (U[:, 0] - us)
 
     @property
     def path_sigma(self):

@@ -33,8 +33,8 @@ from appdyn.dynamics.validate import (check_inertia, finite_array, integer, one_
                                positive_each, unit_axes)
 from appdyn.ocp import Constraint, Problem, annotate, solve, solve_multistart
 
-from .maneuvers import (START_BUDGET, SEED_OPTIONS, bounded, refine_and_verify,
-                        solve_time_optimal)
+from .maneuvers import (START_BUDGET, SEED_OPTIONS, bounded, refine_and_verify, restarted,
+                        solve_time_optimal, with_minimum_time)
 from .problem import attitude_guess, rough_time, seeded_guesses, slew_problem
 from .targets import POINTING_TOL, RATE_TOL, check_tol, targets
 
@@ -106,7 +106,7 @@ def _body_momentum(q, H_inertial):
 def solve_converted(problem, rb_problem, convert, objective, *, starts, seed, N, tol, verbose,
                     ipopt_options, ptol, rtol, polish, scale=None, guess=None,
                     transcription="radau", control="constant", eigenaxis=True,
-                    seed_control=None):
+                    seed_control=None, fastest=None):
     """Solve the slew ``problem`` from the rigid-body guesses of ``rb_problem`` converted by
     ``convert`` (a guess dict of the hub -> one of ``problem``), by the pipelines of
     `time_optimal` (``'time'``: the best of ``starts`` seeded starts, polished when
@@ -118,6 +118,10 @@ def solve_converted(problem, rb_problem, convert, objective, *, starts, seed, N,
     transcription's own, polynomial for Radau: the seed whose switches the polish reads;
     ``'constant'`` or ``'linear'`` keep the bounds between the nodes, so that no bounded
     re-solve follows: `scene_slew.settling_parts`).
+
+    ``fastest`` (``'effort'`` with a control bound): a callable giving the time-optimal slew
+    of the same scene, run when the first solve is infeasible (`maneuvers.restarted`: a
+    ``T`` below the minimum time is said so, else the slew is re-solved from it).
 
     ``guess`` (a solution or mapping of ``problem``) replaces the starts. With ``scale``
     [N m s] the result's ``info['momentum_drift']`` is the largest change of the total
@@ -142,8 +146,10 @@ def solve_converted(problem, rb_problem, convert, objective, *, starts, seed, N,
         else:
             first = solve_multistart(problem, [convert(g) for g in seeded_guesses(
                 rb_problem, starts, seed, eigenaxis=False)], start_budget=START_BUDGET, **opts)
+        first, fast = restarted(problem, first, fastest, opts)
         sol = refine_and_verify(problem, first, tol=tol, scale=None, pointing_tol=ptol,
                                 rate_tol=rtol, ipopt_options=ipopt_options, verbose=verbose)
+        sol = with_minimum_time(sol, problem.T, fast)
     return sol if scale is None else annotate(sol, _momentum_info(sol, scale))
 
 
@@ -259,9 +265,16 @@ def wheel_slew(inertia, axes, wheel_inertia, *, objective="time", T=None, angle=
         return dict(t=t, x=np.vstack([x, W]), u=tau, T=g["T"])
 
     scale = max(float(np.max(J * np.abs(W0))), float(np.max(J)) * 1.0, 1e-300)
+
+    def fastest():  # the time-optimal slew of this scene (see `solve_converted`)
+        return wheel_slew(inertia, axes, wheel_inertia, q0=q0, qf=qf, torque_max=torque_max,
+                          speed_max=speed_max, W0=W0, Wf=Wf, N=N, starts=starts, seed=seed,
+                          tol=tol, ipopt_options=ipopt_options, pointing_tol=ptol, rate_tol=rtol)
+
     return solve_converted(problem, rb, convert, objective, starts=starts, seed=seed, N=N,
                            tol=tol, verbose=verbose, ipopt_options=ipopt_options, ptol=ptol,
-                           rtol=rtol, scale=scale, polish=True)
+                           rtol=rtol, scale=scale, polish=True,
+                           fastest=fastest if objective == "effort" and tmax is not None else None)
 
 
 @interruptible
@@ -364,9 +377,16 @@ def cmg_slew(inertia, geometry, *, objective="time", T=None, angle=None, axis=No
             rates = np.clip(rates, -rmax[:, None], rmax[:, None])
         return dict(t=t, x=np.vstack([x, d]), u=rates, T=g["T"])
 
+    def fastest():  # the time-optimal slew of this scene (see `solve_converted`)
+        return cmg_slew(inertia, geometry, q0=q0, qf=qf, rate_max=rate_max,
+                        min_measure=min_measure, delta0=delta0, deltaf=deltaf, N=N,
+                        starts=starts, seed=seed, tol=tol, ipopt_options=ipopt_options,
+                        pointing_tol=ptol, rate_tol=rtol)
+
     sol = solve_converted(problem, rb, convert, objective, starts=starts, seed=seed, N=N,
                           tol=tol, verbose=verbose, ipopt_options=ipopt_options, ptol=ptol,
-                          rtol=rtol, scale=float(np.sum(geometry.h)), polish=False)
+                          rtol=rtol, scale=float(np.sum(geometry.h)), polish=False,
+                          fastest=fastest if objective == "effort" and rmax is not None else None)
     angles = sol.x[model.layout["cmgs"].coords]
     measure = np.sqrt(np.maximum(gram_determinant(cluster_jacobian(geometry, angles)), 0.0))
     return annotate(sol, {"min_measure": float(np.min(measure))})

@@ -32,7 +32,8 @@ from .targets import (ARCSEC, MIN_REFINE_TOL, POINTING_TOL, RATE_TOL, STATUS_POI
 __all__ = ["time_optimal", "min_effort", "verify", "bounded", "DEFAULT_STARTS_TIME",
            "DEFAULT_STARTS_EFFORT", "POLISH_MIN_BUDGET", "SEED_OPTIONS", "RACE_N", "RACE_AGREE",
            "RACE_IPOPT", "BOUNDED_ITER_FACTOR", "BOUNDED_MIN_ITER", "START_BUDGET",
-           "BOUNDED_TOL_FACTOR", "minimum_time_text"]
+           "BOUNDED_TOL_FACTOR", "minimum_time_text", "restarted",
+           "with_minimum_time"]
 
 DEFAULT_STARTS_TIME = 3  # seeded starts of time_optimal without a user guess
 DEFAULT_STARTS_EFFORT = 4  # seeded starts of min_effort with a keep-out cone
@@ -817,22 +818,40 @@ def min_effort(inertia, T, *, angle=None, axis=None, q0=None, qf=None, u_max=Non
         guesses = seeded_guesses(problem, starts, 0 if seed is None else seed, eigenaxis=False)
         first = solve_multistart(problem, guesses, start_budget=START_BUDGET, **opts)
     fastest = None
-    if first.status == STATUS_INFEASIBLE and u_max is not None:
-        # under a torque bound, IPOPT's "local infeasibility" is a T below the slew's minimum
-        # time, or a start path too slow for T (the eigenaxis path of Bilimoria-Wie needs
-        # 3.545 s where 3.243 s is the minimum): the time-optimal slew of the same scene says
-        # which, and stretched to T it is feasible (the torque scales by (T_min / T)^2)
-        fastest = time_optimal(inertia, angle=angle, axis=axis, q0=q0, qf=qf, u_max=u_max,
-                               norm_bound=norm_bound, w0=w0, wf=wf, keep_out=keep_out,
-                               pointing_tol=ptol, rate_tol=rtol, ipopt_options=ipopt_options)
-        if fastest.success and fastest.T <= problem.T:
-            first = solve(problem, guess=fastest, **opts)
+    if u_max is not None:
+        def fastest():
+            return time_optimal(inertia, angle=angle, axis=axis, q0=q0, qf=qf, u_max=u_max,
+                                norm_bound=norm_bound, w0=w0, wf=wf, keep_out=keep_out,
+                                pointing_tol=ptol, rate_tol=rtol, ipopt_options=ipopt_options)
+    first, fast = restarted(problem, first, fastest, opts)
     sol = refine_and_verify(problem, first, tol=tol, scale=scale, pointing_tol=ptol,
                             rate_tol=rtol, ipopt_options=ipopt_options, verbose=verbose)
-    if fastest is None:
+    return with_minimum_time(sol, problem.T, fast)
+
+
+def restarted(problem, first, fastest, opts: dict):
+    """``(first, time-optimal solution or None)`` of a minimum-effort slew whose first solve
+    ``first`` may be infeasible: with a bounded control, IPOPT's "local infeasibility" is a
+    ``T`` below the slew's minimum time, or a start path too slow for ``T`` (Bilimoria-Wie's
+    eigenaxis path needs 3.545 s where 3.243 s is the minimum). ``fastest()`` (None: no
+    bound) gives the time-optimal slew of the same scene; stretched to ``T`` it is feasible
+    (a rigid body's torque scales by ``(T_min / T)^2``), so when it fits in ``T`` the slew is
+    re-solved from it (`ocp.solve` with ``opts``)."""
+    if first.status != STATUS_INFEASIBLE or fastest is None:
+        return first, None
+    fast = fastest()
+    if fast.success and fast.T <= problem.T:
+        first = solve(problem, guess=fast, **opts)
+    return first, fast
+
+
+def with_minimum_time(sol, T: float, fast):
+    """``sol`` with ``info['minimum_time']`` [s] (None if the time-optimal slew failed) and
+    `minimum_time_text` appended to its message, when `restarted` ran ``fast``."""
+    if fast is None:
         return sol
-    return annotate(sol, {"minimum_time": float(fastest.T) if fastest.success else None},
-                    message=f"{sol.message}; {minimum_time_text(problem.T, fastest)}")
+    return annotate(sol, {"minimum_time": float(fast.T) if fast.success else None},
+                    message=f"{sol.message}; {minimum_time_text(T, fast)}")
 
 
 def minimum_time_text(T: float, fastest: Solution) -> str:
@@ -840,12 +859,12 @@ def minimum_time_text(T: float, fastest: Solution) -> str:
     infeasible, given ``fastest``, the time-optimal slew of the same scene (`time_optimal`)."""
     if not fastest.success:
         return (f"its first solve was infeasible and the time-optimal slew of the same scene "
-                f"did not converge either ({fastest.message[:200]}): check the torque bound "
+                f"did not converge either ({fastest.message[:200]}): check the control bound "
                 f"and the target")
     if fastest.T > T:
-        return (f"T = {T:.6g} s is below this slew's minimum time {fastest.T:.6g} s under "
-                f"u_max (`slew.time_optimal`, verified): no torque within the bounds reaches "
-                f"the target in T; ask T >= {fastest.T:.6g} s")
+        return (f"T = {T:.6g} s is below this slew's minimum time {fastest.T:.6g} s under its "
+                f"control bounds (the time-optimal slew, verified): no control within the "
+                f"bounds reaches the target in T; ask T >= {fastest.T:.6g} s")
     return (f"its first solve was infeasible from its start path; re-solved from the "
             f"time-optimal slew (minimum time {fastest.T:.6g} s, stretched to T = {T:.6g} s)")
 

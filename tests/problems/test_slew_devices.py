@@ -204,3 +204,16 @@ def test_cmg_time_optimal_starts_after_a_converged_one_run_on_a_budget():
         assert later["budget"] == max(BUDGET_MIN_ITER, START_BUDGET * st[0]["iterations"])
         assert later["success"] or later["iterations"] <= later["budget"]
     assert sol.pointing_error <= slew.POINTING_TOL and sol.info["momentum_drift"] < 1e-6
+
+
+@pytest.mark.slow
+def test_wheel_min_effort_below_the_minimum_time_says_so():
+    """Three orthogonal wheels, zero momentum, unit hub: the hub obeys I w' = -tau, so its
+    minimum time for 180 deg about z under |tau_i| <= 1 is Bilimoria & Wie's 3.2430 s.
+    T = 3.2 s: no bounded torque reaches the target; said so (before: IPOPT's "the problem
+    may be infeasible" alone)."""
+    sol = slew.wheel_slew(np.eye(3), np.eye(3), 0.01, objective="effort", T=3.2, angle=np.pi,
+                          axis=[0, 0, 1.0], torque_max=1.0)
+    assert not sol.success
+    assert sol.info["minimum_time"] == pytest.approx(3.2430, abs=1e-4)
+    assert "below this slew's minimum time 3.2430" in sol.message
