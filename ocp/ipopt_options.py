@@ -33,10 +33,10 @@ thread took 0.10 s of CPU during the first Bilimoria-Wie slew of a process (0.33
 0.23 s wall), and on a busy machine that CPU is taken from the solve. `ipopt_solver` (every
 IPOPT solver of this package is built by it) therefore loads the plugin with
 `IPOPT_BLAS_THREADS` BLAS threads unless ``OPENBLAS_NUM_THREADS`` is set in the
-environment, which then decides (`load_ipopt`). Measured with one thread against the
-default, whole processes alternated: the first slew of a process 0.24-0.31 s against
-0.29-0.35 s; Delta III and a minimum-effort slew at N = 2000 unchanged within their
-run-to-run spread.
+environment, which then decides (`load_ipopt`). Measured against the code before, whole
+processes alternated (load 0.5): the first slew of a process 0.18-0.24 s wall and the same
+CPU, against 0.22-0.26 s wall and 0.33-0.37 s CPU; Delta III and a minimum-effort slew at
+N = 2000 unchanged within their run-to-run spread.
 """
 from __future__ import annotations
 
