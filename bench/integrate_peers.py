@@ -10,7 +10,9 @@ right-hand side appdyn compiles (a shared library exporting ``peer_rhs`` in numb
 ``lsoda_sig``, built here with the project's compiler flags): the same arithmetic, so the
 ratio is the integrators'.
 
-For each workload both sweep ``rtol`` (``atol = rtol / 100``); each run is timed
+For each workload both sweep ``rtol`` (``atol = rtol / 100``), appdyn with ``auto`` (each
+answer verified by its own check) and with ``method='dop853'`` (one DOP853 run at the local
+tolerance, nothing verified: the peer's contract, on the same kind of compiled C); each run is timed
 `REPEATS` times (median); the cheapest run of each whose error meets the workload's target
 is compared: ``ratio = numbalsoda time / appdyn time`` (> 1: appdyn faster). numbalsoda
 runs in its own venv (``bench/peers/.venv-numbalsoda``, `bench/peers/README.md`);
@@ -21,7 +23,8 @@ rounds of the call and of its compiled pass alone, and the Python around it
 (`two_point_call`); and the Monte Carlo of issue 31, item 4: 1,000 torque-free runs (`bench/simulate.py`'s batch
 workload, every run within 1e-8 rad/s of its Jacobi truth) in one batched ``simulate`` at
 the default method and tolerances (each run verified: ``all_success``) and with fixed-step
-``rk8`` (the fewest steps meeting the error), against numbalsoda's ``dop853`` in a
+``rk8`` (the fewest steps meeting the error), and with ``method='dop853'`` at the peer's own
+tolerance (nothing verified, as the peer), against numbalsoda's ``dop853`` in a
 numba-jitted loop (the loosest of rtol 1e-9, 1e-10, 1e-11 meeting the error). numbalsoda's
 loop runs on one thread; appdyn's batch is timed on the cores this process may use (its
 default ``threads``) and on one thread (``threads=1``), and both ratios are reported.
@@ -175,13 +178,16 @@ def median_time(fun, repeats: int) -> float:
     return statistics.median(timed(fun, repeats)[1])
 
 
-def appdyn_sweep(w: Workload, tols, repeats) -> list[dict]:
+def appdyn_sweep(w: Workload, tols, repeats, method: str = "auto") -> list[dict]:
+    """appdyn's runs of ``method`` over ``tols`` (``atol = rtol / 100``): error, median
+    time, steps, success and the largest error over the tolerance (every state)."""
     rows = []
     for rtol in tols:
-        run = (lambda r=rtol: simulate(w.model, w.x0, w.t, rtol=r, atol=r / 100))
+        run = (lambda r=rtol: simulate(w.model, w.x0, w.t, rtol=r, atol=r / 100,
+                                       method=method))
         res = run()
         scaled = np.abs(res.x - w.ref) / (rtol / 100 + rtol * np.abs(w.ref))
-        rows.append(dict(solver="appdyn auto", rtol=rtol, error=w.error(res.x),
+        rows.append(dict(solver=f"appdyn {method}", rtol=rtol, error=w.error(res.x),
                          time=median_time(run, repeats), steps=res.n_steps,
                          success=bool(res.success), scaled=float(np.max(scaled[:, 1:]))))
     return rows
@@ -277,6 +283,8 @@ def monte_carlo(quick: bool, detail: list) -> list[Row]:
     verified = bool(res.all_success)
     steps = next(n for n in range(1, 65) if error(batched(method="rk8", steps=n).x) <= BATCH_TOL)
     jobs = {"auto": {}, "rk8": dict(method="rk8", steps=steps)}
+    if peer:  # (the unverified DOP853 at the peer's own tolerance: the same contract)
+        jobs["dop853"] = dict(method="dop853", rtol=peer[0], atol=peer[0] / 100)
     times = {}
     for name, kw in jobs.items():  # (1 thread and the default, interleaved: the VM drifts)
         runs = {1: [], cores: []}
@@ -286,14 +294,17 @@ def monte_carlo(quick: bool, detail: list) -> list[Row]:
         for threads, got in runs.items():
             times[name, threads] = min(got)
     labels = {"auto": "appdyn auto batched (defaults)",
-              "rk8": f"appdyn rk8 batched ({steps} steps per interval)"}
+              "rk8": f"appdyn rk8 batched ({steps} steps per interval)",
+              "dop853": "appdyn dop853 batched (not verified, the peer's rtol)"}
+    runs_of = {name: res if name == "auto" else batched(**kw) for name, kw in jobs.items()}
     for (name, threads), time in times.items():
-        x = res.x if name == "auto" else batched(**jobs["rk8"]).x
+        got = runs_of[name]
         detail.append(dict(workload=f"Monte Carlo {k} runs", target=BATCH_TOL,
                            solver=f"{labels[name]}, {threads} thread(s)",
-                           rtol=1e-8 if name == "auto" else math.nan, error=error(x),
-                           time=time, steps=res.n_steps if name == "auto" else steps * (t.size - 1),
-                           success=verified if name == "auto" else True))
+                           rtol=jobs[name].get("rtol", 1e-8 if name == "auto" else math.nan),
+                           error=error(got.x), time=time,
+                           steps=got.n_steps if name != "rk8" else steps * (t.size - 1),
+                           success=bool(got.all_success)))
     if peer:
         b = numbalsoda_batch(x0s, t, peer[0])
         peer = (peer[0], min(peer[1], *b["times"])) if b else peer
@@ -304,7 +315,9 @@ def monte_carlo(quick: bool, detail: list) -> list[Row]:
                 "steps in the costliest run")]
     if peer:
         for name, label in (("auto", "defaults (auto, verified per run)"),
-                            ("rk8", f"fixed-step rk8, {steps} steps per interval")):
+                            ("rk8", f"fixed-step rk8, {steps} steps per interval"),
+                            ("dop853", f"dop853 at rtol {peer[0]:g} (not verified), error "
+                                       f"{error(runs_of['dop853'].x):.2g}")):
             for threads in sorted({1, cores}):
                 rows.append(Row("integrate_peers", case, f"speed-up vs numbalsoda njit loop "
                                 f"(one thread), {label}, appdyn on {threads} thread(s)",
@@ -323,10 +336,12 @@ def run(quick: bool, out: Path) -> list[Row]:
             # the peer first, then appdyn, then the peer again: the VM's speed drifts
             first = peer_sweep(w, tols, repeats)
             mine = appdyn_sweep(w, tols, repeats)
+            unverified = appdyn_sweep(w, tols, repeats, "dop853")
             again = peer_sweep(w, tols, repeats)
             peer = [dict(a, time=min(a["time"], b["time"])) for a, b in zip(first, again)]
-            for r in mine + peer:
+            for r in mine + unverified + peer:
                 detail.append(dict(workload=w.name, target=w.target, **r))
+            summary += _unverified_rows(w, unverified, peer)
             a, b = cheapest(mine, w.target), cheapest(peer, w.target)
             if a:
                 summary.append(Row("integrate_peers", w.name, "appdyn auto time at matched "
@@ -358,6 +373,26 @@ def run(quick: bool, out: Path) -> list[Row]:
     summary += monte_carlo(quick, detail)
     write_csv(detail, out / "integrate_peers.csv")
     return summary
+
+
+def _unverified_rows(w: Workload, mine: list, peer: list) -> list[Row]:
+    """The rows of ``method='dop853'`` (one DOP853 run at the local tolerance, no global
+    check: numbalsoda's contract) against numbalsoda's ``dop853`` at ``w``'s target error:
+    its time and the ratio interpolated on both work-precision lines (`time_at`)."""
+    ta, tb = time_at(mine, w.target), time_at(peer, w.target)
+    a = cheapest(mine, w.target)
+    rows = []
+    if a:
+        rows.append(Row("integrate_peers", w.name, "appdyn dop853 (not verified) time at "
+                        "matched error", a["time"] * 1e3, "ms",
+                        f"rtol {a['rtol']:.3g}, {a['steps']} steps, error {a['error']:.2g} <= "
+                        f"{w.target:g}"))
+    if math.isfinite(ta) and math.isfinite(tb):
+        rows.append(Row("integrate_peers", w.name, "appdyn dop853 (not verified): speed-up vs "
+                        "numbalsoda dop853, interpolated at the target error", tb / ta, "x",
+                        f"appdyn {ta * 1e3:.3g} ms, numbalsoda {tb * 1e3:.3g} ms (log-log "
+                        "between the sweep's runs)"))
+    return rows
 
 
 def _delivered(rows, rtol) -> float:

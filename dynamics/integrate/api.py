@@ -27,12 +27,13 @@ from .loops import Progress, run_fixed, run_short
 from .result import FAILED, OK, OK_STIFF, VIOLATED, Dense, Run, SimulationResult, new_result
 from .sanity import remedy, violation
 from .smoothness import nonsmooth_operations
+from .stepcontrol import plain_run, run_dop853
 
 __all__ = ["simulate", "METHODS", "Method", "Hold", "CallPlan", "call_plan"]
 
-Method = Literal["auto", "cvodes", "rk4", "rk8", "lie"]
+Method = Literal["auto", "dop853", "cvodes", "rk4", "rk8", "lie"]
 Hold = Literal["linear", "zoh"]
-METHODS = ("auto", "cvodes", "rk4", "rk8", "lie")
+METHODS = ("auto", "dop853", "cvodes", "rk4", "rk8", "lie")
 _FIXED_STEP = ("rk4", "rk8", "lie")
 
 
@@ -73,13 +74,22 @@ def simulate(model: Model, x0, t, *, u=None, p=None, hold: Hold = "linear", meth
         on the grid, where every method's steps start and end, so every method integrates
         each interval with its constant control and loses no order. A constant or ``None``
         ``u`` is the same under both; a callable ``u`` takes only ``'linear'``.
-    method : {'auto', 'cvodes', 'rk4', 'rk8', 'lie'}
+    method : {'auto', 'dop853', 'cvodes', 'rk4', 'rk8', 'lie'}
         * ``'rk4'``, ``'rk8'`` (DOP853's 8th-order weights), ``'lie'`` (CF4 on the quaternion,
           RK4 on the other states; needs ``model.attitude``): fixed step, ``steps`` steps per
           output interval, run by one compiled chunk Function of 512 steps called in a
           loop (the code and its compile time do not depend on the grid or step count).
         * ``'cvodes'``: SUNDIALS CVODES (BDF by default) through ``casadi.integrator`` with
           ``rtol``/``atol`` as its local tolerances (the smallest ``atol`` when a vector).
+        * ``'dop853'``: one run of DOP853 (Hairer's 8(5,3) pair, as scipy's and
+          numbalsoda's) with ``rtol``/``atol`` as its local tolerances, compiled C
+          (`dynamics.integrate.stepcontrol.run_dop853`): under a control constant over the
+          run its steps follow the error estimate alone and the outputs come from its
+          continuous extension of order 7; under sampled controls its steps end on the grid;
+          a callable ``u`` (or ``jit=False``) steps from Python. Its global error is *not*
+          estimated (``error_estimate`` NaN; ``success`` says the run finished and passed
+          the invariant sanity check of the fixed-step methods): the peers' contract, at
+          their speed (``bench/integrate_peers.py``). ``auto`` verifies the tolerance.
         * ``'auto'``: ``rk8`` with the step count chosen from global error estimates so
           that ``|error| <= atol + rtol |x|`` at every output time. First one compiled C
           pass (no callable ``u``, a C compiler, a tolerance at least 1e6 ulps above the
@@ -99,7 +109,7 @@ def simulate(model: Model, x0, t, *, u=None, p=None, hold: Hold = "linear", meth
           ``success=False`` with ``status`` 2 (round-off floor), 3 (``max_steps``) or 5
           (non-smooth right-hand side: order loss at kinks); never a silent fallback.
     rtol : float, optional
-        Relative tolerance, ``100 eps <= rtol < 1`` (used by ``auto`` and ``cvodes``).
+        Relative tolerance, ``100 eps <= rtol < 1`` (used by ``auto``, ``dop853`` and ``cvodes``).
     atol : float or array_like (nx,), optional
         Absolute tolerance [state units], ``>= 0``.
     invariants : bool or sequence of str, optional
@@ -114,7 +124,8 @@ def simulate(model: Model, x0, t, *, u=None, p=None, hold: Hold = "linear", meth
         cached; `dynamics.clear_caches` drops them.
     max_steps : int, optional
         ``auto``: most rk8 steps in one run (default 1e8); a tolerance that needs more is
-        reported as ``status`` 3, not attempted.
+        reported as ``status`` 3, not attempted. ``dop853``: most steps, accepted and
+        rejected (a run that needs more fails, NaN from there on).
     cvodes_options : mapping, optional
         Extra options for ``casadi.integrator('cvodes')`` over casadi's defaults (BDF,
         ``max_num_steps`` 10 000 per output interval), e.g.
@@ -200,11 +211,11 @@ def simulate(model: Model, x0, t, *, u=None, p=None, hold: Hold = "linear", meth
                             max_steps=max_steps, cvodes_options=cvodes_options,
                             progress=bar, events=events, impacts=impacts, threads=threads)
     start = time.perf_counter()
-    if (method == "auto" and u is None and p is None and hold == "linear" and events is None
-            and impacts is None and invariants is False and steps is None
-            and (jit is None or jit is True) and cvodes_options is None and progress is None
-            and threads is None):
-        result = _common_call(model, x0, t, rtol, atol, max_steps, start)
+    if ((method == "auto" or method == "dop853") and u is None and p is None
+            and hold == "linear" and events is None and impacts is None and invariants is False
+            and steps is None and (jit is None or jit is True) and cvodes_options is None
+            and progress is None and threads is None):
+        result = _common_call(model, x0, t, rtol, atol, max_steps, start, method)
         if result is not None:
             return result
     model = check_model(model)
@@ -265,12 +276,15 @@ def simulate(model: Model, x0, t, *, u=None, p=None, hold: Hold = "linear", meth
                             progress=counter)
         elif method == "cvodes":
             run = run_cvodes(problem, rtol, atol, cvodes_options)
+        elif method == "dop853":
+            run = run_dop853(problem, rtol, atol, max_steps,
+                             compiled=cache.should_compile(jit, math.inf), progress=counter)
         else:
             run, used, status, estimate = solve_auto(problem, rtol, atol, max_steps, jit,
                                                      cvodes_options, counter,
                                                      nonsmooth=plan.nonsmooth)
         counter.finish()
-    if method in _FIXED_STEP and run.ok:
+    if (method in _FIXED_STEP or method == "dop853") and run.ok:
         run, status = _sane(model, t, run, control, p, method)
     result = _result(model, t, run, used, status, estimate, control, p, names, start)
     if specs is None:
@@ -281,14 +295,16 @@ def simulate(model: Model, x0, t, *, u=None, p=None, hold: Hold = "linear", meth
                         cache.should_compile(jit, math.inf))
 
 
-def _common_call(model, x0, t, rtol, atol, max_steps, start: float):
-    """`simulate` of the common call, ``method='auto'`` at the model's parameters without a
-    control or options (a `Model` with no clock state and a smooth right-hand side, ``x0`` of
-    shape ``(nx,)`` that `fast_x0` takes, float tolerances, an int ``max_steps``): the
-    answer of the compiled dense pass (`dense.dense_run`) at once when it answers
-    (`auto.dense_outcome`: verified, or below the rounding floor), ``start`` the call's
-    `time.perf_counter`. None for anything else, or when the pass leaves the run to auto's
-    other paths: the general path then decides (and words any error)."""
+def _common_call(model, x0, t, rtol, atol, max_steps, start: float, method: str = "auto"):
+    """`simulate` of the common call, ``method='auto'`` (or ``'dop853'``) at the model's
+    parameters without a control or options (a `Model` with no clock state and a smooth
+    right-hand side, ``x0`` of shape ``(nx,)`` that `fast_x0` takes, float tolerances, an
+    int ``max_steps``): the answer of the compiled dense pass (`dense.dense_run`) at once
+    when it answers (`auto.dense_outcome`: verified, or below the rounding floor; for
+    ``dop853`` its answer alone, `stepcontrol.plain_run`, with the sanity check of an
+    unverified run), ``start`` the call's `time.perf_counter`. None for anything else, or
+    when the pass leaves the run to auto's other paths: the general path then decides (and
+    words any error)."""
     if type(model) is not Model or not call_plan(model).common:
         return None
     if (type(rtol) is not float or type(atol) is not float or type(max_steps) is not int
@@ -298,6 +314,15 @@ def _common_call(model, x0, t, rtol, atol, max_steps, start: float):
     x0 = fast_x0(x0, model)
     if x0 is None:
         return None
+    if method == "dop853":
+        run = plain_run(model, x0, t, rtol, atol, max_steps, p=model.p_default)
+        if run is None:
+            return None
+        status = OK
+        if run.ok:
+            run, status = _sane(model, t, run, None, model.p_default, method)
+        return _result(model, t, run, method, status, math.nan, None, model.p_default, (),
+                       start)
     got = dense_run(model, x0, t, rtol, atol, max_steps, STIFF_STEPS, p=model.p_default)
     out = None if got is None else dense_outcome(got, rtol)
     if out is None:
@@ -411,8 +436,9 @@ def _sane(model: Model, t: np.ndarray, run: Run, control, p: np.ndarray, method:
                     else control.grid(t), p, method)
     if not bad:
         return run, OK
+    said = run.message if type(run.message) is str else run.message()  # (made on first use)
     return (Run.new(run.x, run.n_steps, run.n_rhs, run.substeps, run.compiled, True,
-                    f"{run.message}; not a solution: {bad}; {remedy(method)}"), VIOLATED)
+                    f"{said}; not a solution: {bad}; {remedy(method)}"), VIOLATED)
 
 
 def _zero_grid(t: np.ndarray, nu: int) -> np.ndarray:

@@ -50,7 +50,7 @@ from .result import (FAILED, OK, OK_STIFF, ROUNDOFF, UNVERIFIED, VIOLATED, Dense
                      Run, SimulationResult)
 from .smoothness import nonsmooth_operations
 from .sanity import remedy, violations
-from .stepcontrol import LOCAL_RTOL_MIN
+from .stepcontrol import LOCAL_RTOL_MIN, run_dop853
 
 __all__ = ["Batch", "BatchResult", "check_batch", "simulate_batch", "BATCH_THREADS",
            "first_factor", "dense_rounds"]  # (Batch,
@@ -107,14 +107,27 @@ def simulate_batch(batch: Batch, options: RunOptions, *, start: float) -> "Batch
         status = np.where(ok, OK, FAILED)
         used, message = method, fixed_message(method, steps, n_steps, ok)
         status, message = _sane(batch, x, ok, status, message, method)
-    elif method == "cvodes":
-        runs = [run_cvodes(batch.problem(k), rtol, atol, cvodes_options) for k in range(K)]
-        x = np.stack([r.x for r in runs], axis=2)
-        ok = np.array([r.ok for r in runs])
-        status = np.where(ok, OK, FAILED)
-        used, n_steps, compiled = "cvodes", max(r.n_steps for r in runs), False
-        message = f"cvodes: {K} runs, one after another" + (
-            "" if ok.all() else f"; {int((~ok).sum())} failed: {runs[int(np.argmin(ok))].message}")
+    elif method in ("cvodes", "dop853"):
+        compile_ = cache.should_compile(jit, math.inf)
+        plain = dop853_dense_batch(batch, rtol, atol, max_steps, threads=options.threads) \
+            if method == "dop853" and compile_ else None
+        if plain is not None:  # (one compiled loop over the runs)
+            x, ok, n_steps, failed = plain
+            compiled, how = True, "in one compiled loop"
+        else:
+            runs = [run_cvodes(batch.problem(k), rtol, atol, cvodes_options) if method == "cvodes"
+                    else run_dop853(batch.problem(k), rtol, atol, max_steps, compiled=compile_,
+                                    progress=progress) for k in range(K)]
+            x = np.stack([r.x for r in runs], axis=2)
+            ok = np.array([r.ok for r in runs])
+            n_steps, how = max(r.n_steps for r in runs), "one after another"
+            compiled = method == "dop853" and all(r.compiled for r in runs)
+            failed = "" if ok.all() else runs[int(np.argmin(ok))].message
+        status, used = np.where(ok, OK, FAILED), method
+        message = f"{method}: {K} runs, {how}" + (
+            "" if ok.all() else f"; {int((~ok).sum())} failed: {failed}")
+        if method == "dop853":
+            status, message = _sane(batch, x, ok, status, message, method)
     else:
         target = BatchTarget(batch, options.threads)
         dense = None if target.nonsmooth else auto_dense_batch(
@@ -181,17 +194,11 @@ def auto_dense_batch(batch: Batch, rtol: float, atol: np.ndarray, max_steps: int
     if not auto_jit(jit):
         return None
     K, model, t = batch.K, batch.model, batch.t
-    nx, nu, np_ = model.nx, model.nu, model.np
-    ua = batch.ua
-    if not batch.constant and ua.size and not (np.all(ua == ua[:, :1]) and
-                                               np.all(batch.ub == ua[:, :1])):
+    nx = model.nx
+    inputs = _constant_inputs(batch)
+    if inputs is None:
         return None
-    x0 = np.ascontiguousarray(batch.x0.T)
-    u = np.zeros((K, max(nu, 1)))
-    if nu and ua.shape[1]:
-        u[:, :nu] = ua[:, 0]
-    p = np.zeros((K, max(np_, 1)))
-    p[:, :np_] = batch.p.T
+    x0, u, p = inputs
     X = np.empty((K, nx, t.size))
     head = np.empty((K, DENSE_HEADER))
     missing = []
@@ -248,6 +255,58 @@ def auto_dense_batch(batch: Batch, rtol: float, atol: np.ndarray, max_steps: int
     if redo.size:
         message += f"; {redo.size} run(s) alone through auto's other paths"
     return x, ok, status, estimate, ", ".join(sorted(used)), int(steps.max()), message
+
+
+def _constant_inputs(batch: Batch):
+    """``(x0 (K, nx), u (K, max(nu, 1)), p (K, max(np, 1)))``, C-contiguous, of a batch
+    whose runs each hold one control throughout (`dense.dense_many`'s inputs); None when a
+    run's control varies."""
+    K, model, ua = batch.K, batch.model, batch.ua
+    nu, np_ = model.nu, model.np
+    if not batch.constant and ua.size and not (np.all(ua == ua[:, :1]) and
+                                               np.all(batch.ub == ua[:, :1])):
+        return None
+    x0 = np.ascontiguousarray(batch.x0.T)
+    u = np.zeros((K, max(nu, 1)))
+    if nu and ua.shape[1]:
+        u[:, :nu] = ua[:, 0]
+    p = np.zeros((K, max(np_, 1)))
+    p[:, :np_] = batch.p.T
+    return x0, u, p
+
+
+def dop853_dense_batch(batch: Batch, rtol: float, atol: np.ndarray, max_steps: int, *,
+                       threads: int | None = None):
+    """``method='dop853'`` on a batch whose runs each hold one control throughout: every
+    run's DOP853 answer alone (`stepcontrol.plain_run`'s, no check) in one compiled loop
+    over the runs (`dense.dense_many` with ``check=False``), spread over ``threads`` as
+    `auto_dense_batch` spreads its runs. Returns ``(x (nx, n, K), ok (K,), n_steps (the
+    most of a run), failed)``: a run that failed is made again alone by
+    `stepcontrol.run_dop853` (NaN from where it stopped), and ``failed`` is the first such
+    run's message ("" for none); or None (no compiled pass, a control that varies within a
+    run)."""
+    K, model, t = batch.K, batch.model, batch.t
+    inputs = _constant_inputs(batch)
+    if inputs is None:
+        return None
+    x0, u, p = inputs
+    X, head, missing = np.empty((K, model.nx, t.size)), np.empty((K, DENSE_HEADER)), []
+
+    def call(a, b):
+        if dense_many(model, x0, t, u, p, rtol, atol, max_steps, math.inf, slice(a, b),
+                      out=(X, head), check=False) is None:
+            missing.append(a)
+
+    spread_runs(call, K, batch_threads(threads) if K >= 2 * DENSE_PART else 1, DENSE_PART)
+    if missing:
+        return None
+    ok = head[:, DENSE_FIELDS.index("result")] == 2
+    steps = head[:, DENSE_FIELDS.index("spent")].astype(int)
+    failed = ""
+    for k in np.flatnonzero(~ok):  # (alone: where and why)
+        run = run_dop853(batch.problem(int(k)), rtol, atol, max_steps)
+        X[k], steps[k], failed = run.x, run.n_steps, failed or run.message
+    return X.transpose(1, 2, 0), ok, int(steps.max()), failed
 
 
 #: Most runs of one compiled call of a dense batch (Ctrl-C is looked at between groups of

@@ -514,14 +514,16 @@ _AUTO = r"""
 #define AU_STIFF 4    /* in: `rk8_dense`'s stiff_steps */
 #define AU_T0 5       /* in: the start time */
 #define AU_IQ 6       /* in: index of the attitude quaternion, -1: none */
-#define AU_TRIES 7    /* in: answer-check pairs at most */
+#define AU_TRIES 7    /* in: answer-check pairs at most; 0: the answer alone at the local
+                         factor, no check and no verdict (AU_RESULT 2: `method='dop853'`) */
 #define AU_PHASE 8    /* 0 start, 1 check run, 2 answer, 4 the answer from a moved start (the
                          rounding floor), 3 done */
 #define AU_SPENT 9    /* steps of every run (accepted and rejected) */
 #define AU_NCHK 10    /* steps of the check run */
 #define AU_NANS 11    /* steps of the answer */
-#define AU_RESULT 12  /* 1 verified, 0 not (AU_EST), -2 a tolerance below an ulp of the
-                         states' size (AU_FMIN > 1), -3 a run failed */
+#define AU_RESULT 12  /* 1 verified, 0 not (AU_EST), 2 answered, not checked (AU_TRIES 0),
+                         -2 a tolerance below an ulp of the states' size (AU_FMIN > 1), -3 a
+                         run failed */
 #define AU_EST 13     /* the error estimate [tolerances] */
 #define AU_D 14       /* the scaled difference of the answer and the check run */
 #define AU_FLAG 15    /* `rk8_dense`'s flag of a failed run */
@@ -803,7 +805,8 @@ int rk8_auto(casadi_real* w, int nout, int budget, casadi_real* X, casadi_real* 
     /* the local tolerance kept AU_LOCAL_ULPS ulps above the states' size (a tighter one asks
        for less than DOP853's rounding) and at least AU_RTOL_MIN; a requested tolerance
        itself below that: no run (-2) */
-    w[AU_FMIN] = fmax(au_size(w) * DBL_EPSILON * AU_LOCAL_ULPS, AU_RTOL_MIN / w[AU_RTOL]);
+    w[AU_FMIN] = w[AU_TRIES] <= 0 ? 0  /* (the answer alone: at the tolerance asked) */
+      : fmax(au_size(w) * DBL_EPSILON * AU_LOCAL_ULPS, AU_RTOL_MIN / w[AU_RTOL]);
     if (w[AU_FMIN] > 1.0) {
       w[AU_RESULT] = -2; w[AU_PHASE] = 3;
       return 3;
@@ -814,8 +817,8 @@ int rk8_auto(casadi_real* w, int nout, int budget, casadi_real* X, casadi_real* 
     w[AU_PHASE] = 2;
   }
   while (budget > 0 && w[AU_PHASE] != 3) {
-    int floor = w[AU_PHASE] == 4;
-    if (!au_step(w, w[AU_FACTOR], floor ? XC : X, &budget, !floor, XC))
+    int floor = w[AU_PHASE] == 4, plain = w[AU_TRIES] <= 0;
+    if (!au_step(w, w[AU_FACTOR], floor ? XC : X, &budget, !floor && !plain, XC))
       continue;
     w[AU_SPENT] += count[0] + count[1] + (floor ? 0 : AU_RICH(w)[RI_STEPS]);
     if (count[2] != 0 && floor) {  /* (no floor: not verified) */
@@ -836,6 +839,10 @@ int rk8_auto(casadi_real* w, int nout, int budget, casadi_real* X, casadi_real* 
     w[AU_INTERP] = count[4]; w[AU_LIP] = count[7];
     for (i = 0; i < PASS_NX; ++i) AU_NOISE(w)[i] = count[8 + i];
     w[AU_TRY] += 1;
+    if (plain) {  /* the answer alone: not checked */
+      w[AU_RESULT] = 2; w[AU_EST] = NAN; w[AU_PHASE] = 3;
+      break;
+    }
     au_judge(w, X, XC);
   }
   return (int) w[AU_PHASE];

@@ -87,7 +87,8 @@ class DenseAuto(NamedTuple):
     """The outcome of `dense_auto` (one run) or of a run of `dense_many`.
 
     ``x (nx, n)`` the answer (NaN after a failure); ``result`` 1 verified, 0 not verified
-    (``estimate`` > acceptance or not finite), -2 a requested tolerance below one ulp of a
+    (``estimate`` > acceptance or not finite), 2 answered and not checked (``check`` False:
+    ``estimate`` NaN), -2 a requested tolerance below one ulp of a
     state's size (no run made), -3 a run failed (``reason``); ``estimate`` [tolerances]; ``spent`` steps of
     all runs; ``answer_steps``, ``check_steps`` (accepted and rejected), ``rejected`` of the
     answer, ``hmin`` its smallest step [s], ``interpolated`` its steps that filled outputs,
@@ -203,13 +204,15 @@ _INPUTS = struct.Struct(f"{_PHASE + 1}d")
 
 
 def _fill(ws: np.ndarray, plan: _Plan, t: np.ndarray, rtol: float, atol,
-          max_steps: float, stiff_steps: float, factor: float | None = None) -> None:
+          max_steps: float, stiff_steps: float, factor: float | None = None,
+          check: bool = True) -> None:
     """The inputs shared by the runs: header (the first answer at local tolerance ``factor``
     times the requested one), tolerances (``atol`` a float or ``(nx,)``) and output times
-    (the C code resets the outputs of the header); ``factor`` None: `FIRST`."""
-    factor = FIRST if factor is None else factor
+    (the C code resets the outputs of the header); ``factor`` None: `FIRST`. ``check``
+    False: the answer alone at the requested tolerance (``tries`` 0), not checked."""
+    factor = (FIRST if check else 1.0) if factor is None else factor
     _INPUTS.pack_into(ws, 0, rtol, factor, factor * CHECK, max_steps, stiff_steps, t[0],
-                      plan.iq, TRIES, 0.0)
+                      plan.iq, TRIES if check else 0, 0.0)
     o = HEADER + plan.nx + plan.nu + plan.np
     ws[o:o + plan.nx] = atol
     ws[o + plan.nx:o + plan.nx + t.size - 1] = t[1:]
@@ -259,11 +262,14 @@ def dense_auto(problem: Problem, rtol: float, atol: np.ndarray, max_steps: float
 
 
 def dense_run(model, x0: np.ndarray, t: np.ndarray, rtol: float, atol, max_steps: float,
-              stiff_steps: float, *, u=None, p=None, progress=None) -> DenseAuto | None:
+              stiff_steps: float, *, u=None, p=None, progress=None,
+              check: bool = True) -> DenseAuto | None:
     """`dense_auto` of checked inputs: ``x0 (nx,)``, the grid ``t (n,)``, ``atol`` a float or
     ``(nx,)``, the constant control ``u (nu,)`` (None: zero) and ``p (np,)``; None without a
     compiled pass. Per call: the model's plan looked up, the thread's workspace filled, one
     ``ctypes`` call with arguments built with the workspace, the answer copied out.
+    ``check`` False: DOP853's answer alone at the tolerance asked, no check and no verdict
+    (``result`` 2; ``method='dop853'``); a failed run's outputs after ``filled`` are NaN.
 
     Examples
     --------
@@ -282,7 +288,7 @@ def dense_run(model, x0: np.ndarray, t: np.ndarray, rtol: float, atol, max_steps
     nout = t.size - 1
     work = _workspace(plan, nout)
     ws = work.ws
-    _fill(ws, plan, t, rtol, atol, max_steps, stiff_steps)
+    _fill(ws, plan, t, rtol, atol, max_steps, stiff_steps, check=check)
     nx, nu = plan.nx, plan.nu
     ws[HEADER:HEADER + nx] = x0
     if nu:
@@ -305,7 +311,10 @@ def dense_run(model, x0: np.ndarray, t: np.ndarray, rtol: float, atol, max_steps
         _tell(progress, int(ws[_SPENT]), told)
     elif progress is not None:
         _tell(progress, int(ws[_SPENT]), 0)
-    return _outcome(work.X.copy(), ws[:HEADER].tolist())
+    x = work.X.copy()
+    if ws[_RESULT] == -3:  # (the outputs filled before the failure; NaN after)
+        x[:, 1 + int(ws[HEADER + 3 * nx + nu + plan.np + nout + 2 + 5]):] = np.nan
+    return _outcome(x, ws[:HEADER].tolist())
 
 
 def _tell(progress, steps: int, told: int) -> int:
@@ -323,12 +332,15 @@ def _tell(progress, steps: int, told: int) -> int:
 def dense_many(model, x0: np.ndarray, t: np.ndarray, u: np.ndarray, p: np.ndarray,
                rtol: float, atol: np.ndarray, max_steps: float, stiff_steps: float,
                runs: slice, *, out: tuple[np.ndarray, np.ndarray] | None = None,
-               factor: float | None = None) -> tuple[np.ndarray, np.ndarray] | None:
+               factor: float | None = None,
+               check: bool = True) -> tuple[np.ndarray, np.ndarray] | None:
     """`dense_auto` for the runs ``runs`` of a batch in one compiled loop: ``x0 (K, nx)``,
     ``u (K, max(nu, 1))`` (each run's constant control), ``p (K, max(np, 1))``, all
     C-contiguous; each run's first answer at local tolerance ``factor`` times the requested
     one (None: `FIRST`, as a single call; a batch learns its own,
-    `dynamics.integrate.batch.first_factor`), a retry as in a single call. Returns
+    `dynamics.integrate.batch.first_factor`), a retry as in a single call; ``check`` False:
+    each run's answer alone (as `dense_run`'s; a failed run's outputs past its failure are
+    not written). Returns
     ``(X (r, nx, n), head (r, HEADER))``: the answers and each run's header (`outcome_of`
     reads it); None without a compiled pass. ``out``: C-contiguous ``(X (K, nx, n),
     head (K, HEADER))`` of the whole batch, whose slices ``runs`` the loop fills (and
@@ -353,7 +365,7 @@ def dense_many(model, x0: np.ndarray, t: np.ndarray, u: np.ndarray, p: np.ndarra
         return None
     nout = t.size - 1
     work = _workspace(plan, nout)
-    _fill(work.ws, plan, t, rtol, atol, max_steps, stiff_steps, factor)
+    _fill(work.ws, plan, t, rtol, atol, max_steps, stiff_steps, factor, check)
     r, k0 = runs.stop - runs.start, runs.start
     if out is None:
         X, head, at = np.empty((r, plan.nx, nout + 1)), np.empty((r, HEADER)), 0

@@ -418,11 +418,11 @@ class _CvodesSteps:
 
 
 class _SteppedSteps:
-    """The solution of ``auto``'s step-controlled DOP853 (a non-smooth right-hand side,
-    `dynamics.integrate.stepcontrol`) between the output points: ``sub`` scan points per
+    """The solution of a step-controlled DOP853 run (``method='dop853'``, or ``auto`` on a
+    non-smooth right-hand side: `dynamics.integrate.stepcontrol`) between the output points: ``sub`` scan points per
     output interval (one DOP853 run with step rejection over a block of them from the answer
     at its start), and from any point such a run to any later time, both at the local
-    tolerances ``rtol``, ``atol`` (tighter than those of the answer's runs)."""
+    tolerances ``rtol``, ``atol`` (for ``auto``: tighter than those of the answer's runs)."""
 
     def __init__(self, problem: Problem, rtol, atol, sub: int):
         self.problem, self.sub, self.per_interval = problem, sub, sub
@@ -432,6 +432,8 @@ class _SteppedSteps:
 
     def _run(self, problem: Problem) -> np.ndarray:
         got = self.stepped(problem, self.rtol, self.atol, _STEPPED_MAX)
+        if got is None:  # (no compiled stepper: the same controller from Python)
+            got = run_stepped_callable(problem, self.rtol, self.atol, _STEPPED_MAX)
         run = got[0]
         self.n_steps += run.n_steps
         self.n_rhs += run.n_rhs
@@ -479,10 +481,10 @@ def _stepper(result: SimulationResult, problem: Problem, method: str, rtol, atol
             rtol, atol = max(rtol * _AUTO_CVODES_TIGHTEN, 100 * _EPS), atol * _AUTO_CVODES_TIGHTEN
         sub = min(SUBGRID, max(1, math.ceil(result.n_steps / nint)))
         return _CvodesSteps(problem, rtol, atol, extra, sub)
-    if result.method == "dop853":  # auto on a non-smooth right-hand side
+    if result.method == "dop853":  # method='dop853', or auto on a non-smooth right-hand side
         steps_per = math.ceil(result.n_steps / nint)
-        return _SteppedSteps(problem, max(rtol * _STEPPED_TIGHTEN, LOCAL_RTOL_MIN),
-                             atol * _STEPPED_TIGHTEN,
+        tighten = 1.0 if method == "dop853" else _STEPPED_TIGHTEN  # (auto's: its runs' tol)
+        return _SteppedSteps(problem, max(rtol * tighten, LOCAL_RTOL_MIN), atol * tighten,
                              min(SUBGRID, max(1, steps_per)))
     m = max(1, result.substeps)
     if method != "auto":

@@ -41,6 +41,9 @@ RATE_RTOL = 1e-9
 
 def remedy(method: str) -> str:
     """The advice appended to a violation found in a run of ``method``."""
+    if method == "dop853":
+        return ("the local tolerance of 'dop853' is too loose for this motion: tighten "
+                "`rtol`/`atol` or use method='auto' (a verified tolerance)")
     return (f"the step of {method!r} is too large for this motion: use more `steps` per "
             "output interval or method='auto' (a verified tolerance)")
 

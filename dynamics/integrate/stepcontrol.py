@@ -32,6 +32,7 @@ from __future__ import annotations
 import contextlib
 import math
 from dataclasses import dataclass
+from functools import partial
 
 import casadi as ca
 import numpy as np
@@ -40,6 +41,7 @@ from .. import cache
 from ..interrupts import check_interrupt, deferred_interrupts
 from .adaptive import INTERVALS
 from .cpass import pass_library
+from .dense import dense_run
 from .estimates import initial_step, tightened
 from .evaluate import call_buffered
 from .inputs import Problem
@@ -48,8 +50,9 @@ from .loops import Progress
 from .result import Run
 from .tableaux import DOP853, unique_nodes
 
-__all__ = ["DenseRounding", "LOCAL_RTOL_MIN", "next_step", "run_dense", "run_stepped", "run_stepped_callable",
-           "solve_stepped"]
+__all__ = ["DenseRounding", "LOCAL_RTOL_MIN", "next_step", "plain_answer", "plain_run", "run_dense",
+           "run_dop853",
+           "run_stepped", "run_stepped_callable", "solve_stepped"]
 
 _EPS = float(np.finfo(float).eps)
 #: Most steps of one call of the compiled dense stepper (`run_dense`; interrupts between).
@@ -261,10 +264,11 @@ def _callable_step(model) -> ca.Function:
 
 def run_stepped_callable(problem: Problem, rtol: float, atol: np.ndarray, max_steps: int,
                          *, progress=None, hmax: np.ndarray | None = None):
-    """`run_stepped` for a callable control (``problem.control.mode == 'stages'``): the same
-    controller (`next_step`) stepping from Python, the control called at each step's stage
-    times (a jump of the control shrinks the steps that straddle it, as a kink does)."""
-    model, t, fun = problem.model, problem.t, problem.control.fun
+    """`run_stepped` stepping from Python: for a callable control (``problem.control.mode
+    == 'stages'``, called at each step's stage times: a jump of the control shrinks the
+    steps that straddle it, as a kink does) or any control without a compiled stepper
+    (`Control.at`); the same controller (`next_step`)."""
+    model, t, ctrl = problem.model, problem.t, problem.control
     nx, nint = model.nx, problem.nint
     H = t[1:] - t[:-1]
     hmax = H if hmax is None else hmax
@@ -286,7 +290,7 @@ def run_stepped_callable(problem: Problem, rtol: float, atol: np.ndarray, max_st
             hp = min(h, float(hmax[k]))
             last = tau + 1.01 * hp >= Hk
             hs = Hk - tau if last else hp
-            us = np.concatenate([fun(tk + tau + c * hs) for c in nodes])
+            us = np.concatenate([ctrl.at(tk + tau + c * hs, k, tk, Hk) for c in nodes])
             out = call_buffered(step, [x, np.array([hs]), us, problem.p, rt, atol], (nx + 1,))
             err = float(out[nx]) if np.isfinite(out[:nx]).all() else math.nan
             ok, hn = next_step(hs, err, rejected)
@@ -310,6 +314,90 @@ def run_stepped_callable(problem: Problem, rtol: float, atol: np.ndarray, max_st
         X[:, k + 1] = x
         progress.step(int(count[0] + count[1] - before), (k + 1) / nint)
     return _stepped_run(X, t, count, nint, rtol, False), longest
+
+
+def run_dop853(problem: Problem, rtol: float, atol: np.ndarray, max_steps: int, *,
+               compiled: bool = True, progress=None) -> Run:
+    """``simulate(..., method='dop853')``: ONE DOP853 run at the local tolerances ``rtol``,
+    ``atol``, as scipy's ``solve_ivp(method='DOP853')`` or numbalsoda's ``dop853`` make it:
+    each step's embedded estimate within the tolerance, nothing said of the global error
+    (``auto`` verifies that). Under a control constant over the run, the steps follow the
+    error estimate alone and the outputs come from the continuous extension of order 7
+    (`run_dense`: the work does not grow with the outputs); under a sampled control the
+    steps end on the grid, where the control may kink (`run_stepped`); both compiled C in
+    the model's pass library. A callable control, or ``compiled=False`` (``jit=False``, no
+    C compiler), steps from Python with the same controller (`run_stepped_callable`).
+
+    Returns
+    -------
+    Run
+        ``ok`` False (NaN from the failure on) when a state became non-finite, the step
+        size underflowed or more than ``max_steps`` steps (accepted and rejected) were
+        needed; its message says which and where.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from appdyn.dynamics import rigid_body
+    >>> from appdyn.dynamics.integrate.inputs import Problem, check_u
+    >>> from appdyn.dynamics.integrate.stepcontrol import run_dop853
+    >>> from appdyn.dynamics.truth.torque_free import torque_free_omega
+    >>> model, t = rigid_body([1.5, 2.5, 3.2]), np.linspace(0.0, 60.0, 121)
+    >>> x0 = np.r_[0.0, 0.0, 0.0, 1.0, 0.5, 0.0, 1.0]
+    >>> run = run_dop853(Problem.new(model, x0, t, check_u(None, 3, t), np.zeros(0)),
+    ...                  1e-10, np.full(7, 1e-12), 10**6)
+    >>> w = torque_free_omega([1.5, 2.5, 3.2], x0[4:], t)
+    >>> bool(run.ok and np.abs(run.x[4:] - w).max() < 1e-8)
+    True
+    """
+    ctrl = problem.control
+    if compiled and ctrl.mode == "linear":
+        if _constant(ctrl):
+            run = plain_run(problem.model, problem.x0, problem.t, rtol, atol, max_steps,
+                            u=ctrl.ua[0] if ctrl.ua.shape[0] else None, p=problem.p,
+                            progress=progress)
+            if run is not None:
+                return run
+        got = run_stepped(problem, rtol, atol, max_steps, progress=progress)
+        if got is not None:
+            return got[0]
+    return run_stepped_callable(problem, rtol, atol, max_steps, progress=progress)[0]
+
+
+def plain_run(model, x0: np.ndarray, t: np.ndarray, rtol: float, atol, max_steps: int, *,
+              u=None, p=None, progress=None) -> Run | None:
+    """DOP853's answer alone under a control constant over the run (``u (nu,)``, None:
+    zero), its steps by the error estimate, the outputs from the continuous extension: the
+    compiled call of ``auto``'s dense path without its check (`dense.dense_run` with
+    ``check=False``: the model's plan, the thread's workspace, one ``ctypes`` call). None
+    without the model's compiled pass. As `run_dense` (the same C stepping), with less
+    Python around it."""
+    got = dense_run(model, x0, t, rtol, atol, float(max_steps), math.inf, u=u, p=p,
+                    progress=progress, check=False)
+    return None if got is None else plain_answer(got, t, rtol)
+
+
+def plain_answer(got, t: np.ndarray, rtol: float) -> Run:
+    """The `Run` of DOP853's answer alone (`dense.DenseAuto` ``got`` of ``check=False``) on
+    the grid ``t``: its steps and right-hand-side calls, its message made on first use; a
+    failed run (NaN from the first output it did not reach) says why and where."""
+    steps = got.spent  # (the answer's: accepted and rejected; a failed run's too)
+    n_rhs = DOP853.stages * steps + 4 * got.interpolated
+    if got.result != 2:  # (a failed run: NaN from the first output it did not reach)
+        done = int(np.argmin(np.isfinite(got.x).all(axis=0))) - 1
+        return Run.new(got.x, steps, n_rhs, 0, True, False,
+                       f"dop853: {got.reason} before t = {t[min(done + 1, t.size - 1)]:.6g}")
+    longest = (t[1:] - t[:-1]).max()
+    sub = math.ceil(longest / got.hmin) if got.hmin < math.inf else 1
+    return Run.new(got.x, steps, n_rhs, sub, True, True, partial(_plain_message, got, rtol))
+
+
+def _plain_message(got, rtol: float) -> str:
+    """The message of `plain_run`'s answer (made when the result's message is read)."""
+    return (f"dop853 with dense output: {got.answer_steps - got.rejected} steps, "
+            f"{got.rejected} rejected, smallest step {got.hmin:.3g} s (local rtol {rtol:.3g}), "
+            f"{got.interpolated} steps interpolated; global error not estimated "
+            "(method='auto' verifies it)")
 
 
 def solve_stepped(problem: Problem, rtol: float, atol: np.ndarray, max_steps: int,

@@ -59,7 +59,7 @@ def add_parser(subparsers):
     tf.add_argument("--t-final", type=_positive, default=50.0, help="final time [s] (50)")
     tf.add_argument("--points", type=_integer(2), default=1001, help="output points (1001)")
     tf.add_argument("--method", default="auto",
-                    choices=["auto", "cvodes", *FIXED_STEP], help="integrator (auto)")
+                    choices=["auto", "dop853", "cvodes", *FIXED_STEP], help="integrator (auto)")
     tf.add_argument("--steps", type=_integer(1),
                     help="steps per output interval, fixed-step methods only (1)")
     tf.add_argument("--rtol", type=_positive, default=1e-10,

@@ -470,4 +470,4 @@ def test_callable_u_errors_propagate_from_cvodes():
 
 
 def test_methods_constant_lists_every_method():
-    assert set(METHODS) == {"auto", "cvodes", "rk4", "rk8", "lie"}
+    assert set(METHODS) == {"auto", "dop853", "cvodes", "rk4", "rk8", "lie"}

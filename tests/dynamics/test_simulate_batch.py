@@ -39,12 +39,12 @@ def test_every_run_of_a_torque_free_batch_meets_the_jacobi_truth(method, kw, tol
         assert np.all(res.status == 0)
 
 
-@pytest.mark.parametrize("method", ["rk8", "rk4", "lie", "cvodes"])
+@pytest.mark.parametrize("method", ["rk8", "rk4", "lie", "cvodes", "dop853"])
 def test_a_batch_equals_its_runs_one_by_one(method):
     t = np.linspace(0.0, 5.0, 11)
     _, X0 = _rates(5, seed=1)
     model = rigid_body(INERTIA)
-    kw = {} if method == "cvodes" else {"steps": 3}
+    kw = {} if method in ("cvodes", "dop853") else {"steps": 3}
     res = simulate(model, X0, t, method=method, **kw)
     for k in range(5):
         one = simulate(model, X0[:, k], t, method=method, **kw)

@@ -288,7 +288,7 @@ def test_callable_control_event(method, kwargs):
     assert res.sample(res.t).shape == (2, res.t.size)
 
 
-@pytest.mark.parametrize("method", ["auto", "rk8", "cvodes"])
+@pytest.mark.parametrize("method", ["auto", "rk8", "cvodes", "dop853"])
 def test_an_event_on_the_control_and_the_parameters(method):
     # y'' = -w^2 y with w = p = 2 from (1, 0): y = cos 2t; u = t / 4 sampled on the grid.
     # g1 = u - 0.3 crosses at t = 1.2; g2 = y - p / 4 (y = 1/2) at t = pi / 6
@@ -298,7 +298,8 @@ def test_an_event_on_the_control_and_the_parameters(method):
     model = Model(f=f, states=("y", "v"), controls=("u",), params=("w",), p_default=[2.0])
     on_u = Event(ca.Function("on_u", [T_SYM, x, u, p], [u[0] - 0.3]))
     t = np.linspace(0.0, 2.0, 3)
-    kwargs = {"auto": {}, "rk8": {"steps": 20}, "cvodes": {"rtol": 1e-12, "atol": 1e-12}}[method]
+    kwargs = {"auto": {}, "rk8": {"steps": 20}, "cvodes": {"rtol": 1e-12, "atol": 1e-12},
+              "dop853": {"rtol": 1e-12, "atol": 1e-12}}[method]
     res = simulate(model, [1.0, 0.0], t, u=(t / 4)[None, :], method=method,
                    events=[on_u, lambda t, x, u, p: x[0] - p[0] / 4], **kwargs)
     assert abs(res.t_events[0][0] - 1.2) < 1e-13 and res.t_events[0].size == 1
