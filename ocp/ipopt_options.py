@@ -169,22 +169,32 @@ def load_ipopt() -> bool:
     >>> load_ipopt()
     True
     """
-    return cache.get(("ocp.ipopt-plugin",), _load_plugin)
+    # (held here, not in `dynamics.cache`: a plugin stays loaded for the process, and
+    # loading it again after `clear_caches` made casadi print "Solver ipopt is already in
+    # use. Ignored." on stderr)
+    return _PLUGIN[0] if _PLUGIN else _load_plugin()
+
+
+#: Whether `load_ipopt` loaded the plugin (its one entry), once per process.
+_PLUGIN: list = []
 
 
 def _load_plugin() -> bool:
     with cache.construction_lock():
+        if _PLUGIN:  # (another thread loaded it meanwhile)
+            return _PLUGIN[0]
         unset = "OPENBLAS_NUM_THREADS" not in os.environ
         if unset:
             os.environ["OPENBLAS_NUM_THREADS"] = str(IPOPT_BLAS_THREADS)
         try:
             ca.load_nlpsol("ipopt")
-            return True
+            _PLUGIN.append(True)
         except RuntimeError:  # no IPOPT in this CasADi: the solver's own error says so
-            return False
+            _PLUGIN.append(False)
         finally:
             if unset:
                 del os.environ["OPENBLAS_NUM_THREADS"]
+        return _PLUGIN[0]
 
 
 def ipopt_solver(name: str, nlp: dict, options: dict) -> ca.Function:

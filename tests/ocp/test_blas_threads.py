@@ -44,3 +44,23 @@ def test_openblas_num_threads_of_the_user_is_kept():
     assert int(after) > int(before)  # OpenBLAS started its thread: the user's choice holds
     assert float(x) == pytest.approx(2.0, abs=1e-8)
     assert left == "2"
+
+
+def test_clear_caches_does_not_load_the_plugin_again():
+    """The plugin is loaded once per process: a solve after `clear_caches` prints nothing
+    (casadi said "Solver ipopt is already in use. Ignored." on stderr when it was asked to
+    load it again)."""
+    script = (
+        "import casadi as ca\n"
+        "from appdyn.dynamics import clear_caches\n"
+        "from appdyn.ocp.ipopt_options import ipopt_solver\n"
+        "x = ca.SX.sym('x')\n"
+        "for _ in range(2):\n"
+        "    s = ipopt_solver('s', {'x': x, 'f': (x - 2) ** 2},\n"
+        "                     {'print_time': False, 'ipopt': {'print_level': 0, 'sb': 'yes'}})\n"
+        "    print(float(s(x0=0)['x']))\n"
+        "    clear_caches()\n")
+    out = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True,
+                         timeout=120, check=True)
+    assert [float(v) for v in out.stdout.split()] == pytest.approx([2.0, 2.0], abs=1e-8)
+    assert "already in use" not in out.stderr, out.stderr
