@@ -7,7 +7,9 @@ check and verdict.
 
 The rules (as `dynamics.integrate.auto.dense_pass` states them): the answer runs at the
 local tolerance ``(rtol, atol) f`` (``f = FIRST``, at least the factor that keeps it one ulp
-above the states' size); its check is Richardson's on the answer's
+above the states' size), in at least 12 steps (no step longer than a twelfth of the run:
+on fewer, longer steps the check below is blind to the error of the answer's continuous
+extension, `cpass` ``RI_STEPS_MIN``); its check is Richardson's on the answer's
 own steps: alongside the answer, each pair of its accepted steps is taken again as one
 step of their sum (a lone last step alone), no step rejected, the outputs from that step's
 continuous extension (about half the answer's steps). ``d`` is their scaled difference (max
@@ -160,7 +162,7 @@ def _plan(model) -> _Plan | None:
 
 def _size(plan: _Plan, nout: int) -> int:
     """Doubles of the workspace (``AU_SIZE`` of `cpass._AUTO`)."""
-    return HEADER + 7 * plan.nx + plan.nu + plan.np + nout + 16
+    return HEADER + 7 * plan.nx + plan.nu + plan.np + nout + 17
 
 
 _LOCAL = threading.local()

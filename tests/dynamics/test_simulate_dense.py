@@ -273,7 +273,8 @@ def test_later_rounds_of_a_batch_answer_first_at_the_factor_learned_before(monke
     covered = sorted(k for runs, _ in seen for k in range(runs.start, runs.stop))
     assert covered == list(range(80))
     first = {k0 for k0, _ in rounds[0]}
-    assert all((f == dense.FIRST) == (runs.start in first) for runs, f in seen)
+    assert all(f == dense.FIRST for runs, f in seen if runs.start in first)
+    assert all(f <= dense.FIRST for _, f in seen)  # (never looser than a single call's)
     w = np.stack([torque_free_omega(INERTIA, x0[4:, k], t) for k in range(80)], axis=2)
     assert np.all(np.abs(res.x[4:] - w) <= 1e-10 + 1e-8 * np.abs(w))
     for runs, factor in seen[::4]:
@@ -306,7 +307,8 @@ def test_each_round_of_a_batch_draws_from_every_part_of_it():
 
 def test_first_factor_weighs_over_delivery_against_retries():
     """`batch.first_factor`: runs far inside their acceptance loosen the factor (at most
-    `REACH` beyond where they were measured, never past 1), runs accepted only at a tighter
+    `REACH` beyond where they were measured, never past a single call's `dense.FIRST`: the
+    check's Richardson ratio is that call's), runs accepted only at a tighter
     factor bring it there (never below the local rtol floor), a lone chaotic run among regular ones retries alone
     (the factor is the regular runs'), while a tail of hard runs tightens it."""
     from appdyn.dynamics.integrate.batch import REACH, first_factor
@@ -321,8 +323,10 @@ def test_first_factor_weighs_over_delivery_against_retries():
     base = choose(regular)
     assert np.isclose(10.0 ** (np.arange(-8, 9) / 8.0), base / 0.003).any()  # (on the grid)
     assert 0.003 / REACH <= base <= 0.003 * REACH
-    assert choose([1e-4] * 20) == pytest.approx(0.003 * REACH)  # (no further than measured)
-    assert 0.5 < choose([1e-4] * 20, current=0.5) <= 1.0
+    assert choose([1e-4] * 20, current=3e-4) == pytest.approx(3e-4 * REACH)  # (no further
+    assert choose([1e-4] * 20, current=1e-5) == pytest.approx(1e-5 * REACH)  # than measured)
+    assert choose([1e-4] * 20) == pytest.approx(0.003)  # (no looser than a single call's)
+    assert choose([1e-4] * 20, current=0.5) == pytest.approx(0.003)
     # runs accepted only after retries, at 1e-5 with estimates 0.4: there, with a margin
     assert 0.3e-5 <= choose([0.4] * 20, at=1e-5) <= 1e-5
     assert choose([0.4] * 20, at=2e-5, rtol=1e-10) >= LOCAL_RTOL_MIN / 1e-10  # (the floor)
