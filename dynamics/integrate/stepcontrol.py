@@ -51,8 +51,7 @@ from .result import Run
 from .tableaux import DOP853, unique_nodes
 
 __all__ = ["DenseRounding", "LOCAL_RTOL_MIN", "next_step", "plain_answer", "plain_run", "run_dense",
-           "run_dop853",
-           "run_stepped", "run_stepped_callable", "solve_stepped"]
+           "run_dop853", "run_stepped", "run_stepped_callable", "solve_stepped"]
 
 _EPS = float(np.finfo(float).eps)
 #: Most steps of one call of the compiled dense stepper (`run_dense`; interrupts between).
@@ -323,7 +322,7 @@ def run_dop853(problem: Problem, rtol: float, atol: np.ndarray, max_steps: int, 
     each step's embedded estimate within the tolerance, nothing said of the global error
     (``auto`` verifies that). Under a control constant over the run, the steps follow the
     error estimate alone and the outputs come from the continuous extension of order 7
-    (`run_dense`: the work does not grow with the outputs); under a sampled control the
+    (`plain_run`: the work does not grow with the outputs); under a sampled control the
     steps end on the grid, where the control may kink (`run_stepped`); both compiled C in
     the model's pass library. A callable control, or ``compiled=False`` (``jit=False``, no
     C compiler), steps from Python with the same controller (`run_stepped_callable`).
