@@ -1,5 +1,5 @@
-"""Per-step cost of appdyn's compiled DOP853 (`cpass._DENSE` ``rk8_dense``, no check run, no
-outputs but the end) against numbalsoda's ``dop853`` on the same casadi-generated C
+"""Per-step cost of appdyn's compiled DOP853 (`stepcontrol.plain_run`: `cpass._DENSE`, no
+check run, no outputs but the end) against numbalsoda's ``dop853`` on the same casadi-generated C
 right-hand side (`integrate_peers.peer_library`, which counts the peer's rhs calls), on
 long runs at a fixed tolerance (10,000+ steps): the torque-free body and the wheel
 spacecraft. Reports steps, rhs evaluations and time per step [us] on both sides (the least of
@@ -20,8 +20,7 @@ from pathlib import Path
 import numpy as np
 
 from appdyn.dynamics import rigid_body
-from appdyn.dynamics.integrate.inputs import Problem, check_u
-from appdyn.dynamics.integrate.stepcontrol import run_dense
+from appdyn.dynamics.integrate.stepcontrol import plain_run
 
 from _common import Row, script_main, timed, write_csv
 from integrate_peers import peer_library
@@ -46,11 +45,10 @@ def cases(quick: bool):
 
 def appdyn_side(model, x0, horizon, repeats):
     t = np.array([0.0, horizon])
-    problem = Problem.new(model, x0, t, check_u(None, model.nu, t), np.zeros(model.np))
     atol = np.full(model.nx, RTOL / 100)
 
     def go():
-        return run_dense(problem, RTOL, atol, 10**7)[0]
+        return plain_run(model, x0, t, RTOL, atol, 10**7)
 
     run = go()
     return run, min(timed(go, repeats)[1])
@@ -68,8 +66,7 @@ def peer_side(lib, x0, horizon, repeats):
 def dense_states(model, x0, t, rtol):
     """DOP853 with dense output at local tolerance ``rtol`` (``atol = rtol / 100``), no
     check: the states (nx, t.size)."""
-    problem = Problem.new(model, x0, t, check_u(None, model.nu, t), np.zeros(model.np))
-    return run_dense(problem, rtol, np.full(model.nx, rtol / 100), 10**8)[0].x
+    return plain_run(model, x0, t, rtol, np.full(model.nx, rtol / 100), 10**8).x
 
 
 def hinged_divergence() -> list[Row]:
@@ -109,9 +106,9 @@ def run(quick: bool, out: Path) -> list[Row]:
             ta = min(ta, appdyn_side(model, x0, horizon, repeats)[1])
             p3 = peer_side(lib, x0, horizon, repeats)
             steps = mine.n_steps  # (accepted and rejected)
-            d = dict(workload=name, horizon=horizon, rtol=RTOL, solver="appdyn rk8_dense",
+            d = dict(workload=name, horizon=horizon, rtol=RTOL, solver="appdyn dop853 (plain_run)",
                      steps=steps, rhs=mine.n_rhs, time=ta, us_per_step=ta / steps * 1e6,
-                     message=mine.message)
+                     message=mine.message if isinstance(mine.message, str) else mine.message())
             detail.append(d)
             rows.append(Row("step_cost", name, "appdyn time per step", d["us_per_step"], "us",
                             f"{steps} steps, {mine.n_rhs} rhs, {ta * 1e3:.3g} ms"))

@@ -24,7 +24,7 @@ The public entry points are `dynamics.simulate`, `dynamics.SimulationResult`,
 ``sanity``       fixed-step runs checked against the model's invariants (status 4)
 ``smoothness``   the non-smooth operations (kinks, jumps) of a model's expression graph
 ``stepcontrol``  DOP853 with step rejection for non-smooth right-hand sides, and stepping
-                 by its error estimate alone with dense output (`stepcontrol.run_dense`)
+                 by its error estimate alone with dense output (`stepcontrol.plain_run`)
 ``dense``        ``auto`` for a smooth right-hand side under a constant control in ONE
                  compiled call: the dense-output answer, its check and the verdict
                  (`dense.dense_auto`); a batch's runs in one compiled loop, each with its

@@ -374,7 +374,7 @@ def one_pass(problem: Problem, rtol, atol, max_steps, jit_pref, progress):
 def dense_pass(problem: Problem, rtol, atol, max_steps, progress):
     """``auto`` for a smooth right-hand side under a control constant over the run: DOP853
     stepping by its error estimate alone, the outputs filled from its continuous extension
-    (`stepcontrol.run_dense`), so the work follows the solution, not the output grid; the
+    (`stepcontrol.plain_run`), so the work follows the solution, not the output grid; the
     answer, its check (its steps merged in pairs), their comparison and the verdict in
     one compiled call (`dense.dense_auto`, whose docstring states the rules).
     Returns ``(run, estimate, status, spent)``: status ``OK`` (verified), ``ROUNDOFF`` (not

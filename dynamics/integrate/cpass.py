@@ -310,8 +310,8 @@ int rk8_adaptive(casadi_real* x, casadi_real* hio, int nint, const casadi_real* 
 """
 
 
-# DOP853 stepping by its error estimate alone, for a control constant over the run (used by
-# `dynamics.integrate.stepcontrol.run_dense`): the output times never cut a step (but the
+# DOP853 stepping by its error estimate alone, for a control constant over the run (`dense_run`,
+# called by `_AUTO`): the output times never cut a step (but the
 # last of each call); an output inside a step is filled from the step's continuous
 # extension of order 7 (`rk8_cont`, four more right-hand sides, only on such a step), as
 # Hairer's DOP853 with dense output does.
@@ -503,16 +503,6 @@ static int dense_run(casadi_real* x, casadi_real* t, casadi_real* hio, int nout,
   count[6] = rejected;
   return j;
 }
-
-/* `dense_run` without the check (`stepcontrol.run_dense`) */
-int rk8_dense(casadi_real* x, casadi_real* t, casadi_real* hio, int nout,
-              const casadi_real* ts, const casadi_real* u, const casadi_real* p,
-              casadi_real rtol, const casadi_real* atol, casadi_real max_steps,
-              casadi_real* X, int ldx, casadi_real* count, int budget,
-              casadi_real stiff_steps) {
-  return dense_run(x, t, hio, nout, ts, u, p, rtol, atol, max_steps, X, ldx, count, budget,
-                   stiff_steps, NULL, NULL);
-}
 """
 
 
@@ -527,7 +517,7 @@ _AUTO = r"""
 #define AU_FACTOR 1   /* in/out: the answer's local tolerance over the requested one */
 #define AU_LOOSE 2    /* in/out: the check run's */
 #define AU_MAXSTEPS 3 /* in: most steps of all runs */
-#define AU_STIFF 4    /* in: `rk8_dense`'s stiff_steps */
+#define AU_STIFF 4    /* in: `dense_run`'s stiff_steps */
 #define AU_T0 5       /* in: the start time */
 #define AU_IQ 6       /* in: index of the attitude quaternion, -1: none */
 #define AU_TRIES 7    /* in: answer-check pairs at most; 0: the answer alone at the local
@@ -542,7 +532,7 @@ _AUTO = r"""
                          run failed */
 #define AU_EST 13     /* the error estimate [tolerances] */
 #define AU_D 14       /* the scaled difference of the answer and the check run */
-#define AU_FLAG 15    /* `rk8_dense`'s flag of a failed run */
+#define AU_FLAG 15    /* `dense_run`'s flag of a failed run */
 #define AU_TRY 16     /* answers made */
 #define AU_ACC 17     /* the answer's accepted steps */
 #define AU_REJ 18     /* its rejected steps */
@@ -966,11 +956,6 @@ def pass_library(model: Model) -> object | None:
                             i32, ptr, ptr]
         stepper.restype = i32
         fun.stepper = stepper  # (`dynamics.integrate.stepcontrol`)
-        dense = lib.rk8_dense
-        dense.argtypes = [ptr, ptr, ptr, i32, ptr, ptr, ptr, f64, ptr, f64, ptr, i32, ptr, i32,
-                          f64]
-        dense.restype = i32
-        fun.dense = dense  # (`dynamics.integrate.stepcontrol.run_dense`)
         auto = lib.rk8_auto
         auto.argtypes = [ptr, i32, i32, ptr, ptr]
         auto.restype = i32

@@ -149,7 +149,9 @@ class SimulationResult(Result):
         (``auto`` makes several).
     substeps : int
         Fixed-step methods: steps per output interval of the returned solution (``auto``'s
-        one-pass path: the most in any interval); 0 for cvodes and ``dop853``.
+        one-pass path: the most in any interval); a run with dense output (``auto`` or
+        ``dop853`` under a constant control): the longest output interval over its smallest
+        step, a bound the event search steps with, not a step count; 0 for cvodes.
     error_estimate : float
         ``auto``: estimated max over states and output times of ``|error| / (atol + rtol
         |x|)`` (1.0 is exactly the tolerance), for every path (rk8, cvodes on a stiff
@@ -266,12 +268,16 @@ class SimulationResult(Result):
         }
 
     def __str__(self) -> str:
+        # (a dense-output run's ``substeps`` bounds its steps per interval for the event
+        # search; its steps follow the error, so the report gives its step count alone)
+        per = self.substeps and "dense output" not in self.message
         rows = [("success", f"{self.success} (status {self.status})"),
                 ("method", f"{self.method}" + (f", {self.substeps} step(s) per interval"
-                                               if self.substeps else "")),
+                                               if per else "")),
                 ("grid", f"{self.t.size} points, t = {self.t[0]:g} .. {self.t[-1]:g} s"),
                 ("steps / rhs", f"{self.n_steps} / {self.n_rhs}"),
-                ("error estimate", f"{self.error_estimate:.3g} of tolerance"),
+                ("error estimate", f"{self.error_estimate:.3g} of tolerance"
+                 if math.isfinite(self.error_estimate) else "not estimated (method='auto' does)"),
                 ("wall time", f"{1e3 * self.wall_time:.3f} ms"),
                 ("message", self.message)]
         if self.impacts is not None:

@@ -31,7 +31,6 @@ from __future__ import annotations
 
 import contextlib
 import math
-from dataclasses import dataclass
 from functools import partial
 
 import casadi as ca
@@ -41,7 +40,7 @@ from .. import cache
 from ..interrupts import check_interrupt, deferred_interrupts
 from .adaptive import INTERVALS
 from .cpass import pass_library
-from .dense import dense_run
+from .dense import constant_control, dense_run
 from .estimates import initial_step, tightened
 from .evaluate import call_buffered
 from .inputs import Problem
@@ -50,12 +49,10 @@ from .loops import Progress
 from .result import Run
 from .tableaux import DOP853, unique_nodes
 
-__all__ = ["DenseRounding", "LOCAL_RTOL_MIN", "next_step", "plain_answer", "plain_run", "run_dense",
-           "run_dop853", "run_stepped", "run_stepped_callable", "solve_stepped"]
+__all__ = ["LOCAL_RTOL_MIN", "next_step", "plain_answer", "plain_run", "run_dop853",
+           "run_stepped", "run_stepped_callable", "solve_stepped"]
 
 _EPS = float(np.finfo(float).eps)
-#: Most steps of one call of the compiled dense stepper (`run_dense`; interrupts between).
-_DENSE_BUDGET = 4096
 
 _FIRST = 0.1      # the first run's local tolerance, relative to the requested one
 _TIGHTEN = 1e-2   # the local tolerance of each further run, relative to the one before
@@ -108,103 +105,6 @@ def run_stepped(problem: Problem, rtol: float, atol: np.ndarray, max_steps: int,
             progress.step(int(count[0] + count[1] - before), done / nint)
     X[:, 1:done + 1] = out[:, :done]
     return _stepped_run(X, t, count, done, rtol, True), longest
-
-
-def run_dense(problem: Problem, rtol: float, atol: np.ndarray, max_steps: int,
-              *, progress=None,
-              stiff_steps: float = math.inf) -> tuple[Run, "DenseRounding"] | None:
-    """One DOP853 run at the local tolerances ``rtol``, ``atol`` whose steps follow its
-    error estimate alone (`cpass._DENSE`): the output grid never cuts a step, the outputs
-    inside a step come from its continuous extension of order 7 (as Hairer's DOP853 with
-    dense output), so the work does not grow with the number of outputs. For a control
-    constant over the run; None otherwise or without the model's compiled library
-    (`cpass.pass_library`). Returns ``(run, rounding)``: the run's message gives the steps,
-    rejections, the steps that filled outputs and the smallest step; `DenseRounding` what
-    was measured of the model's rounding on the way. ``stiff_steps``: no step is taken (the
-    run fails, "stiff" in its message) when the first step's Lipschitz estimate ``L`` says
-    that stability alone needs more than that many steps (``L T / 6``, ``T`` the horizon).
-    The run's ``substeps`` is the longest output interval over the smallest step taken
-    (but a last one cut short): equal steps of that many per interval are no longer than
-    any the run took (`dynamics.integrate.events` re-integrates with them).
-
-    Examples
-    --------
-    >>> import numpy as np
-    >>> from appdyn.dynamics import rigid_body
-    >>> from appdyn.dynamics.integrate.inputs import Problem, check_u
-    >>> from appdyn.dynamics.integrate.stepcontrol import run_dense
-    >>> from appdyn.dynamics.truth.torque_free import torque_free_omega
-    >>> model, t = rigid_body([1.5, 2.5, 3.2]), np.linspace(0.0, 60.0, 121)
-    >>> x0 = np.r_[0.0, 0.0, 0.0, 1.0, 0.5, 0.0, 1.0]
-    >>> problem = Problem.new(model, x0, t, check_u(None, 3, t), np.zeros(0))
-    >>> run, _ = run_dense(problem, 1e-10, np.full(7, 1e-12), 10**6)
-    >>> w = torque_free_omega([1.5, 2.5, 3.2], x0[4:], t)
-    >>> bool(run.ok and np.abs(run.x[4:] - w).max() < 1e-8 and run.n_steps < 240)
-    True
-    """
-    lib = pass_library(problem.model)
-    ctrl = problem.control
-    if lib is None or ctrl.mode != "linear" or not _constant(ctrl):
-        return None
-    model, t = problem.model, problem.t
-    nx, nu, nout = model.nx, model.nu, problem.nint
-    # one workspace: x, t, h, u, p, atol, count (8 + nx), output times; X the outputs
-    np_ = problem.p.size
-    ws = np.empty(3 * nx + nu + np_ + 10 + nout)
-    ws[:nx] = problem.x0
-    ws[nx:nx + 2] = (t[0], 0.0)  # (h 0: the C code's first step)
-    o = nx + 2
-    ws[o:o + nu] = ctrl.ua[0] if ctrl.ua.shape[0] else 0.0
-    ws[o + nu:o + nu + np_] = problem.p
-    o += nu + np_
-    ws[o:o + nx] = atol
-    count = ws[o + nx:o + 2 * nx + 8]
-    count[:] = 0.0
-    count[3] = math.inf
-    ws[o + 2 * nx + 8:] = t[1:]
-    X = np.empty((nx, nout + 1))
-    X[:, 0] = problem.x0
-    base, xb = ws.ctypes.data, X.ctypes.data
-    args = (base, base + 8 * nx, base + 8 * (nx + 1), nout, base + 8 * (o + 2 * nx + 8),
-            base + 16 + 8 * nx, base + 8 * (nx + 2 + nu), rtol, base + 8 * o,
-            float(max_steps), xb + 8, nout + 1, base + 8 * (o + nx), _DENSE_BUDGET,
-            float(stiff_steps))
-    done = lib.dense(*args)
-    if done < nout and not count[2]:  # (a long run: interrupts checked between calls)
-        progress = Progress(None) if progress is None else progress
-        with deferred_interrupts():
-            while done < nout and not count[2]:
-                check_interrupt()
-                before = count[0] + count[1]
-                done = lib.dense(*args)
-                progress.step(int(count[0] + count[1] - before), done / nout)
-    if done < nout:
-        X[:, done + 1:] = np.nan
-    run = _stepped_run(X, t, count, done, rtol, True)
-    if run.ok:
-        longest = float(np.max(t[1:] - t[:-1]))
-        sub = math.ceil(longest / count[3]) if count[3] < math.inf else 1
-        run = Run(run.x, run.n_steps, run.n_rhs + 4 * int(count[4]), sub, True, True,
-                  run.message.replace("dop853 with step rejection", "dop853 with dense output")
-                  + f", {int(count[4])} steps interpolated")
-    return run, DenseRounding(float(count[7]), count[8:])
-
-
-@dataclass(frozen=True)
-class DenseRounding:
-    """What `run_dense` measured on the way: ``lipschitz`` [1/s], the first step's estimate
-    ``|f(x + h f) - f| / (h |f|)`` (scaled norms), and ``noise (nx,)``, the largest change
-    of each component of ``f`` when the state moves by one ulp (every 8th step)."""
-
-    lipschitz: float
-    noise: np.ndarray
-
-
-def _constant(ctrl) -> bool:
-    """Whether the linear control ``ctrl`` is one value over the whole run."""
-    if ctrl.constant or ctrl.ua.size == 0:
-        return True
-    return bool(np.all(ctrl.ua == ctrl.ua[0]) and np.all(ctrl.ub == ctrl.ua[0]))
 
 
 def _first_step(problem: Problem, rtol: float, atol: np.ndarray) -> float:
@@ -351,7 +251,7 @@ def run_dop853(problem: Problem, rtol: float, atol: np.ndarray, max_steps: int, 
     """
     ctrl = problem.control
     if compiled and ctrl.mode == "linear":
-        if _constant(ctrl):
+        if constant_control(ctrl):
             run = plain_run(problem.model, problem.x0, problem.t, rtol, atol, max_steps,
                             u=ctrl.ua[0] if ctrl.ua.shape[0] else None, p=problem.p,
                             progress=progress)
@@ -369,8 +269,24 @@ def plain_run(model, x0: np.ndarray, t: np.ndarray, rtol: float, atol, max_steps
     zero), its steps by the error estimate, the outputs from the continuous extension: the
     compiled call of ``auto``'s dense path without its check (`dense.dense_run` with
     ``check=False``: the model's plan, the thread's workspace, one ``ctypes`` call). None
-    without the model's compiled pass. As `run_dense` (the same C stepping), with less
-    Python around it."""
+    without the model's compiled pass. The run's ``substeps`` is the longest output interval
+    over the smallest step taken (but a last one cut short): equal steps of that many per
+    interval are no longer than any the run took (`dynamics.integrate.events` re-integrates
+    with them).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from appdyn.dynamics import rigid_body
+    >>> from appdyn.dynamics.integrate.stepcontrol import plain_run
+    >>> from appdyn.dynamics.truth.torque_free import torque_free_omega
+    >>> model, t = rigid_body([1.5, 2.5, 3.2]), np.linspace(0.0, 60.0, 121)
+    >>> x0 = np.r_[0.0, 0.0, 0.0, 1.0, 0.5, 0.0, 1.0]
+    >>> run = plain_run(model, x0, t, 1e-10, np.full(7, 1e-12), 10**6)
+    >>> w = torque_free_omega([1.5, 2.5, 3.2], x0[4:], t)
+    >>> bool(run.ok and np.abs(run.x[4:] - w).max() < 1e-8 and run.n_steps < 240)
+    True
+    """
     got = dense_run(model, x0, t, rtol, atol, float(max_steps), math.inf, u=u, p=p,
                     progress=progress, check=False)
     return None if got is None else plain_answer(got, t, rtol)

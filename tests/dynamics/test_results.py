@@ -26,6 +26,31 @@ def test_to_dict_and_json_hold_the_trajectory_by_name():
     assert "success" in str(res) and res.message in str(res)
 
 
+def _report_rows(res) -> dict:
+    """The rows of ``str(res)``: label -> text."""
+    rows = {}
+    for line in str(res).splitlines()[1:]:
+        label, _, text = line.strip().partition("  ")
+        rows[label] = text.strip()
+    return rows
+
+
+def test_report_says_steps_per_interval_only_where_the_grid_sets_them():
+    """A dense-output run's steps follow its error, not the grid: its report gives its step
+    count, never the event search's bound (``substeps``, 549 "per interval" for 46 steps on
+    one 10 s interval before); a fixed-step run's report gives its steps per interval. An
+    unverified run's estimate reads "not estimated", not "nan of tolerance"."""
+    model, x0 = rigid_body([1.0, 2.0, 3.0]), [0, 0, 0, 1, 1.0, 0.1, 0.8]
+    dense = simulate(model, x0, [0.0, 10.0])
+    assert "dense output" in dense.message and dense.substeps > dense.n_steps
+    rows = _report_rows(dense)
+    assert rows["method"] == "rk8" and rows["steps / rhs"] == f"{dense.n_steps} / {dense.n_rhs}"
+    fixed = _report_rows(simulate(model, x0, np.linspace(0.0, 10.0, 11), method="rk8", steps=20))
+    assert fixed["method"] == "rk8, 20 step(s) per interval"
+    plain = _report_rows(simulate(model, x0, [0.0, 10.0], method="dop853"))
+    assert plain["method"] == "dop853" and plain["error estimate"].startswith("not estimated")
+
+
 def test_failed_run_serializes_non_finite_as_null():
     res = simulate(rigid_body([1.0, 2.0, 3.0]), [0, 0, 0, 1, 1.0, 0.1, 0.8],
                    np.linspace(0.0, 1e4, 3), method="rk8")

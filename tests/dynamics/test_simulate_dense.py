@@ -1,4 +1,4 @@
-"""DOP853 with dense output (`stepcontrol.run_dense`, `auto.dense_pass`): the continuous
+"""DOP853 with dense output (`stepcontrol.plain_run`, `auto.dense_pass`): the continuous
 extension's order, steps chosen by the error estimate and not by the output grid, and the
 global tolerance delivered (not exceeded by orders of magnitude) against closed forms."""
 import numpy as np
@@ -7,7 +7,7 @@ import pytest
 from appdyn.dynamics import rigid_body, simulate
 from appdyn.dynamics.integrate.inputs import Problem, check_u
 from appdyn.dynamics.integrate.kernels import dense_kernels, kernel
-from appdyn.dynamics.integrate.stepcontrol import run_dense
+from appdyn.dynamics.integrate.stepcontrol import plain_run
 from appdyn.dynamics.truth import axisymmetric
 from appdyn.dynamics.truth.torque_free import torque_free_omega
 
@@ -56,7 +56,7 @@ def test_steps_follow_the_error_not_the_grid(rtol):
     runs = {}
     for n in (121, 1201, 2):
         t = np.linspace(0.0, 60.0, n)
-        run, _ = run_dense(_problem(model, X0, t), rtol, np.full(7, rtol * 1e-2), 10 ** 6)
+        run = plain_run(model, X0, t, rtol, np.full(7, rtol * 1e-2), 10 ** 6)
         assert run.ok
         w = torque_free_omega(INERTIA, X0[4:], t)
         assert np.abs(run.x[4:] - w).max() < 10 * rtol
@@ -127,8 +127,8 @@ def test_the_check_verifies_a_chaotic_run_while_it_is_determined():
     problem = _problem(model, x0, t)
     got = dense_auto(problem, rtol, np.full(3, rtol / 100), 1e8, 1e6)
     assert got.result == 1
-    ref, _ = run_dense(problem, 1e-5 * rtol * got.factor, np.full(3, 1e-7 * rtol * got.factor),
-                       10 ** 8)
+    ref = plain_run(model, x0, t, 1e-5 * rtol * got.factor, np.full(3, 1e-7 * rtol * got.factor),
+                    10 ** 8)
     scaled = np.max(np.abs(got.x[:, 1:] - ref.x[:, 1:]) / (rtol / 100 + rtol * np.abs(ref.x[:, 1:])))
     assert scaled <= min(1.0, got.estimate), (scaled, got.estimate)
 
@@ -140,8 +140,8 @@ def test_the_check_refuses_a_chaotic_answer_double_precision_cannot_give():
     does not call its answer verified, nor does ``simulate`` report success."""
     from appdyn.dynamics.integrate.dense import dense_auto
     model, t, x0, rtol = _lorenz(), np.linspace(0.0, 40.0, 41), np.ones(3), 1e-6
-    a, _ = run_dense(_problem(model, x0, t), 1e-13, np.full(3, 1e-15), 10 ** 8)
-    b, _ = run_dense(_problem(model, x0 * (1 + 2.3e-16), t), 1e-13, np.full(3, 1e-15), 10 ** 8)
+    a = plain_run(model, x0, t, 1e-13, np.full(3, 1e-15), 10 ** 8)
+    b = plain_run(model, x0 * (1 + 2.3e-16), t, 1e-13, np.full(3, 1e-15), 10 ** 8)
     assert np.max(np.abs(a.x - b.x) / (rtol / 100 + rtol * np.abs(a.x))) > 1.0
     got = dense_auto(_problem(model, x0, t), rtol, np.full(3, rtol / 100), 1e8, 1e6)
     assert got.result != 1
@@ -176,8 +176,9 @@ def test_varying_control_keeps_the_grid_paths():
     t = np.linspace(0.0, 10.0, 11)
     u = np.zeros((3, 11))
     u[0] = np.linspace(0.0, 0.1, 11)
-    assert run_dense(_problem(model, X0, t).__class__.new(
-        model, X0, t, check_u(u, 3, t), np.zeros(0)), 1e-8, np.full(7, 1e-10), 10 ** 6) is None
+    from appdyn.dynamics.integrate.dense import dense_auto
+    varying = Problem.new(model, X0, t, check_u(u, 3, t), np.zeros(0))
+    assert dense_auto(varying, 1e-8, np.full(7, 1e-10), 1e8, 1e6) is None
     res = simulate(model, X0, t, u=u)
     assert res.success and "dense output" not in res.message
 
@@ -185,7 +186,7 @@ def test_varying_control_keeps_the_grid_paths():
 @pytest.mark.parametrize("n", [2, 121])
 def test_the_one_call_is_the_stepper_run_and_its_merged_steps(n):
     """`dense.dense_auto` (answer, check and verdict in one compiled call) makes the run
-    `stepcontrol.run_dense` makes at the answer's local tolerance, equal to the last bit and
+    `stepcontrol.plain_run` makes at the answer's local tolerance, equal to the last bit and
     with its steps; its check takes the answer's accepted steps merged in pairs (half of
     them, a lone last one alone); the Jacobi truth lies within the estimate."""
     from appdyn.dynamics.integrate.dense import FIRST, dense_auto
@@ -194,7 +195,7 @@ def test_the_one_call_is_the_stepper_run_and_its_merged_steps(n):
     got = dense_auto(_problem(model, X0, t), rtol, atol, 1e8, 1e6)
     assert got.result == 1 and got.factor <= FIRST and got.ratio == 2
     f = got.factor
-    answer, _ = run_dense(_problem(model, X0, t), rtol * f, atol * f, 10 ** 8)
+    answer = plain_run(model, X0, t, rtol * f, atol * f, 10 ** 8)
     assert np.array_equal(got.x, answer.x)
     assert got.answer_steps == answer.n_steps
     assert got.check_steps == (got.answer_steps - got.rejected + 1) // 2
