@@ -10,6 +10,10 @@ from .report import Margins, StabilityReport, build_report
 
 __all__ = ["loop"]
 
+#: The gain factors on either side of a phase crossover's gain margin at which the closed
+#: loop's count of unstable poles must differ for the crossover to be one (`_margins`).
+CONFIRM = 1e-3
+
 
 @timed
 def loop(plant, controller, *, title: str = "Feedback loop", closed_form=None) -> StabilityReport:
@@ -85,8 +89,7 @@ def loop(plant, controller, *, title: str = "Feedback loop", closed_form=None) -
     margins, notes = None, []
     if plant.ninputs == 1:
         L = control.series(plant, controller)
-        gm, pm, sm, wpc, wgc, wms = control.stability_margins(L)
-        gm = float(gm)
+        gm, pm, sm, wpc, wgc, wms = _margins(L)
         margins = Margins(gain_margin=gm,
                           gain_margin_db=20 * math.log10(gm) if gm > 0 and math.isfinite(gm)
                           else (math.inf if gm == math.inf else math.nan),
@@ -102,3 +105,64 @@ def loop(plant, controller, *, title: str = "Feedback loop", closed_form=None) -
                         closed_form=closed_form)
 
 
+
+
+def _unstable(L, k: float) -> int:
+    """The closed loop ``feedback(k L)``'s poles in the right half-plane (its scale's
+    1e-12 on the imaginary axis counts as stable)."""
+    import control
+
+    closed = control.feedback(k * L, 1, sign=-1)
+    poles = np.linalg.eigvals(np.asarray(closed.A)) if closed.nstates else np.zeros(0)
+    scale = max(1.0, float(np.max(np.abs(poles)))) if poles.size else 1.0
+    return int(np.sum(poles.real > 1e-12 * scale))
+
+
+def _margins(L) -> tuple[float, float, float, float, float, float]:
+    """``control.stability_margins(L)`` (gain margin, phase margin, stability margin, and
+    their frequencies), without the phase crossovers that are not: a gain margin ``g``
+    counts only where the closed loop's unstable poles differ between the gains
+    ``g (1 - CONFIRM)`` and ``g (1 + CONFIRM)``, the property that defines it. A crossover
+    python-control finds at a zero on the imaginary axis (an undamped slosh zero: the phase
+    flips by 180 deg there with |L| = 0) changes nothing: rounding decides whether it is
+    found and at what |L| (1e-9 on one CPU, 3e-4 on another, a gain margin of 3197
+    against none), so it is dropped. Of the rest, the one nearest 1 in log is reported, as
+    python-control does.
+
+    Examples
+    --------
+    >>> import control
+    >>> from appdyn.problems.stability.loop import _margins
+    >>> L = control.tf([1.0], [1.0, 3.0, 3.0, 1.0])  # 1 / (s + 1)^3: unstable beyond 8
+    >>> round(_margins(L)[0], 9), round(_margins(L)[3] ** 2, 9)
+    (8.0, 3.0)
+    >>> z = control.tf([1.0, 0.0, 4.0], [1.0, 1.0, 5.0, 1.0])  # zeros at +-2j: stable for all k
+    >>> gm, _, _, w, _, _ = control.stability_margins(z)  # a crossover at the zero
+    >>> bool(gm > 1e12), round(float(w), 9)
+    (True, 2.0)
+    >>> _margins(z)[0], bool(math.isnan(_margins(z)[3]))
+    (inf, True)
+    """
+    import control
+
+    gms, pms, sms, wpcs, wgcs, wmss = (np.atleast_1d(np.asarray(v, float)) for v in
+                                       control.stability_margins(L, returnall=True))
+    ss = control.ss(L)
+    real = [i for i, g in enumerate(gms) if np.isfinite(g) and g > 0
+            and _unstable(ss, g * (1 - CONFIRM)) != _unstable(ss, g * (1 + CONFIRM))]
+    if real:
+        i = min(real, key=lambda j: abs(math.log(gms[j])))
+        gm, wpc = float(gms[i]), float(wpcs[i])
+    else:
+        gm, wpc = math.inf, math.nan
+    if pms.size:
+        j = int(np.argmin(np.abs(pms)))
+        pm, wgc = float(pms[j]), float(wgcs[j])
+    else:
+        pm, wgc = math.inf, math.nan
+    if sms.size:
+        k = int(np.argmin(sms))
+        sm, wms = float(sms[k]), float(wmss[k])
+    else:
+        sm, wms = math.inf, math.nan
+    return gm, pm, sm, wpc, wgc, wms

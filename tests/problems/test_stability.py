@@ -347,6 +347,21 @@ def test_loop_dynamic_controller_and_mimo_note():
         loop(mimo, np.eye(3))
 
 
+def test_loop_gain_margin_ignores_a_crossover_at_an_undamped_zero():
+    """L = k (s^2 + 4) / (s^3 + s^2 + 5 s + 1): closed loop s^3 + (1 + k) s^2 + 5 s + 1 + 4 k,
+    Routh-stable for every k > 0 ((1 + k) 5 > 1 + 4 k), so no gain margin. python-control
+    finds a phase crossover at the zero 2 rad/s (the phase flips there with |L| = 0) and a
+    gain margin of ~1e15 that rounding set; `loop` drops it. With s^3 + 2 s^2 + 2 s + 1 the
+    closed loop s^3 + (2 + k) s^2 + 2 s + 1 + 4 k is stable only for k < 3/2 (Routh): that
+    margin, at w^2 = 2 (where 2 w - w^3 = 0), stays."""
+    plant = control.tf([1.0, 0.0, 4.0], [1.0, 1.0, 5.0, 1.0])
+    assert control.stability_margins(plant)[0] > 1e12  # (the crossover `loop` drops)
+    m = loop(plant, 1.0).margins
+    assert m.gain_margin == np.inf and np.isnan(m.phase_crossover)
+    m = loop(control.tf([1.0, 0.0, 4.0], [1.0, 2.0, 2.0, 1.0]), 1.0).margins
+    assert abs(m.gain_margin - 1.5) <= 1e-9 and abs(m.phase_crossover - np.sqrt(2.0)) <= 1e-9
+
+
 # ------------------------------------------------------------------------ verdict
 def test_classify_rules():
     assert classify([[0, 1], [0, 0]])[0] == "unstable"  # Jordan block at 0

@@ -4,7 +4,6 @@ margins and closed-loop eigenvalues, rigid, with air, with the actuator, with ma
 slosh and with the body bending mode (the engine on it, the gyros on its slope)."""
 import math
 
-import control
 import numpy as np
 import pytest
 
@@ -37,12 +36,6 @@ CASES = {
 }
 
 
-def _undamped_zeros(report):
-    """The frequencies [rad/s] of the loop's zeros on the imaginary axis (`loop_transfer`)."""
-    z = np.asarray(control.zeros(stability.loop_transfer(report)), complex)
-    return np.abs(z[np.abs(z.real) <= 1e-9 * np.abs(z)])
-
-
 def _margins(m):
     return np.array([m.gain_margin, m.phase_margin, m.gain_crossover, m.phase_crossover])
 
@@ -59,16 +52,6 @@ def test_each_axis_equals_the_planar_autopilot_loop(case):
         rep = loops[axis]
         assert rep.verdict == planar.verdict
         ref, got = _margins(planar.margins), _margins(rep.margins)
-        if not np.isclose(got[0], ref[0], rtol=1e-8, atol=0.0):
-            # an undamped slosh zero on the imaginary axis: the phase jumps by 180 deg there
-            # with |L| = 0, so whether python-control finds a crossover (and its |L|: 1e-9
-            # on one machine, 3e-4 on another) is rounding; such a crossover must sit on
-            # that zero, and the rest must agree
-            zeros = _undamped_zeros(planar)
-            for m in (got, ref):
-                assert not np.isfinite(m[0]) or np.any(np.isclose(m[3], zeros, rtol=1e-4)), (
-                    axis, got, ref, zeros)
-            ref, got = ref[1:3], got[1:3]
         same = np.isclose(got, ref, rtol=1e-8, atol=0.0) | (np.isnan(ref) & np.isnan(got)) | (
             np.isinf(ref) & np.isinf(got))
         assert np.all(same), (axis, got, ref)
