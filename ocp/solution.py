@@ -457,9 +457,10 @@ class Solution(Result):
         within each mesh interval, possibly jumping at the mesh points (Radau, bang-bang
         solutions). Each interval is therefore integrated by a fresh CVODES solve (one
         CasADi ``mapaccum`` over the intervals, the state handed on), so no integrator steps
-        across a jump. ``rtol``/``atol`` are CVODES' local tolerances: the global integration
-        error is typically 10-100x larger, still far below the collocation errors this is
-        meant to reveal.
+        across a jump. CVODES runs its Adams-Moulton method (the re-simulated flow is not
+        stiff; BDF where Adams fails: `ocp.propagation.METHODS`). ``rtol``/``atol`` are
+        CVODES' local tolerances: the global integration error is typically 10-100x larger,
+        still far below the collocation errors this is meant to reveal.
 
         The running cost ``L`` (``problem.lagrange``) is integrated along as a CVODES
         quadrature and the terminal cost ``phi`` (``problem.mayer``) is evaluated at the

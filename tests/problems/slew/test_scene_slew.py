@@ -5,6 +5,8 @@ conservation of momentum where no external torque acts."""
 import dataclasses
 import math
 
+import re
+
 import numpy as np
 import pytest
 
@@ -396,8 +398,16 @@ def test_dispatch_equals_cmg_slew():
     assert (fast.success, fast.status) == (old.success, old.status)
     assert abs(fast.T - old.T) <= 1e-9
     assert fast.success or "which failed" in fast.message, fast.message
-    # a failed re-solve ends within its iteration budget (it once took 1861 iterations, 35 s)
-    assert fast.success or "a budget of 200 IPOPT iterations" in fast.message, fast.message
+    # a failed re-solve ends within its iteration budget (it once took 1861 iterations, 35 s):
+    # `BOUNDED_ITER_FACTOR` times the first solve's iterations (200 on one CPU, 220 on
+    # another: the first solve's count is rounding's too), at least `BOUNDED_MIN_ITER`
+    if not fast.success:
+        from appdyn.problems.slew.maneuvers import BOUNDED_ITER_FACTOR, BOUNDED_MIN_ITER
+        budget = int(re.search(r"a budget of (\d+) IPOPT iterations", fast.message).group(1))
+        assert budget == max(BOUNDED_MIN_ITER, BOUNDED_ITER_FACTOR * old.iterations), (
+            budget, old.iterations)
+        assert all(int(n) <= budget for n in re.findall(r"after (\d+) iterations",
+                                                            fast.message.split("which failed")[1]))
 
 
 @pytest.mark.slow
