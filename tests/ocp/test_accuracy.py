@@ -247,3 +247,20 @@ def test_goddard_rocket_rejects_bad_regularization():
     with pytest.raises(TypeError, match="`regularization`"):
         goddard_rocket(regularization="1e-4")
     assert goddard_rocket(regularization=np.float32(1e-4)).lagrange is not None
+
+
+def test_propagation_falls_back_to_bdf_when_adams_fails(monkeypatch):
+    """`propagate` tries CVODES' methods in turn (`propagation.METHODS`): the first one
+    failing (here a method CVODES refuses) leaves the re-simulation to the next, and the
+    message names the one that integrated; the end state is the closed form's."""
+    from appdyn.ocp import propagation
+
+    sol = _constructed([[0.0, 2.0], [0.0, 2.0]])
+    assert "(adams)" in sol.propagate().message
+    monkeypatch.setattr(propagation, "METHODS", ("no-such-method", "bdf"))
+    prop = sol.propagate()
+    assert prop.success and "(bdf)" in prop.message, prop.message
+    np.testing.assert_allclose(prop.x[:, -1], [2.0, 2.0], atol=1e-10)
+    monkeypatch.setattr(propagation, "METHODS", ("no-such-method",))
+    prop = sol.propagate()
+    assert not prop.success and "cvodes (no-such-method) failed" in prop.message
