@@ -22,8 +22,9 @@ __all__ = ["margins_of", "compensator", "stability_check", "resimulate", "limit_
 
 # ------------------------------------------------------------------- verification
 def margins_of(report, L) -> dict:
-    """The report's margins of the loop ``L`` and its lower and upper gain margins."""
-    import control
+    """The report's margins of the loop ``L`` and its lower and upper gain margins
+    (`stability.loop.gain_margins`)."""
+    from appdyn.problems.stability.loop import gain_margins
 
     out = {}
     m = report.margins
@@ -31,8 +32,8 @@ def margins_of(report, L) -> dict:
         out.update(gain_margin=m.gain_margin, gain_margin_db=m.gain_margin_db,
                    phase_margin_deg=m.phase_margin, stability_margin=m.stability_margin,
                    phase_crossover=m.phase_crossover, gain_crossover=m.gain_crossover)
-    gms = np.atleast_1d(control.stability_margins(L, returnall=True)[0])
-    gms = gms[np.isfinite(gms) & (gms > 0) & (gms < GM_INF)]
+    gms = gain_margins(L)[0]  # (the crossovers that change the closed loop's stability)
+    gms = gms[gms < GM_INF]
     lower, upper = gms[gms < 1], gms[gms > 1]
     out["gain_margin_lower"] = float(lower.max()) if lower.size else 0.0
     out["gain_margin_upper"] = float(upper.min()) if upper.size else math.inf

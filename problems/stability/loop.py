@@ -118,6 +118,30 @@ def _unstable(L, k: float) -> int:
     return int(np.sum(poles.real > 1e-12 * scale))
 
 
+def gain_margins(L) -> tuple[np.ndarray, np.ndarray]:
+    """Every gain margin of the SISO loop ``L`` and its phase crossover frequency [rad/s]:
+    python-control's (``stability_margins(L, returnall=True)``) where the closed loop's
+    unstable poles differ between the gains ``g (1 - CONFIRM)`` and ``g (1 + CONFIRM)``
+    (what a gain margin is; a crossover found at a zero on the imaginary axis changes
+    nothing, `_margins`). Shapes (k,), (k,).
+
+    Examples
+    --------
+    >>> import control
+    >>> from appdyn.problems.stability.loop import gain_margins
+    >>> gain_margins(control.tf([1.0, 0.0, 4.0], [1.0, 2.0, 2.0, 1.0]))[0].round(9)
+    array([1.5])
+    """
+    import control
+
+    gms, _, _, wpcs, _, _ = (np.atleast_1d(np.asarray(v, float)) for v in
+                             control.stability_margins(L, returnall=True))
+    ss = control.ss(L)
+    real = [i for i, g in enumerate(gms) if np.isfinite(g) and g > 0
+            and _unstable(ss, g * (1 - CONFIRM)) != _unstable(ss, g * (1 + CONFIRM))]
+    return gms[real], wpcs[real]
+
+
 def _margins(L) -> tuple[float, float, float, float, float, float]:
     """``control.stability_margins(L)`` (gain margin, phase margin, stability margin, and
     their frequencies), without the phase crossovers that are not: a gain margin ``g``
@@ -145,13 +169,11 @@ def _margins(L) -> tuple[float, float, float, float, float, float]:
     """
     import control
 
-    gms, pms, sms, wpcs, wgcs, wmss = (np.atleast_1d(np.asarray(v, float)) for v in
-                                       control.stability_margins(L, returnall=True))
-    ss = control.ss(L)
-    real = [i for i, g in enumerate(gms) if np.isfinite(g) and g > 0
-            and _unstable(ss, g * (1 - CONFIRM)) != _unstable(ss, g * (1 + CONFIRM))]
-    if real:
-        i = min(real, key=lambda j: abs(math.log(gms[j])))
+    _, pms, sms, _, wgcs, wmss = (np.atleast_1d(np.asarray(v, float)) for v in
+                                  control.stability_margins(L, returnall=True))
+    gms, wpcs = gain_margins(L)
+    if gms.size:
+        i = int(np.argmin(np.abs(np.log(gms))))
         gm, wpc = float(gms[i]), float(wpcs[i])
     else:
         gm, wpc = math.inf, math.nan
