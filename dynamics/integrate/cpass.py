@@ -12,7 +12,7 @@ import casadi as ca
 
 from .. import cache
 from ..model import Model
-from .kernels import calls_rhs, dense_kernels, kernel
+from .kernels import calls_rhs, dense_kernels, kernel, step_all_kernel
 from .loops import chunk_compile_job
 
 __all__ = ["BMAX", "CHECK_EVERY", "NOISE", "pass_library"]
@@ -52,7 +52,7 @@ _DRIVER = r"""
 #define PASS_NRES %(nres)d
 #define PASS_U (PASS_NU > 0 ? PASS_NU : 1)
 #define CHECK_EVERY %(every)d
-
+%(steps)s
 typedef struct {
   const casadi_real *p, *atol, *ud;
   casadi_real rtol;
@@ -914,21 +914,67 @@ int rk8_fixed_many(int k0, int k1, int nint, int m, const casadi_real* H,
 """
 
 
+# The three step uses as wrappers of ONE generated step (`kernels.step_all_kernel`, a model
+# whose rhs is called): the plain step (stages not stored), the step with its error (the
+# stages into a local array, then `rk8_err`), and the dense step under a constant control
+# (``ud`` 0). Each wrapper hands the generated step its own argument and result arrays (the
+# step's call of the rhs uses those past its own as scratch).
+_ONE_STEP = r"""
+#define STEP_K (12 * PASS_NX)
+static int rk8_step(const casadi_real** arg, casadi_real** res, casadi_int* iw,
+                    casadi_real* w, int mem) {
+  const casadi_real* a[PASS_NARG + 7];
+  casadi_real* r[PASS_NRES + 3];
+  int i;
+  for (i = 0; i < 5; ++i) a[i] = arg[i];
+  r[0] = res[0]; r[1] = 0;
+  return rk8_step_all(a, r, iw, w, mem);
+}
+static int step_err(const casadi_real** arg, const casadi_real* u, const casadi_real* ud,
+                    const casadi_real* p, const casadi_real* rtol, const casadi_real* atol,
+                    casadi_real* xn, casadi_real* err, casadi_real* K, casadi_int* iw,
+                    casadi_real* w, int mem) {
+  const casadi_real* a[PASS_NARG + 7];
+  casadi_real* r[PASS_NRES + 3];
+  a[0] = arg[0]; a[1] = arg[1]; a[2] = u; a[3] = ud; a[4] = p;
+  r[0] = xn; r[1] = K;
+  if (rk8_step_all(a, r, iw, w, mem)) return 1;
+  if (!err) return 0;
+  a[0] = arg[0]; a[1] = xn; a[2] = K; a[3] = arg[1]; a[4] = rtol; a[5] = atol;
+  r[0] = err;
+  return rk8_err(a, r, iw, w, mem);
+}
+static int rk8_step_err(const casadi_real** arg, casadi_real** res, casadi_int* iw,
+                        casadi_real* w, int mem) {
+  casadi_real K[STEP_K];
+  return step_err(arg, arg[2], arg[3], arg[4], arg[5], arg[6], res[0], res[1], K, iw, w, mem);
+}
+static int rk8_step_k(const casadi_real** arg, casadi_real** res, casadi_int* iw,
+                      casadi_real* w, int mem) {
+  return step_err(arg, arg[2], 0, arg[3], arg[4], arg[5], res[0], res[1], res[2], iw, w, mem);
+}
+"""
+
+
 def pass_library(model: Model) -> object | None:
     """The compiled pass of ``model`` (a ``ctypes`` function, cached); None without a C
     compiler or when the model cannot be code-generated (the pass is worth it only as C)."""
     def make():
-        step = kernel(model, "rk8", "linear", error=True, compiled=True)
         # (a step that calls the rhs shares its C function with pass_rhs: one copy of it)
-        rhs = _renamed(model.f, "pass_rhs", ca.MX if calls_rhs(model, "rk8") else None)
-        dense = dense_kernels(model, compiled=True)
-        funs = (step, rhs) + dense  # (the plain step needs less)
+        called = calls_rhs(model, "rk8")
+        rhs = _renamed(model.f, "pass_rhs", ca.MX if called else None)
+        if called:  # (one generated step for the three uses: `_ONE_STEP`)
+            steps = [*step_all_kernel(model), rhs, dense_kernels(model, compiled=True)[1]]
+            wrappers = _ONE_STEP
+        else:
+            step = _renamed(kernel(model, "rk8", "linear", error=True, compiled=True),
+                            "rk8_step_err")
+            plain = _renamed(kernel(model, "rk8", "linear", compiled=True), "rk8_step")
+            steps, wrappers = [step, plain, rhs, *dense_kernels(model, compiled=True)], ""
         sizes = dict(every=CHECK_EVERY, nx=model.nx, nu=model.nu, np=model.np,
-                     nw=max(f.sz_w() for f in funs), niw=max(f.sz_iw() for f in funs),
-                     narg=max(f.sz_arg() for f in funs), nres=max(f.sz_res() for f in funs))
-        steps = [_renamed(step, "rk8_step_err"),
-                 _renamed(kernel(model, "rk8", "linear", compiled=True), "rk8_step"), rhs,
-                 *dense]
+                     nw=max(f.sz_w() for f in steps), niw=max(f.sz_iw() for f in steps),
+                     narg=max(f.sz_arg() for f in steps), nres=max(f.sz_res() for f in steps),
+                     steps=wrappers)
         return steps, _DRIVER % sizes + _STEPPER + _DENSE + _AUTO + _FIXED
 
     def job(opt):

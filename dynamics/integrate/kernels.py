@@ -11,7 +11,8 @@ from ..model import Model
 from .tableaux import (DOP853_DENSE_A, DOP853_DENSE_C, DOP853_DENSE_D, DOP853_E3, DOP853_E5,
                        TABLEAUX, unique_nodes)
 
-__all__ = ["kernel", "check_lie_model", "INLINE_MAX", "calls_rhs", "dense_kernels"]
+__all__ = ["kernel", "check_lie_model", "INLINE_MAX", "calls_rhs", "dense_kernels",
+           "step_all_kernel"]
 
 #: Most right-hand-side instructions a compiled Runge-Kutta step inlines (stages times the
 #: rhs's instruction count); a larger step calls the rhs as a C function instead (see
@@ -153,6 +154,52 @@ def dense_kernels(model: Model, *, compiled: bool = False) -> tuple[ca.Function,
         return step, cont
 
     return cache.get(key, build, keepalive=model.f)
+
+
+def step_all_kernel(model: Model) -> tuple[ca.Function, ca.Function]:
+    """``rk8_step_all (x, h, ua, ud, p) -> (x_next, K)`` and ``rk8_err (x, x_next, K, h,
+    rtol, atol) -> err`` (cached): the DOP853 step of `kernel` (``rk8``, control linear over
+    the step, the right-hand side called: an SX call node) with its stages ``K (12 nx)`` as
+    `dense_kernels`' step gives them, and the embedded error estimate from those stages (as
+    `kernel`'s ``error`` step). The compiled pass of a model whose rhs is called
+    (`calls_rhs`) generates this one step for its three uses (the plain step, the step with
+    its error, the dense step under a constant control: ``ud`` 0) instead of three: each is
+    scalar C of the stages' sums of every state, 3,900-5,300 lines for the 26-state hinged
+    bodies, and gcc's time grows with them (`dynamics.cache`, First compile); the plain
+    step computes no error (its stages are not stored).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from appdyn.dynamics import rigid_body
+    >>> from appdyn.dynamics.integrate.kernels import dense_kernels, step_all_kernel
+    >>> model = rigid_body([1.0, 2.0, 3.0])
+    >>> step, err = step_all_kernel(model)
+    >>> x0, u, p, atol = np.r_[0, 0, 0, 1, 0.1, 0.2, 0.3], np.zeros(3), np.zeros(0), np.full(7, 1e-10)
+    >>> xn, K = step(x0, 0.5, u, u, p)
+    >>> xd, ed, Kd = dense_kernels(model)[0](x0, 0.5, u, p, 1e-8, atol)
+    >>> e = err(x0, xn, K, 0.5, 1e-8, atol)
+    >>> bool(np.allclose(xn, xd, rtol=1e-15, atol=1e-15) and np.isclose(float(e), float(ed)))
+    True
+    """
+    def build():
+        f, tab = model.f, TABLEAUX["rk8"]
+        nx, nu, np_ = model.nx, model.nu, f.numel_in(2)
+        ins, u_at = _kernel_inputs(ca.SX, nx, nu, np_, "linear", 0)
+        x, h, p = ins[0], ins[1], ins[-1]
+        k = _stages(f, tab.a, tab.c, x, h, u_at, p, [], call=True)
+        x_next = x + h * _combine(tab.b, k)
+        step = ca.Function("rk8_step_all", ins, [x_next, ca.vertcat(*k)])
+        x, xn, h = ca.SX.sym("x", nx), ca.SX.sym("x_next", nx), ca.SX.sym("h")
+        K = ca.SX.sym("K", tab.stages * nx)
+        rtol, atol = ca.SX.sym("rtol"), ca.SX.sym("atol", nx)
+        k = [K[i * nx:(i + 1) * nx] for i in range(tab.stages)]
+        err = ca.Function("rk8_err", [x, xn, K, h, rtol, atol],
+                          [_embedded_error(x, xn, k, h, rtol, atol)])
+        return step, err
+
+    return cache.get(("rk8_step_all", cache.function_key(model.f)), build,
+                     keepalive=model.f)
 
 
 def _combine(weights, k: list):
