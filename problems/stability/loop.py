@@ -105,8 +105,6 @@ def loop(plant, controller, *, title: str = "Feedback loop", closed_form=None) -
                         closed_form=closed_form)
 
 
-
-
 def _unstable(L, k: float) -> int:
     """The closed loop ``feedback(k L)``'s poles in the right half-plane (its scale's
     1e-12 on the imaginary axis counts as stable)."""
@@ -132,10 +130,23 @@ def gain_margins(L) -> tuple[np.ndarray, np.ndarray]:
     >>> gain_margins(control.tf([1.0, 0.0, 4.0], [1.0, 2.0, 2.0, 1.0]))[0].round(9)
     array([1.5])
     """
+    return _confirmed(L, _all_margins(L))
+
+
+def _all_margins(L) -> tuple[np.ndarray, ...]:
+    """``control.stability_margins(L, returnall=True)`` as six float arrays."""
     import control
 
-    gms, _, _, wpcs, _, _ = (np.atleast_1d(np.asarray(v, float)) for v in
-                             control.stability_margins(L, returnall=True))
+    return tuple(np.atleast_1d(np.asarray(v, float))
+                 for v in control.stability_margins(L, returnall=True))
+
+
+def _confirmed(L, margins: tuple) -> tuple[np.ndarray, np.ndarray]:
+    """The gain margins and phase crossovers of ``margins`` (`_all_margins`) where the
+    closed loop's unstable poles change across the margin (`gain_margins`)."""
+    import control
+
+    gms, wpcs = margins[0], margins[3]
     ss = control.ss(L)
     real = [i for i, g in enumerate(gms) if np.isfinite(g) and g > 0
             and _unstable(ss, g * (1 - CONFIRM)) != _unstable(ss, g * (1 + CONFIRM))]
@@ -167,11 +178,9 @@ def _margins(L) -> tuple[float, float, float, float, float, float]:
     >>> _margins(z)[0], bool(math.isnan(_margins(z)[3]))
     (inf, True)
     """
-    import control
-
-    _, pms, sms, _, wgcs, wmss = (np.atleast_1d(np.asarray(v, float)) for v in
-                                  control.stability_margins(L, returnall=True))
-    gms, wpcs = gain_margins(L)
+    margins = _all_margins(L)
+    _, pms, sms, _, wgcs, wmss = margins
+    gms, wpcs = _confirmed(L, margins)
     if gms.size:
         i = int(np.argmin(np.abs(np.log(gms))))
         gm, wpc = float(gms[i]), float(wpcs[i])
