@@ -37,6 +37,9 @@ API
     Path of the C compiler (``gcc`` or ``cc`` on the ``PATH``), or ``None``.
 ``compile_function(f)``
     ``f`` compiled to C and loaded with ``casadi.external``; no files stay behind.
+``compile_parallel(jobs)``, ``compile_ahead(jobs)``
+    Compile several `Job` at once and wait; start compiling and return at once (a later
+    ``compile_parallel`` of the job waits for that compile).
 
 Entries are evicted least-recently-used beyond `MAXSIZE` (`set_maxsize`); a ``build`` may
 itself call `get` (a loop built from a cached step): the construction lock is re-entrant.
@@ -138,11 +141,23 @@ Since then the pass's steps around a called right-hand side sum their stages as 
 took 4-6 us, now under 1 us), which made each step large again: the hinged bodies' pass
 held four of them (the plain step, the step with its error, the dense step and its
 continuous extension, 3,900-5,300 lines each; 465 kB of C, 2.6 s of gcc). It now
-generates one step for the first three uses (`kernels.step_all_kernel`, wrapped in C by
-`integrate.cpass`): 294 kB, 1.55 s of gcc (paired runs, one core).
+generated one step for the first three uses: 294 kB, 1.55 s of gcc (paired runs, one core).
+
+Now a model whose right-hand side is called runs DOP853's sums as C loops over the state
+(`integrate.csteps`, as Hairer's dop853.f): the only model-specific C of its pass is the
+rhs (the hinged bodies' pass 294 to 75 kB, gcc 1.47 to 0.41 s; the steps are the
+generated ones' to the last bit, and cost the same or less per step: the wheel spacecraft
+0.70 to 0.56 us, the hinged scene 6.35 and 6.38 us). And the chunk loop, which ``auto``
+runs only in its multi-run fallback, is compiled *ahead* (`compile_ahead`): its compiler
+starts with the pass's and runs in the background; a call that needs the chunk waits for
+it, and the process's exit waits for compiles under way so that they land in the
+persistent cache. This is not the interpreted fallback rejected above: no answer depends
+on timing, only when a library is ready does. The first ``simulate`` of a model then waits
+for its pass alone (``bench/compile_cache.py``).
 """
 from __future__ import annotations
 
+import atexit
 import contextlib
 import functools
 import os
@@ -159,7 +174,7 @@ from .validate import integer
 __all__ = ["MAXSIZE", "JIT_MIN_WORK", "CacheInfo", "FunctionCache", "get", "contains", "clear",
            "info", "set_maxsize", "function_key", "memoize", "memoize_values", "value_key",
            "checkout", "construction_lock", "POOL_SIZE", "compiler", "should_compile",
-           "compile_function", "compile_c", "compile_parallel", "Job", "recipe"]
+           "compile_function", "compile_c", "compile_parallel", "compile_ahead", "Job", "recipe"]
 
 #: Most entries kept (least recently used are dropped first).
 MAXSIZE = 512
@@ -384,73 +399,204 @@ def compile_parallel(jobs: list) -> list:
     A library compiled before on this machine is loaded from the persistent compile cache
     (`dynamics.diskcache`) instead: looked up by the job's recipe before anything is built,
     or by the hash of the generated C source; the compiler runs only for the jobs whose
-    library is not there (or is rejected as corrupted or foreign)."""
+    library is not there (or is rejected as corrupted or foreign). A job whose compile
+    `compile_ahead` started waits for that compile instead of starting another."""
     compiler = _CACHE.compiler()
     if compiler is None:
         return [None] * len(jobs)
-    jobs = [job if isinstance(job, Job) else
-            Job(lambda job=job: (job[0], job[1]), job[2], job[3]) for job in jobs]
+    jobs = [_as_job(job) for job in jobs]
     results: list = [None] * len(jobs)
-    with contextlib.ExitStack() as stack:
-        work = None  # the scratch directory, made at the first compile
-        procs = []
+    try:
         for i, job in enumerate(jobs):
-            flags = [*job.opt.split(), "-w", "-fPIC", "-shared"]
-            key = None
-            if job.recipe is not None:
-                key = diskcache.artifact_key(job.recipe.encode() + diskcache.code_version(),
-                                             compiler, flags)
-                if _load_cached(key, job, results, i):
-                    continue
-            if work is None:
-                import tempfile  # (stdlib, imported when first compiling)
+            results[i] = _start(job, compiler)
+        for i, job in enumerate(jobs):
+            if isinstance(results[i], _Build):
+                results[i] = _finish(results[i], job)
+    finally:  # (an interrupt: no compiler process or scratch directory is left behind)
+        for out in results:
+            if isinstance(out, _Build):
+                if out.proc is not None and out.proc.poll() is None:
+                    out.proc.kill()
+                    out.proc.wait()
+                out.close()
+    return results
 
-                work = stack.enter_context(tempfile.TemporaryDirectory(prefix="appdyn-cc-"))
-            try:
-                functions, extra = job.make()
-                name = functions[0].name()
-                source = _generate_c(functions, extra, work)
-            except RuntimeError as exc:  # (a Function that cannot be code-generated)
-                results[i] = RuntimeError(f"generating C failed: {exc}")
+
+def compile_ahead(jobs: list) -> None:
+    """Start compiling the jobs (`Job` with a recipe) whose libraries are neither in the
+    persistent cache nor being compiled, and return at once: the compilers run in the
+    background (their libraries go into the persistent cache when they finish), and a later
+    `compile_parallel` of such a job waits for its compile rather than starting another
+    (results do not depend on timing: only when a library is ready does). What a call does
+    not need now is compiled while it runs and after it returns; a process exiting waits
+    for its compiles under way (so that the machine compiles each library once). Nothing
+    happens without a C compiler."""
+    compiler = _CACHE.compiler()
+    if compiler is None:
+        return
+    for job in map(_as_job, jobs):
+        if job.recipe is None:
+            continue
+        key = _job_key(job, compiler)
+        with _AHEAD_LOCK:
+            if key in _AHEAD:
                 continue
-            if key is None:
-                with open(source, "rb") as f:
-                    key = diskcache.artifact_key(f.read(), compiler, flags)
-                if _load_cached(key, job, results, i):
-                    continue
-            library = os.path.join(work, f"{name}.so")
-            diskcache.compiled()
-            import subprocess  # (stdlib, imported when first compiling)
-
-            procs.append((i, name, key, library, subprocess.Popen(
-                [compiler, *flags, os.path.basename(source), "-o", library, "-lm"], cwd=work,
-                stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)))
-        for i, name, key, library, proc in procs:
-            _, err = proc.communicate()
-            if proc.returncode != 0:
-                results[i] = RuntimeError(f"C compilation of {name} failed: "
-                                          f"{err.strip()[-500:]}")
-                continue
-            try:
-                results[i] = jobs[i].load(diskcache.publish(key, library))
-            except (OSError, RuntimeError) as exc:  # (a library that does not load)
-                results[i] = RuntimeError(f"loading {name} failed: {exc}")
-        return results
+        if diskcache.lookup(key) is not None:
+            continue
+        build = _spawn(job, compiler, key)
+        if isinstance(build, _Build):
+            with _AHEAD_LOCK:
+                _AHEAD[key] = build
+            threading.Thread(target=build.wait, name="appdyn-compile", daemon=True).start()
 
 
-def _load_cached(key: str, job: Job, results: list, i: int) -> bool:
-    """Load the library of ``key`` from the persistent cache into ``results[i]``; whether
-    it was there (one that fails to load is deleted, to be rebuilt)."""
+def _as_job(job) -> Job:
+    return job if isinstance(job, Job) else Job(lambda job=job: (job[0], job[1]), job[2], job[3])
+
+
+def _flags(job: Job) -> list:
+    return [*job.opt.split(), "-w", "-fPIC", "-shared"]
+
+
+def _job_key(job: Job, compiler: str) -> str:
+    """The persistent cache's key of a job with a recipe."""
+    return diskcache.artifact_key(job.recipe.encode() + diskcache.code_version(), compiler,
+                                  _flags(job))
+
+
+class _Build:
+    """One C compile in its scratch directory ``work`` (removed by `close`): once started,
+    the generated library's ``name``, its persistent-cache ``key``, the ``library`` the
+    compiler process ``proc`` writes."""
+
+    def __init__(self, work: str):
+        self.work, self.name, self.key, self.library, self.proc = work, "", "", "", None
+        self._lock = threading.Lock()
+        self._outcome = None
+
+    def wait(self):
+        """Wait for the compiler (once; any thread): the library's path (published to the
+        persistent cache) or the ``RuntimeError`` saying why the compile failed."""
+        with self._lock:
+            if self._outcome is None:
+                _, err = self.proc.communicate()
+                self._outcome = (RuntimeError(f"C compilation of {self.name} failed: "
+                                              f"{err.strip()[-500:]}")
+                                 if self.proc.returncode != 0 else
+                                 diskcache.publish(self.key, self.library))
+            return self._outcome
+
+    def close(self) -> None:
+        import shutil
+
+        shutil.rmtree(self.work, ignore_errors=True)
+
+
+def _start(job: Job, compiler: str):
+    """The job's library loaded from the persistent cache, a compile under way (`_Build`:
+    started by `compile_ahead`, or now) or the ``RuntimeError`` of a failed generation."""
+    key = None
+    if job.recipe is not None:
+        key = _job_key(job, compiler)
+        with _AHEAD_LOCK:
+            ahead = _AHEAD.pop(key, None)
+        if ahead is not None:
+            return ahead
+        found = _load_cached(key, job)
+        if found is not None:
+            return found
+    return _spawn(job, compiler, key)
+
+
+def _spawn(job: Job, compiler: str, key: str | None):
+    """Generate the job's C and start its compiler: a `_Build`, the library loaded from the
+    persistent cache (found by the hash of the source, ``key`` None), or the
+    ``RuntimeError`` of a failed generation."""
+    import subprocess  # (stdlib, imported when first compiling)
+    import tempfile
+
+    # (a plain directory, removed by `_Build.close`: a TemporaryDirectory's own exit hook
+    # would remove it under a compile that the exit waits for)
+    work = tempfile.mkdtemp(prefix="appdyn-cc-")
+    build = _Build(work)
+    try:
+        functions, extra = job.make()
+        build.name = functions[0].name()
+        source = _generate_c(functions, extra, work)
+    except RuntimeError as exc:  # (a Function that cannot be code-generated)
+        build.close()
+        return RuntimeError(f"generating C failed: {exc}")
+    except BaseException:
+        build.close()
+        raise
+    flags = _flags(job)
+    if key is None:
+        with open(source, "rb") as f:
+            key = diskcache.artifact_key(f.read(), compiler, flags)
+        found = _load_cached(key, job)
+        if found is not None:
+            build.close()
+            return found
+    build.key, build.library = key, os.path.join(work, f"{build.name}.so")
+    diskcache.compiled()
+    build.proc = subprocess.Popen(
+        [compiler, *flags, os.path.basename(source), "-o", build.library, "-lm"], cwd=work,
+        stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    return build
+
+
+def _finish(build: _Build, job: Job):
+    """The job's library loaded once its compile has finished, or the ``RuntimeError``."""
+    try:
+        out = build.wait()
+        if isinstance(out, RuntimeError):
+            return out
+        try:
+            return job.load(out)
+        except (OSError, RuntimeError) as exc:  # (a library that does not load)
+            return RuntimeError(f"loading {build.name} failed: {exc}")
+    finally:
+        build.close()
+
+
+def _load_cached(key: str, job: Job):
+    """The library of ``key`` loaded from the persistent cache, or None (absent; one that
+    fails to load is deleted, to be rebuilt)."""
     found = diskcache.lookup(key)
     if found is None:
-        return False
+        return None
     try:
-        results[i] = job.load(found)
+        out = job.load(found)
     except (OSError, RuntimeError):
         diskcache.discard(key)
-        return False
+        return None
     diskcache.hit()
-    return True
+    return out
+
+
+#: compiles started by `compile_ahead`, by persistent-cache key, until a job takes them
+_AHEAD: dict = {}
+_AHEAD_LOCK = threading.Lock()
+
+
+def _finish_ahead() -> None:
+    """At exit: wait for the compiles under way (their libraries land in the persistent
+    cache) and remove their scratch directories."""
+    with _AHEAD_LOCK:
+        builds = list(_AHEAD.values())
+        _AHEAD.clear()
+    for build in builds:
+        build.wait()
+        build.close()
+
+
+def _forget_ahead() -> None:
+    """In a forked child: the parent's compiler processes are not the child's to wait for."""
+    _AHEAD.clear()
+
+
+atexit.register(_finish_ahead)
+os.register_at_fork(after_in_child=_forget_ahead)
 
 
 def _generate_c(functions: list, extra: str, work: str) -> str:

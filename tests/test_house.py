@@ -52,6 +52,7 @@ CIRCLES_ALLOWED: set = set()
 # holds the problems a multistart worker process received (its inputs, not a cache).
 CACHES_ALLOWED = {
     ("appdyn.dynamics.cache", "_KEYS"),
+    ("appdyn.dynamics.cache", "_AHEAD"),  # compiler processes under way, not built objects
     ("appdyn.dynamics.diskcache", "_IDS"),
     ("appdyn.ocp.refine.multistart", "_RECEIVED"),  # a worker's unpickled problems
 }

@@ -12,7 +12,8 @@ import casadi as ca
 
 from .. import cache
 from ..model import Model
-from .kernels import calls_rhs, dense_kernels, kernel, step_all_kernel
+from .csteps import loop_steps
+from .kernels import calls_rhs, dense_kernels, kernel
 from .loops import chunk_compile_job
 
 __all__ = ["BMAX", "CHECK_EVERY", "NOISE", "pass_library"]
@@ -914,79 +915,60 @@ int rk8_fixed_many(int k0, int k1, int nint, int m, const casadi_real* H,
 """
 
 
-# The three step uses as wrappers of ONE generated step (`kernels.step_all_kernel`, a model
-# whose rhs is called): the plain step (stages not stored), the step with its error (the
-# stages into a local array, then `rk8_err`), and the dense step under a constant control
-# (``ud`` 0). Each wrapper hands the generated step its own argument and result arrays (the
-# step's call of the rhs uses those past its own as scratch).
-_ONE_STEP = r"""
-#define STEP_K (12 * PASS_NX)
-static int rk8_step(const casadi_real** arg, casadi_real** res, casadi_int* iw,
-                    casadi_real* w, int mem) {
-  const casadi_real* a[PASS_NARG + 7];
-  casadi_real* r[PASS_NRES + 3];
-  int i;
-  for (i = 0; i < 5; ++i) a[i] = arg[i];
-  r[0] = res[0]; r[1] = 0;
-  return rk8_step_all(a, r, iw, w, mem);
-}
-static int step_err(const casadi_real** arg, const casadi_real* u, const casadi_real* ud,
-                    const casadi_real* p, const casadi_real* rtol, const casadi_real* atol,
-                    casadi_real* xn, casadi_real* err, casadi_real* K, casadi_int* iw,
-                    casadi_real* w, int mem) {
-  const casadi_real* a[PASS_NARG + 7];
-  casadi_real* r[PASS_NRES + 3];
-  a[0] = arg[0]; a[1] = arg[1]; a[2] = u; a[3] = ud; a[4] = p;
-  r[0] = xn; r[1] = K;
-  if (rk8_step_all(a, r, iw, w, mem)) return 1;
-  if (!err) return 0;
-  a[0] = arg[0]; a[1] = xn; a[2] = K; a[3] = arg[1]; a[4] = rtol; a[5] = atol;
-  r[0] = err;
-  return rk8_err(a, r, iw, w, mem);
-}
-static int rk8_step_err(const casadi_real** arg, casadi_real** res, casadi_int* iw,
-                        casadi_real* w, int mem) {
-  casadi_real K[STEP_K];
-  return step_err(arg, arg[2], arg[3], arg[4], arg[5], arg[6], res[0], res[1], K, iw, w, mem);
-}
-static int rk8_step_k(const casadi_real** arg, casadi_real** res, casadi_int* iw,
-                      casadi_real* w, int mem) {
-  return step_err(arg, arg[2], 0, arg[3], arg[4], arg[5], res[0], res[1], res[2], iw, w, mem);
+# One call of each compiled step form on the same data, for tests (the pass's steps against
+# the casadi kernels they stand for): into out, in turn, the plain step's x_next (nx), the
+# error step's x_next (nx) and error (1), the dense step's x_next (nx), error (1) and
+# stages (12 nx) under the constant control ua, and that step's extension F (7 nx).
+_PROBE = r"""
+int rk8_probe(const casadi_real* x, casadi_real h, const casadi_real* ua,
+              const casadi_real* ud, const casadi_real* p, casadi_real rtol,
+              const casadi_real* atol, casadi_real* out) {
+  const casadi_real* arg[PASS_NARG + 7];
+  casadi_real* res[PASS_NRES + 3];
+  pass_ctx c;
+  casadi_real *xk = out + 2 * PASS_NX + 1, *K = xk + PASS_NX + 1;
+  arg[0] = x; arg[1] = &h; arg[2] = ua; arg[3] = ud; arg[4] = p; arg[5] = &rtol;
+  arg[6] = atol; res[0] = out;
+  if (rk8_step(arg, res, c.iw, c.w, 0)) return 1;
+  res[0] = out + PASS_NX; res[1] = out + 2 * PASS_NX;
+  if (rk8_step_err(arg, res, c.iw, c.w, 0)) return 1;
+  arg[3] = p; arg[4] = &rtol; arg[5] = atol;
+  res[0] = xk; res[1] = xk + PASS_NX; res[2] = K;
+  if (rk8_step_k(arg, res, c.iw, c.w, 0)) return 1;
+  arg[1] = xk; arg[2] = K; arg[3] = &h; arg[4] = ua; arg[5] = p;
+  res[0] = K + 12 * PASS_NX;
+  return rk8_cont(arg, res, c.iw, c.w, 0);
 }
 """
-
 
 def pass_library(model: Model) -> object | None:
     """The compiled pass of ``model`` (a ``ctypes`` function, cached); None without a C
     compiler or when the model cannot be code-generated (the pass is worth it only as C)."""
     def make():
-        # (a step that calls the rhs shares its C function with pass_rhs: one copy of it)
-        called = calls_rhs(model, "rk8")
-        rhs = _renamed(model.f, "pass_rhs", ca.MX if called else None)
-        if called:  # (one generated step for the three uses: `_ONE_STEP`)
-            steps = [*step_all_kernel(model), rhs, dense_kernels(model, compiled=True)[1]]
-            wrappers = _ONE_STEP
+        rhs = _renamed(model.f, "pass_rhs")
+        if calls_rhs(model, "rk8"):  # (the steps as C loops around the one rhs: `csteps`)
+            steps, wrappers = [rhs], loop_steps()
         else:
             step = _renamed(kernel(model, "rk8", "linear", error=True, compiled=True),
                             "rk8_step_err")
             plain = _renamed(kernel(model, "rk8", "linear", compiled=True), "rk8_step")
-            steps, wrappers = [step, plain, rhs, *dense_kernels(model, compiled=True)], ""
+            steps, wrappers = [step, plain, rhs, *dense_kernels(model)], ""
         sizes = dict(every=CHECK_EVERY, nx=model.nx, nu=model.nu, np=model.np,
                      nw=max(f.sz_w() for f in steps), niw=max(f.sz_iw() for f in steps),
                      narg=max(f.sz_arg() for f in steps), nres=max(f.sz_res() for f in steps),
                      steps=wrappers)
-        return steps, _DRIVER % sizes + _STEPPER + _DENSE + _AUTO + _FIXED
+        return steps, _DRIVER % sizes + _STEPPER + _DENSE + _AUTO + _FIXED + _PROBE
 
     def job(opt):
         return cache.Job(make, opt, ctypes.CDLL, cache.recipe("rk8_pass", model.f, opt))
 
     def build():
-        # auto's multi-run search (the fallback) runs the rk8 chunk loop: compiled now, at
-        # the same time (a later call with this model then compiles nothing)
+        # auto's multi-run search (the fallback) runs the rk8 chunk loop: its compile starts
+        # now, in the background (`cache.compile_ahead`; a call that needs it waits for it)
         chunk = chunk_compile_job(model, "rk8", "linear")
-        lib, *rest = cache.compile_parallel([job(_OPTS[0])] + ([chunk[0]] if chunk else []))
-        if chunk:
-            chunk[1](rest[0])
+        if chunk is not None:
+            cache.compile_ahead([chunk])
+        lib = cache.compile_parallel([job(_OPTS[0])])[0]
         if isinstance(lib, RuntimeError):  # (e.g. a compiler without -march=native)
             lib = cache.compile_parallel([job(_OPTS[1])])[0]
         if lib is None or isinstance(lib, RuntimeError):
@@ -1014,6 +996,10 @@ def pass_library(model: Model) -> object | None:
         fixed.argtypes = [i32, i32, i32, i32, ptr, ptr, ptr, ptr, ptr]
         fixed.restype = i32
         fun.fixed_many = fixed  # (`dynamics.integrate.batch_fixed`)
+        probe = lib.rk8_probe
+        probe.argtypes = [ptr, f64, ptr, ptr, ptr, f64, ptr, ptr]
+        probe.restype = i32
+        fun.probe = probe  # (tests: `_PROBE`)
         return fun
 
     return cache.get(("rk8_pass", cache.function_key(model.f)), build, keepalive=model.f)

@@ -11,8 +11,7 @@ from ..model import Model
 from .tableaux import (DOP853_DENSE_A, DOP853_DENSE_C, DOP853_DENSE_D, DOP853_E3, DOP853_E5,
                        TABLEAUX, unique_nodes)
 
-__all__ = ["kernel", "check_lie_model", "INLINE_MAX", "calls_rhs", "dense_kernels",
-           "step_all_kernel"]
+__all__ = ["kernel", "check_lie_model", "INLINE_MAX", "calls_rhs", "dense_kernels"]
 
 #: Most right-hand-side instructions a compiled Runge-Kutta step inlines (stages times the
 #: rhs's instruction count); a larger step calls the rhs as a C function instead (see
@@ -101,13 +100,15 @@ def _embedded_error(x, x_next, k: list, h, rtol, atol):
     return ca.fabs(h) * e5 / ca.sqrt(x.numel() * ca.fmax(e5 + 0.01 * e3, 1e-300))
 
 
-def dense_kernels(model: Model, *, compiled: bool = False) -> tuple[ca.Function, ca.Function]:
+def dense_kernels(model: Model) -> tuple[ca.Function, ca.Function]:
     """DOP853 with its dense output for a control constant over the run (cached):
     ``rk8_step_k (x, h, u, p, rtol, atol) -> (x_next, err, K)`` (``err`` as the ``error``
     step of `kernel`; ``K (12 nx)`` the stages, stacked) and ``rk8_cont (x, x_next, K, h,
     u, p) -> F (7 nx)``, the coefficients of the step's continuous extension of order 7
     (`tableaux.DOP853_DENSE_D`; four more right-hand sides, spent only on a step that
-    holds an output time). ``compiled``: the form to generate C from (see `kernel`).
+    holds an output time). The compiled pass generates them for a model whose right-hand
+    side inlines (`calls_rhs` False); for a larger one it runs the same sums as C loops
+    (`csteps`).
 
     Examples
     --------
@@ -121,84 +122,28 @@ def dense_kernels(model: Model, *, compiled: bool = False) -> tuple[ca.Function,
     >>> bool(np.allclose(F[0], np.ravel(xn - x0)))  # F0 = x_next - x: the end is exact
     True
     """
-    call = compiled and calls_rhs(model, "rk8")
-    key = ("dense_kernels", cache.function_key(model.f)) + (("call",) if call else ()) + \
-        (("compiled",) if compiled else ())
-
     def build():
-        # a called rhs is an SX call node: the stages' sums stay scalar C code (an MX step
-        # copies every vector through its work array: 1.9x numbalsoda's time per step on
-        # the wheel spacecraft, bench/step_cost.py)
         f, tab = model.f, TABLEAUX["rk8"]
-        sym = ca.SX if call else _sym(f)
+        sym = _sym(f)
         nx, nu, np_ = model.nx, model.nu, f.numel_in(2)
         x, h, u, p = sym.sym("x", nx), sym.sym("h"), sym.sym("u", nu), sym.sym("p", np_)
         rtol, atol = sym.sym("rtol"), sym.sym("atol", nx)
-        k = _stages(f, tab.a, tab.c, x, h, lambda c: u, p, [], call=call)
+        k = _stages(f, tab.a, tab.c, x, h, lambda c: u, p, [])
         x_next = x + h * _combine(tab.b, k)
         step = ca.Function("rk8_step_k", [x, h, u, p, rtol, atol],
                            [x_next, _embedded_error(x, x_next, k, h, rtol, atol),
                             ca.vertcat(*k)])
-        # the extension's 4 rhs inline unless they too exceed `INLINE_MAX` (as `calls_rhs`)
-        extra = compiled and 4 * f.n_instructions() > INLINE_MAX
-        sym = ca.SX if extra else _sym(f)
-        x, h, u, p = sym.sym("x", nx), sym.sym("h"), sym.sym("u", nu), sym.sym("p", np_)
         xn, K = sym.sym("x_next", nx), sym.sym("K", tab.stages * nx)
         k = [K[i * nx:(i + 1) * nx] for i in range(tab.stages)]
-        k = _stages(f, ((),), (1.0,), xn, h, lambda c: u, p, k, call=extra)  # k13 = f(x_next)
-        k = _stages(f, DOP853_DENSE_A, DOP853_DENSE_C, x, h, lambda c: u, p, k, call=extra)
+        k = _stages(f, ((),), (1.0,), xn, h, lambda c: u, p, k)  # k13 = f(x_next)
+        k = _stages(f, DOP853_DENSE_A, DOP853_DENSE_C, x, h, lambda c: u, p, k)
         dx = xn - x
         F = [dx, h * k[0] - dx, 2 * dx - h * (k[12] + k[0])] + \
             [h * _combine(row, k) for row in DOP853_DENSE_D]
         cont = ca.Function("rk8_cont", [x, xn, K, h, u, p], [ca.vertcat(*F)])
         return step, cont
 
-    return cache.get(key, build, keepalive=model.f)
-
-
-def step_all_kernel(model: Model) -> tuple[ca.Function, ca.Function]:
-    """``rk8_step_all (x, h, ua, ud, p) -> (x_next, K)`` and ``rk8_err (x, x_next, K, h,
-    rtol, atol) -> err`` (cached): the DOP853 step of `kernel` (``rk8``, control linear over
-    the step, the right-hand side called: an SX call node) with its stages ``K (12 nx)`` as
-    `dense_kernels`' step gives them, and the embedded error estimate from those stages (as
-    `kernel`'s ``error`` step). The compiled pass of a model whose rhs is called
-    (`calls_rhs`) generates this one step for its three uses (the plain step, the step with
-    its error, the dense step under a constant control: ``ud`` 0) instead of three: each is
-    scalar C of the stages' sums of every state, 3,900-5,300 lines for the 26-state hinged
-    bodies, and gcc's time grows with them (`dynamics.cache`, First compile); the plain
-    step computes no error (its stages are not stored).
-
-    Examples
-    --------
-    >>> import numpy as np
-    >>> from appdyn.dynamics import rigid_body
-    >>> from appdyn.dynamics.integrate.kernels import dense_kernels, step_all_kernel
-    >>> model = rigid_body([1.0, 2.0, 3.0])
-    >>> step, err = step_all_kernel(model)
-    >>> x0, u, p, atol = np.r_[0, 0, 0, 1, 0.1, 0.2, 0.3], np.zeros(3), np.zeros(0), np.full(7, 1e-10)
-    >>> xn, K = step(x0, 0.5, u, u, p)
-    >>> xd, ed, Kd = dense_kernels(model)[0](x0, 0.5, u, p, 1e-8, atol)
-    >>> e = err(x0, xn, K, 0.5, 1e-8, atol)
-    >>> bool(np.allclose(xn, xd, rtol=1e-15, atol=1e-15) and np.isclose(float(e), float(ed)))
-    True
-    """
-    def build():
-        f, tab = model.f, TABLEAUX["rk8"]
-        nx, nu, np_ = model.nx, model.nu, f.numel_in(2)
-        ins, u_at = _kernel_inputs(ca.SX, nx, nu, np_, "linear", 0)
-        x, h, p = ins[0], ins[1], ins[-1]
-        k = _stages(f, tab.a, tab.c, x, h, u_at, p, [], call=True)
-        x_next = x + h * _combine(tab.b, k)
-        step = ca.Function("rk8_step_all", ins, [x_next, ca.vertcat(*k)])
-        x, xn, h = ca.SX.sym("x", nx), ca.SX.sym("x_next", nx), ca.SX.sym("h")
-        K = ca.SX.sym("K", tab.stages * nx)
-        rtol, atol = ca.SX.sym("rtol"), ca.SX.sym("atol", nx)
-        k = [K[i * nx:(i + 1) * nx] for i in range(tab.stages)]
-        err = ca.Function("rk8_err", [x, xn, K, h, rtol, atol],
-                          [_embedded_error(x, xn, k, h, rtol, atol)])
-        return step, err
-
-    return cache.get(("rk8_step_all", cache.function_key(model.f)), build,
+    return cache.get(("dense_kernels", cache.function_key(model.f)), build,
                      keepalive=model.f)
 
 

@@ -64,21 +64,13 @@ def chunk_function(model: Model, method: str, mode: str, jit: bool, *, size: int
     return cache.get(base_key + (True,), build_compiled, keepalive=model.f)
 
 
-def chunk_compile_job(model: Model, method: str, mode: str):
-    """The compile of the (default-size) chunk Function, for `cache.compile_parallel`, when
-    it is not cached yet and would be compiled: ``(job, store)``, ``store(result)`` putting
-    the compiled Function (or, after a failure, the interpreted one) into the cache as
-    `chunk_function` would; else None."""
-    key = chunk_key(model, method, mode) + (True,)
-    if cache.compiler() is None or cache.contains(key):
+def chunk_compile_job(model: Model, method: str, mode: str) -> cache.Job | None:
+    """The compile of the (default-size) compiled chunk Function as `chunk_function` would
+    run it (for `cache.compile_ahead`), or None when that Function is built already or
+    would not be compiled."""
+    if cache.compiler() is None or cache.contains(chunk_key(model, method, mode) + (True,)):
         return None
-
-    def store(result):
-        value = ((_build_chunk(model, method, mode), False)
-                 if result is None or isinstance(result, RuntimeError) else (result, True))
-        return cache.get(key, lambda: value, keepalive=model.f)
-
-    return _chunk_job(model, method, mode, CHUNK), store
+    return _chunk_job(model, method, mode, CHUNK)
 
 
 def _chunk_job(model: Model, method: str, mode: str, size: int) -> cache.Job:

@@ -149,6 +149,63 @@ def test_two_processes_compiling_at_once_both_succeed(tmp_path):
     assert verified(library) and not list(tmp_path.glob(".tmp-*"))
 
 
+def scaled_job(k, extra=""):
+    """The `cache.Job` of a compiled ``x -> k x`` (with the C source ``extra``)."""
+    x = ca.SX.sym("x")
+    fun = ca.Function("scaled", [x], [k * x])
+    return cache.Job(lambda: ([fun], extra), "-O0", lambda path: ca.external("scaled", path),
+                     cache.recipe("scaled", fun, extra))
+
+
+def test_a_compile_started_ahead_is_waited_for_not_repeated(disk):
+    job = scaled_job(7.0)
+    before = counts()
+    cache.compile_ahead([job])
+    cache.compile_ahead([job])  # (under way: not started twice)
+    assert list(counts() - before) == [0, 1, 0, 0]
+    (fun,) = cache.compile_parallel([job])
+    assert float(fun(3.0)) == 21.0
+    assert list(counts() - before) == [0, 1, 0, 0]
+    (library,) = artifacts(disk)
+    assert verified(library)
+    cache.compile_ahead([job])  # (on disk: nothing to compile)
+    (again,) = cache.compile_parallel([job])
+    assert float(again(1.0)) == 7.0 and list(counts() - before) == [1, 1, 0, 0]
+
+
+def test_a_compile_ahead_that_fails_says_why_when_taken(disk):
+    job = scaled_job(2.0, extra="this is not C;")
+    cache.compile_ahead([job])
+    (out,) = cache.compile_parallel([job])
+    assert isinstance(out, RuntimeError) and "C compilation of scaled failed" in str(out)
+    assert not artifacts(disk)
+
+
+AHEAD = """
+import sys, casadi as ca
+from appdyn.dynamics import cache
+x = ca.SX.sym("x")
+fun = ca.Function("scaled", [x], [sum(x ** k / (k + 1) for k in range(400))])
+cache.compile_ahead([cache.Job(lambda: ([fun], ""), "-O2", lambda p: ca.external("scaled", p),
+                               cache.recipe("scaled", fun))])
+assert cache._AHEAD  # (still compiling when the process ends)
+"""
+
+
+@pytest.mark.slow
+def test_an_exit_waits_for_the_compiles_under_way(tmp_path):
+    """A process that ends while a compile it started ahead runs leaves the library in
+    the cache (the next process compiles nothing) and no scratch directory behind."""
+    scratch = tmp_path / "tmp"
+    scratch.mkdir()
+    env = {**os.environ, "APPDYN_CACHE_DIR": str(tmp_path / "cache"), "TMPDIR": str(scratch)}
+    done = subprocess.run([sys.executable, "-c", AHEAD], cwd=ROOT, env=env,
+                          capture_output=True, text=True, timeout=600)
+    assert done.returncode == 0, done.stderr
+    (library,) = artifacts(tmp_path / "cache")
+    assert verified(library) and not list(scratch.iterdir())
+
+
 def test_in_process_hits_and_the_key(disk):
     before = counts()
     scaled(5.0)

@@ -437,27 +437,67 @@ def test_header_inputs_are_the_first_slots():
                           "tries", "phase")
 
 
-def test_a_called_rhs_step_is_the_inlined_step():
-    """A right-hand side too large to inline (the wheel spacecraft) is called from the
-    compiled steps as an SX call node (scalar sums around one C function, not an MX step):
-    the dense step, its extension and the pass's error step equal the inlined forms."""
+def _wheels():
     from appdyn.dynamics import wheel_spacecraft
-    from appdyn.dynamics.integrate.kernels import calls_rhs
 
     hub = np.array([[10.0, 0.2, -0.1], [0.2, 12.0, 0.3], [-0.1, 0.3, 8.0]])
     model = wheel_spacecraft(hub, np.c_[np.eye(3), np.ones(3) / np.sqrt(3.0)], 0.05)
-    assert calls_rhs(model, "rk8")
-    x0 = np.r_[0.0, 0.0, 0.0, 1.0, 0.3, -0.2, 0.4, 100.0, -50.0, 80.0, 30.0]
-    u, p, atol = np.zeros(model.nu), np.zeros(model.f.numel_in(2)), np.full(11, 1e-10)
-    (step, cont), (cstep, ccont) = dense_kernels(model), dense_kernels(model, compiled=True)
-    assert cstep.is_a("SXFunction")
-    assert cstep.n_instructions() < 12 * model.f.n_instructions()  # (called, not inlined)
-    a, b = step(x0, 0.7, u, p, 1e-8, atol), cstep(x0, 0.7, u, p, 1e-8, atol)
-    for ai, bi in zip(a, b):
-        assert np.allclose(np.ravel(bi), np.ravel(ai), rtol=1e-14, atol=1e-14)
-    F, G = cont(x0, a[0], a[2], 0.7, u, p), ccont(x0, a[0], a[2], 0.7, u, p)
-    assert np.allclose(np.ravel(G), np.ravel(F), rtol=1e-13, atol=1e-13)
-    e, ce = (kernel(model, "rk8", "linear", error=True, compiled=c) for c in (False, True))
-    assert ce.is_a("SXFunction")
-    for ai, bi in zip(e(x0, 0.7, u, u, p, 1e-8, atol), ce(x0, 0.7, u, u, p, 1e-8, atol)):
-        assert np.allclose(np.ravel(bi), np.ravel(ai), rtol=1e-14, atol=1e-14)
+    return model, np.r_[0.0, 0.0, 0.0, 1.0, 0.3, -0.2, 0.4, 100.0, -50.0, 80.0, 30.0]
+
+
+def _hinged():
+    from appdyn.dynamics import hinged_bodies
+
+    model = hinged_bodies(2.0, [1.0, 1.2, 0.8], 3.0, [0.9, 1.1, 1.3], [0, 0, 0.5], [0, 0, -0.5])
+    return model, model.initial_state([0, 0, 0, 1], [0.1, 0, 0.2], [1.0, 0, 0], [0, 0, 0, 1],
+                                      [0.1, 0, 0.2])
+
+
+@pytest.mark.parametrize("which", ["rigid", "wheels", "hinged"])
+def test_the_compiled_steps_are_the_casadi_kernels(which):
+    """Every step form of the compiled pass (`cpass._PROBE`) equals the casadi kernel it
+    stands for, evaluated by casadi: generated C for a small model (the rigid body), C
+    loops around one generated right-hand side for a large one (`csteps`: the wheel
+    spacecraft with a control linear over the step, the hinged bodies)."""
+    import ctypes
+
+    from appdyn.dynamics.integrate.cpass import pass_library
+    from appdyn.dynamics.integrate.kernels import calls_rhs
+
+    if which == "rigid":
+        model, x0 = rigid_body([1.5, 2.5, 3.2]), np.r_[0.1, -0.2, 0.3, 0.9, 0.5, 0.1, 1.0]
+        x0[:4] /= np.linalg.norm(x0[:4])
+    else:
+        model, x0 = _wheels() if which == "wheels" else _hinged()
+    assert calls_rhs(model, "rk8") == (which != "rigid")
+    lib = pass_library(model)
+    if lib is None:
+        pytest.skip("no C compiler")
+    nx, nu = model.nx, model.nu
+    rng = np.random.default_rng(7)
+    ua, ud = rng.normal(size=nu), rng.normal(size=nu)
+    p, atol, h, rtol = np.zeros(model.f.numel_in(2)), np.full(nx, 1e-10), 0.3, 1e-8
+    out = np.zeros(22 * nx + 2)
+    x0, ua, ud, p, atol = (np.ascontiguousarray(a, float) for a in (x0, ua, ud, p, atol))
+    ptr = [a.ctypes.data_as(ctypes.c_void_p) for a in (x0, ua, ud, p, atol, out)]
+    assert lib.probe(ptr[0], h, ptr[1], ptr[2], ptr[3], rtol, ptr[4], ptr[5]) == 0
+    plain, xe, e, xk, ek = out[:nx], out[nx:2 * nx], out[2 * nx], out[2 * nx + 1:3 * nx + 1], \
+        out[3 * nx + 1]
+    K, F = out[3 * nx + 2:15 * nx + 2], out[15 * nx + 2:]
+
+    def close(got, want, tol=1e-14):
+        want = np.ravel(np.asarray(want, float))
+        assert np.allclose(got, want, rtol=tol, atol=tol * max(1.0, np.abs(want).max()))
+
+    close(plain, kernel(model, "rk8", "linear")(x0, h, ua, ud, p))
+    xw, ew = kernel(model, "rk8", "linear", error=True)(x0, h, ua, ud, p, rtol, atol)
+    close(xe, xw)
+    close(e, ew, 1e-12)
+    step, cont = dense_kernels(model)
+    xw, ew, Kw = step(x0, h, ua, p, rtol, atol)
+    close(xk, xw)
+    close(ek, ew, 1e-12)
+    close(K, Kw)
+    close(F, cont(x0, xw, Kw, h, ua, p), 1e-13)
+    if nu:  # (the control's slope is taken in the one, not in the other)
+        assert not np.allclose(xe, xk, rtol=1e-12, atol=1e-12)
