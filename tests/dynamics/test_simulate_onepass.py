@@ -181,20 +181,25 @@ def test_not_accepted_passes_hand_their_steps_to_the_search():
 
 
 @pytest.mark.slow
-def test_the_first_auto_call_also_compiles_the_fallback_loop():
-    """No hidden compile later: the first ``auto`` call of a model compiles the pass and,
-    at the same time, the rk8 chunk loop its multi-run search runs, so a later call that
-    falls back (here a tolerance near round-off) finds both in the cache."""
-    from appdyn.dynamics import clear_caches
+def test_the_first_auto_call_also_starts_the_fallback_loops_compile(tmp_path):
+    """No second compile later: the first ``auto`` call of a model starts the compile of
+    the rk8 chunk loop its multi-run search runs (in the background: `cache.compile_ahead`),
+    so a later call that falls back (here a tolerance near round-off) waits for that
+    compile, or loads its library, rather than compiling again."""
+    from appdyn.dynamics import clear_caches, diskcache
     from appdyn.dynamics.integrate.loops import chunk_key
-    clear_caches()  # the first call of this model in the process, whatever ran before
-    model = rigid_body([1.0, 2.2, 3.0])
-    t = np.linspace(0.0, 10.0, 11)
-    simulate(model, X0, t, rtol=1e-4)
-    key = chunk_key(model, "rk8", "linear") + (True,)
-    assert cache.contains(key)
-    before = cache.info().kinds
-    res = simulate(model, X0, t, rtol=1e-12, atol=1e-14)
-    assert ONE_PASS not in res.message and res.compiled
-    after = cache.info().kinds  # (interpreted helpers such as the Jacobian may be new)
-    assert after["chunk"] == before["chunk"] and after["rk8_pass"] == before["rk8_pass"]
+    old = diskcache.configure(directory=tmp_path, enabled=True)  # (nothing compiled before)
+    try:
+        clear_caches()  # the first call of this model in the process, whatever ran before
+        model = rigid_body([1.0, 2.2, 3.0])
+        t = np.linspace(0.0, 10.0, 11)
+        start = diskcache.info().compiles
+        simulate(model, X0, t, rtol=1e-4)
+        key = chunk_key(model, "rk8", "linear") + (True,)
+        assert not cache.contains(key)  # (not waited for: the pass answered)
+        assert diskcache.info().compiles == start + 2  # (the pass, and the chunk under way)
+        res = simulate(model, X0, t, rtol=1e-12, atol=1e-14)
+        assert ONE_PASS not in res.message and res.compiled and cache.contains(key)
+        assert diskcache.info().compiles == start + 2
+    finally:
+        diskcache.configure(**old)
