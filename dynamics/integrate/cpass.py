@@ -14,9 +14,9 @@ from .. import cache
 from ..model import Model
 from .csteps import loop_steps
 from .kernels import calls_rhs, dense_kernels, kernel
-from .loops import chunk_compile_job
+from .chunks import BATCH_CHUNK, CHUNK, chunk_compile_job, chunk_name
 
-__all__ = ["BMAX", "CHECK_EVERY", "NOISE", "pass_library"]
+__all__ = ["BMAX", "CHECK_EVERY", "NOISE", "pass_library", "pass_chunk"]
 
 #: Most check-run steps in one output interval (the answer takes ``2 b + 1``; a longer
 #: interval, or a problem that needs more, leaves the pass to the multi-run search).
@@ -915,6 +915,53 @@ int rk8_fixed_many(int k0, int k1, int nint, int m, const casadi_real* H,
 """
 
 
+# The fixed-step rk8 chunk of `chunks.build_chunk` for a model whose rhs is called (`csteps`:
+# the C loops' steps), exported in casadi's external-function form under the chunk's names
+# (`chunk_name`), its signature (inputs, outputs, work) that of a generated stand-in
+# Function (`_chunk_signature`, named `chunk_sig_<size>`): (x0, n, h (1 x B), ua (nu x B),
+# ud (nu x B), p) -> X (nx x B), the state after each of the first n steps, then the state
+# after step n repeated.
+_CHUNK = r"""
+static int pass_chunk(const casadi_real** arg, casadi_real** res, int size) {
+  const casadi_real* a[5];
+  casadi_real* r[1];
+  pass_ctx c;
+  const casadi_real *h = arg[2], *ua = arg[3], *ud = arg[4];
+  casadi_real n = arg[1] ? arg[1][0] : 0, x[PASS_NX], *X = res[0];
+  int s, i;
+  for (i = 0; i < PASS_NX; ++i) x[i] = arg[0] ? arg[0][i] : 0;
+  a[4] = arg[5];
+  for (s = 0; s < size; ++s) {
+    if (s < n) {
+      a[0] = x; a[1] = h + s;
+      a[2] = ua ? ua + s * PASS_NU : 0; a[3] = ud ? ud + s * PASS_NU : 0;
+      r[0] = X + s * PASS_NX;
+      rk8_step(a, r, c.iw, c.w, 0);
+      for (i = 0; i < PASS_NX; ++i) x[i] = X[s * PASS_NX + i];
+    } else {
+      for (i = 0; i < PASS_NX; ++i) X[s * PASS_NX + i] = x[i];
+    }
+  }
+  return 0;
+}
+#define PASS_CHUNK(NAME, SIG, SIZE) \
+CASADI_SYMBOL_EXPORT int NAME(const casadi_real** arg, casadi_real** res, casadi_int* iw, \
+                              casadi_real* w, int mem) { return pass_chunk(arg, res, SIZE); } \
+CASADI_SYMBOL_EXPORT casadi_int NAME##_n_in(void) { return SIG##_n_in(); } \
+CASADI_SYMBOL_EXPORT casadi_int NAME##_n_out(void) { return SIG##_n_out(); } \
+CASADI_SYMBOL_EXPORT const char* NAME##_name_in(casadi_int i) { return SIG##_name_in(i); } \
+CASADI_SYMBOL_EXPORT const char* NAME##_name_out(casadi_int i) { return SIG##_name_out(i); } \
+CASADI_SYMBOL_EXPORT const casadi_int* NAME##_sparsity_in(casadi_int i) { \
+  return SIG##_sparsity_in(i); } \
+CASADI_SYMBOL_EXPORT const casadi_int* NAME##_sparsity_out(casadi_int i) { \
+  return SIG##_sparsity_out(i); } \
+CASADI_SYMBOL_EXPORT int NAME##_work(casadi_int* sz_arg, casadi_int* sz_res, \
+                                     casadi_int* sz_iw, casadi_int* sz_w) { \
+  return SIG##_work(sz_arg, sz_res, sz_iw, sz_w); }
+PASS_CHUNK(%(chunk)s, chunk_sig_%(chunk_size)d, %(chunk_size)d)
+PASS_CHUNK(%(batch)s, chunk_sig_%(batch_size)d, %(batch_size)d)
+"""
+
 # One call of each compiled step form on the same data, for tests (the pass's steps against
 # the casadi kernels they stand for): into out, in turn, the plain step's x_next (nx), the
 # error step's x_next (nx) and error (1), the dense step's x_next (nx), error (1) and
@@ -947,7 +994,8 @@ def pass_library(model: Model) -> object | None:
     def make():
         rhs = _renamed(model.f, "pass_rhs")
         if calls_rhs(model, "rk8"):  # (the steps as C loops around the one rhs: `csteps`)
-            steps, wrappers = [rhs], loop_steps()
+            steps = [rhs, *(_chunk_signature(model, size) for size in (CHUNK, BATCH_CHUNK))]
+            wrappers = loop_steps()
         else:
             step = _renamed(kernel(model, "rk8", "linear", error=True, compiled=True),
                             "rk8_step_err")
@@ -957,7 +1005,12 @@ def pass_library(model: Model) -> object | None:
                      nw=max(f.sz_w() for f in steps), niw=max(f.sz_iw() for f in steps),
                      narg=max(f.sz_arg() for f in steps), nres=max(f.sz_res() for f in steps),
                      steps=wrappers)
-        return steps, _DRIVER % sizes + _STEPPER + _DENSE + _AUTO + _FIXED + _PROBE
+        extra = _DRIVER % sizes + _STEPPER + _DENSE + _AUTO + _FIXED + _PROBE
+        if calls_rhs(model, "rk8"):
+            extra += _CHUNK % dict(chunk=chunk_name("rk8", CHUNK), chunk_size=CHUNK,
+                                   batch=chunk_name("rk8", BATCH_CHUNK),
+                                   batch_size=BATCH_CHUNK)
+        return steps, extra
 
     def job(opt):
         return cache.Job(make, opt, ctypes.CDLL, cache.recipe("rk8_pass", model.f, opt))
@@ -965,8 +1018,8 @@ def pass_library(model: Model) -> object | None:
     def build():
         # auto's multi-run search (the fallback) runs the rk8 chunk loop: its compile starts
         # now, in the background (`cache.compile_ahead`; a call that needs it waits for it)
-        chunk = chunk_compile_job(model, "rk8", "linear")
-        if chunk is not None:
+        chunk = None if calls_rhs(model, "rk8") else chunk_compile_job(model, "rk8", "linear")
+        if chunk is not None:  # (a called rhs: the pass runs the chunk, `pass_chunk`)
             cache.compile_ahead([chunk])
         lib = cache.compile_parallel([job(_OPTS[0])])[0]
         if isinstance(lib, RuntimeError):  # (e.g. a compiler without -march=native)
@@ -1000,9 +1053,32 @@ def pass_library(model: Model) -> object | None:
         probe.argtypes = [ptr, f64, ptr, ptr, ptr, f64, ptr, ptr]
         probe.restype = i32
         fun.probe = probe  # (tests: `_PROBE`)
+        fun.path = lib._name  # (`pass_chunk`)
         return fun
 
     return cache.get(("rk8_pass", cache.function_key(model.f)), build, keepalive=model.f)
+
+
+def pass_chunk(model: Model, size: int) -> ca.Function | None:
+    """The rk8 chunk Function of ``size`` steps (`chunks.build_chunk`'s inputs and output,
+    control linear over each step) run by the compiled pass of a model whose right-hand
+    side is called (`kernels.calls_rhs`): the pass's C loop over its steps (`_CHUNK`),
+    loaded with ``casadi.external`` from the pass's library. None for another model,
+    without a compiled pass, or for a size the pass does not hold."""
+    if size not in (CHUNK, BATCH_CHUNK) or not calls_rhs(model, "rk8"):
+        return None
+    lib = pass_library(model)
+    return None if lib is None else ca.external(chunk_name("rk8", size), lib.path)
+
+
+def _chunk_signature(model: Model, size: int) -> ca.Function:
+    """A Function with the chunk's inputs and output (`chunks.build_chunk`, ``linear``
+    control; its value ``x0`` repeated): generated only for its signature (`_CHUNK`)."""
+    nx, nu, np_ = model.nx, model.nu, model.np
+    ins = [ca.MX.sym("x0", nx), ca.MX.sym("n"), ca.MX.sym("h", 1, size),
+           ca.MX.sym("ua", nu, size), ca.MX.sym("ud", nu, size), ca.MX.sym("p", np_)]
+    # (MX: a few lines of C; an SX output of nx x size scalars would be as many lines)
+    return ca.Function(f"chunk_sig_{size}", ins, [ca.repmat(ins[0], 1, size)])
 
 
 def _renamed(fun: ca.Function, name: str, sym=None) -> ca.Function:

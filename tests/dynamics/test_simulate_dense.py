@@ -501,3 +501,29 @@ def test_the_compiled_steps_are_the_casadi_kernels(which):
     close(F, cont(x0, xw, Kw, h, ua, p), 1e-13)
     if nu:  # (the control's slope is taken in the one, not in the other)
         assert not np.allclose(xe, xk, rtol=1e-12, atol=1e-12)
+
+
+@pytest.mark.parametrize("size", [512, 64])
+def test_the_passs_chunk_is_the_casadi_chunk(size):
+    """The fixed-step rk8 chunk that the compiled pass runs for a model whose right-hand
+    side is called (`cpass.pass_chunk`, C loops) equals the casadi chunk it stands for
+    (`chunks.build_chunk`, evaluated by casadi): the first ``n`` steps of a control linear
+    over each step, then the state after step ``n`` repeated."""
+    from appdyn.dynamics.integrate.chunks import build_chunk
+    from appdyn.dynamics.integrate.cpass import pass_chunk
+
+    model, x0 = _wheels()
+    fast = pass_chunk(model, size)
+    if fast is None:
+        pytest.skip("no C compiler")
+    assert pass_chunk(rigid_body([1.0, 2.0, 3.0]), size) is None  # (inlined: casadi's chunk)
+    rng = np.random.default_rng(3)
+    n = size - 5
+    h = 0.01 + 0.02 * rng.random((1, size))
+    ua, ud = rng.normal(size=(model.nu, size)), rng.normal(size=(model.nu, size))
+    p = np.zeros(model.np)
+    got = np.asarray(fast(x0, n, h, ua, ud, p))
+    want = np.asarray(build_chunk(model, "rk8", "linear", size=size)(x0, n, h, ua, ud, p))
+    assert got.shape == want.shape == (model.nx, size)
+    assert np.allclose(got, want, rtol=1e-13, atol=1e-11)
+    assert np.array_equal(got[:, n:], np.repeat(got[:, n - 1:n], size - n, axis=1))
