@@ -421,9 +421,7 @@ def compile_parallel(jobs: list) -> list:
     finally:  # (an interrupt: no compiler process or scratch directory is left behind)
         for out in results:
             if isinstance(out, _Build):
-                if out.proc is not None and out.proc.poll() is None:
-                    out.proc.kill()
-                    out.proc.wait()
+                out.stop()
                 out.close()
     return results
 
@@ -492,6 +490,22 @@ class _Build:
                                  diskcache.publish(self.key, self.library))
             return self._outcome
 
+    def stop(self) -> None:
+        """Stop the compiler (its whole process group: the driver and its passes) if it
+        still runs."""
+        if self.proc is not None and self.proc.poll() is None:
+            import signal
+
+            try:
+                if hasattr(os, "killpg"):
+                    os.killpg(self.proc.pid, signal.SIGKILL)
+                else:  # (no process groups)
+                    self.proc.kill()
+            except OSError:
+                pass
+        if self.proc is not None:
+            self.wait()
+
     def close(self) -> None:
         import shutil
 
@@ -545,9 +559,12 @@ def _spawn(job: Job, compiler: str, key: str | None):
             return found
     build.key, build.library = key, os.path.join(work, f"{build.name}.so")
     diskcache.compiled()
+    # (the compiler's own temporary files go to the scratch directory too; its own process
+    # group, so that `_Build.stop` stops its passes with it)
     build.proc = subprocess.Popen(
         [compiler, *flags, os.path.basename(source), "-o", build.library, "-lm"], cwd=work,
-        stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+        stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+        env={**os.environ, "TMPDIR": work}, start_new_session=True)
     return build
 
 
@@ -587,12 +604,16 @@ _AHEAD_LOCK = threading.Lock()
 
 def _finish_ahead() -> None:
     """At exit: wait for the compiles under way (their libraries land in the persistent
-    cache) and remove their scratch directories."""
+    cache; with that cache off, stop them instead) and remove their scratch directories."""
     with _AHEAD_LOCK:
         builds = list(_AHEAD.values())
         _AHEAD.clear()
+    keep = diskcache.directory() is not None
     for build in builds:
-        build.wait()
+        if keep:
+            build.wait()
+        else:
+            build.stop()
         build.close()
 
 

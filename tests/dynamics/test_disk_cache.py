@@ -206,6 +206,19 @@ def test_an_exit_waits_for_the_compiles_under_way(tmp_path):
     assert verified(library) and not list(scratch.iterdir())
 
 
+@pytest.mark.slow
+def test_with_the_cache_off_an_exit_stops_the_compiles_under_way(tmp_path):
+    """Nothing would keep the library: the compile is stopped, its scratch removed."""
+    scratch = tmp_path / "tmp"
+    scratch.mkdir()
+    env = {**os.environ, "APPDYN_CACHE_DIR": str(tmp_path / "cache"), "TMPDIR": str(scratch),
+           "APPDYN_DISK_CACHE": "0"}
+    done = subprocess.run([sys.executable, "-c", AHEAD], cwd=ROOT, env=env,
+                          capture_output=True, text=True, timeout=600)
+    assert done.returncode == 0, done.stderr
+    assert not list(scratch.iterdir()) and not (tmp_path / "cache").exists()
+
+
 def test_in_process_hits_and_the_key(disk):
     before = counts()
     scaled(5.0)
