@@ -165,6 +165,23 @@ def save_figure(fig, path: Path) -> Path:
     return path
 
 
+#: Seconds of the timed work run before a short timing (`warmed`): the VM's cores come out
+#: of idle slowly, and a sub-millisecond call timed right after one (a peer's subprocess
+#: waited for, a sleep) measured 1.7x its time on a busy core (bench/integrate_peers.py's
+#: 121-output body: 85-133 against 51-53 us, alternating in one process). Both sides of a
+#: comparison are warmed alike (the peers' scripts with the same `WARM`).
+WARM = 0.2
+
+
+def warmed(fun, seconds: float = WARM) -> None:
+    """Call ``fun()`` repeatedly for ``seconds`` (at least once): the core is at speed
+    for the timing that follows."""
+    end = time.perf_counter() + seconds
+    fun()
+    while time.perf_counter() < end:
+        fun()
+
+
 def timed(fun, repeats: int = 1):
     """``(first-call time, later times, result)``: ``fun()`` once, then ``repeats`` more."""
     t0 = time.perf_counter()

@@ -13,7 +13,8 @@ ratio is the integrators'.
 For each workload both sweep ``rtol`` (``atol = rtol / 100``), appdyn with ``auto`` (each
 answer verified by its own check) and with ``method='dop853'`` (one DOP853 run at the local
 tolerance, nothing verified: the peer's contract, on the same kind of compiled C); each run is timed
-`REPEATS` times (median); the cheapest run of each whose error meets the workload's target
+`REPEATS` times (median) after `_common.WARM` seconds of the same run, on both sides (a
+short call timed on a core just out of idle took 1.7x its time: `_common.warmed`); the cheapest run of each whose error meets the workload's target
 is compared: ``ratio = numbalsoda time / appdyn time`` (> 1: appdyn faster). numbalsoda
 runs in its own venv (``bench/peers/.venv-numbalsoda``, `bench/peers/README.md`);
 without it the appdyn columns alone are reported.
@@ -51,7 +52,7 @@ import numpy as np
 from appdyn.dynamics import rigid_body, simulate
 from appdyn.dynamics.truth import torque_free_omega
 
-from _common import Row, script_main, timed, write_csv
+from _common import WARM, Row, script_main, timed, warmed, write_csv
 
 from overhead import dense_pass_call, paired_per_call  # noqa: E402
 from simulate import (BATCH_TOL, INERTIA, batch_workload, numbalsoda,  # noqa: E402
@@ -174,7 +175,9 @@ def workloads(quick: bool, build: Path) -> list[Workload]:
 
 
 def median_time(fun, repeats: int) -> float:
-    """The median of ``repeats`` calls after a first one [s]."""
+    """The median of ``repeats`` calls after `WARM` seconds of them [s] (`warmed`: the
+    peer's script warms its runs alike)."""
+    warmed(fun)
     return statistics.median(timed(fun, repeats)[1])
 
 
@@ -195,7 +198,7 @@ def appdyn_sweep(w: Workload, tols, repeats, method: str = "auto") -> list[dict]
 
 def peer_sweep(w: Workload, tols, repeats) -> list[dict]:
     job = dict(w.peer, t=w.t.tolist(), x0=w.x0.tolist(), tols=tols, repeats=repeats,
-               solvers=["dop853"])
+               solvers=["dop853"], warm=WARM)
     ans = numbalsoda(job)
     if ans is None:
         return []

@@ -4,7 +4,9 @@ Reads a JSON job from stdin, prints JSON to stdout. Job: ``inertia``, ``t`` (out
 ``x0`` (7,), ``tols`` (rtol list; atol = rtol/100), ``repeats``, and optionally ``batch``:
 ``{"x0s": (K, 7), "t": grid, "rtol": r}`` for the numba-jitted loop of dop853 runs.
 Answers carry body rates (the main process computes errors against the Jacobi truth).
-``mxstep`` (optional, default numbalsoda's 10,000): most steps of a run.
+``mxstep`` (optional, default numbalsoda's 10,000): most steps of a run. ``warm`` (optional,
+seconds, default 0): each tolerance's runs repeated that long before they are timed (as
+appdyn's side is: ``bench/_common.py``, `warmed`).
 
 A job with ``library`` (path of a shared library exporting ``peer_rhs(t, x, dx, p)``, the
 signature of numbalsoda's ``lsoda_sig``: the right-hand side of any appdyn model compiled
@@ -59,6 +61,9 @@ def main():
             continue
         for rtol in job["tols"]:
             times, extra = [], {}
+            warm = time.perf_counter() + job.get("warm", 0.0)  # (as appdyn's `warmed`)
+            while time.perf_counter() < warm:
+                solver(ptr, x0, t, rtol=rtol, atol=rtol * 1e-2, mxstep=mxstep)
             for k in range(job["repeats"] + 1):
                 if calls is not None and k == 1:
                     calls()
