@@ -155,11 +155,16 @@ multi-run fallback, is compiled *ahead* (`compile_ahead`): its compiler starts w
 pass's and runs in the background; a call that needs the chunk waits for it, and the
 process's exit waits for compiles under way so that they land in the persistent cache.
 This is not the interpreted fallback rejected above: no answer depends on timing, only
-when a library is ready does. Measured first ``simulate`` in a fresh process with an empty
-cache (``bench/compile_cache.py``, quiet 2-core VM): the hinged bodies 1.77 to 0.55 s, the
-10-part scene 1.08 to 0.53 s, the tests' 10-part registry scene (35 states) 3.47 to 0.70 s;
-13 registry parts (39 states), whose run ``auto`` hands to its multi-run search, 1.35 s
-with the chunk compiled ahead, 0.84 s from the pass's library.
+when a library is ready does. And a library's big generated functions compile as
+translation units of their own, at once, then linked (`Job`: a list among the functions):
+the rigid body's four inlined steps in two units beside the driver's (one unit of 0.85 s
+of gcc became 0.24, 0.30 and 0.40 s side by side), a large model's right-hand side beside
+the driver. Measured first ``simulate`` in a fresh process with an empty cache
+(``bench/compile_cache.py``, 2-core VM, repeated runs): the rigid body 0.79-1.06 to
+0.49-0.52 s, the hinged bodies 1.77 to 0.39 s, the 10-part scene 1.08 to 0.38-0.40 s, the
+tests' 10-part registry scene (35 states) 3.47 to 0.41-0.45 s; 13 registry parts (39
+states), whose run ``auto`` hands to its multi-run search, 1.35 s (the chunk compiled
+ahead) to 0.60-0.76 s; all 15 registry parts (45 states) 0.54-0.69 s.
 """
 from __future__ import annotations
 
@@ -359,7 +364,9 @@ class Job(NamedTuple):
     """A compile for `compile_parallel` whose functions are built only when needed.
 
     ``make()`` returns ``(functions, extra)`` (the casadi Functions to generate, the first
-    naming the library, and C source appended to them); ``opt`` the compiler flags;
+    naming the library, and C source appended to them; an item that is a list of Functions
+    is a translation unit of its own, compiled at the same time as the others and linked
+    with them, its functions declared for ``extra``); ``opt`` the compiler flags;
     ``load(path)`` the loaded result; ``recipe`` a text that determines the generated source
     (with the code of `diskcache.code_version`): the persistent cache is looked up by it
     before anything is built (`recipe`). ``None``: the source is generated and hashed.
@@ -470,40 +477,52 @@ def _job_key(job: Job, compiler: str) -> str:
 
 class _Build:
     """One C compile in its scratch directory ``work`` (removed by `close`): once started,
-    the generated library's ``name``, its persistent-cache ``key``, the ``library`` the
-    compiler process ``proc`` writes."""
+    the generated library's ``name``, its persistent-cache ``key``, the ``library`` it
+    makes, the compiler processes ``procs`` (one per translation unit, running at once)
+    and the ``link`` command joining their objects (None: one unit, compiled to the
+    library directly)."""
 
     def __init__(self, work: str):
-        self.work, self.name, self.key, self.library, self.proc = work, "", "", "", None
+        self.work, self.name, self.key, self.library = work, "", "", ""
+        self.procs: list = []
+        self.link: list | None = None
         self._lock = threading.Lock()
         self._outcome = None
 
     def wait(self):
-        """Wait for the compiler (once; any thread): the library's path (published to the
-        persistent cache) or the ``RuntimeError`` saying why the compile failed."""
+        """Wait for the compilers and link (once; any thread): the library's path
+        (published to the persistent cache) or the ``RuntimeError`` saying why the compile
+        failed."""
         with self._lock:
             if self._outcome is None:
-                _, err = self.proc.communicate()
+                errors = [err for err, code in ((p.communicate()[1], p.returncode)
+                                                for p in self.procs) if code != 0]
+                if not errors and self.link is not None:
+                    import subprocess
+
+                    done = subprocess.run(self.link, cwd=self.work, capture_output=True,
+                                          text=True)
+                    errors = [done.stderr] if done.returncode != 0 else []
                 self._outcome = (RuntimeError(f"C compilation of {self.name} failed: "
-                                              f"{err.strip()[-500:]}")
-                                 if self.proc.returncode != 0 else
+                                              f"{errors[0].strip()[-500:]}") if errors else
                                  diskcache.publish(self.key, self.library))
             return self._outcome
 
     def stop(self) -> None:
-        """Stop the compiler (its whole process group: the driver and its passes) if it
-        still runs."""
-        if self.proc is not None and self.proc.poll() is None:
-            import signal
+        """Stop the compilers (each one's whole process group: the driver and its passes)
+        that still run."""
+        import signal
 
-            try:
-                if hasattr(os, "killpg"):
-                    os.killpg(self.proc.pid, signal.SIGKILL)
-                else:  # (no process groups)
-                    self.proc.kill()
-            except OSError:
-                pass
-        if self.proc is not None:
+        for proc in self.procs:
+            if proc.poll() is None:
+                try:
+                    if hasattr(os, "killpg"):
+                        os.killpg(proc.pid, signal.SIGKILL)
+                    else:  # (no process groups)
+                        proc.kill()
+                except OSError:
+                    pass
+        if self.procs:
             self.wait()
 
     def close(self) -> None:
@@ -541,8 +560,11 @@ def _spawn(job: Job, compiler: str, key: str | None):
     build = _Build(work)
     try:
         functions, extra = job.make()
-        build.name = functions[0].name()
-        source = _generate_c(functions, extra, work)
+        units = [list(f) for f in functions if isinstance(f, (list, tuple))]
+        main = [f for f in functions if not isinstance(f, (list, tuple))]
+        build.name = main[0].name()
+        sources = [_generate_c(main, _prototypes(units) + extra, work)] + \
+            [_generate_c(unit, "", work) for unit in units]
     except RuntimeError as exc:  # (a Function that cannot be code-generated)
         build.close()
         return RuntimeError(f"generating C failed: {exc}")
@@ -551,21 +573,39 @@ def _spawn(job: Job, compiler: str, key: str | None):
         raise
     flags = _flags(job)
     if key is None:
-        with open(source, "rb") as f:
-            key = diskcache.artifact_key(f.read(), compiler, flags)
+        text = b""
+        for source in sources:
+            with open(source, "rb") as f:
+                text += f.read()
+        key = diskcache.artifact_key(text, compiler, flags)
         found = _load_cached(key, job)
         if found is not None:
             build.close()
             return found
     build.key, build.library = key, os.path.join(work, f"{build.name}.so")
     diskcache.compiled()
-    # (the compiler's own temporary files go to the scratch directory too; its own process
-    # group, so that `_Build.stop` stops its passes with it)
-    build.proc = subprocess.Popen(
-        [compiler, *flags, os.path.basename(source), "-o", build.library, "-lm"], cwd=work,
-        stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
-        env={**os.environ, "TMPDIR": work}, start_new_session=True)
+    # (the compiler's own temporary files go to the scratch directory too; each its own
+    # process group, so that `_Build.stop` stops its passes with it)
+    names = [os.path.basename(source) for source in sources]
+    if len(names) == 1:
+        commands = [[compiler, *flags, names[0], "-o", build.library, "-lm"]]
+    else:  # (the units compiled at once, then linked: `_Build.wait`)
+        compile_flags = [f for f in flags if f != "-shared"]
+        commands = [[compiler, *compile_flags, "-c", n, "-o", n[:-2] + ".o"] for n in names]
+        build.link = [compiler, *flags, *(n[:-2] + ".o" for n in names), "-o", build.library,
+                      "-lm"]
+    build.procs = [subprocess.Popen(command, cwd=work, stdout=subprocess.PIPE,
+                                    stderr=subprocess.PIPE, text=True,
+                                    env={**os.environ, "TMPDIR": work}, start_new_session=True)
+                   for command in commands]
     return build
+
+
+def _prototypes(units: list) -> str:
+    """C declarations of the generated functions of other translation units."""
+    return "".join(f"int {f.name()}(const casadi_real** arg, casadi_real** res, "
+                   "casadi_int* iw, casadi_real* w, int mem);\n"
+                   for unit in units for f in unit)
 
 
 def _finish(build: _Build, job: Job):

@@ -219,6 +219,30 @@ def test_with_the_cache_off_an_exit_stops_the_compiles_under_way(tmp_path):
     assert not list(scratch.iterdir()) and not (tmp_path / "cache").exists()
 
 
+def test_translation_units_compile_at_once_into_one_library(disk):
+    """A job's item that is a list of Functions is its own translation unit: compiled
+    beside the others, linked into the one library (cached as one), its functions
+    declared for the job's C source, which may call them."""
+    x = ca.SX.sym("x")
+    twice, thrice = ca.Function("twice", [x], [2 * x]), ca.Function("thrice", [x], [3 * x])
+    extra = ("double six_times(double x) { const casadi_real* a[1]; casadi_real* r[1]; "
+             "casadi_real y; a[0] = &x; r[0] = &y; thrice(a, r, 0, 0, 0); return 2 * y; }\n")
+
+    def load(path):
+        import ctypes
+        lib = ctypes.CDLL(path)
+        lib.six_times.restype, lib.six_times.argtypes = ctypes.c_double, [ctypes.c_double]
+        return ca.external("twice", path), ca.external("thrice", path), lib.six_times
+
+    job = cache.Job(lambda: ([twice, [thrice]], extra), "-O0", load,
+                    cache.recipe("units", twice, thrice, extra))
+    before = counts()
+    (two, three, six), = cache.compile_parallel([job])
+    assert (float(two(5.0)), float(three(5.0)), six(5.0)) == (10.0, 15.0, 30.0)
+    (library,) = artifacts(disk)
+    assert verified(library) and list(counts() - before) == [0, 1, 0, 0]
+
+
 def test_in_process_hits_and_the_key(disk):
     before = counts()
     scaled(5.0)
