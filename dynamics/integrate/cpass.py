@@ -1074,7 +1074,12 @@ def pass_chunk(model: Model, size: int) -> ca.Function | None:
     if size not in (CHUNK, BATCH_CHUNK) or not calls_rhs(model, "rk8"):
         return None
     lib = pass_library(model)
-    return None if lib is None else ca.external(chunk_name("rk8", size), lib.path)
+    if lib is None:
+        return None
+    try:  # (the loaded library by its path: with the disk cache off, its file is gone)
+        return ca.external(chunk_name("rk8", size), lib.path)
+    except RuntimeError:  # (then the casadi chunk is compiled instead)
+        return None
 
 
 def _chunk_signature(model: Model, size: int) -> ca.Function:

@@ -527,3 +527,22 @@ def test_the_passs_chunk_is_the_casadi_chunk(size):
     assert got.shape == want.shape == (model.nx, size)
     assert np.allclose(got, want, rtol=1e-13, atol=1e-11)
     assert np.array_equal(got[:, n:], np.repeat(got[:, n - 1:n], size - n, axis=1))
+
+
+def test_the_passs_chunk_with_the_disk_cache_off():
+    """With the persistent cache off the pass's library file is gone once loaded: its
+    chunk still runs (the loaded library, by its path), as with the cache on."""
+    from appdyn.dynamics import clear_caches, diskcache
+
+    model, x0 = _wheels()
+    t = np.linspace(0.0, 5.0, 6)
+    want = simulate(model, x0, t, method="rk8", steps=20)
+    old = diskcache.configure(enabled=False)
+    try:
+        clear_caches()
+        got = simulate(model, x0, t, method="rk8", steps=20)
+    finally:
+        diskcache.configure(**old)
+        clear_caches()
+    assert want.success and got.success and got.compiled
+    assert np.allclose(got.x, want.x, rtol=1e-13, atol=1e-12)
