@@ -110,23 +110,10 @@ static int rk8_step_k(const casadi_real** arg, casadi_real** res, casadi_int* iw
 """
 
 
-def _terms(weights, scale: str = "") -> list:
-    """``w K_i[j]`` per nonzero weight (``(w h)`` coefficients when ``scale``)."""
-    out = []
-    for i, w in enumerate(weights):
-        if w != 0.0:
-            coef = f"({w!r} * {scale})" if scale else repr(w)
-            out.append(f"{coef} * K[{i} * PASS_NX + j]")
-    return out
-
-
 def _sum(weights) -> str:
-    """``_combine``'s sum of the nonzero weights, left to right."""
-    terms = _terms(weights)
-    out = terms[0]
-    for t in terms[1:]:
-        out = f"{out} + {t}"
-    return out
+    """``_combine``'s sum ``w_i K_i[j]`` over the nonzero weights, left to right."""
+    return " + ".join(f"{w!r} * K[{i} * PASS_NX + j]" for i, w in enumerate(weights)
+                      if w != 0.0)
 
 
 def _stage(row, node: float, base: str, out: str, control: str) -> list:

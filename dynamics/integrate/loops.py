@@ -34,8 +34,7 @@ def chunk_function(model: Model, method: str, mode: str, jit: bool, *, size: int
     ``h``, ``us (nu*s x B)`` control at the distinct stage nodes of each step, ``p``.
     Output ``X (nx x B)``: the state after each step.
     """
-    att = model.attitude if method == "lie" else None
-    base_key = ("chunk", cache.function_key(model.f), att, method, mode)  # `chunk_key`
+    base_key = chunk_key(model, method, mode)
     if size != CHUNK:
         base_key += (size,)
     if not jit or cache.compiler() is None:
