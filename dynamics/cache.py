@@ -185,7 +185,8 @@ from .validate import integer
 __all__ = ["MAXSIZE", "JIT_MIN_WORK", "CacheInfo", "FunctionCache", "get", "contains", "clear",
            "info", "set_maxsize", "function_key", "memoize", "memoize_values", "value_key",
            "checkout", "construction_lock", "POOL_SIZE", "compiler", "should_compile",
-           "compile_function", "compile_c", "compile_parallel", "compile_ahead", "Job", "recipe"]
+           "compile_function", "compile_c", "compile_parallel", "compile_ahead", "ready", "Job",
+           "recipe"]
 
 #: Most entries kept (least recently used are dropped first).
 MAXSIZE = 512
@@ -461,6 +462,22 @@ def compile_ahead(jobs: list) -> None:
             threading.Thread(target=build.wait, name="appdyn-compile", daemon=True).start()
 
 
+def ready(job: Job) -> bool:
+    """Whether `compile_parallel` of ``job`` (a `Job` with a recipe) would load its library
+    without waiting for a compiler: the persistent cache holds it, or `compile_ahead`'s
+    compile of it has finished. With `compile_ahead`, a call that can do without a library
+    uses it only once it is ready: the first call does not wait for the compile."""
+    compiler = _CACHE.compiler()
+    if compiler is None or job.recipe is None:
+        return False
+    key = _job_key(job, compiler)
+    with _AHEAD_LOCK:
+        ahead = _AHEAD.get(key)
+    if ahead is not None:
+        return ahead.finished()
+    return diskcache.lookup(key) is not None
+
+
 def _as_job(job) -> Job:
     return job if isinstance(job, Job) else Job(lambda job=job: (job[0], job[1]), job[2], job[3])
 
@@ -507,6 +524,15 @@ class _Build:
                                               f"{errors[0].strip()[-500:]}") if errors else
                                  diskcache.publish(self.key, self.library))
             return self._outcome
+
+    def finished(self) -> bool:
+        """Whether the compilers (and the link) are done: `wait` then returns at once."""
+        if self._outcome is not None:
+            return True
+        if any(proc.poll() is None for proc in self.procs):
+            return False
+        self.wait()  # (the link, if any: a few milliseconds)
+        return True
 
     def stop(self) -> None:
         """Stop the compilers (each one's whole process group: the driver and its passes)

@@ -20,7 +20,8 @@ The public entry points are `dynamics.simulate`, `dynamics.SimulationResult`,
                  integration restarts; `Impact`, `ImpactRecord`, the Zeno guard
 ``batch``        K runs at once (``x0`` of shape (nx, K)): compiled loops over the runs,
                  spread over threads (``threads=``); `BatchResult`
-``lanes``        fixed-step rk8 over a batch, four runs per step in vector registers
+``lanes``        a batch's runs four at a time in vector registers: fixed-step rk8, and
+                 the DOP853 step and extension of ``auto``/``dop853`` batches
 ``sanity``       fixed-step runs checked against the model's invariants (status 4)
 ``smoothness``   the non-smooth operations (kinks, jumps) of a model's expression graph
 ``stepcontrol``  DOP853 with step rejection for non-smooth right-hand sides, and stepping

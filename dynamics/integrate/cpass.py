@@ -15,6 +15,7 @@ from ..model import Model
 from .csteps import loop_steps
 from .kernels import calls_rhs, dense_kernels, kernel
 from .chunks import BATCH_CHUNK, CHUNK, chunk_compile_job, chunk_name
+from .lanes import LANES
 
 __all__ = ["BMAX", "CHECK_EVERY", "NOISE", "pass_library", "pass_chunk"]
 
@@ -51,6 +52,7 @@ _DRIVER = r"""
 #define PASS_NIW %(niw)d
 #define PASS_NARG %(narg)d
 #define PASS_NRES %(nres)d
+#define PASS_LANES %(lanes)d
 #define PASS_U (PASS_NU > 0 ? PASS_NU : 1)
 #define CHECK_EVERY %(every)d
 %(steps)s
@@ -349,23 +351,26 @@ static casadi_real dense_first_step(pass_ctx* c, const casadi_real* x, const cas
 
 /* The outputs ts[*j] ... in the step of `hs` from (t, x) to (tn, xn) (stages K) into X
    (nx, ldx): those inside from the step's continuous extension of order 7 (`rk8_cont`,
-   evaluated only for a step that holds one: *have 1 then), those on its end from xn. */
+   evaluated only for a step that holds one: *have 1 then; or given, Fin not NULL), those
+   on its end from xn. */
 static void dense_outputs(pass_ctx* c, const casadi_real* x, const casadi_real* xn,
                           const casadi_real* K, casadi_real hs, const casadi_real* u,
                           const casadi_real* p, casadi_real t, casadi_real tn, int nout,
-                          const casadi_real* ts, int* j, casadi_real* X, int ldx, int* have) {
+                          const casadi_real* ts, int* j, casadi_real* X, int ldx, int* have,
+                          const casadi_real* Fin) {
   const casadi_real* arg[PASS_NARG + 7];
   casadi_real* res[PASS_NRES + 3];
-  casadi_real F[7 * PASS_NX], s, r;
+  casadi_real Fout[7 * PASS_NX], s, r;
+  const casadi_real* F = Fin ? Fin : Fout;
   int i;
   *have = 0;
   while (*j < nout && ts[*j] < tn) {
-    if (!*have) {
+    if (!*have && !Fin) {
       arg[0] = x; arg[1] = xn; arg[2] = K; arg[3] = &hs; arg[4] = u; arg[5] = p;
-      res[0] = F;
+      res[0] = Fout;
       rk8_cont(arg, res, c->iw, c->w, 0);
-      *have = 1;
     }
+    *have = 1;
     s = (ts[*j] - t) / hs;
     for (i = 0; i < PASS_NX; ++i) {
       r = F[5 * PASS_NX + i] + s * F[6 * PASS_NX + i];
@@ -408,23 +413,145 @@ static void dense_outputs(pass_ctx* c, const casadi_real* x, const casadi_real* 
    floor; 8 left one of 2,210 batch runs at 1.16). */
 #define RI_STEPS_MIN 12.0
 
-/* one step of the check from its time to `tn` (two of the answer's steps merged, or its
-   lone last step), its outputs into XC (nx, ldx) */
-static void rich_step(pass_ctx* c, casadi_real* rich, casadi_real tn, const casadi_real* u,
-                      const casadi_real* p, const casadi_real* atol, int nout,
-                      const casadi_real* ts, casadi_real* XC, int ldx) {
+/* DOP853's step with its stages (`rk8_step_k`) of `h` from x under the run's tolerances */
+static void dense_step(pass_ctx* c, const casadi_real* x, casadi_real h, const casadi_real* u,
+                       const casadi_real* p, casadi_real* xn, casadi_real* err, casadi_real* K) {
   const casadi_real* arg[PASS_NARG + 7];
   casadi_real* res[PASS_NRES + 3];
-  casadi_real xn[PASS_NX], K[12 * PASS_NX], err, H = tn - rich[RI_T];
+  arg[0] = x; arg[1] = &h; arg[2] = u; arg[3] = p; arg[4] = &c->rtol; arg[5] = c->atol;
+  res[0] = xn; res[1] = err; res[2] = K;
+  rk8_step_k(arg, res, c->iw, c->w, 0);
+}
+
+/* A `dense_run` in progress: its arguments and its loop's variables, so that its steps can
+   be taken by the step function (`dense_run`) or in the lanes of a vector step
+   (`rk8_auto_lanes`) alike: `dense_open`, then per step `dense_next`, the step, `dense_take`
+   (and the check's step when `check_due`: `rich_step`, or the step and `rich_take`), then
+   `dense_close`. */
+typedef struct {
+  pass_ctx c;
+  casadi_real *x, *t, *count, *rich, *X, *XC;
+  const casadi_real *ts, *u, *p;
+  casadi_real h, hs, tend, max_steps, due;  /* due: the end of the check's step due */
+  int j, nout, ldx, rejected, last, check_due;
+} dense_state;
+
+/* `dense_run`'s start (its arguments); 0 when the run ends at once (count[2] 4: stiff) */
+static int dense_open(dense_state* s, casadi_real* x, casadi_real* t, casadi_real hio,
+                      int nout, const casadi_real* ts, const casadi_real* u,
+                      const casadi_real* p, casadi_real rtol, const casadi_real* atol,
+                      casadi_real max_steps, casadi_real* X, int ldx, casadi_real* count,
+                      casadi_real stiff_steps, casadi_real* rich, casadi_real* XC) {
+  s->c.p = p; s->c.atol = atol; s->c.rtol = rtol;
+  s->x = x; s->t = t; s->count = count; s->rich = rich; s->X = X; s->XC = XC;
+  s->ts = ts; s->u = u; s->p = p; s->tend = ts[nout - 1]; s->max_steps = max_steps;
+  s->j = (int) count[5]; s->nout = nout; s->ldx = ldx; s->rejected = count[6] > 0;
+  s->check_due = 0; s->h = hio;
+  if (!(s->h > 0)) {
+    s->h = dense_first_step(&s->c, x, u, *t, s->tend, count + 7);
+    if (count[7] * (s->tend - *t) / 6.0 > stiff_steps) {  /* stability alone: too many steps */
+      count[2] = 4;
+      return 0;
+    }
+    if (rich) {  /* under a check: at least RI_STEPS_MIN steps */
+      rich[RI_HMAX] = (s->tend - *t) / RI_STEPS_MIN;
+      s->h = fmin(s->h, rich[RI_HMAX]);
+    }
+  }
+  return 1;
+}
+
+/* the next step: its size s->hs (the proposal, or to the last output: s->last) */
+static void dense_next(dense_state* s) {
+  s->last = *s->t + 1.01 * s->h >= s->tend;
+  s->hs = s->last ? s->tend - *s->t : s->h;
+}
+
+/* whether the step of `dense_next`, accepted, holds an output inside (its stages then
+   serve the continuous extension) */
+static int dense_wants_k(const dense_state* s) {
+  return s->j < s->nout && s->ts[s->j] < (s->last ? s->tend : *s->t + s->hs);
+}
+
+/* after the step of s->hs to xn (its estimate err, stages K: read only when
+   `dense_wants_k`, and not when its continuous extension F is given): accepted, its outputs, the check's pair (a step of the check due to
+   s->due: s->check_due), the rounding noise; then the controller. Returns 1 when the run
+   stops (its flag in count[2]). */
+static int dense_take(dense_state* s, casadi_real* xn, casadi_real err, const casadi_real* K,
+                      const casadi_real* F) {
+  casadi_real *x = s->x, *count = s->count, *rich = s->rich, hs = s->hs, fac, tn;
+  int i, have, finite = isfinite(err);
+  for (i = 0; i < PASS_NX && finite; ++i) finite = isfinite(xn[i]);
+  fac = finite ? pow(err, 0.125) / 0.9 : 3.0;
+  if (finite && err <= 1.0) {
+    tn = s->last ? s->tend : *s->t + hs;
+    dense_outputs(&s->c, x, xn, K, hs, s->u, s->p, *s->t, tn, s->nout, s->ts, &s->j, s->X,
+                  s->ldx, &have, F);
+    count[4] += have;
+    for (i = 0; i < PASS_NX; ++i) x[i] = xn[i];
+    *s->t = tn;
+    count[0] += 1;
+    if (rich) {
+      rich[RI_E] += err;
+      if (rich[RI_PEND] > 0 || s->last) {  /* a pair (or the lone last step): checked */
+        rich[RI_PEND] = 0;
+        s->check_due = 1;
+        s->due = tn;
+      } else {
+        rich[RI_PEND] = hs;
+      }
+    }
+    if (((int) count[0]) % DENSE_NOISE_EVERY == 1) {
+      casadi_real f0[PASS_NX], f1[PASS_NX], sg = ((int) count[0] / DENSE_NOISE_EVERY) % 2
+                                                  ? -DBL_EPSILON : DBL_EPSILON;
+      pass_rhs_at(&s->c, x, s->u, f0);
+      for (i = 0; i < PASS_NX; ++i) xn[i] = x[i] * (1 + (i % 2 ? -sg : sg));
+      pass_rhs_at(&s->c, xn, s->u, f1);
+      for (i = 0; i < PASS_NX; ++i)
+        if (fabs(f1[i] - f0[i]) > count[8 + i]) count[8 + i] = fabs(f1[i] - f0[i]);
+    }
+    if (hs < count[3] && !s->last) count[3] = hs;
+  }
+  s->h = ctl_next(hs, s->h, fac, finite && err <= 1.0, &s->rejected, count);
+  if (rich && s->h > rich[RI_HMAX]) s->h = rich[RI_HMAX];
+  count[2] = ctl_flag(count, s->max_steps, s->h, fmax(fabs(*s->t), fabs(s->tend)), finite);
+  return count[2] != 0;
+}
+
+/* `dense_run`'s end: the proposal into *hio, the outputs filled and the rejection kept */
+static void dense_close(dense_state* s, casadi_real* hio) {
+  *hio = s->h;
+  s->count[5] = s->j;
+  s->count[6] = s->rejected;
+}
+
+/* whether the check's step due holds an output inside (as `dense_wants_k`) */
+static int rich_wants_k(const dense_state* s) {
+  int j = (int) s->rich[RI_J];
+  return j < s->nout && s->ts[j] < s->due;
+}
+
+/* the check's step due (two of the answer's steps merged, or its lone last step) taken to
+   xn (estimate err, stages K: read only when `rich_wants_k`, and not when its continuous
+   extension F is given): its outputs into XC */
+static void rich_take(dense_state* s, const casadi_real* xn, casadi_real err,
+                      const casadi_real* K, const casadi_real* F) {
+  casadi_real* rich = s->rich;
   casadi_real* xc = rich + RI_X;
   int j = (int) rich[RI_J], i, have;
-  arg[0] = xc; arg[1] = &H; arg[2] = u; arg[3] = p; arg[4] = &c->rtol; arg[5] = atol;
-  res[0] = xn; res[1] = &err; res[2] = K;
-  rk8_step_k(arg, res, c->iw, c->w, 0);
-  dense_outputs(c, xc, xn, K, H, u, p, rich[RI_T], tn, nout, ts, &j, XC, ldx, &have);
+  dense_outputs(&s->c, xc, xn, K, s->due - rich[RI_T], s->u, s->p, rich[RI_T], s->due,
+                s->nout, s->ts, &j, s->XC, s->ldx, &have, F);
   for (i = 0; i < PASS_NX; ++i) xc[i] = xn[i];
-  rich[RI_T] = tn; rich[RI_PEND] = 0; rich[RI_J] = j; rich[RI_STEPS] += 1;
+  rich[RI_T] = s->due; rich[RI_J] = j; rich[RI_STEPS] += 1;
   rich[RI_EC] += isfinite(err) ? err : INFINITY;
+  s->check_due = 0;
+}
+
+/* the check's step due, by the step function */
+static void rich_step(dense_state* s) {
+  casadi_real xn[PASS_NX], K[12 * PASS_NX], err;
+  dense_step(&s->c, s->rich + RI_X, s->due - s->rich[RI_T], s->u, s->p, xn, &err, K);
+  rich_take(s, xn, err, K, NULL);
 }
 
 /* Steps of x (in/out) from time *t (in/out) towards ts[nout - 1], the outputs at the times
@@ -433,76 +560,33 @@ static void rich_step(pass_ctx* c, casadi_real* rich, casadi_real tn, const casa
    rejected steps, flag (as `rk8_adaptive`'s), smallest accepted step, steps whose continuous
    extension was evaluated, outputs filled, 1 after a rejection, the Lipschitz estimate of
    `dense_first_step` (flag 4 when that many times the run's length over DOP853's stability
-   interval 6 exceeds `stiff_steps`: no step is taken), then per state the rounding noise max |f_i(x (1 + eps s)) - f_i(x)| of
-   the right-hand side at every DENSE_NOISE_EVERY-th accepted state (s = +-1 alternating
-   over the states and the samples). At most `budget` steps per
-   call (the caller checks for interrupts between calls). Returns the outputs filled. The
-   controller is `rk8_adaptive`'s; the last step lands on ts[nout - 1]. With `rich` (not
-   NULL) the check of merged step pairs runs alongside (`rich_step`, outputs into XC). */
+   interval 6 exceeds `stiff_steps`: no step is taken), then per state the rounding noise
+   max |f_i(x (1 + eps s)) - f_i(x)| of the right-hand side at every DENSE_NOISE_EVERY-th
+   accepted state (s = +-1 alternating over the states and the samples). At most `budget`
+   steps per call (the caller checks for interrupts between calls). Returns the outputs
+   filled. The controller is `rk8_adaptive`'s; the last step lands on ts[nout - 1]. With
+   `rich` (not NULL) the check of merged step pairs runs alongside (`rich_step`, outputs
+   into XC). */
 static int dense_run(casadi_real* x, casadi_real* t, casadi_real* hio, int nout,
                      const casadi_real* ts, const casadi_real* u, const casadi_real* p,
                      casadi_real rtol, const casadi_real* atol, casadi_real max_steps,
                      casadi_real* X, int ldx, casadi_real* count, int budget,
                      casadi_real stiff_steps, casadi_real* rich, casadi_real* XC) {
-  pass_ctx c;
-  const casadi_real* arg[PASS_NARG + 7];
-  casadi_real* res[PASS_NRES + 3];
-  casadi_real xn[PASS_NX], K[12 * PASS_NX];
-  casadi_real h = *hio, hp, hs, err, fac, tend = ts[nout - 1], tn;
-  int j = (int) count[5], i, last, rejected = count[6] > 0, finite, have;
-  c.p = p; c.atol = atol; c.rtol = rtol;
-  if (!(h > 0)) {
-    h = dense_first_step(&c, x, u, *t, tend, count + 7);
-    if (count[7] * (tend - *t) / 6.0 > stiff_steps) {  /* stability alone: too many steps */
-      count[2] = 4;
-      return j;
-    }
-    if (rich) {  /* under a check: at least RI_STEPS_MIN steps */
-      rich[RI_HMAX] = (tend - *t) / RI_STEPS_MIN;
-      h = fmin(h, rich[RI_HMAX]);
-    }
+  dense_state s;
+  casadi_real xn[PASS_NX], K[12 * PASS_NX], err;
+  int stop;
+  if (!dense_open(&s, x, t, *hio, nout, ts, u, p, rtol, atol, max_steps, X, ldx, count,
+                  stiff_steps, rich, XC))
+    return s.j;
+  while (s.j < nout && budget-- > 0) {
+    dense_next(&s);
+    dense_step(&s.c, x, s.hs, u, p, xn, &err, K);
+    stop = dense_take(&s, xn, err, K, NULL);
+    if (s.check_due) rich_step(&s);
+    if (stop) break;
   }
-  while (j < nout && budget-- > 0) {
-    hp = h;
-    last = *t + 1.01 * hp >= tend;
-    hs = last ? tend - *t : hp;
-    arg[0] = x; arg[1] = &hs; arg[2] = u; arg[3] = p; arg[4] = &c.rtol; arg[5] = atol;
-    res[0] = xn; res[1] = &err; res[2] = K;
-    rk8_step_k(arg, res, c.iw, c.w, 0);
-    finite = isfinite(err);
-    for (i = 0; i < PASS_NX && finite; ++i) finite = isfinite(xn[i]);
-    fac = finite ? pow(err, 0.125) / 0.9 : 3.0;
-    if (finite && err <= 1.0) {
-      tn = last ? tend : *t + hs;
-      dense_outputs(&c, x, xn, K, hs, u, p, *t, tn, nout, ts, &j, X, ldx, &have);
-      count[4] += have;
-      for (i = 0; i < PASS_NX; ++i) x[i] = xn[i];
-      *t = tn;
-      count[0] += 1;
-      if (rich) {
-        rich[RI_E] += err;
-        if (rich[RI_PEND] > 0 || last) rich_step(&c, rich, tn, u, p, atol, nout, ts, XC, ldx);
-        else rich[RI_PEND] = hs;
-      }
-      if (((int) count[0]) % DENSE_NOISE_EVERY == 1) {
-        casadi_real f0[PASS_NX], f1[PASS_NX], sg = ((int) count[0] / DENSE_NOISE_EVERY) % 2
-                                                    ? -DBL_EPSILON : DBL_EPSILON;
-        pass_rhs_at(&c, x, u, f0);
-        for (i = 0; i < PASS_NX; ++i) xn[i] = x[i] * (1 + (i % 2 ? -sg : sg));
-        pass_rhs_at(&c, xn, u, f1);
-        for (i = 0; i < PASS_NX; ++i)
-          if (fabs(f1[i] - f0[i]) > count[8 + i]) count[8 + i] = fabs(f1[i] - f0[i]);
-      }
-      if (hs < count[3] && !last) count[3] = hs;
-    }
-    h = ctl_next(hs, h, fac, finite && err <= 1.0, &rejected, count);
-    if (rich && h > rich[RI_HMAX]) h = rich[RI_HMAX];
-    if ((count[2] = ctl_flag(count, max_steps, h, fmax(fabs(*t), fabs(tend)), finite))) break;
-  }
-  *hio = h;
-  count[5] = j;
-  count[6] = rejected;
-  return j;
+  dense_close(&s, hio);
+  return s.j;
 }
 """
 
@@ -798,61 +882,86 @@ static void au_floor(casadi_real* w, casadi_real* X, casadi_real* XC) {
   au_verdict(w, w[AU_EST] - ulps + w[AU_FLOOR]);
 }
 
-/* The whole of `dense.dense_auto` for one problem: the answer into X (nx, nout + 1; column
-   0 = x0) and, alongside, its check (its steps merged in pairs) into XC, compared; at most `budget` steps per call (interrupts
-   are looked at between calls). Returns AU_PHASE (3: done). */
-int rk8_auto(casadi_real* w, int nout, int budget, casadi_real* X, casadi_real* XC) {
-  casadi_real* count = AU_COUNT(w);
+/* `rk8_auto`'s start (AU_PHASE 0): the header reset, the first answer begun (AU_PHASE 2);
+   1 when no run is made (AU_RESULT -2, AU_PHASE 3) */
+static int au_start(casadi_real* w, int nout, casadi_real* X, casadi_real* XC) {
   int i, ld = nout + 1;
-  w[AU_NOUT] = nout;
-  if (w[AU_PHASE] == 0) {
-    w[AU_SPENT] = 0; w[AU_TRY] = 0; w[AU_RESULT] = 0; w[AU_FLAG] = 0; w[AU_EST] = NAN;
-    w[AU_BOUND] = 0; w[AU_FLOOR] = 0; w[AU_ULPS] = 0; w[AU_PFAC] = 0; w[AU_PEST] = 0;
-    for (i = 0; i < PASS_NX; ++i) X[i * ld] = XC[i * ld] = AU_X0(w)[i];
-    /* the local tolerance kept AU_LOCAL_ULPS ulps above the states' size (a tighter one asks
-       for less than DOP853's rounding) and at least AU_RTOL_MIN; a requested tolerance
-       itself below that: no run (-2) */
-    w[AU_FMIN] = w[AU_TRIES] <= 0 ? 0  /* (the answer alone: at the tolerance asked) */
-      : fmax(au_size(w) * DBL_EPSILON * AU_LOCAL_ULPS, AU_RTOL_MIN / w[AU_RTOL]);
-    if (w[AU_FMIN] > 1.0) {
-      w[AU_RESULT] = -2; w[AU_PHASE] = 3;
-      return 3;
-    }
-    if (w[AU_FACTOR] < w[AU_FMIN]) w[AU_FACTOR] = w[AU_FMIN];
-    w[AU_LOOSE] = w[AU_FACTOR];
-    au_begin(w, w[AU_FACTOR]);
-    w[AU_PHASE] = 2;
+  w[AU_SPENT] = 0; w[AU_TRY] = 0; w[AU_RESULT] = 0; w[AU_FLAG] = 0; w[AU_EST] = NAN;
+  w[AU_BOUND] = 0; w[AU_FLOOR] = 0; w[AU_ULPS] = 0; w[AU_PFAC] = 0; w[AU_PEST] = 0;
+  for (i = 0; i < PASS_NX; ++i) X[i * ld] = XC[i * ld] = AU_X0(w)[i];
+  /* the local tolerance kept AU_LOCAL_ULPS ulps above the states' size (a tighter one asks
+     for less than DOP853's rounding) and at least AU_RTOL_MIN; a requested tolerance
+     itself below that: no run (-2) */
+  w[AU_FMIN] = w[AU_TRIES] <= 0 ? 0  /* (the answer alone: at the tolerance asked) */
+    : fmax(au_size(w) * DBL_EPSILON * AU_LOCAL_ULPS, AU_RTOL_MIN / w[AU_RTOL]);
+  if (w[AU_FMIN] > 1.0) {
+    w[AU_RESULT] = -2; w[AU_PHASE] = 3;
+    return 1;
   }
+  if (w[AU_FACTOR] < w[AU_FMIN]) w[AU_FACTOR] = w[AU_FMIN];
+  w[AU_LOOSE] = w[AU_FACTOR];
+  au_begin(w, w[AU_FACTOR]);
+  w[AU_PHASE] = 2;
+  return 0;
+}
+
+/* `rk8_auto` after a run ended (an answer with its check, or the rerun from a moved start:
+   `floor`; `plain`: the answer alone): its steps counted, then the verdict, a retry or the
+   rerun (AU_PHASE) */
+static void au_ended(casadi_real* w, casadi_real* X, casadi_real* XC, int floor, int plain) {
+  casadi_real* count = AU_COUNT(w);
+  int i;
+  w[AU_SPENT] += count[0] + count[1] + (floor ? 0 : AU_RICH(w)[RI_STEPS]);
+  if (count[2] != 0 && floor) {  /* (no floor: not verified) */
+    au_verdict(w, INFINITY);
+    return;
+  }
+  if (count[2] != 0) {
+    w[AU_FLAG] = count[2]; w[AU_RESULT] = -3; w[AU_PHASE] = 3;
+    return;
+  }
+  if (floor) {
+    au_floor(w, X, XC);
+    return;
+  }
+  w[AU_NCHK] = AU_RICH(w)[RI_STEPS];
+  w[AU_NANS] = count[0] + count[1];
+  w[AU_ACC] = count[0]; w[AU_REJ] = count[1]; w[AU_HMIN] = count[3];
+  w[AU_INTERP] = count[4]; w[AU_LIP] = count[7];
+  for (i = 0; i < PASS_NX; ++i) AU_NOISE(w)[i] = count[8 + i];
+  w[AU_TRY] += 1;
+  if (plain) {  /* the answer alone: not checked */
+    w[AU_RESULT] = 2; w[AU_EST] = NAN; w[AU_PHASE] = 3;
+    return;
+  }
+  au_judge(w, X, XC);
+}
+
+/* The whole of `dense.dense_auto` for one problem: the answer into X (nx, nout + 1; column
+   0 = x0) and, alongside, its check (its steps merged in pairs) into XC, compared; at most
+   `budget` steps per call (interrupts are looked at between calls). Returns AU_PHASE (3:
+   done). */
+int rk8_auto(casadi_real* w, int nout, int budget, casadi_real* X, casadi_real* XC) {
+  w[AU_NOUT] = nout;
+  if (w[AU_PHASE] == 0 && au_start(w, nout, X, XC)) return 3;
   while (budget > 0 && w[AU_PHASE] != 3) {
     int floor = w[AU_PHASE] == 4, plain = w[AU_TRIES] <= 0;
-    if (!au_step(w, w[AU_FACTOR], floor ? XC : X, &budget, !floor && !plain, XC))
-      continue;
-    w[AU_SPENT] += count[0] + count[1] + (floor ? 0 : AU_RICH(w)[RI_STEPS]);
-    if (count[2] != 0 && floor) {  /* (no floor: not verified) */
-      au_verdict(w, INFINITY);
-      break;
-    }
-    if (count[2] != 0) {
-      w[AU_FLAG] = count[2]; w[AU_RESULT] = -3; w[AU_PHASE] = 3;
-      break;
-    }
-    if (floor) {
-      au_floor(w, X, XC);
-      continue;
-    }
-    w[AU_NCHK] = AU_RICH(w)[RI_STEPS];
-    w[AU_NANS] = count[0] + count[1];
-    w[AU_ACC] = count[0]; w[AU_REJ] = count[1]; w[AU_HMIN] = count[3];
-    w[AU_INTERP] = count[4]; w[AU_LIP] = count[7];
-    for (i = 0; i < PASS_NX; ++i) AU_NOISE(w)[i] = count[8 + i];
-    w[AU_TRY] += 1;
-    if (plain) {  /* the answer alone: not checked */
-      w[AU_RESULT] = 2; w[AU_EST] = NAN; w[AU_PHASE] = 3;
-      break;
-    }
-    au_judge(w, X, XC);
+    if (au_step(w, w[AU_FACTOR], floor ? XC : X, &budget, !floor && !plain, XC))
+      au_ended(w, X, XC, floor, plain);
   }
   return (int) w[AU_PHASE];
+}
+
+/* the workspace wk of run k of a batch: the shared inputs of w with the run's x0, u and
+   p (K rows of nx, max(nu, 1) and max(np, 1)), at its start (AU_PHASE 0) */
+static void au_load(casadi_real* wk, const casadi_real* w, int size, size_t k,
+                    const casadi_real* x0, const casadi_real* u, const casadi_real* p) {
+  int i;
+  for (i = 0; i < size; ++i) wk[i] = w[i];
+  for (i = 0; i < PASS_NX; ++i) AU_X0(wk)[i] = x0[k * PASS_NX + i];
+  for (i = 0; i < PASS_NU; ++i) AU_U(wk)[i] = u[k * PASS_U + i];
+  for (i = 0; i < PASS_NP; ++i) AU_P(wk)[i] = p[k * (PASS_NP > 0 ? PASS_NP : 1) + i];
+  wk[AU_PHASE] = 0;
 }
 
 /* `rk8_auto` for the runs k0 <= k < k1 of a batch, one after another, each with its own
@@ -866,13 +975,209 @@ int rk8_auto_many(const casadi_real* w, int nout, int k0, int k1, const casadi_r
   casadi_real* wk = (casadi_real*) malloc(sizeof(casadi_real) * size);
   if (!wk) return 0;
   for (k = k0; k < k1; ++k) {
-    for (i = 0; i < size; ++i) wk[i] = w[i];
-    for (i = 0; i < PASS_NX; ++i) AU_X0(wk)[i] = x0[k * PASS_NX + i];
-    for (i = 0; i < PASS_NU; ++i) AU_U(wk)[i] = u[k * PASS_U + i];
-    for (i = 0; i < PASS_NP; ++i) AU_P(wk)[i] = p[k * (PASS_NP > 0 ? PASS_NP : 1) + i];
-    wk[AU_PHASE] = 0;
+    au_load(wk, w, size, (size_t) k, x0, u, p);
     rk8_auto(wk, nout, INT_MAX, X + (size_t) k * PASS_NX * ld, XC);
     for (i = 0; i < AU_HDR; ++i) res[(size_t) k * AU_HDR + i] = wk[i];
+  }
+  free(wk);
+  return k1 - k0;
+}
+
+/* ---- `rk8_auto_many` with PASS_LANES runs stepped at once in the lanes of a vector step:
+   `lanes.lane_source`'s `rk8_step_k` and `rk8_cont`, each lane a run's own arithmetic in
+   the order of the step function (the same bits). Each lane keeps its own steps,
+   controller, outputs and check (`dense_state`); a lane whose run ended takes the next
+   run. The continuous extension is taken for the lanes whose step holds an output. ---- */
+typedef double au_vec __attribute__((vector_size(8 * PASS_LANES)));
+typedef int (*au_vstep)(const au_vec** arg, au_vec** res);
+
+/* the vector step's inputs and outputs (those of `rk8_step_k`, a lane per run), then the
+   step's continuous extension (`rk8_cont` of x, xn, K, h, u, p) */
+typedef struct {
+  au_vec x[PASS_NX], h, u[PASS_U], p[PASS_NP > 0 ? PASS_NP : 1], rtol, atol[PASS_NX];
+  au_vec xn[PASS_NX], err, K[12 * PASS_NX], F[7 * PASS_NX];
+} au_vio;
+
+/* a lane: its run k (-1: none), that run's workspace, answer and check outputs, and its
+   `dense_run` in progress (`opened` 0: it ended at its start) */
+typedef struct {
+  dense_state s;
+  casadi_real *w, *X, *XC;
+  long k;
+  int opened, ended;
+} au_lane;
+
+/* lane l's inputs: a step of h from x under the run's control, parameters and tolerances */
+static void au_vset(au_vio* v, int l, const dense_state* s, const casadi_real* x,
+                    casadi_real h) {
+  int i;
+  for (i = 0; i < PASS_NX; ++i) {
+    v->x[i][l] = x[i];
+    v->atol[i][l] = s->c.atol[i];
+  }
+  for (i = 0; i < PASS_NU; ++i) v->u[i][l] = s->u[i];
+  for (i = 0; i < PASS_NP; ++i) v->p[i][l] = s->p[i];
+  v->h[l] = h;
+  v->rtol[l] = s->c.rtol;
+}
+
+/* the vector step of the lanes `use` (the others repeat the inputs of the first in use) */
+static void au_vcall(au_vstep step, au_vio* v, const int* use) {
+  const au_vec* arg[6];
+  au_vec* res[3];
+  int l, i, f = 0;
+  while (!use[f]) ++f;
+  for (l = 0; l < PASS_LANES; ++l)
+    if (!use[l]) {
+      for (i = 0; i < PASS_NX; ++i) {
+        v->x[i][l] = v->x[i][f];
+        v->atol[i][l] = v->atol[i][f];
+      }
+      for (i = 0; i < PASS_U; ++i) v->u[i][l] = v->u[i][f];
+      for (i = 0; i < (PASS_NP > 0 ? PASS_NP : 1); ++i) v->p[i][l] = v->p[i][f];
+      v->h[l] = v->h[f];
+      v->rtol[l] = v->rtol[f];
+    }
+  arg[0] = v->x; arg[1] = &v->h; arg[2] = v->u; arg[3] = v->p; arg[4] = &v->rtol;
+  arg[5] = v->atol;
+  res[0] = v->xn; res[1] = &v->err; res[2] = v->K;
+  step(arg, res);
+}
+
+/* the continuous extension of the vector step just taken (`vcont`), when a lane of `want`
+   needs it */
+static void au_vcont(au_vstep vcont, au_vio* v, const int* want) {
+  const au_vec* arg[6];
+  au_vec* res[1];
+  int l, any = 0;
+  for (l = 0; l < PASS_LANES; ++l) any |= want[l];
+  if (!any) return;
+  arg[0] = v->x; arg[1] = v->xn; arg[2] = v->K; arg[3] = &v->h; arg[4] = v->u; arg[5] = v->p;
+  res[0] = v->F;
+  vcont(arg, res);
+}
+
+/* lane l's outputs: x_next, the estimate and (`withf`) the continuous extension */
+static void au_vget(const au_vio* v, int l, casadi_real* xn, casadi_real* err,
+                    casadi_real* F, int withf) {
+  int i;
+  for (i = 0; i < PASS_NX; ++i) xn[i] = v->xn[i][l];
+  *err = v->err[l];
+  if (withf)
+    for (i = 0; i < 7 * PASS_NX; ++i) F[i] = v->F[i][l];
+}
+
+/* the check steps due in the lanes, in one vector step, when one of them cannot wait
+   (`all`; or a lane whose next accepted step would make another due: it ends a pair or
+   the run); a check step waits at most one answer step, so about one vector step of
+   checks serves every lane's pair */
+static void au_checks(au_lane* L, au_vio* v, au_vstep step, au_vstep vcont, int all) {
+  casadi_real xn[PASS_NX], F[7 * PASS_NX], err;
+  int use[PASS_LANES], want[PASS_LANES], l, any = 0, urgent = all;
+  for (l = 0; l < PASS_LANES; ++l) {
+    dense_state* s = &L[l].s;
+    use[l] = L[l].k >= 0 && L[l].opened && s->check_due;
+    any |= use[l];
+    if (use[l] && (s->rich[RI_PEND] > 0 || *s->t + 1.01 * s->h >= s->tend)) urgent = 1;
+  }
+  if (!any || !urgent) return;
+  for (l = 0; l < PASS_LANES; ++l)
+    if (use[l]) au_vset(v, l, &L[l].s, L[l].s.rich + RI_X, L[l].s.due - L[l].s.rich[RI_T]);
+  au_vcall(step, v, use);
+  for (l = 0; l < PASS_LANES; ++l) want[l] = use[l] && rich_wants_k(&L[l].s);
+  au_vcont(vcont, v, want);
+  for (l = 0; l < PASS_LANES; ++l)
+    if (use[l]) {
+      au_vget(v, l, xn, &err, F, want[l]);
+      rich_take(&L[l].s, xn, err, NULL, F);
+    }
+}
+
+/* lane L's run, its first answer (and check) ended: `rk8_auto`'s verdict, any retry or
+   rerun as `rk8_auto` (one run alone), the header into res (AU_HDR per run) */
+static void au_lane_finish(au_lane* L, int nout, casadi_real* res, int plain) {
+  int i;
+  if (L->opened) dense_close(&L->s, AU_H(L->w));
+  au_ended(L->w, L->X, L->XC, 0, plain);
+  if (L->w[AU_PHASE] != 3) rk8_auto(L->w, nout, INT_MAX, L->X, L->XC);
+  for (i = 0; i < AU_HDR; ++i) res[(size_t) L->k * AU_HDR + i] = L->w[i];
+  L->k = -1;
+}
+
+/* lane L takes run k (`au_load`, `rk8_auto`'s start, its first answer opened as `au_step`
+   opens it); a run that takes no step is finished at once (the lane is then empty) */
+static void au_lane_load(au_lane* L, const casadi_real* w, int size, int nout, long k,
+                         const casadi_real* x0, const casadi_real* u, const casadi_real* p,
+                         casadi_real* X, casadi_real* res, int plain) {
+  casadi_real* wk = L->w;
+  int i;
+  au_load(wk, w, size, (size_t) k, x0, u, p);
+  wk[AU_NOUT] = nout;
+  L->k = k;
+  L->X = X + (size_t) k * PASS_NX * (nout + 1);
+  L->ended = 0;
+  if (au_start(wk, nout, L->X, L->XC)) {
+    for (i = 0; i < AU_HDR; ++i) res[(size_t) k * AU_HDR + i] = wk[i];
+    L->k = -1;
+    return;
+  }
+  L->opened = dense_open(&L->s, AU_XR(wk), AU_TT(wk), *AU_H(wk), nout, AU_TS(wk), AU_U(wk),
+                         AU_P(wk), wk[AU_RTOL] * wk[AU_FACTOR], AU_AL(wk),
+                         wk[AU_MAXSTEPS] - wk[AU_SPENT], L->X + 1, nout + 1, AU_COUNT(wk),
+                         wk[AU_STIFF], plain ? NULL : AU_RICH(wk), L->XC + 1);
+  if (!L->opened || L->s.j >= nout) au_lane_finish(L, nout, res, plain);
+}
+
+/* `rk8_auto_many` (the same arguments, the same answers and headers) with the runs'
+   first answers and their checks stepped PASS_LANES at a time by `vstep` and `vcont` (the
+   vector `rk8_step_k` and `rk8_cont`); XC (PASS_LANES, nx, nout + 1) scratch, a lane's
+   each. */
+int rk8_auto_lanes(const casadi_real* w, int nout, int k0, int k1, const casadi_real* x0,
+                   const casadi_real* u, const casadi_real* p, casadi_real* X,
+                   casadi_real* XC, casadi_real* res, void* vstep, void* vcont) {
+  au_vstep step = (au_vstep) vstep, cont = (au_vstep) vcont;
+  au_vio v;
+  au_lane L[PASS_LANES];
+  casadi_real xn[PASS_NX], F[7 * PASS_NX], err;
+  int size = AU_SIZE(nout), plain = w[AU_TRIES] <= 0, use[PASS_LANES], want[PASS_LANES], l;
+  int any;
+  long next = k0;
+  casadi_real* wk = (casadi_real*) malloc(sizeof(casadi_real) * size * PASS_LANES);
+  if (!wk) return 0;
+  for (l = 0; l < PASS_LANES; ++l) {
+    L[l].w = wk + (size_t) l * size;
+    L[l].XC = XC + (size_t) l * PASS_NX * (nout + 1);
+    L[l].k = -1;
+  }
+  for (;;) {
+    for (l = 0; l < PASS_LANES; ++l)  /* (an empty lane takes the next run) */
+      while (L[l].k < 0 && next < k1) au_lane_load(&L[l], w, size, nout, next++, x0, u, p,
+                                                   X, res, plain);
+    any = 0;
+    for (l = 0; l < PASS_LANES; ++l) any |= use[l] = L[l].k >= 0;
+    if (!any) break;
+    au_checks(L, &v, step, cont, 0);
+    for (l = 0; l < PASS_LANES; ++l)
+      if (use[l]) {
+        dense_next(&L[l].s);
+        au_vset(&v, l, &L[l].s, L[l].s.x, L[l].s.hs);
+      }
+    au_vcall(step, &v, use);
+    for (l = 0; l < PASS_LANES; ++l)  /* (the extension of a step that is accepted) */
+      want[l] = use[l] && v.err[l] <= 1.0 && dense_wants_k(&L[l].s);
+    au_vcont(cont, &v, want);
+    any = 0;
+    for (l = 0; l < PASS_LANES; ++l)
+      if (use[l]) {
+        au_vget(&v, l, xn, &err, F, want[l]);
+        L[l].ended = dense_take(&L[l].s, xn, err, NULL, want[l] ? F : NULL) ||
+                     L[l].s.j >= nout;
+        any |= L[l].ended;
+      }
+    if (!any) continue;
+    au_checks(L, &v, step, cont, 1);  /* (a run ends with its checks taken) */
+    for (l = 0; l < PASS_LANES; ++l)
+      if (use[l] && L[l].ended) au_lane_finish(&L[l], nout, res, plain);
   }
   free(wk);
   return k1 - k0;
@@ -1006,7 +1311,7 @@ def pass_library(model: Model) -> object | None:
             plain = _renamed(kernel(model, "rk8", "linear", compiled=True), "rk8_step")
             main, units, wrappers = [rhs], [[step, plain], list(dense_kernels(model))], ""
         every = main + [f for unit in units for f in unit]
-        sizes = dict(every=CHECK_EVERY, nx=model.nx, nu=model.nu, np=model.np,
+        sizes = dict(every=CHECK_EVERY, lanes=LANES, nx=model.nx, nu=model.nu, np=model.np,
                      nw=max(f.sz_w() for f in every), niw=max(f.sz_iw() for f in every),
                      narg=max(f.sz_arg() for f in every), nres=max(f.sz_res() for f in every),
                      steps=wrappers)
@@ -1051,6 +1356,10 @@ def pass_library(model: Model) -> object | None:
         many.argtypes = [ptr, i32, i32, i32, ptr, ptr, ptr, ptr, ptr, ptr]
         many.restype = i32
         fun.auto_many = many  # (`dynamics.integrate.dense`, a batch)
+        lanes = lib.rk8_auto_lanes
+        lanes.argtypes = [ptr, i32, i32, i32, ptr, ptr, ptr, ptr, ptr, ptr, ptr, ptr]
+        lanes.restype = i32
+        fun.auto_lanes = lanes  # (the same, in vector lanes: `lanes.lane_steps`)
         fixed = lib.rk8_fixed_many
         fixed.argtypes = [i32, i32, i32, i32, ptr, ptr, ptr, ptr, ptr]
         fixed.restype = i32

@@ -51,6 +51,7 @@ import numpy as np
 from .. import cache
 from ..interrupts import check_interrupt, deferred_interrupts
 from .cpass import pass_library
+from .lanes import LANES
 from .inputs import Problem
 
 __all__ = ["FIELDS", "HEADER", "FIRST", "CHECK", "TRIES", "DenseAuto", "dense_auto", "dense_run",
@@ -143,6 +144,7 @@ class _Plan(NamedTuple):
 
     auto: object
     many: object
+    lanes: object
     nx: int
     nu: int
     np: int
@@ -154,7 +156,7 @@ def _plan(model) -> _Plan | None:
     def build():
         lib = pass_library(model)
         return None if lib is None else _Plan(
-            lib.auto, lib.auto_many, model.nx, model.nu, model.np,
+            lib.auto, lib.auto_many, lib.auto_lanes, model.nx, model.nu, model.np,
             -1 if model.attitude is None else model.attitude[0])
 
     return cache.get(("dense_plan", cache.function_key(model.f)), build, keepalive=model.f)
@@ -170,8 +172,9 @@ _LOCAL = threading.local()
 
 class _Work(NamedTuple):
     """A thread's workspace for ``nout`` outputs: ``ws`` (`_size` doubles), the check-run
-    scratch ``XC (nx, nout + 1)``, the answer's buffer ``X (nx, nout + 1)`` (copied out after
-    a call), their addresses and the arguments of the single run's call ``args``."""
+    scratch ``XC (nx, nout + 1)`` (``XL (LANES, nx, nout + 1)``: a lane's each, for
+    ``rk8_auto_lanes``), the answer's buffer ``X (nx, nout + 1)`` (copied out after a
+    call), their addresses and the arguments of the single run's call ``args``."""
 
     ws: np.ndarray
     XC: np.ndarray
@@ -179,6 +182,8 @@ class _Work(NamedTuple):
     xc_addr: int
     X: np.ndarray
     args: tuple
+    XL: np.ndarray
+    xl_addr: int
 
 
 def _workspace(plan: _Plan, nout: int) -> _Work:
@@ -194,9 +199,11 @@ def _workspace(plan: _Plan, nout: int) -> _Work:
             table.clear()
         ws, XC, X = np.zeros(_size(plan, nout)), np.empty((plan.nx, nout + 1)), \
             np.empty((plan.nx, nout + 1))
+        XL = np.empty((LANES, plan.nx, nout + 1))
         ws[_TRIES], ws[_NOUT] = TRIES, nout
         got = table[key] = _Work(ws, XC, ws.ctypes.data, XC.ctypes.data, X,
-                                 (ws.ctypes.data, nout, BUDGET, X.ctypes.data, XC.ctypes.data))
+                                 (ws.ctypes.data, nout, BUDGET, X.ctypes.data, XC.ctypes.data),
+                                 XL, XL.ctypes.data)
     return got
 
 
@@ -334,15 +341,16 @@ def _tell(progress, steps: int, told: int) -> int:
 def dense_many(model, x0: np.ndarray, t: np.ndarray, u: np.ndarray, p: np.ndarray,
                rtol: float, atol: np.ndarray, max_steps: float, stiff_steps: float,
                runs: slice, *, out: tuple[np.ndarray, np.ndarray] | None = None,
-               factor: float | None = None,
-               check: bool = True) -> tuple[np.ndarray, np.ndarray] | None:
+               factor: float | None = None, check: bool = True,
+               vector=None) -> tuple[np.ndarray, np.ndarray] | None:
     """`dense_auto` for the runs ``runs`` of a batch in one compiled loop: ``x0 (K, nx)``,
     ``u (K, max(nu, 1))`` (each run's constant control), ``p (K, max(np, 1))``, all
     C-contiguous; each run's first answer at local tolerance ``factor`` times the requested
     one (None: `FIRST`, as a single call; a batch learns its own,
     `dynamics.integrate.batch.first_factor`), a retry as in a single call; ``check`` False:
     each run's answer alone (as `dense_run`'s; a failed run's outputs past its failure are
-    not written). Returns
+    not written); ``vector`` (`lanes.dense_lanes` of the model, or None): the runs stepped
+    `lanes.LANES` at a time in its vector lanes (``rk8_auto_lanes``: the same bits). Returns
     ``(X (r, nx, n), head (r, HEADER))``: the answers and each run's header (`outcome_of`
     reads it); None without a compiled pass. ``out``: C-contiguous ``(X (K, nx, n),
     head (K, HEADER))`` of the whole batch, whose slices ``runs`` the loop fills (and
@@ -379,9 +387,12 @@ def dense_many(model, x0: np.ndarray, t: np.ndarray, u: np.ndarray, p: np.ndarra
                              "covering `runs`")
         at = k0
     # (the loop runs k = at .. at + r - 1 of X and head, reading x0, u, p from row k0 - at)
-    plan.many(work.ws_addr, nout, at, at + r, x0[k0 - at:].ctypes.data,
-              u[k0 - at:].ctypes.data, p[k0 - at:].ctypes.data, X.ctypes.data, work.xc_addr,
-              head.ctypes.data)
+    args = (work.ws_addr, nout, at, at + r, x0[k0 - at:].ctypes.data, u[k0 - at:].ctypes.data,
+            p[k0 - at:].ctypes.data, X.ctypes.data)
+    if vector is not None and r > 1:
+        plan.lanes(*args, work.xl_addr, head.ctypes.data, vector.address, vector.cont)
+    else:
+        plan.many(*args, work.xc_addr, head.ctypes.data)
     return X[at:at + r], head[at:at + r]
 
 
