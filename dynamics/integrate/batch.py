@@ -188,7 +188,10 @@ def auto_dense_batch(batch: Batch, rtol: float, atol: np.ndarray, max_steps: int
     ``threads`` threads by `batch_fixed.spread_runs` from ``2 DENSE_PART`` runs on, each
     part filling its own slice of the answers), each run with its own steps; round by round
     (`dense_rounds`, each spread over the batch), each later round's first answers at the
-    factor `first_factor` learns from the runs before. A run not verified there goes alone
+    factor `first_factor` learns from the runs before (a round's runs gathered end to end:
+    one compiled loop per part, `lanes.dense_lanes`' vector lanes kept full; its answers
+    put back in place; each run's answer does not depend on its neighbours, so the bits do
+    not depend on the gathering, the parts or the lanes). A run not verified there goes alone
     through `solve_auto` (as a single call would). Returns ``(x (nx, n, K), ok, status,
     estimate, method, n_steps, message)``, or None (no compiled pass, a control that varies
     within a run, jit off)."""
@@ -213,22 +216,22 @@ def auto_dense_batch(batch: Batch, rtol: float, atol: np.ndarray, max_steps: int
         if done:
             factor = _learned(head[np.concatenate(done)], factor, rtol)
         factors.append(factor)
-        starts = np.cumsum([0] + [k1 - k0 for k0, k1 in pieces])
+        # the round's runs gathered end to end (one compiled loop per thread's part, its
+        # vector lanes kept full), their answers and headers put back in place
+        runs = np.concatenate([np.arange(k0, k1) for k0, k1 in pieces])
+        xr, ur, pr = x0[runs], u[runs], p[runs]
+        Xr, hr = np.empty((runs.size, nx, t.size)), np.empty((runs.size, DENSE_HEADER))
 
-        def call(a, b, pieces=pieces, starts=starts, factor=factor):
-            # the round's runs a <= i < b, its pieces laid end to end: each piece's share
-            for (k0, _), s0, s1 in zip(pieces, starts[:-1], starts[1:]):
-                lo, hi = max(a, s0), min(b, s1)
-                if lo < hi and dense_many(model, x0, t, u, p, rtol, atol, max_steps,
-                                          STIFF_STEPS, slice(k0 + lo - s0, k0 + hi - s0),
-                                          out=(X, head), factor=factor,
-                                          vector=vector) is None:
-                    missing.append(k0)
+        def call(a, b, xr=xr, ur=ur, pr=pr, Xr=Xr, hr=hr, factor=factor):
+            if dense_many(model, xr, t, ur, pr, rtol, atol, max_steps, STIFF_STEPS,
+                          slice(a, b), out=(Xr, hr), factor=factor, vector=vector) is None:
+                missing.append(a)
 
-        spread_runs(call, int(starts[-1]), spread, DENSE_PART)
+        spread_runs(call, runs.size, spread, DENSE_PART)
         if missing:
             return None
-        done += [np.arange(k0, k1) for k0, k1 in pieces]
+        X[runs], head[runs] = Xr, hr
+        done.append(runs)
     result = head[:, DENSE_FIELDS.index("result")]  # (each run's header read as columns)
     estimate = head[:, DENSE_FIELDS.index("estimate")].copy()
     steps = head[:, DENSE_FIELDS.index("spent")].astype(int)
