@@ -588,6 +588,121 @@ static int dense_run(casadi_real* x, casadi_real* t, casadi_real* hio, int nout,
   dense_close(&s, hio);
   return s.j;
 }
+
+/* ---- Steps in the lanes of a vector step (`lanes.dense_lanes`: `rk8_step_k` and
+   `rk8_cont` rewritten with each value a vector of PASS_LANES doubles, each lane the step
+   function's arithmetic in its order: the same bits): a lane is a slot for any step of
+   the run's model, an answer's or a check's, of any run. ---- */
+typedef double au_vec __attribute__((vector_size(8 * PASS_LANES)));
+typedef int (*au_vstep)(const au_vec** arg, au_vec** res);
+
+/* the vector step's inputs and outputs (those of `rk8_step_k`, a lane per run), then the
+   step's continuous extension (`rk8_cont` of x, xn, K, h, u, p) */
+typedef struct {
+  au_vec x[PASS_NX], h, u[PASS_U], p[PASS_NP > 0 ? PASS_NP : 1], rtol, atol[PASS_NX];
+  au_vec xn[PASS_NX], err, K[12 * PASS_NX], F[7 * PASS_NX];
+} au_vio;
+
+/* lane l's inputs: a step of h from x under the run's control, parameters and tolerances */
+static void au_vset(au_vio* v, int l, const dense_state* s, const casadi_real* x,
+                    casadi_real h) {
+  int i;
+  for (i = 0; i < PASS_NX; ++i) {
+    v->x[i][l] = x[i];
+    v->atol[i][l] = s->c.atol[i];
+  }
+  for (i = 0; i < PASS_NU; ++i) v->u[i][l] = s->u[i];
+  for (i = 0; i < PASS_NP; ++i) v->p[i][l] = s->p[i];
+  v->h[l] = h;
+  v->rtol[l] = s->c.rtol;
+}
+
+/* the vector step of the lanes `use` (the others repeat the inputs of the first in use) */
+static void au_vcall(au_vstep step, au_vio* v, const int* use) {
+  const au_vec* arg[6];
+  au_vec* res[3];
+  int l, i, f = 0;
+  while (!use[f]) ++f;
+  for (l = 0; l < PASS_LANES; ++l)
+    if (!use[l]) {
+      for (i = 0; i < PASS_NX; ++i) {
+        v->x[i][l] = v->x[i][f];
+        v->atol[i][l] = v->atol[i][f];
+      }
+      for (i = 0; i < PASS_U; ++i) v->u[i][l] = v->u[i][f];
+      for (i = 0; i < (PASS_NP > 0 ? PASS_NP : 1); ++i) v->p[i][l] = v->p[i][f];
+      v->h[l] = v->h[f];
+      v->rtol[l] = v->rtol[f];
+    }
+  arg[0] = v->x; arg[1] = &v->h; arg[2] = v->u; arg[3] = v->p; arg[4] = &v->rtol;
+  arg[5] = v->atol;
+  res[0] = v->xn; res[1] = &v->err; res[2] = v->K;
+  step(arg, res);
+}
+
+/* the continuous extension of the vector step just taken (`vcont`), when a lane of `want`
+   needs it */
+static void au_vcont(au_vstep vcont, au_vio* v, const int* want) {
+  const au_vec* arg[6];
+  au_vec* res[1];
+  int l, any = 0;
+  for (l = 0; l < PASS_LANES; ++l) any |= want[l];
+  if (!any) return;
+  arg[0] = v->x; arg[1] = v->xn; arg[2] = v->K; arg[3] = &v->h; arg[4] = v->u; arg[5] = v->p;
+  res[0] = v->F;
+  vcont(arg, res);
+}
+
+/* lane l's outputs: x_next, the estimate and (`withf`) the continuous extension */
+static void au_vget(const au_vio* v, int l, casadi_real* xn, casadi_real* err,
+                    casadi_real* F, int withf) {
+  int i;
+  for (i = 0; i < PASS_NX; ++i) xn[i] = v->xn[i][l];
+  *err = v->err[l];
+  if (withf)
+    for (i = 0; i < 7 * PASS_NX; ++i) F[i] = v->F[i][l];
+}
+
+/* `dense_run` with its check's step in a lane of the answer's next vector step (`step`,
+   `cont`): a check step waits one answer step, so a checked run costs one vector step per
+   answer step (about one scalar step) where `dense_run` takes one and a half; the same
+   bits. A check still due when the run stops (or the budget ends) is taken alone. */
+static int dense_run_v(casadi_real* x, casadi_real* t, casadi_real* hio, int nout,
+                       const casadi_real* ts, const casadi_real* u, const casadi_real* p,
+                       casadi_real rtol, const casadi_real* atol, casadi_real max_steps,
+                       casadi_real* X, int ldx, casadi_real* count, int budget,
+                       casadi_real stiff_steps, casadi_real* rich, casadi_real* XC,
+                       au_vstep step, au_vstep cont) {
+  dense_state s;
+  au_vio v;
+  casadi_real xn[PASS_NX], F[7 * PASS_NX], err;
+  int use[PASS_LANES], want[PASS_LANES], l, stop = 0, had;
+  for (l = 0; l < PASS_LANES; ++l) use[l] = want[l] = 0;
+  if (!dense_open(&s, x, t, *hio, nout, ts, u, p, rtol, atol, max_steps, X, ldx, count,
+                  stiff_steps, rich, XC))
+    return s.j;
+  while (s.j < nout && budget-- > 0) {
+    dense_next(&s);
+    had = s.check_due;
+    use[0] = 1; use[1] = had;
+    au_vset(&v, 0, &s, x, s.hs);
+    if (had) au_vset(&v, 1, &s, rich + RI_X, s.due - rich[RI_T]);
+    au_vcall(step, &v, use);
+    want[0] = v.err[0] <= 1.0 && dense_wants_k(&s);
+    want[1] = had && rich_wants_k(&s);
+    au_vcont(cont, &v, want);
+    if (had) {  /* (the check's step due before this answer step) */
+      au_vget(&v, 1, xn, &err, F, want[1]);
+      rich_take(&s, xn, err, NULL, F);
+    }
+    au_vget(&v, 0, xn, &err, F, want[0]);
+    stop = dense_take(&s, xn, err, NULL, want[0] ? F : NULL);
+    if (stop) break;
+  }
+  if (s.check_due) rich_step(&s);
+  dense_close(&s, hio);
+  return s.j;
+}
 """
 
 
@@ -702,13 +817,18 @@ static void au_begin(casadi_real* w, casadi_real factor) {
    most *budget steps, with the check of merged step pairs into XC when `check`; returns 1
    when it ended (finished or failed) */
 static int au_step(casadi_real* w, casadi_real factor, casadi_real* Y, int* budget,
-                   int check, casadi_real* XC) {
+                   int check, casadi_real* XC, au_vstep step, au_vstep cont) {
   casadi_real* count = AU_COUNT(w);
   int nout = (int) w[AU_NOUT], j;
   casadi_real before = count[0] + count[1];
-  j = dense_run(AU_XR(w), AU_TT(w), AU_H(w), nout, AU_TS(w), AU_U(w), AU_P(w),
-                w[AU_RTOL] * factor, AU_AL(w), w[AU_MAXSTEPS] - w[AU_SPENT], Y + 1, nout + 1,
-                count, *budget, w[AU_STIFF], check ? AU_RICH(w) : NULL, XC + 1);
+  if (check && step)  /* (the check's steps in a lane of the answer's) */
+    j = dense_run_v(AU_XR(w), AU_TT(w), AU_H(w), nout, AU_TS(w), AU_U(w), AU_P(w),
+                    w[AU_RTOL] * factor, AU_AL(w), w[AU_MAXSTEPS] - w[AU_SPENT], Y + 1,
+                    nout + 1, count, *budget, w[AU_STIFF], AU_RICH(w), XC + 1, step, cont);
+  else
+    j = dense_run(AU_XR(w), AU_TT(w), AU_H(w), nout, AU_TS(w), AU_U(w), AU_P(w),
+                  w[AU_RTOL] * factor, AU_AL(w), w[AU_MAXSTEPS] - w[AU_SPENT], Y + 1,
+                  nout + 1, count, *budget, w[AU_STIFF], check ? AU_RICH(w) : NULL, XC + 1);
   *budget -= (int) (count[0] + count[1] - before);
   return j >= nout || count[2] != 0;
 }
@@ -939,17 +1059,25 @@ static void au_ended(casadi_real* w, casadi_real* X, casadi_real* XC, int floor,
 
 /* The whole of `dense.dense_auto` for one problem: the answer into X (nx, nout + 1; column
    0 = x0) and, alongside, its check (its steps merged in pairs) into XC, compared; at most
-   `budget` steps per call (interrupts are looked at between calls). Returns AU_PHASE (3:
-   done). */
-int rk8_auto(casadi_real* w, int nout, int budget, casadi_real* X, casadi_real* XC) {
+   `budget` steps per call (interrupts are looked at between calls); with `vstep` and
+   `vcont` (`lanes.dense_lanes`, else NULL) the check's steps ride in a lane of the
+   answer's (`dense_run_v`: the same bits). Returns AU_PHASE (3: done). */
+int rk8_auto_v(casadi_real* w, int nout, int budget, casadi_real* X, casadi_real* XC,
+               void* vstep, void* vcont) {
   w[AU_NOUT] = nout;
   if (w[AU_PHASE] == 0 && au_start(w, nout, X, XC)) return 3;
   while (budget > 0 && w[AU_PHASE] != 3) {
     int floor = w[AU_PHASE] == 4, plain = w[AU_TRIES] <= 0;
-    if (au_step(w, w[AU_FACTOR], floor ? XC : X, &budget, !floor && !plain, XC))
+    if (au_step(w, w[AU_FACTOR], floor ? XC : X, &budget, !floor && !plain, XC,
+                (au_vstep) vstep, (au_vstep) vcont))
       au_ended(w, X, XC, floor, plain);
   }
   return (int) w[AU_PHASE];
+}
+
+/* `rk8_auto_v` with the step function alone */
+int rk8_auto(casadi_real* w, int nout, int budget, casadi_real* X, casadi_real* XC) {
+  return rk8_auto_v(w, nout, budget, X, XC, NULL, NULL);
 }
 
 /* the workspace wk of run k of a batch: the shared inputs of w with the run's x0, u and
@@ -988,16 +1116,6 @@ int rk8_auto_many(const casadi_real* w, int nout, int k0, int k1, const casadi_r
    the order of the step function (the same bits). Each lane keeps its own steps,
    controller, outputs and check (`dense_state`); a lane whose run ended takes the next
    run. The continuous extension is taken for the lanes whose step holds an output. ---- */
-typedef double au_vec __attribute__((vector_size(8 * PASS_LANES)));
-typedef int (*au_vstep)(const au_vec** arg, au_vec** res);
-
-/* the vector step's inputs and outputs (those of `rk8_step_k`, a lane per run), then the
-   step's continuous extension (`rk8_cont` of x, xn, K, h, u, p) */
-typedef struct {
-  au_vec x[PASS_NX], h, u[PASS_U], p[PASS_NP > 0 ? PASS_NP : 1], rtol, atol[PASS_NX];
-  au_vec xn[PASS_NX], err, K[12 * PASS_NX], F[7 * PASS_NX];
-} au_vio;
-
 /* a lane: its run k (-1: none), that run's workspace, answer and check outputs, and its
    `dense_run` in progress (`opened` 0: it ended at its start) */
 typedef struct {
@@ -1006,66 +1124,6 @@ typedef struct {
   long k;
   int opened, ended;
 } au_lane;
-
-/* lane l's inputs: a step of h from x under the run's control, parameters and tolerances */
-static void au_vset(au_vio* v, int l, const dense_state* s, const casadi_real* x,
-                    casadi_real h) {
-  int i;
-  for (i = 0; i < PASS_NX; ++i) {
-    v->x[i][l] = x[i];
-    v->atol[i][l] = s->c.atol[i];
-  }
-  for (i = 0; i < PASS_NU; ++i) v->u[i][l] = s->u[i];
-  for (i = 0; i < PASS_NP; ++i) v->p[i][l] = s->p[i];
-  v->h[l] = h;
-  v->rtol[l] = s->c.rtol;
-}
-
-/* the vector step of the lanes `use` (the others repeat the inputs of the first in use) */
-static void au_vcall(au_vstep step, au_vio* v, const int* use) {
-  const au_vec* arg[6];
-  au_vec* res[3];
-  int l, i, f = 0;
-  while (!use[f]) ++f;
-  for (l = 0; l < PASS_LANES; ++l)
-    if (!use[l]) {
-      for (i = 0; i < PASS_NX; ++i) {
-        v->x[i][l] = v->x[i][f];
-        v->atol[i][l] = v->atol[i][f];
-      }
-      for (i = 0; i < PASS_U; ++i) v->u[i][l] = v->u[i][f];
-      for (i = 0; i < (PASS_NP > 0 ? PASS_NP : 1); ++i) v->p[i][l] = v->p[i][f];
-      v->h[l] = v->h[f];
-      v->rtol[l] = v->rtol[f];
-    }
-  arg[0] = v->x; arg[1] = &v->h; arg[2] = v->u; arg[3] = v->p; arg[4] = &v->rtol;
-  arg[5] = v->atol;
-  res[0] = v->xn; res[1] = &v->err; res[2] = v->K;
-  step(arg, res);
-}
-
-/* the continuous extension of the vector step just taken (`vcont`), when a lane of `want`
-   needs it */
-static void au_vcont(au_vstep vcont, au_vio* v, const int* want) {
-  const au_vec* arg[6];
-  au_vec* res[1];
-  int l, any = 0;
-  for (l = 0; l < PASS_LANES; ++l) any |= want[l];
-  if (!any) return;
-  arg[0] = v->x; arg[1] = v->xn; arg[2] = v->K; arg[3] = &v->h; arg[4] = v->u; arg[5] = v->p;
-  res[0] = v->F;
-  vcont(arg, res);
-}
-
-/* lane l's outputs: x_next, the estimate and (`withf`) the continuous extension */
-static void au_vget(const au_vio* v, int l, casadi_real* xn, casadi_real* err,
-                    casadi_real* F, int withf) {
-  int i;
-  for (i = 0; i < PASS_NX; ++i) xn[i] = v->xn[i][l];
-  *err = v->err[l];
-  if (withf)
-    for (i = 0; i < 7 * PASS_NX; ++i) F[i] = v->F[i][l];
-}
 
 /* the check steps due in the lanes, in one vector step, when one of them cannot wait
    (`all`; or a lane whose next accepted step would make another due: it ends a pair or
@@ -1094,12 +1152,15 @@ static void au_checks(au_lane* L, au_vio* v, au_vstep step, au_vstep vcont, int 
 }
 
 /* lane L's run, its first answer (and check) ended: `rk8_auto`'s verdict, any retry or
-   rerun as `rk8_auto` (one run alone), the header into res (AU_HDR per run) */
-static void au_lane_finish(au_lane* L, int nout, casadi_real* res, int plain) {
+   rerun as `rk8_auto_v` (one run alone, its checks in a lane of its steps), the header
+   into res (AU_HDR per run) */
+static void au_lane_finish(au_lane* L, int nout, casadi_real* res, int plain,
+                           au_vstep step, au_vstep cont) {
   int i;
   if (L->opened) dense_close(&L->s, AU_H(L->w));
   au_ended(L->w, L->X, L->XC, 0, plain);
-  if (L->w[AU_PHASE] != 3) rk8_auto(L->w, nout, INT_MAX, L->X, L->XC);
+  if (L->w[AU_PHASE] != 3)
+    rk8_auto_v(L->w, nout, INT_MAX, L->X, L->XC, (void*) step, (void*) cont);
   for (i = 0; i < AU_HDR; ++i) res[(size_t) L->k * AU_HDR + i] = L->w[i];
   L->k = -1;
 }
@@ -1108,7 +1169,8 @@ static void au_lane_finish(au_lane* L, int nout, casadi_real* res, int plain) {
    opens it); a run that takes no step is finished at once (the lane is then empty) */
 static void au_lane_load(au_lane* L, const casadi_real* w, int size, int nout, long k,
                          const casadi_real* x0, const casadi_real* u, const casadi_real* p,
-                         casadi_real* X, casadi_real* res, int plain) {
+                         casadi_real* X, casadi_real* res, int plain, au_vstep step,
+                         au_vstep cont) {
   casadi_real* wk = L->w;
   int i;
   au_load(wk, w, size, (size_t) k, x0, u, p);
@@ -1125,7 +1187,7 @@ static void au_lane_load(au_lane* L, const casadi_real* w, int size, int nout, l
                          AU_P(wk), wk[AU_RTOL] * wk[AU_FACTOR], AU_AL(wk),
                          wk[AU_MAXSTEPS] - wk[AU_SPENT], L->X + 1, nout + 1, AU_COUNT(wk),
                          wk[AU_STIFF], plain ? NULL : AU_RICH(wk), L->XC + 1);
-  if (!L->opened || L->s.j >= nout) au_lane_finish(L, nout, res, plain);
+  if (!L->opened || L->s.j >= nout) au_lane_finish(L, nout, res, plain, step, cont);
 }
 
 /* `rk8_auto_many` (the same arguments, the same answers and headers) with the runs'
@@ -1152,7 +1214,7 @@ int rk8_auto_lanes(const casadi_real* w, int nout, int k0, int k1, const casadi_
   for (;;) {
     for (l = 0; l < PASS_LANES; ++l)  /* (an empty lane takes the next run) */
       while (L[l].k < 0 && next < k1) au_lane_load(&L[l], w, size, nout, next++, x0, u, p,
-                                                   X, res, plain);
+                                                   X, res, plain, step, cont);
     any = 0;
     for (l = 0; l < PASS_LANES; ++l) any |= use[l] = L[l].k >= 0;
     if (!any) break;
@@ -1177,7 +1239,7 @@ int rk8_auto_lanes(const casadi_real* w, int nout, int k0, int k1, const casadi_
     if (!any) continue;
     au_checks(L, &v, step, cont, 1);  /* (a run ends with its checks taken) */
     for (l = 0; l < PASS_LANES; ++l)
-      if (use[l] && L[l].ended) au_lane_finish(&L[l], nout, res, plain);
+      if (use[l] && L[l].ended) au_lane_finish(&L[l], nout, res, plain, step, cont);
   }
   free(wk);
   return k1 - k0;
@@ -1352,6 +1414,10 @@ def pass_library(model: Model) -> object | None:
         auto.argtypes = [ptr, i32, i32, ptr, ptr]
         auto.restype = i32
         fun.auto = auto  # (`dynamics.integrate.dense`)
+        auto_v = lib.rk8_auto_v
+        auto_v.argtypes = [ptr, i32, i32, ptr, ptr, ptr, ptr]
+        auto_v.restype = i32
+        fun.auto_v = auto_v  # (the same, the check in a lane: `lanes.dense_lanes`)
         many = lib.rk8_auto_many
         many.argtypes = [ptr, i32, i32, i32, ptr, ptr, ptr, ptr, ptr, ptr]
         many.restype = i32

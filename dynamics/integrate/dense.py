@@ -51,7 +51,7 @@ import numpy as np
 from .. import cache
 from ..interrupts import check_interrupt, deferred_interrupts
 from .cpass import pass_library
-from .lanes import LANES
+from .lanes import LANES, dense_lanes
 from .inputs import Problem
 
 __all__ = ["FIELDS", "HEADER", "FIRST", "CHECK", "TRIES", "DenseAuto", "dense_auto", "dense_run",
@@ -140,11 +140,14 @@ def constant_control(ctrl) -> bool:
 
 class _Plan(NamedTuple):
     """What a model's calls share: the compiled functions, the sizes, the index of the
-    attitude quaternion (-1: none)."""
+    attitude quaternion (-1: none), and ``single`` ``[calls, vector]``: the single calls
+    made before the model's vector lanes were loaded, then the lanes (`_single_lanes`)."""
 
     auto: object
     many: object
     lanes: object
+    auto_v: object
+    single: list
     nx: int
     nu: int
     np: int
@@ -156,8 +159,8 @@ def _plan(model) -> _Plan | None:
     def build():
         lib = pass_library(model)
         return None if lib is None else _Plan(
-            lib.auto, lib.auto_many, lib.auto_lanes, model.nx, model.nu, model.np,
-            -1 if model.attitude is None else model.attitude[0])
+            lib.auto, lib.auto_many, lib.auto_lanes, lib.auto_v, [0, None], model.nx,
+            model.nu, model.np, -1 if model.attitude is None else model.attitude[0])
 
     return cache.get(("dense_plan", cache.function_key(model.f)), build, keepalive=model.f)
 
@@ -307,6 +310,9 @@ def dense_run(model, x0: np.ndarray, t: np.ndarray, rtol: float, atol, max_steps
     if progress is not None and progress.fun is None:
         progress = None  # (nobody is told: no counting)
     auto, args = plan.auto, work.args
+    vector = _single_lanes(model, plan) if check else None
+    if vector is not None:  # (the check's steps in a lane of the answer's: the same bits)
+        auto, args = plan.auto_v, args + (vector.address, vector.cont)
     if auto(*args) != 3:  # a long run: interrupts looked at between calls
         # (the steps made so far: of the runs ended, and of the run in progress)
         count = HEADER + 3 * nx + nu + plan.np + nout + 2
@@ -324,6 +330,24 @@ def dense_run(model, x0: np.ndarray, t: np.ndarray, rtol: float, atol, max_steps
     if ws[_RESULT] == -3:  # (the outputs filled before the failure; NaN after)
         x[:, 1 + int(ws[HEADER + 3 * nx + nu + plan.np + nout + 2 + 5]):] = np.nan
     return _outcome(x, ws[:HEADER].tolist())
+
+
+#: Single checked calls of a model in a process after which its vector lanes are asked for
+#: (`lanes.dense_lanes`: loaded from disk, or compiled in the background while the calls go
+#: on without them), and again every as many calls until they are there: a model called
+#: this often is worth the one compile per machine (~0.5 s), a script's few calls are not.
+SINGLE_LANES_AFTER = 16
+
+
+def _single_lanes(model, plan: _Plan):
+    """The vector lanes a single checked call of ``model`` takes (`lanes.dense_lanes`), or
+    None (not loaded yet: asked for every `SINGLE_LANES_AFTER` calls)."""
+    single = plan.single
+    if single[1] is None:
+        single[0] += 1
+        if single[0] % SINGLE_LANES_AFTER == 0:
+            single[1] = dense_lanes(model)
+    return single[1]
 
 
 def _tell(progress, steps: int, told: int) -> int:

@@ -181,3 +181,51 @@ def test_a_dense_batch_does_not_wait_for_its_lanes_and_takes_them_once_ready():
     assert lanes.dense_lanes(model, build=False) is first
     np.testing.assert_array_equal(simulate(model, X0, t, threads=1).x, before.x)
     del cache
+
+
+@pytest.mark.parametrize("kw,budget", [({}, None), ({}, 7), (dict(rtol=1e-10, atol=1e-12), None)],
+                         ids=["defaults", "budgets of 7 steps", "near the rounding"])
+def test_a_single_call_with_its_check_in_a_lane_is_the_scalar_call(kw, budget, monkeypatch):
+    """A single checked call whose check's steps ride in a lane of its answer's vector steps
+    (the pass's ``rk8_auto_v``, `dense_run_v`) is the scalar call to the bit: answer,
+    estimate, steps, message; also when the call is cut into budgets of 7 steps (a check
+    due at a cut is taken alone) and near the rounding (a rerun from a moved start).
+    Truth: Jacobi's closed form within the tolerance."""
+    from appdyn.dynamics.integrate import dense
+    from appdyn.dynamics.truth import torque_free_omega
+    inertia, x0 = [1.5, 2.5, 3.2], np.r_[0.0, 0.0, 0.0, 1.0, 0.5, 0.0, 1.0]
+    model, t = rigid_body(inertia), np.linspace(0.0, 60.0, 121)
+    vector = lanes.dense_lanes(model, wait=True)
+    assert vector is not None
+    if budget is not None:
+        monkeypatch.setattr(dense, "BUDGET", budget)
+        monkeypatch.setattr(dense._LOCAL, "work", {})  # (workspaces made with this budget)
+    monkeypatch.setattr(dense, "_single_lanes", lambda m, plan: vector)
+    got = simulate(model, x0, t, **kw)
+    monkeypatch.setattr(dense, "_single_lanes", lambda m, plan: None)
+    ref = simulate(model, x0, t, **kw)
+    np.testing.assert_array_equal(got.x, ref.x)
+    assert got.error_estimate == ref.error_estimate and got.n_steps == ref.n_steps
+    assert got.message == ref.message and got.success
+    rtol, atol = kw.get("rtol", 1e-8), kw.get("atol", 1e-10)
+    w = torque_free_omega(inertia, x0[4:], t)
+    assert np.all(np.abs(got.x[4:] - w) <= atol + rtol * np.abs(w))
+
+
+def test_single_calls_ask_for_the_lanes_every_so_many_calls(monkeypatch):
+    """A model's single checked calls ask for its vector lanes (`lanes.dense_lanes`, which
+    loads them or compiles them in the background) at every `dense.SINGLE_LANES_AFTER`-th
+    call until they are there, then take them; a script's few calls never ask."""
+    from appdyn.dynamics.integrate import dense
+    model, t = rigid_body([1.2, 2.2, 3.1]), np.linspace(0.0, 2.0, 3)  # (a plan of its own)
+    asked = []
+    monkeypatch.setattr(dense, "dense_lanes", lambda m: asked.append(m) or None)
+    x0 = np.r_[0.0, 0.0, 0.0, 1.0, 0.3, 0.1, 0.2]
+    for _ in range(dense.SINGLE_LANES_AFTER - 1):
+        simulate(model, x0, t)
+    assert asked == []
+    simulate(model, x0, t)
+    assert asked == [model]
+    for _ in range(dense.SINGLE_LANES_AFTER):
+        simulate(model, x0, t)
+    assert asked == [model, model]
