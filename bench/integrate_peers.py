@@ -15,7 +15,10 @@ answer verified by its own check) and with ``method='dop853'`` (one DOP853 run a
 tolerance, nothing verified: the peer's contract, on the same kind of compiled C); each run is timed
 `REPEATS` times (median) after `_common.WARM` seconds of the same run, on both sides (a
 short call timed on a core just out of idle took 1.7x its time: `_common.warmed`); the cheapest run of each whose error meets the workload's target
-is compared: ``ratio = numbalsoda time / appdyn time`` (> 1: appdyn faster). numbalsoda
+is compared: ``ratio = numbalsoda time / appdyn time`` (> 1: appdyn faster). appdyn is
+timed in its steady state for repeated calls (`steady`: the model's vector lanes loaded,
+as after `dense.SINGLE_LANES_AFTER` calls; numbalsoda's numba compile is outside its times
+too). numbalsoda
 runs in its own venv (``bench/peers/.venv-numbalsoda``, `bench/peers/README.md`);
 without it the appdyn columns alone are reported.
 
@@ -50,6 +53,8 @@ import casadi as ca
 import numpy as np
 
 from appdyn.dynamics import rigid_body, simulate
+from appdyn.dynamics.integrate import dense
+from appdyn.dynamics.integrate.lanes import dense_lanes
 from appdyn.dynamics.truth import torque_free_omega
 
 from _common import WARM, Row, script_main, timed, warmed, write_csv
@@ -174,6 +179,16 @@ def workloads(quick: bool, build: Path) -> list[Workload]:
     return out
 
 
+def steady(model, x0, t) -> None:
+    """appdyn's steady state for repeated calls of ``model``: its vector lanes compiled (or
+    loaded from disk) and taken, as a model's calls take them after
+    `dense.SINGLE_LANES_AFTER` of them (`lanes.dense_lanes`; none for a model whose steps
+    call its right-hand side)."""
+    dense_lanes(model, wait=True)
+    for _ in range(dense.SINGLE_LANES_AFTER):
+        simulate(model, x0, t)
+
+
 def median_time(fun, repeats: int) -> float:
     """The median of ``repeats`` calls after `WARM` seconds of them [s] (`warmed`: the
     peer's script warms its runs alike)."""
@@ -247,6 +262,7 @@ def two_point_call(calls: int, rounds: int) -> tuple[float, float, float]:
     in the compiled pass)."""
     model = rigid_body([1.0, 2.0, 3.0])
     x0, t = np.r_[0.0, 0.0, 0.0, 1.0, 1.0, 0.1, 0.8], np.array([0.0, 10.0])
+    steady(model, x0, t)
     floor, _ = dense_pass_call(model, x0, t)
     return paired_per_call(lambda: simulate(model, x0, t), floor, calls, rounds)
 
@@ -261,6 +277,7 @@ def monte_carlo(quick: bool, detail: list) -> list[Row]:
     k = 100 if quick else 1000
     x0s, t, truth = batch_workload(k)
     model = rigid_body(INERTIA)
+    dense_lanes(model, wait=True)  # (steady state: a batch of 256 runs or more builds them)
     cores = batch_threads(None)
 
     def error(x):  # x (7, n, K) -> the worst rate error over all runs
@@ -336,6 +353,7 @@ def run(quick: bool, out: Path) -> list[Row]:
     detail, summary = [], []
     with tempfile.TemporaryDirectory() as tmp:
         for w in workloads(quick, Path(tmp)):
+            steady(w.model, w.x0, w.t)
             # the peer first, then appdyn, then the peer again: the VM's speed drifts
             first = peer_sweep(w, tols, repeats)
             mine = appdyn_sweep(w, tols, repeats)

@@ -80,30 +80,34 @@ def compiled_call(model, method: str):
 
 
 def dense_pass_call(model, x0, t):
-    """The call of ``auto``'s compiled dense pass (`dynamics.integrate.dense`, ``rk8_auto``)
-    that ``simulate(model, x0, t)`` at the defaults makes, captured and replayed with the
-    workspace as `simulate` filled it (restored before each call: one copy of ~100 doubles):
-    the floor no Python wrapper can go under. Returns ``(call, True)``."""
+    """The call of ``auto``'s compiled dense pass (`dynamics.integrate.dense`: ``rk8_auto``,
+    or ``rk8_auto_v`` once the model's vector lanes are loaded) that ``simulate(model, x0,
+    t)`` at the defaults makes, captured and replayed with the workspace as `simulate`
+    filled it (restored before each call: one copy of ~100 doubles): the floor no Python
+    wrapper can go under. Returns ``(call, True)``."""
     plan = dense._plan(model)
     work = dense._workspace(plan, len(t) - 1)  # (this thread's: the one `simulate` fills)
     seen = []
 
-    def spy(*args):
-        seen.append((args, work.ws.copy()))
-        return plan.auto(*args)
+    def spying(fun):
+        def spy(*args):
+            seen.append((fun, args, work.ws.copy()))
+            return fun(*args)
+        return spy
 
     real = dense._plan
-    dense._plan = lambda m: plan._replace(auto=spy) if m is model else real(m)
+    dense._plan = lambda m: plan._replace(auto=spying(plan.auto), auto_v=spying(
+        plan.auto_v)) if m is model else real(m)
     try:
         res = simulate(model, x0, t)
     finally:
         dense._plan = real
-    args, filled = seen[-1]
+    fun, args, filled = seen[-1]
     ws = work.ws
 
     def call():
         ws[:] = filled
-        return plan.auto(*args)
+        return fun(*args)
 
     _KEEP.append((res, work, filled))
     return call, True

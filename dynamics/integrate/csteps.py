@@ -27,6 +27,12 @@ pass's probe equals the casadi kernels (tests/dynamics/test_simulate_dense.py).
 
 The source expects the pass's macros ``PASS_NX``, ``PASS_NU``, ``PASS_U``, ``PASS_NARG``,
 ``PASS_NRES`` and the generated ``pass_rhs (x, u, p) -> xdot``.
+
+With ``lanes=True`` the same loops are written with every value a vector of the lane
+library's ``lane_t`` (`dynamics.integrate.lanes`) around its rewritten right-hand side
+``rk8_lane_rhs``: the exported ``rk8_lane_step_k`` and ``rk8_lane_cont`` that the pass's
+vector lanes take (a lane per run, or an answer's and its check's step side by side), each
+lane the scalar loops' arithmetic in their order (the same bits).
 """
 from __future__ import annotations
 
@@ -71,20 +77,6 @@ static int rk8_cont(const casadi_real** arg, casadi_real** res, casadi_int* iw,
 """
 
 _ERR = r"""
-/* the step's embedded error estimate in units of the tolerance */
-static casadi_real loop_err(const casadi_real* x, const casadi_real* xn, const casadi_real* K,
-                           casadi_real h, casadi_real rtol, const casadi_real* atol) {
-  casadi_real e5 = 0, e3 = 0, s, q;
-  int j;
-  for (j = 0; j < PASS_NX; ++j) {
-    s = atol[j] + rtol * fmax(fabs(x[j]), fabs(xn[j]));
-    q = (%(e5)s) / s;
-    e5 += q * q;
-    q = (%(e3)s) / s;
-    e3 += q * q;
-  }
-  return fabs(h) * e5 / sqrt(PASS_NX * fmax(e5 + 0.01 * e3, 1e-300));
-}
 /* the pass's step forms, in casadi's calling convention: the plain step (x, h, ua, ud, p)
    -> x_next; the step with its error (x, h, ua, ud, p, rtol, atol) -> (x_next, err); the
    dense step under a constant control (x, h, u, p, rtol, atol) -> (x_next, err, K) */
@@ -110,6 +102,65 @@ static int rk8_step_k(const casadi_real** arg, casadi_real** res, casadi_int* iw
 """
 
 
+# The vector forms (``lanes``): the lane library's types and lane-wise functions, its
+# rewritten rhs; no control ramp (the dense steps hold the control over the step).
+_LANE_HEAD = r"""
+/* DOP853 as loops around rk8_lane_rhs, every value a vector (`dynamics.integrate.csteps`) */
+#define PASS_NX LANE_NX
+static void loop_rhs(const lane_t* x, const lane_t* u, const lane_t* p, lane_t* xdot,
+                     void* iw, void* w) {
+  const lane_t* a[3];
+  lane_t* r[1];
+  a[0] = x; a[1] = u; a[2] = p; r[0] = xdot;
+  rk8_lane_rhs(a, r);
+}
+static void loop_step(const lane_t* x, lane_t h, const lane_t* u, const lane_t* p,
+                      lane_t* xn, lane_t* K) {
+  lane_t xs[PASS_NX], c;
+  void *iw = 0, *w = 0;
+  int j;
+"""
+
+_LANE_ERR = r"""
+int rk8_lane_step_k(const lane_t** arg, lane_t** res) {
+  loop_step(arg[0], arg[1][0], arg[2], arg[3], res[0], res[2]);
+  res[1][0] = loop_err(arg[0], res[0], res[2], arg[1][0], arg[4][0], arg[5]);
+  return 0;
+}
+"""
+
+_LANE_DENSE_HEAD = r"""
+int rk8_lane_cont(const lane_t** arg, lane_t** res) {
+  const lane_t *x = arg[0], *xn = arg[1], *K0 = arg[2], *u = arg[4], *p = arg[5];
+  lane_t h = arg[3][0], K[16 * PASS_NX], xs[PASS_NX], dx, c;
+  lane_t* F = res[0];
+  void *iw = 0, *w = 0;
+  int j;
+  for (j = 0; j < 12 * PASS_NX; ++j) K[j] = K0[j];
+  loop_rhs(xn, u, p, K + 12 * PASS_NX, iw, w);
+"""
+
+
+# the step's embedded error estimate, scalar or vector (the type ``t``, the functions' prefix
+# ``v``, the constants ``zero`` and ``tiny`` of that type)
+_LOOP_ERR = r"""
+/* the step's embedded error estimate in units of the tolerance */
+static %(t)s loop_err(const %(t)s* x, const %(t)s* xn, const %(t)s* K, %(t)s h, %(t)s rtol,
+                      const %(t)s* atol) {
+  %(t)s e5 = %(zero)s, e3 = %(zero)s, s, q;
+  int j;
+  for (j = 0; j < PASS_NX; ++j) {
+    s = atol[j] + rtol * %(v)sfmax(%(v)sfabs(x[j]), %(v)sfabs(xn[j]));
+    q = (%(e5)s) / s;
+    e5 += q * q;
+    q = (%(e3)s) / s;
+    e3 += q * q;
+  }
+  return %(v)sfabs(h) * e5 / %(v)ssqrt(PASS_NX * %(v)sfmax(e5 + 0.01 * e3, %(tiny)s));
+}
+"""
+
+
 def _sum(weights) -> str:
     """``_combine``'s sum ``w_i K_i[j]`` over the nonzero weights, left to right."""
     return " + ".join(f"{w!r} * K[{i} * PASS_NX + j]" for i, w in enumerate(weights)
@@ -130,10 +181,11 @@ def _stage(row, node: float, base: str, out: str, control: str) -> list:
     return lines
 
 
-def loop_steps() -> str:
+def loop_steps(*, lanes: bool = False) -> str:
     """The C source of the pass's step forms ``rk8_step``, ``rk8_step_err``, ``rk8_step_k``
     and ``rk8_cont`` (and their helpers ``loop_rhs``, ``loop_u``, ``loop_step``,
-    ``loop_err``), generated from `tableaux.DOP853` and its dense output.
+    ``loop_err``), generated from `tableaux.DOP853` and its dense output; ``lanes``: their
+    vector forms ``rk8_lane_step_k`` and ``rk8_lane_cont`` (see the module docstring).
 
     Examples
     --------
@@ -144,13 +196,18 @@ def loop_steps() -> str:
     True
     """
     tab = TABLEAUX["rk8"]
-    lines = [_HEAD]
+    head, err, dense_head, control = (
+        (_LANE_HEAD, _LANE_ERR, _LANE_DENSE_HEAD, "u") if lanes else
+        (_HEAD, _ERR, _DENSE_HEAD, "loop_u(ua, ud, {node} * h, ub)"))
+    lines = [head]
     for i, (row, node) in enumerate(zip(tab.a, tab.c)):
-        lines += _stage(row, node, "x", str(i), "loop_u(ua, ud, {node} * h, ub)")
+        lines += _stage(row, node, "x", str(i), control)
     lines.append(f"  for (j = 0; j < PASS_NX; ++j) xn[j] = x[j] + h * ({_sum(tab.b)});")
     lines.append("}")
-    lines.append(_ERR % dict(e5=_sum(DOP853_E5), e3=_sum(DOP853_E3)))
-    lines.append(_DENSE_HEAD)
+    kinds = (dict(t="lane_t", v="v_", zero="VB(0.0)", tiny="VB(1e-300)") if lanes else
+             dict(t="casadi_real", v="", zero="0", tiny="1e-300"))
+    lines.append(_LOOP_ERR % dict(kinds, e5=_sum(DOP853_E5), e3=_sum(DOP853_E3)) + err)
+    lines.append(dense_head)
     for i, row in enumerate(DOP853_DENSE_A):
         lines += _stage(row, 0.0, "x", str(13 + i), "u")
     lines.append("  for (j = 0; j < PASS_NX; ++j) {")

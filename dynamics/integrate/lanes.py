@@ -26,6 +26,7 @@ import casadi as ca
 
 from .. import cache
 from ..model import Model
+from .csteps import loop_steps
 from .kernels import calls_rhs, dense_kernels, kernel
 
 __all__ = ["LANES", "lane_source", "lanes_library", "dense_lanes"]
@@ -200,8 +201,11 @@ def dense_lanes(model: Model, *, build: bool = True, wait: bool = False):
     compiled once per model for this machine (cached; kept on disk by the persistent
     compile cache).
 
-    None: the step cannot be rewritten, the model's steps call its right-hand side
-    (`kernels.calls_rhs`: the pass's steps are C loops, `csteps`), no C compiler, ``build``
+    A model whose steps call its right-hand side (`kernels.calls_rhs`: the pass's steps are
+    C loops, `csteps`) gets the vector form of those loops around its rewritten right-hand
+    side (`csteps.loop_steps` with ``lanes``).
+
+    None: the step (or that right-hand side) cannot be rewritten, no C compiler, ``build``
     False and not loaded in this process, or (``wait`` False) the library is neither on disk
     nor compiled yet: its compile then starts in the background (`cache.compile_ahead`) and
     a later call takes it once it is ready; a batch does not wait for it (the scalar loop
@@ -209,9 +213,13 @@ def dense_lanes(model: Model, *, build: bool = True, wait: bool = False):
     key = ("rk8_dense_lanes", cache.function_key(model.f))
     if cache.contains(key):
         return cache.get(key, lambda: None)
-    if not build or calls_rhs(model, "rk8"):
+    if not build:
         return None
+
     def body():
+        if calls_rhs(model, "rk8"):  # (the pass's loops around its rhs, `csteps`)
+            rhs = lane_source(model.f, name="rk8_lane_rhs")
+            return None if rhs is None else rhs + loop_steps(lanes=True)
         step, cont = (lane_source(f, name="rk8_lane_" + f.name()[4:], export=True)
                       for f in dense_kernels(model))
         return None if step is None or cont is None else step + cont

@@ -229,3 +229,42 @@ def test_single_calls_ask_for_the_lanes_every_so_many_calls(monkeypatch):
     for _ in range(dense.SINGLE_LANES_AFTER):
         simulate(model, x0, t)
     assert asked == [model, model]
+
+
+@pytest.mark.parametrize("which", ["wheels", "hinged"])
+def test_a_model_whose_steps_call_its_rhs_takes_the_lanes_with_the_same_bits(which, monkeypatch):
+    """A model whose steps call its right-hand side (`kernels.calls_rhs`: the pass's steps
+    are C loops, `csteps`) gets the vector form of those loops around its rewritten
+    right-hand side (`csteps.loop_steps(lanes=True)`): a single checked call (its check in a
+    lane of its steps) and a batch of 6 runs (a lane per run) are the scalar pass's bits;
+    the wheel spacecraft with a constant wheel torque, the hinged bodies."""
+    from appdyn.dynamics.integrate import batch, dense
+    from appdyn.dynamics.integrate.kernels import calls_rhs
+    from tests.dynamics.test_simulate_dense import _hinged, _wheels
+
+    model, x0 = _wheels() if which == "wheels" else _hinged()
+    assert calls_rhs(model, "rk8")
+    vector = lanes.dense_lanes(model, wait=True)
+    assert vector is not None
+    t = np.linspace(0.0, 4.0, 9)
+    u = np.full(model.nu, 0.01) if model.nu else None
+    monkeypatch.setattr(dense, "_single_lanes", lambda m, plan: vector)
+    got = simulate(model, x0, t, u=u)
+    monkeypatch.setattr(dense, "_single_lanes", lambda m, plan: None)
+    ref = simulate(model, x0, t, u=u)
+    np.testing.assert_array_equal(got.x, ref.x)
+    assert got.error_estimate == ref.error_estimate and got.n_steps == ref.n_steps
+    assert got.success and "dense output" in got.message, got.message
+    rng = np.random.default_rng(2)
+    X0 = np.repeat(x0[:, None], 6, axis=1)
+    w = model.attitude[1]  # (the first body's rates dispersed)
+    X0[w:w + 3] += rng.uniform(-0.05, 0.05, (3, 6))
+    if which == "hinged":  # (a consistent start for each: the constraint holds)
+        X0 = np.stack([model.initial_state([0, 0, 0, 1], X0[w:w + 3, k], [1.0, 0, 0],
+                                           [0, 0, 0, 1], [0.1, 0, 0.2]) for k in range(6)], 1)
+    got = simulate(model, X0, t, u=u, threads=1)
+    monkeypatch.setattr(batch, "dense_lanes", lambda m, **k: None)
+    ref = simulate(model, X0, t, u=u, threads=1)
+    np.testing.assert_array_equal(got.x, ref.x)
+    np.testing.assert_array_equal(got.error_estimate, ref.error_estimate)
+    assert got.all_success, got.message
