@@ -224,7 +224,10 @@ def dense_lanes(model: Model, *, build: bool = True, wait: bool = False):
                       for f in dense_kernels(model))
         return None if step is None or cont is None else step + cont
 
-    jobs = _jobs(model, "rk8_dense_lanes", body, "")
+    # (the jobs kept: their recipe serializes the model, and a caller that does not wait
+    # asks again until the library is ready)
+    jobs = cache.get(("rk8_dense_lanes_jobs", key[1]),
+                     lambda: _jobs(model, "rk8_dense_lanes", body, ""), keepalive=model.f)
     if not wait and not cache.ready(jobs[0]):
         cache.compile_ahead(jobs[:1])
         return None
