@@ -1122,7 +1122,7 @@ typedef struct {
   dense_state s;
   casadi_real *w, *X, *XC;
   long k;
-  int opened, ended;
+  int opened, ended, floor;
 } au_lane;
 
 /* the check steps due in the lanes, in one vector step, when one of them cannot wait
@@ -1151,26 +1151,41 @@ static void au_checks(au_lane* L, au_vio* v, au_vstep step, au_vstep vcont, int 
     }
 }
 
-/* lane L's run, its first answer (and check) ended: `rk8_auto`'s verdict, any retry or
-   rerun as `rk8_auto_v` (one run alone, its checks in a lane of its steps), the header
-   into res (AU_HDR per run) */
-static void au_lane_finish(au_lane* L, int nout, casadi_real* res, int plain,
-                           au_vstep step, au_vstep cont) {
+/* lane L's run in progress opened as `au_step` opens it (a retried answer with its check,
+   or the rerun from a moved start into XC, `floor`); 1 when it has steps to take */
+static int au_lane_open(au_lane* L, int nout, int plain) {
+  casadi_real* w = L->w;
+  L->opened = dense_open(&L->s, AU_XR(w), AU_TT(w), *AU_H(w), nout, AU_TS(w), AU_U(w),
+                         AU_P(w), w[AU_RTOL] * w[AU_FACTOR], AU_AL(w),
+                         w[AU_MAXSTEPS] - w[AU_SPENT], (L->floor ? L->XC : L->X) + 1,
+                         nout + 1, AU_COUNT(w), w[AU_STIFF],
+                         L->floor || plain ? NULL : AU_RICH(w), L->XC + 1);
+  return L->opened && L->s.j < nout;
+}
+
+/* lane L's run after its answer (or rerun) ended: `rk8_auto`'s verdict; a retry or a rerun
+   from a moved start goes on in the lane (the lanes stay full); a run done leaves its
+   header in res (AU_HDR per run) and the lane empty */
+static void au_lane_next(au_lane* L, int nout, casadi_real* res, int plain) {
+  casadi_real* w = L->w;
   int i;
-  if (L->opened) dense_close(&L->s, AU_H(L->w));
-  au_ended(L->w, L->X, L->XC, 0, plain);
-  if (L->w[AU_PHASE] != 3)
-    rk8_auto_v(L->w, nout, INT_MAX, L->X, L->XC, (void*) step, (void*) cont);
-  for (i = 0; i < AU_HDR; ++i) res[(size_t) L->k * AU_HDR + i] = L->w[i];
-  L->k = -1;
+  do {
+    if (L->opened) dense_close(&L->s, AU_H(w));
+    au_ended(w, L->X, L->XC, L->floor, plain);
+    if (w[AU_PHASE] == 3) {
+      for (i = 0; i < AU_HDR; ++i) res[(size_t) L->k * AU_HDR + i] = w[i];
+      L->k = -1;
+      return;
+    }
+    L->floor = w[AU_PHASE] == 4;
+  } while (!au_lane_open(L, nout, plain));
 }
 
 /* lane L takes run k (`au_load`, `rk8_auto`'s start, its first answer opened as `au_step`
    opens it); a run that takes no step is finished at once (the lane is then empty) */
 static void au_lane_load(au_lane* L, const casadi_real* w, int size, int nout, long k,
                          const casadi_real* x0, const casadi_real* u, const casadi_real* p,
-                         casadi_real* X, casadi_real* res, int plain, au_vstep step,
-                         au_vstep cont) {
+                         casadi_real* X, casadi_real* res, int plain) {
   casadi_real* wk = L->w;
   int i;
   au_load(wk, w, size, (size_t) k, x0, u, p);
@@ -1183,17 +1198,14 @@ static void au_lane_load(au_lane* L, const casadi_real* w, int size, int nout, l
     L->k = -1;
     return;
   }
-  L->opened = dense_open(&L->s, AU_XR(wk), AU_TT(wk), *AU_H(wk), nout, AU_TS(wk), AU_U(wk),
-                         AU_P(wk), wk[AU_RTOL] * wk[AU_FACTOR], AU_AL(wk),
-                         wk[AU_MAXSTEPS] - wk[AU_SPENT], L->X + 1, nout + 1, AU_COUNT(wk),
-                         wk[AU_STIFF], plain ? NULL : AU_RICH(wk), L->XC + 1);
-  if (!L->opened || L->s.j >= nout) au_lane_finish(L, nout, res, plain, step, cont);
+  L->floor = 0;
+  if (!au_lane_open(L, nout, plain)) au_lane_next(L, nout, res, plain);
 }
 
 /* `rk8_auto_many` (the same arguments, the same answers and headers) with the runs'
-   first answers and their checks stepped PASS_LANES at a time by `vstep` and `vcont` (the
-   vector `rk8_step_k` and `rk8_cont`); XC (PASS_LANES, nx, nout + 1) scratch, a lane's
-   each. */
+   answers, their checks, retries and reruns stepped PASS_LANES at a time by `vstep` and
+   `vcont` (the vector `rk8_step_k` and `rk8_cont`); XC (PASS_LANES, nx, nout + 1)
+   scratch, a lane's each. */
 int rk8_auto_lanes(const casadi_real* w, int nout, int k0, int k1, const casadi_real* x0,
                    const casadi_real* u, const casadi_real* p, casadi_real* X,
                    casadi_real* XC, casadi_real* res, void* vstep, void* vcont) {
@@ -1214,7 +1226,7 @@ int rk8_auto_lanes(const casadi_real* w, int nout, int k0, int k1, const casadi_
   for (;;) {
     for (l = 0; l < PASS_LANES; ++l)  /* (an empty lane takes the next run) */
       while (L[l].k < 0 && next < k1) au_lane_load(&L[l], w, size, nout, next++, x0, u, p,
-                                                   X, res, plain, step, cont);
+                                                   X, res, plain);
     any = 0;
     for (l = 0; l < PASS_LANES; ++l) any |= use[l] = L[l].k >= 0;
     if (!any) break;
@@ -1239,7 +1251,7 @@ int rk8_auto_lanes(const casadi_real* w, int nout, int k0, int k1, const casadi_
     if (!any) continue;
     au_checks(L, &v, step, cont, 1);  /* (a run ends with its checks taken) */
     for (l = 0; l < PASS_LANES; ++l)
-      if (use[l] && L[l].ended) au_lane_finish(&L[l], nout, res, plain, step, cont);
+      if (use[l] && L[l].ended) au_lane_next(&L[l], nout, res, plain);
   }
   free(wk);
   return k1 - k0;
