@@ -43,6 +43,12 @@ _FUNCTIONS.update(casadi_sq="v_sq", casadi_fabs="v_fabs")
 _FUNCTIONS2 = {"fmin": "v_fmin", "fmax": "v_fmax", "casadi_fmin": "v_fmin",
                "casadi_fmax": "v_fmax"}
 
+#: Most right-hand-side instructions of a model given vector lanes (`dense_lanes`): gcc
+#: -O2 takes about 0.7 s for the 35-state registry scene (3,760 instructions) and 0.9 s for
+#: 45 states (4,992), in the background, but a process that exits waits for a compile under
+#: way; a larger model keeps the scalar pass.
+DENSE_MAX_INSTRUCTIONS = 20_000
+
 #: C flags tried in turn (as the pass library's: this machine's instructions, else plain),
 #: at -O2 without contracting ``a * b + c`` into fused multiply-adds: the scalar steps (-O1)
 #: contract none either, so a lane's arithmetic is the scalar step's to the bit; -O2 made
@@ -205,7 +211,8 @@ def dense_lanes(model: Model, *, build: bool = True, wait: bool = False):
     C loops, `csteps`) gets the vector form of those loops around its rewritten right-hand
     side (`csteps.loop_steps` with ``lanes``).
 
-    None: the step (or that right-hand side) cannot be rewritten, no C compiler, ``build``
+    None: the step (or that right-hand side) cannot be rewritten, a right-hand side of more
+    than `DENSE_MAX_INSTRUCTIONS` instructions, no C compiler, ``build``
     False and not loaded in this process, or (``wait`` False) the library is neither on disk
     nor compiled yet: its compile then starts in the background (`cache.compile_ahead`) and
     a later call takes it once it is ready; a batch does not wait for it (the scalar loop
@@ -213,7 +220,7 @@ def dense_lanes(model: Model, *, build: bool = True, wait: bool = False):
     key = ("rk8_dense_lanes", cache.function_key(model.f))
     if cache.contains(key):
         return cache.get(key, lambda: None)
-    if not build:
+    if not build or model.f.n_instructions() > DENSE_MAX_INSTRUCTIONS:
         return None
 
     def body():

@@ -268,3 +268,19 @@ def test_a_model_whose_steps_call_its_rhs_takes_the_lanes_with_the_same_bits(whi
     np.testing.assert_array_equal(got.x, ref.x)
     np.testing.assert_array_equal(got.error_estimate, ref.error_estimate)
     assert got.all_success, got.message
+
+
+def test_a_model_past_the_instruction_bound_keeps_the_scalar_pass(monkeypatch):
+    """`lanes.dense_lanes` gives no lanes to a right-hand side of more than
+    `lanes.DENSE_MAX_INSTRUCTIONS` instructions (its background compile would hold up the
+    process's exit); the batch is then the scalar loop's, and correct."""
+    from appdyn.dynamics.truth import torque_free_omega
+    model = rigid_body([1.3, 2.1, 2.7])  # (a body of its own)
+    monkeypatch.setattr(lanes, "DENSE_MAX_INSTRUCTIONS", model.f.n_instructions() - 1)
+    assert lanes.dense_lanes(model, wait=True) is None
+    X0, t = _tumbling(3, 4), np.linspace(0.0, 5.0, 11)
+    got = simulate(model, X0, t)
+    assert got.all_success
+    for k in range(3):
+        w = torque_free_omega([1.3, 2.1, 2.7], X0[4:, k], t)
+        assert np.all(np.abs(got.x[4:, :, k] - w) <= 1e-10 + 1e-8 * np.abs(w))
