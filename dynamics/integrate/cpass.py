@@ -28,8 +28,10 @@ NOISE = 30
 #: C flags of the pass, tried in turn: compiled for this machine's instruction set (the
 #: library is built and used here only; FMA and AVX made the pass 22% faster on the 2-core
 #: VM, 742 steps in 149 against 191 us), else plain -O1 (as the chunk loops; -O2/-O3 were
-#: no faster and compile 30-80% longer).
-_OPTS = ("-O1 -march=native", "-O1")
+#: no faster and compile 30-80% longer). No ``a * b + c`` is contracted into a fused
+#: multiply-add (gcc's -O1 contracts none: the same code with the flag), as in the vector
+#: lanes (`lanes`): a lane's arithmetic is then the scalar step's to the bit on any gcc.
+_OPTS = ("-O1 -ffp-contract=off -march=native", "-O1 -ffp-contract=off")
 
 #: The answer's embedded estimate (and the model's rounding) is taken in every
 #: `CHECK_EVERY`-th interval (-1 in the others): it only tells whether the two runs show the

@@ -50,8 +50,9 @@ _FUNCTIONS2 = {"fmin": "v_fmin", "fmax": "v_fmax", "casadi_fmin": "v_fmin",
 DENSE_MAX_INSTRUCTIONS = 20_000
 
 #: C flags tried in turn (as the pass library's: this machine's instructions, else plain),
-#: at -O2 without contracting ``a * b + c`` into fused multiply-adds: the scalar steps (-O1)
-#: contract none either, so a lane's arithmetic is the scalar step's to the bit; -O2 made
+#: at -O2 without contracting ``a * b + c`` into fused multiply-adds: the pass's scalar
+#: steps contract none either (`cpass._OPTS`), so a lane's arithmetic is the scalar step's
+#: to the bit; -O2 made
 #: the vector DOP853 step 1.5x faster than -O1 (219 against 353 ns for 4 runs of the rigid
 #: body, its scalar step 215 ns) at the same compile time.
 _OPTS = ("-O2 -ffp-contract=off -march=native", "-O2 -ffp-contract=off")
