@@ -556,39 +556,15 @@ static void rich_step(dense_state* s) {
   rich_take(s, xn, err, K, NULL);
 }
 
-/* Steps of x (in/out) from time *t (in/out) towards ts[nout - 1], the outputs at the times
-   ts (increasing, after the start) in X (nx, ldx); control u throughout; `hio` (in/out) the
-   controller's proposed step (<= 0: `dense_first_step`); `count` (in/out): accepted steps,
-   rejected steps, flag (as `rk8_adaptive`'s), smallest accepted step, steps whose continuous
-   extension was evaluated, outputs filled, 1 after a rejection, the Lipschitz estimate of
-   `dense_first_step` (flag 4 when that many times the run's length over DOP853's stability
-   interval 6 exceeds `stiff_steps`: no step is taken), then per state the rounding noise
-   max |f_i(x (1 + eps s)) - f_i(x)| of the right-hand side at every DENSE_NOISE_EVERY-th
-   accepted state (s = +-1 alternating over the states and the samples). At most `budget`
-   steps per call (the caller checks for interrupts between calls). Returns the outputs
-   filled. The controller is `rk8_adaptive`'s; the last step lands on ts[nout - 1]. With
-   `rich` (not NULL) the check of merged step pairs runs alongside (`rich_step`, outputs
-   into XC). */
-static int dense_run(casadi_real* x, casadi_real* t, casadi_real* hio, int nout,
-                     const casadi_real* ts, const casadi_real* u, const casadi_real* p,
-                     casadi_real rtol, const casadi_real* atol, casadi_real max_steps,
-                     casadi_real* X, int ldx, casadi_real* count, int budget,
-                     casadi_real stiff_steps, casadi_real* rich, casadi_real* XC) {
-  dense_state s;
+/* one answer step of the run in progress (`dense_next`'s) by the step function, and the
+   check's step it makes due at once; 1 when the run stops */
+static int dense_advance(dense_state* s) {
   casadi_real xn[PASS_NX], K[12 * PASS_NX], err;
   int stop;
-  if (!dense_open(&s, x, t, *hio, nout, ts, u, p, rtol, atol, max_steps, X, ldx, count,
-                  stiff_steps, rich, XC))
-    return s.j;
-  while (s.j < nout && budget-- > 0) {
-    dense_next(&s);
-    dense_step(&s.c, x, s.hs, u, p, xn, &err, K);
-    stop = dense_take(&s, xn, err, K, NULL);
-    if (s.check_due) rich_step(&s);
-    if (stop) break;
-  }
-  dense_close(&s, hio);
-  return s.j;
+  dense_step(&s->c, s->x, s->hs, s->u, s->p, xn, &err, K);
+  stop = dense_take(s, xn, err, K, NULL);
+  if (s->check_due) rich_step(s);
+  return stop;
 }
 
 /* ---- Steps in the lanes of a vector step (`lanes.dense_lanes`: `rk8_step_k` and
@@ -665,41 +641,58 @@ static void au_vget(const au_vio* v, int l, casadi_real* xn, casadi_real* err,
     for (i = 0; i < 7 * PASS_NX; ++i) F[i] = v->F[i][l];
 }
 
-/* `dense_run` with its check's step in a lane of the answer's next vector step (`step`,
-   `cont`): a check step waits one answer step, so a checked run costs one vector step per
-   answer step (about one scalar step) where `dense_run` takes one and a half; the same
-   bits. A check still due when the run stops (or the budget ends) is taken alone. */
-static int dense_run_v(casadi_real* x, casadi_real* t, casadi_real* hio, int nout,
-                       const casadi_real* ts, const casadi_real* u, const casadi_real* p,
-                       casadi_real rtol, const casadi_real* atol, casadi_real max_steps,
-                       casadi_real* X, int ldx, casadi_real* count, int budget,
-                       casadi_real stiff_steps, casadi_real* rich, casadi_real* XC,
-                       au_vstep step, au_vstep cont) {
+/* one answer step of the run in progress (`dense_next`'s) in lane 0 of a vector step
+   (`step`, `cont`), the check's step due before it in lane 1: a check step waits one answer
+   step, so a checked run costs one vector step per answer step (about one scalar step)
+   where `dense_advance` takes one and a half; the same bits. 1 when the run stops. */
+static int dense_advance_v(dense_state* s, au_vio* v, au_vstep step, au_vstep cont) {
+  casadi_real xn[PASS_NX], F[7 * PASS_NX], err;
+  int use[PASS_LANES], want[PASS_LANES], l, had = s->check_due;
+  for (l = 0; l < PASS_LANES; ++l) use[l] = want[l] = 0;
+  use[0] = 1; use[1] = had;
+  au_vset(v, 0, s, s->x, s->hs);
+  if (had) au_vset(v, 1, s, s->rich + RI_X, s->due - s->rich[RI_T]);
+  au_vcall(step, v, use);
+  want[0] = v->err[0] <= 1.0 && dense_wants_k(s);
+  want[1] = had && rich_wants_k(s);
+  au_vcont(cont, v, want);
+  if (had) {  /* (the check's step due before this answer step) */
+    au_vget(v, 1, xn, &err, F, want[1]);
+    rich_take(s, xn, err, NULL, F);
+  }
+  au_vget(v, 0, xn, &err, F, want[0]);
+  return dense_take(s, xn, err, NULL, want[0] ? F : NULL);
+}
+
+/* Steps of x (in/out) from time *t (in/out) towards ts[nout - 1], the outputs at the times
+   ts (increasing, after the start) in X (nx, ldx); control u throughout; `hio` (in/out) the
+   controller's proposed step (<= 0: `dense_first_step`); `count` (in/out): accepted steps,
+   rejected steps, flag (as `rk8_adaptive`'s), smallest accepted step, steps whose continuous
+   extension was evaluated, outputs filled, 1 after a rejection, the Lipschitz estimate of
+   `dense_first_step` (flag 4 when that many times the run's length over DOP853's stability
+   interval 6 exceeds `stiff_steps`: no step is taken), then per state the rounding noise
+   max |f_i(x (1 + eps s)) - f_i(x)| of the right-hand side at every DENSE_NOISE_EVERY-th
+   accepted state (s = +-1 alternating over the states and the samples). At most `budget`
+   steps per call (the caller checks for interrupts between calls). Returns the outputs
+   filled. The controller is `rk8_adaptive`'s; the last step lands on ts[nout - 1]. With
+   `rich` (not NULL) the check of merged step pairs runs alongside (outputs into XC), its
+   steps in a lane of the answer's when `step` and `cont` (`lanes.dense_lanes`) are given
+   (`dense_advance_v`; a check still due when the run stops or the budget ends is taken
+   alone), else by the step function (`dense_advance`). */
+static int dense_run(casadi_real* x, casadi_real* t, casadi_real* hio, int nout,
+                     const casadi_real* ts, const casadi_real* u, const casadi_real* p,
+                     casadi_real rtol, const casadi_real* atol, casadi_real max_steps,
+                     casadi_real* X, int ldx, casadi_real* count, int budget,
+                     casadi_real stiff_steps, casadi_real* rich, casadi_real* XC,
+                     au_vstep step, au_vstep cont) {
   dense_state s;
   au_vio v;
-  casadi_real xn[PASS_NX], F[7 * PASS_NX], err;
-  int use[PASS_LANES], want[PASS_LANES], l, stop = 0, had;
-  for (l = 0; l < PASS_LANES; ++l) use[l] = want[l] = 0;
   if (!dense_open(&s, x, t, *hio, nout, ts, u, p, rtol, atol, max_steps, X, ldx, count,
                   stiff_steps, rich, XC))
     return s.j;
   while (s.j < nout && budget-- > 0) {
     dense_next(&s);
-    had = s.check_due;
-    use[0] = 1; use[1] = had;
-    au_vset(&v, 0, &s, x, s.hs);
-    if (had) au_vset(&v, 1, &s, rich + RI_X, s.due - rich[RI_T]);
-    au_vcall(step, &v, use);
-    want[0] = v.err[0] <= 1.0 && dense_wants_k(&s);
-    want[1] = had && rich_wants_k(&s);
-    au_vcont(cont, &v, want);
-    if (had) {  /* (the check's step due before this answer step) */
-      au_vget(&v, 1, xn, &err, F, want[1]);
-      rich_take(&s, xn, err, NULL, F);
-    }
-    au_vget(&v, 0, xn, &err, F, want[0]);
-    stop = dense_take(&s, xn, err, NULL, want[0] ? F : NULL);
-    if (stop) break;
+    if (rich && step ? dense_advance_v(&s, &v, step, cont) : dense_advance(&s)) break;
   }
   if (s.check_due) rich_step(&s);
   dense_close(&s, hio);
@@ -823,14 +816,9 @@ static int au_step(casadi_real* w, casadi_real factor, casadi_real* Y, int* budg
   casadi_real* count = AU_COUNT(w);
   int nout = (int) w[AU_NOUT], j;
   casadi_real before = count[0] + count[1];
-  if (check && step)  /* (the check's steps in a lane of the answer's) */
-    j = dense_run_v(AU_XR(w), AU_TT(w), AU_H(w), nout, AU_TS(w), AU_U(w), AU_P(w),
-                    w[AU_RTOL] * factor, AU_AL(w), w[AU_MAXSTEPS] - w[AU_SPENT], Y + 1,
-                    nout + 1, count, *budget, w[AU_STIFF], AU_RICH(w), XC + 1, step, cont);
-  else
-    j = dense_run(AU_XR(w), AU_TT(w), AU_H(w), nout, AU_TS(w), AU_U(w), AU_P(w),
-                  w[AU_RTOL] * factor, AU_AL(w), w[AU_MAXSTEPS] - w[AU_SPENT], Y + 1,
-                  nout + 1, count, *budget, w[AU_STIFF], check ? AU_RICH(w) : NULL, XC + 1);
+  j = dense_run(AU_XR(w), AU_TT(w), AU_H(w), nout, AU_TS(w), AU_U(w), AU_P(w),
+                w[AU_RTOL] * factor, AU_AL(w), w[AU_MAXSTEPS] - w[AU_SPENT], Y + 1, nout + 1,
+                count, *budget, w[AU_STIFF], check ? AU_RICH(w) : NULL, XC + 1, step, cont);
   *budget -= (int) (count[0] + count[1] - before);
   return j >= nout || count[2] != 0;
 }
@@ -1063,7 +1051,7 @@ static void au_ended(casadi_real* w, casadi_real* X, casadi_real* XC, int floor,
    0 = x0) and, alongside, its check (its steps merged in pairs) into XC, compared; at most
    `budget` steps per call (interrupts are looked at between calls); with `vstep` and
    `vcont` (`lanes.dense_lanes`, else NULL) the check's steps ride in a lane of the
-   answer's (`dense_run_v`: the same bits). Returns AU_PHASE (3: done). */
+   answer's (`dense_advance_v`: the same bits). Returns AU_PHASE (3: done). */
 int rk8_auto_v(casadi_real* w, int nout, int budget, casadi_real* X, casadi_real* XC,
                void* vstep, void* vcont) {
   w[AU_NOUT] = nout;

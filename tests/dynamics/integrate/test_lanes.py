@@ -187,7 +187,7 @@ def test_a_dense_batch_does_not_wait_for_its_lanes_and_takes_them_once_ready():
                          ids=["defaults", "budgets of 7 steps", "near the rounding"])
 def test_a_single_call_with_its_check_in_a_lane_is_the_scalar_call(kw, budget, monkeypatch):
     """A single checked call whose check's steps ride in a lane of its answer's vector steps
-    (the pass's ``rk8_auto_v``, `dense_run_v`) is the scalar call to the bit: answer,
+    (the pass's ``rk8_auto_v``, `dense_advance_v`) is the scalar call to the bit: answer,
     estimate, steps, message; also when the call is cut into budgets of 7 steps (a check
     due at a cut is taken alone) and near the rounding (a rerun from a moved start).
     Truth: Jacobi's closed form within the tolerance."""
