@@ -351,29 +351,15 @@ static casadi_real dense_first_step(pass_ctx* c, const casadi_real* x, const cas
   return isfinite(h1) && h1 > 0 ? fmin(h1, tend - t) : tend - t;
 }
 
-/* The outputs ts[*j] ... in the step of `hs` from (t, x) to (tn, xn) (stages K) into X
-   (nx, ldx): those inside from the step's continuous extension of order 7 (`rk8_cont`,
-   evaluated only for a step that holds one: *have 1 then; or given, Fin not NULL), those
-   on its end from xn. */
-static void dense_outputs(pass_ctx* c, const casadi_real* x, const casadi_real* xn,
-                          const casadi_real* K, casadi_real hs, const casadi_real* u,
-                          const casadi_real* p, casadi_real t, casadi_real tn, int nout,
-                          const casadi_real* ts, int* j, casadi_real* X, int ldx, int* have,
-                          const casadi_real* Fin) {
-  const casadi_real* arg[PASS_NARG + 7];
-  casadi_real* res[PASS_NRES + 3];
-  casadi_real Fout[7 * PASS_NX], s, r;
-  const casadi_real* F = Fin ? Fin : Fout;
-  int i;
-  *have = 0;
-  while (*j < nout && ts[*j] < tn) {
-    if (!*have && !Fin) {
-      arg[0] = x; arg[1] = xn; arg[2] = K; arg[3] = &hs; arg[4] = u; arg[5] = p;
-      res[0] = Fout;
-      rk8_cont(arg, res, c->iw, c->w, 0);
-    }
-    *have = 1;
-    s = (ts[*j] - t) / hs;
+/* The outputs ts[j0] ... ts[j1 - 1], inside the step of `hs` from (t, x), from its
+   continuous extension F (`rk8_cont`: order 7) into X (nx, ldx) */
+static void dense_fill(const casadi_real* x, const casadi_real* F, casadi_real t,
+                       casadi_real hs, const casadi_real* ts, int j0, int j1, casadi_real* X,
+                       int ldx) {
+  casadi_real s, r;
+  int i, j;
+  for (j = j0; j < j1; ++j) {
+    s = (ts[j] - t) / hs;
     for (i = 0; i < PASS_NX; ++i) {
       r = F[5 * PASS_NX + i] + s * F[6 * PASS_NX + i];
       r = F[4 * PASS_NX + i] + (1 - s) * r;
@@ -381,9 +367,36 @@ static void dense_outputs(pass_ctx* c, const casadi_real* x, const casadi_real* 
       r = F[2 * PASS_NX + i] + (1 - s) * r;
       r = F[PASS_NX + i] + s * r;
       r = F[i] + (1 - s) * r;
-      X[i * ldx + *j] = x[i] + s * r;
+      X[i * ldx + j] = x[i] + s * r;
     }
-    ++*j;
+  }
+}
+
+/* The outputs ts[*j] ... in the step of `hs` from (t, x) to (tn, xn) (stages K) into X
+   (nx, ldx): those inside from the step's continuous extension of order 7 (`rk8_cont`,
+   evaluated only for a step that holds one: *have 1 then; or given, Fin not NULL; or, with
+   `span` not NULL, left to the caller: their range of indices into span[0], span[1]), those
+   on its end from xn. */
+static void dense_outputs(pass_ctx* c, const casadi_real* x, const casadi_real* xn,
+                          const casadi_real* K, casadi_real hs, const casadi_real* u,
+                          const casadi_real* p, casadi_real t, casadi_real tn, int nout,
+                          const casadi_real* ts, int* j, casadi_real* X, int ldx, int* have,
+                          const casadi_real* Fin, int* span) {
+  const casadi_real* arg[PASS_NARG + 7];
+  casadi_real* res[PASS_NRES + 3];
+  casadi_real Fout[7 * PASS_NX];
+  int j0 = *j, i;
+  while (*j < nout && ts[*j] < tn) ++*j;
+  *have = *j > j0;
+  if (span) {
+    span[0] = j0; span[1] = *j;
+  } else if (*have) {
+    if (!Fin) {
+      arg[0] = x; arg[1] = xn; arg[2] = K; arg[3] = &hs; arg[4] = u; arg[5] = p;
+      res[0] = Fout;
+      rk8_cont(arg, res, c->iw, c->w, 0);
+    }
+    dense_fill(x, Fin ? Fin : Fout, t, hs, ts, j0, *j, X, ldx);
   }
   while (*j < nout && ts[*j] == tn) {  /* an output on the step's end */
     for (i = 0; i < PASS_NX; ++i) X[i * ldx + *j] = xn[i];
@@ -476,19 +489,22 @@ static int dense_wants_k(const dense_state* s) {
 }
 
 /* after the step of s->hs to xn (its estimate err, stages K: read only when
-   `dense_wants_k`, and not when its continuous extension F is given): accepted, its outputs, the check's pair (a step of the check due to
+   `dense_wants_k`, and not when its continuous extension F is given): accepted, its
+   outputs (those inside left to the caller with `span` not NULL: their indices in
+   [span[0], span[1]), empty when none), the check's pair (a step of the check due to
    s->due: s->check_due), the rounding noise; then the controller. Returns 1 when the run
    stops (its flag in count[2]). */
 static int dense_take(dense_state* s, casadi_real* xn, casadi_real err, const casadi_real* K,
-                      const casadi_real* F) {
+                      const casadi_real* F, int* span) {
   casadi_real *x = s->x, *count = s->count, *rich = s->rich, hs = s->hs, fac, tn;
   int i, have, finite = isfinite(err);
+  if (span) span[0] = span[1] = 0;
   for (i = 0; i < PASS_NX && finite; ++i) finite = isfinite(xn[i]);
   fac = finite ? pow(err, 0.125) / 0.9 : 3.0;
   if (finite && err <= 1.0) {
     tn = s->last ? s->tend : *s->t + hs;
     dense_outputs(&s->c, x, xn, K, hs, s->u, s->p, *s->t, tn, s->nout, s->ts, &s->j, s->X,
-                  s->ldx, &have, F);
+                  s->ldx, &have, F, span);
     count[4] += have;
     for (i = 0; i < PASS_NX; ++i) x[i] = xn[i];
     *s->t = tn;
@@ -537,12 +553,12 @@ static int rich_wants_k(const dense_state* s) {
    xn (estimate err, stages K: read only when `rich_wants_k`, and not when its continuous
    extension F is given): its outputs into XC */
 static void rich_take(dense_state* s, const casadi_real* xn, casadi_real err,
-                      const casadi_real* K, const casadi_real* F) {
+                      const casadi_real* K, const casadi_real* F, int* span) {
   casadi_real* rich = s->rich;
   casadi_real* xc = rich + RI_X;
   int j = (int) rich[RI_J], i, have;
   dense_outputs(&s->c, xc, xn, K, s->due - rich[RI_T], s->u, s->p, rich[RI_T], s->due,
-                s->nout, s->ts, &j, s->XC, s->ldx, &have, F);
+                s->nout, s->ts, &j, s->XC, s->ldx, &have, F, span);
   for (i = 0; i < PASS_NX; ++i) xc[i] = xn[i];
   rich[RI_T] = s->due; rich[RI_J] = j; rich[RI_STEPS] += 1;
   rich[RI_EC] += isfinite(err) ? err : INFINITY;
@@ -553,7 +569,7 @@ static void rich_take(dense_state* s, const casadi_real* xn, casadi_real err,
 static void rich_step(dense_state* s) {
   casadi_real xn[PASS_NX], K[12 * PASS_NX], err;
   dense_step(&s->c, s->rich + RI_X, s->due - s->rich[RI_T], s->u, s->p, xn, &err, K);
-  rich_take(s, xn, err, K, NULL);
+  rich_take(s, xn, err, K, NULL, NULL);
 }
 
 /* one answer step of the run in progress (`dense_next`'s) by the step function, and the
@@ -562,7 +578,7 @@ static int dense_advance(dense_state* s) {
   casadi_real xn[PASS_NX], K[12 * PASS_NX], err;
   int stop;
   dense_step(&s->c, s->x, s->hs, s->u, s->p, xn, &err, K);
-  stop = dense_take(s, xn, err, K, NULL);
+  stop = dense_take(s, xn, err, K, NULL, NULL);
   if (s->check_due) rich_step(s);
   return stop;
 }
@@ -658,10 +674,10 @@ static int dense_advance_v(dense_state* s, au_vio* v, au_vstep step, au_vstep co
   au_vcont(cont, v, want);
   if (had) {  /* (the check's step due before this answer step) */
     au_vget(v, 1, xn, &err, F, want[1]);
-    rich_take(s, xn, err, NULL, F);
+    rich_take(s, xn, err, NULL, F, NULL);
   }
   au_vget(v, 0, xn, &err, F, want[0]);
-  return dense_take(s, xn, err, NULL, want[0] ? F : NULL);
+  return dense_take(s, xn, err, NULL, want[0] ? F : NULL, NULL);
 }
 
 /* Steps of x (in/out) from time *t (in/out) towards ts[nout - 1], the outputs at the times
@@ -708,6 +724,7 @@ static int dense_run(casadi_real* x, casadi_real* t, casadi_real* hio, int nout,
 _AUTO = r"""
 #include <limits.h>
 #include <stdlib.h>
+#include <string.h>
 #define AU_RTOL 0     /* in: the requested rtol */
 #define AU_FACTOR 1   /* in/out: the answer's local tolerance over the requested one */
 #define AU_LOOSE 2    /* in/out: the check run's */
@@ -1115,13 +1132,63 @@ typedef struct {
   int opened, ended, floor;
 } au_lane;
 
+/* Continuous extensions gathered from the lanes' steps (answers' and checks'), PASS_LANES to
+   a vector call of `rk8_cont`: slot q holds a step's inputs of `rk8_cont` (x, xn, K, h, u,
+   p: v's fields, lane q) and the outputs it fills (ts[j0] ... ts[j1 - 1] of a step from
+   time t into X, ldx). A lane's steps hold an output on about one step in three, so a
+   call for the lanes of one step would mostly compute lanes nobody reads. */
+typedef struct {
+  au_vio v;
+  int n;
+  const casadi_real* ts[PASS_LANES];
+  casadi_real t[PASS_LANES], *X[PASS_LANES];
+  int j0[PASS_LANES], j1[PASS_LANES], ldx[PASS_LANES];
+} au_pend;
+
+/* the extension of slots 0 ... n - 1 in one vector call, their outputs filled (the other
+   lanes compute what they last held: finite values, read by nobody) */
+static void au_flush(au_pend* P, au_vstep vcont) {
+  casadi_real x[PASS_NX], F[7 * PASS_NX];
+  int want[PASS_LANES], q, i;
+  if (!P->n) return;
+  for (q = 0; q < PASS_LANES; ++q) want[q] = q < P->n;
+  au_vcont(vcont, &P->v, want);
+  for (q = 0; q < P->n; ++q) {
+    for (i = 0; i < PASS_NX; ++i) x[i] = P->v.x[i][q];
+    for (i = 0; i < 7 * PASS_NX; ++i) F[i] = P->v.F[i][q];
+    dense_fill(x, F, P->t[q], P->v.h[q], P->ts[q], P->j0[q], P->j1[q], P->X[q], P->ldx[q]);
+  }
+  P->n = 0;
+}
+
+/* lane l's step of v, taken from time t by the run of s, its outputs inside left in
+   [span[0], span[1]) (`dense_take`, `rich_take`), into a slot for X; a vector call when the
+   slots are full */
+static void au_defer(au_pend* P, au_vstep vcont, const au_vio* v, int l, const dense_state* s,
+                     casadi_real t, const int* span, casadi_real* X) {
+  int q = P->n, i;
+  if (span[1] <= span[0]) return;
+  for (i = 0; i < PASS_NX; ++i) {
+    P->v.x[i][q] = v->x[i][l];
+    P->v.xn[i][q] = v->xn[i][l];
+  }
+  for (i = 0; i < 12 * PASS_NX; ++i) P->v.K[i][q] = v->K[i][l];
+  for (i = 0; i < PASS_U; ++i) P->v.u[i][q] = v->u[i][l];
+  for (i = 0; i < (PASS_NP > 0 ? PASS_NP : 1); ++i) P->v.p[i][q] = v->p[i][l];
+  P->v.h[q] = v->h[l];
+  P->t[q] = t; P->ts[q] = s->ts; P->X[q] = X; P->ldx[q] = s->ldx;
+  P->j0[q] = span[0]; P->j1[q] = span[1];
+  if (++P->n == PASS_LANES) au_flush(P, vcont);
+}
+
 /* the check steps due in the lanes, in one vector step, when one of them cannot wait
    (`all`; or a lane whose next accepted step would make another due: it ends a pair or
    the run); a check step waits at most one answer step, so about one vector step of
-   checks serves every lane's pair */
-static void au_checks(au_lane* L, au_vio* v, au_vstep step, au_vstep vcont, int all) {
-  casadi_real xn[PASS_NX], F[7 * PASS_NX], err;
-  int use[PASS_LANES], want[PASS_LANES], l, any = 0, urgent = all;
+   checks serves every lane's pair; their continuous extensions gathered in P */
+static void au_checks(au_lane* L, au_vio* v, au_pend* P, au_vstep step, au_vstep vcont,
+                      int all) {
+  casadi_real xn[PASS_NX], err, t;
+  int use[PASS_LANES], span[2], l, any = 0, urgent = all;
   for (l = 0; l < PASS_LANES; ++l) {
     dense_state* s = &L[l].s;
     use[l] = L[l].k >= 0 && L[l].opened && s->check_due;
@@ -1132,12 +1199,12 @@ static void au_checks(au_lane* L, au_vio* v, au_vstep step, au_vstep vcont, int 
   for (l = 0; l < PASS_LANES; ++l)
     if (use[l]) au_vset(v, l, &L[l].s, L[l].s.rich + RI_X, L[l].s.due - L[l].s.rich[RI_T]);
   au_vcall(step, v, use);
-  for (l = 0; l < PASS_LANES; ++l) want[l] = use[l] && rich_wants_k(&L[l].s);
-  au_vcont(vcont, v, want);
   for (l = 0; l < PASS_LANES; ++l)
     if (use[l]) {
-      au_vget(v, l, xn, &err, F, want[l]);
-      rich_take(&L[l].s, xn, err, NULL, F);
+      au_vget(v, l, xn, &err, NULL, 0);
+      t = L[l].s.rich[RI_T];
+      rich_take(&L[l].s, xn, err, NULL, NULL, span);
+      au_defer(P, vcont, v, l, &L[l].s, t, span, L[l].s.XC);
     }
 }
 
@@ -1201,13 +1268,14 @@ int rk8_auto_lanes(const casadi_real* w, int nout, int k0, int k1, const casadi_
                    casadi_real* XC, casadi_real* res, void* vstep, void* vcont) {
   au_vstep step = (au_vstep) vstep, cont = (au_vstep) vcont;
   au_vio v;
+  au_pend P;
   au_lane L[PASS_LANES];
-  casadi_real xn[PASS_NX], F[7 * PASS_NX], err;
-  int size = AU_SIZE(nout), plain = w[AU_TRIES] <= 0, use[PASS_LANES], want[PASS_LANES], l;
-  int any;
+  casadi_real xn[PASS_NX], err, t;
+  int size = AU_SIZE(nout), plain = w[AU_TRIES] <= 0, use[PASS_LANES], span[2], l, any;
   long next = k0;
   casadi_real* wk = (casadi_real*) malloc(sizeof(casadi_real) * size * PASS_LANES);
   if (!wk) return 0;
+  memset(&P, 0, sizeof P);
   for (l = 0; l < PASS_LANES; ++l) {
     L[l].w = wk + (size_t) l * size;
     L[l].XC = XC + (size_t) l * PASS_NX * (nout + 1);
@@ -1220,26 +1288,25 @@ int rk8_auto_lanes(const casadi_real* w, int nout, int k0, int k1, const casadi_
     any = 0;
     for (l = 0; l < PASS_LANES; ++l) any |= use[l] = L[l].k >= 0;
     if (!any) break;
-    au_checks(L, &v, step, cont, 0);
+    au_checks(L, &v, &P, step, cont, 0);
     for (l = 0; l < PASS_LANES; ++l)
       if (use[l]) {
         dense_next(&L[l].s);
         au_vset(&v, l, &L[l].s, L[l].s.x, L[l].s.hs);
       }
     au_vcall(step, &v, use);
-    for (l = 0; l < PASS_LANES; ++l)  /* (the extension of a step that is accepted) */
-      want[l] = use[l] && v.err[l] <= 1.0 && dense_wants_k(&L[l].s);
-    au_vcont(cont, &v, want);
     any = 0;
     for (l = 0; l < PASS_LANES; ++l)
       if (use[l]) {
-        au_vget(&v, l, xn, &err, F, want[l]);
-        L[l].ended = dense_take(&L[l].s, xn, err, NULL, want[l] ? F : NULL) ||
-                     L[l].s.j >= nout;
+        au_vget(&v, l, xn, &err, NULL, 0);
+        t = *L[l].s.t;
+        L[l].ended = dense_take(&L[l].s, xn, err, NULL, NULL, span) || L[l].s.j >= nout;
+        au_defer(&P, cont, &v, l, &L[l].s, t, span, L[l].s.X);
         any |= L[l].ended;
       }
     if (!any) continue;
-    au_checks(L, &v, step, cont, 1);  /* (a run ends with its checks taken) */
+    au_checks(L, &v, &P, step, cont, 1);  /* (a run ends with its checks taken) */
+    au_flush(&P, cont);  /* (and its outputs filled) */
     for (l = 0; l < PASS_LANES; ++l)
       if (use[l] && L[l].ended) au_lane_next(&L[l], nout, res, plain);
   }
