@@ -64,7 +64,11 @@ from simulate import (BATCH_TOL, INERTIA, batch_workload, numbalsoda,  # noqa: E
                       numbalsoda_batch)
 
 REPEATS = 11
-TOLS = [10.0 ** -k for k in np.arange(4.0, 12.01, 1.0)]
+#: The sweep's tolerances, both solvers: from 1e-2, where neither meets any target, to
+#: 1e-12. (It began at 1e-4, where ``auto`` already delivered 17-140x below the 1e-6 targets
+#: of the slow long body, the wheel spacecraft and the hinged scene: its cheapest run meeting
+#: them lay outside the sweep, and the ratio was measured at a run it did not need.)
+TOLS = [10.0 ** -k for k in np.arange(2.0, 12.01, 1.0)]
 
 
 @dataclass(frozen=True)
