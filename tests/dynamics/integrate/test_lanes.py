@@ -105,20 +105,25 @@ def _tumbling(k, seed):
     return np.vstack([np.zeros((3, k)), np.ones(k), w])
 
 
-@pytest.mark.parametrize("kw", [{}, dict(rtol=1e-10, atol=1e-12),
-                                dict(method="dop853", rtol=1e-9, atol=1e-11)],
-                         ids=["auto", "auto near the rounding", "dop853"])
-def test_dense_batches_in_lanes_are_the_scalar_loop_to_the_bit(kw, monkeypatch):
+@pytest.mark.parametrize("kw, n", [({}, 41), (dict(rtol=1e-10, atol=1e-12), 41),
+                                   (dict(method="dop853", rtol=1e-9, atol=1e-11), 41),
+                                   ({}, 2), ({}, 801)],
+                         ids=["auto", "auto near the rounding", "dop853", "auto, 2 points",
+                              "auto, several outputs a step"])
+def test_dense_batches_in_lanes_are_the_scalar_loop_to_the_bit(kw, n, monkeypatch):
     """``auto`` and ``dop853`` batches whose runs step four at a time in the lanes of the
     vector DOP853 step (`lanes.dense_lanes`; the pass's ``rk8_auto_lanes``: each lane its
-    own steps, controller, outputs and check, an emptied lane taking the next run) are the
-    scalar loop's bits: answers, estimates, steps, verdicts; 11 runs (lanes refilled, a
-    short last group); near the rounding some runs retry or rerun from a moved start
-    alone. Truth: Jacobi's closed form within the tolerance."""
+    own steps, controller, outputs and check, an emptied lane taking the next run, the
+    continuous extensions of the lanes' steps gathered four to a vector call and their
+    outputs filled from it later) are the scalar loop's bits: answers, estimates, steps,
+    verdicts; 11 runs (lanes refilled, a short last group); near the rounding some runs
+    retry or rerun from a moved start alone; grids with no output inside a step (2 points)
+    and with several inside each (801). Truth: Jacobi's closed form within the
+    tolerance."""
     from appdyn.dynamics.integrate import batch
     from appdyn.dynamics.truth import torque_free_omega
     inertia = [1.0, 2.0, 3.0]
-    model, t = rigid_body(inertia), np.linspace(0.0, 20.0, 41)
+    model, t = rigid_body(inertia), np.linspace(0.0, 20.0, n)
     X0 = _tumbling(11, 3)
     assert lanes.dense_lanes(model, wait=True) is not None
     got = simulate(model, X0, t, threads=1, **kw)
