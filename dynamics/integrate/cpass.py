@@ -591,10 +591,12 @@ typedef double au_vec __attribute__((vector_size(8 * PASS_LANES)));
 typedef int (*au_vstep)(const au_vec** arg, au_vec** res);
 
 /* the vector step's inputs and outputs (those of `rk8_step_k`, a lane per run), then the
-   step's continuous extension (`rk8_cont` of x, xn, K, h, u, p) */
+   step's continuous extension (`rk8_cont` of x, xn, K, h, u, p); `filled` the lanes that
+   hold a step's inputs (a bit each; 0 where declared) */
 typedef struct {
   au_vec x[PASS_NX], h, u[PASS_U], p[PASS_NP > 0 ? PASS_NP : 1], rtol, atol[PASS_NX];
   au_vec xn[PASS_NX], err, K[12 * PASS_NX], F[7 * PASS_NX];
+  int filled;
 } au_vio;
 
 /* lane l's inputs: a step of h from x under the run's control, parameters and tolerances */
@@ -609,16 +611,19 @@ static void au_vset(au_vio* v, int l, const dense_state* s, const casadi_real* x
   for (i = 0; i < PASS_NP; ++i) v->p[i][l] = s->p[i];
   v->h[l] = h;
   v->rtol[l] = s->c.rtol;
+  v->filled |= 1 << l;
 }
 
-/* the vector step of the lanes `use` (the others repeat the inputs of the first in use) */
+/* the vector step of the lanes `use`; a lane not in use computes the inputs it last held
+   (a step's: finite values, read by nobody), or, never filled, those of the first in use */
 static void au_vcall(au_vstep step, au_vio* v, const int* use) {
   const au_vec* arg[6];
   au_vec* res[3];
   int l, i, f = 0;
   while (!use[f]) ++f;
   for (l = 0; l < PASS_LANES; ++l)
-    if (!use[l]) {
+    if (!use[l] && !(v->filled & (1 << l))) {
+      v->filled |= 1 << l;
       for (i = 0; i < PASS_NX; ++i) {
         v->x[i][l] = v->x[i][f];
         v->atol[i][l] = v->atol[i][f];
@@ -703,6 +708,7 @@ static int dense_run(casadi_real* x, casadi_real* t, casadi_real* hio, int nout,
                      au_vstep step, au_vstep cont) {
   dense_state s;
   au_vio v;
+  v.filled = 0;
   if (!dense_open(&s, x, t, *hio, nout, ts, u, p, rtol, atol, max_steps, X, ldx, count,
                   stiff_steps, rich, XC))
     return s.j;
@@ -1276,6 +1282,7 @@ int rk8_auto_lanes(const casadi_real* w, int nout, int k0, int k1, const casadi_
   casadi_real* wk = (casadi_real*) malloc(sizeof(casadi_real) * size * PASS_LANES);
   if (!wk) return 0;
   memset(&P, 0, sizeof P);
+  v.filled = 0;
   for (l = 0; l < PASS_LANES; ++l) {
     L[l].w = wk + (size_t) l * size;
     L[l].XC = XC + (size_t) l * PASS_NX * (nout + 1);
