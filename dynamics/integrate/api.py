@@ -226,7 +226,9 @@ def simulate(model: Model, x0, t, *, u=None, p=None, hold: Hold = "linear", meth
         batch_threads(threads)
     x = fast_x0(x0, model)  # the common x0 at once (shape (nx,): no batch); else in full
     if x is None:
-        if np.ndim(x0) == 2 and np.shape(x0)[1] >= 2:
+        shape = getattr(x0, "shape", None)  # (a casadi DM's own: numpy's would warn on it)
+        shape = shape if isinstance(shape, tuple) else np.shape(x0)
+        if len(shape) == 2 and shape[1] >= 2:
             for name, given in (("events", events), ("impacts", impacts)):
                 if given is not None:
                     raise ValueError(f"`{name}` are located for single runs only; simulate "

@@ -119,7 +119,7 @@ def dense_kernels(model: Model) -> tuple[ca.Function, ca.Function]:
     >>> x0, u, p = np.r_[0, 0, 0, 1, 0.1, 0.2, 0.3], np.zeros(3), np.zeros(0)
     >>> xn, err, K = step(x0, 0.5, u, p, 1e-8, 1e-10 * np.ones(7))
     >>> F = np.asarray(cont(x0, xn, K, 0.5, u, p)).reshape(7, 7)
-    >>> bool(np.allclose(F[0], np.ravel(xn - x0)))  # F0 = x_next - x: the end is exact
+    >>> bool(np.allclose(F[0], np.asarray(xn).ravel() - x0))  # F0 = x_next - x: the end is exact
     True
     """
     def build():

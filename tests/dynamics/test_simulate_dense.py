@@ -38,11 +38,11 @@ def test_continuous_extension_is_seventh_order():
     for H in (1.6, 0.8, 0.4):
         xn, _, K = step(X0, H, u, p, 1e-8, np.full(7, 1e-10))
         F = np.asarray(cont(X0, xn, K, H, u, p)).reshape(7, 7)
-        assert np.array_equal(F[0], np.ravel(xn) - X0)  # the step's end is exact
+        assert np.array_equal(F[0], np.asarray(xn).ravel() - X0)  # the step's end is exact
         s = 0.37
         ref = X0.copy()
         for _ in range(200):
-            ref = np.ravel(fine(ref, s * H / 200, u, u, p))
+            ref = np.asarray(fine(ref, s * H / 200, u, u, p)).ravel()
         errors.append(np.abs(_interpolate(F, X0, s) - ref).max())
     ratios = np.array(errors[:-1]) / np.array(errors[1:])
     assert np.all((ratios > 128) & (ratios < 512)), ratios
