@@ -1128,7 +1128,8 @@ int rk8_auto_many(const casadi_real* w, int nout, int k0, int k1, const casadi_r
    `lanes.lane_source`'s `rk8_step_k` and `rk8_cont`, each lane a run's own arithmetic in
    the order of the step function (the same bits). Each lane keeps its own steps,
    controller, outputs and check (`dense_state`); a lane whose run ended takes the next
-   run. The continuous extension is taken for the lanes whose step holds an output. ---- */
+   run. The continuous extensions of the lanes' steps that hold an output are gathered four
+   to a vector call (`au_pend`). ---- */
 /* a lane: its run k (-1: none), that run's workspace, answer and check outputs, and its
    `dense_run` in progress (`opened` 0: it ended at its start) */
 typedef struct {
