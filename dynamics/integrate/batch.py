@@ -185,13 +185,15 @@ def auto_dense_batch(batch: Batch, rtol: float, atol: np.ndarray, max_steps: int
     """``auto`` on a batch of smooth runs, each under a control constant over its run: the
     answer, check run and verdict of `dense.dense_auto` for every run in one compiled loop
     over the runs (`dense.dense_many`; the runs in parts of at most `DENSE_PART` spread over
-    ``threads`` threads by `batch_fixed.spread_runs` from ``2 DENSE_PART`` runs on, each
-    part filling its own slice of the answers), each run with its own steps; round by round
+    ``threads`` threads by `batch_fixed.spread_runs`, each part filling its own slice of
+    the answers), each run with its own steps; round by round
     (`dense_rounds`, each spread over the batch), each later round's first answers at the
-    factor `first_factor` learns from the runs before (a round's runs gathered end to end:
-    one compiled loop per part, `lanes.dense_lanes`' vector lanes kept full; its answers
-    put back in place; each run's answer does not depend on its neighbours, so the bits do
-    not depend on the gathering, the parts or the lanes). A run not verified there goes alone
+    factor `first_factor` learns from the runs before (a round of small slices gathered end
+    to end: one compiled loop per part, `lanes.dense_lanes`' vector lanes kept full, its
+    answers put back in place; a round of slices of `GATHER_BELOW` runs or more in place,
+    slice by slice; a round of fewer than ``2 DENSE_PART`` runs on one thread; each run's
+    answer does not depend on its neighbours, so the bits do not depend on the gathering,
+    the parts or the lanes). A run not verified there goes alone
     through `solve_auto` (as a single call would). Returns ``(x (nx, n, K), ok, status,
     estimate, method, n_steps, message)``, or None (no compiled pass, a control that varies
     within a run, jit off)."""
@@ -208,29 +210,37 @@ def auto_dense_batch(batch: Batch, rtol: float, atol: np.ndarray, max_steps: int
     missing = []
     vector = dense_lanes(model, build=K >= LANES_MIN)
 
-    # (a small batch stays on one thread: a hand-over costs tens of microseconds on an idle
-    # machine and milliseconds on a loaded one, where the woken thread waits for a core)
-    spread = batch_threads(threads) if K >= 2 * DENSE_PART else 1
+    cores = batch_threads(threads)
     factor, factors, done = FIRST, [], []
     for pieces in dense_rounds(K):  # (the rounds do not depend on `threads`: same bits)
         if done:
             factor = _learned(head[np.concatenate(done)], factor, rtol)
         factors.append(factor)
-        # the round's runs gathered end to end (one compiled loop per thread's part, its
-        # vector lanes kept full), their answers and headers put back in place
         runs = np.concatenate([np.arange(k0, k1) for k0, k1 in pieces])
-        xr, ur, pr = x0[runs], u[runs], p[runs]
-        Xr, hr = np.empty((runs.size, nx, t.size)), np.empty((runs.size, DENSE_HEADER))
+        if min(k1 - k0 for k0, k1 in pieces) >= GATHER_BELOW:  # in place, slice by slice
+            inputs, outputs, parts = (x0, u, p), (X, head), pieces
+        else:  # the round's runs gathered end to end (one compiled loop per thread's part,
+            # its vector lanes kept full), their answers and headers put back in place
+            inputs = (x0[runs], u[runs], p[runs])
+            outputs, parts = (np.empty((runs.size, nx, t.size)),
+                              np.empty((runs.size, DENSE_HEADER))), None
 
-        def call(a, b, xr=xr, ur=ur, pr=pr, Xr=Xr, hr=hr, factor=factor):
-            if dense_many(model, xr, t, ur, pr, rtol, atol, max_steps, STIFF_STEPS,
-                          slice(a, b), out=(Xr, hr), factor=factor, vector=vector) is None:
+        def call(a, b, inputs=inputs, outputs=outputs, factor=factor):
+            xk, uk, pk = inputs
+            if dense_many(model, xk, t, uk, pk, rtol, atol, max_steps, STIFF_STEPS,
+                          slice(a, b), out=outputs, factor=factor, vector=vector) is None:
                 missing.append(a)
 
-        spread_runs(call, runs.size, spread, DENSE_PART)
+        # (a small round stays on one thread: a hand-over costs tens of microseconds on an
+        # idle machine and milliseconds on a loaded one, where the woken thread waits for a
+        # core; the first two rounds of 1,000 runs, 16 and 48 runs, took 1.2-1.5 and 1.6-1.9
+        # ms on two threads against 0.6-0.7 and 1.7-1.85 ms on one)
+        spread_runs(call, runs.size, cores if runs.size >= 2 * DENSE_PART else 1, DENSE_PART,
+                    pieces=parts)
         if missing:
             return None
-        X[runs], head[runs] = Xr, hr
+        if parts is None:
+            X[runs], head[runs] = outputs
         done.append(runs)
     result = head[:, DENSE_FIELDS.index("result")]  # (each run's header read as columns)
     estimate = head[:, DENSE_FIELDS.index("estimate")].copy()
@@ -321,6 +331,11 @@ def dop853_dense_batch(batch: Batch, rtol: float, atol: np.ndarray, max_steps: i
 #: a later one takes it): for the rigid body, 256 runs of 41 outputs are ~20 ms of the
 #: scalar loop, which the lanes cut about 2x. A smaller batch takes the lanes once built.
 LANES_MIN = 256
+#: A round of a dense batch whose slices (`dense_rounds`) all hold at least this many runs
+#: runs them in place, slice by slice; a round of smaller slices (the first ones: 1-3 runs
+#: each) is gathered end to end, so that the compiled loops keep their vector lanes full,
+#: and put back (copies of ~2 MB on 1,000 runs of 41 outputs, ~1.4 ms of fresh memory).
+GATHER_BELOW = 8
 #: Most runs of one compiled call of a dense batch (Ctrl-C is looked at between groups of
 #: them, `batch_fixed.spread_runs`).
 DENSE_PART = 64

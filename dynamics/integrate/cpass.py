@@ -14,6 +14,7 @@ from .. import cache
 from ..model import Model
 from .csteps import loop_steps
 from .kernels import calls_rhs, dense_kernels, kernel
+from .tableaux import DOP853_DENSE_STAGES
 from .chunks import BATCH_CHUNK, CHUNK, chunk_compile_job, chunk_name
 from .lanes import LANES
 
@@ -28,10 +29,15 @@ NOISE = 30
 #: C flags of the pass, tried in turn: compiled for this machine's instruction set (the
 #: library is built and used here only; FMA and AVX made the pass 22% faster on the 2-core
 #: VM, 742 steps in 149 against 191 us), else plain -O1 (as the chunk loops; -O2/-O3 were
-#: no faster and compile 30-80% longer). No ``a * b + c`` is contracted into a fused
-#: multiply-add (gcc's -O1 contracts none: the same code with the flag), as in the vector
-#: lanes (`lanes`): a lane's arithmetic is then the scalar step's to the bit on any gcc.
-_OPTS = ("-O1 -ffp-contract=off -march=native", "-O1 -ffp-contract=off")
+#: no faster and compile 30-80% longer on the generated steps). The driver's own C (the
+#: loops, controller, outputs and checks around the steps: `_DRIVER` on) is built at -O2
+#: by a pragma: the 1,000-run Monte Carlo of ``bench/integrate_peers.py`` took 8% less
+#: time, the same bits. No ``a * b + c`` is contracted into a fused multiply-add (gcc's
+#: -O1 contracts none: the same code with the flag), as in the vector lanes (`lanes`): a
+#: lane's arithmetic is then the scalar step's to the bit on any gcc. ``sqrt`` sets no
+#: ``errno`` (no value changes), so the lanes' controller roots are one vector ``sqrt``.
+_OPTS = ("-O1 -ffp-contract=off -fno-math-errno -march=native",
+         "-O1 -ffp-contract=off -fno-math-errno")
 
 #: The answer's embedded estimate (and the model's rounding) is taken in every
 #: `CHECK_EVERY`-th interval (-1 in the others): it only tells whether the two runs show the
@@ -45,6 +51,7 @@ _N, _E, _EC, _S = range(4)
 # The driver: the generated steps `rk8_step_err` (x, h, ua, ud, p, rtol, atol) -> (x+, err)
 # and `rk8_step` (x, h, ua, ud, p) -> x+ called from a plain C loop over the output intervals.
 _DRIVER = r"""
+#pragma GCC optimize ("O2", "fp-contract=off")
 #include <float.h>
 #include <stddef.h>
 #define PASS_NX %(nx)d
@@ -57,6 +64,9 @@ _DRIVER = r"""
 #define PASS_LANES %(lanes)d
 #define PASS_U (PASS_NU > 0 ? PASS_NU : 1)
 #define CHECK_EVERY %(every)d
+/* the stages the continuous extension reads (`tableaux.DOP853_DENSE_STAGES`) */
+#define CONT_STAGES {%(cont)s}
+#define CONT_NSTAGES %(ncont)d
 %(steps)s
 typedef struct {
   const casadi_real *p, *atol, *ud;
@@ -488,19 +498,25 @@ static int dense_wants_k(const dense_state* s) {
   return s->j < s->nout && s->ts[s->j] < (s->last ? s->tend : *s->t + s->hs);
 }
 
-/* after the step of s->hs to xn (its estimate err, stages K: read only when
-   `dense_wants_k`, and not when its continuous extension F is given): accepted, its
+/* err^(1/8) of an embedded estimate err >= 0 (the controller's; a third of pow's cost, and
+   the same bits in a vector lane: `au_vcall`; not finite for err not finite) */
+static casadi_real ctl_root(casadi_real err) {
+  return sqrt(sqrt(sqrt(err)));
+}
+
+/* after the step of s->hs to xn (its estimate err, its root `ctl_root(err)`, stages K: read
+   only when `dense_wants_k`, and not when its continuous extension F is given): accepted, its
    outputs (those inside left to the caller with `span` not NULL: their indices in
    [span[0], span[1]), empty when none), the check's pair (a step of the check due to
    s->due: s->check_due), the rounding noise; then the controller. Returns 1 when the run
    stops (its flag in count[2]). */
-static int dense_take(dense_state* s, casadi_real* xn, casadi_real err, const casadi_real* K,
-                      const casadi_real* F, int* span) {
+static int dense_take(dense_state* s, casadi_real* xn, casadi_real err, casadi_real root,
+                      const casadi_real* K, const casadi_real* F, int* span) {
   casadi_real *x = s->x, *count = s->count, *rich = s->rich, hs = s->hs, fac, tn;
   int i, have, finite = isfinite(err);
   if (span) span[0] = span[1] = 0;
   for (i = 0; i < PASS_NX && finite; ++i) finite = isfinite(xn[i]);
-  fac = finite ? pow(err, 0.125) / 0.9 : 3.0;
+  fac = finite ? root / 0.9 : 3.0;
   if (finite && err <= 1.0) {
     tn = s->last ? s->tend : *s->t + hs;
     dense_outputs(&s->c, x, xn, K, hs, s->u, s->p, *s->t, tn, s->nout, s->ts, &s->j, s->X,
@@ -578,7 +594,7 @@ static int dense_advance(dense_state* s) {
   casadi_real xn[PASS_NX], K[12 * PASS_NX], err;
   int stop;
   dense_step(&s->c, s->x, s->hs, s->u, s->p, xn, &err, K);
-  stop = dense_take(s, xn, err, K, NULL, NULL);
+  stop = dense_take(s, xn, err, ctl_root(err), K, NULL, NULL);
   if (s->check_due) rich_step(s);
   return stop;
 }
@@ -595,7 +611,7 @@ typedef int (*au_vstep)(const au_vec** arg, au_vec** res);
    hold a step's inputs (a bit each; 0 where declared) */
 typedef struct {
   au_vec x[PASS_NX], h, u[PASS_U], p[PASS_NP > 0 ? PASS_NP : 1], rtol, atol[PASS_NX];
-  au_vec xn[PASS_NX], err, K[12 * PASS_NX], F[7 * PASS_NX];
+  au_vec xn[PASS_NX], err, root, K[12 * PASS_NX], F[7 * PASS_NX];
   int filled;
 } au_vio;
 
@@ -637,6 +653,8 @@ static void au_vcall(au_vstep step, au_vio* v, const int* use) {
   arg[5] = v->atol;
   res[0] = v->xn; res[1] = &v->err; res[2] = v->K;
   step(arg, res);
+  for (l = 0; l < PASS_LANES; ++l)  /* (every lane's `ctl_root` at once) */
+    v->root[l] = ctl_root(v->err[l]);
 }
 
 /* the continuous extension of the vector step just taken (`vcont`), when a lane of `want`
@@ -654,10 +672,11 @@ static void au_vcont(au_vstep vcont, au_vio* v, const int* want) {
 
 /* lane l's outputs: x_next, the estimate and (`withf`) the continuous extension */
 static void au_vget(const au_vio* v, int l, casadi_real* xn, casadi_real* err,
-                    casadi_real* F, int withf) {
+                    casadi_real* root, casadi_real* F, int withf) {
   int i;
   for (i = 0; i < PASS_NX; ++i) xn[i] = v->xn[i][l];
   *err = v->err[l];
+  *root = v->root[l];
   if (withf)
     for (i = 0; i < 7 * PASS_NX; ++i) F[i] = v->F[i][l];
 }
@@ -667,7 +686,7 @@ static void au_vget(const au_vio* v, int l, casadi_real* xn, casadi_real* err,
    step, so a checked run costs one vector step per answer step (about one scalar step)
    where `dense_advance` takes one and a half; the same bits. 1 when the run stops. */
 static int dense_advance_v(dense_state* s, au_vio* v, au_vstep step, au_vstep cont) {
-  casadi_real xn[PASS_NX], F[7 * PASS_NX], err;
+  casadi_real xn[PASS_NX], F[7 * PASS_NX], err, root;
   int use[PASS_LANES], want[PASS_LANES], l, had = s->check_due;
   for (l = 0; l < PASS_LANES; ++l) use[l] = want[l] = 0;
   use[0] = 1; use[1] = had;
@@ -678,11 +697,11 @@ static int dense_advance_v(dense_state* s, au_vio* v, au_vstep step, au_vstep co
   want[1] = had && rich_wants_k(s);
   au_vcont(cont, v, want);
   if (had) {  /* (the check's step due before this answer step) */
-    au_vget(v, 1, xn, &err, F, want[1]);
+    au_vget(v, 1, xn, &err, &root, F, want[1]);
     rich_take(s, xn, err, NULL, F, NULL);
   }
-  au_vget(v, 0, xn, &err, F, want[0]);
-  return dense_take(s, xn, err, NULL, want[0] ? F : NULL, NULL);
+  au_vget(v, 0, xn, &err, &root, F, want[0]);
+  return dense_take(s, xn, err, root, NULL, want[0] ? F : NULL, NULL);
 }
 
 /* Steps of x (in/out) from time *t (in/out) towards ts[nout - 1], the outputs at the times
@@ -1173,13 +1192,16 @@ static void au_flush(au_pend* P, au_vstep vcont) {
    slots are full */
 static void au_defer(au_pend* P, au_vstep vcont, const au_vio* v, int l, const dense_state* s,
                      casadi_real t, const int* span, casadi_real* X) {
-  int q = P->n, i;
+  static const int stages[CONT_NSTAGES] = CONT_STAGES;
+  int q = P->n, i, j;
   if (span[1] <= span[0]) return;
   for (i = 0; i < PASS_NX; ++i) {
     P->v.x[i][q] = v->x[i][l];
     P->v.xn[i][q] = v->xn[i][l];
   }
-  for (i = 0; i < 12 * PASS_NX; ++i) P->v.K[i][q] = v->K[i][l];
+  for (j = 0; j < CONT_NSTAGES; ++j)  /* (the stages the extension reads) */
+    for (i = stages[j] * PASS_NX; i < (stages[j] + 1) * PASS_NX; ++i)
+      P->v.K[i][q] = v->K[i][l];
   for (i = 0; i < PASS_U; ++i) P->v.u[i][q] = v->u[i][l];
   for (i = 0; i < (PASS_NP > 0 ? PASS_NP : 1); ++i) P->v.p[i][q] = v->p[i][l];
   P->v.h[q] = v->h[l];
@@ -1194,7 +1216,7 @@ static void au_defer(au_pend* P, au_vstep vcont, const au_vio* v, int l, const d
    checks serves every lane's pair; their continuous extensions gathered in P */
 static void au_checks(au_lane* L, au_vio* v, au_pend* P, au_vstep step, au_vstep vcont,
                       int all) {
-  casadi_real xn[PASS_NX], err, t;
+  casadi_real xn[PASS_NX], err, root, t;
   int use[PASS_LANES], span[2], l, any = 0, urgent = all;
   for (l = 0; l < PASS_LANES; ++l) {
     dense_state* s = &L[l].s;
@@ -1208,7 +1230,7 @@ static void au_checks(au_lane* L, au_vio* v, au_pend* P, au_vstep step, au_vstep
   au_vcall(step, v, use);
   for (l = 0; l < PASS_LANES; ++l)
     if (use[l]) {
-      au_vget(v, l, xn, &err, NULL, 0);
+      au_vget(v, l, xn, &err, &root, NULL, 0);
       t = L[l].s.rich[RI_T];
       rich_take(&L[l].s, xn, err, NULL, NULL, span);
       au_defer(P, vcont, v, l, &L[l].s, t, span, L[l].s.XC);
@@ -1277,7 +1299,7 @@ int rk8_auto_lanes(const casadi_real* w, int nout, int k0, int k1, const casadi_
   au_vio v;
   au_pend P;
   au_lane L[PASS_LANES];
-  casadi_real xn[PASS_NX], err, t;
+  casadi_real xn[PASS_NX], err, root, t;
   int size = AU_SIZE(nout), plain = w[AU_TRIES] <= 0, use[PASS_LANES], span[2], l, any;
   long next = k0;
   casadi_real* wk = (casadi_real*) malloc(sizeof(casadi_real) * size * PASS_LANES);
@@ -1306,9 +1328,10 @@ int rk8_auto_lanes(const casadi_real* w, int nout, int k0, int k1, const casadi_
     any = 0;
     for (l = 0; l < PASS_LANES; ++l)
       if (use[l]) {
-        au_vget(&v, l, xn, &err, NULL, 0);
+        au_vget(&v, l, xn, &err, &root, NULL, 0);
         t = *L[l].s.t;
-        L[l].ended = dense_take(&L[l].s, xn, err, NULL, NULL, span) || L[l].s.j >= nout;
+        L[l].ended = dense_take(&L[l].s, xn, err, root, NULL, NULL, span) ||
+                     L[l].s.j >= nout;
         au_defer(&P, cont, &v, l, &L[l].s, t, span, L[l].s.X);
         any |= L[l].ended;
       }
@@ -1450,7 +1473,8 @@ def pass_library(model: Model) -> object | None:
             plain = _renamed(kernel(model, "rk8", "linear", compiled=True), "rk8_step")
             main, units, wrappers = [rhs], [[step, plain], list(dense_kernels(model))], ""
         every = main + [f for unit in units for f in unit]
-        sizes = dict(every=CHECK_EVERY, lanes=LANES, nx=model.nx, nu=model.nu, np=model.np,
+        sizes = dict(every=CHECK_EVERY, lanes=LANES, ncont=len(DOP853_DENSE_STAGES),
+                     cont=", ".join(map(str, DOP853_DENSE_STAGES)), nx=model.nx, nu=model.nu, np=model.np,
                      nw=max(f.sz_w() for f in every), niw=max(f.sz_iw() for f in every),
                      narg=max(f.sz_arg() for f in every), nres=max(f.sz_res() for f in every),
                      steps=wrappers)

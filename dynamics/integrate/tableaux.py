@@ -8,7 +8,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 __all__ = ["Tableau", "RK4", "DOP853", "DOP853_E3", "DOP853_E5", "DOP853_DENSE_A",
-           "DOP853_DENSE_C", "DOP853_DENSE_D", "CF4_NODES", "TABLEAUX", "unique_nodes"]
+           "DOP853_DENSE_C", "DOP853_DENSE_D", "DOP853_DENSE_STAGES", "CF4_NODES", "TABLEAUX",
+           "unique_nodes"]
 
 
 @dataclass(frozen=True)
@@ -117,6 +118,11 @@ DOP853_DENSE_D = (
      29.8402934266605, -43.53345659001114, 96.32455395918828, -39.17726167561544,
      -149.72683625798564),
 )
+#: The steps' stages (0-based, of the 12) that the dense output reads: ``k1`` (``F1``,
+#: ``F2``) and those with a nonzero weight in `DOP853_DENSE_A` or `DOP853_DENSE_D` (``k2 .. k5``
+#: are not read; `dynamics.integrate.cpass` copies only these for a deferred extension).
+DOP853_DENSE_STAGES = tuple(j for j in range(12) if j == 0 or any(
+    j < len(row) and row[j] != 0.0 for row in DOP853_DENSE_A + DOP853_DENSE_D))
 
 # Stage nodes of the commutator-free method CF4 used by "lie" (four right-hand sides a step).
 CF4_NODES = (0.0, 0.5, 0.5, 1.0)
