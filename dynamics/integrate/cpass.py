@@ -657,17 +657,20 @@ static void au_vcall(au_vstep step, au_vio* v, const int* use) {
     v->root[l] = ctl_root(v->err[l]);
 }
 
-/* the continuous extension of the vector step just taken (`vcont`), when a lane of `want`
-   needs it */
-static void au_vcont(au_vstep vcont, au_vio* v, const int* want) {
+/* the continuous extension of the vector step in v (`vcont`) into v->F */
+static void au_vext(au_vstep vcont, au_vio* v) {
   const au_vec* arg[6];
   au_vec* res[1];
-  int l, any = 0;
-  for (l = 0; l < PASS_LANES; ++l) any |= want[l];
-  if (!any) return;
   arg[0] = v->x; arg[1] = v->xn; arg[2] = v->K; arg[3] = &v->h; arg[4] = v->u; arg[5] = v->p;
   res[0] = v->F;
   vcont(arg, res);
+}
+
+/* the continuous extension of the vector step just taken, when a lane of `want` needs it */
+static void au_vcont(au_vstep vcont, au_vio* v, const int* want) {
+  int l, any = 0;
+  for (l = 0; l < PASS_LANES; ++l) any |= want[l];
+  if (any) au_vext(vcont, v);
 }
 
 /* lane l's outputs: x_next, the estimate and (`withf`) the continuous extension */
@@ -1175,10 +1178,9 @@ typedef struct {
    lanes compute what they last held: finite values, read by nobody) */
 static void au_flush(au_pend* P, au_vstep vcont) {
   casadi_real x[PASS_NX], F[7 * PASS_NX];
-  int want[PASS_LANES], q, i;
+  int q, i;
   if (!P->n) return;
-  for (q = 0; q < PASS_LANES; ++q) want[q] = q < P->n;
-  au_vcont(vcont, &P->v, want);
+  au_vext(vcont, &P->v);
   for (q = 0; q < P->n; ++q) {
     for (i = 0; i < PASS_NX; ++i) x[i] = P->v.x[i][q];
     for (i = 0; i < 7 * PASS_NX; ++i) F[i] = P->v.F[i][q];
