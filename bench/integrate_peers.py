@@ -32,8 +32,10 @@ workload, every run within 1e-8 rad/s of its Jacobi truth) in one batched ``simu
 the default method and tolerances (each run verified: ``all_success``) and with fixed-step
 ``rk8`` (the fewest steps meeting the error), and with ``method='dop853'`` at the peer's own
 tolerance (nothing verified, as the peer), against numbalsoda's ``dop853`` in a
-numba-jitted loop (the loosest of rtol 1e-9, 1e-10, 1e-11 meeting the error). numbalsoda's
-loop runs on one thread; appdyn's batch is timed on the cores this process may use (its
+numba-jitted loop (the loosest of rtol 1e-9, 1e-10, 1e-11 meeting the error); and, for
+context, not as the target, the peer at the error the defaults deliver (about 1e-10: the
+default tolerances verify every state, the quaternion's components near zero at atol
+1e-10; the loosest of rtol 1e-10 ... 1e-13 meeting it). numbalsoda's loop runs on one thread; appdyn's batch is timed on the cores this process may use (its
 default ``threads``) and on one thread (``threads=1``), and both ratios are reported.
 
 Writes ``integrate_peers.csv``; returns the ratio rows.
@@ -282,6 +284,12 @@ def two_point_call(calls: int, rounds: int) -> tuple[float, float, float]:
     return paired_per_call(lambda: simulate(model, x0, t), floor, calls, rounds)
 
 
+#: Interleaved timings of each batch job, one thread and the default (the minimum is kept):
+#: ~50 ms each, and this VM's second core ran 25-35 % slower for seconds at a time, which
+#: five timings did not always outlast (two threads 19.8 and 23.1 ms between two runs).
+BATCH_REPEATS = 15
+
+
 def monte_carlo(quick: bool, detail: list) -> list[Row]:
     """The 1,000-run Monte Carlo at the defaults and fixed-step, against numbalsoda's njit
     loop (see the module docstring); rows of the ratios. numbalsoda's loop runs on one
@@ -301,20 +309,26 @@ def monte_carlo(quick: bool, detail: list) -> list[Row]:
     def batched(**kw):
         return simulate(model, x0s.T, t, **kw)
 
-    peer = None  # (numbalsoda first, then appdyn, then numbalsoda again: the VM drifts)
-    for rtol in (1e-9, 1e-10, 1e-11):
-        b = numbalsoda_batch(x0s, t, rtol)
-        if b is None:
-            break
-        e = float(np.max(np.abs(np.asarray(b["w"]) - truth)))
-        detail.append(dict(workload=f"Monte Carlo {k} runs", target=BATCH_TOL,
-                           solver="numbalsoda dop853 njit loop (one thread)", rtol=rtol,
-                           error=e, time=min(b["times"]), steps=-1,
-                           success=bool(b["success"])))
-        if e <= BATCH_TOL and b["success"]:
-            peer = (rtol, min(b["times"]))
-            break
+    def peer_at(target, tols):  # numbalsoda's loosest rtol of `tols` meeting `target`
+        for rtol in tols:
+            b = numbalsoda_batch(x0s, t, rtol)
+            if b is None:
+                return None
+            e = float(np.max(np.abs(np.asarray(b["w"]) - truth)))
+            detail.append(dict(workload=f"Monte Carlo {k} runs", target=target,
+                               solver="numbalsoda dop853 njit loop (one thread)", rtol=rtol,
+                               error=e, time=min(b["times"]), steps=-1,
+                               success=bool(b["success"])))
+            if e <= target and b["success"]:
+                return rtol, min(b["times"])
+        return None
+
+    # (numbalsoda first, then appdyn, then numbalsoda again: the VM drifts)
+    peer = peer_at(BATCH_TOL, (1e-9, 1e-10, 1e-11))
     res = batched()
+    # the peer at the error auto delivers (its contract verifies every state, the
+    # quaternion's near-zero components at atol 1e-10, so its rates land far inside 1e-8)
+    matched = peer_at(error(res.x), (1e-10, 1e-11, 1e-12, 1e-13)) if peer else None
     verified = bool(res.all_success)
     steps = next(n for n in range(1, 65) if error(batched(method="rk8", steps=n).x) <= BATCH_TOL)
     jobs = {"auto": {}, "rk8": dict(method="rk8", steps=steps)}
@@ -323,7 +337,7 @@ def monte_carlo(quick: bool, detail: list) -> list[Row]:
     times = {}
     for name, kw in jobs.items():  # (1 thread and the default, interleaved: the VM drifts)
         runs = {1: [], cores: []}
-        for _ in range(5):
+        for _ in range(BATCH_REPEATS):
             for threads in runs:
                 runs[threads] += timed(lambda: batched(threads=threads, **kw), 1)[1]
         for threads, got in runs.items():
@@ -359,6 +373,14 @@ def monte_carlo(quick: bool, detail: list) -> list[Row]:
                                 peer[1] / times[name, threads], "x",
                                 f"numbalsoda rtol {peer[0]:g}, {peer[1] * 1e3:.3g} ms; appdyn "
                                 f"{times[name, threads] * 1e3:.3g} ms"))
+    if matched:
+        for threads in sorted({1, cores}):
+            rows.append(Row("integrate_peers", case, "speed-up vs numbalsoda njit loop at the "
+                            f"error auto delivers ({error(res.x):.2g}), defaults (auto, "
+                            f"verified per run), appdyn on {threads} thread(s)",
+                            matched[1] / times["auto", threads], "x",
+                            f"numbalsoda rtol {matched[0]:g}, {matched[1] * 1e3:.3g} ms; not "
+                            "the issue's target (the peer at error 1e-8, above)"))
     return rows
 
 

@@ -256,6 +256,18 @@ def test_spread_runs_calls_every_run_once_in_contiguous_parts():
 
 
 @pytest.mark.parametrize("threads", [1, 2])
+def test_spread_runs_of_given_slices_calls_each_of_their_runs_once_inside_them(threads):
+    pieces = ((0, 5), (9, 20), (30, 31))
+    seen = []
+    batch_module.spread_runs(lambda k0, k1: seen.append((k0, k1)), 17, threads, 4,
+                             pieces=pieces)
+    assert sorted(k for a, b in seen for k in range(a, b)) == \
+        [k for a, b in pieces for k in range(a, b)]
+    assert all(any(a >= k0 and b <= k1 for k0, k1 in pieces) and b - a <= 4
+               for a, b in seen)
+
+
+@pytest.mark.parametrize("threads", [1, 2])
 def test_a_ctrl_c_stops_the_compiled_loops_between_groups_of_parts(threads):
     """A Ctrl-C during a part of a compiled loop over the runs is raised (KeyboardInterrupt)
     once the parts handed out with it have finished; no later group is started."""
