@@ -15,7 +15,7 @@ from .. import cache
 from .inputs import Problem
 from .result import Run
 
-__all__ = ["ControlCallback", "integrator_options", "run_cvodes"]
+__all__ = ["ControlCallback", "integrator_options", "run_cvodes", "failure_reason"]
 
 
 class ControlCallback(ca.Callback):
@@ -117,15 +117,72 @@ def _run(problem: Problem, integ, opts, rtol, atol, callback) -> Run:
         stats = integ.stats()
         reached = float(stats.get("tcur", t[0]))
         x = _cvodes_prefix(problem, opts, reached, callback)
-        text = str(exc)
-        cut = text.find("CVode returned")
-        reason = text[cut:] if cut >= 0 else text.strip().splitlines()[-1]
         return Run(x, int(stats.get("nsteps", 0)), int(stats.get("nfevals", 0)), 0, False, False,
-                   f"cvodes failed near t = {reached:.6g}: {reason}")
+                   f"cvodes failed near t = {reached:.6g}: {failure_reason(str(exc))}")
     stats = integ.stats()
     x = np.concatenate([problem.x0[:, None], out.T], axis=1)
     return Run(x, int(stats["nsteps"]), int(stats["nfevals"]), 0, False, True,
                f"cvodes: {int(stats['nsteps'])} steps (rtol {rtol:g}, atol {np.min(atol):g})")
+
+
+#: What a CVODES failure flag means and what to do about it (`failure_reason`); the
+#: right-hand-side flags mean the model returned NaN or inf there (casadi reports a
+#: non-finite right-hand side to CVODES as a recoverable error).
+_FLAGS = {
+    "CV_TOO_MUCH_WORK": (
+        "more than max_num_steps internal steps before the next output time (a finite-time "
+        "blow-up, a singularity, or a stiff or fast transient)",
+        "look at the model and its inputs near that time (a solution that blows up cannot be "
+        "integrated past it); for a long but regular stretch raise "
+        "cvodes_options={'max_num_steps': ...} or add output times"),
+    "CV_TOO_MUCH_ACC": (
+        "the tolerances ask for more accuracy than double precision gives there",
+        "loosen rtol/atol (atol above the rounding of the states, rtol above 1e-14)"),
+    "CV_ERR_FAILURE": (
+        "the error test failed repeatedly, down to the least step (a discontinuity, a kink "
+        "or a singularity of the right-hand side)",
+        "split the run at the discontinuity, or simulate with method='auto', which steps "
+        "across non-smooth right-hand sides"),
+    "CV_CONV_FAILURE": (
+        "the Newton iteration failed repeatedly, down to the least step (the right-hand "
+        "side is not defined or not smooth there, e.g. sqrt or log of a negative, or its "
+        "Jacobian is singular)",
+        "check the model's domain near that time; method='dop853' or 'auto' stop at the "
+        "first non-finite state and name it"),
+    "CV_LSETUP_FAIL": (
+        "the linear solver's setup failed (a singular or non-finite Jacobian)",
+        "check the model's domain near that time; method='dop853' or 'auto' stop at the "
+        "first non-finite state and name it"),
+    "CV_LSOLVE_FAIL": (
+        "the linear solve failed (a singular or non-finite Jacobian)",
+        "check the model's domain near that time; method='dop853' or 'auto' stop at the "
+        "first non-finite state and name it"),
+}
+_RHS = ("the right-hand side returned NaN or inf there (the state left the model's domain: "
+        "a division by zero, sqrt or log of a negative, a singular matrix)",
+        "check the model and its inputs near that time; method='dop853' or 'auto' stop at "
+        "the first non-finite state and name it")
+for _flag in ("CV_RHSFUNC_FAIL", "CV_REPTD_RHSFUNC_ERR", "CV_FIRST_RHSFUNC_ERR",
+              "CV_UNREC_RHSFUNC_ERR"):
+    _FLAGS[_flag] = _RHS
+
+
+def failure_reason(text: str) -> str:
+    """The reason of a failed cvodes call from casadi's error ``text``: CVODES' flag, what
+    it means and a remedy (the flag alone for one not listed in `_FLAGS`).
+
+    Examples
+    --------
+    >>> from appdyn.dynamics.integrate.cvodes import failure_reason
+    >>> print(failure_reason('CVode returned "CV_TOO_MUCH_ACC". Consult CVODES documentation.'))
+    CV_TOO_MUCH_ACC: the tolerances ask for more accuracy than double precision gives there; loosen rtol/atol (atol above the rounding of the states, rtol above 1e-14)
+    """
+    cut = text.find("CVode returned")
+    reason = text[cut:] if cut >= 0 else (text.strip().splitlines() or [""])[-1]
+    for flag, (meaning, remedy) in _FLAGS.items():
+        if f'"{flag}"' in reason:
+            return f"{flag}: {meaning}; {remedy}"
+    return reason.replace(" Consult CVODES documentation.", "")
 
 
 def _cvodes_call(integ, x0, p, uaug) -> np.ndarray:

@@ -329,6 +329,22 @@ def test_cvodes_failure_is_reported_not_raised():
     assert np.all(np.isnan(res.x[0, t > 1.0]))
 
 
+def test_cvodes_failure_names_its_flag_what_it_means_and_a_remedy():
+    """A right-hand side that turns NaN past x = 0.5 (x' = 1: at t = 0.5) makes CVODES give
+    up with CV_REPTD_RHSFUNC_ERR; the blow-up of x' = x^2 from 1 (at t = 1) with
+    CV_TOO_MUCH_WORK. The message says where, which flag, what it means and what to do."""
+    x = ca.SX.sym("x")
+    domain = Model.from_expressions({"x": x}, {"x": ca.if_else(x > 0.5, np.nan, 1.0)})
+    res = simulate(domain, [0.0], np.linspace(0.0, 1.0, 11), method="cvodes")
+    assert not res.success and res.status == -1
+    assert "cvodes failed near t = 0.5: CV_REPTD_RHSFUNC_ERR: the right-hand side returned " \
+        "NaN or inf there" in res.message and "method='dop853' or 'auto'" in res.message
+    assert "Consult CVODES documentation" not in res.message
+    res = simulate(blow_up_model(), [1.0], np.linspace(0.0, 2.0, 21), method="cvodes")
+    assert "CV_TOO_MUCH_WORK: more than max_num_steps" in res.message, res.message
+    assert "max_num_steps': ...}" in res.message
+
+
 @pytest.mark.parametrize("method", ["rk4", "rk8", "auto"])
 def test_other_methods_report_blow_up(method):
     kwargs = {"steps": 2} if method != "auto" else {"max_steps": 2000}
