@@ -28,6 +28,9 @@ API
     that no other thread uses until the block ends (see Threads below).
 ``construction_lock()``
     The lock to hold around casadi construction outside `get` (see Threads below).
+``constructs``
+    Decorator for helpers that build and drop CasADi symbols outside `get` (each call
+    under the construction lock).
 ``memoize``
     Decorator for factories of hashable arguments (e.g. ``rigid_body``'s model builder).
 ``memoize_values``
@@ -183,7 +186,7 @@ from . import diskcache
 from .validate import integer
 
 __all__ = ["MAXSIZE", "JIT_MIN_WORK", "CacheInfo", "FunctionCache", "get", "contains", "clear",
-           "info", "set_maxsize", "function_key", "memoize", "memoize_values", "value_key",
+           "info", "set_maxsize", "function_key", "constructs", "memoize", "memoize_values", "value_key",
            "checkout", "construction_lock", "POOL_SIZE", "compiler", "should_compile",
            "compile_function", "compile_c", "compile_parallel", "compile_ahead", "ready", "Job",
            "recipe"]
@@ -739,6 +742,20 @@ def function_key(f: ca.Function) -> int:
 
 #: `function_key`'s memory: ``id(f) -> (weak reference to f, key)``, dropped with ``f``
 _KEYS: dict = {}
+
+
+def constructs(fun: Callable) -> Callable:
+    """Decorator: each call of ``fun`` (which builds CasADi symbols and Functions outside
+    `get`, evaluates and drops them) runs under the construction lock, so that its symbols
+    are made and released there (Threads above: CasADi counts references without atomics;
+    two threads building from one model at once crashed a thread-pooled stability sweep).
+    For quick helpers: a long solve should hold the lock only while it builds."""
+    @functools.wraps(fun)
+    def locked(*args, **kwargs):
+        with _CACHE.construction_lock():
+            return fun(*args, **kwargs)
+
+    return locked
 
 
 def memoize(fun: Callable) -> Callable:

@@ -10,7 +10,7 @@ from typing import Mapping, Sequence
 import casadi as ca
 import numpy as np
 
-from appdyn.dynamics import simulate
+from appdyn.dynamics import cache, simulate
 from appdyn.dynamics.model import Model
 from appdyn.dynamics.scene import ExternalTorque, RigidHub, Scene
 from appdyn.dynamics.validate import finite_array, nonnegative
@@ -144,6 +144,7 @@ def pd_law(x, p, per_axis: bool):
     return -2 * kp * x[Q_VECTOR] - kd * x[RATES]
 
 
+@cache.constructs
 def attitude_loop(inertia, *, per_axis: bool = False) -> Model:
     """The closed loop of the rigid spacecraft (`spacecraft_scene`: ``rigid_body(inertia)``)
     + ``u = -2 kp q_e - kd w``, gains as parameters.
@@ -218,6 +219,7 @@ def settle_time(t, angle, band: float) -> float:
     return float(t[i] + (t[i + 1] - t[i]) * (a[i] - band) / (a[i] - a[i + 1]))
 
 
+@cache.constructs
 def linearized_loop(loop: Model, gains: np.ndarray) -> np.ndarray:
     """Jacobian (6, 6) of the loop in ``(q1, q2, q3, w1, w2, w3)`` at the target at rest."""
     x = ca.SX.sym("x", loop.nx)

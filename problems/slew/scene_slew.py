@@ -35,6 +35,7 @@ import casadi as ca
 import numpy as np
 
 from appdyn.config import param
+from appdyn.dynamics import cache
 from appdyn.dynamics.attitude import dcm_from_quat
 from appdyn.dynamics.interrupts import interruptible
 from appdyn.dynamics.momentum import ClusterGeometry
@@ -380,6 +381,7 @@ def _cmgs(scene, objective, angle, axis, q_final, T, w0, wf, opts):
 
 
 # ------------------------------------------------------------------ generic path
+@cache.constructs
 def torque_map(model, x) -> np.ndarray:
     """The hub's angular acceleration per unit control at the state ``x``: ``d(w')/du``.
 
@@ -457,6 +459,7 @@ def settling_parts(scene, problem) -> tuple:
                  if name != "hub" and bool(np.any(fixed[lay.states])))
 
 
+@cache.constructs
 def scene_intervals(problem, least: int, horizon: float) -> int:
     """Collocation intervals for a scene's slew ``problem``: at least ``least``, and at least
     `INTERVALS_PER_PERIOD` per period of the fastest oscillation of the model linearized at

@@ -13,6 +13,7 @@ import math
 import casadi as ca
 import numpy as np
 
+from appdyn.dynamics import cache
 from appdyn.dynamics.hinged import hinged_scene
 from appdyn.dynamics.scene import Scene
 from appdyn.dynamics.results import timed
@@ -30,6 +31,7 @@ _TWO_BODY = {"p1": "q1_rel", "p2": "q2_rel", "u1": "w1_2", "u2": "w2_2"}
 is the panel's ``p``; ``w_2``: body 2's angular velocity in its own axes)."""
 
 
+@cache.constructs
 def _two_body_coordinates(scene: Scene, x, red):
     """``red`` (reduced states ``w1, w2, p1, p2, u1, u2`` of a ball panel) in the two-body
     coordinates ``w1, w2, q1_rel, q2_rel, w1_2, w2_2``: ``q_rel = p`` and body 2's rate

@@ -60,6 +60,7 @@ import casadi as ca
 import numpy as np
 from numpy.polynomial import Polynomial
 
+from appdyn.dynamics import cache
 from appdyn.dynamics.launch_vehicle import launch_vehicle as vehicle_model
 from appdyn.dynamics.linearize import linearization
 from appdyn.dynamics.results import timed
@@ -105,6 +106,7 @@ def frozen_state(model, velocity, mass):
     return x
 
 
+@cache.constructs
 def _sensor_matrix(model, x) -> np.ndarray:
     """``d(psi_sensed, psi_dot_sensed)/dx`` at ``x``, shape (2, nx)."""
     xs = ca.SX.sym("x", model.nx)

@@ -202,6 +202,7 @@ def _indices(model, key: str) -> list:
     return out
 
 
+@cache.constructs
 def spin_point(scene: Scene, axis: np.ndarray, rate: float) -> SpinPoint:
     """The state of ``scene`` spinning at ``rate * axis`` with its parts at rest on the hub
     (``axis``: unit, hub axes; ``rate`` [rad/s]).
@@ -249,6 +250,7 @@ def spin_point(scene: Scene, axis: np.ndarray, rate: float) -> SpinPoint:
     return SpinPoint(x, names, res, it, res <= NEWTON_RTOL * scale, tuple(cv.tolist()))
 
 
+@cache.constructs
 def _conserved(model, key: str, x: np.ndarray) -> bool:
     """Whether the invariant ``key`` is conserved by the uncontrolled flow near ``x``:
     ``|d inv/dt| <= _CONSERVED_RTOL |grad| |xdot|`` at three perturbed states."""
@@ -271,6 +273,7 @@ def _conserved(model, key: str, x: np.ndarray) -> bool:
     return True
 
 
+@cache.constructs
 def _gradients(model, x, key: str, square: bool) -> list:
     """Gradients at ``x`` (full state) of the invariant ``key``'s components, or of
     ``|invariant|^2``."""

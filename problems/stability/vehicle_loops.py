@@ -26,6 +26,7 @@ from dataclasses import replace
 import casadi as ca
 import numpy as np
 
+from appdyn.dynamics import cache
 from appdyn.dynamics.scene import check_scene, sensed_attitude
 from appdyn.dynamics.scene.engine import gimbaled_engine
 
@@ -53,6 +54,15 @@ def _reduce(A, C, states, frozen):
     return keep, removed
 
 
+@cache.constructs
+def _sensed_jacobian(scene, model, x0) -> np.ndarray:
+    """``d(sensed attitude)/dx`` at ``x0`` (`sensed_attitude`), shape (4, nx)."""
+    xs = ca.SX.sym("x", model.nx)
+    sensed = ca.Function("C", [xs], [ca.jacobian(sensed_attitude(scene)(xs), xs)])
+    return np.asarray(sensed(x0), dtype=float)
+
+
+@cache.constructs
 def _inertial_velocity_jacobians(model, x0):
     """``(A, B)`` at ``x0`` with the hub velocity as inertial components ``V = A(q)^T v``
     (states ``v1..v3`` stand for ``V1..V3``; module docstring)."""
@@ -138,9 +148,7 @@ def vehicle_loops(scene, *, k_psi, k_psidot, velocity=0.0, engine=None) -> dict:
     inputs = {axis: model.controls.index(local[d] if part.actuator is None else local[d + "_c"])
               for axis, d in _AXES.items()}
     out = {}
-    xs = ca.SX.sym("x", model.nx)
-    sensed = ca.Function("C", [xs], [ca.jacobian(sensed_attitude(scene)(xs), xs)])
-    C = np.asarray(sensed(x0), dtype=float)[[0, 2, 1, 3]]  # pitch angle, rate; yaw
+    C = _sensed_jacobian(scene, model, x0)[[0, 2, 1, 3]]  # pitch angle, rate; yaw
     keep, removed = _reduce(A, C, model.states, frozen)
     A, C = A[np.ix_(keep, keep)], C[:, keep]
     states = [model.states[i] for i in keep]

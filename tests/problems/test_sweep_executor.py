@@ -101,3 +101,18 @@ def test_interrupt_keeps_the_finished_values(pools):
     assert np.array_equal(values[idx], part.values)
     assert [serial.verdicts[i] for i in idx] == list(part.verdicts)
     assert np.array_equal(serial.least_damped[idx], part.least_damped)
+
+
+@pytest.mark.slow
+def test_threaded_sweeps_build_their_casadi_symbols_one_at_a_time():
+    """Found in CI: a heavy-top sweep on a thread pool crashed (SIGSEGV) in two threads'
+    `spin_scene._conserved`, each building a Jacobian from the shared model at once (CasADi
+    counts references without atomics). Before the fix 4 threads crashed within 25-123 such
+    sweeps (three tries); the helpers now build under the construction lock
+    (`cache.constructs`), and every sweep gives the serial one."""
+    kw = dict(TOP)
+    grid = np.linspace(0, 60, 9)
+    serial = st.sweep("heavy-top", "rate", grid, **kw)
+    with concurrent.futures.ThreadPoolExecutor(4) as pool:
+        for _ in range(60):
+            _same(serial, st.sweep("heavy-top", "rate", grid, executor=pool, **kw))
