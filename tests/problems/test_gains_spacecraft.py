@@ -144,6 +144,23 @@ def test_a_failed_re_simulation_is_reported_as_such(monkeypatch):
     assert "cvodes failed near t = 1" in res.message and "nan" not in res.message
 
 
+def test_an_axis_with_components_of_1e_175_is_designed_as_the_exact_axis():
+    """Found by the random valid inputs: about (2.3e-175, -1, 9.4e-167) CVODES gave up on
+    the re-simulation (CV_REPTD_RHSFUNC_ERR near t = 15.2 s, carrying components of ~1e-169
+    for the two other axes), and the design said success=False. The re-simulation now falls
+    back to `auto`; the design is the one about (0, -1, 0)."""
+    J = np.diag([2.71153947, 1.0, 2.70250077])
+    kw = dict(u_max=0.9128582885801971)
+    axis = [2.33577719e-175, -1.0, 9.40160007e-167]
+    tiny = attitude_gains(J, [{"angle": 0.99999, "axis": axis}], **kw)
+    exact = attitude_gains(J, [{"angle": 0.99999, "axis": [0.0, -1.0, 0.0]}], **kw)
+    assert tiny.success and exact.success, tiny.message
+    assert tiny.gains == exact.gains
+    assert tiny.verification["settle_times"] == pytest.approx(
+        exact.verification["settle_times"], rel=1e-9)
+    assert tiny.verification["limits_met"] and exact.verification["limits_met"]
+
+
 class _Failed:
     """What a failed `simulate` run hands back: NaN states, success False, a message."""
 

@@ -645,10 +645,6 @@ MAY_FAIL = {
         " AVX-512 CPU (within it on another): the warm re-solves at a tighter IPOPT tol and"
         " with a constant control stop at IPOPT's acceptable level (bound excess 4e-7-4e-5)"
         " and are not verified; success=False names the re-solve that failed"),
-    "appdyn.problems.gains.attitude_gains": (
-        "KNOWN, not fixed: a slew axis with components of 1e-175 (a unit axis hypothesis "
-        "draws) makes CVODES give up on the closed-loop re-simulation (CV_REPTD_RHSFUNC_ERR "
-        "near t = 18.7 s); the design says success=False, 'the re-simulation ... failed'"),
 }
 # parameters that must be CasADi symbols or expressions: the fixed symbolic example
 SYMBOLIC = {
