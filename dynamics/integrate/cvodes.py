@@ -128,6 +128,8 @@ def _run(problem: Problem, integ, opts, rtol, atol, callback) -> Run:
 #: What a CVODES failure flag means and what to do about it (`failure_reason`); the
 #: right-hand-side flags mean the model returned NaN or inf there (casadi reports a
 #: non-finite right-hand side to CVODES as a recoverable error).
+_DOMAIN = ("check the model and its inputs near that time; method='dop853' or 'auto' stop "
+           "at the first non-finite state and name it")
 _FLAGS = {
     "CV_TOO_MUCH_WORK": (
         "more than max_num_steps internal steps before the next output time (a finite-time "
@@ -146,25 +148,15 @@ _FLAGS = {
     "CV_CONV_FAILURE": (
         "the Newton iteration failed repeatedly, down to the least step (the right-hand "
         "side is not defined or not smooth there, e.g. sqrt or log of a negative, or its "
-        "Jacobian is singular)",
-        "check the model's domain near that time; method='dop853' or 'auto' stop at the "
-        "first non-finite state and name it"),
-    "CV_LSETUP_FAIL": (
-        "the linear solver's setup failed (a singular or non-finite Jacobian)",
-        "check the model's domain near that time; method='dop853' or 'auto' stop at the "
-        "first non-finite state and name it"),
-    "CV_LSOLVE_FAIL": (
-        "the linear solve failed (a singular or non-finite Jacobian)",
-        "check the model's domain near that time; method='dop853' or 'auto' stop at the "
-        "first non-finite state and name it"),
+        "Jacobian is singular)", _DOMAIN),
+    "CV_LSETUP_FAIL": ("the linear solver's setup failed (a singular or non-finite Jacobian)",
+                       _DOMAIN),
+    "CV_LSOLVE_FAIL": ("the linear solve failed (a singular or non-finite Jacobian)", _DOMAIN),
+    **dict.fromkeys(("CV_RHSFUNC_FAIL", "CV_REPTD_RHSFUNC_ERR", "CV_FIRST_RHSFUNC_ERR",
+                     "CV_UNREC_RHSFUNC_ERR"), (
+        "the right-hand side returned NaN or inf there (the state left the model's domain: "
+        "a division by zero, sqrt or log of a negative, a singular matrix)", _DOMAIN)),
 }
-_RHS = ("the right-hand side returned NaN or inf there (the state left the model's domain: "
-        "a division by zero, sqrt or log of a negative, a singular matrix)",
-        "check the model and its inputs near that time; method='dop853' or 'auto' stop at "
-        "the first non-finite state and name it")
-for _flag in ("CV_RHSFUNC_FAIL", "CV_REPTD_RHSFUNC_ERR", "CV_FIRST_RHSFUNC_ERR",
-              "CV_UNREC_RHSFUNC_ERR"):
-    _FLAGS[_flag] = _RHS
 
 
 def failure_reason(text: str) -> str:
