@@ -10,7 +10,9 @@ in floating point and fixed boundary values reach IPOPT unchanged):
 
 * states, controls, parameters: ``max(|lower|, |upper|)`` when both bounds are finite
   (a range the user chose); otherwise the largest magnitude of the initial guess on the
-  nodes (boundary values included); otherwise 1;
+  nodes (boundary values included), at least `ocp.propagation.SCALE_FLOOR` (1e-6, the
+  least magnitude the re-simulation and bound checks measure a variable against; below it
+  a warm start's roundoff set the scale: `_magnitude`); otherwise (zero in the guess) 1;
 * ``T``: the initial guess of ``T``;
 * path and boundary constraint rows: the largest infinity-norm over the nodes of the row's
   gradient with respect to the *scaled* variables at the initial guess, so that scaled rows
@@ -40,6 +42,7 @@ import numpy as np
 
 from .cached import cached, function_key
 from .functions import sx_compatible
+from .propagation import SCALE_FLOOR
 
 __all__ = ["Scaling", "auto_scaling"]
 
@@ -80,6 +83,18 @@ def _pow2(v: np.ndarray) -> np.ndarray:
 
 
 def _magnitude(bounds: np.ndarray, samples: np.ndarray) -> np.ndarray:
+    """Scale of each variable (module docstring): the span of its finite bounds, else its
+    largest magnitude in ``samples`` (n, m) floored at `SCALE_FLOOR`, else (zero in the
+    samples: at most 1e-12) 1; rounded to a power of two.
+
+    The floor: a state that is zero by symmetry (an off-axis rate of a slew about a
+    principal axis) carries roundoff in a warm start from a solution. A time-optimal CMG
+    slew's ``w2`` reached 1.1e-12 and was scaled by 2**-40, so that its defect rows read an
+    absolute roundoff of 1e-16 as 1e-4 in NLP units, above ``constr_viol_tol``: every warm
+    re-solve of `problems.slew.bounded` stopped at IPOPT's acceptable level (at tol 1e-10
+    after 229 iterations, with a constant control after 66). Scaled by 2**-20: 3 and 54
+    iterations to Solve_Succeeded.
+    """
     lo, hi = bounds
     out = np.ones(lo.size)
     both = np.isfinite(lo) & np.isfinite(hi)
@@ -88,7 +103,7 @@ def _magnitude(bounds: np.ndarray, samples: np.ndarray) -> np.ndarray:
     if samples.size:
         g = np.max(np.abs(samples), axis=1)
         use = ~(both & (span > 0)) & (g > 1e-12)
-        out[use] = g[use]
+        out[use] = np.maximum(g[use], SCALE_FLOOR)
     return _pow2(out)
 
 

@@ -217,3 +217,46 @@ def test_wheel_min_effort_below_the_minimum_time_says_so():
     assert not sol.success
     assert sol.info["minimum_time"] == pytest.approx(3.2430, abs=1e-4)
     assert "below this slew's minimum time 3.2430" in sol.message
+
+
+#: The stress test's failing draw (tests/stress/test_valid_inputs.py, seed 20261123): a
+#: time-optimal 1 rad slew about z of a body whose products of inertia are 1e-37 to 1e-164.
+ROUNDOFF_INERTIA = np.array([
+    [5.388482248500089, -1.5413768561098366e-126, -8.27846180971979e-164],
+    [-1.541376856109837e-126, 0.4885253016845221, -2.6042372376544635e-37],
+    [-8.27846180971979e-164, -2.6042372376544635e-37, 5.287344867437695]])
+
+
+@pytest.mark.slow
+def test_cmg_time_optimal_re_solves_from_a_roundoff_rate_are_verified():
+    """Regression (stress draw): the Radau gimbal rates of the seed overshoot their bound by
+    1e-4 next to a switch (on an AVX-512 CPU), and every warm re-solve of `slew.bounded`
+    stopped at IPOPT's acceptable level. The cause was the scaling, not the control: ``w2``,
+    zero by symmetry, carried 1.1e-12 of roundoff in the seed and the warm start scaled it by
+    2**-40, so its defect rows read roundoff (1e-16) as 1e-4 in NLP units. Guess magnitudes
+    are now floored at `ocp.SCALE_FLOOR`: a success within the bounds, verified by
+    re-simulation. The second half injects such roundoff itself (any CPU)."""
+    from appdyn import ocp
+
+    sol = slew.cmg_slew(ROUNDOFF_INERTIA, pyramid(0.9553), angle=1.0, axis=[0.0, 0.0, 1.0])
+    assert sol.success, sol.message
+    assert sol.bound_violation.max <= ocp.DEFAULT_CONSTRAINT_TOL
+    lo, hi = sol.problem.u_bounds
+    u = sol.sample(np.linspace(sol.t0, sol.t0 + sol.T, 20001))[1]
+    assert np.all(u >= lo[:, None] - 1e-6) and np.all(u <= hi[:, None] + 1e-6)
+    assert sol.pointing_error <= slew.POINTING_TOL  # re-simulated final attitude
+    fixed = np.isfinite(np.asarray(sol.problem.x_final, dtype=float))
+    fixed[:4] = False
+    assert np.max(sol.terminal_error[fixed]) <= slew.RATE_TOL
+
+    # a warm start whose zero-by-symmetry rate carries 1.1e-12 of roundoff: before the
+    # floor, Solved_To_Acceptable_Level after 120 iterations; now 11
+    x = np.array(sol.x)
+    w2 = sol.problem.model.states.index("w2")
+    x[w2] += 1.1e-12 * np.sin(np.pi * (sol.t - sol.t0) / sol.T)
+    guess = {"t": np.asarray(sol.t), "x": x, "T": sol.T,
+             "u": np.clip(sol.u, lo[:, None], hi[:, None])}
+    again = ocp.solve(sol.problem, transcription="radau", control="constant", mesh=sol.mesh,
+                      guess=guess)
+    assert again.success, again.message
+    assert again.solver_status == "Solve_Succeeded"

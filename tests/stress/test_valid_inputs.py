@@ -639,12 +639,6 @@ MAY_FAIL = {
         "a bar sliding backwards fast enough (3 u0 + 5 (1 + e) v0 < 0 at 45 deg) would need "
         "a pulling normal impulse to stick: with unbounded or large friction no impulse on "
         "the friction cone stops it (the contact jams); success=False says so"),
-    "appdyn.problems.slew.cmg_slew": (
-        "KNOWN, not fixed: a time-optimal CMG slew (1 rad about z, J = diag(5.39, 0.49, 5.29),"
-        " the pyramid) whose Radau control overshoots its bound by 1e-4 next to a switch on an"
-        " AVX-512 CPU (within it on another): the warm re-solves at a tighter IPOPT tol and"
-        " with a constant control stop at IPOPT's acceptable level (bound excess 4e-7-4e-5)"
-        " and are not verified; success=False names the re-solve that failed"),
 }
 # parameters that must be CasADi symbols or expressions: the fixed symbolic example
 SYMBOLIC = {
