@@ -17,7 +17,8 @@ import functools
 import signal
 import threading
 
-__all__ = ["deferred_interrupts", "check_interrupt", "interrupt_pending", "interruptible"]
+__all__ = ["deferred_interrupts", "check_interrupt", "interrupt_pending", "stop_requested",
+           "interruptible"]
 
 _lock = threading.Lock()
 _state = {"depth": 0, "pending": False, "previous": None}
@@ -79,6 +80,13 @@ def interrupt_pending() -> bool:
     caller then follows by `check_interrupt`.
     """
     return bool(_state["pending"]) and threading.current_thread() is threading.main_thread()
+
+
+def stop_requested() -> bool:
+    """Whether a SIGINT deferred by `deferred_interrupts` waits, seen from any thread: the
+    workers of a loop the main thread waits on (`executors.run_split`) stop taking work,
+    and the main thread then raises it by `check_interrupt`."""
+    return bool(_state["pending"])
 
 
 def check_interrupt() -> None:

@@ -3,13 +3,14 @@ runs spread over the cores.
 
 `simulate` comes here when ``x0`` has shape ``(nx, K)``. Every run shares the grid and the
 method; each has its own initial state, parameters (``p`` of shape ``(np, K)``) and control
-samples (``u`` of shape ``(nu, n, K)``). The runs are independent: they are split into
-contiguous parts that the threads of the process's pool take as they finish
-(`batch_fixed.spread_runs`; ``simulate(..., threads=)``, default the cores this process may
-use, `batch_fixed.batch_threads`), each part filling its own runs' slices of the result, so
-the answers are the same bits for every thread count. ``auto`` on a smooth model under
-controls constant over each run: every run's answer, check run and verdict in one compiled
-loop (`dense.dense_many`), each run with its own steps and its own check; the runs in
+samples (``u`` of shape ``(nu, n, K)``). The runs are independent: the threads of the
+process's pool (``simulate(..., threads=)``, default the cores this process may use,
+`batch_fixed.batch_threads`) take them as they finish, in contiguous parts
+(`batch_fixed.spread_runs`) or one run at a time (`dense.dense_many`), each filling its own
+runs' slices of the result, so the answers are the same bits for every thread count.
+``auto`` on a smooth model under controls constant over each run: every run's answer,
+check run and verdict in one compiled loop (`dense.dense_many`), each run with its own
+steps and its own check; the runs in
 rounds (`dense_rounds`, each spread over the batch), the first round's runs the single
 call's answers to the last bit, each later round's first answers at the local tolerance
 the runs before show to cost the fewest steps (`first_factor`: over-delivery weighed
@@ -35,7 +36,7 @@ from ..model import Model
 from ..validate import integer
 from .auto import STIFF_STEPS, Single, auto_jit, auto_runs, solve_auto
 from .batch_fixed import (BATCH_THREADS, batch_threads, fixed_batch, fixed_message,
-                          run_fixed_batch, spread_runs)
+                          run_fixed_batch)
 from .cvodes import run_cvodes
 from .dense import HEADER as DENSE_HEADER
 from .dense import FIELDS as DENSE_FIELDS
@@ -184,19 +185,14 @@ def auto_dense_batch(batch: Batch, rtol: float, atol: np.ndarray, max_steps: int
                      cvodes_options, progress: Progress, *, threads: int | None = None):
     """``auto`` on a batch of smooth runs, each under a control constant over its run: the
     answer, check run and verdict of `dense.dense_auto` for every run in one compiled loop
-    over the runs (`dense.dense_many`; the runs in parts of at most `DENSE_PART` spread over
-    ``threads`` threads by `batch_fixed.spread_runs`, each part filling its own slice of
-    the answers), each run with its own steps; round by round
-    (`dense_rounds`, each spread over the batch), each later round's first answers at the
-    factor `first_factor` learns from the runs before (a round of small slices gathered end
-    to end: one compiled loop per part, `lanes.dense_lanes`' vector lanes kept full, its
-    answers put back in place; a round of slices of `GATHER_BELOW` runs or more in place,
-    slice by slice; a round of fewer than ``2 DENSE_PART`` runs on one thread; each run's
-    answer does not depend on its neighbours, so the bits do not depend on the gathering,
-    the parts or the lanes). A run not verified there goes alone
-    through `solve_auto` (as a single call would). Returns ``(x (nx, n, K), ok, status,
-    estimate, method, n_steps, message)``, or None (no compiled pass, a control that varies
-    within a run, jit off)."""
+    over the runs (`dense.dense_many`: on ``threads`` threads, each taking the next run
+    as soon as it has room, its answer and header written in place), each run with its
+    own steps; round by round (`dense_rounds`, each spread over the batch), each later
+    round's first answers at the factor `first_factor` learns from the runs before (each
+    run's answer does not depend on its neighbours, so the bits do not depend on the
+    threads or the lanes). A run not verified there goes alone through `solve_auto` (as a
+    single call would). Returns ``(x (nx, n, K), ok, status, estimate, method, n_steps,
+    message)``, or None (no compiled pass, a control that varies within a run, jit off)."""
     if not auto_jit(jit):
         return None
     K, model, t = batch.K, batch.model, batch.t
@@ -207,9 +203,7 @@ def auto_dense_batch(batch: Batch, rtol: float, atol: np.ndarray, max_steps: int
     x0, u, p = inputs
     X = np.empty((K, nx, t.size))
     head = np.empty((K, DENSE_HEADER))
-    missing = []
     vector = dense_lanes(model, build=K >= LANES_MIN)
-
     cores = batch_threads(threads)
     factor, factors, done = FIRST, [], []
     for pieces in dense_rounds(K):  # (the rounds do not depend on `threads`: same bits)
@@ -217,30 +211,11 @@ def auto_dense_batch(batch: Batch, rtol: float, atol: np.ndarray, max_steps: int
             factor = _learned(head[np.concatenate(done)], factor, rtol)
         factors.append(factor)
         runs = np.concatenate([np.arange(k0, k1) for k0, k1 in pieces])
-        if min(k1 - k0 for k0, k1 in pieces) >= GATHER_BELOW:  # in place, slice by slice
-            inputs, outputs, parts = (x0, u, p), (X, head), pieces
-        else:  # the round's runs gathered end to end (one compiled loop per thread's part,
-            # its vector lanes kept full), their answers and headers put back in place
-            inputs = (x0[runs], u[runs], p[runs])
-            outputs, parts = (np.empty((runs.size, nx, t.size)),
-                              np.empty((runs.size, DENSE_HEADER))), None
-
-        def call(a, b, inputs=inputs, outputs=outputs, factor=factor):
-            xk, uk, pk = inputs
-            if dense_many(model, xk, t, uk, pk, rtol, atol, max_steps, STIFF_STEPS,
-                          slice(a, b), out=outputs, factor=factor, vector=vector) is None:
-                missing.append(a)
-
-        # (a small round stays on one thread: a hand-over costs tens of microseconds on an
-        # idle machine and milliseconds on a loaded one, where the woken thread waits for a
-        # core; the first two rounds of 1,000 runs, 16 and 48 runs, took 1.2-1.5 and 1.6-1.9
-        # ms on two threads against 0.6-0.7 and 1.7-1.85 ms on one)
-        spread_runs(call, runs.size, cores if runs.size >= 2 * DENSE_PART else 1, DENSE_PART,
-                    pieces=parts)
-        if missing:
+        # (every run of the round handed out in turn to the loops of every thread, each
+        # writing its rows of X and head in place)
+        if dense_many(model, x0, t, u, p, rtol, atol, max_steps, STIFF_STEPS, runs,
+                      out=(X, head), factor=factor, vector=vector, threads=cores) is None:
             return None
-        if parts is None:
-            X[runs], head[runs] = outputs
         done.append(runs)
     result = head[:, DENSE_FIELDS.index("result")]  # (each run's header read as columns)
     estimate = head[:, DENSE_FIELDS.index("estimate")].copy()
@@ -306,16 +281,10 @@ def dop853_dense_batch(batch: Batch, rtol: float, atol: np.ndarray, max_steps: i
     if inputs is None:
         return None
     x0, u, p = inputs
-    X, head, missing = np.empty((K, model.nx, t.size)), np.empty((K, DENSE_HEADER)), []
-    vector = dense_lanes(model, build=K >= LANES_MIN)
-
-    def call(a, b):
-        if dense_many(model, x0, t, u, p, rtol, atol, max_steps, math.inf, slice(a, b),
-                      out=(X, head), check=False, vector=vector) is None:
-            missing.append(a)
-
-    spread_runs(call, K, batch_threads(threads) if K >= 2 * DENSE_PART else 1, DENSE_PART)
-    if missing:
+    X, head = np.empty((K, model.nx, t.size)), np.empty((K, DENSE_HEADER))
+    if dense_many(model, x0, t, u, p, rtol, atol, max_steps, math.inf, slice(0, K),
+                  out=(X, head), check=False, vector=dense_lanes(model, build=K >= LANES_MIN),
+                  threads=batch_threads(threads)) is None:
         return None
     ok = head[:, DENSE_FIELDS.index("result")] == 2
     steps = head[:, DENSE_FIELDS.index("spent")].astype(int)
@@ -331,14 +300,6 @@ def dop853_dense_batch(batch: Batch, rtol: float, atol: np.ndarray, max_steps: i
 #: a later one takes it): for the rigid body, 256 runs of 41 outputs are ~20 ms of the
 #: scalar loop, which the lanes cut about 2x. A smaller batch takes the lanes once built.
 LANES_MIN = 256
-#: A round of a dense batch whose slices (`dense_rounds`) all hold at least this many runs
-#: runs them in place, slice by slice; a round of smaller slices (the first ones: 1-3 runs
-#: each) is gathered end to end, so that the compiled loops keep their vector lanes full,
-#: and put back (copies of ~2 MB on 1,000 runs of 41 outputs, ~1.4 ms of fresh memory).
-GATHER_BELOW = 8
-#: Most runs of one compiled call of a dense batch (Ctrl-C is looked at between groups of
-#: them, `batch_fixed.spread_runs`).
-DENSE_PART = 64
 #: A dense batch runs in rounds (`dense_rounds`): `PILOT` runs spread over it answer first
 #: at `dense.FIRST` of the tolerance, as single calls do; each later round, `ROUND_GROWTH`
 #: times the runs before it (the last takes the rest), at the factor `first_factor` learns

@@ -298,20 +298,18 @@ PARTS_PER_THREAD = 8
 GROUP = 16
 
 
-def spread_runs(call, K: int, threads: int, part: int, *, pieces=None) -> None:
+def spread_runs(call, K: int, threads: int, part: int) -> None:
     """``call(k0, k1)`` (a compiled loop over the runs ``k0 <= k < k1`` that releases the
     GIL and writes only those runs' slices of its outputs) for every run of a batch of
     ``K``: the runs in contiguous parts of at most ``part`` runs, and at most ``K / (threads
     PARTS_PER_THREAD)`` when spread, taken one after another by ``threads`` threads of the
     process's pool as they finish (`run_split`); Ctrl-C is looked at between groups of
     `GROUP` parts per thread (`deferred_interrupts`). ``threads=1``: every part in the
-    calling thread, in order. ``pieces``: the runs are those of these contiguous slices
-    ``(k0, k1)`` (``K`` runs in all), each cut into parts as above."""
+    calling thread, in order."""
     if threads > 1:
         part = min(part, -(-K // (threads * PARTS_PER_THREAD)))
     part = max(1, part)
-    parts = [(a, min(a + part, k1)) for k0, k1 in (pieces or ((0, K),))
-             for a in range(k0, k1, part)]
+    parts = [(a, min(a + part, K)) for a in range(0, K, part)]
     threads = min(threads, len(parts))
 
     def work(todo):

@@ -1127,23 +1127,45 @@ static void au_load(casadi_real* wk, const casadi_real* w, int size, size_t k,
   wk[AU_PHASE] = 0;
 }
 
-/* `rk8_auto` for the runs k0 <= k < k1 of a batch, one after another, each with its own
-   steps and verdict: x0 (K, nx), u (K, nu), p (K, np) by run; the workspace `w` (its
-   inputs but x0, u, p set) copied to `wk` for each; X (K, nx, nout + 1) the answers; XC
-   (nx, nout + 1) scratch; `res` (K, AU_HDR) each run's header. Returns the runs done. */
-int rk8_auto_many(const casadi_real* w, int nout, int k0, int k1, const casadi_real* x0,
+/* The next run of a batch for a loop of `rk8_auto_many` or `rk8_auto_lanes`: the runs are
+   runs[0] ... runs[n - 1] (rows of x0, u, p, X and res), handed out one at a time through
+   the counter *cursor that the loops of every thread share (an atomic increment: a thread
+   takes the next run as soon as it has room, so the threads finish together); -1 when
+   every run is handed out. */
+static long long au_claim(const long long* runs, long long n, long long* cursor) {
+  long long i = __atomic_fetch_add(cursor, 1, __ATOMIC_RELAXED);
+  return i < n ? runs[i] : -1;
+}
+
+/* `rk8_auto` for runs of a batch (`au_claim`: runs[0 ... n - 1] through the shared
+   `cursor`), one after another, each with its own steps and verdict: x0 (K, nx), u (K,
+   nu), p (K, np) by run; the workspace `w` (its inputs but x0, u, p set) copied to `wk`
+   for each; X (K, nx, nout + 1) the answers; XC (nx, nout + 1) scratch; `res` (K, AU_HDR)
+   each run's header. No run is taken once the runs done have spent `budget` steps (0: no
+   limit), so that the caller can look at Ctrl-C between calls. Returns 1 when every run
+   is handed out, 0 when the budget stopped it first (-1: no memory). */
+int rk8_auto_many(const casadi_real* w, int nout, const long long* runs, long long n,
+                  long long* cursor, double budget, const casadi_real* x0,
                   const casadi_real* u, const casadi_real* p, casadi_real* X, casadi_real* XC,
                   casadi_real* res) {
-  int size = AU_SIZE(nout), k, i, ld = nout + 1;
+  int size = AU_SIZE(nout), i, ld = nout + 1;
+  long long k;
+  double spent = 0;
   casadi_real* wk = (casadi_real*) malloc(sizeof(casadi_real) * size);
-  if (!wk) return 0;
-  for (k = k0; k < k1; ++k) {
+  if (!wk) return -1;
+  for (;;) {
+    if (budget > 0 && spent >= budget) break;
+    if ((k = au_claim(runs, n, cursor)) < 0) {
+      free(wk);
+      return 1;
+    }
     au_load(wk, w, size, (size_t) k, x0, u, p);
     rk8_auto(wk, nout, INT_MAX, X + (size_t) k * PASS_NX * ld, XC);
     for (i = 0; i < AU_HDR; ++i) res[(size_t) k * AU_HDR + i] = wk[i];
+    spent += wk[AU_SPENT];
   }
   free(wk);
-  return k1 - k0;
+  return 0;
 }
 
 /* ---- `rk8_auto_many` with PASS_LANES runs stepped at once in the lanes of a vector step:
@@ -1293,8 +1315,10 @@ static void au_lane_load(au_lane* L, const casadi_real* w, int size, int nout, l
 /* `rk8_auto_many` (the same arguments, the same answers and headers) with the runs'
    answers, their checks, retries and reruns stepped PASS_LANES at a time by `vstep` and
    `vcont` (the vector `rk8_step_k` and `rk8_cont`); XC (PASS_LANES, nx, nout + 1)
-   scratch, a lane's each. */
-int rk8_auto_lanes(const casadi_real* w, int nout, int k0, int k1, const casadi_real* x0,
+   scratch, a lane's each. An empty lane takes the next run (`au_claim`) until the vector
+   steps have made `budget` lane-steps; the runs in the lanes then finish. */
+int rk8_auto_lanes(const casadi_real* w, int nout, const long long* runs, long long n,
+                   long long* cursor, double budget, const casadi_real* x0,
                    const casadi_real* u, const casadi_real* p, casadi_real* X,
                    casadi_real* XC, casadi_real* res, void* vstep, void* vcont) {
   au_vstep step = (au_vstep) vstep, cont = (au_vstep) vcont;
@@ -1303,9 +1327,11 @@ int rk8_auto_lanes(const casadi_real* w, int nout, int k0, int k1, const casadi_
   au_lane L[PASS_LANES];
   casadi_real xn[PASS_NX], err, root, t;
   int size = AU_SIZE(nout), plain = w[AU_TRIES] <= 0, use[PASS_LANES], span[2], l, any;
-  long next = k0;
+  int taking = 1, handed = 0;
+  long long k;
+  double spent = 0;
   casadi_real* wk = (casadi_real*) malloc(sizeof(casadi_real) * size * PASS_LANES);
-  if (!wk) return 0;
+  if (!wk) return -1;
   memset(&P, 0, sizeof P);
   v.filled = 0;
   for (l = 0; l < PASS_LANES; ++l) {
@@ -1314,12 +1340,20 @@ int rk8_auto_lanes(const casadi_real* w, int nout, int k0, int k1, const casadi_
     L[l].k = -1;
   }
   for (;;) {
-    for (l = 0; l < PASS_LANES; ++l)  /* (an empty lane takes the next run) */
-      while (L[l].k < 0 && next < k1) au_lane_load(&L[l], w, size, nout, next++, x0, u, p,
-                                                   X, res, plain);
+    taking = taking && !(budget > 0 && spent >= budget);
+    for (l = 0; l < PASS_LANES && taking; ++l)  /* (an empty lane takes the next run) */
+      while (L[l].k < 0) {
+        if ((k = au_claim(runs, n, cursor)) < 0) {
+          taking = 0;
+          handed = 1;
+          break;
+        }
+        au_lane_load(&L[l], w, size, nout, k, x0, u, p, X, res, plain);
+      }
     any = 0;
     for (l = 0; l < PASS_LANES; ++l) any |= use[l] = L[l].k >= 0;
     if (!any) break;
+    spent += PASS_LANES;
     au_checks(L, &v, &P, step, cont, 0);
     for (l = 0; l < PASS_LANES; ++l)
       if (use[l]) {
@@ -1344,7 +1378,7 @@ int rk8_auto_lanes(const casadi_real* w, int nout, int k0, int k1, const casadi_
       if (use[l] && L[l].ended) au_lane_next(&L[l], nout, res, plain);
   }
   free(wk);
-  return k1 - k0;
+  return handed;
 }
 """
 
@@ -1522,11 +1556,13 @@ def pass_library(model: Model) -> object | None:
         auto_v.restype = i32
         fun.auto_v = auto_v  # (the same, the check in a lane: `lanes.dense_lanes`)
         many = lib.rk8_auto_many
-        many.argtypes = [ptr, i32, i32, i32, ptr, ptr, ptr, ptr, ptr, ptr]
+        i64 = ctypes.c_longlong
+        many.argtypes = [ptr, i32, ptr, i64, ptr, f64, ptr, ptr, ptr, ptr, ptr, ptr]
         many.restype = i32
         fun.auto_many = many  # (`dynamics.integrate.dense`, a batch)
         lanes = lib.rk8_auto_lanes
-        lanes.argtypes = [ptr, i32, i32, i32, ptr, ptr, ptr, ptr, ptr, ptr, ptr, ptr]
+        lanes.argtypes = [ptr, i32, ptr, i64, ptr, f64, ptr, ptr, ptr, ptr, ptr, ptr, ptr,
+                          ptr]
         lanes.restype = i32
         fun.auto_lanes = lanes  # (the same, in vector lanes: `lanes.lane_steps`)
         fixed = lib.rk8_fixed_many

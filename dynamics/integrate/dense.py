@@ -49,7 +49,8 @@ from typing import NamedTuple
 import numpy as np
 
 from .. import cache
-from ..interrupts import check_interrupt, deferred_interrupts
+from ..executors import run_split
+from ..interrupts import check_interrupt, deferred_interrupts, stop_requested
 from .cpass import pass_library
 from .lanes import LANES, dense_lanes
 from .inputs import Problem
@@ -364,22 +365,31 @@ def _tell(progress, steps: int, told: int) -> int:
 
 def dense_many(model, x0: np.ndarray, t: np.ndarray, u: np.ndarray, p: np.ndarray,
                rtol: float, atol: np.ndarray, max_steps: float, stiff_steps: float,
-               runs: slice, *, out: tuple[np.ndarray, np.ndarray] | None = None,
+               runs, *, out: tuple[np.ndarray, np.ndarray] | None = None,
                factor: float | None = None, check: bool = True,
-               vector=None) -> tuple[np.ndarray, np.ndarray] | None:
+               vector=None, threads: int = 1) -> tuple[np.ndarray, np.ndarray] | None:
     """`dense_auto` for the runs ``runs`` of a batch in one compiled loop: ``x0 (K, nx)``,
     ``u (K, max(nu, 1))`` (each run's constant control), ``p (K, max(np, 1))``, all
-    C-contiguous; each run's first answer at local tolerance ``factor`` times the requested
+    C-contiguous; ``runs`` a slice or integer indices of their rows; each run's first
+    answer at local tolerance ``factor`` times the requested
     one (None: `FIRST`, as a single call; a batch learns its own,
     `dynamics.integrate.batch.first_factor`), a retry as in a single call; ``check`` False:
     each run's answer alone (as `dense_run`'s; a failed run's outputs past its failure are
     not written); ``vector`` (`lanes.dense_lanes` of the model, or None): the runs stepped
-    `lanes.LANES` at a time in its vector lanes (``rk8_auto_lanes``: the same bits). Returns
-    ``(X (r, nx, n), head (r, HEADER))``: the answers and each run's header (`outcome_of`
-    reads it); None without a compiled pass. ``out``: C-contiguous ``(X (K, nx, n),
-    head (K, HEADER))`` of the whole batch, whose slices ``runs`` the loop fills (and
-    returns) in place: calls on other threads (each with its own workspace) may fill other
-    slices of the same arrays at the same time.
+    `lanes.LANES` at a time in its vector lanes (``rk8_auto_lanes``: the same bits).
+
+    The runs are handed out one at a time, in their order, through one counter that
+    ``threads`` compiled loops share (`cpass` ``au_claim``: each thread, the caller's and
+    those of `executors.worker_pool`, takes the next run as soon as it has room, so they
+    finish together, and a thread that wakes late takes fewer); each loop returns to
+    Python after about `MANY_BUDGET` steps to look at Ctrl-C (a deferred SIGINT: no run is
+    taken after it, `KeyboardInterrupt` once the runs taken have finished). A run's answer
+    depends on nothing but its inputs: the same bits on any number of threads, in any lane.
+
+    Returns ``(X (r, nx, n), head (r, HEADER))``: the answers and each run's header
+    (`outcome_of` reads it), in the order of ``runs``; None without a compiled pass.
+    ``out``: C-contiguous ``(X (K, nx, n), head (K, HEADER))`` of the whole batch, whose
+    rows ``runs`` the loops fill in place; those two arrays are then returned.
 
     Examples
     --------
@@ -397,27 +407,54 @@ def dense_many(model, x0: np.ndarray, t: np.ndarray, u: np.ndarray, p: np.ndarra
     plan = _plan(model)
     if plan is None:
         return None
-    nout = t.size - 1
-    work = _workspace(plan, nout)
-    _fill(work.ws, plan, t, rtol, atol, max_steps, stiff_steps, factor, check)
-    r, k0 = runs.stop - runs.start, runs.start
+    nout, K = t.size - 1, len(x0)
+    index = np.arange(K, dtype=np.int64)[runs] if isinstance(runs, slice) else \
+        np.ascontiguousarray(runs, dtype=np.int64)
     if out is None:
-        X, head, at = np.empty((r, plan.nx, nout + 1)), np.empty((r, HEADER)), 0
-    else:
-        X, head = out
-        if not (X.flags.c_contiguous and head.flags.c_contiguous and X.shape[1:] == (
-                plan.nx, nout + 1) and head.shape[1:] == (HEADER,) and runs.stop <= len(X)):
-            raise ValueError("`out` must be C-contiguous (X (K, nx, n), head (K, HEADER)) "
-                             "covering `runs`")
-        at = k0
-    # (the loop runs k = at .. at + r - 1 of X and head, reading x0, u, p from row k0 - at)
-    args = (work.ws_addr, nout, at, at + r, x0[k0 - at:].ctypes.data, u[k0 - at:].ctypes.data,
-            p[k0 - at:].ctypes.data, X.ctypes.data)
-    if vector is not None and r > 1:
-        plan.lanes(*args, work.xl_addr, head.ctypes.data, vector.address, vector.cont)
-    else:
-        plan.many(*args, work.xc_addr, head.ctypes.data)
-    return X[at:at + r], head[at:at + r]
+        X, head = np.empty((K, plan.nx, nout + 1)), np.empty((K, HEADER))
+        if dense_many(model, x0, t, u, p, rtol, atol, max_steps, stiff_steps, index,
+                      out=(X, head), factor=factor, check=check, vector=vector,
+                      threads=threads) is None:
+            return None
+        return X[index], head[index]
+    X, head = out
+    if not (X.flags.c_contiguous and head.flags.c_contiguous and X.shape[1:] == (
+            plan.nx, nout + 1) and head.shape[1:] == (HEADER,) and len(X) >= K and
+            len(head) >= K):
+        raise ValueError("`out` must be C-contiguous (X (K, nx, n), head (K, HEADER)) "
+                         "covering the runs")
+    cursor = np.zeros(1, np.int64)
+    shared = (index.ctypes.data, index.size, cursor.ctypes.data, MANY_BUDGET,
+              x0.ctypes.data, u.ctypes.data, p.ctypes.data, X.ctypes.data)
+    lanes = vector is not None and index.size > 1
+
+    def loop(_):  # (a thread's: its own workspace, calls until every run is handed out)
+        work = _workspace(plan, nout)
+        _fill(work.ws, plan, t, rtol, atol, max_steps, stiff_steps, factor, check)
+        while not stop_requested():
+            if lanes:
+                done = plan.lanes(work.ws_addr, nout, *shared, work.xl_addr,
+                                  head.ctypes.data, vector.address, vector.cont)
+            else:
+                done = plan.many(work.ws_addr, nout, *shared, work.xc_addr, head.ctypes.data)
+            if done < 0:
+                raise MemoryError("the compiled loop over the runs could not allocate its "
+                                  "workspace")
+            if done:
+                return
+
+    threads = max(1, min(threads, -(-index.size // LANES) if lanes else index.size))
+    with deferred_interrupts():
+        run_split(loop, [None] * threads)
+        check_interrupt()
+    return X, head
+
+
+#: Steps (lane-steps in vector lanes) after which a compiled loop of `dense_many` takes no
+#: further run and returns, so that Ctrl-C is looked at: about 50 ms on the rigid body (a
+#: second on a model 20 times its cost); each return lets the loop's lanes empty (~0.5 ms
+#: on the torque-free batch of `bench/simulate.py`, 1 % of that time).
+MANY_BUDGET = float(1 << 18)
 
 
 def outcome_of(x: np.ndarray, head: np.ndarray) -> DenseAuto:

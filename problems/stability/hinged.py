@@ -137,11 +137,9 @@ def hinged_spin(*, m1, inertia1, m2, inertia2, r1, r2, rate, kind="revolute",
     for both, and the system mass centre is at rest: the pair spins about z as if rigid, a
     relative equilibrium.
 
-    Reduction
-    ---------
-    The pair is the scene `hinged_scene` (body 1 the six-degree-of-freedom hub, body 2 a
-    `dynamics.scene.HingedPanel`: minimal coordinates, no multipliers) and goes through
-    `spin_linearization`, as `spin` does: its translation is removed exactly
+    The reduction: the pair is the scene `hinged_scene` (body 1 the six-degree-of-freedom
+    hub, body 2 a `dynamics.scene.HingedPanel`: minimal coordinates, no multipliers) goes
+    through `spin_linearization`, as `spin` does: its translation is removed exactly
     (`attitude_subsystem`: ``r`` is cyclic, and on the level set ``P = 0`` of the linear
     momentum the hub's ``v`` follows from the other speeds), it is linearized in body rates
     (the attitude, with the spin phase, does not enter), the hinge angle (``theta``, or the

@@ -2,6 +2,8 @@
 independent truth (the Jacobi-elliptic torque-free rates, closed forms under constant
 torque and of a damped oscillator with per-run parameters), against single runs, per-run
 failure, and the argument checks."""
+import threading
+
 import casadi as ca
 import numpy as np
 import pytest
@@ -207,14 +209,22 @@ def test_threads_and_parts_give_the_bits_of_one_serial_call(spread, method):
                 simulate(model, X0[:, :7], t, method=method, steps=2).x, ref[2])
 
 
-@pytest.mark.parametrize("kw", [{}, {"method": "rk8", "steps": 3}],
-                         ids=["auto (one C loop per part)", "rk8 (one C loop per part)"])
-def test_the_compiled_loops_give_the_same_bits_on_any_number_of_threads(kw, monkeypatch):
+@pytest.mark.parametrize("kw, vector", [({}, False), ({}, True),
+                                        ({"method": "rk8", "steps": 3}, False)],
+                         ids=["auto (runs handed out one at a time)", "auto in vector lanes",
+                              "rk8 (one C loop per part)"])
+def test_the_compiled_loops_give_the_same_bits_on_any_number_of_threads(kw, vector,
+                                                                       monkeypatch):
     """The runs are independent: 1 thread (the serial loop), 2, 3 (parts of uneven sizes)
-    and more threads than parts give the same bits; ``auto``'s runs each meet their Jacobi
-    truth within the tolerance."""
-    from appdyn.dynamics.integrate import batch as dense_batch
-    monkeypatch.setattr(dense_batch, "DENSE_PART", 4)  # (37 runs spread: parts of 4 runs)
+    and more threads than runs give the same bits, with ``auto``'s loops returning to
+    Python after every few steps (the threads then take the runs in other orders);
+    ``auto``'s runs each meet their Jacobi truth within the tolerance."""
+    from appdyn.dynamics.integrate import batch as batch_auto, dense, lanes
+    monkeypatch.setattr(dense, "MANY_BUDGET", 8.0)  # (a compiled loop returns after 8 steps)
+    if vector:
+        assert lanes.dense_lanes(rigid_body(INERTIA), wait=True) is not None
+    else:
+        monkeypatch.setattr(batch_auto, "dense_lanes", lambda model, build: None)
     model, t = rigid_body(INERTIA), np.linspace(0.0, 10.0, 21)
     W, X0 = _rates(37, seed=5)
     ref = simulate(model, X0, t, threads=1, **kw)
@@ -256,18 +266,6 @@ def test_spread_runs_calls_every_run_once_in_contiguous_parts():
 
 
 @pytest.mark.parametrize("threads", [1, 2])
-def test_spread_runs_of_given_slices_calls_each_of_their_runs_once_inside_them(threads):
-    pieces = ((0, 5), (9, 20), (30, 31))
-    seen = []
-    batch_module.spread_runs(lambda k0, k1: seen.append((k0, k1)), 17, threads, 4,
-                             pieces=pieces)
-    assert sorted(k for a, b in seen for k in range(a, b)) == \
-        [k for a, b in pieces for k in range(a, b)]
-    assert all(any(a >= k0 and b <= k1 for k0, k1 in pieces) and b - a <= 4
-               for a, b in seen)
-
-
-@pytest.mark.parametrize("threads", [1, 2])
 def test_a_ctrl_c_stops_the_compiled_loops_between_groups_of_parts(threads):
     """A Ctrl-C during a part of a compiled loop over the runs is raised (KeyboardInterrupt)
     once the parts handed out with it have finished; no later group is started."""
@@ -290,6 +288,41 @@ def test_a_ctrl_c_stops_the_compiled_loops_between_groups_of_parts(threads):
     model, t = rigid_body(INERTIA), np.linspace(0.0, 1.0, 5)
     _, X0 = _rates(3)
     assert simulate(model, X0, t, threads=threads).all_success  # (and the next call is whole)
+
+
+@pytest.mark.parametrize("threads", [1, 2])
+def test_a_ctrl_c_stops_the_dense_loops_from_taking_runs(threads, monkeypatch):
+    """A Ctrl-C while ``auto``'s compiled loops over a batch's runs go (`dense.dense_many`)
+    is raised (KeyboardInterrupt) once the runs taken have finished: the calling thread's
+    loop takes no run after it (here the SIGINT arrives as it starts), and the next call
+    is whole."""
+    import os
+    import signal
+
+    from appdyn.dynamics.integrate import dense
+
+    if signal.getsignal(signal.SIGINT) is not signal.default_int_handler:
+        pytest.skip("SIGINT has a handler of its own here")
+    real, taken = dense._workspace, []
+
+    def workspace(plan, nout):
+        if threading.current_thread() is threading.main_thread() and not taken:
+            os.kill(os.getpid(), signal.SIGINT)
+        taken.append(1)
+        return real(plan, nout)
+
+    monkeypatch.setattr(dense, "MANY_BUDGET", 1.0)  # (a loop returns after every run)
+    monkeypatch.setattr(dense, "_workspace", workspace)
+    model, t, K = rigid_body(INERTIA), np.linspace(0.0, 1.0, 5), 400
+    _, X0 = _rates(K)
+    head = np.full((K, dense.HEADER), np.nan)
+    with pytest.raises(KeyboardInterrupt):
+        dense.dense_many(model, np.ascontiguousarray(X0.T), t, np.zeros((K, 3)),
+                         np.zeros((K, 1)), 1e-8, np.full(7, 1e-10), 1e8, 1e6, slice(0, K),
+                         out=(np.empty((K, 7, 5)), head), threads=threads)
+    assert np.isnan(head[:, 0]).sum() >= (K if threads == 1 else 1)  # (runs never taken)
+    monkeypatch.setattr(dense, "_workspace", real)
+    assert simulate(model, X0[:, :40], t, threads=threads).all_success
 
 
 def test_a_run_that_blows_up_fails_alone_in_any_part(spread):

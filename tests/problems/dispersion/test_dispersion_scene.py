@@ -100,8 +100,8 @@ def test_a_batched_dispersion_over_a_scene_steps_each_sample_alone(monkeypatch):
     for key in ("h", "w3"):
         np.testing.assert_array_equal(many.outputs[key], one.outputs[key])
     assert np.max(np.abs(many.outputs["h"])) < 1e-8
-    from appdyn.dynamics.integrate import batch as dense_batch
-    monkeypatch.setattr(dense_batch, "DENSE_PART", 1)  # (6 samples spread: parts of 1)
+    from appdyn.dynamics.integrate import dense
+    monkeypatch.setattr(dense, "MANY_BUDGET", 1.0)  # (a compiled loop returns after each run)
     for threads in (1, 3):  # the samples spread over threads: the same bits
         spread = dispersion(model, x0, T, batch=True, threads=threads, **kw)
         for key in ("h", "w3"):
