@@ -11,9 +11,9 @@ runs' slices of the result, so the answers are the same bits for every thread co
 ``auto`` on a smooth model under controls constant over each run: every run's answer,
 check run and verdict in one compiled loop (`dense.dense_many`), each run with its own
 steps and its own check; the runs in
-rounds (`dense_rounds`, each spread over the batch), the first round's runs the single
-call's answers to the last bit, each later round's first answers at the local tolerance
-the runs before show to cost the fewest steps (`first_factor`: over-delivery weighed
+two rounds (`dense_rounds`, each spread over the batch), the first round's runs the single
+call's answers to the last bit, the second round's first answers at the local tolerance
+the first round's runs show to cost the fewest steps (`first_factor`: over-delivery weighed
 against retries), each of its runs the single call's answer at that first tolerance;
 otherwise auto's multi-run error control over the whole batch (one step count for all
 runs; a stiff or non-smooth batch goes run by run as single runs do). The fixed-step
@@ -188,7 +188,7 @@ def auto_dense_batch(batch: Batch, rtol: float, atol: np.ndarray, max_steps: int
     over the runs (`dense.dense_many`: on ``threads`` threads, each taking the next run
     as soon as it has room, its answer and header written in place), each run with its
     own steps; round by round (`dense_rounds`, each spread over the batch), each later
-    round's first answers at the factor `first_factor` learns from the runs before (each
+    round's first answers at the factor `first_factor` learns from the runs before it (each
     run's answer does not depend on its neighbours, so the bits do not depend on the
     threads or the lanes). A run not verified there goes alone through `solve_auto` (as a
     single call would). Returns ``(x (nx, n, K), ok, status, estimate, method, n_steps,
@@ -300,12 +300,17 @@ def dop853_dense_batch(batch: Batch, rtol: float, atol: np.ndarray, max_steps: i
 #: a later one takes it): for the rigid body, 256 runs of 41 outputs are ~20 ms of the
 #: scalar loop, which the lanes cut about 2x. A smaller batch takes the lanes once built.
 LANES_MIN = 256
-#: A dense batch runs in rounds (`dense_rounds`): `PILOT` runs spread over it answer first
-#: at `dense.FIRST` of the tolerance, as single calls do; each later round, `ROUND_GROWTH`
-#: times the runs before it (the last takes the rest), at the factor `first_factor` learns
-#: from every run before it.
-PILOT = 16
-ROUND_GROWTH = 4
+#: A dense batch runs in two rounds (`dense_rounds`): the batch cut into `STRATA`
+#: contiguous strata, the first `PILOT` runs of each answer first at `dense.FIRST` of the
+#: tolerance, as single calls do; the rest, at the factor `first_factor` learns from them.
+#: Each round ends when its slowest run does (its lanes empty meanwhile) and learns in
+#: Python: on the 1,000-run torque-free batch of `bench/simulate.py` four rounds (16, 48,
+#: 192 and 744 runs, each learning from all before) took 18.4 ms on two threads (minimum
+#: of 30, median 20.1), two (32 and 968 runs) 17.4 ms (median 19.1); one round costs
+#: ~0.2 ms of Python and one slowest run (~0.3 ms). The factor is chosen on a grid of 8
+#: per decade, never looser than `dense.FIRST`, and a run it misjudges retries alone.
+STRATA = 16
+PILOT = 2
 #: DOP853's order: a run's steps grow as its local tolerance to the power -1/8 (measured:
 #: -0.10..-0.12 per run on `bench/simulate.py`'s torque-free batch, factors 1e-4..0.3).
 ORDER = 8
@@ -324,34 +329,27 @@ SPREAD = 2.0
 
 def dense_rounds(K: int) -> list[tuple[tuple[int, int], ...]]:
     """The rounds of a dense batch of ``K`` runs, each a tuple of slices ``(k0, k1)``: the
-    batch cut into `PILOT` near-equal contiguous strata, round 0 takes the first run of
-    each, every later round `ROUND_GROWTH` times the runs before from each stratum (the
-    last one the rest). The runs done before a round are thus spread over the whole batch
-    (a batch sorted by a parameter, easy runs first, would otherwise teach the first
-    rounds the wrong first tolerance), and every round writes its slices in place. One
-    round for a batch under ``2 PILOT`` runs.
+    batch cut into `STRATA` near-equal contiguous strata, round 0 takes the first `PILOT`
+    runs of each, round 1 the rest. The runs of the first round are thus spread over the
+    whole batch (a batch sorted by a parameter, easy runs first, would otherwise teach the
+    second round the wrong first tolerance). One round for a batch under ``2 STRATA
+    PILOT`` runs.
 
     Examples
     --------
     >>> from appdyn.dynamics.integrate.batch import dense_rounds
     >>> [sum(k1 - k0 for k0, k1 in r) for r in dense_rounds(1000)]
-    [16, 48, 192, 744]
+    [32, 968]
     >>> dense_rounds(1000)[0][:3]
-    ((0, 1), (62, 63), (125, 126))
+    ((0, 2), (62, 64), (125, 127))
     >>> dense_rounds(12)
     [((0, 12),)]
     """
-    if K < 2 * PILOT:
+    if K < 2 * STRATA * PILOT:
         return [((0, K),)]
-    edges = [K * i // PILOT for i in range(PILOT + 1)]
-    counts, c = [0], 1
-    while c < max(b - a for a, b in zip(edges[:-1], edges[1:])):
-        counts.append(c)
-        c *= ROUND_GROWTH
-    counts.append(K)
-    return [tuple((a + min(c0, b - a), a + min(c1, b - a))
-                  for a, b in zip(edges[:-1], edges[1:]) if min(c0, b - a) < min(c1, b - a))
-            for c0, c1 in zip(counts[:-1], counts[1:])]
+    edges = [K * i // STRATA for i in range(STRATA + 1)]
+    return [tuple((a, a + PILOT) for a in edges[:-1]),
+            tuple((a + PILOT, b) for a, b in zip(edges[:-1], edges[1:]))]
 
 
 def first_factor(estimate, factor, steps, gate, *, current: float, rtol: float) -> float:
@@ -428,13 +426,16 @@ def first_factor(estimate, factor, steps, gate, *, current: float, rtol: float) 
     ratio = np.concatenate([e / f / SPREAD, e / f, e / f * SPREAD])
     weight = np.concatenate([0.25 * scale, 0.5 * scale, 0.25 * scale])
     cost = np.zeros(grid.size)
-    gates = np.tile(g, 3)
-    for gate in np.unique(g):
-        key = np.round(32 * np.log10(ratio[gates == gate])).astype(int)
+    gates = np.concatenate([g, g, g])
+    for gate in sorted(set(g.tolist())):  # (0.5 or 1)
+        mine = gates == gate
+        key = np.round(32 * np.log10(ratio[mine])).astype(int)
         lo = key.min()
-        w = np.bincount(key - lo, weights=weight[gates == gate])
+        w = np.bincount(key - lo, weights=weight[mine])
         used = np.flatnonzero(w)
-        cost += _expected_steps(grid, 10.0 ** ((used + lo) / 32), gate) @ w[used]
+        # (a sum, not a matrix product: no BLAS call, whose threads would then spin on
+        # the cores the batch's loops run on)
+        cost += (_expected_steps(grid, 10.0 ** ((used + lo) / 32), gate) * w[used]).sum(axis=1)
     return float(grid[int(np.argmin(cost))])
 
 
@@ -450,7 +451,8 @@ def _expected_steps(grid: np.ndarray, ratio: np.ndarray, gate: float) -> np.ndar
         total += np.where(live, at ** (-1.0 / ORDER), 0.0)
         est = ratio * at
         live &= est > gate
-        at = np.where(live, at * np.clip(RETRY_AIM / est, RETRY_LADDER, 0.5), at)
+        at = np.where(live, at * np.minimum(np.maximum(RETRY_AIM / est, RETRY_LADDER), 0.5),
+                      at)
     return np.where(live, 2 * total, total)
 
 

@@ -251,9 +251,9 @@ def test_a_batch_run_not_verified_in_the_loop_goes_alone(monkeypatch):
 
 
 def test_later_rounds_of_a_batch_answer_first_at_the_factor_learned_before(monkeypatch):
-    """A batch of 80 runs goes in rounds (`batch.dense_rounds`): the first round's runs are
-    their single calls to the last bit; each later round's runs are the single call with
-    its first answer at the factor the runs before chose (`batch.first_factor`), each
+    """A batch of 80 runs goes in two rounds (`batch.dense_rounds`): the first round's runs
+    are their single calls to the last bit; the second round's runs are the single call
+    with its first answer at the factor the first round's runs chose (`batch.first_factor`), each
     verified by its own check and within the tolerance of its Jacobi truth."""
     from appdyn.dynamics.integrate import batch as batch_module, dense
     seen = []
@@ -272,7 +272,7 @@ def test_later_rounds_of_a_batch_answer_first_at_the_factor_learned_before(monke
     res = simulate(model, x0, t, threads=1)
     assert res.all_success and "learned from the runs before" in res.message, res.message
     rounds = batch_module.dense_rounds(80)
-    assert len(rounds) == 3
+    assert len(rounds) == 2
     assert sorted(k for runs, _ in seen for k in runs) == list(range(80))
     first = {k0 for k0, _ in rounds[0]}
     assert all(f == dense.FIRST for runs, f in seen if first & set(runs))
@@ -289,22 +289,19 @@ def test_later_rounds_of_a_batch_answer_first_at_the_factor_learned_before(monke
 
 def test_each_round_of_a_batch_draws_from_every_part_of_it():
     """`batch.dense_rounds`: the rounds cover every run once, in slices; the first takes
-    one run from each sixteenth of the batch and every later round but the last takes
-    from each sixteenth alike, so a batch sorted by a parameter (easy runs first) does not
-    teach its first rounds the wrong tolerance."""
-    from appdyn.dynamics.integrate.batch import PILOT, dense_rounds
-    for K in (33, 80, 1000, 1024, 5000):
+    the first `PILOT` runs of each sixteenth of the batch, so a batch sorted by a parameter
+    (easy runs first) does not teach the second round the wrong tolerance."""
+    from appdyn.dynamics.integrate.batch import PILOT, STRATA, dense_rounds
+    for K in (64, 80, 1000, 1024, 5000):
         rounds = dense_rounds(K)
+        assert len(rounds) == 2
         runs = [k for r in rounds for k0, k1 in r for k in range(k0, k1)]
         assert sorted(runs) == list(range(K))
-        strata = np.array([K * i // PILOT for i in range(PILOT + 1)])
+        strata = np.array([K * i // STRATA for i in range(STRATA + 1)])
         part = lambda k: int(np.searchsorted(strata, k, side="right")) - 1
-        assert sorted(part(k0) for k0, _ in rounds[0]) == list(range(PILOT))
-        assert all(k1 - k0 == 1 for k0, k1 in rounds[0])
-        for r in rounds[1:-1]:
-            assert sorted(part(k0) for k0, _ in r) == list(range(PILOT))
-            assert len({k1 - k0 for k0, k1 in r}) == 1
-    assert dense_rounds(31) == [((0, 31),)]
+        assert sorted(part(k0) for k0, _ in rounds[0]) == list(range(STRATA))
+        assert all(k1 - k0 == PILOT and part(k1 - 1) == part(k0) for k0, k1 in rounds[0])
+    assert dense_rounds(2 * STRATA * PILOT - 1) == [((0, 2 * STRATA * PILOT - 1),)]
 
 
 def test_first_factor_weighs_over_delivery_against_retries():
