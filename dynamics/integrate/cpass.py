@@ -615,18 +615,22 @@ typedef struct {
   int filled;
 } au_vio;
 
-/* lane l's inputs: a step of h from x under the run's control, parameters and tolerances */
-static void au_vset(au_vio* v, int l, const dense_state* s, const casadi_real* x,
-                    casadi_real h) {
+/* lane l's inputs that hold over a run's answer and its check: the run's control,
+   parameters and tolerances (`au_vstep_in` sets a step's own) */
+static void au_vrun(au_vio* v, int l, const dense_state* s) {
   int i;
-  for (i = 0; i < PASS_NX; ++i) {
-    v->x[i][l] = x[i];
-    v->atol[i][l] = s->c.atol[i];
-  }
+  for (i = 0; i < PASS_NX; ++i) v->atol[i][l] = s->c.atol[i];
   for (i = 0; i < PASS_NU; ++i) v->u[i][l] = s->u[i];
   for (i = 0; i < PASS_NP; ++i) v->p[i][l] = s->p[i];
-  v->h[l] = h;
   v->rtol[l] = s->c.rtol;
+}
+
+/* lane l's inputs: a step of h from x (the run's control, parameters and tolerances in
+   the lane already: `au_vrun`) */
+static void au_vstep_in(au_vio* v, int l, const casadi_real* x, casadi_real h) {
+  int i;
+  for (i = 0; i < PASS_NX; ++i) v->x[i][l] = x[i];
+  v->h[l] = h;
   v->filled |= 1 << l;
 }
 
@@ -693,8 +697,8 @@ static int dense_advance_v(dense_state* s, au_vio* v, au_vstep step, au_vstep co
   int use[PASS_LANES], want[PASS_LANES], l, had = s->check_due;
   for (l = 0; l < PASS_LANES; ++l) use[l] = want[l] = 0;
   use[0] = 1; use[1] = had;
-  au_vset(v, 0, s, s->x, s->hs);
-  if (had) au_vset(v, 1, s, s->rich + RI_X, s->due - s->rich[RI_T]);
+  au_vstep_in(v, 0, s->x, s->hs);  /* (the run's inputs in lanes 0 and 1: `dense_run`) */
+  if (had) au_vstep_in(v, 1, s->rich + RI_X, s->due - s->rich[RI_T]);
   au_vcall(step, v, use);
   want[0] = v->err[0] <= 1.0 && dense_wants_k(s);
   want[1] = had && rich_wants_k(s);
@@ -734,6 +738,10 @@ static int dense_run(casadi_real* x, casadi_real* t, casadi_real* hio, int nout,
   if (!dense_open(&s, x, t, *hio, nout, ts, u, p, rtol, atol, max_steps, X, ldx, count,
                   stiff_steps, rich, XC))
     return s.j;
+  if (rich && step) {  /* (the answer's lane 0 and its check's lane 1: one run's inputs) */
+    au_vrun(&v, 0, &s);
+    au_vrun(&v, 1, &s);
+  }
   while (s.j < nout && budget-- > 0) {
     dense_next(&s);
     if (rich && step ? dense_advance_v(&s, &v, step, cont) : dense_advance(&s)) break;
@@ -1180,7 +1188,7 @@ typedef struct {
   dense_state s;
   casadi_real *w, *X, *XC;
   long k;
-  int opened, ended, floor;
+  int opened, ended, floor, fresh, lane;  /* fresh: opened since its lane took `au_vrun` */
 } au_lane;
 
 /* Continuous extensions gathered from the lanes' steps (answers' and checks'), PASS_LANES to
@@ -1262,6 +1270,17 @@ static void au_extend(au_pend* P, au_vstep vcont, au_vio* v, int (*span)[2],
     }
 }
 
+/* lane L's step of h from x into lane l = L's index of v: the run's control, parameters
+   and tolerances only after its run (or answer) was opened, the step's own inputs always */
+static void au_vlane(au_vio* v, au_lane* L, const casadi_real* x, casadi_real h) {
+  int l = L->lane;
+  if (L->fresh) {
+    au_vrun(v, l, &L->s);
+    L->fresh = 0;
+  }
+  au_vstep_in(v, l, x, h);
+}
+
 /* the check steps due in the lanes, in one vector step, when one of them cannot wait
    (`all`; or a lane whose next accepted step would make another due: it ends a pair or
    the run); a check step waits at most one answer step, so about one vector step of
@@ -1279,7 +1298,7 @@ static void au_checks(au_lane* L, au_vio* v, au_pend* P, au_vstep step, au_vstep
   }
   if (!any || !urgent) return;
   for (l = 0; l < PASS_LANES; ++l)
-    if (use[l]) au_vset(v, l, &L[l].s, L[l].s.rich + RI_X, L[l].s.due - L[l].s.rich[RI_T]);
+    if (use[l]) au_vlane(v, &L[l], L[l].s.rich + RI_X, L[l].s.due - L[l].s.rich[RI_T]);
   au_vcall(step, v, use);
   for (l = 0; l < PASS_LANES; ++l) {
     S[l] = &L[l].s; X[l] = L[l].s.XC; t[l] = 0; span[l][0] = span[l][1] = 0;
@@ -1296,6 +1315,7 @@ static void au_checks(au_lane* L, au_vio* v, au_pend* P, au_vstep step, au_vstep
    or the rerun from a moved start into XC, `floor`); 1 when it has steps to take */
 static int au_lane_open(au_lane* L, int nout, int plain) {
   casadi_real* w = L->w;
+  L->fresh = 1;
   L->opened = dense_open(&L->s, AU_XR(w), AU_TT(w), *AU_H(w), nout, AU_TS(w), AU_U(w),
                          AU_P(w), w[AU_RTOL] * w[AU_FACTOR], AU_AL(w),
                          w[AU_MAXSTEPS] - w[AU_SPENT], (L->floor ? L->XC : L->X) + 1,
@@ -1370,6 +1390,8 @@ int rk8_auto_lanes(const casadi_real* w, int nout, const long long* runs, long l
     L[l].w = wk + (size_t) l * size;
     L[l].XC = XC + (size_t) l * PASS_NX * (nout + 1);
     L[l].k = -1;
+    L[l].lane = l;
+    L[l].fresh = 1;
   }
   for (;;) {
     taking = taking && !(budget > 0 && spent >= budget);
@@ -1390,7 +1412,7 @@ int rk8_auto_lanes(const casadi_real* w, int nout, const long long* runs, long l
     for (l = 0; l < PASS_LANES; ++l)
       if (use[l]) {
         dense_next(&L[l].s);
-        au_vset(&v, l, &L[l].s, L[l].s.x, L[l].s.hs);
+        au_vlane(&v, &L[l], L[l].s.x, L[l].s.hs);
       }
     au_vcall(step, &v, use);
     any = 0;
