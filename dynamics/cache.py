@@ -588,12 +588,15 @@ def _spawn(job: Job, compiler: str, key: str | None):
     work = tempfile.mkdtemp(prefix="appdyn-cc-")
     build = _Build(work)
     try:
-        functions, extra = job.make()
-        units = [list(f) for f in functions if isinstance(f, (list, tuple))]
-        main = [f for f in functions if not isinstance(f, (list, tuple))]
-        build.name = main[0].name()
-        sources = [_generate_c(main, _prototypes(units) + extra, work)] + \
-            [_generate_c(unit, "", work) for unit in units]
+        # (the job's Functions are built and generated under the construction lock: a call
+        # outside a build, e.g. `compile_ahead` from a thread-pool task, builds symbols too)
+        with _CACHE.construction_lock():
+            functions, extra = job.make()
+            units = [list(f) for f in functions if isinstance(f, (list, tuple))]
+            main = [f for f in functions if not isinstance(f, (list, tuple))]
+            build.name = main[0].name()
+            sources = [_generate_c(main, _prototypes(units) + extra, work)] + \
+                [_generate_c(unit, "", work) for unit in units]
     except RuntimeError as exc:  # (a Function that cannot be code-generated)
         build.close()
         return RuntimeError(f"generating C failed: {exc}")

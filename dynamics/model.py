@@ -13,6 +13,8 @@ from typing import Mapping
 import casadi as ca
 import numpy as np
 
+from . import cache
+
 __all__ = ["Model", "check_model", "model_from_expressions", "named_symbols"]
 
 
@@ -382,6 +384,7 @@ def _check_declared(expr: ca.SX, declared: ca.SX, label: str, allowed: str) -> N
                          f"{allowed}")
 
 
+@cache.constructs
 def model_from_expressions(states, xdot, controls=None, params=None, *, p_default=None,
                            units=None, invariants=None, name: str = "model",
                            attitude=None) -> Model:

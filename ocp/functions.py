@@ -35,14 +35,18 @@ from typing import Sequence
 import casadi as ca
 import numpy as np
 
+from appdyn.dynamics import cache
 from appdyn.dynamics.model import Model
 
 __all__ = ["named_function", "canonical", "by_name", "vocabulary", "valid_names", "POSITIONAL",
            "sx_compatible"]
 
 
+@cache.constructs
 def sx_compatible(fun: ca.Function) -> bool:
     """Whether ``fun`` can be called on SX symbols (then kernels are built expanded, in SX).
+
+    The trial call builds symbols, under the construction lock (`dynamics.cache`).
 
     Examples
     --------
@@ -214,10 +218,16 @@ def by_name(fun, kind: str, model: Model, argname: str):
     return positional_call
 
 
+@cache.constructs
 def canonical(fun, inputs: Sequence[tuple[str, int]], out_name: str, argname: str, *,
               scalar: bool = False) -> ca.Function:
     """A user Function or (positional) callable as a named-I/O Function with one flattened
     output.
+
+    Built under the construction lock (`dynamics.cache`), the user's callable evaluated on
+    symbols with it: problems are stated in the tasks of thread pools
+    (`problems.slew.maneuver_table`), and two threads building symbols at once can corrupt
+    CasADi's reference counts.
 
     Parameters
     ----------

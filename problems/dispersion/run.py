@@ -144,7 +144,9 @@ def dispersion(model, x0, t, *, samples: int, seed: int | None, outputs: Mapping
         ``model(**draws) -> Model or Scene`` called in each sample with the drawn ``params``
         it names as keywords (all of them if it takes ``**kwargs``), e.g. an inertia that
         `dynamics.rigid_body` or a scene's hub bakes into its model. For a process pool, a
-        module-level function.
+        module-level function. A factory runs under the construction lock of
+        `dynamics.cache` (it builds CasADi symbols, and samples may run on threads): keep
+        heavy numeric work out of it.
     x0 : array_like, shape (nx,), or callable
         Nominal initial state, or ``x0(**draws) -> (nx,)`` (keywords as for the factory).
     t : array_like, shape (n,) [s]

@@ -19,7 +19,7 @@ from typing import Callable
 
 import numpy as np
 
-from appdyn.dynamics import simulate, validate
+from appdyn.dynamics import cache, simulate, validate
 from appdyn.dynamics.attitude import quat_mul
 from appdyn.dynamics.model import Model, check_model
 from appdyn.dynamics.scene import Scene
@@ -145,6 +145,14 @@ def _evaluate(task: SampleTask, res) -> dict:
     return out
 
 
+@cache.constructs
+def _built(factory, values) -> Model:
+    """The factory's model of one sample, built under the construction lock: a factory
+    builds CasADi symbols (``model_from_expressions``, a scene), and samples run on threads
+    (`dynamics.cache`)."""
+    return as_model(factory(**picked(factory, values)), "model (returned by the factory)")
+
+
 def run_sample(task: SampleTask) -> SampleOutcome:
     """One sample: build the model, set ``x0`` and ``p``, simulate, evaluate the outputs.
 
@@ -162,9 +170,7 @@ def run_sample(task: SampleTask) -> SampleOutcome:
     status = NOT_SIMULATED
     try:
         kwargs = dict(task.simulate_kwargs)
-        model = task.model if isinstance(task.model, Model) else \
-            task.model(**picked(task.model, task.values))
-        model = as_model(model, "model (returned by the factory)")
+        model = task.model if isinstance(task.model, Model) else _built(task.model, task.values)
         x0, p = _initial(task, model, kwargs.pop("p", None))
         res = simulate(model, x0, task.t, p=p, **kwargs)
         status = int(res.status)

@@ -80,9 +80,7 @@ def slew_problem(inertia, *, objective, T=None, angle=None, axis=None, q0=None, 
     if norm_bound:
         if u_max is None or np.ptp(u_lim) != 0:
             raise ValueError("`norm_bound=True` needs a scalar `u_max`")
-        x, u, p = ca.SX.sym("x", 7), ca.SX.sym("u", 3), ca.SX.sym("p", 0)
-        path.append(Constraint(ca.Function("torque_norm", [x, u, p], [ca.sumsqr(u) - u_lim[0] ** 2],
-                                           ["x", "u", "p"], ["g"]), name="torque_norm"))
+        path.append(Constraint(_torque_norm(float(u_lim[0])), name="torque_norm"))
     if keep_out is not None:
         if not isinstance(keep_out, KeepOut):
             raise TypeError(f"`keep_out` must be a KeepOut, got {type(keep_out).__name__}")
@@ -100,9 +98,7 @@ def slew_problem(inertia, *, objective, T=None, angle=None, axis=None, q0=None, 
         if T is None:
             raise ValueError("`T` must be a positive finite horizon [s], got None")
         horizon = positive(T, "T")
-        x, u, p = ca.SX.sym("x", 7), ca.SX.sym("u", 3), ca.SX.sym("p", 0)
-        costs = dict(lagrange=ca.Function("effort", [x, u, p], [0.5 * ca.sumsqr(u)],
-                                          ["x", "u", "p"], ["L"]))
+        costs = dict(lagrange=_effort())
     return Problem(
         model,
         T=horizon,
@@ -114,6 +110,23 @@ def slew_problem(inertia, *, objective, T=None, angle=None, axis=None, q0=None, 
         name=f"slew ({objective})",
         **costs,
     )
+
+
+@cache.memoize
+def _torque_norm(limit: float) -> ca.Function:
+    """``g(x, u, p) = |u|^2 - limit^2``: the torque norm bound, built once per limit (in the
+    one cache, under its construction lock: slews are stated in thread-pool tasks)."""
+    x, u, p = ca.SX.sym("x", 7), ca.SX.sym("u", 3), ca.SX.sym("p", 0)
+    return ca.Function("torque_norm", [x, u, p], [ca.sumsqr(u) - limit ** 2], ["x", "u", "p"],
+                       ["g"])
+
+
+@cache.memoize
+def _effort() -> ca.Function:
+    """``L(x, u, p) = |u|^2 / 2``: the minimum-effort running cost, built once (as
+    `_torque_norm`)."""
+    x, u, p = ca.SX.sym("x", 7), ca.SX.sym("u", 3), ca.SX.sym("p", 0)
+    return ca.Function("effort", [x, u, p], [0.5 * ca.sumsqr(u)], ["x", "u", "p"], ["L"])
 
 
 def eigenaxis_time(inertia, angle, axis, u_max=1.0) -> float:

@@ -12,6 +12,7 @@ from dataclasses import dataclass
 import casadi as ca
 import numpy as np
 
+from appdyn.dynamics import cache
 from appdyn.dynamics.attitude import dcm_from_quat, quat_from_axis_angle, quat_mul, quat_normalize
 from appdyn.dynamics.validate import finite_array, finite_scalar, unit_quaternion, unit_vector
 from appdyn.dynamics.validate import positive
@@ -81,7 +82,13 @@ class KeepOut:
         return math.cos(self.half_angle) - cosang
 
     def function(self) -> ca.Function:
-        """Path constraint ``g(x, u, p) = dot(b, A(q) s) - cos(half_angle) <= 0``."""
+        """Path constraint ``g(x, u, p) = dot(b, A(q) s) - cos(half_angle) <= 0``, built once
+        per cone (in the one cache, under its construction lock: slews are stated in
+        thread-pool tasks)."""
+        return cache.get(("slew.keep_out", self), self._function)
+
+    def _function(self) -> ca.Function:
+        """`function`, built."""
         x, u, p = ca.SX.sym("x", 7), ca.SX.sym("u", 3), ca.SX.sym("p", 0)
         g = ca.dot(ca.DM(self.boresight), ca.mtimes(dcm_from_quat(x[:4]), ca.DM(self.direction)))
         return ca.Function("keep_out", [x, u, p], [g - math.cos(self.half_angle)],

@@ -121,3 +121,34 @@ def test_memoize_values_never_caches_bad_input_and_keeps_types_apart():
         with pytest.raises(c._Unkeyable):
             c.value_key(unkeyable)
     assert c.value_key(float("nan")) != c.value_key(float("nan"))   # NaN: always a miss
+
+
+@pytest.mark.skipif(not HAVE_CC, reason="no C compiler: nothing is made")
+def test_a_compile_job_is_made_under_the_construction_lock():
+    """`compile_ahead` runs outside any build (e.g. from `simulate` in a thread-pool task):
+    its job's ``make`` builds CasADi symbols, so the compile holds the construction lock
+    while it makes and generates (another thread cannot take the lock meanwhile)."""
+    seen = []
+
+    def other_thread_can_lock() -> bool:
+        out = []
+
+        def probe():
+            got = cache.construction_lock().acquire(blocking=False)
+            if got:
+                cache.construction_lock().release()
+            out.append(got)
+
+        th = threading.Thread(target=probe)
+        th.start()
+        th.join()
+        return out[0]
+
+    def make():
+        seen.append(other_thread_can_lock())
+        raise RuntimeError("not generated")  # (nothing is compiled)
+
+    job = cache.Job(make, "-O1", lambda path: path)
+    out = cache.compile_parallel([job])[0]
+    assert isinstance(out, RuntimeError) and "not generated" in str(out)
+    assert seen == [False] and other_thread_can_lock()

@@ -154,6 +154,28 @@ def test_thread_and_process_pools_give_the_serial_result():
     assert threads.executor == "ThreadPoolExecutor" and processes.executor == "ProcessPoolExecutor"
 
 
+
+def _pendulum(k):
+    """A factory that builds its model from fresh symbols in each sample."""
+    y, v = ca.SX.sym("y"), ca.SX.sym("v")
+    return model_from_expressions({"y": y, "v": v}, {"y": v, "v": -k * ca.sin(y) - 0.1 * v},
+                                  invariants={"energy": 0.5 * v ** 2 + k * (1 - ca.cos(y))})
+
+
+def test_threaded_factories_build_their_casadi_symbols_one_at_a_time():
+    """Found in an audit of the executors: a model factory builds CasADi symbols in each
+    sample's task, beside other threads' builds (CasADi counts references without atomics).
+    The factory now runs under the construction lock (`dynamics.cache`): every threaded
+    dispersion is the serial one."""
+    kw = dict(samples=8, seed=2, params={"k": Uniform(1.0, 2.0)}, outputs={"y": "y"},
+              invariant_drift=True, method="rk4", steps=20)
+    serial = dispersion(_pendulum, [0.5, 0.0], np.linspace(0, 1.0, 6), **kw)
+    assert serial.success
+    with ThreadPoolExecutor(4) as pool:
+        for _ in range(20):
+            _assert_identical(serial, dispersion(_pendulum, [0.5, 0.0], np.linspace(0, 1.0, 6),
+                                                 executor=pool, **kw))
+
 def test_results_pickle():
     res = spin_dispersion(samples=2)
     back = pickle.loads(pickle.dumps(res))

@@ -181,3 +181,36 @@ def test_cli_table_bad_options_exit_2(argv):
     with pytest.raises(SystemExit) as exc:
         main(["slew", "--inertia", "1,1,1", "--time-optimal", *argv])
     assert exc.value.code == 2
+
+
+# Found in an audit of the executors: each target's task states its slew (`slew_problem`: the
+# torque-norm, effort and keep-out Functions; `ocp.Problem` making its functions canonical on
+# symbols), building CasADi symbols outside the construction lock while other threads build
+# (CasADi counts references without atomics; the heavy-top sweep crashed so). Those builds
+# now run under the lock (`dynamics.cache`); every threaded table is the serial one. (The
+# time-optimal polish has a wall-time budget, so it is off here: under a loaded CPU a
+# threaded row can run out of it where the serial one did not.)
+RACED = {
+    "time": dict(objective="time", polish=False, **FAST),
+    "keep-out": dict(objective="time", N=10, starts=2, norm_bound=True,
+                     keep_out=slew.KeepOut([1, 0, 0], [0.955336, 0.29552, 0.5], 0.3)),
+    "effort": dict(objective="effort", T=3.0, N=10),
+}
+RACED_TARGETS = [{"name": f"t{k}", "angle": 0.3 + 0.2 * k, "axis": [1.0, k % 2, 0.5]}
+                 for k in range(3)]
+
+
+@pytest.mark.parametrize("which", [pytest.param("time", marks=pytest.mark.slow),
+                                   pytest.param("keep-out", marks=pytest.mark.slow), "effort"])
+def test_threaded_tables_build_their_casadi_symbols_one_at_a_time(which):
+    inertia = np.diag([1.0, 2.0, 3.0])
+    serial = maneuver_table(inertia, RACED_TARGETS, **RACED[which])
+    assert serial.success
+    with ThreadPoolExecutor(4) as pool:
+        for _ in range(5):
+            got = maneuver_table(inertia, RACED_TARGETS, executor=pool, **RACED[which])
+            assert np.array_equal(got.T, serial.T) and np.array_equal(got.cost, serial.cost)
+            assert got.row_status == serial.row_status
+            assert np.array_equal(got.iterations, serial.iterations)
+            for a, b in zip(got.solutions, serial.solutions):
+                assert np.array_equal(a.x, b.x) and np.array_equal(a.u, b.u)
