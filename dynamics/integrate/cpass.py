@@ -604,6 +604,7 @@ static int dense_advance(dense_state* s) {
    function's arithmetic in its order: the same bits): a lane is a slot for any step of
    the run's model, an answer's or a check's, of any run. ---- */
 typedef double au_vec __attribute__((vector_size(8 * PASS_LANES)));
+typedef long long au_lmask __attribute__((vector_size(8 * PASS_LANES)));  /* a lane mask */
 typedef int (*au_vstep)(const au_vec** arg, au_vec** res);
 
 /* the vector step's inputs and outputs (those of `rk8_step_k`, a lane per run), then the
@@ -1270,15 +1271,16 @@ static void au_extend(au_pend* P, au_vstep vcont, au_vio* v, int (*span)[2],
     }
 }
 
-/* lane L's step of h from x into lane l = L's index of v: the run's control, parameters
-   and tolerances only after its run (or answer) was opened, the step's own inputs always */
-static void au_vlane(au_vio* v, au_lane* L, const casadi_real* x, casadi_real h) {
-  int l = L->lane;
-  if (L->fresh) {
-    au_vrun(v, l, &L->s);
-    L->fresh = 0;
-  }
-  au_vstep_in(v, l, x, h);
+/* lane L's run (or answer) opened since it last came here: its control, parameters and
+   tolerances into its lane of the answers' v and the checks' vc (`au_vrun`), and its state
+   into v (which then follows its accepted steps in place: `rk8_auto_lanes`) */
+static void au_vfresh(au_vio* v, au_vio* vc, au_lane* L) {
+  int i, l = L->lane;
+  if (!L->fresh) return;
+  au_vrun(v, l, &L->s);
+  au_vrun(vc, l, &L->s);
+  for (i = 0; i < PASS_NX; ++i) v->x[i][l] = L->s.x[i];
+  L->fresh = 0;
 }
 
 /* the check steps due in the lanes, in one vector step, when one of them cannot wait
@@ -1297,8 +1299,8 @@ static void au_checks(au_lane* L, au_vio* v, au_pend* P, au_vstep step, au_vstep
     if (use[l] && (s->rich[RI_PEND] > 0 || *s->t + 1.01 * s->h >= s->tend)) urgent = 1;
   }
   if (!any || !urgent) return;
-  for (l = 0; l < PASS_LANES; ++l)
-    if (use[l]) au_vlane(v, &L[l], L[l].s.rich + RI_X, L[l].s.due - L[l].s.rich[RI_T]);
+  for (l = 0; l < PASS_LANES; ++l)  /* (the runs' inputs in the lanes: `au_vfresh`) */
+    if (use[l]) au_vstep_in(v, l, L[l].s.rich + RI_X, L[l].s.due - L[l].s.rich[RI_T]);
   au_vcall(step, v, use);
   for (l = 0; l < PASS_LANES; ++l) {
     S[l] = &L[l].s; X[l] = L[l].s.XC; t[l] = 0; span[l][0] = span[l][1] = 0;
@@ -1373,19 +1375,20 @@ int rk8_auto_lanes(const casadi_real* w, int nout, const long long* runs, long l
                    const casadi_real* u, const casadi_real* p, casadi_real* X,
                    casadi_real* XC, casadi_real* res, void* vstep, void* vcont) {
   au_vstep step = (au_vstep) vstep, cont = (au_vstep) vcont;
-  au_vio v;
+  au_vio v, vc;  /* the answers' steps and the checks' */
   au_pend P;
   au_lane L[PASS_LANES];
-  casadi_real xn[PASS_NX], err, root, t[PASS_LANES], *XO[PASS_LANES];
+  au_lmask took;
+  casadi_real xn[PASS_NX], err, root, t[PASS_LANES], *XO[PASS_LANES], count;
   dense_state* S[PASS_LANES];
   int size = AU_SIZE(nout), plain = w[AU_TRIES] <= 0, use[PASS_LANES], span[PASS_LANES][2];
-  int l, any, taking = 1, handed = 0;
+  int l, i, any, taking = 1, handed = 0;
   long long k;
   double spent = 0;
   casadi_real* wk = (casadi_real*) malloc(sizeof(casadi_real) * size * PASS_LANES);
   if (!wk) return -1;
   memset(&P, 0, sizeof P);
-  v.filled = 0;
+  v.filled = vc.filled = 0;
   for (l = 0; l < PASS_LANES; ++l) {
     L[l].w = wk + (size_t) l * size;
     L[l].XC = XC + (size_t) l * PASS_NX * (nout + 1);
@@ -1408,27 +1411,35 @@ int rk8_auto_lanes(const casadi_real* w, int nout, const long long* runs, long l
     for (l = 0; l < PASS_LANES; ++l) any |= use[l] = L[l].k >= 0;
     if (!any) break;
     spent += PASS_LANES;
-    au_checks(L, &v, &P, step, cont, 0);
     for (l = 0; l < PASS_LANES; ++l)
-      if (use[l]) {
+      if (use[l]) au_vfresh(&v, &vc, &L[l]);
+    au_checks(L, &vc, &P, step, cont, 0);
+    for (l = 0; l < PASS_LANES; ++l)
+      if (use[l]) {  /* (a lane's x in v is its run's: `au_vfresh`, then the blend below) */
         dense_next(&L[l].s);
-        au_vlane(&v, &L[l], L[l].s.x, L[l].s.hs);
+        v.h[l] = L[l].s.hs;
+        v.filled |= 1 << l;
       }
     au_vcall(step, &v, use);
     any = 0;
     for (l = 0; l < PASS_LANES; ++l) {
       S[l] = &L[l].s; XO[l] = L[l].s.X; t[l] = 0; span[l][0] = span[l][1] = 0;
+      took[l] = 0;
       if (use[l]) {
         au_vget(&v, l, xn, &err, &root, NULL, 0);
         t[l] = *L[l].s.t;
+        count = L[l].s.count[0];
         L[l].ended = dense_take(&L[l].s, xn, err, root, NULL, NULL, span[l]) ||
                      L[l].s.j >= nout;
+        took[l] = L[l].s.count[0] != count ? -1 : 0;  /* (accepted: its state is xn) */
         any |= L[l].ended;
       }
     }
     au_extend(&P, cont, &v, span, t, S, XO);
+    for (i = 0; i < PASS_NX; ++i)  /* (each lane's next x, bit for bit: xn where accepted) */
+      v.x[i] = (au_vec) (((au_lmask) v.xn[i] & took) | ((au_lmask) v.x[i] & ~took));
     if (!any) continue;
-    au_checks(L, &v, &P, step, cont, 1);  /* (a run ends with its checks taken) */
+    au_checks(L, &vc, &P, step, cont, 1);  /* (a run ends with its checks taken) */
     au_flush(&P, cont);  /* (and its outputs filled) */
     for (l = 0; l < PASS_LANES; ++l)
       if (use[l] && L[l].ended) au_lane_next(&L[l], nout, res, plain);
