@@ -1272,14 +1272,17 @@ static void au_extend(au_pend* P, au_vstep vcont, au_vio* v, int (*span)[2],
 }
 
 /* lane L's run (or answer) opened since it last came here: its control, parameters and
-   tolerances into its lane of the answers' v and the checks' vc (`au_vrun`), and its state
-   into v (which then follows its accepted steps in place: `rk8_auto_lanes`) */
+   tolerances into its lane of the answers' v and the checks' vc (`au_vrun`), its state
+   into v and its check's into vc (each then follows its steps in place: `rk8_auto_lanes`,
+   `au_checks`) */
 static void au_vfresh(au_vio* v, au_vio* vc, au_lane* L) {
   int i, l = L->lane;
   if (!L->fresh) return;
   au_vrun(v, l, &L->s);
   au_vrun(vc, l, &L->s);
   for (i = 0; i < PASS_NX; ++i) v->x[i][l] = L->s.x[i];
+  if (L->s.rich)
+    for (i = 0; i < PASS_NX; ++i) vc->x[i][l] = L->s.rich[RI_X + i];
   L->fresh = 0;
 }
 
@@ -1291,7 +1294,8 @@ static void au_checks(au_lane* L, au_vio* v, au_pend* P, au_vstep step, au_vstep
                       int all) {
   casadi_real xn[PASS_NX], err, root, t[PASS_LANES], *X[PASS_LANES];
   dense_state* S[PASS_LANES];
-  int use[PASS_LANES], span[PASS_LANES][2], l, any = 0, urgent = all;
+  au_lmask took;
+  int use[PASS_LANES], span[PASS_LANES][2], l, i, any = 0, urgent = all;
   for (l = 0; l < PASS_LANES; ++l) {
     dense_state* s = &L[l].s;
     use[l] = L[l].k >= 0 && L[l].opened && s->check_due;
@@ -1299,11 +1303,15 @@ static void au_checks(au_lane* L, au_vio* v, au_pend* P, au_vstep step, au_vstep
     if (use[l] && (s->rich[RI_PEND] > 0 || *s->t + 1.01 * s->h >= s->tend)) urgent = 1;
   }
   if (!any || !urgent) return;
-  for (l = 0; l < PASS_LANES; ++l)  /* (the runs' inputs in the lanes: `au_vfresh`) */
-    if (use[l]) au_vstep_in(v, l, L[l].s.rich + RI_X, L[l].s.due - L[l].s.rich[RI_T]);
+  for (l = 0; l < PASS_LANES; ++l)  /* (the runs' inputs and states: `au_vfresh`) */
+    if (use[l]) {
+      v->h[l] = L[l].s.due - L[l].s.rich[RI_T];
+      v->filled |= 1 << l;
+    }
   au_vcall(step, v, use);
   for (l = 0; l < PASS_LANES; ++l) {
     S[l] = &L[l].s; X[l] = L[l].s.XC; t[l] = 0; span[l][0] = span[l][1] = 0;
+    took[l] = use[l] ? -1 : 0;
     if (use[l]) {
       au_vget(v, l, xn, &err, &root, NULL, 0);
       t[l] = L[l].s.rich[RI_T];
@@ -1311,6 +1319,8 @@ static void au_checks(au_lane* L, au_vio* v, au_pend* P, au_vstep step, au_vstep
     }
   }
   au_extend(P, vcont, v, span, t, S, X);
+  for (i = 0; i < PASS_NX; ++i)  /* (a check step is never rejected: its lane's next x) */
+    v->x[i] = (au_vec) (((au_lmask) v->xn[i] & took) | ((au_lmask) v->x[i] & ~took));
 }
 
 /* lane L's run in progress opened as `au_step` opens it (a retried answer with its check,
