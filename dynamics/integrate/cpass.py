@@ -635,6 +635,14 @@ static void au_vstep_in(au_vio* v, int l, const casadi_real* x, casadi_real h) {
   v->filled |= 1 << l;
 }
 
+/* the lanes `took` (all bits set) of the vector step in v start their next step where it
+   ended: x = xn there, bit for bit (the others keep x) */
+static void au_vkeep(au_vio* v, au_lmask took) {
+  int i;
+  for (i = 0; i < PASS_NX; ++i)
+    v->x[i] = (au_vec) (((au_lmask) v->xn[i] & took) | ((au_lmask) v->x[i] & ~took));
+}
+
 /* the vector step of the lanes `use`; a lane not in use computes the inputs it last held
    (a step's: finite values, read by nobody), or, never filled, those of the first in use */
 static void au_vcall(au_vstep step, au_vio* v, const int* use) {
@@ -694,12 +702,15 @@ static void au_vget(const au_vio* v, int l, casadi_real* xn, casadi_real* err,
    step, so a checked run costs one vector step per answer step (about one scalar step)
    where `dense_advance` takes one and a half; the same bits. 1 when the run stops. */
 static int dense_advance_v(dense_state* s, au_vio* v, au_vstep step, au_vstep cont) {
-  casadi_real xn[PASS_NX], F[7 * PASS_NX], err, root;
-  int use[PASS_LANES], want[PASS_LANES], l, had = s->check_due;
-  for (l = 0; l < PASS_LANES; ++l) use[l] = want[l] = 0;
+  casadi_real xn[PASS_NX], F[7 * PASS_NX], err, root, count = s->count[0];
+  au_lmask took;
+  int use[PASS_LANES], want[PASS_LANES], l, had = s->check_due, stop;
+  for (l = 0; l < PASS_LANES; ++l) use[l] = want[l] = took[l] = 0;
   use[0] = 1; use[1] = had;
-  au_vstep_in(v, 0, s->x, s->hs);  /* (the run's inputs in lanes 0 and 1: `dense_run`) */
-  if (had) au_vstep_in(v, 1, s->rich + RI_X, s->due - s->rich[RI_T]);
+  /* (the run's inputs, the answer's state and the check's in lanes 0 and 1: `dense_run`) */
+  v->h[0] = s->hs;
+  if (had) v->h[1] = s->due - s->rich[RI_T];
+  v->filled |= use[1] ? 3 : 1;
   au_vcall(step, v, use);
   want[0] = v->err[0] <= 1.0 && dense_wants_k(s);
   want[1] = had && rich_wants_k(s);
@@ -707,9 +718,13 @@ static int dense_advance_v(dense_state* s, au_vio* v, au_vstep step, au_vstep co
   if (had) {  /* (the check's step due before this answer step) */
     au_vget(v, 1, xn, &err, &root, F, want[1]);
     rich_take(s, xn, err, NULL, F, NULL);
+    took[1] = -1;
   }
   au_vget(v, 0, xn, &err, &root, F, want[0]);
-  return dense_take(s, xn, err, root, NULL, want[0] ? F : NULL, NULL);
+  stop = dense_take(s, xn, err, root, NULL, want[0] ? F : NULL, NULL);
+  took[0] = s->count[0] != count ? -1 : 0;
+  au_vkeep(v, took);
+  return stop;
 }
 
 /* Steps of x (in/out) from time *t (in/out) towards ts[nout - 1], the outputs at the times
@@ -739,9 +754,12 @@ static int dense_run(casadi_real* x, casadi_real* t, casadi_real* hio, int nout,
   if (!dense_open(&s, x, t, *hio, nout, ts, u, p, rtol, atol, max_steps, X, ldx, count,
                   stiff_steps, rich, XC))
     return s.j;
-  if (rich && step) {  /* (the answer's lane 0 and its check's lane 1: one run's inputs) */
+  if (rich && step) {  /* (the answer's lane 0 and its check's lane 1: one run's inputs;
+                          their states, which then follow their steps: `dense_advance_v`) */
     au_vrun(&v, 0, &s);
     au_vrun(&v, 1, &s);
+    au_vstep_in(&v, 0, s.x, s.h);
+    au_vstep_in(&v, 1, rich + RI_X, s.h);
   }
   while (s.j < nout && budget-- > 0) {
     dense_next(&s);
@@ -1319,8 +1337,7 @@ static void au_checks(au_lane* L, au_vio* v, au_pend* P, au_vstep step, au_vstep
     }
   }
   au_extend(P, vcont, v, span, t, S, X);
-  for (i = 0; i < PASS_NX; ++i)  /* (a check step is never rejected: its lane's next x) */
-    v->x[i] = (au_vec) (((au_lmask) v->xn[i] & took) | ((au_lmask) v->x[i] & ~took));
+  au_vkeep(v, took);  /* (a check step is never rejected) */
 }
 
 /* lane L's run in progress opened as `au_step` opens it (a retried answer with its check,
@@ -1446,8 +1463,7 @@ int rk8_auto_lanes(const casadi_real* w, int nout, const long long* runs, long l
       }
     }
     au_extend(&P, cont, &v, span, t, S, XO);
-    for (i = 0; i < PASS_NX; ++i)  /* (each lane's next x, bit for bit: xn where accepted) */
-      v.x[i] = (au_vec) (((au_lmask) v.xn[i] & took) | ((au_lmask) v.x[i] & ~took));
+    au_vkeep(&v, took);  /* (each lane's next x: xn where accepted) */
     if (!any) continue;
     au_checks(L, &vc, &P, step, cont, 1);  /* (a run ends with its checks taken) */
     au_flush(&P, cont);  /* (and its outputs filled) */
