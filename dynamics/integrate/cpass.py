@@ -1223,18 +1223,41 @@ typedef struct {
   int j0[PASS_LANES], j1[PASS_LANES], ldx[PASS_LANES];
 } au_pend;
 
+/* `dense_fill` of every lane of v at once, from its extension in v->F: lane l's outputs
+   ts[l][j0[l]] ... ts[l][j1[l] - 1] inside its step of v->h[l] from (t[l], v->x lane l)
+   into X[l] (nx, ldx[l]); the vectors read whole, each lane `dense_fill`'s arithmetic in
+   its order (the same bits); a lane with j1 <= j0 has none */
+static void au_vfill(const au_vio* v, const casadi_real* t, const casadi_real* const* ts,
+                     const int* j0, const int* j1, casadi_real* const* X, const int* ldx) {
+  au_vec sv, r;
+  int l, i, k, most = 0;
+  for (l = 0; l < PASS_LANES; ++l)
+    if (j1[l] - j0[l] > most) most = j1[l] - j0[l];
+  for (k = 0; k < most; ++k) {
+    for (l = 0; l < PASS_LANES; ++l)
+      sv[l] = k < j1[l] - j0[l] ? (ts[l][j0[l] + k] - t[l]) / v->h[l] : 0.0;
+    for (i = 0; i < PASS_NX; ++i) {
+      r = v->F[5 * PASS_NX + i] + sv * v->F[6 * PASS_NX + i];
+      r = v->F[4 * PASS_NX + i] + (1 - sv) * r;
+      r = v->F[3 * PASS_NX + i] + sv * r;
+      r = v->F[2 * PASS_NX + i] + (1 - sv) * r;
+      r = v->F[PASS_NX + i] + sv * r;
+      r = v->F[i] + (1 - sv) * r;
+      r = v->x[i] + sv * r;
+      for (l = 0; l < PASS_LANES; ++l)
+        if (k < j1[l] - j0[l]) X[l][i * ldx[l] + j0[l] + k] = r[l];
+    }
+  }
+}
+
 /* the extension of slots 0 ... n - 1 in one vector call, their outputs filled (the other
    lanes compute what they last held: finite values, read by nobody) */
 static void au_flush(au_pend* P, au_vstep vcont) {
-  casadi_real x[PASS_NX], F[7 * PASS_NX];
-  int q, i;
+  int q;
   if (!P->n) return;
   au_vext(vcont, &P->v);
-  for (q = 0; q < P->n; ++q) {
-    for (i = 0; i < PASS_NX; ++i) x[i] = P->v.x[i][q];
-    for (i = 0; i < 7 * PASS_NX; ++i) F[i] = P->v.F[i][q];
-    dense_fill(x, F, P->t[q], P->v.h[q], P->ts[q], P->j0[q], P->j1[q], P->X[q], P->ldx[q]);
-  }
+  for (q = P->n; q < PASS_LANES; ++q) P->j0[q] = P->j1[q] = 0;  /* (slots not in use) */
+  au_vfill(&P->v, P->t, P->ts, P->j0, P->j1, P->X, P->ldx);
   P->n = 0;
 }
 
@@ -1272,8 +1295,8 @@ static void au_defer(au_pend* P, au_vstep vcont, const au_vio* v, int l, const d
    P (`au_defer`); the same bits either way (each lane its own arithmetic) */
 static void au_extend(au_pend* P, au_vstep vcont, au_vio* v, int (*span)[2],
                       const casadi_real* t, dense_state* const* S, casadi_real* const* X) {
-  casadi_real x[PASS_NX], F[7 * PASS_NX];
-  int l, i, n = 0;
+  const casadi_real* ts[PASS_LANES];
+  int l, n = 0, j0[PASS_LANES], j1[PASS_LANES], ldx[PASS_LANES];
   for (l = 0; l < PASS_LANES; ++l) n += span[l][1] > span[l][0];
   if (n < AU_DIRECT) {
     for (l = 0; l < PASS_LANES; ++l)
@@ -1281,12 +1304,10 @@ static void au_extend(au_pend* P, au_vstep vcont, au_vio* v, int (*span)[2],
     return;
   }
   au_vext(vcont, v);
-  for (l = 0; l < PASS_LANES; ++l)
-    if (span[l][1] > span[l][0]) {
-      for (i = 0; i < PASS_NX; ++i) x[i] = v->x[i][l];
-      for (i = 0; i < 7 * PASS_NX; ++i) F[i] = v->F[i][l];
-      dense_fill(x, F, t[l], v->h[l], S[l]->ts, span[l][0], span[l][1], X[l], S[l]->ldx);
-    }
+  for (l = 0; l < PASS_LANES; ++l) {
+    ts[l] = S[l]->ts; j0[l] = span[l][0]; j1[l] = span[l][1]; ldx[l] = S[l]->ldx;
+  }
+  au_vfill(v, t, ts, j0, j1, X, ldx);
 }
 
 /* lane L's run (or answer) opened since it last came here: its control, parameters and
