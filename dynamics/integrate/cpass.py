@@ -1315,13 +1315,12 @@ static void au_extend(au_pend* P, au_vstep vcont, au_vio* v, int (*span)[2],
    into v and its check's into vc (each then follows its steps in place: `rk8_auto_lanes`,
    `au_checks`) */
 static void au_vfresh(au_vio* v, au_vio* vc, au_lane* L) {
-  int i, l = L->lane;
+  int l = L->lane;
   if (!L->fresh) return;
   au_vrun(v, l, &L->s);
   au_vrun(vc, l, &L->s);
-  for (i = 0; i < PASS_NX; ++i) v->x[i][l] = L->s.x[i];
-  if (L->s.rich)
-    for (i = 0; i < PASS_NX; ++i) vc->x[i][l] = L->s.rich[RI_X + i];
+  au_vstep_in(v, l, L->s.x, L->s.h);
+  if (L->s.rich) au_vstep_in(vc, l, L->s.rich + RI_X, L->s.h);
   L->fresh = 0;
 }
 

@@ -410,6 +410,9 @@ def dense_many(model, x0: np.ndarray, t: np.ndarray, u: np.ndarray, p: np.ndarra
     nout, K = t.size - 1, len(x0)
     index = np.arange(K, dtype=np.int64)[runs] if isinstance(runs, slice) else \
         np.ascontiguousarray(runs, dtype=np.int64)
+    if index.size and not (0 <= index.min() and index.max() < K):  # (C reads these rows)
+        raise ValueError(f"`runs` must index the {K} rows of `x0`, got indices from "
+                         f"{index.min()} to {index.max()}")
     if out is None:
         X, head = np.empty((K, plan.nx, nout + 1)), np.empty((K, HEADER))
         if dense_many(model, x0, t, u, p, rtol, atol, max_steps, stiff_steps, index,

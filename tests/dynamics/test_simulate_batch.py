@@ -492,3 +492,16 @@ def test_a_constant_control_rk8_batch_is_one_c_loop_matching_single_runs(monkeyp
         np.testing.assert_allclose(res.x[:, :, k], one, rtol=0, atol=1e-13)
         w = torque_free_omega(INERTIA, x0[4:, k], t)
         assert np.max(np.abs(res.x[4:, :, k] - w)) < 1e-9
+
+
+def test_dense_loops_refuse_runs_outside_the_batch():
+    """`dense.dense_many` hands its ``runs`` to compiled loops that read those rows: an
+    index outside ``x0`` is a ValueError naming ``runs``, not a read past the array."""
+    from appdyn.dynamics.integrate import dense
+
+    model, t = rigid_body(INERTIA), np.linspace(0.0, 1.0, 3)
+    x0 = np.ascontiguousarray(_rates(3)[1].T)
+    for runs in ([0, 3], [-1]):
+        with pytest.raises(ValueError, match="`runs`"):
+            dense.dense_many(model, x0, t, np.zeros((3, 3)), np.zeros((3, 1)), 1e-8,
+                             np.full(7, 1e-10), 1e8, 1e6, runs)
