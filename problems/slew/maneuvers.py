@@ -30,7 +30,7 @@ from .targets import (ARCSEC, MIN_REFINE_TOL, POINTING_TOL, RATE_TOL, STATUS_POI
                       STATUS_REFINE, check_tol)
 
 __all__ = ["time_optimal", "min_effort", "verify", "bounded", "DEFAULT_STARTS_TIME",
-           "DEFAULT_STARTS_EFFORT", "POLISH_MIN_BUDGET", "SEED_OPTIONS", "RACE_N", "RACE_AGREE",
+           "DEFAULT_STARTS_EFFORT", "POLISH_ITER_FACTOR", "POLISH_MIN_ITER", "SEED_OPTIONS", "RACE_N", "RACE_AGREE",
            "RACE_IPOPT", "BOUNDED_ITER_FACTOR", "BOUNDED_MIN_ITER", "START_BUDGET",
            "BOUNDED_TOL_FACTOR", "minimum_time_text", "restarted",
            "with_minimum_time"]
@@ -210,15 +210,16 @@ def time_optimal(inertia, *, angle=None, axis=None, q0=None, qf=None, u_max=1.0,
         zero): the arc durations are solved for directly (``'switch-times'``: a few IPOPT
         iterations, ``T`` exact to about 1e-12 s; 3 iterations on Bilimoria-Wie; should that
         fail, the moving-knot re-solve at Radau degree 5 within what is left of the budget).
-        The polish has a wall-time budget: the first solve's wall time (all starts), at
-        least `POLISH_MIN_BUDGET` = 0.5 s. A first solution that is not bang-bang (a
+        Each NLP of the polish has an iteration budget: `POLISH_ITER_FACTOR` = 10 times the
+        first solution's IPOPT iterations, at least `POLISH_MIN_ITER` = 200 (``max_iter`` of
+        ``ipopt_options`` wins), so the answer does not depend on the machine's load. A first solution that is not bang-bang (a
         singular arc) is not polished (the moving-knot re-solve took 6-70 s there, 20-200
         times the first solve, and was rarely kept). The polished result is returned only
         if it is verified and not slower than the first (a switch-time result may be slower
         by 1e-4 relative: the first's fixed mesh can put T below the exact optimum by its
         discretization error); otherwise the first solution. ``info['polish']`` records
-        what happened: ``ran``, ``used``, ``why``, ``method``, ``wall_time`` and ``budget``
-        [s], ``T_before``, ``T_polished``, ``T_after`` [s] and ``gain`` (``T_before -
+        what happened: ``ran``, ``used``, ``why``, ``method``, ``wall_time`` [s], ``budget``
+        (IPOPT iterations per NLP), ``T_before``, ``T_polished``, ``T_after`` [s] and ``gain`` (``T_before -
         T_after`` [s] when used, else 0); the message ends with the same in words
         (`polish_text`) and ``info['wall_time']`` is the wall time of the whole call. Should
         neither be verified (the first's fixed mesh can smear the switches beyond
@@ -448,10 +449,15 @@ EIGENAXIS_START = {"hessian_approximation": "limited-memory", "max_iter": 20}
 _EXACT_SLACK = 1e-4
 
 
-#: Least wall-time budget [s] of the switch-time polish of `solve_time_optimal` (its budget
-#: is the wall time of the first solve, multi-start included, or this if more): building
-#: the switch-time NLP of a new structure takes 0.1-0.5 s the first time (measured).
-POLISH_MIN_BUDGET = 0.5
+#: IPOPT iteration budget of each NLP of the switch-time polish of `solve_time_optimal`
+#: (`ocp.polish_switches`: the switch-time NLP, then should it fail the moving-knot
+#: re-solve): this many times the first solution's iterations, at least `POLISH_MIN_ITER`
+#: (the user's ``max_iter`` wins). A budget in iterations, not in seconds: the pipeline's
+#: answer is the same on a loaded machine (it once had the first solve's wall time, at least
+#: 0.5 s, which the first build of a new structure's NLP could spend under load, and the
+#: unpolished T came back). Bilimoria-Wie's polish takes 3 iterations.
+POLISH_ITER_FACTOR = 10
+POLISH_MIN_ITER = 200
 
 #: Intervals of the coarse race of `time_optimal`'s seeded starts (`_raced`): every start
 #: is solved on this mesh, only the best again on ``N`` (warm from it). Measured at N = 30
@@ -495,7 +501,7 @@ def _labelled_starts(start_options, n: int, verbose):
 def _polish_record(ran: bool, why: str, *, wall_time=0.0, budget=None, method=None,
                    T_before=None, T_polished=None, T_after=None, used=False) -> dict:
     """``info['polish']`` of `solve_time_optimal`: whether the polish ran and was used,
-    why, its wall time and budget [s], ``T`` before, of the polished result and after
+    why, its wall time [s] and iteration budget (per NLP), ``T`` before, of the polished result and after
     (the polished one when used, else the first's) [s], and the gain ``T_before - T_after``
     [s] (0 when not used)."""
     gain = float(T_before) - float(T_after) if used else 0.0
@@ -535,23 +541,25 @@ def _fine(problem, coarse, opts):
         f"{keep['best']}, re-solved on {fine.mesh.N}; {fine.message}"))
 
 
-def _polish(problem, seed, opts, *, budget, verbose, ipopt_options, ptol, rtol,
-            method="auto"):
+def _polish(problem, seed, opts, *, verbose, ipopt_options, ptol, rtol, method="auto"):
     """``(polished and verified, record fields)``: `ocp.polish_switches` of ``seed`` (Radau
-    degree 5 for the moving knots; IPOPT tol 1e-9 unless ``ipopt_options`` says otherwise)
-    within ``budget`` [s]."""
+    degree 5 for the moving knots; IPOPT tol 1e-9 unless ``ipopt_options`` says otherwise),
+    each of its NLPs within the iteration budget `POLISH_ITER_FACTOR` x ``seed``'s
+    iterations, at least `POLISH_MIN_ITER` (the record's ``budget``)."""
     # a bang-bang first solution: switch-time optimization (arc durations only, RK8 shooting;
     # Bilimoria-Wie: 3 IPOPT iterations, T = 3.2430832775, re-simulated pointing error 8e-10
     # rad). Otherwise the moving-knot fallback, at degree 5: at degree 3 the ~4 intervals per
     # arc under-resolve the states and the free knots exploit the collocation error (T below
     # the best known); at degree 4 the re-simulated pointing error of Bilimoria-Wie is 4e-7
     # rad, at degree 5 3e-10 (measured)
-    polish_opts = {"tol": 1e-9, **(ipopt_options or {})}
+    polish_opts, budget = iteration_budget({"tol": 1e-9, **(ipopt_options or {})},
+                                           seed.iterations, POLISH_ITER_FACTOR,
+                                           minimum=POLISH_MIN_ITER)
     pscale = None if opts["scale"] is None else {"objective": opts["scale"]["objective"],
                                                  "t_clock": opts["scale"]["T"]}
     t_polish = time.perf_counter()
     polished = polish_switches(problem, seed, degree=5, verbose=verbose, ipopt_options=polish_opts,
-                               scale=pscale, budget=budget, method=method)
+                               scale=pscale, method=method)
     polished = verify(polished, pointing_tol=ptol, rate_tol=rtol)
     ran = dict(wall_time=time.perf_counter() - t_polish, budget=budget,
                method=polished.info.get("method"), T_before=float(seed.T),
@@ -575,8 +583,10 @@ def solve_time_optimal(problem, guess, guesses, opts, *, polish, pointing_tol, r
     (`_refined_fallback`). ``opts`` are `ocp.solve` keywords.
 
     The polish runs only when the first solution is bang-bang (`ocp.refine.arcs.bang_arcs`,
-    a few samples: decided before anything is built), within a wall-time budget of the first
-    solve's wall time (at least `POLISH_MIN_BUDGET`). The result records it in
+    a few samples: decided before anything is built), each of its NLPs within an iteration
+    budget (`POLISH_ITER_FACTOR` times the first solution's IPOPT iterations, at least
+    `POLISH_MIN_ITER`; a budget in iterations gives the same answer on any load). The
+    result records it in
     ``info['polish']`` (`_polish_record`: ran, used, why, method, wall_time, budget,
     T_before, T_polished, T_after, gain) and in its message (`polish_text`);
     ``info['wall_time']`` is the wall time of the whole pipeline [s]. With ``verbose`` the
@@ -599,8 +609,7 @@ def solve_time_optimal(problem, guess, guesses, opts, *, polish, pointing_tol, r
         coarse = _race(problem, guesses, opts, start_options, race_N)
         arcs = None if not (polish and coarse is not None) else bang_arcs(coarse)[0]
         if arcs is not None:
-            budget = max(time.perf_counter() - t_start, POLISH_MIN_BUDGET)
-            polished, ran = _polish(problem, coarse, opts, budget=budget, verbose=verbose,
+            polished, ran = _polish(problem, coarse, opts, verbose=verbose,
                                     ipopt_options=ipopt_options, ptol=ptol, rtol=rtol,
                                     method="switch-times")
             if polished.success and polished.T <= coarse.T * (1.0 + WORSE_SLACK):
@@ -611,7 +620,6 @@ def solve_time_optimal(problem, guess, guesses, opts, *, polish, pointing_tol, r
         sol = solve_multistart(problem, guesses, start_options=_labelled_starts(
             start_options, len(guesses), opts.get("verbose")), start_budget=START_BUDGET,
             **opts)
-    t_main = time.perf_counter() - t_start
     first = sol
     arcs, not_bang = (None, "") if not (polish and first.success) else bang_arcs(first)
     if arcs is None:
@@ -621,8 +629,7 @@ def solve_time_optimal(problem, guess, guesses, opts, *, polish, pointing_tol, r
                                 ptol, rtol, ipopt_options, opts["scale"])
         return _finish(out, _polish_record(False, why, T_before=float(first.T),
                                            T_after=float(first.T)), t_start)
-    polished, ran = _polish(problem, sol, opts, budget=max(t_main, POLISH_MIN_BUDGET),
-                            verbose=verbose, ipopt_options=ipopt_options, ptol=ptol, rtol=rtol)
+    polished, ran = _polish(problem, sol, opts, verbose=verbose, ipopt_options=ipopt_options, ptol=ptol, rtol=rtol)
     # switch times are integrated to ~1e-13 while a fixed-mesh T can sit below the exact
     # optimum by its discretization error (J = diag(1, 2, 3), 1 rad: 2.2075331 against
     # 2.2075385, 2.4e-6 relative), so an exact polish may come out a hair slower and is kept

@@ -81,8 +81,8 @@ def polish_text(record: Mapping) -> str:
     ----------
     record : mapping
         ``info['polish']`` of a time-optimal slew: ``ran``, ``why`` and, when it ran,
-        ``used``, ``method``, ``wall_time`` [s], ``budget`` [s], ``T_before``, ``T_after``
-        [s], ``gain`` [s].
+        ``used``, ``method``, ``wall_time`` [s], ``budget`` (IPOPT iterations per NLP),
+        ``T_before``, ``T_after`` [s], ``gain`` [s].
 
     Returns
     -------
@@ -111,8 +111,8 @@ def polish_text(record: Mapping) -> str:
         raise ValueError(f"`record` lacks {missing}: pass a time-optimal slew's info['polish']")
     if not record["ran"]:
         return f"polish skipped: {record['why']}"
-    head = (f"polish ({record.get('method') or 'none'}, {record['wall_time']:.3g} s of a "
-            f"{record['budget']:.3g} s budget)")
+    head = (f"polish ({record.get('method') or 'none'}, {record['wall_time']:.3g} s, at most "
+            f"{record['budget']} IPOPT iterations per NLP)")
     if record.get("used"):
         return (f"{head}: T {record['T_before']:.10g} -> {record['T_after']:.10g} s, gain "
                 f"{record['gain']:.3g} s")

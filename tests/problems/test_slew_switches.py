@@ -92,9 +92,33 @@ def test_polish_record_of_a_bang_bang_slew(bilimoria_wie):
     assert record["ran"] and record["used"] and record["method"] == "switch-times"
     assert record["T_after"] == sol.T and abs(sol.T - 3.2430833) < 1e-6
     assert record["gain"] == pytest.approx(record["T_before"] - sol.T, abs=1e-15)
-    assert record["budget"] >= 0.5 and record["wall_time"] <= record["budget"] + 2.0
+    # an iteration budget per NLP (the same answer on any load): at least POLISH_MIN_ITER
+    from appdyn.problems.slew.maneuvers import POLISH_ITER_FACTOR, POLISH_MIN_ITER
+    first = sol.info["race"]["iterations"] if "race" in sol.info else None
+    assert isinstance(record["budget"], int) and record["budget"] >= POLISH_MIN_ITER
+    assert first is None or record["budget"] <= max(POLISH_MIN_ITER, POLISH_ITER_FACTOR * first)
+    assert f"at most {record['budget']} IPOPT iterations per NLP" in sol.message
     assert sol.info["wall_time"] >= record["wall_time"]
     assert "polish (switch-times" in sol.message and "gain" in sol.message
+
+
+def test_the_polish_stops_at_its_iteration_budget(monkeypatch):
+    """A budget of 2 IPOPT iterations per NLP (Bilimoria-Wie's switch-time NLP needs 3):
+    the polish runs, is not used, and the first solution comes back as `polish=False`
+    gives it, the record and the message naming the budget. The budget counts iterations,
+    not seconds, so this is the answer on any load."""
+    from appdyn.problems.slew import maneuvers
+
+    monkeypatch.setattr(maneuvers, "POLISH_MIN_ITER", 2)
+    monkeypatch.setattr(maneuvers, "POLISH_ITER_FACTOR", 0)
+    kw = dict(angle=np.pi, axis=[0, 0, 1], u_max=1.0, N=10, starts=1)
+    plain = slew.time_optimal(np.eye(3), polish=False, **kw)
+    sol = slew.time_optimal(np.eye(3), **kw)
+    record = sol.info["polish"]
+    assert plain.success and sol.success, sol.message
+    assert record["ran"] and not record["used"] and record["budget"] == 2
+    assert sol.T == plain.T and record["gain"] == 0.0
+    assert "at most 2 IPOPT iterations per NLP" in sol.message
 
 
 # ------------------------------------------------------------------ the coarse race

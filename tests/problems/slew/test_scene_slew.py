@@ -41,22 +41,25 @@ def test_bilimoria_wie_through_slew(bilimoria_wie):
 
 @pytest.mark.slow
 def test_dispatch_equals_time_optimal():
-    """Compared unpolished: the polish runs within a wall-time budget, so a polished T may
-    depend on the machine's load (Bilimoria-Wie unpolished at N = 30: 3.24391)."""
-    sol = slew(rigid(), angle=np.pi, axis=[0, 0, 1], polish=False)
-    old = pkg.time_optimal(np.eye(3), angle=np.pi, axis=[0, 0, 1], u_max=1.0, polish=False)
-    assert sol.success and old.success and sol.info["engine"] == "time_optimal"
-    assert abs(sol.T - old.T) <= 1e-9
-    assert BW_T < sol.T < BW_T + 1e-3
+    """Polished and unpolished alike (the polish's budget is in IPOPT iterations: the same
+    answer on any load; Bilimoria-Wie unpolished at N = 30: 3.24391)."""
+    for polish in (False, True):
+        sol = slew(rigid(), angle=np.pi, axis=[0, 0, 1], polish=polish)
+        old = pkg.time_optimal(np.eye(3), angle=np.pi, axis=[0, 0, 1], u_max=1.0, polish=polish)
+        assert sol.success and old.success and sol.info["engine"] == "time_optimal"
+        assert abs(sol.T - old.T) <= 1e-9
+        if polish:  # (the switch times exact: Bilimoria-Wie's 3.2430832775 s)
+            assert abs(sol.T - 3.2430832775) < 1e-9 and sol.info["polish"]["used"]
+        else:
+            assert BW_T < sol.T < BW_T + 1e-3
 
 
 @pytest.mark.slow
 def test_target_as_q_final_is_the_same_slew():
     q = [0.0, 0.0, math.sin(0.05), math.cos(0.05)]  # 0.1 rad about z
     for scene in (rigid(), HELD0):
-        # unpolished: the polish runs within a wall-time budget (T moves ~2e-8 with load)
-        by_angle = slew(scene, angle=0.1, axis=[0, 0, 1], N=10, starts=1, polish=False)
-        by_q = slew(scene, q_final=q, N=10, starts=1, polish=False)
+        by_angle = slew(scene, angle=0.1, axis=[0, 0, 1], N=10, starts=1)
+        by_q = slew(scene, q_final=q, N=10, starts=1)
         assert by_angle.success and by_q.success
         assert abs(by_q.T - by_angle.T) <= 1e-9
 
@@ -74,15 +77,18 @@ def test_dispatch_equals_min_effort_and_its_closed_form():
 
 def test_dispatch_to_wheel_slew_time_optimal():
     """Three wheels at zero total momentum: I w' = -tau, the rigid bang-bang 2 sqrt(0.2).
-    (Not compared with `wheel_slew` to 1e-9: the switch-time polish runs within a wall-time
-    budget, 0.5 s here, which the first build of its NLP can exceed on a loaded machine --
-    then the unpolished constant-control result, T 2.3e-8 above, is returned; the
-    minimum-effort dispatch below has no budget and is compared exactly.)"""
+    Compared with `wheel_slew` to 1e-9: the switch-time polish's budget is in IPOPT
+    iterations, so both polish alike on any load (under a wall-time budget of 0.5 s a
+    loaded machine could spend it on the first build of the NLP and return the unpolished
+    result, T 2.3e-8 above)."""
     scene = Scene(RigidHub(np.eye(3)), ReactionWheels(np.eye(3), 0.01, u_max=1.0))
     sol = slew(scene, angle=0.2, axis=[0, 0, 1], N=10, starts=1)
     assert sol.success, sol.message
     assert sol.info["engine"] == "wheel_slew" and "momentum_drift" in sol.info
     assert sol.T == pytest.approx(2 * math.sqrt(0.2), rel=1e-6)
+    old = pkg.wheel_slew(np.eye(3), np.eye(3), 0.01, angle=0.2, axis=[0, 0, 1], N=10, starts=1)
+    assert old.success and abs(sol.T - old.T) <= 1e-9
+    assert sol.info["polish"]["used"] == old.info["polish"]["used"]
 
 
 def test_wheel_dispatch_passes_initial_speeds_and_speed_limit():
