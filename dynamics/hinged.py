@@ -568,19 +568,20 @@ def two_body_state(scene) -> ca.Function:
         raise ValueError("`scene` must be a hinged_scene: a hub with `mass` (reference at its "
                          f"mass centre) and one HingedPanel, got {scene!r}")
     panel, model = parts[0], scene.model()
-    x = ca.SX.sym("x", model.nx)
-    hub_lay, lay = model.layout["hub"], model.layout[scene.part_names[0]]
-    names = model.states
-    q, w = x[hub_lay.coords], x[hub_lay.speeds]
-    r = x[names.index("r1"):names.index("r3") + 1]
-    v = x[names.index("v1"):names.index("v3") + 1]
-    own = SimpleNamespace(coords=x[lay.coords], speeds=x[lay.speeds])
-    R, w_rel = panel.attitude(own)
-    p = own.coords if not panel.revolute else quat_from_axis_angle(ca.DM(panel.axis),
-                                                                   own.coords[0])
-    arm = ca.mtimes(R, ca.DM(panel.cm_offset))
-    rho = ca.DM(panel.hinge_point) + arm
-    v2 = v + ca.cross(w, rho) + ca.cross(w_rel, arm)
-    x2 = ca.vertcat(q, w, v, r, quat_mul(p, q), ca.mtimes(R.T, w + w_rel), ca.mtimes(R.T, v2),
-                    r + ca.mtimes(dcm_from_quat(q).T, rho))
-    return ca.Function("two_body_state", [x], [x2], ["x"], ["x2"])
+    with cache.construction_lock():  # (casadi construction: one thread at a time)
+        x = ca.SX.sym("x", model.nx)
+        hub_lay, lay = model.layout["hub"], model.layout[scene.part_names[0]]
+        names = model.states
+        q, w = x[hub_lay.coords], x[hub_lay.speeds]
+        r = x[names.index("r1"):names.index("r3") + 1]
+        v = x[names.index("v1"):names.index("v3") + 1]
+        own = SimpleNamespace(coords=x[lay.coords], speeds=x[lay.speeds])
+        R, w_rel = panel.attitude(own)
+        p = own.coords if not panel.revolute else quat_from_axis_angle(ca.DM(panel.axis),
+                                                                       own.coords[0])
+        arm = ca.mtimes(R, ca.DM(panel.cm_offset))
+        rho = ca.DM(panel.hinge_point) + arm
+        v2 = v + ca.cross(w, rho) + ca.cross(w_rel, arm)
+        x2 = ca.vertcat(q, w, v, r, quat_mul(p, q), ca.mtimes(R.T, w + w_rel), ca.mtimes(R.T, v2),
+                        r + ca.mtimes(dcm_from_quat(q).T, rho))
+        return ca.Function("two_body_state", [x], [x2], ["x"], ["x2"])

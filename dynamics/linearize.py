@@ -337,12 +337,14 @@ def error_dynamics(model: Model, q_ref, w_ref) -> ca.Function:
     model = check_model(model)
     if model.attitude is None:
         raise ValueError(f"`model` {model.name!r} has no attitude (model.attitude is None)")
-    xr = ca.SX.sym("xr", model.nx - 1)
-    u = ca.SX.sym("u", model.nu)
-    p = ca.SX.sym("p", model.np)
-    xrdot = _error_expression(model, xr, u, p, ca.DM(np.asarray(q_ref, dtype=float)),
-                              ca.DM(np.asarray(w_ref, dtype=float)))
-    return ca.Function(f"{model.name}_error", [xr, u, p], [xrdot], ["xr", "u", "p"], ["xrdot"])
+    with cache.construction_lock():  # (casadi construction: one thread at a time)
+        xr = ca.SX.sym("xr", model.nx - 1)
+        u = ca.SX.sym("u", model.nu)
+        p = ca.SX.sym("p", model.np)
+        xrdot = _error_expression(model, xr, u, p, ca.DM(np.asarray(q_ref, dtype=float)),
+                                  ca.DM(np.asarray(w_ref, dtype=float)))
+        return ca.Function(f"{model.name}_error", [xr, u, p], [xrdot], ["xr", "u", "p"],
+                           ["xrdot"])
 
 
 def _jacobian_function(model: Model) -> ca.Function:
