@@ -16,7 +16,7 @@ import json
 import math
 from pathlib import Path
 
-__all__ = ["BEGIN", "END", "render", "update_page", "update_readme", "current", "format_value"]
+__all__ = ["BEGIN", "END", "GLANCE", "glance", "render", "update_page", "update_readme", "current", "format_value"]
 
 BEGIN = "<!-- bench:begin -->"
 END = "<!-- bench:end -->"
@@ -51,6 +51,63 @@ TITLES = {
     "flexible": "Flexible appendages: the four-antenna satellite's build and simulation, a "
                 "spin-up with and without geometric stiffening (`bench/flexible.py`)",
 }
+
+
+#: The page's first table, "At a glance": headline comparisons read from the rows of the
+#: tables below it (never typed in): ``(job, against, benchmark, test(case, metric))``; a
+#: job whose test matches several rows (workloads, meshes, error targets) shows their range.
+#: Ratios are the peer's time over appdyn's (> 1: appdyn faster) as in the tables.
+GLANCE = (
+    ("single run, `auto` (the default; its global error verified), at matched error",
+     "numbalsoda dop853", "integrate_peers",
+     lambda c, m: m == "speed-up vs numbalsoda dop853, interpolated at the target error"),
+    ("single run, `method='dop853'` (not verified, as the peer), at matched error",
+     "numbalsoda dop853", "integrate_peers", lambda c, m: m == (
+         "appdyn dop853 (not verified): speed-up vs numbalsoda dop853, interpolated at the "
+         "target error")),
+    ("1,000-run Monte Carlo at the defaults (every run verified), 1 thread",
+     "numbalsoda njit loop", "integrate_peers",
+     lambda c, m: "njit loop (one thread), defaults" in m and m.endswith("on 1 thread(s)")),
+    ("1,000-run Monte Carlo at the defaults (every run verified), 2 threads",
+     "numbalsoda njit loop", "integrate_peers",
+     lambda c, m: "njit loop (one thread), defaults" in m and m.endswith("on 2 thread(s)")),
+    ("1,000-run Monte Carlo, fixed-step rk8, 1 thread", "numbalsoda njit loop",
+     "integrate_peers", lambda c, m: "fixed-step rk8" in m and m.endswith("on 1 thread(s)")),
+    ("torque-free body, `auto`", "scipy DOP853", "simulate",
+     lambda c, m: m == "speed-up of auto vs scipy DOP853"),
+    ("every model with a truth, `auto`", "scipy", "workprecision",
+     lambda c, m: m == "speed-up of auto vs scipy"),
+    ("time-optimal slew (Bilimoria-Wie), at matched accuracy", "rockit", "slew",
+     lambda c, m: m == "speed-up vs rockit at matched accuracy"),
+    ("Delta III ascent to GTO, 4 phases", "ASSET", "ascent",
+     lambda c, m: m.startswith("ASSET") and "|u| = 1" not in m),
+    ("shuttle reentry (Betts), meshes of 32-128 segments", "ASSET", "literature",
+     lambda c, m: c.startswith("shuttle") and m.startswith("ASSET")),
+    ("orbit raising (Bryson & Ho), meshes of 20-160 segments", "ASSET", "literature",
+     lambda c, m: c.startswith("orbit raising") and m.startswith("ASSET")),
+    ("orbit raising and shuttle reentry", "rockit", "literature",
+     lambda c, m: m.startswith("rockit") and "/ appdyn" in m),
+    ("first `simulate` in a fresh process, the model compiled before", "", "compile_cache",
+     lambda c, m: "compiled before" in c and m == "wall time"),
+)
+
+
+def glance(rows: list[dict]) -> list[str]:
+    """The lines of the "At a glance" table (`GLANCE`) from the ``summary.csv`` rows; a job
+    without rows is left out (its benchmark not run)."""
+    lines = ["**At a glance** (read from the tables below; ratios are the peer's time over "
+             "appdyn's, > 1: appdyn faster)", "",
+             "| job | against | result | rows |", "| --- | --- | ---: | ---: |"]
+    for job, peer, bench, test in GLANCE:
+        got = [r for r in rows if r["benchmark"] == bench and test(r["case"], r["metric"])]
+        values = sorted(float(r["value"]) for r in got if math.isfinite(float(r["value"])))
+        if not values:
+            continue
+        unit = f" {got[0]['unit']}" if got[0].get("unit") else ""
+        text = format_value(values[0]) if len(values) == 1 else \
+            f"{format_value(values[0])} - {format_value(values[-1])}"
+        lines.append(f"| {_cell(job)} | {_cell(peer)} | {text}{unit} | {len(values)} |")
+    return lines if len(lines) > 4 else []
 
 
 def format_value(value: float) -> str:
@@ -93,6 +150,8 @@ def render(results_dir) -> str:
              f"casadi {m.get('casadi')}, numpy {m.get('numpy')}, scipy {m.get('scipy')}, "
              f"IPOPT linear solver {m.get('ipopt_linear_solver')}; "
              "regenerate with `make bench`."]
+    head = glance(rows)
+    lines += [""] + head if head else []
     names = list(dict.fromkeys(r["benchmark"] for r in rows))
     order = list(TITLES)
     names = sorted(names, key=lambda b: (order.index(b) if b in order else len(order),

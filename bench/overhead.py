@@ -20,6 +20,7 @@ import statistics
 import sys
 import time
 from pathlib import Path
+from types import SimpleNamespace
 
 import numpy as np
 
@@ -95,13 +96,15 @@ def dense_pass_call(model, x0, t):
             return fun(*args)
         return spy
 
-    real = dense._plan
-    dense._plan = lambda m: plan._replace(auto=spying(plan.auto), auto_v=spying(
-        plan.auto_v)) if m is model else real(m)
+    real, vector = dense._plan, plan.single[1]  # (the vector lanes, once loaded)
+    dense._plan = lambda m: plan._replace(auto=spying(plan.auto)) if m is model else real(m)
+    if vector is not None:
+        plan.single[1] = SimpleNamespace(address=vector.address, cont=vector.cont,
+                                         auto_v=spying(vector.auto_v))
     try:
         res = simulate(model, x0, t)
     finally:
-        dense._plan = real
+        dense._plan, plan.single[1] = real, vector
     fun, args, filled = seen[-1]
     ws = work.ws
 

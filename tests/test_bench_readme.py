@@ -96,6 +96,27 @@ def test_render_a_synthetic_results_folder(tmp_path):
         "| c | error | -1.17e-04 |  |\n")
 
 
+def test_the_glance_table_reads_the_rows_below_it(tmp_path):
+    """"At a glance" is read from the rows of the tables (never typed in): one row gives
+    its value, several their range and count, a job without rows is left out, and no row
+    at all gives no table."""
+    rows = [dict(benchmark="integrate_peers", case=f"w{k}", metric="speed-up vs numbalsoda "
+                 "dop853, interpolated at the target error", value=v, unit="x", note="")
+            for k, v in enumerate([0.5, 2.25, 1.0])]
+    rows.append(dict(benchmark="slew", case="bw", metric="speed-up vs rockit at matched "
+                     "accuracy", value=55.0, unit="x", note=""))
+    rows.append(dict(benchmark="slew", case="bw", metric="speed-up vs rockit N = 20",
+                     value=9.0, unit="x", note=""))
+    lines = readme.glance(rows)
+    assert lines[2:4] == ["| job | against | result | rows |", "| --- | --- | ---: | ---: |"]
+    assert len(lines) == 6  # (two jobs with rows; every other job of GLANCE left out)
+    assert lines[4].endswith("| numbalsoda dop853 | 0.5000 - 2.250 x | 3 |")
+    assert lines[5].endswith("| rockit | 55.00 x | 1 |")
+    assert readme.glance(rows[-1:]) == []
+    text = readme.render(_results(tmp_path, rows))
+    assert text.index("**At a glance**") < text.index("**Single runs against numbalsoda")
+
+
 @pytest.mark.parametrize("value, text", [(0, "0"), (1.0, "1.000"), (0.0012345, "0.001234"),
                                          (9.99996, "10.00"), (123456.0, "1.23e+05"),
                                          (float("nan"), "nan")])

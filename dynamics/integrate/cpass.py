@@ -16,9 +16,14 @@ from .csteps import loop_steps
 from .kernels import calls_rhs, dense_kernels, kernel
 from .tableaux import DOP853_DENSE_STAGES
 from .chunks import BATCH_CHUNK, CHUNK, chunk_compile_job, chunk_name
-from .lanes import LANES
 
-__all__ = ["BMAX", "CHECK_EVERY", "NOISE", "pass_library", "pass_chunk"]
+__all__ = ["BMAX", "CHECK_EVERY", "LANES", "NOISE", "pass_library", "pass_lanes_job",
+           "pass_chunk"]
+
+#: Runs stepped together in the lanes of a vector step (4 doubles: 256-bit registers;
+#: narrower machines split them): the pass's lane driver (``PASS_LANES``) and the vector
+#: steps of `lanes` it drives.
+LANES = 4
 
 #: Most check-run steps in one output interval (the answer takes ``2 b + 1``; a longer
 #: interval, or a problem that needs more, leaves the pass to the multi-run search).
@@ -62,6 +67,9 @@ _DRIVER = r"""
 #define PASS_NARG %(narg)d
 #define PASS_NRES %(nres)d
 #define PASS_LANES %(lanes)d
+/* 1: with the steps in vector lanes (`rk8_auto_v` given vector steps, `rk8_auto_lanes`):
+   the pass's second build, compiled with `lanes.dense_lanes`; 0: the first call's build */
+#define PASS_WITH_LANES %(with_lanes)d
 #define PASS_U (PASS_NU > 0 ? PASS_NU : 1)
 #define CHECK_EVERY %(every)d
 /* the stages the continuous extension reads (`tableaux.DOP853_DENSE_STAGES`) */
@@ -616,6 +624,7 @@ typedef struct {
   int filled;
 } au_vio;
 
+#if PASS_WITH_LANES
 /* lane l's inputs that hold over a run's answer and its check: the run's control,
    parameters and tolerances (`au_vstep_in` sets a step's own) */
 static void au_vrun(au_vio* v, int l, const dense_state* s) {
@@ -726,6 +735,7 @@ static int dense_advance_v(dense_state* s, au_vio* v, au_vstep step, au_vstep co
   au_vkeep(v, took);
   return stop;
 }
+#endif
 
 /* Steps of x (in/out) from time *t (in/out) towards ts[nout - 1], the outputs at the times
    ts (increasing, after the start) in X (nx, ldx); control u throughout; `hio` (in/out) the
@@ -749,11 +759,14 @@ static int dense_run(casadi_real* x, casadi_real* t, casadi_real* hio, int nout,
                      casadi_real stiff_steps, casadi_real* rich, casadi_real* XC,
                      au_vstep step, au_vstep cont) {
   dense_state s;
+#if PASS_WITH_LANES
   au_vio v;
   v.filled = 0;
+#endif
   if (!dense_open(&s, x, t, *hio, nout, ts, u, p, rtol, atol, max_steps, X, ldx, count,
                   stiff_steps, rich, XC))
     return s.j;
+#if PASS_WITH_LANES
   if (rich && step) {  /* (the answer's lane 0 and its check's lane 1: one run's inputs;
                           their states, which then follow their steps: `dense_advance_v`) */
     au_vrun(&v, 0, &s);
@@ -765,6 +778,12 @@ static int dense_run(casadi_real* x, casadi_real* t, casadi_real* hio, int nout,
     dense_next(&s);
     if (rich && step ? dense_advance_v(&s, &v, step, cont) : dense_advance(&s)) break;
   }
+#else
+  while (s.j < nout && budget-- > 0) {
+    dense_next(&s);
+    if (dense_advance(&s)) break;
+  }
+#endif
   if (s.check_due) rich_step(&s);
   dense_close(&s, hio);
   return s.j;
@@ -1195,6 +1214,7 @@ int rk8_auto_many(const casadi_real* w, int nout, const long long* runs, long lo
   return 0;
 }
 
+#if PASS_WITH_LANES
 /* ---- `rk8_auto_many` with PASS_LANES runs stepped at once in the lanes of a vector step:
    `lanes.lane_source`'s `rk8_step_k` and `rk8_cont`, each lane a run's own arithmetic in
    the order of the step function (the same bits). Each lane keeps its own steps,
@@ -1493,6 +1513,7 @@ int rk8_auto_lanes(const casadi_real* w, int nout, const long long* runs, long l
   free(wk);
   return handed;
 }
+#endif
 """
 
 
@@ -1604,9 +1625,48 @@ int rk8_probe(const casadi_real* x, casadi_real h, const casadi_real* ua,
 }
 """
 
-def pass_library(model: Model) -> object | None:
+def pass_library(model: Model, *, lanes: bool = False) -> object | None:
     """The compiled pass of ``model`` (a ``ctypes`` function, cached); None without a C
-    compiler or when the model cannot be code-generated (the pass is worth it only as C)."""
+    compiler or when the model cannot be code-generated (the pass is worth it only as C).
+
+    ``lanes`` False: the first call's build, without the driver of steps in vector lanes
+    (``auto_lanes`` None; ``auto_v`` takes no vector steps); True: the same C with it
+    (``PASS_WITH_LANES``), which `lanes.dense_lanes` compiles in the background with the
+    vector steps it drives. The lane driver at -O2 was half the first build's gcc time:
+    the first `simulate` of a model with an empty cache 1.0-1.2 s, against 0.4-0.7 s before
+    it was added (`bench/compile_cache.py`). Both builds' scalar paths are the same C: the
+    same bits."""
+    def job(opt):
+        return _pass_job(model, opt, lanes)
+
+    def build():
+        lib = cache.compile_parallel([job(_OPTS[0])])[0]
+        if isinstance(lib, RuntimeError):  # (e.g. a compiler without -march=native)
+            lib = cache.compile_parallel([job(_OPTS[1])])[0]
+        # auto's multi-run search (the fallback) runs the rk8 chunk loop: its compile starts
+        # now, in the background (`cache.compile_ahead`; a call that needs it waits for it),
+        # after the pass's units had the cores to themselves
+        chunk = None if lanes or calls_rhs(model, "rk8") else \
+            chunk_compile_job(model, "rk8", "linear")
+        if chunk is not None:  # (a called rhs: the pass runs the chunk, `pass_chunk`)
+            cache.compile_ahead([chunk])
+        if lib is None or isinstance(lib, RuntimeError):
+            return None
+        return _loaded(lib, lanes)
+
+    name = "rk8_pass_lanes" if lanes else "rk8_pass"
+    return cache.get((name, cache.function_key(model.f)), build, keepalive=model.f)
+
+
+def pass_lanes_job(model: Model) -> cache.Job:
+    """The compile job of ``pass_library(model, lanes=True)`` (this machine's flags), for
+    `lanes.dense_lanes` to start in the background and to ask whether it is ready."""
+    return _pass_job(model, _OPTS[0], True)
+
+
+def _pass_job(model: Model, opt: str, lanes: bool) -> cache.Job:
+    """The `cache.Job` of the pass of ``model`` at the flags ``opt``, with the lane driver
+    when ``lanes``."""
     def make():
         # Translation units compiled at once (`cache.compile_parallel`), each a list: the
         # driver's own C with what it needs beside it, and the big generated functions (the
@@ -1622,8 +1682,10 @@ def pass_library(model: Model) -> object | None:
             plain = _renamed(kernel(model, "rk8", "linear", compiled=True), "rk8_step")
             main, units, wrappers = [rhs], [[step, plain], list(dense_kernels(model))], ""
         every = main + [f for unit in units for f in unit]
-        sizes = dict(every=CHECK_EVERY, lanes=LANES, ncont=len(DOP853_DENSE_STAGES),
-                     cont=", ".join(map(str, DOP853_DENSE_STAGES)), nx=model.nx, nu=model.nu, np=model.np,
+        sizes = dict(every=CHECK_EVERY, lanes=LANES, with_lanes=int(lanes),
+                     ncont=len(DOP853_DENSE_STAGES),
+                     cont=", ".join(map(str, DOP853_DENSE_STAGES)), nx=model.nx,
+                     nu=model.nu, np=model.np,
                      nw=max(f.sz_w() for f in every), niw=max(f.sz_iw() for f in every),
                      narg=max(f.sz_arg() for f in every), nres=max(f.sz_res() for f in every),
                      steps=wrappers)
@@ -1634,62 +1696,52 @@ def pass_library(model: Model) -> object | None:
                                    batch_size=BATCH_CHUNK)
         return main + units, extra
 
-    def job(opt):
-        return cache.Job(make, opt, ctypes.CDLL, cache.recipe("rk8_pass", model.f, opt))
+    name = "rk8_pass_lanes" if lanes else "rk8_pass"
+    return cache.Job(make, opt, ctypes.CDLL, cache.recipe(name, model.f, opt))
 
-    def build():
-        lib = cache.compile_parallel([job(_OPTS[0])])[0]
-        if isinstance(lib, RuntimeError):  # (e.g. a compiler without -march=native)
-            lib = cache.compile_parallel([job(_OPTS[1])])[0]
-        # auto's multi-run search (the fallback) runs the rk8 chunk loop: its compile starts
-        # now, in the background (`cache.compile_ahead`; a call that needs it waits for it),
-        # after the pass's units had the cores to themselves
-        chunk = None if calls_rhs(model, "rk8") else chunk_compile_job(model, "rk8", "linear")
-        if chunk is not None:  # (a called rhs: the pass runs the chunk, `pass_chunk`)
-            cache.compile_ahead([chunk])
-        if lib is None or isinstance(lib, RuntimeError):
-            return None
-        fun = lib.rk8_pass_ws
-        ptr, i32 = ctypes.c_void_p, ctypes.c_int
-        fun.argtypes = [ptr, ptr, i32, i32, ptr, ptr]
-        fun.restype = i32
-        fun.library = lib  # (kept alive with the function)
-        stepper = lib.rk8_adaptive
-        f64 = ctypes.c_double
-        stepper.argtypes = [ptr, ptr, i32, ptr, ptr, ptr, ptr, i32, ptr, f64, ptr, f64, ptr,
-                            i32, ptr, ptr]
-        stepper.restype = i32
-        fun.stepper = stepper  # (`dynamics.integrate.stepcontrol`)
-        auto = lib.rk8_auto
-        auto.argtypes = [ptr, i32, i32, ptr, ptr]
-        auto.restype = i32
-        fun.auto = auto  # (`dynamics.integrate.dense`)
-        auto_v = lib.rk8_auto_v
-        auto_v.argtypes = [ptr, i32, i32, ptr, ptr, ptr, ptr]
-        auto_v.restype = i32
-        fun.auto_v = auto_v  # (the same, the check in a lane: `lanes.dense_lanes`)
-        many = lib.rk8_auto_many
-        i64 = ctypes.c_longlong
-        many.argtypes = [ptr, i32, ptr, i64, ptr, f64, ptr, ptr, ptr, ptr, ptr, ptr]
-        many.restype = i32
-        fun.auto_many = many  # (`dynamics.integrate.dense`, a batch)
-        lanes = lib.rk8_auto_lanes
-        lanes.argtypes = [ptr, i32, ptr, i64, ptr, f64, ptr, ptr, ptr, ptr, ptr, ptr, ptr,
-                          ptr]
-        lanes.restype = i32
-        fun.auto_lanes = lanes  # (the same, in vector lanes: `lanes.lane_steps`)
-        fixed = lib.rk8_fixed_many
-        fixed.argtypes = [i32, i32, i32, i32, ptr, ptr, ptr, ptr, ptr]
-        fixed.restype = i32
-        fun.fixed_many = fixed  # (`dynamics.integrate.batch_fixed`)
-        probe = lib.rk8_probe
-        probe.argtypes = [ptr, f64, ptr, ptr, ptr, f64, ptr, ptr]
-        probe.restype = i32
-        fun.probe = probe  # (tests: `_PROBE`)
-        fun.path = lib._name  # (`pass_chunk`)
-        return fun
 
-    return cache.get(("rk8_pass", cache.function_key(model.f)), build, keepalive=model.f)
+def _loaded(lib, lanes: bool):
+    """The pass's entry points of the loaded library ``lib`` (`pass_library`)."""
+    fun = lib.rk8_pass_ws
+    ptr, i32 = ctypes.c_void_p, ctypes.c_int
+    fun.argtypes = [ptr, ptr, i32, i32, ptr, ptr]
+    fun.restype = i32
+    fun.library = lib  # (kept alive with the function)
+    stepper = lib.rk8_adaptive
+    f64 = ctypes.c_double
+    stepper.argtypes = [ptr, ptr, i32, ptr, ptr, ptr, ptr, i32, ptr, f64, ptr, f64, ptr,
+                        i32, ptr, ptr]
+    stepper.restype = i32
+    fun.stepper = stepper  # (`dynamics.integrate.stepcontrol`)
+    auto = lib.rk8_auto
+    auto.argtypes = [ptr, i32, i32, ptr, ptr]
+    auto.restype = i32
+    fun.auto = auto  # (`dynamics.integrate.dense`)
+    auto_v = lib.rk8_auto_v
+    auto_v.argtypes = [ptr, i32, i32, ptr, ptr, ptr, ptr]
+    auto_v.restype = i32
+    fun.auto_v = auto_v  # (the same, the check in a lane when ``lanes``: `lanes.dense_lanes`)
+    many = lib.rk8_auto_many
+    i64 = ctypes.c_longlong
+    many.argtypes = [ptr, i32, ptr, i64, ptr, f64, ptr, ptr, ptr, ptr, ptr, ptr]
+    many.restype = i32
+    fun.auto_many = many  # (`dynamics.integrate.dense`, a batch)
+    fun.auto_lanes = None
+    if lanes:  # (the same, in vector lanes: `lanes.dense_lanes`)
+        fun.auto_lanes = lib.rk8_auto_lanes
+        fun.auto_lanes.argtypes = [ptr, i32, ptr, i64, ptr, f64, ptr, ptr, ptr, ptr, ptr, ptr,
+                                   ptr, ptr]
+        fun.auto_lanes.restype = i32
+    fixed = lib.rk8_fixed_many
+    fixed.argtypes = [i32, i32, i32, i32, ptr, ptr, ptr, ptr, ptr]
+    fixed.restype = i32
+    fun.fixed_many = fixed  # (`dynamics.integrate.batch_fixed`)
+    probe = lib.rk8_probe
+    probe.argtypes = [ptr, f64, ptr, ptr, ptr, f64, ptr, ptr]
+    probe.restype = i32
+    fun.probe = probe  # (tests: `_PROBE`)
+    fun.path = lib._name  # (`pass_chunk`)
+    return fun
 
 
 def pass_chunk(model: Model, size: int) -> ca.Function | None:

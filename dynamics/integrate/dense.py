@@ -140,14 +140,13 @@ def constant_control(ctrl) -> bool:
 
 
 class _Plan(NamedTuple):
-    """What a model's calls share: the compiled functions, the sizes, the index of the
+    """What a model's calls share: the compiled functions (the pass's first build: the
+    steps in vector lanes come with `lanes.dense_lanes`), the sizes, the index of the
     attitude quaternion (-1: none), and ``single`` ``[calls, vector]``: the single calls
     made before the model's vector lanes were loaded, then the lanes (`_single_lanes`)."""
 
     auto: object
     many: object
-    lanes: object
-    auto_v: object
     single: list
     nx: int
     nu: int
@@ -160,7 +159,7 @@ def _plan(model) -> _Plan | None:
     def build():
         lib = pass_library(model)
         return None if lib is None else _Plan(
-            lib.auto, lib.auto_many, lib.auto_lanes, lib.auto_v, [0, None], model.nx,
+            lib.auto, lib.auto_many, [0, None], model.nx,
             model.nu, model.np, -1 if model.attitude is None else model.attitude[0])
 
     return cache.get(("dense_plan", cache.function_key(model.f)), build, keepalive=model.f)
@@ -313,7 +312,7 @@ def dense_run(model, x0: np.ndarray, t: np.ndarray, rtol: float, atol, max_steps
     auto, args = plan.auto, work.args
     vector = _single_lanes(model, plan) if check else None
     if vector is not None:  # (the check's steps in a lane of the answer's: the same bits)
-        auto, args = plan.auto_v, args + (vector.address, vector.cont)
+        auto, args = vector.auto_v, args + (vector.address, vector.cont)
     if auto(*args) != 3:  # a long run: interrupts looked at between calls
         # (the steps made so far: of the runs ended, and of the run in progress)
         count = HEADER + 3 * nx + nu + plan.np + nout + 2
@@ -436,8 +435,8 @@ def dense_many(model, x0: np.ndarray, t: np.ndarray, u: np.ndarray, p: np.ndarra
         _fill(work.ws, plan, t, rtol, atol, max_steps, stiff_steps, factor, check)
         while not stop_requested():
             if lanes:
-                done = plan.lanes(work.ws_addr, nout, *shared, work.xl_addr,
-                                  head.ctypes.data, vector.address, vector.cont)
+                done = vector.auto_lanes(work.ws_addr, nout, *shared, work.xl_addr,
+                                         head.ctypes.data, vector.address, vector.cont)
             else:
                 done = plan.many(work.ws_addr, nout, *shared, work.xc_addr, head.ctypes.data)
             if done < 0:

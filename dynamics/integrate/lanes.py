@@ -26,13 +26,12 @@ import casadi as ca
 
 from .. import cache
 from ..model import Model
+from .cpass import LANES, pass_lanes_job, pass_library
 from .csteps import loop_steps
 from .kernels import calls_rhs, dense_kernels, kernel
 
 __all__ = ["LANES", "lane_source", "lanes_library", "dense_lanes"]
 
-#: Runs stepped together (4 doubles: 256-bit registers; narrower machines split them).
-LANES = 4
 
 #: C functions of generated code and their lane-wise forms (each lane by the C function).
 _FUNCTIONS = {name: f"v_{name}" for name in (
@@ -205,8 +204,11 @@ def dense_lanes(model: Model, *, build: bool = True, wait: bool = False):
     exported as ``rk8_lane_step_k`` and ``rk8_lane_cont`` for the compiled pass's
     ``rk8_auto_lanes`` (`cpass`): a ``ctypes`` function pointer of the step (its
     ``address`` and ``cont`` the values the pass takes; the library kept alive with it),
-    compiled once per model for this machine (cached; kept on disk by the persistent
-    compile cache).
+    with the entry points of the pass's build that drives them (`cpass.pass_library` with
+    ``lanes=True``: ``auto_v``, a single call with its check in a lane, and
+    ``auto_lanes``, a batch's loop), compiled once per model for this machine (cached; kept
+    on disk by the persistent compile cache). Both libraries compile together, in the
+    background unless ``wait``: the first call's pass does without the lane driver.
 
     A model whose steps call its right-hand side (`kernels.calls_rhs`: the pass's steps are
     C loops, `csteps`) gets the vector form of those loops around its rewritten right-hand
@@ -235,19 +237,23 @@ def dense_lanes(model: Model, *, build: bool = True, wait: bool = False):
     # (the jobs kept: their recipe serializes the model, and a caller that does not wait
     # asks again until the library is ready)
     jobs = cache.get(("rk8_dense_lanes_jobs", key[1]),
-                     lambda: _jobs(model, "rk8_dense_lanes", body, ""), keepalive=model.f)
-    if not wait and not cache.ready(jobs[0]):
-        cache.compile_ahead(jobs[:1])
+                     lambda: _jobs(model, "rk8_dense_lanes", body, "") + [
+                         pass_lanes_job(model)], keepalive=model.f)
+    if not wait and not (cache.ready(jobs[0]) and cache.ready(jobs[-1])):
+        cache.compile_ahead([jobs[0], jobs[-1]])
         return None
 
     def make_library():
-        lib = _compiled(jobs)
-        if lib is None:
+        cache.compile_ahead([jobs[0], jobs[-1]])  # (both at once, when not on disk yet)
+        lib = _compiled(jobs[:-1])
+        driver = None if lib is None else pass_library(model, lanes=True)
+        if driver is None:
             return None
         fun = lib.rk8_lane_step_k
         fun.address = ctypes.cast(fun, ctypes.c_void_p).value
         fun.cont = ctypes.cast(lib.rk8_lane_cont, ctypes.c_void_p).value
         fun.library = lib  # (kept alive with the function)
+        fun.auto_v, fun.auto_lanes, fun.driver = driver.auto_v, driver.auto_lanes, driver
         return fun
 
     return cache.get(key, make_library, keepalive=model.f)

@@ -289,3 +289,25 @@ def test_a_model_past_the_instruction_bound_keeps_the_scalar_pass(monkeypatch):
     for k in range(3):
         w = torque_free_omega([1.3, 2.1, 2.7], X0[4:, k], t)
         assert np.all(np.abs(got.x[4:, :, k] - w) <= 1e-10 + 1e-8 * np.abs(w))
+
+
+def test_the_first_pass_has_no_lane_driver_and_the_lanes_bring_theirs():
+    """The first call's pass is built without the driver of steps in vector lanes (half its
+    gcc time); `dense_lanes` compiles the pass's build with it beside the vector steps and
+    hands over its entry points, which drive those steps: a single call through them is
+    the first build's scalar call to the bit."""
+    from appdyn.dynamics.integrate import cpass, dense
+
+    model = rigid_body([1.0, 2.0, 2.5])
+    first = cpass.pass_library(model)
+    assert first.auto_lanes is None
+    vector = lanes.dense_lanes(model, wait=True)
+    assert vector.driver is cpass.pass_library(model, lanes=True) and vector.driver is not first
+    assert vector.auto_v is vector.driver.auto_v and vector.auto_lanes is not None
+    x0, t = np.r_[0.0, 0.0, 0.0, 1.0, 0.3, 1.1, -0.4], np.linspace(0.0, 15.0, 31)
+    plan = dense._plan(model)
+    plan.single[1] = None  # (the scalar call of the first build)
+    scalar = dense.dense_run(model, x0, t, 1e-9, 1e-11, 1e8, 1e6, p=model.p_default)
+    plan.single[1] = vector  # (its check in a lane of the lanes build's driver)
+    laned = dense.dense_run(model, x0, t, 1e-9, 1e-11, 1e8, 1e6, p=model.p_default)
+    assert scalar.result == laned.result == 1 and np.array_equal(scalar.x, laned.x)
