@@ -8,6 +8,7 @@ import math
 import casadi as ca
 import numpy as np
 
+from appdyn.dynamics import cache
 from appdyn.dynamics.launch_vehicle import Actuator
 from appdyn.dynamics.launch_vehicle import launch_vehicle as vehicle_model
 from appdyn.dynamics.model import Model
@@ -30,6 +31,7 @@ def wind_of(veh: LaunchVehicle, sym):
     return ca.vertcat(0, sym) if veh.aero is not None else ca.SX(0, 1)
 
 
+@cache.constructs
 def closed_loop_model(veh: LaunchVehicle, actuator, integral: bool, filter_tau) -> tuple[Model, ca.Function]:
     """The closed loop on the vehicle's own right-hand side, the gains as parameters."""
     ol = open_loop(veh, actuator)
@@ -118,6 +120,7 @@ def design_model(vehicle, *, integral: bool = False,
     return closed_loop_model(veh, tau, bool(integral), tf)
 
 
+@cache.constructs
 def hurwitz_rows(veh: LaunchVehicle, model: Model, min_decay: float) -> ca.Function:
     """``k -> rows >= 0`` iff every pole of the linear closed loop has ``Re <= -min_decay``.
 

@@ -9,6 +9,7 @@ import casadi as ca
 import numpy as np
 
 from appdyn import ocp
+from appdyn.dynamics import cache
 from appdyn.dynamics.launch_vehicle import launch_vehicle as vehicle_model
 from appdyn.ocp.status import describe, status_code
 
@@ -96,16 +97,13 @@ def stability_check(veh: LaunchVehicle, gains, *, filter_tau=None) -> tuple[dict
     return ver, rep
 
 
-def resimulate(veh: LaunchVehicle, gains, scenarios, horizon, points, *,
-                filter_tau=None) -> list:
-    """Every scenario re-simulated on a fine grid: on the library's closed-loop vehicle
-    (`dynamics.launch_vehicle` with the gains given) for the PD law; for the integral/filter
-    law on `closed_loop_model` with the user's actuator (clamps included)."""
-    from appdyn.dynamics import simulate
-
-    gains = np.asarray(gains, dtype=float)
-    V = veh.velocity or 0.0
-    dynamic = gains.size > 2 or bool(filter_tau)
+@cache.constructs
+def _outputs(veh: LaunchVehicle, gains: np.ndarray, scenarios, filter_tau, dynamic: bool,
+             n: int):
+    """`resimulate`'s model and outputs (built under the construction lock): ``(model, X0
+    (the scenarios' initial states, dynamic law) or None, the outputs Function mapped over
+    ``n`` points, the indices of psi and psi_dot)``."""
+    X0 = None
     if dynamic:
         model, out = closed_loop_model(veh, veh.actuator, gains.size > 2, filter_tau)
         X0 = initial_states(veh, scenarios, model.states)
@@ -127,7 +125,22 @@ def resimulate(veh: LaunchVehicle, gains, scenarios, horizon, points, *,
                 else ca.SX(0)]
         fun = ca.Function("outputs", [xs, ps], [ca.vertcat(*outs)])
         i_psi, i_rate = 2, 5
+    return model, X0, fun.map(n), i_psi, i_rate
+
+
+def resimulate(veh: LaunchVehicle, gains, scenarios, horizon, points, *,
+                filter_tau=None) -> list:
+    """Every scenario re-simulated on a fine grid: on the library's closed-loop vehicle
+    (`dynamics.launch_vehicle` with the gains given) for the PD law; for the integral/filter
+    law on `closed_loop_model` with the user's actuator (clamps included)."""
+    from appdyn.dynamics import simulate
+
+    gains = np.asarray(gains, dtype=float)
+    V = veh.velocity or 0.0
+    dynamic = gains.size > 2 or bool(filter_tau)
     t = np.linspace(0.0, horizon, points)
+    model, X0, outputs, i_psi, i_rate = _outputs(veh, gains, scenarios, filter_tau, dynamic,
+                                                 t.size)
     fastest = min([horizon] + [tc for tc in (filter_tau, veh.actuator and
                                              veh.actuator.time_constant) if tc])
     steps = max(4, math.ceil((t[1] - t[0]) / (0.25 * fastest)))
@@ -140,7 +153,7 @@ def resimulate(veh: LaunchVehicle, gains, scenarios, horizon, points, *,
             x0[2], x0[3], x0[5] = sc.psi0, V, sc.psi_dot0
             p = w = [0.0, V * math.tan(sc.gust_alpha)] if veh.aero is not None else []
         res = simulate(model, x0, t, p=p, method="rk8", steps=steps, jit=False)
-        y = np.asarray(fun.map(t.size)(res.x, ca.repmat(ca.DM(w), 1, t.size)), dtype=float)
+        y = np.asarray(outputs(res.x, ca.repmat(ca.DM(w), 1, t.size)), dtype=float)
         run = {"name": sc.name, "t": t, "x": np.asarray(res.x), "states": model.states,
                "psi": res.x[i_psi], "psi_dot": res.x[i_rate], "delta": y[0],
                "delta_rate": y[1], "alpha": y[2], "gust_alpha": sc.gust_alpha}

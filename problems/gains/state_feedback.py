@@ -29,6 +29,7 @@ import numpy as np
 
 from appdyn.config import param
 from appdyn import ocp
+from appdyn.dynamics import cache
 from appdyn.dynamics.model import Model
 from appdyn.dynamics.validate import finite_array, positive
 
@@ -121,6 +122,7 @@ def _names(nu: int, n: int) -> list[str]:
     return [f"K[{i},{j}]" for i in range(nu) for j in range(n)]
 
 
+@cache.constructs
 def _closed_loop(A, B) -> Model:
     """``x' = (A - B K) x`` with the entries of ``K`` (row-major) as parameters (SX)."""
     n, nu = B.shape
