@@ -16,7 +16,8 @@ import json
 import math
 from pathlib import Path
 
-__all__ = ["BEGIN", "END", "GLANCE", "glance", "render", "update_page", "update_readme", "current", "format_value"]
+__all__ = ["BEGIN", "END", "GLANCE", "glance", "render", "update_page", "update_readme",
+           "current", "format_value"]
 
 BEGIN = "<!-- bench:begin -->"
 END = "<!-- bench:end -->"

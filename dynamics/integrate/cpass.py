@@ -1654,8 +1654,8 @@ def pass_library(model: Model, *, lanes: bool = False) -> object | None:
             return None
         return _loaded(lib, lanes)
 
-    name = "rk8_pass_lanes" if lanes else "rk8_pass"
-    return cache.get((name, cache.function_key(model.f)), build, keepalive=model.f)
+    return cache.get((_pass_name(lanes), cache.function_key(model.f)), build,
+                     keepalive=model.f)
 
 
 def pass_lanes_job(model: Model) -> cache.Job:
@@ -1696,8 +1696,12 @@ def _pass_job(model: Model, opt: str, lanes: bool) -> cache.Job:
                                    batch_size=BATCH_CHUNK)
         return main + units, extra
 
-    name = "rk8_pass_lanes" if lanes else "rk8_pass"
-    return cache.Job(make, opt, ctypes.CDLL, cache.recipe(name, model.f, opt))
+    return cache.Job(make, opt, ctypes.CDLL, cache.recipe(_pass_name(lanes), model.f, opt))
+
+
+def _pass_name(lanes: bool) -> str:
+    """The name of the pass's build (with the lane driver or not): its cache key and recipe."""
+    return "rk8_pass_lanes" if lanes else "rk8_pass"
 
 
 def _loaded(lib, lanes: bool):

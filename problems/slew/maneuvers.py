@@ -30,7 +30,8 @@ from .targets import (ARCSEC, MIN_REFINE_TOL, POINTING_TOL, RATE_TOL, STATUS_POI
                       STATUS_REFINE, check_tol)
 
 __all__ = ["time_optimal", "min_effort", "verify", "bounded", "DEFAULT_STARTS_TIME",
-           "DEFAULT_STARTS_EFFORT", "POLISH_ITER_FACTOR", "POLISH_MIN_ITER", "SEED_OPTIONS", "RACE_N", "RACE_AGREE",
+           "DEFAULT_STARTS_EFFORT", "POLISH_ITER_FACTOR", "POLISH_MIN_ITER", "SEED_OPTIONS",
+           "RACE_N", "RACE_AGREE",
            "RACE_IPOPT", "BOUNDED_ITER_FACTOR", "BOUNDED_MIN_ITER", "START_BUDGET",
            "BOUNDED_TOL_FACTOR", "minimum_time_text", "restarted",
            "with_minimum_time"]
@@ -209,19 +210,21 @@ def time_optimal(inertia, *, angle=None, axis=None, q0=None, qf=None, u_max=1.0,
         torque is zero throughout, as off the axis of a principal-axis slew, is held at
         zero): the arc durations are solved for directly (``'switch-times'``: a few IPOPT
         iterations, ``T`` exact to about 1e-12 s; 3 iterations on Bilimoria-Wie; should that
-        fail, the moving-knot re-solve at Radau degree 5 within what is left of the budget).
-        Each NLP of the polish has an iteration budget: `POLISH_ITER_FACTOR` = 10 times the
-        first solution's IPOPT iterations, at least `POLISH_MIN_ITER` = 200 (``max_iter`` of
-        ``ipopt_options`` wins), so the answer does not depend on the machine's load. A first solution that is not bang-bang (a
+        fail, the moving-knot re-solve at Radau degree 5). Each NLP of the polish has an
+        iteration budget: `POLISH_ITER_FACTOR` = 10 times the first solution's IPOPT
+        iterations, at least `POLISH_MIN_ITER` = 200 (``max_iter`` of ``ipopt_options``
+        wins), so the answer does not depend on the machine's load. A first solution that is
+        not bang-bang (a
         singular arc) is not polished (the moving-knot re-solve took 6-70 s there, 20-200
         times the first solve, and was rarely kept). The polished result is returned only
         if it is verified and not slower than the first (a switch-time result may be slower
         by 1e-4 relative: the first's fixed mesh can put T below the exact optimum by its
         discretization error); otherwise the first solution. ``info['polish']`` records
         what happened: ``ran``, ``used``, ``why``, ``method``, ``wall_time`` [s], ``budget``
-        (IPOPT iterations per NLP), ``T_before``, ``T_polished``, ``T_after`` [s] and ``gain`` (``T_before -
-        T_after`` [s] when used, else 0); the message ends with the same in words
-        (`polish_text`) and ``info['wall_time']`` is the wall time of the whole call. Should
+        (IPOPT iterations per NLP), ``T_before``, ``T_polished``, ``T_after`` [s] and
+        ``gain`` (``T_before - T_after`` [s] when used, else 0); the message ends with the
+        same in words (`polish_text`) and ``info['wall_time']`` is the wall time of the
+        whole call. Should
         neither be verified (the first's fixed mesh can smear the switches beyond
         ``pointing_tol``), the first is mesh-refined (`ocp.refine`, tol 1e-6, at most 4
         rounds) and verified again; should that stall too (its error estimates do not
@@ -501,9 +504,9 @@ def _labelled_starts(start_options, n: int, verbose):
 def _polish_record(ran: bool, why: str, *, wall_time=0.0, budget=None, method=None,
                    T_before=None, T_polished=None, T_after=None, used=False) -> dict:
     """``info['polish']`` of `solve_time_optimal`: whether the polish ran and was used,
-    why, its wall time [s] and iteration budget (per NLP), ``T`` before, of the polished result and after
-    (the polished one when used, else the first's) [s], and the gain ``T_before - T_after``
-    [s] (0 when not used)."""
+    why, its wall time [s] and iteration budget (per NLP), ``T`` before, of the polished
+    result and after (the polished one when used, else the first's) [s], and the gain
+    ``T_before - T_after`` [s] (0 when not used)."""
     gain = float(T_before) - float(T_after) if used else 0.0
     return {"ran": ran, "used": used, "why": why, "method": method, "wall_time": wall_time,
             "budget": budget, "T_before": T_before, "T_polished": T_polished,
@@ -629,7 +632,8 @@ def solve_time_optimal(problem, guess, guesses, opts, *, polish, pointing_tol, r
                                 ptol, rtol, ipopt_options, opts["scale"])
         return _finish(out, _polish_record(False, why, T_before=float(first.T),
                                            T_after=float(first.T)), t_start)
-    polished, ran = _polish(problem, sol, opts, verbose=verbose, ipopt_options=ipopt_options, ptol=ptol, rtol=rtol)
+    polished, ran = _polish(problem, sol, opts, verbose=verbose, ipopt_options=ipopt_options,
+                            ptol=ptol, rtol=rtol)
     # switch times are integrated to ~1e-13 while a fixed-mesh T can sit below the exact
     # optimum by its discretization error (J = diag(1, 2, 3), 1 rad: 2.2075331 against
     # 2.2075385, 2.4e-6 relative), so an exact polish may come out a hair slower and is kept
