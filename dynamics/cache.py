@@ -506,6 +506,7 @@ class _Build:
         self.work, self.name, self.key, self.library = work, "", "", ""
         self.procs: list = []
         self.link: list | None = None
+        self.objects: list = []  # (key, path) of the units compiled here, kept as objects
         self._lock = threading.Lock()
         self._outcome = None
 
@@ -519,6 +520,9 @@ class _Build:
                                                 for p in self.procs) if code != 0]
                 if not errors and self.link is not None:
                     import subprocess
+
+                    for key, path in self.objects:  # (for a later build sharing the unit)
+                        diskcache.publish(key, path, suffix=".o")
 
                     done = subprocess.run(self.link, cwd=self.work, capture_output=True,
                                           text=True)
@@ -623,7 +627,18 @@ def _spawn(job: Job, compiler: str, key: str | None):
         commands = [[compiler, *flags, names[0], "-o", build.library, "-lm"]]
     else:  # (the units compiled at once, then linked: `_Build.wait`)
         compile_flags = [f for f in flags if f != "-shared"]
-        commands = [[compiler, *compile_flags, "-c", n, "-o", n[:-2] + ".o"] for n in names]
+        commands = []
+        for i, name in enumerate(names):
+            # (a unit after the driver is kept as an object under the key of its own source:
+            # a build sharing it, as the pass's two builds share their steps, takes it)
+            unit = None if i == 0 else _unit_key(os.path.join(work, name), compiler,
+                                                   compile_flags)
+            obj = os.path.join(work, name[:-2] + ".o")
+            if unit is not None and _take_object(unit, obj):
+                continue
+            if unit is not None:
+                build.objects.append((unit, obj))
+            commands.append([compiler, *compile_flags, "-c", name, "-o", obj])
         build.link = [compiler, *flags, *(n[:-2] + ".o" for n in names), "-o", build.library,
                       "-lm"]
     build.procs = [subprocess.Popen(command, cwd=work, stdout=subprocess.PIPE,
@@ -631,6 +646,28 @@ def _spawn(job: Job, compiler: str, key: str | None):
                                     env={**os.environ, "TMPDIR": work}, start_new_session=True)
                    for command in commands]
     return build
+
+
+def _unit_key(source: str, compiler: str, flags: list) -> str:
+    """The persistent cache's key of the object of the translation unit ``source``."""
+    with open(source, "rb") as f:
+        return diskcache.artifact_key(f.read(), compiler, [*flags, "-c"])
+
+
+def _take_object(key: str, obj: str) -> bool:
+    """Copy the object of ``key`` from the persistent cache to ``obj`` (for the link: an
+    eviction meanwhile cannot take it away); False when it is not there."""
+    import shutil
+
+    found = diskcache.lookup(key, suffix=".o")
+    if found is None:
+        return False
+    try:
+        shutil.copyfile(found, obj)
+    except OSError:
+        return False
+    diskcache.reused()
+    return True
 
 
 def _prototypes(units: list) -> str:

@@ -35,6 +35,11 @@ Safety
   sidecar. A reader sees either nothing (and compiles too: both succeed, the later rename
   wins with identical content) or a complete pair. A library already loaded stays mapped
   when another process replaces or evicts its file.
+* **Objects too.** A library built from several translation units (`dynamics.cache`:
+  the compiled pass of ``auto``, in two builds that share their step units) keeps each
+  unit but the first (the driver) as an object ``<key>.o`` under the key of the unit's own
+  source and compile flags, verified the same way: a library whose units were compiled
+  before (with the other build of the pass) compiles only its own.
 * **Bounded.** After each publish the least recently used artifacts (a hit refreshes the
   library's modification time) are deleted until the directory holds at most `MAX_BYTES`
   (500 MB by default; ``APPDYN_CACHE_MAX_MB`` or `configure`); the one just published stays.
@@ -62,7 +67,7 @@ import casadi as ca
 
 __all__ = ["MAX_BYTES", "FORMAT", "DiskCacheInfo", "configure", "directory", "enabled", "info",
            "clear", "lookup", "publish", "artifact_key", "discard", "code_version", "hit",
-           "compiled", "limit"]
+           "compiled", "reused", "limit"]
 
 #: Default size limit of the cache directory [bytes] (``APPDYN_CACHE_MAX_MB`` overrides).
 MAX_BYTES = 500 * 1024 * 1024
@@ -79,7 +84,8 @@ class DiskCacheInfo(NamedTuple):
     """What `info` reports: the directory (None when the cache is off), the artifacts in it,
     their size [bytes], the limit [bytes], and this process's counts: libraries loaded from
     the cache (``hits``), compiles (``compiles``), artifacts rejected as corrupted or foreign
-    (``rejected``) and deleted to keep the bound (``evicted``)."""
+    (``rejected``) and deleted to keep the bound (``evicted``), and translation units whose
+    object was taken from the cache instead of compiled (``reused``)."""
 
     directory: str | None
     entries: int
@@ -89,11 +95,12 @@ class DiskCacheInfo(NamedTuple):
     compiles: int
     rejected: int
     evicted: int
+    reused: int = 0
 
 
 _lock = threading.Lock()
 _settings: dict = {"directory": _UNSET, "enabled": None, "limit": None}
-_counts = {"hits": 0, "compiles": 0, "rejected": 0, "evicted": 0}
+_counts = {"hits": 0, "compiles": 0, "rejected": 0, "evicted": 0, "reused": 0}
 
 
 def configure(*, directory=_UNSET, enabled: bool | None = _UNSET, max_bytes: int | None = _UNSET) -> dict:
@@ -249,13 +256,14 @@ def code_version() -> bytes:
     return out
 
 
-def lookup(key: str) -> str | None:
-    """Path of the verified library of ``key`` in the cache, or None (off, absent, or
-    rejected: a rejected artifact is deleted). A hit refreshes its last use."""
+def lookup(key: str, *, suffix: str = ".so") -> str | None:
+    """Path of the verified library of ``key`` in the cache (``suffix`` ``".o"``: of the
+    object), or None (off, absent, or rejected: a rejected artifact is deleted). A hit
+    refreshes its last use."""
     root = directory()
     if root is None:
         return None
-    library, sidecar = _paths(root, key)
+    library, sidecar = _paths(root, key, suffix)
     try:
         meta = json.loads(sidecar.read_text())
         data = library.read_bytes()
@@ -265,7 +273,7 @@ def lookup(key: str) -> str | None:
         meta, data = None, b""
     if not (isinstance(meta, dict) and meta.get("key") == key and meta.get("size") == len(data)
             and meta.get("sha256") == hashlib.sha256(data).hexdigest()):
-        discard(key)
+        discard(key, suffix=suffix)
         return None
     try:
         os.utime(library)
@@ -284,24 +292,30 @@ def compiled() -> None:
     _count("compiles")
 
 
-def discard(key: str) -> None:
-    """Delete the artifact of ``key`` (a corrupted or foreign one: counted as rejected)."""
+def reused() -> None:
+    """Count a translation unit whose object was taken from the cache (`info`)."""
+    _count("reused")
+
+
+def discard(key: str, *, suffix: str = ".so") -> None:
+    """Delete the artifact of ``key`` (``suffix`` as `lookup`'s; a corrupted or foreign one:
+    counted as rejected)."""
     root = directory()
     if root is None:
         return
     _count("rejected")
-    for path in _paths(root, key):
+    for path in _paths(root, key, suffix):
         _unlink(path)
 
 
-def publish(key: str, built: str) -> str:
-    """Put the compiled library ``built`` into the cache under ``key`` and return its path
-    there (atomically, then evicting beyond the limit); ``built`` itself when the cache is
-    off or cannot be written."""
+def publish(key: str, built: str, *, suffix: str = ".so") -> str:
+    """Put the compiled library ``built`` (``suffix`` ``".o"``: an object) into the cache
+    under ``key`` and return its path there (atomically, then evicting beyond the limit);
+    ``built`` itself when the cache is off or cannot be written."""
     root = directory()
     if root is None:
         return built
-    library, sidecar = _paths(root, key)
+    library, sidecar = _paths(root, key, suffix)
     try:
         root.mkdir(parents=True, exist_ok=True)
         data = Path(built).read_bytes()
@@ -360,8 +374,8 @@ def clear() -> int:
 
 
 # ---------------------------------------------------------------------------------------
-def _paths(root: Path, key: str) -> tuple[Path, Path]:
-    return root / f"{key}.so", root / f"{key}.json"
+def _paths(root: Path, key: str, suffix: str = ".so") -> tuple[Path, Path]:
+    return root / f"{key}{suffix}", root / f"{key}.json"
 
 
 def _count(name: str) -> None:
@@ -392,10 +406,10 @@ def _atomic_write(path: Path, data: bytes) -> None:
 
 
 def _entries(root: Path) -> list:
-    """``(library, size of library and sidecar, last use)`` of every artifact."""
+    """``(library or object, size with its sidecar, last use)`` of every artifact."""
     out = []
     try:
-        libraries = list(root.glob("*.so"))
+        libraries = [*root.glob("*.so"), *root.glob("*.o")]
     except OSError:
         return out
     for library in libraries:

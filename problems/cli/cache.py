@@ -40,5 +40,6 @@ def run(args) -> int:
     print(f"directory: {info.directory if info.directory is not None else 'off (no disk cache)'}")
     print(f"entries:   {info.entries}")
     print(f"size:      {info.size / mb:.1f} MB of {info.limit / mb:.0f} MB")
-    print(f"this process: {info.hits} loaded from the cache, {info.compiles} compiled")
+    print(f"this process: {info.hits} loaded from the cache, {info.compiles} compiled"
+          + (f" ({info.reused} translation units taken from the cache)" if info.reused else ""))
     return 0

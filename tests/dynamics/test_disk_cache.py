@@ -345,3 +345,43 @@ def test_the_code_hash_is_the_imported_code_not_files_changed_later(tmp_path):
                           env=env, capture_output=True, text=True, timeout=120)
     assert done.returncode == 0, done.stderr[-2000:]
     assert done.stdout.split() == ["True"]
+
+
+def _units_job(k: float, unit: ca.Function):
+    """A library of a driver ``x -> k x`` (its own source for each ``k``) and the
+    translation unit ``unit``; loads as ``(driver, unit)`` Functions."""
+    x = ca.SX.sym("x")
+    driver = ca.Function("drv", [x], [k * x])
+    return cache.Job(lambda: ([driver, [unit]], ""), "-O0",
+                     lambda path: (ca.external("drv", path), ca.external(unit.name(), path)),
+                     cache.recipe("shared unit", driver, unit))
+
+
+def objects(directory):
+    return sorted(Path(directory).glob("*.o"))
+
+
+def test_a_unit_compiled_before_is_taken_not_compiled_again(disk):
+    """Two libraries sharing a translation unit (as the pass's two builds share their
+    steps): the second compiles its driver only and links the first's object of the unit,
+    taken from the cache (verified as a library is); a corrupted object is rejected and
+    compiled again, never linked. Truth: the drivers compute ``k x``, the unit ``x^3``."""
+    x = ca.SX.sym("x")
+    cube = ca.Function("cube", [x], [x ** 3])
+    before = diskcache.info()
+    (d2, c2), = cache.compile_parallel([_units_job(2.0, cube)])
+    (obj,) = objects(disk)
+    assert verified(obj) and diskcache.info().reused == before.reused
+    (d3, c3), = cache.compile_parallel([_units_job(3.0, cube)])
+    assert (float(d2(5.0)), float(c2(5.0)), float(d3(5.0)), float(c3(5.0))) == \
+        (10.0, 125.0, 15.0, 125.0)
+    after = diskcache.info()
+    assert after.reused == before.reused + 1 and after.compiles == before.compiles + 2
+    assert objects(disk) == [obj] and len(artifacts(disk)) == 2
+    obj.write_bytes(obj.read_bytes()[:100])  # (truncated: rejected, compiled again)
+    (d4, c4), = cache.compile_parallel([_units_job(4.0, cube)])
+    assert (float(d4(5.0)), float(c4(5.0))) == (20.0, 125.0)
+    last = diskcache.info()
+    assert last.reused == after.reused and last.rejected == after.rejected + 1
+    assert objects(disk) == [obj] and verified(obj)
+    assert diskcache.clear() == 4 and objects(disk) == [] and artifacts(disk) == []

@@ -204,7 +204,8 @@ def test_a_single_call_with_its_check_in_a_lane_is_the_scalar_call(kw, budget, m
     assert vector is not None
     if budget is not None:
         monkeypatch.setattr(dense, "BUDGET", budget)
-        monkeypatch.setattr(dense._LOCAL, "work", {})  # (workspaces made with this budget)
+        # (workspaces made with this budget; a thread that made no call yet has none)
+        monkeypatch.setattr(dense._LOCAL, "work", {}, raising=False)
     monkeypatch.setattr(dense, "_single_lanes", lambda m, plan: vector)
     got = simulate(model, x0, t, **kw)
     monkeypatch.setattr(dense, "_single_lanes", lambda m, plan: None)
