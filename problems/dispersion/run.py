@@ -187,11 +187,13 @@ def dispersion(model, x0, t, *, samples: int, seed: int | None, outputs: Mapping
         loop is rebuilt, ~20 ms for a rigid body), so small jobs waste that per sample.
     batch : bool, optional
         With a fixed `Model` (not a factory) and no executor: all samples in ONE batched
-        `dynamics.simulate` call (``x0`` of shape ``(nx, K)``, the compiled loop mapped over
-        the samples on the cores). ``method='auto'`` then steps every sample with the step
-        count its hardest sample needs, so the results differ from per-sample runs within
-        the tolerance. ``progress`` is called once, when all are done; a Ctrl-C keeps no
-        partial result.
+        `dynamics.simulate` call (``x0`` of shape ``(nx, K)``, one compiled loop over the
+        samples on the cores). ``method='auto'`` then runs each sample with its own DOP853
+        steps, check and verdict, as a single call does (`dynamics.integrate.batch`); from
+        64 samples on, most samples' first local tolerance is learned from the first ones
+        (`dynamics.integrate.batch.first_factor`), so their results differ from per-sample
+        runs within the tolerance, the same bits on any number of threads. ``progress`` is
+        called once, when all are done; a Ctrl-C keeps no partial result.
     **simulate_kwargs
         Passed to `dynamics.simulate` (``method``, ``rtol``, ``atol``, ``u``, ``p``,
         ``steps``, ``jit``, ...). With a factory, ``jit`` defaults to ``False`` (each sample
