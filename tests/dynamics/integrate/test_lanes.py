@@ -312,3 +312,31 @@ def test_the_first_pass_has_no_lane_driver_and_the_lanes_bring_theirs():
     plan.single[1] = vector  # (its check in a lane of the lanes build's driver)
     laned = dense.dense_run(model, x0, t, 1e-9, 1e-11, 1e8, 1e6, p=model.p_default)
     assert scalar.result == laned.result == 1 and np.array_equal(scalar.x, laned.x)
+
+
+def test_the_lanes_build_takes_the_first_builds_steps_from_the_cache(tmp_path):
+    """The pass's two builds share their step units: with an empty compile cache, the first
+    build keeps each unit after its driver as an object, and the lanes build links those
+    objects (counted as reused) instead of compiling the model's DOP853 steps again; its
+    single call is still the first build's to the bit."""
+    from appdyn.dynamics import diskcache
+    from appdyn.dynamics.integrate import cpass, dense
+
+    old = diskcache.configure(directory=tmp_path, enabled=True)
+    try:
+        model = rigid_body([1.0, 2.0, 2.7])
+        assert cpass.pass_library(model) is not None
+        objects = sorted(tmp_path.glob("*.o"))
+        assert len(objects) == 2  # (the steps with their error, and the dense kernels)
+        before = diskcache.info().reused
+        vector = lanes.dense_lanes(model, wait=True)
+        assert vector is not None and diskcache.info().reused == before + len(objects)
+        x0, t = np.r_[0.0, 0.0, 0.0, 1.0, 0.3, 1.1, -0.4], np.linspace(0.0, 15.0, 31)
+        plan = dense._plan(model)
+        plan.single[1] = None
+        scalar = dense.dense_run(model, x0, t, 1e-9, 1e-11, 1e8, 1e6, p=model.p_default)
+        plan.single[1] = vector
+        laned = dense.dense_run(model, x0, t, 1e-9, 1e-11, 1e8, 1e6, p=model.p_default)
+        assert scalar.result == laned.result == 1 and np.array_equal(scalar.x, laned.x)
+    finally:
+        diskcache.configure(**old)
