@@ -46,7 +46,8 @@ TITLES = {
     "scene": "Scenes: a hub-only scene against `rigid_body`, the build time of scenes of 1 to "
              "10 parts (`bench/scene.py`)",
     "compile_cache": "Compile cache: the first `simulate` of a model in a fresh process, compiled "
-                     "before on this machine and with an empty cache (`bench/compile_cache.py`)",
+                     "before on this machine and with an empty cache, and the vector lanes "
+                     "compiled after it (`bench/compile_cache.py`)",
     "cli": "Start-up of the command line: `appdyn --help` against a bare interpreter, fresh "
            "processes (`bench/cli.py`)",
     "flexible": "Flexible appendages: the four-antenna satellite's build and simulation, a "
