@@ -388,7 +388,8 @@ def dense_pass(problem: Problem, rtol, atol, max_steps, progress):
 
     Within `_PASS_MEASURED` ulps of a state's size the rounding the answer measured on its
     way, carried over the horizon, is added; where it is not small, the floor measured by the
-    answer repeated from a moved start (as `estimates.measured_floor`), in the same call.
+    answer repeated with each step's rounding emulated at random (one or two draws: `dense`),
+    in the same call.
     ``spent``: the steps of its runs (counted in the result whichever path answers).
     """
     got = dense_auto(problem, rtol, atol, max_steps, STIFF_STEPS, progress=progress)
@@ -440,7 +441,8 @@ def dense_message(got: DenseAuto, rtol: float) -> str:
             f"{got.interpolated} interpolated, local rtol {rtol * got.factor:.3g}), checked "
             f"against its steps merged in pairs ({got.check_steps} steps); estimated error "
             f"{got.estimate:.2g} of tolerance"
-            + (f" (a rounding floor of {got.floor:.2g} measured by a run from a moved start "
+            + (f" (a rounding floor of {got.floor:.2g} measured by {got.draws} "
+               f"rerun{'s' if got.draws > 1 else ''} with each step's rounding emulated "
                "included)" if got.floor > 0 else ""))
 
 

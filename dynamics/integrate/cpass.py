@@ -456,6 +456,14 @@ static void dense_step(pass_ctx* c, const casadi_real* x, casadi_real h, const c
   rk8_step_k(arg, res, c->iw, c->w, 0);
 }
 
+/* The rounding of a run's steps emulated at random (`dense_jitter`): after each accepted
+   step of h, x_i moves by eps |x_i| + h scale rate_i, its sign drawn from `stream` */
+typedef struct {
+  const casadi_real* rate;
+  casadi_real scale;
+  unsigned long long stream;
+} dense_jit;
+
 /* A `dense_run` in progress: its arguments and its loop's variables, so that its steps can
    be taken by the step function (`dense_run`) or in the lanes of a vector step
    (`rk8_auto_lanes`) alike: `dense_open`, then per step `dense_next`, the step, `dense_take`
@@ -466,16 +474,44 @@ typedef struct {
   casadi_real *x, *t, *count, *rich, *X, *XC;
   const casadi_real *ts, *u, *p;
   casadi_real h, hs, tend, max_steps, due;  /* due: the end of the check's step due */
+  const dense_jit* jit;  /* not NULL: each accepted state rounded at random */
   int j, nout, ldx, rejected, last, check_due;
 } dense_state;
+
+/* the 64 random bits of stream position k (splitmix64: a hash, so that a run cut into
+   calls draws the same bits) */
+static unsigned long long dense_bits(unsigned long long k) {
+  unsigned long long z = k * 0x9E3779B97F4A7C15ULL + 0x9E3779B97F4A7C15ULL;
+  z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ULL;
+  z = (z ^ (z >> 27)) * 0x94D049BB133111EBULL;
+  return z ^ (z >> 31);
+}
+
+/* the rounding of a step of h emulated on its accepted state x (stochastic arithmetic as
+   in Vignes' CESTAC): x_i moved by eps |x_i| (its own rounding) plus h scale rate_i (the
+   right-hand side's rounding over the step), of a random sign per state and step
+   (`dense_bits` of the stream and the step's count): the rerun that measures the rounding
+   floor (`au_floor`) takes each step's rounding where it arises, so the flow carries it
+   from there on, not from the start */
+static void dense_jitter(const dense_state* s, casadi_real* x, casadi_real h) {
+  const dense_jit* j = s->jit;
+  unsigned long long bits = 0, k = (unsigned long long) s->count[0] * ((PASS_NX + 63) / 64);
+  int i;
+  for (i = 0; i < PASS_NX; ++i) {
+    if (i % 64 == 0) bits = dense_bits((j->stream << 40) + k++);
+    x[i] += ((bits >> (i % 64)) & 1 ? -1.0 : 1.0)
+            * (DBL_EPSILON * fabs(x[i]) + h * j->scale * j->rate[i]);
+  }
+}
 
 /* `dense_run`'s start (its arguments); 0 when the run ends at once (count[2] 4: stiff) */
 static int dense_open(dense_state* s, casadi_real* x, casadi_real* t, casadi_real hio,
                       int nout, const casadi_real* ts, const casadi_real* u,
                       const casadi_real* p, casadi_real rtol, const casadi_real* atol,
                       casadi_real max_steps, casadi_real* X, int ldx, casadi_real* count,
-                      casadi_real stiff_steps, casadi_real* rich, casadi_real* XC) {
-  s->c.p = p; s->c.atol = atol; s->c.rtol = rtol;
+                      casadi_real stiff_steps, casadi_real* rich, casadi_real* XC,
+                      const dense_jit* jit) {
+  s->c.p = p; s->c.atol = atol; s->c.rtol = rtol; s->jit = jit;
   s->x = x; s->t = t; s->count = count; s->rich = rich; s->X = X; s->XC = XC;
   s->ts = ts; s->u = u; s->p = p; s->tend = ts[nout - 1]; s->max_steps = max_steps;
   s->j = (int) count[5]; s->nout = nout; s->ldx = ldx; s->rejected = count[6] > 0;
@@ -533,6 +569,7 @@ static int dense_take(dense_state* s, casadi_real* xn, casadi_real err, casadi_r
     for (i = 0; i < PASS_NX; ++i) x[i] = xn[i];
     *s->t = tn;
     count[0] += 1;
+    if (s->jit) dense_jitter(s, x, hs);
     if (rich) {
       rich[RI_E] += err;
       if (rich[RI_PEND] > 0 || s->last) {  /* a pair (or the lone last step): checked */
@@ -751,20 +788,21 @@ static int dense_advance_v(dense_state* s, au_vio* v, au_vstep step, au_vstep co
    `rich` (not NULL) the check of merged step pairs runs alongside (outputs into XC), its
    steps in a lane of the answer's when `step` and `cont` (`lanes.dense_lanes`) are given
    (`dense_advance_v`; a check still due when the run stops or the budget ends is taken
-   alone), else by the step function (`dense_advance`). */
+   alone), else by the step function (`dense_advance`). With `jit` (not NULL) each
+   accepted state is rounded at random (`dense_jitter`). */
 static int dense_run(casadi_real* x, casadi_real* t, casadi_real* hio, int nout,
                      const casadi_real* ts, const casadi_real* u, const casadi_real* p,
                      casadi_real rtol, const casadi_real* atol, casadi_real max_steps,
                      casadi_real* X, int ldx, casadi_real* count, int budget,
                      casadi_real stiff_steps, casadi_real* rich, casadi_real* XC,
-                     au_vstep step, au_vstep cont) {
+                     const dense_jit* jit, au_vstep step, au_vstep cont) {
   dense_state s;
 #if PASS_WITH_LANES
   au_vio v;
   v.filled = 0;
 #endif
   if (!dense_open(&s, x, t, *hio, nout, ts, u, p, rtol, atol, max_steps, X, ldx, count,
-                  stiff_steps, rich, XC))
+                  stiff_steps, rich, XC, jit))
     return s.j;
 #if PASS_WITH_LANES
   if (rich && step) {  /* (the answer's lane 0 and its check's lane 1: one run's inputs;
@@ -808,8 +846,8 @@ _AUTO = r"""
 #define AU_IQ 6       /* in: index of the attitude quaternion, -1: none */
 #define AU_TRIES 7    /* in: answer-check pairs at most; 0: the answer alone at the local
                          factor, no check and no verdict (AU_RESULT 2: `method='dop853'`) */
-#define AU_PHASE 8    /* 0 start, 1 check run, 2 answer, 4 the answer from a moved start (the
-                         rounding floor), 3 done */
+#define AU_PHASE 8    /* 0 start, 1 check run, 2 answer, 4 the answer rounded at random (the
+                         rounding floor: `dense_jitter`), 3 done */
 #define AU_SPENT 9    /* steps of every run (accepted and rejected) */
 #define AU_NCHK 10    /* steps of the check run */
 #define AU_NANS 11    /* steps of the answer */
@@ -830,7 +868,7 @@ _AUTO = r"""
 #define AU_NOUT 24    /* in: outputs after the start */
 #define AU_SUB 25     /* the longest output interval over the answer's smallest step */
 #define AU_GATE 26    /* the acceptance of the estimate (0.5 or 1) */
-#define AU_FLOOR 27   /* the rounding floor measured by a rerun from a moved start (0: none) */
+#define AU_FLOOR 27   /* the rounding floor measured by a rerun rounded at random (0: none) */
 #define AU_ORDER 28   /* the order shown by the embedded estimates of the check's merged
                          steps against the answer's (`au_order`; NaN: not measured) */
 #define AU_ULPS 29    /* FLOOR_ULPS ulps of the largest state's size over its least tolerance
@@ -839,7 +877,9 @@ _AUTO = r"""
 #define AU_PEST 31    /* ... and the part of its estimate that the local tolerance controls */
 #define AU_FMIN 32    /* the least local factor: the answer's local tolerance kept
                          AU_LOCAL_ULPS ulps above the states' size and at least AU_RTOL_MIN */
-#define AU_HDR 33
+#define AU_DRAWS 33   /* the floor's reruns made (`au_floor`) ... */
+#define AU_DRAW 34    /* ... and the largest of their differences from the answer */
+#define AU_HDR 35
 #define AU_ACCEPT 0.5        /* estimates.AUTO_ACCEPT */
 #define AU_FLOOR_ULPS 1000.0 /* estimates.FLOOR_ULPS */
 #define AU_MEASURED 1e6      /* auto's _PASS_MEASURED */
@@ -856,6 +896,17 @@ _AUTO = r"""
 #define AU_FLOOR_GATE 1.0    /* the acceptance of the estimate with a measured floor on top
                                 (as `auto.auto_runs`: truncation within AU_ACCEPT, floor
                                 included within the tolerance) */
+#define AU_JITTER_MARGIN 1.0 /* the rounding floor over the difference of a rerun rounded
+                                at random (`dense_jitter`) from the answer: a draw of the
+                                rounding's random walk (the answer's own is another); each
+                                step moves a state by eps |x|, twice the most a rounding to
+                                nearest does: the margin is in the draw */
+#define AU_JITTER_RMS 3.5    /* the draw's move over the rms of a rounding to nearest (0.29
+                                ulp, an ulp 0.5-1 eps |x|): at least this */
+#define AU_JITTER_DRAWS 2    /* the most reruns of a floor (the largest counts) */
+#define AU_JITTER_SPREAD 30.0 /* the most one draw fell below another: four draws spread 4x
+                                 on the 39-state scene (rtol 1e-8), 10x on the near-separatrix
+                                 tumble (w0 1e-3), 33x on the hinged scene (rtol 1e-8) */
 #define AU_NOISE_EPS 30.0    /* NOISE: an embedded estimate at most this many eps / rtol
                                 is rounding */
 #define AU_AIM 0.2           /* a new answer's aim [tolerances] */
@@ -880,6 +931,21 @@ _AUTO = r"""
 #define AU_NOISE(w) (AU_AL(w) + PASS_NX)
 #define AU_RICH(w) (AU_NOISE(w) + PASS_NX)
 #define AU_SIZE(nout) (AU_HDR + 7 * PASS_NX + PASS_NU + PASS_NP + (nout) + 17)
+
+/* `estimates.carried`'s growth 2 sqrt(T min(T, 1 / L)) of a rounding rate over the horizon
+   T (L: the answer's Lipschitz estimate) */
+static casadi_real au_carry(const casadi_real* w) {
+  casadi_real horizon = AU_TS(w)[(int) w[AU_NOUT] - 1] - w[AU_T0], lip = w[AU_LIP];
+  return 2 * sqrt(horizon * (lip <= 0 ? horizon : fmin(horizon, 1.0 / lip)));
+}
+
+/* the rounding of the floor's rerun (AU_PHASE 4): the answer's rounding rates (AU_NOISE,
+   carried: `au_carried`) as measured, its draw's own stream */
+static void au_jit(const casadi_real* w, dense_jit* jit) {
+  jit->rate = AU_NOISE(w);
+  jit->scale = 1.0 / au_carry(w);
+  jit->stream = (unsigned long long) w[AU_DRAWS];
+}
 
 /* a run from x0 at the local tolerance (rtol, atol) factor (the check's state reset) */
 static void au_begin(casadi_real* w, casadi_real factor) {
@@ -907,9 +973,12 @@ static int au_step(casadi_real* w, casadi_real factor, casadi_real* Y, int* budg
   casadi_real* count = AU_COUNT(w);
   int nout = (int) w[AU_NOUT], j;
   casadi_real before = count[0] + count[1];
+  dense_jit jit;
+  au_jit(w, &jit);
   j = dense_run(AU_XR(w), AU_TT(w), AU_H(w), nout, AU_TS(w), AU_U(w), AU_P(w),
                 w[AU_RTOL] * factor, AU_AL(w), w[AU_MAXSTEPS] - w[AU_SPENT], Y + 1, nout + 1,
-                count, *budget, w[AU_STIFF], check ? AU_RICH(w) : NULL, XC + 1, step, cont);
+                count, *budget, w[AU_STIFF], check ? AU_RICH(w) : NULL, XC + 1,
+                w[AU_PHASE] == 4 ? &jit : NULL, step, cont);
   *budget -= (int) (count[0] + count[1] - before);
   return j >= nout || count[2] != 0;
 }
@@ -964,10 +1033,9 @@ static casadi_real au_diff(const casadi_real* w, const casadi_real* X, const cas
    horizon (`estimates.carried`), into AU_NOISE; returns its largest */
 static casadi_real au_carried(casadi_real* w) {
   int i;
-  casadi_real horizon = AU_TS(w)[(int) w[AU_NOUT] - 1] - w[AU_T0], lip = w[AU_LIP], tau, out = 0;
-  tau = lip <= 0 ? horizon : fmin(horizon, 1.0 / lip);
+  casadi_real carry = au_carry(w), out = 0;
   for (i = 0; i < PASS_NX; ++i) {
-    AU_NOISE(w)[i] *= 2 * sqrt(horizon * tau);
+    AU_NOISE(w)[i] *= carry;
     if (AU_NOISE(w)[i] > out) out = AU_NOISE(w)[i];
   }
   return out;
@@ -1022,8 +1090,8 @@ static casadi_real au_order(const casadi_real* w, const casadi_real* rich) {
 /* the answer X against the check XC (its steps merged in pairs): AU_D, AU_EST and the
    verdict; near the states' rounding (within 1e6 ulps) the model's rounding measured on
    the way, carried over the horizon, is added when small (`estimates.screen`), else
-   measured: the answer repeated from x0 moved by it (phase 4, into XC, judged by
-   `au_floor`) */
+   measured: the answer repeated with each step's rounding emulated at random (phase 4,
+   `dense_jitter`, into XC, judged by `au_floor`) */
 static void au_judge(casadi_real* w, casadi_real* X, casadi_real* XC) {
   int nout = (int) w[AU_NOUT], j, deep;
   casadi_real d, ulps, lmin, e, est, horizon, lip = w[AU_LIP], order;
@@ -1055,11 +1123,10 @@ static void au_judge(casadi_real* w, casadi_real* X, casadi_real* XC) {
     if (e <= 0.1 * AU_ACCEPT && !deep) {
       w[AU_BOUND] = e;
       est += e;
-    } else {  /* the flow's real amplification: the answer again from x0 + s e */
+    } else {  /* the flow's real amplification: the answer again, rounded at random */
       w[AU_EST] = est;
+      w[AU_DRAWS] = 0; w[AU_DRAW] = 0;
       au_begin(w, w[AU_FACTOR]);
-      for (j = 0; j < PASS_NX; ++j)
-        AU_XR(w)[j] += (j % 2 ? -1 : 1) * AU_NOISE(w)[j];
       w[AU_PHASE] = 4;
       return;
     }
@@ -1067,20 +1134,33 @@ static void au_judge(casadi_real* w, casadi_real* X, casadi_real* XC) {
   au_verdict(w, est);
 }
 
-/* after the rerun from the moved start (in XC): the floor is the largest of its difference
-   from the answer, the carried rounding against the least tolerance and the ulps
-   (`estimates.measured_floor`), in the estimate in place of the ulps; accepted within
-   AU_FLOOR_GATE (the truncation estimate was within the acceptance: the rerun is made only
-   then) */
+/* after a rerun rounded at random (in XC, draw AU_DRAWS): the floor is the largest of
+   AU_JITTER_MARGIN times the draws' differences from the answer, the carried rounding
+   against the least tolerance and the ulps (as `estimates.measured_floor`), in the
+   estimate in place of the ulps; accepted within AU_FLOOR_GATE (the truncation estimate
+   was within the acceptance: the rerun is made only then). A draw may fall far below
+   another (AU_JITTER_SPREAD), so below the answer's own rounding by that over
+   AU_JITTER_RMS: a second is drawn unless the first already rejects (a second only raises
+   the floor) or accepts with that to spare. */
 static void au_floor(casadi_real* w, casadi_real* X, casadi_real* XC) {
-  casadi_real ulps, lmin, d = au_diff(w, X, XC, &ulps, &lmin), local = 0;
+  casadi_real ulps, lmin, d = au_diff(w, X, XC, &ulps, &lmin), local = 0, drawn, fixed, base;
   int i;
   for (i = 0; i < PASS_NX; ++i) local = fmax(local, AU_NOISE(w)[i]);
   local = lmin > 0 ? local / lmin : (local > 0 ? INFINITY : 0);
-  w[AU_FLOOR] = fmax(fmax(d, local), ulps);
+  w[AU_DRAWS] += 1;
+  drawn = fmax(w[AU_DRAW], AU_JITTER_MARGIN * d);  /* (the draws' part; the rest is fixed) */
+  w[AU_DRAW] = drawn;
+  fixed = fmax(local, ulps);
+  w[AU_FLOOR] = fmax(drawn, fixed);
   /* (the floor replaces the ulps in the estimate: it is at least them) */
   w[AU_GATE] = AU_FLOOR_GATE;
-  au_verdict(w, w[AU_EST] - ulps + w[AU_FLOOR]);
+  base = w[AU_EST] - ulps;
+  if (w[AU_DRAWS] < AU_JITTER_DRAWS && base + w[AU_FLOOR] <= w[AU_GATE]
+      && base + fmax(AU_JITTER_SPREAD / AU_JITTER_RMS * drawn, fixed) > w[AU_GATE]) {
+    au_begin(w, w[AU_FACTOR]);  /* (phase 4 again, the next draw's stream) */
+    return;
+  }
+  au_verdict(w, base + w[AU_FLOOR]);
 }
 
 /* `rk8_auto`'s start (AU_PHASE 0): the header reset, the first answer begun (AU_PHASE 2);
@@ -1089,6 +1169,7 @@ static int au_start(casadi_real* w, int nout, casadi_real* X, casadi_real* XC) {
   int i, ld = nout + 1;
   w[AU_SPENT] = 0; w[AU_TRY] = 0; w[AU_RESULT] = 0; w[AU_FLAG] = 0; w[AU_EST] = NAN;
   w[AU_BOUND] = 0; w[AU_FLOOR] = 0; w[AU_ULPS] = 0; w[AU_PFAC] = 0; w[AU_PEST] = 0;
+  w[AU_DRAWS] = 0; w[AU_DRAW] = 0;
   for (i = 0; i < PASS_NX; ++i) X[i * ld] = XC[i * ld] = AU_X0(w)[i];
   /* the local tolerance kept AU_LOCAL_ULPS ulps above the states' size (a tighter one asks
      for less than DOP853's rounding) and at least AU_RTOL_MIN; a requested tolerance
@@ -1106,7 +1187,7 @@ static int au_start(casadi_real* w, int nout, casadi_real* X, casadi_real* XC) {
   return 0;
 }
 
-/* `rk8_auto` after a run ended (an answer with its check, or the rerun from a moved start:
+/* `rk8_auto` after a run ended (an answer with its check, or the rerun rounded at random:
    `floor`; `plain`: the answer alone): its steps counted, then the verdict, a retry or the
    rerun (AU_PHASE) */
 static void au_ended(casadi_real* w, casadi_real* X, casadi_real* XC, int floor, int plain) {
@@ -1225,6 +1306,7 @@ int rk8_auto_many(const casadi_real* w, int nout, const long long* runs, long lo
    `dense_run` in progress (`opened` 0: it ended at its start) */
 typedef struct {
   dense_state s;
+  dense_jit jit;  /* its floor's rerun's (`au_jit`) */
   casadi_real *w, *X, *XC;
   long k;
   int opened, ended, floor, fresh, lane;  /* fresh: opened since its lane took `au_vrun` */
@@ -1381,20 +1463,22 @@ static void au_checks(au_lane* L, au_vio* v, au_pend* P, au_vstep step, au_vstep
 }
 
 /* lane L's run in progress opened as `au_step` opens it (a retried answer with its check,
-   or the rerun from a moved start into XC, `floor`); 1 when it has steps to take */
+   or the rerun rounded at random into XC, `floor`); 1 when it has steps to take */
 static int au_lane_open(au_lane* L, int nout, int plain) {
   casadi_real* w = L->w;
   L->fresh = 1;
+  au_jit(w, &L->jit);
   L->opened = dense_open(&L->s, AU_XR(w), AU_TT(w), *AU_H(w), nout, AU_TS(w), AU_U(w),
                          AU_P(w), w[AU_RTOL] * w[AU_FACTOR], AU_AL(w),
                          w[AU_MAXSTEPS] - w[AU_SPENT], (L->floor ? L->XC : L->X) + 1,
                          nout + 1, AU_COUNT(w), w[AU_STIFF],
-                         L->floor || plain ? NULL : AU_RICH(w), L->XC + 1);
+                         L->floor || plain ? NULL : AU_RICH(w), L->XC + 1,
+                         L->floor ? &L->jit : NULL);
   return L->opened && L->s.j < nout;
 }
 
 /* lane L's run after its answer (or rerun) ended: `rk8_auto`'s verdict; a retry or a rerun
-   from a moved start goes on in the lane (the lanes stay full); a run done leaves its
+   rounded at random goes on in the lane (the lanes stay full); a run done leaves its
    header in res (AU_HDR per run) and the lane empty */
 static void au_lane_next(au_lane* L, int nout, casadi_real* res, int plain) {
   casadi_real* w = L->w;
@@ -1504,6 +1588,9 @@ int rk8_auto_lanes(const casadi_real* w, int nout, const long long* runs, long l
     }
     au_extend(&P, cont, &v, span, t, S, XO);
     au_vkeep(&v, took);  /* (each lane's next x: xn where accepted) */
+    for (l = 0; l < PASS_LANES; ++l)  /* (a rerun's rounded at random: `dense_jitter`) */
+      if (took[l] && L[l].floor)
+        for (i = 0; i < PASS_NX; ++i) v.x[i][l] = L[l].s.x[i];
     if (!any) continue;
     au_checks(L, &vc, &P, step, cont, 1);  /* (a run ends with its checks taken) */
     au_flush(&P, cont);  /* (and its outputs filled) */

@@ -351,14 +351,15 @@ def test_the_learned_factor_models_the_compiled_retry():
 def test_near_round_off_the_floor_is_measured_in_the_same_call():
     """rtol 1e-10 (atol 1e-12) on issue 31's body: within 1e6 ulps of the states, the carried
     rounding is not small against the quaternion's tolerance (1e-12 where a part crosses
-    zero), so the answer is repeated from a start moved by it in the same compiled call (its
-    steps counted); the result meets the tolerance against the Jacobi truth."""
+    zero), so the answer is repeated with each step's rounding emulated at random in the
+    same compiled call (its steps counted); the result meets the tolerance against the
+    Jacobi truth."""
     from appdyn.dynamics.integrate.dense import dense_auto
     model, t = rigid_body(INERTIA), np.linspace(0.0, 60.0, 121)
     rtol, atol = 1e-10, 1e-12
     got = dense_auto(_problem(model, X0, t), rtol, np.full(7, atol), 1e8, 1e6)
-    assert got.result == 1 and got.floor > 0 and got.bound == 0
-    assert got.spent >= 2 * got.answer_steps + got.check_steps
+    assert got.result == 1 and got.floor > 0 and got.bound == 0 and got.draws >= 1
+    assert got.spent >= (1 + got.draws) * got.answer_steps + got.check_steps
     res = simulate(model, X0, t, rtol=rtol, atol=atol)
     assert res.success and "rounding floor" in res.message, res.message
     w = torque_free_omega(INERTIA, X0[4:], t)
@@ -414,7 +415,7 @@ def test_a_retry_far_above_the_rounding_makes_no_floor_run():
     the tolerance) is refused and the retry, predicted from the estimate, lands about 30x
     tighter, 1e5 ulps above the states' size, where rounding is no part of the difference of
     the answer and its check (the floors measured there were 3e-6 of the tolerance): no
-    rerun from a moved start, two answers and their checks in all, verified and within the
+    floor rerun, two answers and their checks in all, verified and within the
     estimate of Jacobi's rates."""
     from appdyn.dynamics.integrate.dense import FIRST, dense_auto
     inertia, w0 = _JACOBI[1]
@@ -544,3 +545,46 @@ def test_the_passs_chunk_with_the_disk_cache_off():
         clear_caches()
     assert want.success and got.success and got.compiled
     assert np.allclose(got.x, want.x, rtol=1e-13, atol=1e-12)
+
+
+def test_the_floor_draws_are_keyed_by_the_step_so_a_run_cut_anywhere_agrees():
+    """The floor's reruns round each accepted state at random from a stream keyed by the
+    run's step count: the bench body at rtol 1e-10 (two draws: the first leaves the verdict
+    open) gives the same answer, floor and steps whether its call runs whole or is cut every
+    97 steps (as Ctrl-C checks cut it), and again on a second call."""
+    from appdyn.dynamics.integrate import dense
+    inertia, w0 = _JACOBI[1]
+    model, t = rigid_body(inertia), np.linspace(0.0, 100.0, 101)
+    x0 = np.r_[0.0, 0.0, 0.0, 1.0, w0]
+    run = lambda: dense.dense_run(model, x0, t, 1e-10, 1e-12, 1e8, 1e6)
+    whole = run()
+    assert whole.result == 1 and whole.draws == 2 and whole.floor > 0
+    again = run()
+    assert (again.floor, again.spent, again.draws) == (whole.floor, whole.spent, whole.draws)
+    saved = dense._LOCAL.__dict__.pop("work", None)
+    budget, dense.BUDGET = dense.BUDGET, 97
+    try:
+        cut = run()
+    finally:
+        dense.BUDGET = budget
+        dense._LOCAL.__dict__.pop("work", None)
+        if saved is not None:
+            dense._LOCAL.work = saved
+    assert np.array_equal(cut.x, whole.x)
+    assert (cut.floor, cut.spent, cut.draws) == (whole.floor, whole.spent, whole.draws)
+    w = torque_free_omega(inertia, w0, t)
+    assert np.all(np.abs(whole.x[4:] - w) <= 1e-12 + 1e-10 * np.abs(w))
+
+
+def test_a_first_floor_draw_that_refuses_makes_no_second():
+    """A tumble 1e-3 rad/s off the separatrix (100 s, rtol 1e-8): the flow amplifies the
+    rounding past the tolerance, so the first draw refuses the answer (a second could only
+    raise the floor) and none is made; the refusal is right: the answer is more than a
+    tolerance from Jacobi's rates."""
+    from appdyn.dynamics.integrate.dense import dense_run
+    inertia, w0 = [1.0, 2.0, 3.0], [1e-3, 1.0, 1e-3]
+    model, t = rigid_body(inertia), np.linspace(0.0, 100.0, 201)
+    got = dense_run(model, np.r_[0.0, 0.0, 0.0, 1.0, w0], t, 1e-8, 1e-10, 1e8, 1e6)
+    assert got.result == 0 and got.draws == 1 and got.floor > 1.0, got
+    w = torque_free_omega(inertia, w0, t)
+    assert np.max(np.abs(got.x[4:] - w) / (1e-10 + 1e-8 * np.abs(w))) > 1.0

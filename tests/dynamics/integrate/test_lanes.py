@@ -117,7 +117,7 @@ def test_dense_batches_in_lanes_are_the_scalar_loop_to_the_bit(kw, n, monkeypatc
     continuous extensions of the lanes' steps gathered four to a vector call and their
     outputs filled from it later) are the scalar loop's bits: answers, estimates, steps,
     verdicts; 11 runs (lanes refilled, a short last group); near the rounding some runs
-    retry or rerun from a moved start alone; grids with no output inside a step (2 points)
+    retry or rerun rounded at random alone; grids with no output inside a step (2 points)
     and with several inside each (801). Truth: Jacobi's closed form within the
     tolerance."""
     from appdyn.dynamics.integrate import batch
@@ -140,6 +140,32 @@ def test_dense_batches_in_lanes_are_the_scalar_loop_to_the_bit(kw, n, monkeypatc
         err = np.abs(got.x[4:, :, k] - w) / (atol + rtol * np.abs(w))
         assert err.max() <= (1.0 if "method" not in kw else 30.0)  # (dop853: not verified)
 
+
+
+def test_a_batch_whose_floors_take_one_or_two_draws_in_lanes_is_the_scalar_loop(monkeypatch):
+    """Runs near the bench body's rounding (100 s, rtol 1e-10: six spins 2 % apart) measure
+    their rounding floor by reruns rounded at random, one or two draws each (the second on
+    its own stream, in the lane the first ran in, its state kept there between steps): the
+    lanes give the scalar loop's bits; each run within the tolerance of Jacobi's rates."""
+    from appdyn.dynamics.integrate import batch, dense
+    from appdyn.dynamics.truth import torque_free_omega
+    inertia = [1.0, 2.0, 3.0]
+    model, t = rigid_body(inertia), np.linspace(0.0, 100.0, 101)
+    w = np.array([[1.0], [0.1], [0.8]]) * (1 + np.linspace(-2e-2, 2e-2, 6))
+    X0 = np.vstack([np.zeros((3, 6)), np.ones(6), w])
+    rtol, atol = 1e-10, 1e-12
+    draws = [dense.dense_run(model, X0[:, k], t, rtol, atol, 1e8, 1e6).draws for k in range(6)]
+    assert 2 in draws and 1 in draws, draws
+    assert lanes.dense_lanes(model, wait=True) is not None
+    got = simulate(model, X0, t, rtol=rtol, atol=atol, threads=1)
+    monkeypatch.setattr(batch, "dense_lanes", lambda m, **k: None)
+    ref = simulate(model, X0, t, rtol=rtol, atol=atol, threads=1)
+    np.testing.assert_array_equal(got.x, ref.x)
+    np.testing.assert_array_equal(got.error_estimate, ref.error_estimate)
+    assert got.n_steps == ref.n_steps and got.all_success
+    for k in range(6):
+        truth = torque_free_omega(inertia, X0[4:, k], t)
+        assert np.all(np.abs(got.x[4:, :, k] - truth) <= atol + rtol * np.abs(truth))
 
 def test_a_dense_batch_with_parameters_and_controls_in_lanes_is_the_scalar_loop():
     """Runs with their own parameter and constant control (the pendulum) in lanes: the
@@ -194,7 +220,7 @@ def test_a_single_call_with_its_check_in_a_lane_is_the_scalar_call(kw, budget, m
     """A single checked call whose check's steps ride in a lane of its answer's vector steps
     (the pass's ``rk8_auto_v``, `dense_advance_v`) is the scalar call to the bit: answer,
     estimate, steps, message; also when the call is cut into budgets of 7 steps (a check
-    due at a cut is taken alone) and near the rounding (a rerun from a moved start).
+    due at a cut is taken alone) and near the rounding (a rerun rounded at random).
     Truth: Jacobi's closed form within the tolerance."""
     from appdyn.dynamics.integrate import dense
     from appdyn.dynamics.truth import torque_free_omega
