@@ -896,13 +896,10 @@ _AUTO = r"""
 #define AU_FLOOR_GATE 1.0    /* the acceptance of the estimate with a measured floor on top
                                 (as `auto.auto_runs`: truncation within AU_ACCEPT, floor
                                 included within the tolerance) */
-#define AU_JITTER_MARGIN 1.0 /* the rounding floor over the difference of a rerun rounded
-                                at random (`dense_jitter`) from the answer: a draw of the
-                                rounding's random walk (the answer's own is another); each
-                                step moves a state by eps |x|, twice the most a rounding to
-                                nearest does: the margin is in the draw */
-#define AU_JITTER_RMS 3.5    /* the draw's move over the rms of a rounding to nearest (0.29
-                                ulp, an ulp 0.5-1 eps |x|): at least this */
+#define AU_JITTER_RMS 3.5    /* a draw's move of a state (eps |x|, `dense_jitter`: twice the
+                                most a rounding to nearest moves it) over that rounding's
+                                rms (0.29 ulp, an ulp 0.5-1 eps |x|): at least this, so a
+                                draw's difference from the answer is the floor as it is */
 #define AU_JITTER_DRAWS 2    /* the most reruns of a floor (the largest counts) */
 #define AU_JITTER_SPREAD 30.0 /* the most one draw fell below another: four draws spread 4x
                                  on the 39-state scene (rtol 1e-8), 10x on the near-separatrix
@@ -1135,7 +1132,8 @@ static void au_judge(casadi_real* w, casadi_real* X, casadi_real* XC) {
 }
 
 /* after a rerun rounded at random (in XC, draw AU_DRAWS): the floor is the largest of
-   AU_JITTER_MARGIN times the draws' differences from the answer, the carried rounding
+   the draws' differences from the answer (a draw of the rounding's random walk, the
+   answer's own another; the margin is in the draw's moves: AU_JITTER_RMS), the carried rounding
    against the least tolerance and the ulps (as `estimates.measured_floor`), in the
    estimate in place of the ulps; accepted within AU_FLOOR_GATE (the truncation estimate
    was within the acceptance: the rerun is made only then). A draw may fall far below
@@ -1148,7 +1146,7 @@ static void au_floor(casadi_real* w, casadi_real* X, casadi_real* XC) {
   for (i = 0; i < PASS_NX; ++i) local = fmax(local, AU_NOISE(w)[i]);
   local = lmin > 0 ? local / lmin : (local > 0 ? INFINITY : 0);
   w[AU_DRAWS] += 1;
-  drawn = fmax(w[AU_DRAW], AU_JITTER_MARGIN * d);  /* (the draws' part; the rest is fixed) */
+  drawn = fmax(w[AU_DRAW], d);  /* (the draws' part; the rest is fixed) */
   w[AU_DRAW] = drawn;
   fixed = fmax(local, ulps);
   w[AU_FLOOR] = fmax(drawn, fixed);
