@@ -183,7 +183,8 @@ class Single:
         return map_eval(problem.model.f, [X, U, problem.p])
 
 
-def auto_runs(target, rtol, atol, max_steps, jit_pref, progress: Progress):
+def auto_runs(target, rtol, atol, max_steps, jit_pref, progress: Progress, *,
+              rounding: float = 0.0):
     """Run ``rk8`` with step counts chosen until the global error estimate meets the tolerance
     (``target``: a `Single` problem or a batch; ``atol`` per flat state).
 
@@ -193,7 +194,8 @@ def auto_runs(target, rtol, atol, max_steps, jit_pref, progress: Progress):
     right-hand side that may be non-smooth, ``target.nonsmooth``, whose runs stopped
     converging far above the modelled round-off, or did not settle: the order is lost at
     kinks) or ``UNVERIFIED`` (not within ``max_steps`` or the run budget); the best run
-    found is returned with them.
+    found is returned with them. ``rounding``: a rounding floor measured before
+    (`dense_pass`'s), the least floor an estimate is accepted with.
     """
     t = target.t
     nint = t.size - 1
@@ -244,6 +246,7 @@ def auto_runs(target, rtol, atol, max_steps, jit_pref, progress: Progress):
             best = runs[max(k for k, r in runs.items() if r.ok)]
             floor, extra = measured_floor(target, best, rtol, atol, lipschitz, auto_jit(jit_pref),
                                   progress)
+            floor = max(floor, rounding)
             total[0] += extra
             total[1] += extra * DOP853.stages
             if est.value + floor > 1.0:
@@ -284,7 +287,8 @@ def _auto_cvodes(problem: Problem, rtol, atol, extra):
     return run, estimate, status, n_steps, n_rhs
 
 
-def one_pass(problem: Problem, rtol, atol, max_steps, jit_pref, progress):
+def one_pass(problem: Problem, rtol, atol, max_steps, jit_pref, progress, *,
+             rounding: float = 0.0):
     """``auto`` in one compiled pass (`dynamics.integrate.adaptive`) where it applies:
     returns ``(run, estimate, steps)``, or ``(None, nan, steps)`` to leave the problem to
     the multi-run search (`auto_runs`) with ``steps`` already spent.
@@ -312,6 +316,14 @@ def one_pass(problem: Problem, rtol, atol, max_steps, jit_pref, progress):
     horizon with the spectral radius at ``x0``, must be below 0.05 (it is added to the
     estimate); otherwise the multi-run search measures the flow's real amplification.
 
+    ``rounding``: a rounding floor measured before (`dense_pass`'s), added at least. Where
+    the Richardson division decides (``2 d`` plus the ulps above 1), the part of ``d`` that
+    the check's start, 2 ulp away, makes is not truncation and is not divided: near a
+    separatrix the flow amplifies it 1e8-fold (``d`` 1.0-5.6 tolerances estimated at
+    0.02-0.09, answers 1.3-2.6 tolerances off); `_amplified` measures it (the answer's
+    steps, at least, from another start 2 ulp away), added to the estimate, which is then
+    accepted within 1, or left to the multi-run search.
+
     Not accepted, the pass is repeated aimed tighter (`_PASS_TRIES` in all). Not taken: a
     callable control, no compiled pass, a tolerance within `_PASS_ULPS` ulps of a state, a
     non-finite state or an interval that needs more than ``2 cpass.BMAX + 1`` steps.
@@ -331,7 +343,7 @@ def one_pass(problem: Problem, rtol, atol, max_steps, jit_pref, progress):
         spent += got.n_steps
         if not got.ok:
             return None, math.nan, spent
-        d, ulps = got.d, got.ulp * FLOOR_ULPS
+        d, ulps = got.d, max(got.ulp * FLOOR_ULPS, rounding)
         if got.ulp * _PASS_MEASURED > 1.0:  # near round-off: the model's rounding, measured
             lipschitz = Single(problem).spectrum(rtol, atol)[0]
             bound = screen(carried(got.rounding, horizon, lipschitz), got.smin, horizon,
@@ -350,6 +362,12 @@ def one_pass(problem: Problem, rtol, atol, max_steps, jit_pref, progress):
             trusted = measured >= 3 and 2 * shown >= measured
         if trusted and richardson + ulps <= AUTO_ACCEPT:
             estimate = richardson + ulps
+            if 2 * d + ulps > 1.0:  # (the Richardson division decides: measured, `_amplified`)
+                floor, extra = _amplified(problem, got, rtol, atol, jit_pref, progress)
+                spent += extra
+                if not richardson + max(floor, ulps) <= 1.0:
+                    return None, math.nan, spent  # (the multi-run search says what it is)
+                estimate = richardson + max(floor, ulps)
         elif got.ec <= 1.0 and 2 * d + ulps <= 1.0:
             estimate = 2 * d + ulps
         else:
@@ -371,17 +389,34 @@ def one_pass(problem: Problem, rtol, atol, max_steps, jit_pref, progress):
     return None, math.nan, spent
 
 
+def _amplified(problem: Problem, got, rtol, atol, jit_pref, progress) -> tuple[float, int]:
+    """`one_pass`'s measure of what the flow makes of a start 2 ulp away (`perturbed`):
+    ``(floor, steps)``, twice the scaled difference from the pass's answer ``got.x`` of
+    fixed-step rk8 with the answer's most steps per interval (at least its steps
+    everywhere: their truncation differs by at most the answer's, which the estimate holds
+    already; twice: one start is one draw of the rounding, as `cpass`'s
+    ``AU_JITTER_SPREAD`` measures; with the average steps instead, a tumble near the
+    separatrix was verified at 0.96 with an error of 1.38), inf when that run fails."""
+    m = int(got.n_range[1])
+    run = Single(problem).run(perturbed(problem.x0, m), m, auto_jit(jit_pref), progress)
+    if not run.ok:
+        return math.inf, run.n_steps
+    scale = atol[:, None] + rtol * np.abs(got.x[:, 1:])
+    return 2 * scaled_diff(run.x[:, 1:], got.x[:, 1:], scale), run.n_steps
+
+
 def dense_pass(problem: Problem, rtol, atol, max_steps, progress):
     """``auto`` for a smooth right-hand side under a control constant over the run: DOP853
     stepping by its error estimate alone, the outputs filled from its continuous extension
     (`stepcontrol.plain_run`), so the work follows the solution, not the output grid; the
     answer, its check (its steps merged in pairs), their comparison and the verdict in
     one compiled call (`dense.dense_auto`, whose docstring states the rules).
-    Returns ``(run, estimate, status, spent)``: status ``OK`` (verified), ``ROUNDOFF`` (not
-    verified because the tolerance lies below the rounding floor of double precision: 1000
-    ulps of a state's size, with the carried rounding, exceed it at the outputs, so no path
-    of ``auto`` can verify it; the answer is returned at once with its estimate, `_floor_message`
-    words it), or ``(None, nan, None, spent)`` to leave the problem to `one_pass` and the multi-run
+    Returns ``(run, estimate, status, spent, floor)``: status ``OK`` (verified), ``ROUNDOFF``
+    (not verified because the tolerance lies below the rounding floor of double precision:
+    1000 ulps of a state's size, with the carried rounding, or the rounding floor measured
+    exceed it at the outputs, so no path of ``auto`` can verify it; the answer is returned
+    at once with its estimate, `_floor_message` words it), or ``(None, nan, None, spent,
+    floor)`` to leave the problem to `one_pass` and the multi-run
     search (stiff by the first step's Lipschitz estimate: more than `STIFF_STEPS` steps for
     stability alone; no compiled library, a control that varies, a requested tolerance below
     one ulp of a state's size, a failed run, or no verdict after `dense.TRIES` answers).
@@ -390,13 +425,16 @@ def dense_pass(problem: Problem, rtol, atol, max_steps, progress):
     way, carried over the horizon, is added; where it is not small, the floor measured by the
     answer repeated with each step's rounding emulated at random (one or two draws: `dense`),
     in the same call.
-    ``spent``: the steps of its runs (counted in the result whichever path answers).
+    ``spent``: the steps of its runs (counted in the result whichever path answers);
+    ``floor`` the rounding floor measured (0: none), which the other paths then add at
+    least (they model the rounding; the pass measured it).
     """
     got = dense_auto(problem, rtol, atol, max_steps, STIFF_STEPS, progress=progress)
     if got is None:
-        return None, math.nan, None, 0
+        return None, math.nan, None, 0, 0.0
     out = dense_outcome(got, rtol)
-    return (*out, got.spent) if out is not None else (None, math.nan, None, got.spent)
+    return (*out, got.spent, got.floor) if out is not None else \
+        (None, math.nan, None, got.spent, got.floor)
 
 
 def dense_outcome(got: DenseAuto, rtol: float) -> tuple[Run, float, int] | None:
@@ -406,9 +444,11 @@ def dense_outcome(got: DenseAuto, rtol: float) -> tuple[Run, float, int] | None:
     call (which would otherwise run the same pass again on the general path)."""
     if got.result == 1:
         return *dense_answer(got, rtol), OK
-    if got.result == 0 and got.ulps + got.bound > 1.0:
+    if got.result == 0 and max(got.ulps + got.bound, got.floor) > 1.0:
         # (every path accepts at most a floor of the tolerance: `auto_runs`' estimate plus
-        # its floor, which is at least these ulps, within 1)
+        # its floor, which is at least these ulps, within 1; and the floor the pass measured
+        # is the rounding of this problem in double precision, whichever path runs it: the
+        # other paths model it, the pass measured it)
         return (Run.new(got.x, got.spent, DOP853.stages * got.spent, got.substeps, True, True,
                         _floor_message(got, rtol)), got.estimate, ROUNDOFF)
     return None
@@ -416,14 +456,22 @@ def dense_outcome(got: DenseAuto, rtol: float) -> tuple[Run, float, int] | None:
 
 def _floor_message(got: DenseAuto, rtol: float) -> str:
     """The message of `dense_pass`'s answer below the rounding floor: what was asked, what
-    the floor is, the answer's estimate and the remedy."""
+    the floor is (the states' ulps, or the rounding the flow amplifies, measured), the
+    answer's estimate and the remedy."""
+    fixed = got.ulps + got.bound
+    if got.floor > fixed:
+        what = (f"the rounding of its steps, amplified by the flow, reaches {got.floor:.2g} "
+                "of the tolerance at the outputs")
+    else:
+        what = (f"1000 ulps of the largest state's size are {got.ulps:.2g} of its least "
+                "tolerance at the outputs"
+                + (f", the rounding carried over the horizon {got.bound:.2g} more"
+                   if got.bound else ""))
     return (f"auto: tolerance not verified: it lies below the round-off floor of double "
-            f"precision for these states (1000 ulps of the largest state's size are "
-            f"{got.ulps:.2g} of its least tolerance at the outputs"
-            + (f", the rounding carried over the horizon {got.bound:.2g} more" if got.bound
-               else "")
-            + f"); {dense_message(got, rtol)[len('auto: '):]}; x is the best solution found; "
-            f"remedy: rtol and atol at least {4 * (got.ulps + got.bound):.2g}x looser")
+            f"precision for these states ({what}); {dense_message(got, rtol)[len('auto: '):]}; "
+            f"x is the best solution found; remedy: rtol and atol at least "
+            f"{4 * max(fixed, got.floor):.2g}x looser" + (" or a shorter horizon"
+                                                          if got.floor > fixed else ""))
 
 
 def dense_answer(got: DenseAuto, rtol: float) -> tuple[Run, float]:
@@ -529,21 +577,25 @@ def solve_auto(problem: Problem, rtol, atol, max_steps, jit, cvodes_options, pro
     path, then the multi-run Richardson search (`auto_runs`)."""
     causes = nonsmooth_causes(problem, operations=nonsmooth)
     spent = tried = 0
+    rounding = 0.0  # (the rounding floor the dense pass measured: the others add it)
     if causes:
         got = _auto_stepped(problem, rtol, atol, max_steps, jit, progress, causes)
         if got is not None:
             return got
     else:
-        run, estimate, status, tried = dense_pass(problem, rtol, atol, max_steps, progress) \
-            if auto_jit(jit) else (None, math.nan, None, 0)
+        run, estimate, status, tried, rounding = dense_pass(problem, rtol, atol, max_steps,
+                                                            progress) \
+            if auto_jit(jit) else (None, math.nan, None, 0, 0.0)
         if run is not None:  # (DOP853's 8th-order steps, as the fixed-step rk8)
             return run, "rk8", status, estimate
-        run, estimate, spent = one_pass(problem, rtol, atol, max_steps, jit, progress)
+        run, estimate, spent = one_pass(problem, rtol, atol, max_steps, jit, progress,
+                                        rounding=rounding)
         if run is not None:  # (the steps of every path tried are counted)
             return replace(run, n_steps=run.n_steps + tried,
                            n_rhs=run.n_rhs + DOP853.stages * tried), "rk8", OK, estimate
     run, estimate, status, reason, n_steps, n_rhs = auto_runs(Single(problem), rtol, atol,
-                                                          max_steps - spent, jit, progress)
+                                                          max_steps - spent, jit, progress,
+                                                          rounding=rounding)
     spent += tried
     n_steps, n_rhs = n_steps + spent, n_rhs + DOP853.stages * spent
     if run is None and reason.startswith("stiff"):
@@ -568,7 +620,9 @@ def solve_auto(problem: Problem, rtol, atol, max_steps, jit, cvodes_options, pro
     if status == ROUNDOFF:
         message = ("auto: tolerance not verified: it lies at the round-off floor of fixed-step "
                    f"runs on this grid ({run.message}; estimated error incl. modelled round-off "
-                   f"{estimate:.2g} of tolerance); x is the best solution found")
+                   f"{estimate:.2g} of tolerance); x is the best solution found; remedy: rtol "
+                   f"and atol at least {4 * max(estimate, 1.0):.2g}x looser, or a shorter "
+                   "horizon")
     elif status == NONSMOOTH:
         message = (f"auto: tolerance not verified: "
                    f"{_nonsmooth_remedy(Single(problem).nonsmooth, 'not round-off')}"
