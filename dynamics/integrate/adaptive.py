@@ -200,6 +200,38 @@ def run_pass(problem: Problem, rtol: float, atol: np.ndarray, theta: float, max_
     return out
 
 
+
+def replay_check(problem: Problem, got: Pass) -> np.ndarray | None:
+    """The check run of the pass ``got`` over ``problem`` replayed on its own steps (``b``
+    per interval, from the answer's ``n = 2 b + 1``, or 2 for ``b = 1``) from the exact start
+    ``x0`` (the check's started 2 ulp away): ``x (nx, intervals done + 1)``, NaN past a
+    non-finite state; its difference from ``got.xc`` is what the flow made of those 2 ulp,
+    truncation alike (`auto._amplified`). None without a compiled pass."""
+    fun = pass_library(problem.model)
+    if fun is None:
+        return None
+    model, t, ctrl = problem.model, problem.t, problem.control
+    done = got.stats.shape[0]
+    n = got.stats[:, 0]
+    b = np.ascontiguousarray(np.where(n <= 2, 1.0, (n - 1) / 2))
+    H = np.ascontiguousarray(np.diff(t)[:done])
+    nu = model.nu
+    if ctrl.constant:
+        ua, ud, ustride = np.ascontiguousarray(np.resize(ctrl.ua[0], max(nu, 1))), \
+            np.zeros(max(nu, 1)), 0
+    else:
+        ua = np.ascontiguousarray(ctrl.ua[:done].ravel())
+        ud = np.ascontiguousarray(((ctrl.ub[:done] - ctrl.ua[:done]) / H[:, None]).ravel())
+        ustride = nu
+    x = np.array(problem.x0, dtype=float)
+    X = np.full((model.nx, done + 1), np.nan)
+    X[:, 0] = x
+    p = np.ascontiguousarray(problem.p, dtype=float)
+    atol = np.ones(model.nx)
+    fun.replay(x.ctypes.data, done, H.ctypes.data, ua.ctypes.data, ud.ctypes.data, ustride,
+               p.ctypes.data, atol.ctypes.data, b.ctypes.data, X.ctypes.data, done + 1)
+    return X
+
 _EPS = float(np.finfo(float).eps)
 _REASONS = ("", "a state became non-finite",
             f"an output interval needs more than {2 * BMAX + 1} steps",

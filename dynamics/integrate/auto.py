@@ -10,7 +10,7 @@ from functools import partial
 import numpy as np
 
 from .. import cache
-from .adaptive import run_pass
+from .adaptive import replay_check, run_pass
 from .cpass import BMAX, CHECK_EVERY, NOISE
 from .cvodes import run_cvodes
 from .dense import DenseAuto, dense_auto
@@ -320,9 +320,9 @@ def one_pass(problem: Problem, rtol, atol, max_steps, jit_pref, progress, *,
     the Richardson division decides (``2 d`` plus the ulps above 1), the part of ``d`` that
     the check's start, 2 ulp away, makes is not truncation and is not divided: near a
     separatrix the flow amplifies it 1e8-fold (``d`` 1.0-5.6 tolerances estimated at
-    0.02-0.09, answers 1.3-2.6 tolerances off); `_amplified` measures it (the answer's
-    steps, at least, from another start 2 ulp away), added to the estimate, which is then
-    accepted within 1, or left to the multi-run search.
+    0.02-0.09, answers 1.3-2.6 tolerances off); `_amplified` measures it (the check's steps
+    replayed from the exact start), added to the estimate, which is then accepted within
+    1, or left to the multi-run search.
 
     Not accepted, the pass is repeated aimed tighter (`_PASS_TRIES` in all). Not taken: a
     callable control, no compiled pass, a tolerance within `_PASS_ULPS` ulps of a state, a
@@ -363,7 +363,7 @@ def one_pass(problem: Problem, rtol, atol, max_steps, jit_pref, progress, *,
         if trusted and richardson + ulps <= AUTO_ACCEPT:
             estimate = richardson + ulps
             if 2 * d + ulps > 1.0:  # (the Richardson division decides: measured, `_amplified`)
-                floor, extra = _amplified(problem, got, rtol, atol, jit_pref, progress)
+                floor, extra = _amplified(problem, got, rtol, atol, progress)
                 spent += extra
                 if not richardson + max(floor, ulps) <= 1.0:
                     return None, math.nan, spent  # (the multi-run search says what it is)
@@ -389,20 +389,19 @@ def one_pass(problem: Problem, rtol, atol, max_steps, jit_pref, progress, *,
     return None, math.nan, spent
 
 
-def _amplified(problem: Problem, got, rtol, atol, jit_pref, progress) -> tuple[float, int]:
-    """`one_pass`'s measure of what the flow makes of a start 2 ulp away (`perturbed`):
-    ``(floor, steps)``, twice the scaled difference from the pass's answer ``got.x`` of
-    fixed-step rk8 with the answer's most steps per interval (at least its steps
-    everywhere: their truncation differs by at most the answer's, which the estimate holds
-    already; twice: one start is one draw of the rounding, as `cpass`'s
-    ``AU_JITTER_SPREAD`` measures; with the average steps instead, a tumble near the
-    separatrix was verified at 0.96 with an error of 1.38), inf when that run fails."""
-    m = int(got.n_range[1])
-    run = Single(problem).run(perturbed(problem.x0, m), m, auto_jit(jit_pref), progress)
-    if not run.ok:
-        return math.inf, run.n_steps
+def _amplified(problem: Problem, got, rtol, atol, progress) -> tuple[float, int]:
+    """`one_pass`'s measure of what the flow made of its check's start, 2 ulp away:
+    ``(floor, steps)``, twice the scaled difference of the check ``got.xc`` from its own
+    steps replayed from the exact start (`adaptive.replay_check`: the same truncation, so
+    the difference is the amplified start alone; twice: one start is one draw of the
+    rounding, as `cpass`'s ``AU_JITTER_SPREAD`` measures), inf when the replay fails."""
+    x = replay_check(problem, got)
+    steps = int(np.sum(np.where(got.stats[:, 0] <= 2, 1, (got.stats[:, 0] - 1) // 2)))
+    if x is None:
+        return math.inf, 0
+    progress.step(steps, 1.0)
     scale = atol[:, None] + rtol * np.abs(got.x[:, 1:])
-    return 2 * scaled_diff(run.x[:, 1:], got.x[:, 1:], scale), run.n_steps
+    return 2 * scaled_diff(x[:, 1:], got.xc[:, 1:], scale), steps
 
 
 def dense_pass(problem: Problem, rtol, atol, max_steps, progress):

@@ -269,6 +269,31 @@ int rk8_pass_ws(casadi_real* ws, const long long* off, int done, int k, casadi_r
                   par[5], ws + off[9], X + done + 1, XC + done + 1, ldx,
                   ws + off[8] + 4 * done);
 }
+
+/* The check run of `rk8_pass` replayed from x (in/out) on its own steps: interval k of
+   length H[k] in b[k] rk8 steps (`pass_steps`, the pass's arithmetic; controls ua + tau ud
+   of stride `ustride`), the states into X (nx, ldx) from column 1; returns the intervals
+   done (fewer at a non-finite state). From the pass's exact start it shows what the flow
+   made of the check's start, 2 ulp away (`auto._amplified`). */
+int rk8_replay(casadi_real* x, int nint, const casadi_real* H, const casadi_real* ua,
+               const casadi_real* ud, int ustride, const casadi_real* p,
+               const casadi_real* atol, const casadi_real* b, casadi_real* X, int ldx) {
+  pass_ctx c;
+  casadi_real tmp[PASS_NX];
+  int k, i, bad;
+  c.p = p; c.atol = atol; c.rtol = 0;
+  for (k = 0; k < nint; ++k) {
+    c.ud = ud + k * ustride;
+    pass_steps(&c, x, tmp, (int) b[k], H[k], ua + k * ustride, 0);
+    for (i = 0, bad = 0; i < PASS_NX; ++i) {
+      x[i] = tmp[i];
+      X[i * ldx + k + 1] = tmp[i];
+      if (!isfinite(tmp[i])) bad = 1;
+    }
+    if (bad) return k + 1;
+  }
+  return nint;
+}
 """
 
 
@@ -1829,6 +1854,10 @@ def _loaded(lib, lanes: bool):
     probe.argtypes = [ptr, f64, ptr, ptr, ptr, f64, ptr, ptr]
     probe.restype = i32
     fun.probe = probe  # (tests: `_PROBE`)
+    replay = lib.rk8_replay
+    replay.argtypes = [ptr, i32, ptr, ptr, ptr, i32, ptr, ptr, ptr, ptr, i32]
+    replay.restype = i32
+    fun.replay = replay  # (`adaptive.replay_check`)
     fun.path = lib._name  # (`pass_chunk`)
     return fun
 
