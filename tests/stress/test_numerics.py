@@ -410,3 +410,35 @@ def test_a_batch_near_the_separatrix_answers_each_run_as_alone():
         truth = torque_free_omega(inertia, X0[4:, k], t)
         err = np.max(np.abs(res.x[4:, :, k] - truth) / (rtol / 100 + rtol * np.abs(truth)))
         assert res.status[k] == 2 or err <= 1.0, (k, err)
+
+
+@pytest.mark.slow  # (the truth: about a minute of mpmath)
+def test_a_chaotic_run_past_double_precision_is_not_called_success():
+    """Lorenz (sigma 10, rho 28, beta 8/3 as a double) from (1, 1, 1) over 30 s, 41 outputs,
+    rtol 1e-6: the flow amplifies a start 2 ulp away about 1e10-fold, so double precision
+    holds the answer only to about 5 tolerances. The multi-run search's Richardson triple
+    looked 8th order and its linear bound on the carried rounding said 0.007, so it said
+    success at 0.47 with an error of 4.7 tolerances; past one time constant it now measures
+    the rounding (a rerun from a moved start) and says "not verified". Truth: mpmath's
+    Taylor integration at 30 digits (`mpmath.odefun`)."""
+    import casadi as ca
+    import mpmath as mp
+    from appdyn.dynamics.model import model_from_expressions
+    x, y, z = ca.SX.sym("x"), ca.SX.sym("y"), ca.SX.sym("z")
+    beta = 8.0 / 3.0
+    model = model_from_expressions({"x": x, "y": y, "z": z},
+                                   [10 * (y - x), x * (28 - z) - y, x * y - beta * z],
+                                   name="lorenz_stress")
+    t, rtol = np.linspace(0.0, 30.0, 41), 1e-6
+    res = simulate(model, np.ones(3), t, rtol=rtol, atol=rtol / 100)
+    with mp.workdps(30):
+        b = mp.mpf(beta)
+        sol = mp.odefun(lambda s, w: [10 * (w[1] - w[0]), w[0] * (28 - w[2]) - w[1],
+                                      w[0] * w[1] - b * w[2]], 0, [mp.mpf(1)] * 3)
+        truth = np.array([[float(v) for v in sol(mp.mpf(float(s)))] for s in t]).T
+    err = np.max(np.abs(res.x - truth) / (rtol / 100 + rtol * np.abs(truth)))
+    if res.success:
+        assert err <= 1.0, (err, res.message)
+    else:
+        assert res.status == 2 and "round-off floor" in res.message, res.message
+        assert err > 1.0  # (here double precision does not hold the tolerance)
