@@ -58,7 +58,8 @@ def factor_mass(M):
     eig = np.linalg.eigvalsh(M)
     if M.size == 0 or not eig[0] > M.shape[0] * np.finfo(float).eps * max(eig[-1], 0.0):
         raise ValueError("`M` must be symmetric positive definite (a singular mass matrix, or "
-                         f"a zero or negative mass or inertia), got eigenvalues {tuple(eig)}")
+                         "a zero or negative mass or inertia), got eigenvalues "
+                         f"{tuple(eig.tolist())}")
     from scipy import linalg  # on first numeric solve (a heavy import)
 
     return linalg.cho_factor(M, lower=True)
@@ -79,5 +80,5 @@ def check_constraints(B, c):
                          f"`c` is not in its range (off by {np.linalg.norm(off):.3g}); no "
                          f"acceleration satisfies B vdot + c = 0")
     raise ValueError(f"the constraints are redundant: `B` has rank {rank} < {m} rows (singular "
-                     f"values {tuple(s)}); the multipliers are not unique -- remove the "
-                     f"dependent rows")
+                     f"values {', '.join(f'{v:.3g}' for v in s)}); the multipliers are not "
+                     "unique -- remove the dependent rows")

@@ -25,7 +25,8 @@ def _inertia(inertia, name="inertia"):
     a = 0.5 * (a + a.T)
     eig = np.linalg.eigvalsh(a)
     if eig[0] < -1e-12 * scale:
-        raise ValueError(f"`{name}` must be positive semi-definite, got eigenvalues {tuple(eig)}")
+        raise ValueError(f"`{name}` must be positive semi-definite, got eigenvalues "
+                         f"{tuple(eig.tolist())}")
     return a
 
 

@@ -59,11 +59,11 @@ def check_inertia(inertia, *, name="inertia", triangle=True):
     eig = np.linalg.eigvalsh(a)
     if eig[0] <= 0:
         raise ValueError(
-            f"`{name}` must be symmetric positive definite, got eigenvalues {tuple(eig)}")
+            f"`{name}` must be symmetric positive definite, got eigenvalues {tuple(eig.tolist())}")
     if triangle and eig[0] + eig[1] < eig[2] * (1 - 1e-12):
         raise ValueError(
             f"`{name}` violates the triangle inequality I1 + I2 >= I3 of rigid-body principal "
             f"moments (Rheinfurth & Wilson, NASA RP-1262, Sec. 4.4 A): principal moments "
-            f"{tuple(eig)}"
+            f"{tuple(eig.tolist())}"
         )
     return a

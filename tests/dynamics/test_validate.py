@@ -261,6 +261,22 @@ def test_check_inertia_lives_here_and_in_rigid_body():
     v.check_inertia([1.0, 1.0, 3.0], triangle=False)
 
 
+def test_an_inertia_error_prints_its_eigenvalues_as_plain_numbers():
+    """The moments and eigenvalues in an inertia's or mass matrix's error read as numbers
+    (numpy 2 printed ``np.float64(0.66)`` for each)."""
+    from appdyn.dynamics.constrained.checks import factor_mass
+    from appdyn.dynamics.mass.inertia import parallel_axis
+    calls = [("principal moments (0.66, 0.69, 2.8)", lambda: v.check_inertia([0.66, 0.69, 2.8])),
+             ("eigenvalues (-1.0, 1.0, 1.0)", lambda: v.check_inertia([-1.0, 1.0, 1.0])),
+             ("eigenvalues (-1.0, 1.0, 1.0)",
+              lambda: parallel_axis(np.diag([-1.0, 1.0, 1.0]), 1.0, [0.0, 0.0, 1.0])),
+             ("eigenvalues (0.0, 1.0)", lambda: factor_mass(np.diag([0.0, 1.0])))]
+    for expected, call in calls:
+        with pytest.raises(ValueError) as info:
+            call()
+        assert expected in str(info.value) and "np.float64" not in str(info.value), info.value
+
+
 def test_wrong_kind_is_a_type_error_that_old_value_error_handlers_still_catch():
     for call in (lambda: v.finite_scalar("x", "rate"), lambda: v.check_inertia("abc")):
         with pytest.raises(TypeError) as info:
