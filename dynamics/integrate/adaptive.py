@@ -160,11 +160,7 @@ def run_pass(problem: Problem, rtol: float, atol: np.ndarray, theta: float, max_
     state[0] = bmin
     np.abs(problem.x0, out=state[_ST:_ST + nx])
     np.subtract(t[1:], t[:-1], out=H)
-    if const:
-        ua[:], ud[:] = ctrl.ua[0], 0.0
-    else:
-        ua[:] = ctrl.ua.ravel()
-        np.divide(ctrl.ub - ctrl.ua, H[:, None], out=ud.reshape(nint, nu))
+    ua[:], ud[:], _ = _controls(ctrl, H, nu)
     par[:] = (rtol, theta, BMAX, bmin, NOISE * _EPS / rtol,
               math.inf if ulps == math.inf else 1.0 / (_EPS * ulps), 0 if const else nu,
               nint + 1)
@@ -199,30 +195,38 @@ def run_pass(problem: Problem, rtol: float, atol: np.ndarray, theta: float, max_
     _return_work(work)
     return out
 
+def _controls(ctrl, H: np.ndarray, nu: int) -> tuple[np.ndarray, np.ndarray, int]:
+    """The pass's controls over the intervals of lengths ``H``: ``(ua, ud, stride)``, each
+    interval's start value and slope (flat, C-contiguous), one of each (stride 0) for a
+    constant control."""
+    if ctrl.constant:
+        return np.array(ctrl.ua[0], dtype=float), np.zeros(nu), 0
+    k = H.size
+    return (np.ascontiguousarray(ctrl.ua[:k], dtype=float).ravel(),
+            ((ctrl.ub[:k] - ctrl.ua[:k]) / H[:, None]).ravel(), nu)
+
+
+def check_steps(got: Pass) -> np.ndarray:
+    """The check run's steps ``b`` per interval of the pass ``got`` (from the answer's
+    ``n = 2 b + 1``, or 2 for ``b = 1``), as floats."""
+    n = got.stats[:, 0]
+    return np.where(n <= 2, 1.0, (n - 1) // 2)
 
 
 def replay_check(problem: Problem, got: Pass) -> np.ndarray | None:
-    """The check run of the pass ``got`` over ``problem`` replayed on its own steps (``b``
-    per interval, from the answer's ``n = 2 b + 1``, or 2 for ``b = 1``) from the exact start
-    ``x0`` (the check's started 2 ulp away): ``x (nx, intervals done + 1)``, NaN past a
-    non-finite state; its difference from ``got.xc`` is what the flow made of those 2 ulp,
-    truncation alike (`auto._amplified`). None without a compiled pass."""
+    """The check run of the pass ``got`` over ``problem`` replayed on its own steps
+    (`check_steps`) from the exact start ``x0`` (the check's started 2 ulp away): ``x (nx,
+    intervals done + 1)``, NaN past a non-finite state; its difference from ``got.xc`` is
+    what the flow made of those 2 ulp, truncation alike (`auto._amplified`). None without
+    a compiled pass."""
     fun = pass_library(problem.model)
     if fun is None:
         return None
-    model, t, ctrl = problem.model, problem.t, problem.control
-    done = got.stats.shape[0]
-    n = got.stats[:, 0]
-    b = np.ascontiguousarray(np.where(n <= 2, 1.0, (n - 1) / 2))
-    H = np.ascontiguousarray(np.diff(t)[:done])
-    nu = model.nu
-    if ctrl.constant:
-        ua, ud, ustride = np.ascontiguousarray(np.resize(ctrl.ua[0], max(nu, 1))), \
-            np.zeros(max(nu, 1)), 0
-    else:
-        ua = np.ascontiguousarray(ctrl.ua[:done].ravel())
-        ud = np.ascontiguousarray(((ctrl.ub[:done] - ctrl.ua[:done]) / H[:, None]).ravel())
-        ustride = nu
+    model, done = problem.model, got.stats.shape[0]
+    b = np.ascontiguousarray(check_steps(got))
+    H = np.ascontiguousarray(np.diff(problem.t)[:done])
+    ua, ud, ustride = _controls(problem.control, H, model.nu)
+    ua, ud = np.resize(ua, max(ua.size, 1)), np.resize(ud, max(ud.size, 1))
     x = np.array(problem.x0, dtype=float)
     X = np.full((model.nx, done + 1), np.nan)
     X[:, 0] = x
@@ -231,6 +235,7 @@ def replay_check(problem: Problem, got: Pass) -> np.ndarray | None:
     fun.replay(x.ctypes.data, done, H.ctypes.data, ua.ctypes.data, ud.ctypes.data, ustride,
                p.ctypes.data, atol.ctypes.data, b.ctypes.data, X.ctypes.data, done + 1)
     return X
+
 
 _EPS = float(np.finfo(float).eps)
 _REASONS = ("", "a state became non-finite",

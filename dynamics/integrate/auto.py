@@ -10,7 +10,7 @@ from functools import partial
 import numpy as np
 
 from .. import cache
-from .adaptive import replay_check, run_pass
+from .adaptive import check_steps, replay_check, run_pass
 from .cpass import BMAX, CHECK_EVERY, NOISE
 from .cvodes import run_cvodes
 from .dense import DenseAuto, dense_auto
@@ -396,7 +396,7 @@ def _amplified(problem: Problem, got, rtol, atol, progress) -> tuple[float, int]
     the difference is the amplified start alone; twice: one start is one draw of the
     rounding, as `cpass`'s ``AU_JITTER_SPREAD`` measures), inf when the replay fails."""
     x = replay_check(problem, got)
-    steps = int(np.sum(np.where(got.stats[:, 0] <= 2, 1, (got.stats[:, 0] - 1) // 2)))
+    steps = int(check_steps(got).sum())
     if x is None:
         return math.inf, 0
     progress.step(steps, 1.0)
