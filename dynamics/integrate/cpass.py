@@ -482,10 +482,9 @@ static void dense_step(pass_ctx* c, const casadi_real* x, casadi_real h, const c
 }
 
 /* The rounding of a run's steps emulated at random (`dense_jitter`): after each accepted
-   step of h, x_i moves by eps |x_i| + h scale rate_i, its sign drawn from `stream` */
+   step of h, x_i moves by eps |x_i| + h rate_i (rate_i the run's own measure of its
+   right-hand side's rounding so far, `dense_take`), its sign drawn from `stream` */
 typedef struct {
-  const casadi_real* rate;
-  casadi_real scale;
   unsigned long long stream;
 } dense_jit;
 
@@ -513,19 +512,20 @@ static unsigned long long dense_bits(unsigned long long k) {
 }
 
 /* the rounding of a step of h emulated on its accepted state x (stochastic arithmetic as
-   in Vignes' CESTAC): x_i moved by eps |x_i| (its own rounding) plus h scale rate_i (the
-   right-hand side's rounding over the step), of a random sign per state and step
-   (`dense_bits` of the stream and the step's count): the rerun that measures the rounding
-   floor (`au_floor`) takes each step's rounding where it arises, so the flow carries it
-   from there on, not from the start */
+   in Vignes' CESTAC): x_i moved by eps |x_i| (its own rounding) plus h rate_i (the
+   right-hand side's rounding over the step: rate_i the largest the run measured so far,
+   count[8 + i], `dense_take`), of a random sign per state and step (`dense_bits` of the
+   stream and the step's count): the rerun that measures the rounding floor (`au_floor`)
+   takes each step's rounding where it arises, so the flow carries it from there on, not
+   from the start; it needs nothing of the answer, so it can run alongside it
+   (`au_step_spec`) */
 static void dense_jitter(const dense_state* s, casadi_real* x, casadi_real h) {
-  const dense_jit* j = s->jit;
   unsigned long long bits = 0, k = (unsigned long long) s->count[0] * ((PASS_NX + 63) / 64);
   int i;
   for (i = 0; i < PASS_NX; ++i) {
-    if (i % 64 == 0) bits = dense_bits((j->stream << 40) + k++);
+    if (i % 64 == 0) bits = dense_bits((s->jit->stream << 40) + k++);
     x[i] += ((bits >> (i % 64)) & 1 ? -1.0 : 1.0)
-            * (DBL_EPSILON * fabs(x[i]) + h * j->scale * j->rate[i]);
+            * (DBL_EPSILON * fabs(x[i]) + h * s->count[8 + i]);
   }
 }
 
@@ -594,7 +594,6 @@ static int dense_take(dense_state* s, casadi_real* xn, casadi_real err, casadi_r
     for (i = 0; i < PASS_NX; ++i) x[i] = xn[i];
     *s->t = tn;
     count[0] += 1;
-    if (s->jit) dense_jitter(s, x, hs);
     if (rich) {
       rich[RI_E] += err;
       if (rich[RI_PEND] > 0 || s->last) {  /* a pair (or the lone last step): checked */
@@ -614,6 +613,7 @@ static int dense_take(dense_state* s, casadi_real* xn, casadi_real err, casadi_r
       for (i = 0; i < PASS_NX; ++i)
         if (fabs(f1[i] - f0[i]) > count[8 + i]) count[8 + i] = fabs(f1[i] - f0[i]);
     }
+    if (s->jit) dense_jitter(s, x, hs);  /* (after the noise it is measured with) */
     if (hs < count[3] && !s->last) count[3] = hs;
   }
   s->h = ctl_next(hs, s->h, fac, finite && err <= 1.0, &s->rejected, count);
@@ -952,7 +952,12 @@ _AUTO = r"""
 #define AU_AL(w) (AU_COUNT(w) + 8 + PASS_NX)
 #define AU_NOISE(w) (AU_AL(w) + PASS_NX)
 #define AU_RICH(w) (AU_NOISE(w) + PASS_NX)
-#define AU_SIZE(nout) (AU_HDR + 7 * PASS_NX + PASS_NU + PASS_NP + (nout) + 17)
+/* the floor's draws alongside the answer (`au_step_spec`): 0 none, 1 due, 2 under way */
+#define AU_SPEC(w) (AU_RICH(w) + RI_SIZE)
+/* draw k alongside: its x (nx), t, h and count (8 + nx) */
+#define AU_DSZ (2 * PASS_NX + 10)
+#define AU_DS(w, k) (AU_SPEC(w) + 1 + (k) * AU_DSZ)
+#define AU_SIZE(nout) (AU_HDR + 11 * PASS_NX + PASS_NU + PASS_NP + (nout) + 38)
 
 /* `estimates.carried`'s growth 2 sqrt(T min(T, 1 / L)) of a rounding rate over the horizon
    T (L: the answer's Lipschitz estimate) */
@@ -961,12 +966,10 @@ static casadi_real au_carry(const casadi_real* w) {
   return 2 * sqrt(horizon * (lip <= 0 ? horizon : fmin(horizon, 1.0 / lip)));
 }
 
-/* the rounding of the floor's rerun (AU_PHASE 4): the answer's rounding rates (AU_NOISE,
-   carried: `au_carried`) as measured, its draw's own stream */
-static void au_jit(const casadi_real* w, dense_jit* jit) {
-  jit->rate = AU_NOISE(w);
-  jit->scale = 1.0 / au_carry(w);
-  jit->stream = (unsigned long long) w[AU_DRAWS];
+/* the rounding of the floor's draw `stream` (AU_PHASE 4, or alongside the answer:
+   `au_step_spec`); its rates are its own (`dense_jitter`) */
+static void au_jit(dense_jit* jit, int stream) {
+  jit->stream = (unsigned long long) stream;
 }
 
 /* a run from x0 at the local tolerance (rtol, atol) factor (the check's state reset) */
@@ -987,16 +990,174 @@ static void au_begin(casadi_real* w, casadi_real factor) {
   count[3] = INFINITY;
 }
 
+#if PASS_WITH_LANES && PASS_LANES >= 4
+/* one vector step of a retried answer (lane 0, `dense_next`'s step; `a` 0: it ended), its
+   check's step due (lane 1, as `dense_advance_v`) and the next step of each draw of its
+   floor under way (lanes 2 and 3: dl[k] 1, each with its own steps and controller, rounded
+   at random: `dense_jitter`; dl[k] set to 0 when draw k ends). The same bits as each run
+   stepped alone. Returns 1 when the answer stops (`dense_take`). */
+static int au_vspec(dense_state* s, int a, dense_state* d, int* dl, au_vio* v,
+                    au_vstep step, au_vstep cont) {
+  casadi_real xn[PASS_NX], F[7 * PASS_NX], err, root, c0;
+  au_lmask took;
+  int use[PASS_LANES], want[PASS_LANES], l, k, i, had = a && s->check_due, stop = 0;
+  for (l = 0; l < PASS_LANES; ++l) use[l] = want[l] = took[l] = 0;
+  if (a) { use[0] = 1; v->h[0] = s->hs; v->filled |= 1; }
+  if (had) { use[1] = 1; v->h[1] = s->due - s->rich[RI_T]; v->filled |= 2; }
+  for (k = 0; k < 2; ++k)
+    if (dl[k]) { use[2 + k] = 1; v->h[2 + k] = d[k].hs; v->filled |= 4 << k; }
+  au_vcall(step, v, use);
+  want[0] = a && v->err[0] <= 1.0 && dense_wants_k(s);
+  want[1] = had && rich_wants_k(s);
+  for (k = 0; k < 2; ++k) want[2 + k] = dl[k] && v->err[2 + k] <= 1.0 && dense_wants_k(&d[k]);
+  au_vcont(cont, v, want);
+  if (had) {
+    au_vget(v, 1, xn, &err, &root, F, want[1]);
+    rich_take(s, xn, err, NULL, F, NULL);
+    took[1] = -1;
+  }
+  if (a) {
+    c0 = s->count[0];
+    au_vget(v, 0, xn, &err, &root, F, want[0]);
+    stop = dense_take(s, xn, err, root, NULL, want[0] ? F : NULL, NULL);
+    took[0] = s->count[0] != c0 ? -1 : 0;
+  }
+  for (k = 0; k < 2; ++k)
+    if (dl[k]) {
+      c0 = d[k].count[0];
+      au_vget(v, 2 + k, xn, &err, &root, F, want[2 + k]);
+      if (dense_take(&d[k], xn, err, root, NULL, want[2 + k] ? F : NULL, NULL)
+          || d[k].j >= d[k].nout)
+        dl[k] = 0;
+      took[2 + k] = d[k].count[0] != c0 ? -1 : 0;
+    }
+  au_vkeep(v, took);
+  for (k = 0; k < 2; ++k)  /* (an accepted draw's state was rounded at random after xn) */
+    if (took[2 + k])
+      for (i = 0; i < PASS_NX; ++i) v->x[i][2 + k] = d[k].x[i];
+  return stop;
+}
+
+/* whether an answer's floor is likely measured (`au_judge`: when the rounding it carries
+   over the horizon, `au_carried`, exceeds a tenth of the acceptance): that rounding as
+   the right-hand side's at x0 gives it (`dense_take`'s measure there; `lip` the answer's
+   Lipschitz estimate), with 10x to spare. Only where the draws run (alongside the answer,
+   or after it when needed) depends on it, never their bits. */
+static int au_deep(const casadi_real* w);
+
+static int au_likely(const casadi_real* w, pass_ctx* c, casadi_real lip) {
+  casadi_real f0[PASS_NX], f1[PASS_NX], xs[PASS_NX], noise = 0, lmin = INFINITY, T;
+  const casadi_real* x0 = AU_X0(w);
+  int i;
+  pass_rhs_at(c, x0, AU_U(w), f0);
+  for (i = 0; i < PASS_NX; ++i) xs[i] = x0[i] * (1 + (i % 2 ? -DBL_EPSILON : DBL_EPSILON));
+  pass_rhs_at(c, xs, AU_U(w), f1);
+  for (i = 0; i < PASS_NX; ++i) {
+    noise = fmax(noise, fabs(f1[i] - f0[i]));
+    lmin = fmin(lmin, AU_ATOL(w)[i] + w[AU_RTOL] * fabs(x0[i]));
+  }
+  T = AU_TS(w)[(int) w[AU_NOUT] - 1] - w[AU_T0];
+  noise *= 2 * sqrt(T * (lip <= 0 ? T : fmin(T, 1.0 / lip))) * (1 + lip * T);
+  return !(noise <= 0.01 * AU_ACCEPT * lmin);
+}
+
+/* `au_step` of an answer with its check, and alongside them in the free lanes of
+   their vector step, both draws of the floor it may need (`au_may_floor`), begun from x0
+   as `au_begin` begins a rerun, into XD (2, nx, nout + 1): the lanes cost the answer's
+   steps nothing, so a floor that a rerun after the answer measured is measured during it.
+   The draws' own bookkeeping is not free (a tumbling body's call 25 % longer), so they
+   run alongside (AU_SPEC 1 -> 2) only when the floor is likely measured: a retry within
+   AU_DEEP ulps (measured whenever accepted), or `au_likely`; else (AU_SPEC 0) after the
+   answer when it is. At most *budget vector steps; 1 when the answer failed, or it and
+   both draws ended (`au_spec_floor` judges them; a draw not needed is not counted). */
+static int au_step_spec(casadi_real* w, casadi_real factor, casadi_real* X, int* budget,
+                        casadi_real* XC, casadi_real* XD, au_vstep step, au_vstep cont) {
+  casadi_real* count = AU_COUNT(w);
+  casadi_real *ds, *dc, rtol = w[AU_RTOL] * factor, most = w[AU_MAXSTEPS] - w[AU_SPENT];
+  int nout = (int) w[AU_NOUT], ld = nout + 1, k, i, a, oa, od[2], dl[2], stop;
+  dense_state s, d[2];
+  dense_jit jit[2];
+  au_vio v;
+  v.filled = 0;
+  oa = count[2] == 0 && count[5] < nout
+       && dense_open(&s, AU_XR(w), AU_TT(w), *AU_H(w), nout, AU_TS(w), AU_U(w), AU_P(w),
+                     rtol, AU_AL(w), most, X + 1, ld, count, w[AU_STIFF], AU_RICH(w),
+                     XC + 1, NULL);
+  if (count[2] != 0) return 1;  /* (failed: no floor is wanted) */
+  if (*AU_SPEC(w) == 1) {  /* (the answer opened: its Lipschitz estimate in count[7]) */
+    *AU_SPEC(w) = (w[AU_TRY] >= 1 && au_deep(w)) || au_likely(w, &s.c, count[7]) ? 2 : 0;
+    for (k = 0; k < 2 && *AU_SPEC(w) == 2; ++k) {
+      ds = AU_DS(w, k);
+      for (i = 0; i < PASS_NX; ++i) ds[i] = XD[((size_t) k * PASS_NX + i) * ld] = AU_X0(w)[i];
+      ds[PASS_NX] = w[AU_T0];
+      for (i = PASS_NX + 1; i < AU_DSZ; ++i) ds[i] = 0;
+      ds[PASS_NX + 2 + 3] = INFINITY;
+    }
+  }
+  a = oa && s.j < nout;
+  if (oa) {
+    au_vrun(&v, 0, &s);
+    au_vrun(&v, 1, &s);
+    au_vstep_in(&v, 0, s.x, s.h);
+    au_vstep_in(&v, 1, AU_RICH(w) + RI_X, s.h);
+  }
+  for (k = 0; k < 2; ++k) {
+    ds = AU_DS(w, k);
+    dc = ds + PASS_NX + 2;
+    au_jit(&jit[k], k);
+    od[k] = *AU_SPEC(w) == 2 && dc[2] == 0 && dc[5] < nout
+            && dense_open(&d[k], ds, ds + PASS_NX, ds[PASS_NX + 1], nout, AU_TS(w), AU_U(w),
+                          AU_P(w), rtol, AU_AL(w), most, XD + (size_t) k * PASS_NX * ld + 1,
+                          ld, dc, w[AU_STIFF], NULL, NULL, &jit[k]);
+    dl[k] = od[k] && d[k].j < nout;
+    if (dl[k]) {
+      au_vrun(&v, 2 + k, &d[k]);
+      au_vstep_in(&v, 2 + k, d[k].x, d[k].h);
+    }
+  }
+  while ((a || dl[0] || dl[1]) && (*budget)-- > 0) {
+    if (a) dense_next(&s);
+    for (k = 0; k < 2; ++k)
+      if (dl[k]) dense_next(&d[k]);
+    stop = au_vspec(&s, a, d, dl, &v, step, cont);
+    if (a && (stop || s.j >= nout)) {
+      if (count[2] != 0) break;  /* (the answer failed) */
+      a = 0;
+    }
+  }
+  if (oa) {
+    if (s.check_due) rich_step(&s);
+    dense_close(&s, AU_H(w));
+  }
+  for (k = 0; k < 2; ++k)
+    if (od[k]) dense_close(&d[k], AU_DS(w, k) + PASS_NX + 1);
+  if (count[2] != 0) return 1;
+  if (count[5] < nout) return 0;
+  for (k = 0; k < 2; ++k) {
+    dc = AU_DS(w, k) + PASS_NX + 2;
+    if (dc[2] == 0 && dc[5] < nout) return 0;
+  }
+  return 1;
+}
+#endif
+
 /* `dense_run` on the run in progress into Y (nx, nout + 1) at local factor `factor`, at
-   most *budget steps, with the check of merged step pairs into XC when `check`; returns 1
-   when it ended (finished or failed) */
+   most *budget steps, with the check of merged step pairs into XC when `check`; a retried
+   answer whose floor's draws are due alongside (AU_SPEC) with them into XD (2, nx,
+   nout + 1) when the vector lanes are given (`au_step_spec`); returns 1 when it ended
+   (finished or failed) */
 static int au_step(casadi_real* w, casadi_real factor, casadi_real* Y, int* budget,
-                   int check, casadi_real* XC, au_vstep step, au_vstep cont) {
+                   int check, casadi_real* XC, au_vstep step, au_vstep cont,
+                   casadi_real* XD) {
   casadi_real* count = AU_COUNT(w);
   int nout = (int) w[AU_NOUT], j;
   casadi_real before = count[0] + count[1];
   dense_jit jit;
-  au_jit(w, &jit);
+#if PASS_WITH_LANES && PASS_LANES >= 4
+  if (w[AU_PHASE] == 2 && *AU_SPEC(w) > 0 && check && step && XD)
+    return au_step_spec(w, factor, Y, budget, XC, XD, step, cont);
+#endif
+  au_jit(&jit, (int) w[AU_DRAWS]);
   j = dense_run(AU_XR(w), AU_TT(w), AU_H(w), nout, AU_TS(w), AU_U(w), AU_P(w),
                 w[AU_RTOL] * factor, AU_AL(w), w[AU_MAXSTEPS] - w[AU_SPENT], Y + 1, nout + 1,
                 count, *budget, w[AU_STIFF], check ? AU_RICH(w) : NULL, XC + 1,
@@ -1020,6 +1181,18 @@ static casadi_real au_size(const casadi_real* w) {
     if (s > 0) out = fmax(out, l > 0 ? s / l : INFINITY);
   }
   return out;
+}
+
+/* whether the answer's local tolerance lies within AU_DEEP ulps of the states' size */
+static int au_deep(const casadi_real* w) {
+  return au_size(w) / w[AU_FACTOR] * DBL_EPSILON * AU_DEEP > 1.0;
+}
+
+/* whether the answer about to begin (AU_TRY made before it) may have its floor measured
+   (`au_judge`): the requested tolerance within AU_MEASURED ulps of the states' size, or,
+   for a retry, its local one within AU_DEEP */
+static int au_may_floor(const casadi_real* w) {
+  return au_size(w) * DBL_EPSILON * AU_MEASURED > 1.0 || (w[AU_TRY] >= 1 && au_deep(w));
 }
 
 /* the largest |X - Y| / (atol + rtol |X|) over the states and the outputs after the first
@@ -1096,6 +1269,7 @@ static void au_verdict(casadi_real* w, casadi_real est) {
   w[AU_FACTOR] *= e;
   w[AU_LOOSE] = w[AU_FACTOR];
   au_begin(w, w[AU_FACTOR]);
+  *AU_SPEC(w) = au_may_floor(w);
   w[AU_PHASE] = 2;
 }
 
@@ -1113,8 +1287,11 @@ static casadi_real au_order(const casadi_real* w, const casadi_real* rich) {
    verdict; near the states' rounding (within 1e6 ulps) the model's rounding measured on
    the way, carried over the horizon, is added when small (`estimates.screen`), else
    measured: the answer repeated with each step's rounding emulated at random (phase 4,
-   `dense_jitter`, into XC, judged by `au_floor`) */
-static void au_judge(casadi_real* w, casadi_real* X, casadi_real* XC) {
+   `dense_jitter`, into XC, judged by `au_floor`; or its draws made alongside it, in XD:
+   `au_spec_floor`) */
+static void au_spec_floor(casadi_real* w, casadi_real* X, casadi_real* XD);
+
+static void au_judge(casadi_real* w, casadi_real* X, casadi_real* XC, casadi_real* XD) {
   int nout = (int) w[AU_NOUT], j, deep;
   casadi_real d, ulps, lmin, e, est, horizon, lip = w[AU_LIP], order;
   d = au_diff(w, X, XC, &ulps, &lmin);
@@ -1136,7 +1313,7 @@ static void au_judge(casadi_real* w, casadi_real* X, casadi_real* XC) {
      difference of the answer and its check may be rounding the flow amplified, which the
      Richardson division would hide (near a separatrix: 20 tolerances estimated at 0.18):
      the floor is measured, not modelled */
-  deep = w[AU_TRY] > 1 && au_size(w) / w[AU_FACTOR] * DBL_EPSILON * AU_DEEP > 1.0;
+  deep = w[AU_TRY] > 1 && au_deep(w);
   if (est <= w[AU_GATE] && (deep || au_size(w) * DBL_EPSILON * AU_MEASURED > 1.0)) {
     horizon = AU_TS(w)[nout - 1] - w[AU_T0];
     e = au_carried(w);
@@ -1148,6 +1325,10 @@ static void au_judge(casadi_real* w, casadi_real* X, casadi_real* XC) {
     } else {  /* the flow's real amplification: the answer again, rounded at random */
       w[AU_EST] = est;
       w[AU_DRAWS] = 0; w[AU_DRAW] = 0;
+      if (*AU_SPEC(w) == 2) {  /* (its draws ran alongside it) */
+        au_spec_floor(w, X, XD);
+        return;
+      }
       au_begin(w, w[AU_FACTOR]);
       w[AU_PHASE] = 4;
       return;
@@ -1164,8 +1345,9 @@ static void au_judge(casadi_real* w, casadi_real* X, casadi_real* XC) {
    was within the acceptance: the rerun is made only then). A draw may fall far below
    another (AU_JITTER_SPREAD), so below the answer's own rounding by that over
    AU_JITTER_RMS: a second is drawn unless the first already rejects (a second only raises
-   the floor) or accepts with that to spare. */
-static void au_floor(casadi_real* w, casadi_real* X, casadi_real* XC) {
+   the floor) or accepts with that to spare. Returns 1 when the second is wanted (the
+   verdict waits for it). */
+static int au_floor(casadi_real* w, casadi_real* X, casadi_real* XC) {
   casadi_real ulps, lmin, d = au_diff(w, X, XC, &ulps, &lmin), local = 0, drawn, fixed, base;
   int i;
   for (i = 0; i < PASS_NX; ++i) local = fmax(local, AU_NOISE(w)[i]);
@@ -1179,11 +1361,31 @@ static void au_floor(casadi_real* w, casadi_real* X, casadi_real* XC) {
   w[AU_GATE] = AU_FLOOR_GATE;
   base = w[AU_EST] - ulps;
   if (w[AU_DRAWS] < AU_JITTER_DRAWS && base + w[AU_FLOOR] <= w[AU_GATE]
-      && base + fmax(AU_JITTER_SPREAD / AU_JITTER_RMS * drawn, fixed) > w[AU_GATE]) {
-    au_begin(w, w[AU_FACTOR]);  /* (phase 4 again, the next draw's stream) */
-    return;
-  }
+      && base + fmax(AU_JITTER_SPREAD / AU_JITTER_RMS * drawn, fixed) > w[AU_GATE])
+    return 1;
   au_verdict(w, base + w[AU_FLOOR]);
+  return 0;
+}
+
+/* the floor from the draws made alongside the answer (`au_step_spec`, XD), judged in turn
+   by `au_floor` as the reruns after it are: a draw's steps counted when it is judged; a
+   draw that failed, or took more steps than the rerun in its place may (the max_steps
+   left then), is not verified */
+static void au_spec_floor(casadi_real* w, casadi_real* X, casadi_real* XD) {
+  int ld = (int) w[AU_NOUT] + 1, k;
+  casadi_real *dc, n, most;
+  for (k = 0; k < AU_JITTER_DRAWS; ++k) {
+    dc = AU_DS(w, k) + PASS_NX + 2;
+    n = dc[0] + dc[1];
+    most = w[AU_MAXSTEPS] - w[AU_SPENT];
+    if (n > most) n = floor(most) + 1;  /* (where `ctl_flag` stops the rerun) */
+    w[AU_SPENT] += n;
+    if (dc[2] != 0 || dc[0] + dc[1] > most) {
+      au_verdict(w, INFINITY);
+      return;
+    }
+    if (!au_floor(w, X, XD + (size_t) k * PASS_NX * ld)) return;
+  }
 }
 
 /* `rk8_auto`'s start (AU_PHASE 0): the header reset, the first answer begun (AU_PHASE 2);
@@ -1192,7 +1394,7 @@ static int au_start(casadi_real* w, int nout, casadi_real* X, casadi_real* XC) {
   int i, ld = nout + 1;
   w[AU_SPENT] = 0; w[AU_TRY] = 0; w[AU_RESULT] = 0; w[AU_FLAG] = 0; w[AU_EST] = NAN;
   w[AU_BOUND] = 0; w[AU_FLOOR] = 0; w[AU_ULPS] = 0; w[AU_PFAC] = 0; w[AU_PEST] = 0;
-  w[AU_DRAWS] = 0; w[AU_DRAW] = 0;
+  w[AU_DRAWS] = 0; w[AU_DRAW] = 0; *AU_SPEC(w) = 0;
   for (i = 0; i < PASS_NX; ++i) X[i * ld] = XC[i * ld] = AU_X0(w)[i];
   /* the local tolerance kept AU_LOCAL_ULPS ulps above the states' size (a tighter one asks
      for less than DOP853's rounding) and at least AU_RTOL_MIN; a requested tolerance
@@ -1206,6 +1408,7 @@ static int au_start(casadi_real* w, int nout, casadi_real* X, casadi_real* XC) {
   if (w[AU_FACTOR] < w[AU_FMIN]) w[AU_FACTOR] = w[AU_FMIN];
   w[AU_LOOSE] = w[AU_FACTOR];
   au_begin(w, w[AU_FACTOR]);
+  *AU_SPEC(w) = au_may_floor(w);
   w[AU_PHASE] = 2;
   return 0;
 }
@@ -1213,7 +1416,8 @@ static int au_start(casadi_real* w, int nout, casadi_real* X, casadi_real* XC) {
 /* `rk8_auto` after a run ended (an answer with its check, or the rerun rounded at random:
    `floor`; `plain`: the answer alone): its steps counted, then the verdict, a retry or the
    rerun (AU_PHASE) */
-static void au_ended(casadi_real* w, casadi_real* X, casadi_real* XC, int floor, int plain) {
+static void au_ended(casadi_real* w, casadi_real* X, casadi_real* XC, int floor, int plain,
+                     casadi_real* XD) {
   casadi_real* count = AU_COUNT(w);
   int i;
   w[AU_SPENT] += count[0] + count[1] + (floor ? 0 : AU_RICH(w)[RI_STEPS]);
@@ -1226,7 +1430,7 @@ static void au_ended(casadi_real* w, casadi_real* X, casadi_real* XC, int floor,
     return;
   }
   if (floor) {
-    au_floor(w, X, XC);
+    if (au_floor(w, X, XC)) au_begin(w, w[AU_FACTOR]);  /* (phase 4 again, the next draw) */
     return;
   }
   w[AU_NCHK] = AU_RICH(w)[RI_STEPS];
@@ -1239,30 +1443,32 @@ static void au_ended(casadi_real* w, casadi_real* X, casadi_real* XC, int floor,
     w[AU_RESULT] = 2; w[AU_EST] = NAN; w[AU_PHASE] = 3;
     return;
   }
-  au_judge(w, X, XC);
+  au_judge(w, X, XC, XD);
 }
 
 /* The whole of `dense.dense_auto` for one problem: the answer into X (nx, nout + 1; column
    0 = x0) and, alongside, its check (its steps merged in pairs) into XC, compared; at most
    `budget` steps per call (interrupts are looked at between calls); with `vstep` and
    `vcont` (`lanes.dense_lanes`, else NULL) the check's steps ride in a lane of the
-   answer's (`dense_advance_v`: the same bits). Returns AU_PHASE (3: done). */
+   answer's (`dense_advance_v`: the same bits), and with XD (2, nx, nout + 1; else NULL)
+   a retried answer's floor is drawn in the two lanes left (`au_step_spec`: the same bits
+   as the reruns after it). Returns AU_PHASE (3: done). */
 int rk8_auto_v(casadi_real* w, int nout, int budget, casadi_real* X, casadi_real* XC,
-               void* vstep, void* vcont) {
+               void* vstep, void* vcont, casadi_real* XD) {
   w[AU_NOUT] = nout;
   if (w[AU_PHASE] == 0 && au_start(w, nout, X, XC)) return 3;
   while (budget > 0 && w[AU_PHASE] != 3) {
     int floor = w[AU_PHASE] == 4, plain = w[AU_TRIES] <= 0;
     if (au_step(w, w[AU_FACTOR], floor ? XC : X, &budget, !floor && !plain, XC,
-                (au_vstep) vstep, (au_vstep) vcont))
-      au_ended(w, X, XC, floor, plain);
+                (au_vstep) vstep, (au_vstep) vcont, XD))
+      au_ended(w, X, XC, floor, plain, XD);
   }
   return (int) w[AU_PHASE];
 }
 
 /* `rk8_auto_v` with the step function alone */
 int rk8_auto(casadi_real* w, int nout, int budget, casadi_real* X, casadi_real* XC) {
-  return rk8_auto_v(w, nout, budget, X, XC, NULL, NULL);
+  return rk8_auto_v(w, nout, budget, X, XC, NULL, NULL, NULL);
 }
 
 /* the workspace wk of run k of a batch: the shared inputs of w with the run's x0, u and
@@ -1490,7 +1696,7 @@ static void au_checks(au_lane* L, au_vio* v, au_pend* P, au_vstep step, au_vstep
 static int au_lane_open(au_lane* L, int nout, int plain) {
   casadi_real* w = L->w;
   L->fresh = 1;
-  au_jit(w, &L->jit);
+  au_jit(&L->jit, (int) w[AU_DRAWS]);
   L->opened = dense_open(&L->s, AU_XR(w), AU_TT(w), *AU_H(w), nout, AU_TS(w), AU_U(w),
                          AU_P(w), w[AU_RTOL] * w[AU_FACTOR], AU_AL(w),
                          w[AU_MAXSTEPS] - w[AU_SPENT], (L->floor ? L->XC : L->X) + 1,
@@ -1508,7 +1714,7 @@ static void au_lane_next(au_lane* L, int nout, casadi_real* res, int plain) {
   int i;
   do {
     if (L->opened) dense_close(&L->s, AU_H(w));
-    au_ended(w, L->X, L->XC, L->floor, plain);
+    au_ended(w, L->X, L->XC, L->floor, plain, NULL);
     if (w[AU_PHASE] == 3) {
       for (i = 0; i < AU_HDR; ++i) res[(size_t) L->k * AU_HDR + i] = w[i];
       L->k = -1;
@@ -1832,7 +2038,7 @@ def _loaded(lib, lanes: bool):
     auto.restype = i32
     fun.auto = auto  # (`dynamics.integrate.dense`)
     auto_v = lib.rk8_auto_v
-    auto_v.argtypes = [ptr, i32, i32, ptr, ptr, ptr, ptr]
+    auto_v.argtypes = [ptr, i32, i32, ptr, ptr, ptr, ptr, ptr]
     auto_v.restype = i32
     fun.auto_v = auto_v  # (the same, the check in a lane when ``lanes``: `lanes.dense_lanes`)
     many = lib.rk8_auto_many

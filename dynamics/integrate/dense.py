@@ -29,11 +29,19 @@ largest of its difference from the answer, the carried rounding and the ulps rep
 ulps; the estimate is then accepted at most 1 (as the multi-run search accepts its
 estimate with its floor on top). One draw may fall 30x below another, so a second draw
 (its own stream; the floor is the larger) is made unless the first already refuses the
-answer or accepts it with that spread to spare. Each step's rounding enters where it
-arises: the start moved by the rounding of the whole horizon (`estimates.measured_floor`,
-which the multi-run search keeps) put it all where the flow amplifies it longest, 20-70x
-too much on the 39-state scene of ``tests/dynamics/scene/registry.py``. Not
-accepted, the answer is redone with its local tolerance predicted from the part of the
+answer or accepts it with that spread to spare. A draw's rounding rates are its own
+measure of the right-hand side's rounding so far, so it needs nothing of the answer: where
+the floor is likely measured (a retried answer whose local tolerance lies within 1e4 ulps
+of a state's size, or the rounding at x0 carried over the horizon within 10x of the bound
+that asks for a measurement), both draws run alongside the answer in the two lanes of its
+vector steps that its check leaves free (`cpass` ``au_step_spec``, once the model's lanes
+are loaded): the same bits as the reruns after it, which the step function makes, at no
+cost in steps (a draw is counted when it is judged). The bench body at rtol 1e-6 and 1e-10
+took 20 % and 25 % less time, the hinged scene at rtol 1e-8 51 % less. Each step's
+rounding enters where it arises: the start moved by the rounding of the whole horizon
+(`estimates.measured_floor`, which the multi-run search keeps) put it all where the flow
+amplifies it longest, 20-70x too much on the 39-state scene of
+``tests/dynamics/scene/registry.py``. Not accepted, the answer is redone with its local tolerance predicted from the part of the
 estimate it controls (the estimate less the ulps and the carried rounding, which no
 tighter tolerance lowers): DOP853's global error follows its local tolerance about
 linearly, so the first retry scales it by ``aim / part`` and a later one by the slope
@@ -179,6 +187,12 @@ def _plan(model) -> _Plan | None:
 
 def _size(plan: _Plan, nout: int) -> int:
     """Doubles of the workspace (``AU_SIZE`` of `cpass._AUTO`)."""
+    return HEADER + 11 * plan.nx + plan.nu + plan.np + nout + 38
+
+
+def _alongside(plan: _Plan, nout: int) -> int:
+    """The workspace's slot ``AU_SPEC`` of `cpass._AUTO`: 2 when the last answer's floor
+    draws ran alongside it in the lanes of its vector steps (``au_step_spec``)."""
     return HEADER + 7 * plan.nx + plan.nu + plan.np + nout + 17
 
 
@@ -324,8 +338,9 @@ def dense_run(model, x0: np.ndarray, t: np.ndarray, rtol: float, atol, max_steps
         progress = None  # (nobody is told: no counting)
     auto, args = plan.auto, work.args
     vector = _single_lanes(model, plan) if check else None
-    if vector is not None:  # (the check's steps in a lane of the answer's: the same bits)
-        auto, args = vector.auto_v, args + (vector.address, vector.cont)
+    if vector is not None:  # (the check's steps in a lane of the answer's, a retry's floor
+        # drawn in the others, into XL: the same bits)
+        auto, args = vector.auto_v, args + (vector.address, vector.cont, work.xl_addr)
     if auto(*args) != 3:  # a long run: interrupts looked at between calls
         # (the steps made so far: of the runs ended, and of the run in progress)
         count = HEADER + 3 * nx + nu + plan.np + nout + 2
