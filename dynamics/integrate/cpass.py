@@ -1378,7 +1378,7 @@ static void au_spec_floor(casadi_real* w, casadi_real* X, casadi_real* XD) {
     dc = AU_DS(w, k) + PASS_NX + 2;
     n = dc[0] + dc[1];
     most = w[AU_MAXSTEPS] - w[AU_SPENT];
-    if (n > most) n = floor(most) + 1;  /* (where `ctl_flag` stops the rerun) */
+    if (n > most) n = fmax(floor(most), 0) + 1;  /* (where `ctl_flag` stops the rerun) */
     w[AU_SPENT] += n;
     if (dc[2] != 0 || dc[0] + dc[1] > most) {
       au_verdict(w, INFINITY);

@@ -594,6 +594,34 @@ def test_the_floor_draws_are_keyed_by_the_step_so_a_run_cut_anywhere_agrees(lane
     assert np.all(np.abs(whole.x[4:] - w) <= 1.5e-12 + 1.5e-10 * np.abs(w))
 
 
+def test_max_steps_ends_the_draws_beside_the_answer_as_after_it(monkeypatch):
+    """``max_steps`` reached in the second draw, in the first, before the first takes a
+    step (the retried answer and its check used them all) or in the answer itself: the
+    draws made beside the answer (the vector lanes) give the outcome, steps and answer of
+    the reruns after it (the step function), to the bit; a floor cut short verifies
+    nothing."""
+    from appdyn.dynamics.integrate import dense
+    inertia, w0 = _JACOBI[1]
+    model, t = rigid_body(inertia), np.linspace(0.0, 100.0, 101)
+    x0 = np.r_[0.0, 0.0, 0.0, 1.0, w0]
+    vector = dense.dense_lanes(model, wait=True)
+    assert vector is not None
+
+    def run(lanes, most):
+        monkeypatch.setattr(dense, "_single_lanes", lambda m, plan: vector if lanes else None)
+        return dense.dense_run(model, x0, t, 1.5e-10, 1.5e-12, float(most), 1e6)
+
+    full = run(True, 1e8)
+    assert full.result == 1 and full.draws == 2
+    answered = full.spent - 2 * (full.answer_steps)  # (before the draws, about)
+    for most in (full.spent - 1, full.spent - full.answer_steps - 100, answered - 300,
+                 answered - 700):
+        beside, after = run(True, most), run(False, most)
+        np.testing.assert_array_equal(beside.x, after.x)
+        assert beside[1:] == after[1:], (most, beside, after)
+        assert beside.result in (0, -3) and beside.spent <= most + 1 + full.check_steps
+
+
 def test_a_first_floor_draw_that_refuses_makes_no_second():
     """A tumble 1e-3 rad/s off the separatrix (100 s, rtol 1e-8): the flow amplifies the
     rounding past the tolerance, so the first draw refuses the answer (a second could only
