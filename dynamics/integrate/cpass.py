@@ -991,7 +991,7 @@ static void au_begin(casadi_real* w, casadi_real factor) {
 }
 
 #if PASS_WITH_LANES && PASS_LANES >= 4
-/* one vector step of a retried answer (lane 0, `dense_next`'s step; `a` 0: it ended), its
+/* one vector step of an answer (lane 0, `dense_next`'s step; `a` 0: it ended), its
    check's step due (lane 1, as `dense_advance_v`) and the next step of each draw of its
    floor under way (lanes 2 and 3: dl[k] 1, each with its own steps and controller, rounded
    at random: `dense_jitter`; dl[k] set to 0 when draw k ends). The same bits as each run

@@ -6,51 +6,52 @@ batch in one compiled loop over the runs (``rk8_auto_many``), each run with its 
 check and verdict.
 
 The rules (as `dynamics.integrate.auto.dense_pass` states them): the answer runs at the
-local tolerance ``(rtol, atol) f`` (``f = FIRST``, at least the factor that keeps it one ulp
-above the states' size), in at least 12 steps (no step longer than a twelfth of the run:
-on fewer, longer steps the check below is blind to the error of the answer's continuous
-extension, `cpass` ``RI_STEPS_MIN``); its check is Richardson's on the answer's
-own steps: alongside the answer, each pair of its accepted steps is taken again as one
-step of their sum (a lone last step alone), no step rejected, the outputs from that step's
+local tolerance ``(rtol, atol) f`` (``f = FIRST``, at least the factor that keeps it one
+ulp above the states' size), in at least 12 steps (no step longer than a twelfth of the
+run: on fewer, longer steps the check below is blind to the error of the answer's
+continuous extension, `cpass` ``RI_STEPS_MIN``); its check is Richardson's on the answer's
+own steps: alongside the answer, each pair of its accepted steps is taken again as one step
+of their sum (a lone last step alone), no step rejected, the outputs from that step's
 continuous extension (about half the answer's steps). ``d`` is their scaled difference (max
 over the outputs, in units of ``atol + rtol |x|``). In the method's asymptotic range the
 check's error is 2^8 times the answer's (order 8); the range is shown by the embedded
-estimates: the sum of the check's over the answer's, doubled, is ``2^p`` with ``p``
-between 5 and 11 (6-8 measured on smooth problems). Then the estimate is ``d / (2^7 - 1)``
-(2x conservative) plus 1000 ulps of each state's size, accepted at most 0.5; otherwise ``d``
+estimates: the sum of the check's over the answer's, doubled, is ``2^p`` with ``p`` between
+5 and 11 (6-8 measured on smooth problems). Then the estimate is ``d / (2^7 - 1)`` (2x
+conservative) plus 1000 ulps of each state's size, accepted at most 0.5; otherwise ``d``
 plus the ulps, accepted at most 1. Within 1e6 ulps of a state's size the rounding of the
 model's formulas (measured on the way) is carried over the horizon (`estimates.carried`)
 and its screening bound (`estimates.screen`) added when at most 0.05; otherwise the flow's
-real amplification is measured: the answer is repeated with each accepted state rounded
-at random (stochastic arithmetic, as Vignes' CESTAC: every state moved by ``eps |x_i|``,
-twice the most a rounding to nearest moves it, plus the step times the right-hand side's
-measured rounding, of a random sign per state and step from a fixed stream), and the
-largest of its difference from the answer, the carried rounding and the ulps replaces the
-ulps; the estimate is then accepted at most 1 (as the multi-run search accepts its
-estimate with its floor on top). One draw may fall 30x below another, so a second draw
-(its own stream; the floor is the larger) is made unless the first already refuses the
-answer or accepts it with that spread to spare. A draw's rounding rates are its own
-measure of the right-hand side's rounding so far, so it needs nothing of the answer: where
-the floor is likely measured (a retried answer whose local tolerance lies within 1e4 ulps
-of a state's size, or the rounding at x0 carried over the horizon within 10x of the bound
-that asks for a measurement), both draws run alongside the answer in the two lanes of its
-vector steps that its check leaves free (`cpass` ``au_step_spec``, once the model's lanes
-are loaded): the same bits as the reruns after it, which the step function makes, at no
-cost in steps (a draw is counted when it is judged). The bench body at rtol 1e-6 and 1e-10
-took 20 % and 25 % less time, the hinged scene at rtol 1e-8 51 % less. Each step's
-rounding enters where it arises: the start moved by the rounding of the whole horizon
-(`estimates.measured_floor`, which the multi-run search keeps) put it all where the flow
-amplifies it longest, 20-70x too much on the 39-state scene of
-``tests/dynamics/scene/registry.py``. Not accepted, the answer is redone with its local tolerance predicted from the part of the
-estimate it controls (the estimate less the ulps and the carried rounding, which no
-tighter tolerance lowers): DOP853's global error follows its local tolerance about
-linearly, so the first retry scales it by ``aim / part`` and a later one by the slope
-measured between the last two answers; the aim is 0.2 (less where the rounding takes more
-of the acceptance), at most 100x tighter per answer, never below the factor that keeps
-the local tolerance an ulp above the states' size (`TRIES` answers at most; none after a
-floor was measured, nor when the rounding alone takes 90 % of the acceptance: the
-tolerance then lies at the rounding floor, and `dynamics.integrate.auto.dense_pass` answers
-with ``ROUNDOFF`` when those ulps exceed the tolerance).
+real amplification is measured: the answer is repeated with each accepted state rounded at
+random (stochastic arithmetic, as Vignes' CESTAC: every state moved by ``eps |x_i|``, twice
+the most a rounding to nearest moves it, plus the step times the right-hand side's measured
+rounding, of a random sign per state and step from a fixed stream), and the largest of its
+difference from the answer, the carried rounding and the ulps replaces the ulps; the
+estimate is then accepted at most 1 (as the multi-run search accepts its estimate with its
+floor on top). One draw may fall 30x below another, so a second draw (its own stream; the
+floor is the larger) is made unless the first already refuses the answer or accepts it with
+that spread to spare. A draw's rounding rates are its own measure of the right-hand side's
+rounding so far, so it needs nothing of the answer: where the floor is likely measured (a
+retried answer whose local tolerance lies within 1e4 ulps of a state's size, or the
+rounding at x0 carried over the horizon within 10x of the bound that asks for a
+measurement), both draws run alongside the answer in the two lanes of its vector steps that
+its check leaves free (`cpass` ``au_step_spec``, once the model's lanes are loaded): the
+same bits as the reruns after it, which the step function makes, in vector steps the answer
+takes anyway (a draw's steps are counted when it is judged). The bench body at rtol 1e-6
+and 1e-10 took 20 % and 25 % less time, the hinged scene at rtol 1e-8 51 % less. Each
+step's rounding enters where it arises: the start moved by the rounding of the whole
+horizon (`estimates.measured_floor`, which the multi-run search keeps) put it all where the
+flow amplifies it longest, 20-70x too much on the 39-state scene of
+``tests/dynamics/scene/registry.py``. Not accepted, the answer is redone with its local
+tolerance predicted from the part of the estimate it controls (the estimate less the ulps
+and the carried rounding, which no tighter tolerance lowers): DOP853's global error follows
+its local tolerance about linearly, so the first retry scales it by ``aim / part`` and a
+later one by the slope measured between the last two answers; the aim is 0.2 (less where
+the rounding takes more of the acceptance), at most 100x tighter per answer, never below
+the factor that keeps the local tolerance an ulp above the states' size (`TRIES` answers at
+most; none after a floor was measured, nor when the rounding alone takes 90 % of the
+acceptance: the tolerance then lies at the rounding floor, and
+`dynamics.integrate.auto.dense_pass` answers with ``ROUNDOFF`` when those ulps exceed the
+tolerance).
 
 Per call the Python is a look-up of the model's plan (its library and the workspace
 layout, `_plan`), a thread's reused workspace, one ``ctypes`` call and the result's array.
