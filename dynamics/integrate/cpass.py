@@ -768,33 +768,57 @@ static void au_vget(const au_vio* v, int l, casadi_real* xn, casadi_real* err,
     for (i = 0; i < 7 * PASS_NX; ++i) F[i] = v->F[i][l];
 }
 
-/* one answer step of the run in progress (`dense_next`'s) in lane 0 of a vector step
-   (`step`, `cont`), the check's step due before it in lane 1: a check step waits one answer
-   step, so a checked run costs one vector step per answer step (about one scalar step)
-   where `dense_advance` takes one and a half; the same bits. 1 when the run stops. */
-static int dense_advance_v(dense_state* s, au_vio* v, au_vstep step, au_vstep cont) {
-  casadi_real xn[PASS_NX], F[7 * PASS_NX], err, root, count = s->count[0];
+/* draws of a floor a vector step carries beside an answer and its check (`au_step_spec`) */
+#define DENSE_VDRAWS (PASS_LANES >= 4 ? 2 : 0)
+
+/* one vector step (`step`, `cont`): the answer's step of the run in progress (lane 0,
+   `dense_next`'s; `a` 0: it ended), the check's step due before it (lane 1: a check step
+   waits one answer step, so a checked run costs one vector step per answer step, about one
+   scalar step, where `dense_advance` takes one and a half) and the next step of each draw
+   k of its floor under way (lanes 2 and 3, dl[k] 1: `au_step_spec`; each with its own
+   steps and controller, rounded at random by `dense_jitter`; dl[k] set to 0 when draw k
+   ends; d NULL: none). The same bits as each run stepped alone. 1 when the answer stops. */
+static int dense_advance_v(dense_state* s, int a, dense_state* d, int* dl, au_vio* v,
+                           au_vstep step, au_vstep cont) {
+  casadi_real xn[PASS_NX], F[7 * PASS_NX], err, root, c0;
   au_lmask took;
-  int use[PASS_LANES], want[PASS_LANES], l, had = s->check_due, stop;
+  int use[PASS_LANES], want[PASS_LANES], l, k, i, had = a && s->check_due, stop = 0;
+  int nd = d ? DENSE_VDRAWS : 0;
   for (l = 0; l < PASS_LANES; ++l) use[l] = want[l] = took[l] = 0;
-  use[0] = 1; use[1] = had;
   /* (the run's inputs, the answer's state and the check's in lanes 0 and 1: `dense_run`) */
-  v->h[0] = s->hs;
-  if (had) v->h[1] = s->due - s->rich[RI_T];
-  v->filled |= use[1] ? 3 : 1;
+  if (a) { use[0] = 1; v->h[0] = s->hs; v->filled |= 1; }
+  if (had) { use[1] = 1; v->h[1] = s->due - s->rich[RI_T]; v->filled |= 2; }
+  for (k = 0; k < nd; ++k)
+    if (dl[k]) { use[2 + k] = 1; v->h[2 + k] = d[k].hs; v->filled |= 4 << k; }
   au_vcall(step, v, use);
-  want[0] = v->err[0] <= 1.0 && dense_wants_k(s);
+  want[0] = a && v->err[0] <= 1.0 && dense_wants_k(s);
   want[1] = had && rich_wants_k(s);
+  for (k = 0; k < nd; ++k) want[2 + k] = dl[k] && v->err[2 + k] <= 1.0 && dense_wants_k(&d[k]);
   au_vcont(cont, v, want);
   if (had) {  /* (the check's step due before this answer step) */
     au_vget(v, 1, xn, &err, &root, F, want[1]);
     rich_take(s, xn, err, NULL, F, NULL);
     took[1] = -1;
   }
-  au_vget(v, 0, xn, &err, &root, F, want[0]);
-  stop = dense_take(s, xn, err, root, NULL, want[0] ? F : NULL, NULL);
-  took[0] = s->count[0] != count ? -1 : 0;
+  if (a) {
+    c0 = s->count[0];
+    au_vget(v, 0, xn, &err, &root, F, want[0]);
+    stop = dense_take(s, xn, err, root, NULL, want[0] ? F : NULL, NULL);
+    took[0] = s->count[0] != c0 ? -1 : 0;
+  }
+  for (k = 0; k < nd; ++k)
+    if (dl[k]) {
+      c0 = d[k].count[0];
+      au_vget(v, 2 + k, xn, &err, &root, F, want[2 + k]);
+      if (dense_take(&d[k], xn, err, root, NULL, want[2 + k] ? F : NULL, NULL)
+          || d[k].j >= d[k].nout)
+        dl[k] = 0;
+      took[2 + k] = d[k].count[0] != c0 ? -1 : 0;
+    }
   au_vkeep(v, took);
+  for (k = 0; k < nd; ++k)  /* (an accepted draw's state was rounded at random after xn) */
+    if (took[2 + k])
+      for (i = 0; i < PASS_NX; ++i) v->x[i][2 + k] = d[k].x[i];
   return stop;
 }
 #endif
@@ -839,7 +863,8 @@ static int dense_run(casadi_real* x, casadi_real* t, casadi_real* hio, int nout,
   }
   while (s.j < nout && budget-- > 0) {
     dense_next(&s);
-    if (rich && step ? dense_advance_v(&s, &v, step, cont) : dense_advance(&s)) break;
+    if (rich && step ? dense_advance_v(&s, 1, NULL, NULL, &v, step, cont)
+                     : dense_advance(&s)) break;
   }
 #else
   while (s.j < nout && budget-- > 0) {
@@ -966,12 +991,6 @@ static casadi_real au_carry(const casadi_real* w) {
   return 2 * sqrt(horizon * (lip <= 0 ? horizon : fmin(horizon, 1.0 / lip)));
 }
 
-/* the rounding of the floor's draw `stream` (AU_PHASE 4, or alongside the answer:
-   `au_step_spec`); its rates are its own (`dense_jitter`) */
-static void au_jit(dense_jit* jit, int stream) {
-  jit->stream = (unsigned long long) stream;
-}
-
 /* a run from x0 at the local tolerance (rtol, atol) factor (the check's state reset) */
 static void au_begin(casadi_real* w, casadi_real factor) {
   casadi_real* count = AU_COUNT(w);
@@ -991,53 +1010,6 @@ static void au_begin(casadi_real* w, casadi_real factor) {
 }
 
 #if PASS_WITH_LANES && PASS_LANES >= 4
-/* one vector step of an answer (lane 0, `dense_next`'s step; `a` 0: it ended), its
-   check's step due (lane 1, as `dense_advance_v`) and the next step of each draw of its
-   floor under way (lanes 2 and 3: dl[k] 1, each with its own steps and controller, rounded
-   at random: `dense_jitter`; dl[k] set to 0 when draw k ends). The same bits as each run
-   stepped alone. Returns 1 when the answer stops (`dense_take`). */
-static int au_vspec(dense_state* s, int a, dense_state* d, int* dl, au_vio* v,
-                    au_vstep step, au_vstep cont) {
-  casadi_real xn[PASS_NX], F[7 * PASS_NX], err, root, c0;
-  au_lmask took;
-  int use[PASS_LANES], want[PASS_LANES], l, k, i, had = a && s->check_due, stop = 0;
-  for (l = 0; l < PASS_LANES; ++l) use[l] = want[l] = took[l] = 0;
-  if (a) { use[0] = 1; v->h[0] = s->hs; v->filled |= 1; }
-  if (had) { use[1] = 1; v->h[1] = s->due - s->rich[RI_T]; v->filled |= 2; }
-  for (k = 0; k < 2; ++k)
-    if (dl[k]) { use[2 + k] = 1; v->h[2 + k] = d[k].hs; v->filled |= 4 << k; }
-  au_vcall(step, v, use);
-  want[0] = a && v->err[0] <= 1.0 && dense_wants_k(s);
-  want[1] = had && rich_wants_k(s);
-  for (k = 0; k < 2; ++k) want[2 + k] = dl[k] && v->err[2 + k] <= 1.0 && dense_wants_k(&d[k]);
-  au_vcont(cont, v, want);
-  if (had) {
-    au_vget(v, 1, xn, &err, &root, F, want[1]);
-    rich_take(s, xn, err, NULL, F, NULL);
-    took[1] = -1;
-  }
-  if (a) {
-    c0 = s->count[0];
-    au_vget(v, 0, xn, &err, &root, F, want[0]);
-    stop = dense_take(s, xn, err, root, NULL, want[0] ? F : NULL, NULL);
-    took[0] = s->count[0] != c0 ? -1 : 0;
-  }
-  for (k = 0; k < 2; ++k)
-    if (dl[k]) {
-      c0 = d[k].count[0];
-      au_vget(v, 2 + k, xn, &err, &root, F, want[2 + k]);
-      if (dense_take(&d[k], xn, err, root, NULL, want[2 + k] ? F : NULL, NULL)
-          || d[k].j >= d[k].nout)
-        dl[k] = 0;
-      took[2 + k] = d[k].count[0] != c0 ? -1 : 0;
-    }
-  au_vkeep(v, took);
-  for (k = 0; k < 2; ++k)  /* (an accepted draw's state was rounded at random after xn) */
-    if (took[2 + k])
-      for (i = 0; i < PASS_NX; ++i) v->x[i][2 + k] = d[k].x[i];
-  return stop;
-}
-
 /* whether an answer's floor is likely measured (`au_judge`: when the rounding it carries
    over the horizon, `au_carried`, exceeds a tenth of the acceptance): that rounding as
    the right-hand side's at x0 gives it (`dense_take`'s measure there; `lip` the answer's
@@ -1104,7 +1076,7 @@ static int au_step_spec(casadi_real* w, casadi_real factor, casadi_real* X, int*
   for (k = 0; k < 2; ++k) {
     ds = AU_DS(w, k);
     dc = ds + PASS_NX + 2;
-    au_jit(&jit[k], k);
+    jit[k].stream = (unsigned long long) k;
     od[k] = *AU_SPEC(w) == 2 && dc[2] == 0 && dc[5] < nout
             && dense_open(&d[k], ds, ds + PASS_NX, ds[PASS_NX + 1], nout, AU_TS(w), AU_U(w),
                           AU_P(w), rtol, AU_AL(w), most, XD + (size_t) k * PASS_NX * ld + 1,
@@ -1119,7 +1091,7 @@ static int au_step_spec(casadi_real* w, casadi_real factor, casadi_real* X, int*
     if (a) dense_next(&s);
     for (k = 0; k < 2; ++k)
       if (dl[k]) dense_next(&d[k]);
-    stop = au_vspec(&s, a, d, dl, &v, step, cont);
+    stop = dense_advance_v(&s, a, d, dl, &v, step, cont);
     if (a && (stop || s.j >= nout)) {
       if (count[2] != 0) break;  /* (the answer failed) */
       a = 0;
@@ -1157,7 +1129,7 @@ static int au_step(casadi_real* w, casadi_real factor, casadi_real* Y, int* budg
   if (w[AU_PHASE] == 2 && *AU_SPEC(w) > 0 && check && step && XD)
     return au_step_spec(w, factor, Y, budget, XC, XD, step, cont);
 #endif
-  au_jit(&jit, (int) w[AU_DRAWS]);
+  jit.stream = (unsigned long long) w[AU_DRAWS];  /* (the floor's draw, in phase 4) */
   j = dense_run(AU_XR(w), AU_TT(w), AU_H(w), nout, AU_TS(w), AU_U(w), AU_P(w),
                 w[AU_RTOL] * factor, AU_AL(w), w[AU_MAXSTEPS] - w[AU_SPENT], Y + 1, nout + 1,
                 count, *budget, w[AU_STIFF], check ? AU_RICH(w) : NULL, XC + 1,
@@ -1535,7 +1507,7 @@ int rk8_auto_many(const casadi_real* w, int nout, const long long* runs, long lo
    `dense_run` in progress (`opened` 0: it ended at its start) */
 typedef struct {
   dense_state s;
-  dense_jit jit;  /* its floor's rerun's (`au_jit`) */
+  dense_jit jit;  /* its floor's rerun's (`dense_jitter`) */
   casadi_real *w, *X, *XC;
   long k;
   int opened, ended, floor, fresh, lane;  /* fresh: opened since its lane took `au_vrun` */
@@ -1696,7 +1668,7 @@ static void au_checks(au_lane* L, au_vio* v, au_pend* P, au_vstep step, au_vstep
 static int au_lane_open(au_lane* L, int nout, int plain) {
   casadi_real* w = L->w;
   L->fresh = 1;
-  au_jit(&L->jit, (int) w[AU_DRAWS]);
+  L->jit.stream = (unsigned long long) w[AU_DRAWS];
   L->opened = dense_open(&L->s, AU_XR(w), AU_TT(w), *AU_H(w), nout, AU_TS(w), AU_U(w),
                          AU_P(w), w[AU_RTOL] * w[AU_FACTOR], AU_AL(w),
                          w[AU_MAXSTEPS] - w[AU_SPENT], (L->floor ? L->XC : L->X) + 1,
