@@ -21,13 +21,13 @@ from .dense import dense_run
 from .events import apply_events, check_events
 from .impacts import check_impact, simulate_impacts
 from .inputs import (RTOL_MIN, Problem, RunOptions, check_cvodes_options, check_invariants,
-                     check_t, check_tolerances, check_u, check_x0, fast_x0)
+                     check_t, check_tolerances, check_u, check_x0, fast_x0, handed_t)
 from .kernels import check_lie_model
 from .loops import Progress, run_fixed, run_short
 from .result import FAILED, OK, OK_STIFF, VIOLATED, Dense, Run, SimulationResult, new_result
 from .sanity import remedy, violation
 from .smoothness import nonsmooth_operations
-from .stepcontrol import plain_run, run_dop853
+from .stepcontrol import plain_answer, run_dop853
 
 __all__ = ["simulate", "METHODS", "Method", "Hold", "CallPlan", "call_plan"]
 
@@ -300,29 +300,31 @@ def simulate(model: Model, x0, t, *, u=None, p=None, hold: Hold = "linear", meth
 def _common_call(model, x0, t, rtol, atol, max_steps, start: float, method: str = "auto"):
     """`simulate` of the common call, ``method='auto'`` (or ``'dop853'``) at the model's
     parameters without a control or options (a `Model` with no clock state and a smooth
-    right-hand side, ``x0`` of shape ``(nx,)`` that `fast_x0` takes, float tolerances, an
-    int ``max_steps``): the answer of the compiled dense pass (`dense.dense_run`) at once
-    when it answers (`auto.dense_outcome`: verified, or below the rounding floor; for
-    ``dop853`` its answer alone, `stepcontrol.plain_run`, with the sanity check of an
-    unverified run), ``start`` the call's `time.perf_counter`. None for anything else, or
-    when the pass leaves the run to auto's other paths: the general path then decides (and
-    words any error)."""
+    right-hand side, ``x0`` of shape ``(nx,)`` that `fast_x0` takes, a float64 grid
+    `inputs.handed_t` takes, float tolerances, an int ``max_steps``): the answer of the
+    compiled dense pass (`dense.dense_run`) at once when it answers (`auto.dense_outcome`:
+    verified, or below the rounding floor; for ``dop853`` its answer alone, as
+    `stepcontrol.plain_run`, with the sanity check of an unverified run on the quaternion's
+    drift the pass measured), ``start`` the call's `time.perf_counter`. None for anything
+    else, for a grid the pass finds not finite and increasing, or when the pass leaves the
+    run to auto's other paths: the general path then decides (and words any error)."""
     if type(model) is not Model or not call_plan(model).common:
         return None
     if (type(rtol) is not float or type(atol) is not float or type(max_steps) is not int
             or not (RTOL_MIN <= rtol < 1 and 0 <= atol < math.inf and max_steps >= 1)):
         return None
-    t = check_t(t)
+    t = handed_t(t)  # (finite and increasing: the pass looks, `dense_run` None if not)
     x0 = fast_x0(x0, model)
-    if x0 is None:
+    if t is None or x0 is None:
         return None
-    if method == "dop853":
-        run = plain_run(model, x0, t, rtol, atol, max_steps, p=model.p_default)
-        if run is None:
+    if method == "dop853":  # (`plain_run`, with the quaternion's drift the pass measured)
+        got = dense_run(model, x0, t, rtol, atol, float(max_steps), math.inf,
+                        p=model.p_default, check=False)
+        if got is None:
             return None
-        status = OK
+        run, status = plain_answer(got, t, rtol), OK
         if run.ok:
-            run, status = _sane(model, t, run, None, model.p_default, method)
+            run, status = _sane(model, t, run, None, model.p_default, method, got.qoff)
         return _result(model, t, run, method, status, math.nan, None, model.p_default, (),
                        start)
     got = dense_run(model, x0, t, rtol, atol, max_steps, STIFF_STEPS, p=model.p_default)
@@ -431,11 +433,13 @@ def _check_options(method, max_steps, jit, steps, cvodes_options, progress):
     return max_steps, steps, cvodes_options, Progress(progress)
 
 
-def _sane(model: Model, t: np.ndarray, run: Run, control, p: np.ndarray, method: str):
+def _sane(model: Model, t: np.ndarray, run: Run, control, p: np.ndarray, method: str,
+          quat_off: float | None = None):
     """``(run, status)`` of a finished fixed-step run: ``VIOLATED`` with the reason and the
-    remedy in its message when its invariants are grossly off (`sanity.violation`)."""
+    remedy in its message when its invariants are grossly off (`sanity.violation`, with
+    the quaternion's ``quat_off`` when known)."""
     bad = violation(model, t, run.x, lambda: _zero_grid(t, model.nu) if control is None
-                    else control.grid(t), p, method)
+                    else control.grid(t), p, method, quat_off=quat_off)
     if not bad:
         return run, OK
     said = run.message if type(run.message) is str else run.message()  # (made on first use)

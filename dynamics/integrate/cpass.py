@@ -903,7 +903,8 @@ _AUTO = r"""
 #define AU_NANS 11    /* steps of the answer */
 #define AU_RESULT 12  /* 1 verified, 0 not (AU_EST), 2 answered, not checked (AU_TRIES 0),
                          -2 a tolerance below an ulp of the states' size (AU_FMIN > 1), -3 a
-                         run failed */
+                         run failed, -4 an output grid not finite and strictly increasing
+                         (no run made: `au_grid_ok`) */
 #define AU_EST 13     /* the error estimate [tolerances] */
 #define AU_D 14       /* the scaled difference of the answer and the check run */
 #define AU_FLAG 15    /* `dense_run`'s flag of a failed run */
@@ -929,7 +930,9 @@ _AUTO = r"""
                          AU_LOCAL_ULPS ulps above the states' size and at least AU_RTOL_MIN */
 #define AU_DRAWS 33   /* the floor's reruns made (`au_floor`) ... */
 #define AU_DRAW 34    /* ... and the largest of their differences from the answer */
-#define AU_HDR 35
+#define AU_QOFF 35    /* the answer alone (AU_TRIES 0): the most its attitude quaternion's
+                         norm is off 1 at the outputs (0: none; `sanity.violation`'s test) */
+#define AU_HDR 36
 #define AU_ACCEPT 0.5        /* estimates.AUTO_ACCEPT */
 #define AU_FLOOR_ULPS 1000.0 /* estimates.FLOOR_ULPS */
 #define AU_MEASURED 1e6      /* auto's _PASS_MEASURED */
@@ -1264,7 +1267,7 @@ static casadi_real au_order(const casadi_real* w, const casadi_real* rich) {
 static void au_spec_floor(casadi_real* w, casadi_real* X, casadi_real* XD);
 
 static void au_judge(casadi_real* w, casadi_real* X, casadi_real* XC, casadi_real* XD) {
-  int nout = (int) w[AU_NOUT], j, deep;
+  int nout = (int) w[AU_NOUT], deep;
   casadi_real d, ulps, lmin, e, est, horizon, lip = w[AU_LIP], order;
   d = au_diff(w, X, XC, &ulps, &lmin);
   w[AU_ULPS] = ulps;
@@ -1278,9 +1281,6 @@ static void au_judge(casadi_real* w, casadi_real* X, casadi_real* XC, casadi_rea
     w[AU_GATE] = 1.0;
   }
   w[AU_D] = d; w[AU_RATIO] = 2; w[AU_BOUND] = 0; w[AU_FLOOR] = 0;
-  for (e = AU_TS(w)[0] - w[AU_T0], j = 1; j < nout; ++j)
-    if (AU_TS(w)[j] - AU_TS(w)[j - 1] > e) e = AU_TS(w)[j] - AU_TS(w)[j - 1];
-  w[AU_SUB] = w[AU_HMIN] < INFINITY ? ceil(e / w[AU_HMIN]) : 1;
   /* a retry whose local tolerance lies within AU_DEEP ulps of the states' size: the
      difference of the answer and its check may be rounding the flow amplified, which the
      Richardson division would hide (near a separatrix: 20 tolerances estimated at 0.18):
@@ -1362,11 +1362,53 @@ static void au_spec_floor(casadi_real* w, casadi_real* X, casadi_real* XD) {
 
 /* `rk8_auto`'s start (AU_PHASE 0): the header reset, the first answer begun (AU_PHASE 2);
    1 when no run is made (AU_RESULT -2, AU_PHASE 3) */
+/* whether the output grid (AU_T0, then the AU_NOUT times AU_TS) is finite and strictly
+   increasing, as `inputs.check_t` asks: `simulate`'s common call hands its grid over
+   unchecked, and a grid that is not is left to `check_t` to word (AU_RESULT -4) */
+static int au_grid_ok(const casadi_real* w) {
+  const casadi_real* ts = AU_TS(w);
+  casadi_real last = w[AU_T0];
+  int j, nout = (int) w[AU_NOUT];
+  if (!isfinite(last)) return 0;
+  for (j = 0; j < nout; last = ts[j++])
+    if (!(ts[j] > last)) return 0;  /* (NaN fails the comparison) */
+  return isfinite(last);
+}
+
+/* AU_SUB: the longest output interval over the answer's smallest step */
+static void au_substeps(casadi_real* w) {
+  const casadi_real* ts = AU_TS(w);
+  casadi_real e = ts[0] - w[AU_T0];
+  int j, nout = (int) w[AU_NOUT];
+  for (j = 1; j < nout; ++j)
+    if (ts[j] - ts[j - 1] > e) e = ts[j] - ts[j - 1];
+  w[AU_SUB] = w[AU_HMIN] < INFINITY ? ceil(e / w[AU_HMIN]) : 1;
+}
+
+/* AU_QOFF of the answer X (nx, nout + 1): max over its outputs of | |q| - 1 | (the sums of
+   squares in `sanity._quat_off`'s order, no contraction: the same bits) */
+static void au_quat_off(casadi_real* w, const casadi_real* X) {
+  int j, iq = (int) w[AU_IQ], ld = (int) w[AU_NOUT] + 1;
+  casadi_real off = 0, a, b, c, d, e;
+  if (iq >= 0)
+    for (j = 0; j < ld; ++j) {
+      a = X[iq * ld + j]; b = X[(iq + 1) * ld + j]; c = X[(iq + 2) * ld + j];
+      d = X[(iq + 3) * ld + j];
+      e = fabs(sqrt(a * a + b * b + c * c + d * d) - 1.0);
+      if (!(e <= off)) off = e;  /* (a NaN is kept) */
+    }
+  w[AU_QOFF] = off;
+}
+
 static int au_start(casadi_real* w, int nout, casadi_real* X, casadi_real* XC) {
   int i, ld = nout + 1;
   w[AU_SPENT] = 0; w[AU_TRY] = 0; w[AU_RESULT] = 0; w[AU_FLAG] = 0; w[AU_EST] = NAN;
   w[AU_BOUND] = 0; w[AU_FLOOR] = 0; w[AU_ULPS] = 0; w[AU_PFAC] = 0; w[AU_PEST] = 0;
-  w[AU_DRAWS] = 0; w[AU_DRAW] = 0; *AU_SPEC(w) = 0;
+  w[AU_DRAWS] = 0; w[AU_DRAW] = 0; w[AU_QOFF] = 0; *AU_SPEC(w) = 0;
+  if (!au_grid_ok(w)) {
+    w[AU_RESULT] = -4; w[AU_PHASE] = 3;
+    return 1;
+  }
   for (i = 0; i < PASS_NX; ++i) X[i * ld] = XC[i * ld] = AU_X0(w)[i];
   /* the local tolerance kept AU_LOCAL_ULPS ulps above the states' size (a tighter one asks
      for less than DOP853's rounding) and at least AU_RTOL_MIN; a requested tolerance
@@ -1411,8 +1453,10 @@ static void au_ended(casadi_real* w, casadi_real* X, casadi_real* XC, int floor,
   w[AU_INTERP] = count[4]; w[AU_LIP] = count[7];
   for (i = 0; i < PASS_NX; ++i) AU_NOISE(w)[i] = count[8 + i];
   w[AU_TRY] += 1;
+  au_substeps(w);
   if (plain) {  /* the answer alone: not checked */
     w[AU_RESULT] = 2; w[AU_EST] = NAN; w[AU_PHASE] = 3;
+    au_quat_off(w, X);
     return;
   }
   au_judge(w, X, XC, XD);

@@ -55,6 +55,10 @@ tolerance).
 
 Per call the Python is a look-up of the model's plan (its library and the workspace
 layout, `_plan`), a thread's reused workspace, one ``ctypes`` call and the result's array.
+What a loop over the outputs finds is found in C: whether the grid is finite and strictly
+increasing (`simulate`'s common call hands it over unchecked: result -4, and `check_t`
+words the error), the longest output interval over the smallest step (``substeps``), and,
+for an answer alone, its quaternion's drift (``qoff``, the sanity check of ``dop853``).
 """
 from __future__ import annotations
 
@@ -94,11 +98,11 @@ FIELDS = ("rtol", "factor", "loose", "max_steps", "stiff_steps", "t0", "iq", "tr
           "spent", "check_steps", "answer_steps", "result", "estimate", "d", "flag", "try",
           "accepted", "rejected", "hmin", "interpolated", "lipschitz", "ratio", "bound",
           "nout", "substeps", "gate", "floor", "order", "ulps", "prev_factor", "prev_part",
-          "factor_min", "draws", "drawn")
-_DRAWS = len(FIELDS) - 2
+          "factor_min", "draws", "drawn", "qoff")
+_DRAWS, _QOFF = FIELDS.index("draws"), FIELDS.index("qoff")
 (_RTOL, _FACTOR, _LOOSE, _MAXSTEPS, _STIFF, _T0, _IQ, _TRIES, _PHASE, _SPENT, _NCHK, _NANS,
  _RESULT, _EST, _D, _FLAG, _TRY, _ACC, _REJ, _HMIN, _INTERP, _LIP, _RATIO, _BOUND,
- _NOUT, _SUB, _GATE, _FLOOR, _ORDER, _ULPS) = range(len(FIELDS) - 5)
+ _NOUT, _SUB, _GATE, _FLOOR, _ORDER, _ULPS) = range(FIELDS.index("prev_factor"))
 #: Doubles of a run's header.
 HEADER = len(FIELDS)
 _REASONS = ("", "a state became non-finite", "the step size underflowed",
@@ -111,7 +115,9 @@ class DenseAuto(NamedTuple):
     ``x (nx, n)`` the answer (NaN after a failure); ``result`` 1 verified, 0 not verified
     (``estimate`` > acceptance or not finite), 2 answered and not checked (``check`` False:
     ``estimate`` NaN), -2 a requested tolerance below one ulp of a
-    state's size (no run made), -3 a run failed (``reason``); ``estimate`` [tolerances]; ``spent`` steps of
+    state's size (no run made), -3 a run failed (``reason``), -4 an output grid not finite
+    and strictly increasing (no run made: a caller that hands over an unchecked grid leaves
+    it to `inputs.check_t` to word); ``estimate`` [tolerances]; ``spent`` steps of
     all runs; ``answer_steps``, ``check_steps`` (accepted and rejected), ``rejected`` of the
     answer, ``hmin`` its smallest step [s], ``interpolated`` its steps that filled outputs,
     ``ratio`` the check's steps over the answer's (2: merged in pairs), ``factor`` the
@@ -122,7 +128,9 @@ class DenseAuto(NamedTuple):
     longest output interval over ``hmin`` (equal steps of that many per interval are no
     longer than any the answer took), ``reason`` why a run failed, ``ulps`` 1000 ulps of the
     largest state's size over its least tolerance at the outputs (part of ``estimate``: the
-    rounding no answer is verified below)."""
+    rounding no answer is verified below), ``qoff`` of an answer alone (``result`` 2) the
+    most its attitude quaternion's norm is off 1 at the outputs (0: no quaternion, or a
+    checked answer; the test of `sanity.violation`, made in the compiled pass)."""
 
     x: np.ndarray
     result: int
@@ -141,6 +149,7 @@ class DenseAuto(NamedTuple):
     reason: str
     ulps: float
     draws: int
+    qoff: float
 
 
 def constant_control(ctrl) -> bool:
@@ -265,7 +274,7 @@ def _outcome(x: np.ndarray, head) -> DenseAuto:
                             int(head[_INTERP]), head[_RATIO], head[_FACTOR], head[_BOUND],
                             head[_FLOOR], int(head[_SUB]),
                             _REASONS[int(head[_FLAG])] if result == -3 else "", head[_ULPS],
-                            int(head[_DRAWS])))
+                            int(head[_DRAWS]), head[_QOFF]))
 
 
 #: ``DenseAuto`` from a tuple of every field, without its ``__new__``'s argument parsing.
@@ -306,7 +315,9 @@ def dense_run(model, x0: np.ndarray, t: np.ndarray, rtol: float, atol, max_steps
               check: bool = True) -> DenseAuto | None:
     """`dense_auto` of checked inputs: ``x0 (nx,)``, the grid ``t (n,)``, ``atol`` a float or
     ``(nx,)``, the constant control ``u (nu,)`` (None: zero) and ``p (np,)``; None without a
-    compiled pass. Per call: the model's plan looked up, the thread's workspace filled, one
+    compiled pass, or for a grid ``t`` that is not finite and strictly increasing (the pass
+    looks, so a caller may hand over a grid `inputs.check_t` has not seen: `check_t` then
+    words the error). Per call: the model's plan looked up, the thread's workspace filled, one
     ``ctypes`` call with arguments built with the workspace, the answer copied out.
     ``check`` False: DOP853's answer alone at the tolerance asked, no check and no verdict
     (``result`` 2; ``method='dop853'``); a failed run's outputs after ``filled`` are NaN.
@@ -355,6 +366,8 @@ def dense_run(model, x0: np.ndarray, t: np.ndarray, rtol: float, atol, max_steps
         _tell(progress, int(ws[_SPENT]), told)
     elif progress is not None:
         _tell(progress, int(ws[_SPENT]), 0)
+    if ws[_RESULT] == -4:  # (a grid handed over unchecked: `check_t` words what is wrong)
+        return None
     x = work.X.copy()
     if ws[_RESULT] == -3:  # (the outputs filled before the failure; NaN after)
         x[:, 1 + int(ws[HEADER + 3 * nx + nu + plan.np + nout + 2 + 5]):] = np.nan

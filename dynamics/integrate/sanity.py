@@ -129,9 +129,11 @@ def _quat_off(q: np.ndarray) -> float:
 
 
 def violation(model: Model, t: np.ndarray, x: np.ndarray, u, p: np.ndarray,
-              method: str) -> str:
+              method: str, *, quat_off: float | None = None) -> str:
     """`violations` of one run of ``method`` (``x (nx, n)``, ``u() -> (nu, n)``, ``p
-    (np,)``), screened first; ``""`` for a sane run.
+    (np,)``), screened first; ``""`` for a sane run. ``quat_off``: the most the attitude
+    quaternion's norm is off 1 on ``x`` when it is known (the compiled pass measures it:
+    `dense.DenseAuto` ``qoff``), else None (measured here).
 
     The quaternion's norm is looked at first (a few microseconds). A Runge-Kutta method
     does not keep it, so a step too large for the attitude motion shows there before
@@ -139,7 +141,9 @@ def violation(model: Model, t: np.ndarray, x: np.ndarray, u, p: np.ndarray,
     invariants are screened (one call of `_screen`) where the norm cannot tell: ``lie``
     keeps it exactly, and a model without an attitude has none."""
     if model.attitude is not None:
-        if _quat_off(x[model.attitude[0]:model.attitude[0] + 4]) > QUAT_DRIFT:
+        if quat_off is None:
+            quat_off = _quat_off(x[model.attitude[0]:model.attitude[0] + 4])
+        if quat_off > QUAT_DRIFT:
             return violations(model, t, x[:, :, None], lambda: u()[:, :, None], p[:, None],
                               method)[0]
         if method != "lie":

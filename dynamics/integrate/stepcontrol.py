@@ -302,9 +302,8 @@ def plain_answer(got, t: np.ndarray, rtol: float) -> Run:
         done = int(np.argmin(np.isfinite(got.x).all(axis=0))) - 1
         return Run.new(got.x, steps, n_rhs, 0, True, False,
                        f"dop853: {got.reason} before t = {t[min(done + 1, t.size - 1)]:.6g}")
-    longest = (t[1:] - t[:-1]).max()
-    sub = math.ceil(longest / got.hmin) if got.hmin < math.inf else 1
-    return Run.new(got.x, steps, n_rhs, sub, True, True, partial(_plain_message, got, rtol))
+    return Run.new(got.x, steps, n_rhs, got.substeps, True, True,
+                   partial(_plain_message, got, rtol))
 
 
 def _plain_message(got, rtol: float) -> str:

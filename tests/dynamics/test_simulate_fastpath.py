@@ -379,3 +379,69 @@ def test_dense_message_made_on_first_read_pickled_made(body, common_calls):
     assert fields.message == res.message == pickle.loads(pickle.dumps(res)).message
     common_calls.off()
     assert dynamics.simulate(body, X0, GRID).message == res.message
+
+
+def _grids():
+    """Grids the compiled pass refuses as `check_t` does, short and long (it looks at every
+    time, in its first loop over them), the fault at the start, inside and at the end."""
+    long = np.linspace(0.0, 30.0, 40)
+    out = {}
+    for where, k in (("first", 0), ("inside", 17), ("last", 39)):
+        for what, value in (("nan", np.nan), ("inf", np.inf), ("-inf", -np.inf)):
+            g = long.copy()
+            g[k] = value
+            out[f"{what} {where}"] = g
+    g = long.copy()
+    g[18] = g[17]
+    out["a time repeated"] = g
+    g = long.copy()
+    g[38], g[39] = g[39], g[38]
+    out["the last two swapped"] = g
+    out["decreasing"] = long[::-1].copy()
+    out["a list, nan inside"] = [0.0, 1.0, float("nan"), 3.0]
+    return out
+
+
+@needs_compiler
+@pytest.mark.parametrize("method", ["auto", "dop853"])
+@pytest.mark.parametrize("name", list(_grids()))
+def test_a_grid_handed_over_unchecked_is_refused_as_check_t_refuses_it(
+        body, common_calls, method, name):
+    """The common call hands its grid to the compiled pass unchecked (`inputs.handed_t`);
+    the pass looks (`cpass` ``au_grid_ok``) and a grid `check_t` refuses is never run: the
+    same error, word for word, from the general path."""
+    t = _grids()[name]
+    fast = _message(lambda: dynamics.simulate(body, X0, t, method=method))
+    assert fast[0] is ValueError and ("`t` must be" in fast[1]), fast
+    assert common_calls.answered == []
+    with pytest.raises(ValueError) as info:
+        check_t(t)
+    assert str(info.value) == fast[1]
+    common_calls.off()
+    assert _message(lambda: dynamics.simulate(body, X0, t, method=method)) == fast
+
+
+@needs_compiler
+@pytest.mark.parametrize("case", ["2-point", "41 outputs", "list grid", "too loose",
+                                  "oscillator"])
+def test_common_dop853_call_is_the_general_path(body, common_calls, case):
+    """``method='dop853'`` at the defaults takes the pass at once, its substeps and the
+    quaternion's drift measured in C: the same result, bit for bit, as the general path
+    (`stepcontrol.plain_run`, `sanity.violation` in Python), a drifting quaternion (rtol
+    0.05 over 600 s) refused alike."""
+    model, x0, t, rtol = body, np.array(X0, dtype=float), np.array([0.0, 10.0]), 1e-8
+    if case == "41 outputs":
+        t = np.linspace(0.0, 20.0, 41)
+    elif case == "list grid":
+        t = [0.0, 0.5, 2.0]
+    elif case == "too loose":
+        t, rtol = np.linspace(0.0, 600.0, 601), 0.05
+    elif case == "oscillator":
+        model, x0 = _oscillator(), [1.0, 0.0]
+    fast = dynamics.simulate(model, x0, t, method="dop853", rtol=rtol)
+    assert len(common_calls.answered) == 1
+    assert fast.success == (case != "too loose")
+    if case == "too loose":
+        assert fast.status == 4 and "the attitude quaternion's norm is" in fast.message
+    common_calls.off()
+    _same(fast, dynamics.simulate(model, x0, t, method="dop853", rtol=rtol))
