@@ -301,16 +301,21 @@ def _common_call(model, x0, t, rtol, atol, max_steps, start: float, method: str 
     """`simulate` of the common call, ``method='auto'`` (or ``'dop853'``) at the model's
     parameters without a control or options (a `Model` with no clock state and a smooth
     right-hand side, ``x0`` of shape ``(nx,)`` that `fast_x0` takes, a float64 grid
-    `inputs.handed_t` takes, float tolerances, an int ``max_steps``): the answer of the
-    compiled dense pass (`dense.dense_run`) at once when it answers (`auto.dense_outcome`:
-    verified, or below the rounding floor; for ``dop853`` its answer alone, as
-    `stepcontrol.plain_run`, with the sanity check of an unverified run on the quaternion's
-    drift the pass measured), ``start`` the call's `time.perf_counter`. None for anything
-    else, for a grid the pass finds not finite and increasing, or when the pass leaves the
-    run to auto's other paths: the general path then decides (and words any error)."""
+    `inputs.handed_t` takes, float tolerances (Python's or numpy's float64 scalars), an int
+    ``max_steps``): the answer of the compiled dense pass (`dense.dense_run`) at once when
+    it answers (`auto.dense_outcome`: verified, or below the rounding floor; for
+    ``dop853`` its answer alone, as `stepcontrol.plain_run`, with the sanity check of an
+    unverified run on the quaternion's drift the pass measured), ``start`` the call's
+    `time.perf_counter`. None for anything else, for a grid the pass finds not finite and
+    increasing, or when the pass leaves the run to auto's other paths: the general path
+    then decides (and words any error)."""
     if type(model) is not Model or not call_plan(model).common:
         return None
-    if (type(rtol) is not float or type(atol) is not float or type(max_steps) is not int
+    if type(rtol) is not float or type(atol) is not float:  # (numpy's float64 scalars too:
+        if type(rtol) not in _FLOATS or type(atol) not in _FLOATS:  # a sweep's `logspace`)
+            return None
+        rtol, atol = float(rtol), float(atol)
+    if (type(max_steps) is not int
             or not (RTOL_MIN <= rtol < 1 and 0 <= atol < math.inf and max_steps >= 1)):
         return None
     t = handed_t(t)  # (finite and increasing: the pass looks, `dense_run` None if not)
@@ -333,6 +338,10 @@ def _common_call(model, x0, t, rtol, atol, max_steps, start: float, method: str 
         return None
     run, estimate, status = out
     return _result(model, t, run, "rk8", status, estimate, None, model.p_default, (), start)
+
+
+#: The tolerance types `_common_call` takes (a numpy float64 scalar is a Python float).
+_FLOATS = (float, np.float64)
 
 
 def _result(model: Model, t: np.ndarray, run: Run, used: str, status: int, estimate: float,

@@ -310,7 +310,7 @@ def test_common_auto_call_is_the_general_path(body, common_calls, case):
 
 
 @needs_compiler
-@pytest.mark.parametrize("kwargs", [dict(rtol=np.float64(1e-6)), dict(atol=[1e-9] * 7),
+@pytest.mark.parametrize("kwargs", [dict(atol=[1e-9] * 7), dict(atol=np.float32(1e-9)),
                                     dict(max_steps=np.int64(10 ** 6)), dict(jit=False),
                                     dict(invariants=True), dict(p=[]), dict(threads=1)])
 def test_common_auto_call_declines_the_rest_alike(body, common_calls, kwargs):
@@ -445,3 +445,20 @@ def test_common_dop853_call_is_the_general_path(body, common_calls, case):
         assert fast.status == 4 and "the attitude quaternion's norm is" in fast.message
     common_calls.off()
     _same(fast, dynamics.simulate(model, x0, t, method="dop853", rtol=rtol))
+
+
+@needs_compiler
+@pytest.mark.parametrize("method", ["auto", "dop853"])
+@pytest.mark.parametrize("tolerances", [(np.float64(1e-6), 1e-10), (1e-6, np.float64(1e-9)),
+                                        tuple(np.logspace(-7, -9, 2))])
+def test_numpy_float64_tolerances_take_the_common_call(body, common_calls, method,
+                                                       tolerances):
+    """A tolerance that is a numpy float64 scalar (a Python float: a sweep over
+    ``np.logspace`` hands them over) takes the common call, with the result the general
+    path gives to the bit."""
+    rtol, atol = tolerances
+    fast = dynamics.simulate(body, X0, GRID, method=method, rtol=rtol, atol=atol)
+    assert len(common_calls.answered) == 1 and fast.success
+    common_calls.off()
+    slow = dynamics.simulate(body, X0, GRID, method=method, rtol=rtol, atol=atol)
+    (_same_auto if method == "auto" else _same)(fast, slow)
