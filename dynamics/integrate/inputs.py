@@ -121,11 +121,12 @@ def check_t(t) -> np.ndarray:
 
 def handed_t(t) -> np.ndarray | None:
     """The grid of `simulate`'s common call, handed to the compiled pass unchecked: a
-    read-only float64 copy of a 1-D ``t`` of at least 2 times (an ndarray, or a list or
-    tuple numpy makes one of); None for any other ``t`` (`check_t` decides). Whether it is
-    finite and strictly increasing the pass looks, in its first loop over the times
-    (`dense.dense_run` returns None for a grid `check_t` refuses): in Python that took a
-    third of the call's time on 121 outputs."""
+    read-only float64 copy of a 1-D ``t`` of at least 2 real times (an ndarray, or a list
+    or tuple numpy makes one of; integers converted, as `check_t` converts them); None for
+    any other ``t`` (`check_t` decides). Whether it is finite and strictly increasing the
+    pass looks, in its first loop over the times (`dense.dense_run` returns None for a
+    grid `check_t` refuses): in Python that took a third of the call's time on 121
+    outputs."""
     tp = type(t)
     if tp is not np.ndarray:
         if tp is not list and tp is not tuple:
@@ -136,7 +137,11 @@ def handed_t(t) -> np.ndarray | None:
             return None
     elif t.dtype is _FLOAT64:
         t = t.copy()
-    if t.dtype is not _FLOAT64 or t.ndim != 1 or t.size < 2:
+    if t.dtype is not _FLOAT64:
+        if t.dtype.kind not in "iu":
+            return None
+        t = t.astype(np.float64)  # (exact to 2**53 s, as `check_t`'s conversion)
+    if t.ndim != 1 or t.size < 2:
         return None
     t.setflags(False)  # (read-only; positional: a third of the keyword's cost)
     return t

@@ -288,11 +288,18 @@ def _same_auto(a, b):
 
 
 @needs_compiler
-@pytest.mark.parametrize("case", ["2-point", "list grid", "41 outputs", "x0 list", "oscillator"])
+@pytest.mark.parametrize("case", ["2-point", "list grid", "41 outputs", "x0 list", "oscillator",
+                                  "int list grid", "int64 grid", "uint8 grid"])
 def test_common_auto_call_is_the_general_path(body, common_calls, case):
     model, x0, t = body, np.array(X0, dtype=float), np.array([0.0, 10.0])
     if case == "list grid":
         t = [0.0, 0.5, 2.0]
+    elif case == "int list grid":
+        t = [0, 1, 3]
+    elif case == "int64 grid":
+        t = np.arange(0, 21, 2)
+    elif case == "uint8 grid":
+        t = np.array([0, 2, 5], dtype=np.uint8)
     elif case == "41 outputs":
         t = np.linspace(0.0, 20.0, 41)
     elif case == "x0 list":
