@@ -27,7 +27,7 @@ from .loops import Progress, run_fixed, run_short
 from .result import FAILED, OK, OK_STIFF, VIOLATED, Dense, Run, SimulationResult, new_result
 from .sanity import remedy, violation
 from .smoothness import nonsmooth_operations
-from .stepcontrol import plain_answer, run_dop853
+from .stepcontrol import plain_run, run_dop853
 
 __all__ = ["simulate", "METHODS", "Method", "Hold", "CallPlan", "call_plan"]
 
@@ -304,7 +304,7 @@ def _common_call(model, x0, t, rtol, atol, max_steps, start: float, method: str 
     `inputs.handed_t` takes, float tolerances (Python's or numpy's float64 scalars), an int
     ``max_steps``): the answer of the compiled dense pass (`dense.dense_run`) at once when
     it answers (`auto.dense_outcome`: verified, or below the rounding floor; for
-    ``dop853`` its answer alone, as `stepcontrol.plain_run`, with the sanity check of an
+    ``dop853`` its answer alone, `stepcontrol.plain_run`, with the sanity check of an
     unverified run on the quaternion's drift the pass measured), ``start`` the call's
     `time.perf_counter`. None for anything else, for a grid the pass finds not finite and
     increasing, or when the pass leaves the run to auto's other paths: the general path
@@ -322,14 +322,13 @@ def _common_call(model, x0, t, rtol, atol, max_steps, start: float, method: str 
     x0 = fast_x0(x0, model)
     if t is None or x0 is None:
         return None
-    if method == "dop853":  # (`plain_run`, with the quaternion's drift the pass measured)
-        got = dense_run(model, x0, t, rtol, atol, float(max_steps), math.inf,
-                        p=model.p_default, check=False)
-        if got is None:
+    if method == "dop853":
+        run = plain_run(model, x0, t, rtol, atol, max_steps, p=model.p_default)
+        if run is None:
             return None
-        run, status = plain_answer(got, t, rtol), OK
+        status = OK
         if run.ok:
-            run, status = _sane(model, t, run, None, model.p_default, method, got.qoff)
+            run, status = _sane(model, t, run, None, model.p_default, method)
         return _result(model, t, run, method, status, math.nan, None, model.p_default, (),
                        start)
     got = dense_run(model, x0, t, rtol, atol, max_steps, STIFF_STEPS, p=model.p_default)
@@ -442,13 +441,12 @@ def _check_options(method, max_steps, jit, steps, cvodes_options, progress):
     return max_steps, steps, cvodes_options, Progress(progress)
 
 
-def _sane(model: Model, t: np.ndarray, run: Run, control, p: np.ndarray, method: str,
-          quat_off: float | None = None):
+def _sane(model: Model, t: np.ndarray, run: Run, control, p: np.ndarray, method: str):
     """``(run, status)`` of a finished fixed-step run: ``VIOLATED`` with the reason and the
     remedy in its message when its invariants are grossly off (`sanity.violation`, with
-    the quaternion's ``quat_off`` when known)."""
+    the quaternion's drift the run measured, ``run.quat_off``)."""
     bad = violation(model, t, run.x, lambda: _zero_grid(t, model.nu) if control is None
-                    else control.grid(t), p, method, quat_off=quat_off)
+                    else control.grid(t), p, method, quat_off=run.quat_off)
     if not bad:
         return run, OK
     said = run.message if type(run.message) is str else run.message()  # (made on first use)

@@ -1360,8 +1360,6 @@ static void au_spec_floor(casadi_real* w, casadi_real* X, casadi_real* XD) {
   }
 }
 
-/* `rk8_auto`'s start (AU_PHASE 0): the header reset, the first answer begun (AU_PHASE 2);
-   1 when no run is made (AU_RESULT -2, AU_PHASE 3) */
 /* whether the output grid (AU_T0, then the AU_NOUT times AU_TS) is finite and strictly
    increasing, as `inputs.check_t` asks: `simulate`'s common call hands its grid over
    unchecked, and a grid that is not is left to `check_t` to word (AU_RESULT -4) */
@@ -1400,6 +1398,8 @@ static void au_quat_off(casadi_real* w, const casadi_real* X) {
   w[AU_QOFF] = off;
 }
 
+/* `rk8_auto`'s start (AU_PHASE 0): the header reset, the first answer begun (AU_PHASE 2);
+   1 when no run is made (AU_RESULT -2 or -4, AU_PHASE 3) */
 static int au_start(casadi_real* w, int nout, casadi_real* X, casadi_real* XC) {
   int i, ld = nout + 1;
   w[AU_SPENT] = 0; w[AU_TRY] = 0; w[AU_RESULT] = 0; w[AU_FLAG] = 0; w[AU_EST] = NAN;

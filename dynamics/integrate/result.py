@@ -434,7 +434,9 @@ def _hermite(t, x, xdot, xdot_left, tq):
 class Run:
     """One integration run inside a call: ``x (nx, n)``, its counts, whether it ran compiled
     and reached the end, and its ``message`` (a str, or a callable making it: the verified
-    dense pass's, made only when the result's ``message`` is read)."""
+    dense pass's, made only when the result's ``message`` is read); ``quat_off`` the most
+    its attitude quaternion's norm is off 1 on ``x`` where the run measured it (the
+    compiled pass's answer alone: `sanity.violation` reads it), else None."""
 
     x: np.ndarray  # (nx, n)
     n_steps: int
@@ -443,13 +445,15 @@ class Run:
     compiled: bool
     ok: bool
     message: str | Callable[[], str]
+    quat_off: float | None = None
 
     @classmethod
-    def new(cls, x, n_steps, n_rhs, substeps, compiled, ok, message) -> "Run":
+    def new(cls, x, n_steps, n_rhs, substeps, compiled, ok, message, *,
+            quat_off=None) -> "Run":
         """``Run(...)`` without the frozen dataclass's per-field ``object.__setattr__``."""
         run = object.__new__(cls)
         run.__dict__.update(x=x, n_steps=n_steps, n_rhs=n_rhs, substeps=substeps,
-                            compiled=compiled, ok=ok, message=message)
+                            compiled=compiled, ok=ok, message=message, quat_off=quat_off)
         return run
 
 

@@ -294,8 +294,9 @@ def plain_run(model, x0: np.ndarray, t: np.ndarray, rtol: float, atol, max_steps
 
 def plain_answer(got, t: np.ndarray, rtol: float) -> Run:
     """The `Run` of DOP853's answer alone (`dense.DenseAuto` ``got`` of ``check=False``) on
-    the grid ``t``: its steps and right-hand-side calls, its message made on first use; a
-    failed run (NaN from the first output it did not reach) says why and where."""
+    the grid ``t``: its steps and right-hand-side calls, its substeps and quaternion drift
+    (found in the pass), its message made on first use; a failed run (NaN from the first
+    output it did not reach) says why and where."""
     steps = got.spent  # (the answer's: accepted and rejected; a failed run's too)
     n_rhs = DOP853.stages * steps + 4 * got.interpolated
     if got.result != 2:  # (a failed run: NaN from the first output it did not reach)
@@ -303,7 +304,7 @@ def plain_answer(got, t: np.ndarray, rtol: float) -> Run:
         return Run.new(got.x, steps, n_rhs, 0, True, False,
                        f"dop853: {got.reason} before t = {t[min(done + 1, t.size - 1)]:.6g}")
     return Run.new(got.x, steps, n_rhs, got.substeps, True, True,
-                   partial(_plain_message, got, rtol))
+                   partial(_plain_message, got, rtol), quat_off=got.qoff)
 
 
 def _plain_message(got, rtol: float) -> str:

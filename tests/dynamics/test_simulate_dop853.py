@@ -113,6 +113,27 @@ def test_failures_are_reported_with_their_cause():
     assert "tighten `rtol`/`atol` or use method='auto'" in res.message
 
 
+@pytest.mark.parametrize("rtol, points", [(1e-9, 2), (1e-9, 121), (1e-3, 601), (0.05, 601)])
+def test_the_pass_measures_the_drift_and_substeps_the_sanity_check_reads(rtol, points):
+    """The compiled answer alone measures its quaternion's drift and its substeps in C
+    (`Run.quat_off`, ``substeps``): against numpy's norm of the returned states and the
+    grid's longest interval over the smallest step, on runs that keep the norm and one
+    that loses it (rtol 0.05 over 600 s, refused by the sanity check)."""
+    import math
+
+    from appdyn.dynamics.integrate.dense import dense_run
+    from appdyn.dynamics.integrate.stepcontrol import plain_run
+    t = np.linspace(0.0, 600.0 if points == 601 else 60.0, points)
+    model = rigid_body(INERTIA)
+    run = plain_run(model, X0, t, rtol, np.full(7, rtol / 100), 10 ** 6)
+    off = np.abs(np.linalg.norm(run.x[:4], axis=0) - 1.0).max()
+    assert run.ok and abs(run.quat_off - off) <= 4e-16, (run.quat_off, off)
+    got = dense_run(model, X0, t, rtol, rtol / 100, 1e6, math.inf, check=False)
+    assert run.substeps == got.substeps == math.ceil(np.diff(t).max() / got.hmin) >= 1
+    res = simulate(model, X0, t, method="dop853", rtol=rtol, atol=rtol / 100, p=[])
+    assert res.success == (off <= 1e-3) and (res.status == VIOLATED) == (off > 1e-3)
+
+
 def test_steps_are_refused():
     with pytest.raises(ValueError, match="`steps` applies to the fixed-step methods"):
         simulate(rigid_body(INERTIA), X0, T, method="dop853", steps=4)
