@@ -6,6 +6,7 @@ models only through this container.
 """
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 from types import MappingProxyType
 from typing import Mapping
@@ -247,7 +248,7 @@ class Model:
         p = np.asarray(p, dtype=float).reshape(-1)
         if p.size != self.np:
             raise ValueError(f"`p` must have {self.np} elements {self.params}, got {p.size}")
-        if not np.all(np.isfinite(p)):
+        if not all(map(math.isfinite, p.tolist())):  # (floats: a few times numpy's speed)
             raise ValueError(f"`p` must be finite, got {p}")
         return p
 

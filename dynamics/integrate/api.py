@@ -17,7 +17,7 @@ from .auto import STIFF_STEPS, dense_outcome, solve_auto
 from .batch import BatchResult, check_batch, simulate_batch
 from .batch_fixed import batch_threads
 from .cvodes import run_cvodes
-from .dense import dense_run
+from .dense import constant_control, dense_run
 from .events import apply_events, check_events
 from .impacts import check_impact, simulate_impacts
 from .inputs import (RTOL_MIN, Problem, RunOptions, check_cvodes_options, check_invariants,
@@ -211,11 +211,11 @@ def simulate(model: Model, x0, t, *, u=None, p=None, hold: Hold = "linear", meth
                             max_steps=max_steps, cvodes_options=cvodes_options,
                             progress=bar, events=events, impacts=impacts, threads=threads)
     start = time.perf_counter()
-    if ((method == "auto" or method == "dop853") and u is None and p is None
-            and hold == "linear" and events is None and impacts is None and invariants is False
-            and steps is None and (jit is None or jit is True) and cvodes_options is None
-            and progress is None and threads is None):
-        result = _common_call(model, x0, t, rtol, atol, max_steps, start, method)
+    if ((method == "auto" or method == "dop853") and hold == "linear" and events is None
+            and impacts is None and invariants is False and steps is None
+            and (jit is None or jit is True) and cvodes_options is None and progress is None
+            and threads is None):
+        result = _common_call(model, x0, t, rtol, atol, max_steps, start, method, u, p)
         if result is not None:
             return result
     model = check_model(model)
@@ -297,12 +297,16 @@ def simulate(model: Model, x0, t, *, u=None, p=None, hold: Hold = "linear", meth
                         cache.should_compile(jit, math.inf))
 
 
-def _common_call(model, x0, t, rtol, atol, max_steps, start: float, method: str = "auto"):
-    """`simulate` of the common call, ``method='auto'`` (or ``'dop853'``) at the model's
-    parameters without a control or options (a `Model` with no clock state and a smooth
-    right-hand side, ``x0`` of shape ``(nx,)`` that `fast_x0` takes, a float64 grid
-    `inputs.handed_t` takes, float tolerances (Python's or numpy's float64 scalars), an int
-    ``max_steps``): the answer of the compiled dense pass (`dense.dense_run`) at once when
+def _common_call(model, x0, t, rtol, atol, max_steps, start: float, method: str = "auto",
+                 u=None, p=None):
+    """`simulate` of the common call, ``method='auto'`` (or ``'dop853'``) without options:
+    a `Model` with no clock state and a smooth right-hand side, ``x0`` of shape ``(nx,)``
+    that `fast_x0` takes, a float64 grid `inputs.handed_t` takes, tolerances
+    `check_tolerances` takes (``atol`` a float or one per state), an int ``max_steps``, a
+    control constant over
+    the run (``u`` None, ``(nu,)``, or samples all equal, as `check_u` takes them; not a
+    callable) and the model's parameters or a ``p`` `Model.resolve_p` takes. Returns
+    the answer of the compiled dense pass (`dense.dense_run`) at once when
     it answers (`auto.dense_outcome`: verified, or below the rounding floor; for
     ``dop853`` its answer alone, `stepcontrol.plain_run`, with the sanity check of an
     unverified run on the quaternion's drift the pass measured), ``start`` the call's
@@ -311,32 +315,53 @@ def _common_call(model, x0, t, rtol, atol, max_steps, start: float, method: str 
     then decides (and words any error)."""
     if type(model) is not Model or not call_plan(model).common:
         return None
-    if type(rtol) is not float or type(atol) is not float:  # (numpy's float64 scalars too:
-        if type(rtol) not in _FLOATS or type(atol) not in _FLOATS:  # a sweep's `logspace`)
+    if type(rtol) in _FLOATS and type(atol) in _FLOATS:  # (numpy's float64 scalars too: a
+        rtol, atol = float(rtol), float(atol)            # sweep over `np.logspace`)
+        if not (RTOL_MIN <= rtol < 1 and 0 <= atol < math.inf):
             return None
-        rtol, atol = float(rtol), float(atol)
-    if (type(max_steps) is not int
-            or not (RTOL_MIN <= rtol < 1 and 0 <= atol < math.inf and max_steps >= 1)):
+    else:  # (an atol per state, other number types: as the general path checks them)
+        try:
+            rtol, atol = check_tolerances(rtol, atol, model.nx)
+        except (TypeError, ValueError):
+            return None
+    if type(max_steps) is not int or max_steps < 1:
         return None
     t = handed_t(t)  # (finite and increasing: the pass looks, `dense_run` None if not)
     x0 = fast_x0(x0, model)
     if t is None or x0 is None:
         return None
+    control = uc = None
+    if u is not None:  # (a constant one; samples and a callable: the general path)
+        if callable(u):
+            return None
+        try:
+            control = check_u(u, model.nu, t)
+        except ValueError:  # (the general path words it, after the checks before it)
+            return None
+        if not constant_control(control):
+            return None
+        uc = control.ua[0]
+    if p is None:
+        p = model.p_default
+    else:
+        try:
+            p = model.resolve_p(p)
+        except (TypeError, ValueError):
+            return None
     if method == "dop853":
-        run = plain_run(model, x0, t, rtol, atol, max_steps, p=model.p_default)
+        run = plain_run(model, x0, t, rtol, atol, max_steps, u=uc, p=p)
         if run is None:
             return None
         status = OK
         if run.ok:
-            run, status = _sane(model, t, run, None, model.p_default, method)
-        return _result(model, t, run, method, status, math.nan, None, model.p_default, (),
-                       start)
-    got = dense_run(model, x0, t, rtol, atol, max_steps, STIFF_STEPS, p=model.p_default)
+            run, status = _sane(model, t, run, control, p, method)
+        return _result(model, t, run, method, status, math.nan, control, p, (), start)
+    got = dense_run(model, x0, t, rtol, atol, max_steps, STIFF_STEPS, u=uc, p=p)
     out = None if got is None else dense_outcome(got, rtol)
     if out is None:
         return None
     run, estimate, status = out
-    return _result(model, t, run, "rk8", status, estimate, None, model.p_default, (), start)
+    return _result(model, t, run, "rk8", status, estimate, control, p, (), start)
 
 
 #: The tolerance types `_common_call` takes (a numpy float64 scalar is a Python float).

@@ -317,9 +317,11 @@ def test_common_auto_call_is_the_general_path(body, common_calls, case):
 
 
 @needs_compiler
-@pytest.mark.parametrize("kwargs", [dict(atol=[1e-9] * 7), dict(atol=np.float32(1e-9)),
-                                    dict(max_steps=np.int64(10 ** 6)), dict(jit=False),
-                                    dict(invariants=True), dict(p=[]), dict(threads=1)])
+@pytest.mark.parametrize("kwargs", [dict(max_steps=np.int64(10 ** 6)), dict(jit=False),
+                                    dict(invariants=True), dict(threads=1),
+                                    dict(u=np.outer([0.1, 0.0, -0.2], [1.0, 0.5, 0.0])),
+                                    dict(u=lambda t: [0.1, 0.0, 0.0]),
+                                    dict(u=[0.1, 0.0, 0.0], hold="zoh")])
 def test_common_auto_call_declines_the_rest_alike(body, common_calls, kwargs):
     """What the common path does not take (other types, options) goes the general way,
     unchanged."""
@@ -327,6 +329,53 @@ def test_common_auto_call_declines_the_rest_alike(body, common_calls, kwargs):
     assert common_calls.answered == []
     common_calls.off()
     _same(fast, dynamics.simulate(body, X0, GRID, **kwargs))
+
+
+@needs_compiler
+@pytest.mark.parametrize("method", ["auto", "dop853"])
+@pytest.mark.parametrize("case", ["p", "p for none", "constant u", "u a scalar",
+                                  "samples all equal", "u and p"])
+def test_common_call_takes_a_constant_control_and_parameters(body, common_calls, method,
+                                                              case):
+    """A control constant over the run (``(nu,)``, or samples all equal) and given
+    parameters take the common call: what the general path gives, to the bit (the result's
+    dense output and derivatives included), here against a body under a constant torque
+    and the oscillator ``y'' = -k y + u`` at its own ``k``."""
+    model, x0, t, kw = body, list(X0), np.linspace(0.0, 5.0, 6), {}
+    if case == "p":
+        model, x0, kw = _oscillator(), [1.0, 0.0], dict(p=[2.5])
+    elif case == "p for none":
+        kw = dict(p=[])
+    elif case == "constant u":
+        kw = dict(u=[0.05, -0.02, 0.01])
+    elif case == "u a scalar":
+        model, x0, kw = _oscillator(), [1.0, 0.0], dict(u=0.3)
+    elif case == "samples all equal":
+        kw = dict(u=np.tile([[0.05], [-0.02], [0.01]], t.size))
+    else:
+        model, x0, kw = _oscillator(), [1.0, 0.0], dict(u=[0.3], p=np.array([2.5]))
+    fast = dynamics.simulate(model, x0, t, method=method, **kw)
+    assert len(common_calls.answered) == 1 and fast.success
+    common_calls.off()
+    slow = dynamics.simulate(model, x0, t, method=method, **kw)
+    (_same_auto if method == "auto" else _same)(fast, slow)
+    np.testing.assert_array_equal(fast.xdot, slow.xdot)
+    if case in ("p", "u and p", "u a scalar"):  # y = A cos(w t) + u / k, w = sqrt(k)
+        k = 2.5 if "p" in case else 4.0
+        uu = 0.3 if "u" in case else 0.0
+        y = (1.0 - uu / k) * np.cos(np.sqrt(k) * t) + uu / k
+        assert np.abs(fast.x[0] - y).max() <= 1e-7
+
+
+@needs_compiler
+@pytest.mark.parametrize("bad", [dict(p=[1.0, 2.0]), dict(p=[np.nan]), dict(u=[np.inf]),
+                                 dict(u=[1.0, 2.0]), dict(u="a"), dict(p="k")])
+def test_bad_control_or_parameters_refused_alike_by_the_common_call(common_calls, bad):
+    model = _oscillator()
+    fast = _message(lambda: dynamics.simulate(model, [1.0, 0.0], GRID, **bad))
+    assert common_calls.answered == [] and fast[0] is ValueError
+    common_calls.off()
+    assert _message(lambda: dynamics.simulate(model, [1.0, 0.0], GRID, **bad)) == fast
 
 
 @needs_compiler
@@ -457,12 +506,13 @@ def test_common_dop853_call_is_the_general_path(body, common_calls, case):
 @needs_compiler
 @pytest.mark.parametrize("method", ["auto", "dop853"])
 @pytest.mark.parametrize("tolerances", [(np.float64(1e-6), 1e-10), (1e-6, np.float64(1e-9)),
-                                        tuple(np.logspace(-7, -9, 2))])
-def test_numpy_float64_tolerances_take_the_common_call(body, common_calls, method,
-                                                       tolerances):
-    """A tolerance that is a numpy float64 scalar (a Python float: a sweep over
-    ``np.logspace`` hands them over) takes the common call, with the result the general
-    path gives to the bit."""
+                                        tuple(np.logspace(-7, -9, 2)), (1e-7, [1e-9] * 7),
+                                        (1e-7, np.geomspace(1e-12, 1e-9, 7)),
+                                        (np.float32(1e-6), np.float32(1e-9))])
+def test_other_tolerances_take_the_common_call(body, common_calls, method, tolerances):
+    """Tolerances that are numpy scalars (a sweep over ``np.logspace`` hands them over) or
+    an ``atol`` per state: the common call checks them as the general path does
+    (`check_tolerances`), with the result the general path gives to the bit."""
     rtol, atol = tolerances
     fast = dynamics.simulate(body, X0, GRID, method=method, rtol=rtol, atol=atol)
     assert len(common_calls.answered) == 1 and fast.success
