@@ -245,7 +245,7 @@ class Model:
         """
         if p is None:
             return np.array(self.p_default)
-        p = np.asarray(p, dtype=float).reshape(-1)
+        p = np.array(p, dtype=float).reshape(-1)  # (a copy: a result keeps its own)
         if p.size != self.np:
             raise ValueError(f"`p` must have {self.np} elements {self.params}, got {p.size}")
         if not all(map(math.isfinite, p.tolist())):  # (floats: a few times numpy's speed)

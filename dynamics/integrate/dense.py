@@ -366,12 +366,13 @@ def dense_run(model, x0: np.ndarray, t: np.ndarray, rtol: float, atol, max_steps
         _tell(progress, int(ws[_SPENT]), told)
     elif progress is not None:
         _tell(progress, int(ws[_SPENT]), 0)
-    if ws[_RESULT] == -4:  # (a grid handed over unchecked: `check_t` words what is wrong)
+    head = ws[:HEADER].tolist()  # (Python floats: read once, cheaper than items of ws)
+    if head[_RESULT] == -4:  # (a grid handed over unchecked: `check_t` words what is wrong)
         return None
     x = work.X.copy()
-    if ws[_RESULT] == -3:  # (the outputs filled before the failure; NaN after)
+    if head[_RESULT] == -3:  # (the outputs filled before the failure; NaN after)
         x[:, 1 + int(ws[HEADER + 3 * nx + nu + plan.np + nout + 2 + 5]):] = np.nan
-    return _outcome(x, ws[:HEADER].tolist())
+    return _outcome(x, head)
 
 
 #: Single checked calls of a model in a process after which its vector lanes are asked for

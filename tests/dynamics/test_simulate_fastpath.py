@@ -100,6 +100,19 @@ def test_inputs_are_copied_not_shared(body):
     np.testing.assert_array_equal(res.x, again.x)
 
 
+@pytest.mark.parametrize("method", ["auto", "dop853", "rk8"])
+def test_parameters_and_control_are_copied_not_shared(method):
+    """A result keeps the ``p`` and ``u`` it was made with: changed by the caller after
+    the call, its derivatives and dense samples do not move."""
+    model = _oscillator()
+    p, u = np.array([2.5]), np.array([0.3])
+    res = dynamics.simulate(model, [1.0, 0.0], GRID, p=p, u=u, method=method)
+    p[0], u[0] = 100.0, -7.0
+    again = dynamics.simulate(model, [1.0, 0.0], GRID, p=[2.5], u=[0.3], method=method)
+    np.testing.assert_array_equal(res.xdot, again.xdot)
+    np.testing.assert_array_equal(res.sample(0.3), again.sample(0.3))
+
+
 def test_default_options_path_matches_explicit_options(body):
     base = dynamics.simulate(body, X0, GRID, method="rk8", steps=2)
     for kwargs in (dict(jit=True), dict(max_steps=10, cvodes_options=None),
