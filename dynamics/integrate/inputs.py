@@ -266,6 +266,10 @@ def check_tolerances(rtol, atol, nx: int) -> tuple[float, np.ndarray]:
         raise ValueError(f"`rtol` must be in [{RTOL_MIN:.3g}, 1), got {rtol!r}")
     if type(atol) is float and 0 <= atol < math.inf:  # fast path: the common case
         return rtol_f, np.full(nx, atol)
+    if type(atol) is np.ndarray and atol.dtype is _FLOAT64 and atol.shape == (nx,):
+        a = atol.copy()  # fast path: one per state, every check passed (in Python floats)
+        if all(0.0 <= v < math.inf for v in a.tolist()):
+            return rtol_f, a
     a = finite_array(atol, "atol")
     if a.shape not in ((), (nx,)):
         raise ValueError(f"`atol` must be a scalar or have shape ({nx},), got {a.shape}")

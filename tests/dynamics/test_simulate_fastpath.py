@@ -532,3 +532,27 @@ def test_other_tolerances_take_the_common_call(body, common_calls, method, toler
     common_calls.off()
     slow = dynamics.simulate(body, X0, GRID, method=method, rtol=rtol, atol=atol)
     (_same_auto if method == "auto" else _same)(fast, slow)
+
+
+@pytest.mark.parametrize("atol", [np.geomspace(1e-12, 1e-6, 7), np.zeros(7),
+                                  np.r_[np.full(6, 1e-9), np.nan], np.r_[np.full(6, 1e-9), np.inf],
+                                  np.r_[np.full(6, 1e-9), -1e-9], np.r_[np.full(6, 1e-9), -0.0]])
+def test_an_atol_per_state_is_checked_alike_as_an_array_and_as_a_list(atol):
+    """`inputs.check_tolerances` takes a float64 array of one ``atol`` per state at once
+    (its checks in Python floats); a list of the same numbers takes the general checks:
+    the same values returned (a copy), the same error refused."""
+    from appdyn.dynamics.integrate.inputs import check_tolerances
+
+    def outcome(value):
+        try:
+            return check_tolerances(1e-8, value, 7)
+        except ValueError as exc:
+            return str(exc)
+
+    fast, slow = outcome(atol), outcome(atol.tolist())
+    if isinstance(slow, str):
+        assert isinstance(fast, str) and fast.split(",")[0] == slow.split(",")[0]
+    else:
+        assert fast[0] == slow[0] == 1e-8
+        np.testing.assert_array_equal(fast[1], slow[1])
+        assert fast[1] is not atol and not np.shares_memory(fast[1], atol)
