@@ -303,11 +303,11 @@ def _common_call(model, x0, t, rtol, atol, max_steps, start: float, method: str 
     a `Model` with no clock state and a smooth right-hand side, ``x0`` of shape ``(nx,)``
     that `fast_x0` takes, a float64 grid `inputs.handed_t` takes, tolerances
     `check_tolerances` takes (``atol`` a float or one per state), an int ``max_steps``, a
-    control constant over
-    the run (``u`` None, ``(nu,)``, or samples all equal, as `check_u` takes them; not a
-    callable) and the model's parameters or a ``p`` `Model.resolve_p` takes. Returns
-    the answer of the compiled dense pass (`dense.dense_run`) at once when
-    it answers (`auto.dense_outcome`: verified, or below the rounding floor; for
+    control constant over the run (``u`` None, ``(nu,)``, or samples all equal, as
+    `check_u` takes them; not a callable) and the model's parameters or a ``p``
+    `Model.resolve_p` takes. Returns the answer of the compiled dense pass
+    (`dense.dense_run`) at once when it answers (`auto.dense_outcome`: verified, or below
+    the rounding floor; for
     ``dop853`` its answer alone, `stepcontrol.plain_run`, with the sanity check of an
     unverified run on the quaternion's drift the pass measured), ``start`` the call's
     `time.perf_counter`. None for anything else, for a grid the pass finds not finite and
