@@ -175,7 +175,7 @@ def simulate_batch(batch: Batch, options: RunOptions, *, start: float) -> "Batch
                        FAILED: "a run became non-finite"}.get(st, "")
             message = f"auto: {run.message}; {verdict}"
     x.setflags(write=False)
-    return BatchResult(t=batch.t, x=x, success=ok & np.isin(status, (OK, OK_STIFF)),
+    return BatchResult(t=batch.t, x=x, success=ok & ((status == OK) | (status == OK_STIFF)),
                        status=status, message=message, method=used,
                        wall_time=time.perf_counter() - start, n_steps=int(n_steps),
                        error_estimate=estimate, compiled=bool(compiled), _batch=batch)
@@ -240,7 +240,10 @@ def auto_dense_batch(batch: Batch, rtol: float, atol: np.ndarray, max_steps: int
         used.add(method)
         steps[k] = run.n_steps
     x = X.transpose(1, 2, 0)
-    ok = np.isfinite(x).all(axis=(0, 1))
+    # (a run verified in the loop has finite outputs: `cpass` ``au_diff`` counts a
+    # non-finite one as an infinite error, which no gate accepts; the others are looked at)
+    ok = result == 1
+    ok[redo] = np.isfinite(X[redo]).all(axis=(1, 2))
     status = np.where(ok, status, FAILED)
     message = (f"auto: DOP853 with dense output per run ({K} runs, each with its own steps, "
                f"checked against its own steps merged in pairs): "
@@ -435,23 +438,22 @@ def first_factor(estimate, factor, steps, gate, *, current: float, rtol: float) 
     scale = n * f ** (1.0 / ORDER)
     ratio = np.concatenate([e / f / SPREAD, e / f, e / f * SPREAD])
     weight = np.concatenate([0.25 * scale, 0.5 * scale, 0.25 * scale])
-    cost = np.zeros(grid.size)
-    gates = np.concatenate([g, g, g])
-    for gate in sorted(set(g.tolist())):  # (0.5 or 1)
-        mine = gates == gate
-        key = np.round(32 * np.log10(ratio[mine])).astype(int)
-        lo = key.min()
-        w = np.bincount(key - lo, weights=weight[mine])
-        used = np.flatnonzero(w)
-        # (a sum, not a matrix product: no BLAS call, whose threads would then spin on
-        # the cores the batch's loops run on)
-        cost += (_expected_steps(grid, 10.0 ** ((used + lo) / 32), gate) * w[used]).sum(axis=1)
+    # (the bins of every gate, 0.5 or 1, in one: bin = key - lo + span * the gate's index)
+    gate, which = np.unique(np.concatenate([g, g, g]), return_inverse=True)
+    key = np.round(32 * np.log10(ratio)).astype(int)
+    lo, span = key.min(), key.max() - key.min() + 1
+    w = np.bincount(key - lo + span * which, weights=weight)
+    used = np.flatnonzero(w)
+    # (a sum, not a matrix product: no BLAS call, whose threads would then spin on the
+    # cores the batch's loops run on)
+    cost = (_expected_steps(grid, 10.0 ** ((used % span + lo) / 32), gate[used // span]) *
+            w[used]).sum(axis=1)
     return float(grid[int(np.argmin(cost))])
 
 
-def _expected_steps(grid: np.ndarray, ratio: np.ndarray, gate: float) -> np.ndarray:
+def _expected_steps(grid: np.ndarray, ratio: np.ndarray, gate: np.ndarray) -> np.ndarray:
     """The steps ``(c, m)`` of runs of unit steps at factor 1 (steps ``factor^(-1/ORDER)``),
-    of estimates ``ratio (m,)`` per unit factor and acceptance ``gate``, had their first
+    of estimates ``ratio (m,)`` per unit factor and acceptances ``gate (m,)``, had their first
     answer been at each factor of ``grid (c,)``: the answers until one is accepted (a
     retry as `cpass._AUTO` makes one), double when none of `dense.TRIES` is."""
     at = np.repeat(grid[:, None], ratio.size, axis=1)

@@ -340,12 +340,14 @@ class Control:
 HOLDS = ("linear", "zoh")
 
 
-def _rows(a: np.ndarray, m: int) -> np.ndarray:
-    """``np.broadcast_to(a, (m, a.size))`` of a fresh C-contiguous float64 ``a``: the same
-    read-only view of ``m`` rows with stride 0, made directly (a tenth of its cost)."""
+def _rows(a: np.ndarray, *lead: int) -> np.ndarray:
+    """``np.broadcast_to(a, (*lead, a.size))`` of a fresh C-contiguous float64 ``a``: the
+    same read-only view, strides 0 but the last, made directly (a tenth of its cost); a
+    constant control's rows (``lead`` ``(m,)``: its ``m`` intervals; ``(K, m)``: those of
+    ``K`` runs in a batch, nothing allocated per run nor faulted in when read)."""
     if a.size == 0:
-        return np.broadcast_to(a, (m, 0))
-    rows = np.ndarray((m, a.size), np.float64, a, 0, (0, a.itemsize))
+        return np.broadcast_to(a, (*lead, 0))
+    rows = np.ndarray((*lead, a.size), np.float64, a, 0, (0,) * len(lead) + (a.itemsize,))
     rows.flags.writeable = False
     return rows
 
@@ -506,7 +508,8 @@ def check_batch(model: Model, x0, t: np.ndarray, u, p, *, hold: str = "linear") 
     K = X0.shape[1]
     if model.attitude is not None:
         iq = model.attitude[0]
-        bad = np.abs(np.linalg.norm(X0[iq:iq + 4], axis=0) - 1.0) > QUAT_NORM_TOL
+        q = X0[iq:iq + 4]  # (the norm of each run's quaternion, without a temporary per row)
+        bad = np.abs(np.sqrt(np.einsum("ik,ik->k", q, q)) - 1.0) > QUAT_NORM_TOL
         if bad.any():  # the message of the single-run check, naming the run
             k = int(np.argmax(bad))
             unit_quaternion(X0[iq:iq + 4, k], f"x0[{iq}:{iq + 4}, {k}] (the attitude quaternion)")
@@ -524,12 +527,11 @@ def check_batch(model: Model, x0, t: np.ndarray, u, p, *, hold: str = "linear") 
     if callable(u):
         raise ValueError("`u` must be None or an array for a batch of runs (x0 of shape "
                          f"({nx}, K)): give samples of shape ({nu}, {n}) or ({nu}, {n}, K)")
-    if u is None:  # (zeros cost nothing until written: no copies)
-        return Batch(model, X0, t, P, np.zeros((K, n - 1, nu)), np.zeros((K, n - 1, nu)), True)
-    a = np.asarray(finite_array(u, "u"), dtype=float)
-    if a.shape == (nu,):
-        U = np.broadcast_to(a, (K, n, nu))
-    elif a.shape == (nu, n):
+    a = np.zeros(nu) if u is None else np.asarray(finite_array(u, "u"), dtype=float)
+    if a.shape == (nu,):  # (one value for every run and time: a view, nothing copied per run)
+        same = _rows(np.array(a), K, n - 1)
+        return Batch(model, X0, t, P, same, same, True)
+    if a.shape == (nu, n):
         U = np.broadcast_to(a.T, (K, n, nu))
     elif a.shape == (nu, n, K):
         U = a.transpose(2, 1, 0)
@@ -537,6 +539,6 @@ def check_batch(model: Model, x0, t: np.ndarray, u, p, *, hold: str = "linear") 
         raise ValueError(f"`u` must be None, ({nu},), ({nu}, {n}) or ({nu}, {n}, {K}) for "
                          f"a batch of {K} runs, got {a.shape}")
     ua = np.ascontiguousarray(U[:, :-1])
-    if hold == "zoh" and a.shape != (nu,):
+    if hold == "zoh":
         return Batch(model, X0, t, P, ua, ua, False, np.array(U[:, -1]))
-    return Batch(model, X0, t, P, ua, np.ascontiguousarray(U[:, 1:]), a.shape == (nu,))
+    return Batch(model, X0, t, P, ua, np.ascontiguousarray(U[:, 1:]))

@@ -70,6 +70,31 @@ def test_constant_torque_per_run_on_a_sphere():
                                atol=1e-12)
 
 
+@pytest.mark.parametrize("u", [None, [0.3, -0.2, 0.1]])
+@pytest.mark.parametrize("method", ["auto", "rk8"])
+def test_a_torque_shared_by_the_runs_is_held_once_and_integrated_exactly(u, method):
+    """J = E under one constant torque (``u`` of shape (nu,), or none) for every run:
+    w(t) = w0 + u t; the batch holds that control once (a view of strides 0, not a copy per
+    run and interval) and each run equals its single call."""
+    t = np.linspace(0.0, 2.0, 9)
+    K = 5
+    W0 = np.random.default_rng(3).normal(size=(3, K))
+    X0 = np.vstack([np.tile([[0.0], [0.0], [0.0], [1.0]], (1, K)), W0])
+    model = rigid_body([1.0, 1.0, 1.0])
+    kw = {"steps": 4} if method == "rk8" else {}
+    res = simulate(model, X0, t, u=u, method=method, **kw)
+    assert res.all_success
+    T = np.zeros(3) if u is None else np.asarray(u)
+    np.testing.assert_allclose(res.x[4:], W0[:, None, :] + T[:, None, None] * t[None, :, None],
+                               atol=1e-12)
+    ua = res._batch.ua
+    assert ua.shape == (K, t.size - 1, 3) and ua.strides[:2] == (0, 0)
+    assert not ua.flags.writeable and res._batch.ub is ua
+    for k in (0, K - 1):
+        np.testing.assert_array_equal(res.x[:, :, k], simulate(model, X0[:, k], t, u=u,
+                                                               method=method, **kw).x)
+
+
 def test_parameters_per_run():
     """x'' = -k x: x(t) = cos(sqrt(k) t) with each run's own k (p of shape (np, K))."""
     x, v, k = ca.SX.sym("x"), ca.SX.sym("v"), ca.SX.sym("k")
@@ -92,6 +117,24 @@ def test_a_run_that_blows_up_fails_alone():
     assert res.success.tolist() == [True, False] and res.status.tolist() == [0, -1]
     np.testing.assert_allclose(res.x[0, :, 0], 0.1 / (1 - 0.1 * t), rtol=1e-12)
     assert np.isnan(res.x[0, -1, 1]) and "non-finite" in res.message
+
+
+def test_an_auto_run_that_blows_up_fails_alone_among_verified_runs():
+    """The same blow-up among 40 runs of the dense loop (``auto``): the runs it verified are
+    reported finite without a look at their outputs, so each must be; the blown-up run
+    fails with the true cause."""
+    x = ca.SX.sym("x")
+    model = Model.from_expressions({"x": x}, {"x": x ** 2})
+    t = np.linspace(0.0, 0.9, 10)
+    x0 = np.linspace(0.05, 1.0, 40)
+    x0[17] = 2.0
+    res = simulate(model, x0[None, :], t)
+    assert res.status[17] == -1 and not res.success[17]
+    assert not np.all(np.isfinite(res.x[:, :, 17]))
+    good = np.delete(np.arange(40), 17)
+    assert res.success[good].all() and np.isfinite(res.x[:, :, good]).all()
+    np.testing.assert_allclose(res.x[0, :, good], x0[good, None] / (1 - x0[good, None] * t),
+                               rtol=1e-7)
 
 
 def test_progress_counts_the_steps_of_a_batch():
