@@ -150,3 +150,29 @@ def test_a_batch_run_that_fails_is_said_and_the_others_answer():
     assert np.isfinite(res.x[:, :, 0]).all() and np.isnan(res.x[:, -1, 1]).all()
     one = simulate(model, slow, T, method="dop853", max_steps=200)
     np.testing.assert_array_equal(res.x[:, :, 0], one.x)
+
+
+@pytest.mark.parametrize("case", ["body", "no inputs", "parameters"])
+def test_the_first_step_evaluates_the_model_as_its_rhs_does_to_the_bit(case):
+    """`estimates._xdot` (the buffered call `initial_step` makes) gives `Model.rhs`'s bits,
+    also for a model without controls or parameters; so a run's first step, and every step
+    after it, is what the dictionary call gave."""
+    import casadi as ca
+
+    from appdyn.dynamics import Model
+    from appdyn.dynamics.integrate.estimates import _xdot
+
+    rng = np.random.default_rng(5)
+    if case == "body":
+        model = rigid_body([1.5, 2.5, 3.2])
+        x, u, p = np.r_[0.1, -0.2, 0.3, 0.9, rng.normal(size=3)], rng.normal(size=3), None
+    else:
+        s, k = ca.SX.sym("s"), ca.SX.sym("k")
+        params = {"k": k} if case == "parameters" else None
+        model = Model.from_expressions({"s": s}, {"s": (k if params else 1.0) * s ** 2 - 0.3},
+                                       params=params, p_default=[1.7] if params else None)
+        x, u, p = np.array([0.7]), np.zeros(0), None
+    p = model.resolve_p(p)
+    for _ in range(5):
+        assert np.array_equal(_xdot(model, x, u, p), model.rhs(x, u, p))
+        x = x + 0.1 * rng.normal(size=x.size)
