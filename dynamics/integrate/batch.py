@@ -52,7 +52,7 @@ from .result import (FAILED, OK, OK_STIFF, ROUNDOFF, UNVERIFIED, VIOLATED, Dense
                      Run, SimulationResult)
 from .smoothness import nonsmooth_operations
 from .sanity import remedy, violations
-from .stepcontrol import LOCAL_RTOL_MIN, run_dop853
+from .stepcontrol import LOCAL_RTOL_MIN, run_dop853, run_stepped_many
 
 __all__ = ["Batch", "BatchResult", "check_batch", "simulate_batch", "BATCH_THREADS",
            "first_factor", "dense_rounds"]  # (Batch,
@@ -113,9 +113,18 @@ def simulate_batch(batch: Batch, options: RunOptions, *, start: float) -> "Batch
         compile_ = cache.should_compile(jit, math.inf)
         plain = dop853_dense_batch(batch, rtol, atol, max_steps, threads=options.threads) \
             if method == "dop853" and compile_ else None
+        stepped = run_stepped_many(batch.model, batch.x0.T, batch.t, batch.ua, batch.ub,
+                                   batch.p.T, rtol, atol, max_steps,
+                                   threads=batch_threads(options.threads)) \
+            if plain is None and method == "dop853" and compile_ else None
         if plain is not None:  # (one compiled loop over the runs)
             x, ok, n_steps, failed = plain
             compiled, how = True, "in one compiled loop"
+        elif stepped is not None:  # (the compiled stepper per run, steps ending on the grid)
+            X, runs = stepped
+            x, ok, n_steps = X.transpose(1, 2, 0), runs.ok, int(runs.steps.max())
+            failed = "" if ok.all() else runs(int(np.argmin(ok))).message
+            compiled, how = True, "each by the compiled stepper, its steps ending on the grid"
         else:
             runs = [run_cvodes(batch.problem(k), rtol, atol, cvodes_options) if method == "cvodes"
                     else run_dop853(batch.problem(k), rtol, atol, max_steps, compiled=compile_,

@@ -355,6 +355,42 @@ int rk8_adaptive(casadi_real* x, casadi_real* hio, int nint, const casadi_real* 
   *hio = h;
   return k;
 }
+
+/* `rk8_adaptive` for the runs of a batch on one grid, each run's calls as a run alone
+   makes them (`stepcontrol._intervals`: `chunk` intervals to a call), the runs handed out
+   through the shared `cursor` (atomic, as `au_claim`) to the threads that call this: run k
+   from x + k nx (updated in place) with the proposal h[k], controls ua, ud + k nint nu
+   (stride nu), parameters p + k pstride, its outputs into X + k nx nint (nx, nint), hbig +
+   k nint and count + 4 k, its intervals done into done[k]. No run is taken once the runs
+   done have made `budget` steps (0: no limit). Returns 1 when every run is handed out,
+   else 0. */
+int rk8_adaptive_many(long long n, long long* cursor, double budget, int nint, int chunk,
+                      const casadi_real* H, casadi_real* x, casadi_real* h,
+                      const casadi_real* ua, const casadi_real* ud, int nu,
+                      const casadi_real* p, int pstride, casadi_real rtol,
+                      const casadi_real* atol, casadi_real max_steps, casadi_real* X,
+                      casadi_real* hbig, casadi_real* count, long long* done) {
+  long long k;
+  int d, m;
+  double spent = 0;
+  while (!(budget > 0 && spent >= budget)) {
+    k = __atomic_fetch_add(cursor, 1, __ATOMIC_RELAXED);
+    if (k >= n) return 1;
+    {
+      casadi_real *c = count + 4 * k, *xk = x + k * PASS_NX, *Xk = X + k * PASS_NX * nint;
+      const casadi_real *uak = ua + k * nint * nu, *udk = ud + k * nint * nu;
+      for (d = 0; d < nint && !c[2]; d += m) {
+        m = nint - d < chunk ? nint - d : chunk;
+        m = rk8_adaptive(xk, h + k, m, H + d, H + d, uak + d * nu, udk + d * nu, nu,
+                         p + k * pstride, rtol, atol, max_steps, Xk + d, nint,
+                         hbig + k * nint + d, c);
+      }
+      done[k] = d;
+      spent += c[0] + c[1];
+    }
+  }
+  return 0;
+}
 """
 
 
@@ -2049,6 +2085,12 @@ def _loaded(lib, lanes: bool):
                         i32, ptr, ptr]
     stepper.restype = i32
     fun.stepper = stepper  # (`dynamics.integrate.stepcontrol`)
+    many = lib.rk8_adaptive_many
+    i64 = ctypes.c_longlong
+    many.argtypes = [i64, ptr, f64, i32, i32, ptr, ptr, ptr, ptr, ptr, i32, ptr, i32, f64, ptr,
+                     f64, ptr, ptr, ptr, ptr]
+    many.restype = i32
+    fun.stepper_many = many  # (`stepcontrol.run_stepped_many`)
     auto = lib.rk8_auto
     auto.argtypes = [ptr, i32, i32, ptr, ptr]
     auto.restype = i32

@@ -10,7 +10,7 @@ import casadi as ca
 import numpy as np
 
 from .. import cache
-from .evaluate import call_buffered
+from .evaluate import call_buffered, map_eval
 from .inputs import Problem
 from .result import Run
 
@@ -89,6 +89,7 @@ def initial_step(problem: Problem, rtol, atol, order: int) -> tuple[float | None
     ``h``: Hairer's heuristic (Hairer, Norsett & Wanner I, II.4), capped at ``2 / L`` for
     explicit stability, with ``L = |f(x0 + h0 f0) - f0| / |h0 f0|`` (scaled norms). ``h`` is
     None when the heuristic is degenerate (a zero state or zero derivative); ``L`` is then 0.
+    (`initial_steps` makes the same for many runs at once, to the bit.)
     """
     model, x0 = problem.model, problem.x0
     t0, H0 = float(problem.t[0]), float(problem.t[1] - problem.t[0])
@@ -102,23 +103,77 @@ def initial_step(problem: Problem, rtol, atol, order: int) -> tuple[float | None
     if not (np.isfinite(d1) and d0 > 1e-5 and d1 > 1e-5):
         return None, 0.0
     h0 = 0.01 * d0 / d1
-    f1 = _xdot(model, x0 + h0 * f0, problem.control.at(t0 + min(h0, H0), 0, t0, H0),
-               problem.p)
+    u1 = problem.control.at(t0 + min(h0, H0), 0, t0, H0)
+    f1 = _xdot(model, x0 + h0 * f0, u1, problem.p)
     d2 = np.sqrt(np.mean(((f1 - f0) / scale) ** 2)) / h0
     if not np.isfinite(d2):
         return None, 0.0
-    h1 = (0.01 / max(d1, d2)) ** (1.0 / (order + 1)) if max(d1, d2) > 1e-15 else 100 * h0
-    lipschitz = d2 / d1
-    h = min(100 * h0, h1)
+    return _hairer(float(h0), float(d1), float(d2), order)
+
+
+def _hairer(h0: float, d1: float, d2: float, order: int) -> tuple[float, float]:
+    """``(h, L)`` of `initial_step` from its trial step ``h0`` and scaled norms ``d1`` (of
+    f0) and ``d2`` (of the change of f over h0, per second), in Python floats."""
+    big = max(d1, d2)
+    h1 = (0.01 / big) ** (1.0 / (order + 1)) if big > 1e-15 else 100 * h0
+    h, lipschitz = min(100 * h0, h1), d2 / d1
     return (min(h, 2.0 / lipschitz) if lipschitz > 0 else h), lipschitz
 
 
-def _xdot(model, x: np.ndarray, u, p: np.ndarray) -> np.ndarray:
-    """``xdot (nx,)`` of ``model.f`` at ``(x, u, p)``: `Model.rhs`'s answer to the bit,
-    through a buffer (`call_buffered`: 5 against 51 us a call on the rigid body, whose
-    dictionary call converts every argument; `initial_step` makes two on each call of a
-    run stepped from Python's side)."""
-    return call_buffered(model.f, [x, u, p], (model.nx,))
+def initial_steps(model, x0: np.ndarray, p: np.ndarray, rtol: float, atol: np.ndarray,
+                  order: int, t0: float, H0: float, control_at) -> tuple[list, list]:
+    """`initial_step` of K runs at once, each run's the same bits as alone (the norms
+    reduced along each run's row, as numpy reduces one run's vector; the rest, `_hairer`,
+    in Python floats for both; tested against single runs).
+
+    Parameters
+    ----------
+    model : Model
+    x0 : ndarray, shape (K, nx)
+        The runs' initial states, C-contiguous.
+    p : ndarray, shape (K, np)
+    rtol : float
+    atol : ndarray, shape (nx,)
+    order : int
+        The method's order (the step grows as the tolerance to the ``1 / (order + 1)``).
+    t0, H0 : float [s]
+        The start and the first output interval of every run.
+    control_at : callable
+        ``control_at(t (K,)) -> (K, nu)``: each run's control at its time ``t[k]`` in the
+        first interval.
+
+    Returns
+    -------
+    h : list of float or None, length K [s]
+    lipschitz : list of float, length K [1/s]
+    """
+    scale = atol + rtol * np.abs(x0)
+    f0 = _xdot(model, x0, control_at(np.full(len(x0), t0)), p)
+    with np.errstate(all="ignore"):  # (a degenerate run's values are not used)
+        d0 = np.sqrt(np.mean((x0 / scale) ** 2, axis=1))
+        d1 = np.sqrt(np.mean((f0 / scale) ** 2, axis=1))
+        usable = ~np.any(scale == 0, axis=1) & np.isfinite(d1) & (d0 > 1e-5) & (d1 > 1e-5)
+        h0 = np.where(usable, 0.01 * d0 / d1, 0.0)
+        f1 = _xdot(model, x0 + h0[:, None] * f0, control_at(t0 + np.minimum(h0, H0)), p)
+        d2 = np.sqrt(np.mean(((f1 - f0) / scale) ** 2, axis=1)) / h0
+    steps, lipschitz = [], []
+    for ok, a, b, c in zip((usable & np.isfinite(d2)).tolist(), h0.tolist(), d1.tolist(),
+                           d2.tolist()):
+        h, L = _hairer(a, b, c, order) if ok else (None, 0.0)
+        steps.append(h)
+        lipschitz.append(L)
+    return steps, lipschitz
+
+
+def _xdot(model, x: np.ndarray, u: np.ndarray, p: np.ndarray) -> np.ndarray:
+    """``xdot`` of ``model.f`` at one run's ``x (nx,)``, ``u (nu,)``, ``p (np,)`` (shape
+    ``(nx,)``) or at the rows of ``(K, nx)``, ``(K, nu)``, ``(K, np)`` (shape ``(K, nx)``):
+    `Model.rhs`'s answers to the bit, through a buffer (`call_buffered`, one run: 5 against
+    51 us a call on the rigid body, whose dictionary call converts every argument;
+    `map_eval` for K runs)."""
+    if x.ndim == 1:
+        return call_buffered(model.f, [x, u, p], (model.nx,))
+    return map_eval(model.f, [x.T, u.T, p.T]).T
 
 
 def spectrum(problem: Problem) -> tuple[float, float] | None:

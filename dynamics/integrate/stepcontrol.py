@@ -37,11 +37,12 @@ import casadi as ca
 import numpy as np
 
 from .. import cache
-from ..interrupts import check_interrupt, deferred_interrupts
+from ..executors import run_split
+from ..interrupts import check_interrupt, deferred_interrupts, stop_requested
 from .adaptive import INTERVALS
 from .cpass import pass_library
 from .dense import constant_control, dense_run
-from .estimates import initial_step, tightened
+from .estimates import initial_step, initial_steps, tightened
 from .evaluate import call_buffered
 from .inputs import Problem
 from .kernels import kernel
@@ -50,7 +51,7 @@ from .result import Run
 from .tableaux import DOP853, unique_nodes
 
 __all__ = ["LOCAL_RTOL_MIN", "next_step", "plain_answer", "plain_run", "run_dop853",
-           "run_stepped", "run_stepped_callable", "solve_stepped"]
+           "run_stepped", "run_stepped_callable", "run_stepped_many", "solve_stepped"]
 
 _EPS = float(np.finfo(float).eps)
 
@@ -90,21 +91,122 @@ def run_stepped(problem: Problem, rtol: float, atol: np.ndarray, max_steps: int,
     out = X[:, 1:].copy()  # (nx, nint), row stride nint
     longest = np.zeros(nint)
     count = np.array([0.0, 0.0, 0.0, math.inf])
-    addr = lambda a, off=0: a.ctypes.data + 8 * off  # noqa: E731
     progress = Progress(None) if progress is None else progress
-    done = 0
     with deferred_interrupts() if nint > INTERVALS else contextlib.nullcontext():
-        while done < nint and not count[2]:
-            check_interrupt()
-            k = min(INTERVALS, nint - done)
-            before = count[0] + count[1]
-            done += stepper(addr(x), addr(h), k, addr(H, done), addr(hmax, done),
-                            addr(ua, done * nu), addr(ud, done * nu), nu, addr(p), rtol,
-                            addr(at), float(max_steps), addr(out, done), nint,
-                            addr(longest, done), addr(count))
-            progress.step(int(count[0] + count[1] - before), done / nint)
+        done = _intervals(stepper, x, h, H, hmax, ua, ud, p, rtol, at, max_steps, out,
+                          longest, count, progress)
     X[:, 1:done + 1] = out[:, :done]
     return _stepped_run(X, t, count, done, rtol, True), longest
+
+
+def _intervals(stepper, x, h, H, hmax, ua, ud, p, rtol, at, max_steps, out, longest, count,
+               progress=None) -> int:
+    """One run's calls of the compiled stepper (``cpass`` ``rk8_adaptive``) over its
+    ``nint = H.size`` output intervals, `INTERVALS` to a call (between them Ctrl-C is
+    looked at and ``progress`` told): ``x (nx,)`` and ``h (1,)`` updated in place, the
+    outputs into ``out (nx, nint)``, ``longest (nint,)`` and ``count (4,)`` as the stepper
+    writes them; ``ua, ud (nint, nu)`` C-contiguous. Returns the intervals done."""
+    nint, nu = H.size, ua.shape[1]
+    addr = lambda a, off=0: a.ctypes.data + 8 * off  # noqa: E731
+    done = 0
+    while done < nint and not count[2]:
+        check_interrupt()
+        k = min(INTERVALS, nint - done)
+        before = count[0] + count[1]
+        done += stepper(addr(x), addr(h), k, addr(H, done), addr(hmax, done),
+                        addr(ua, done * nu), addr(ud, done * nu), nu, addr(p), rtol,
+                        addr(at), float(max_steps), addr(out, done), nint,
+                        addr(longest, done), addr(count))
+        if progress is not None:
+            progress.step(int(count[0] + count[1] - before), done / nint)
+    return done
+
+
+#: Steps (accepted and rejected) after which a compiled loop of `run_stepped_many` takes no
+#: further run and returns, so that Ctrl-C is looked at (about 0.1 s on the rigid body).
+STEPPED_BUDGET = float(1 << 18)
+
+
+def run_stepped_many(model, x0: np.ndarray, t: np.ndarray, ua: np.ndarray, ub: np.ndarray,
+                     p: np.ndarray, rtol: float, atol: np.ndarray, max_steps: int, *,
+                     threads: int = 1):
+    """`run_stepped` of K runs on one grid, each the same bits as alone: their first steps
+    found together (`estimates.initial_steps`), then each run's compiled stepper, the runs
+    handed out one at a time to ``threads`` threads (the caller's and those of
+    `executors.worker_pool`: the stepper releases the GIL); Ctrl-C (deferred) stops the
+    threads taking runs.
+
+    Parameters
+    ----------
+    model : Model
+    x0 : ndarray, shape (K, nx)
+    t : ndarray, shape (n,) [s]
+    ua, ub : ndarray, shape (K, n - 1, nu)
+        Each run's control at the start and end of each output interval (linear between).
+    p : ndarray, shape (K, np)
+    rtol : float
+    atol : ndarray, shape (nx,)
+    max_steps : int
+        Most steps (accepted and rejected) of a run.
+    threads : int, optional
+
+    Returns
+    -------
+    tuple or None
+        ``(X (K, nx, n), runs)``: the states (NaN after a run's failure) and each run's
+        `Run` made lazily by ``runs(k)``; ``steps (K,)`` its steps and ``ok (K,)`` are
+        the attributes of ``runs``. None without the model's compiled library.
+    """
+    lib = pass_library(model)
+    if lib is None:
+        return None
+    K, nint = len(x0), t.size - 1
+    H = np.ascontiguousarray(t[1:] - t[:-1])
+    ua = np.ascontiguousarray(ua, dtype=float)
+    ud = np.ascontiguousarray((ub - ua) / H[None, :, None], dtype=float)
+    x = np.array(x0, dtype=float, order="C")  # (C-contiguous rows, updated in place)
+    p = np.ascontiguousarray(p, dtype=float)
+    at = np.ascontiguousarray(atol, dtype=float)
+    t0, H0 = float(t[0]), float(H[0])
+    u0 = ua[:, 0]
+    first = initial_steps(model, x, p, rtol, at, 8, t0, H0,
+                          lambda tt: u0 + ((tt - t0) / H0)[:, None] * (ub[:, 0] - u0))[0]
+    h = np.array([v if v is not None and v > 0 else H0 / 100.0 for v in first])
+    out = np.full((K, x.shape[1], nint), np.nan)
+    longest = np.zeros((K, nint))
+    count = np.tile([0.0, 0.0, 0.0, math.inf], (K, 1))
+    done = np.zeros(K, dtype=np.int64)
+    cursor = np.zeros(1, np.int64)  # (the next run, shared by the threads' compiled loops)
+    args = (K, cursor.ctypes.data, STEPPED_BUDGET, nint, INTERVALS, H.ctypes.data,
+            x.ctypes.data, h.ctypes.data, ua.ctypes.data, ud.ctypes.data, ua.shape[2],
+            p.ctypes.data, p.shape[1], rtol, at.ctypes.data, float(max_steps),
+            out.ctypes.data, longest.ctypes.data, count.ctypes.data, done.ctypes.data)
+
+    def loop(_):  # (until every run is handed out; between calls Ctrl-C is looked at)
+        while not stop_requested() and not lib.stepper_many(*args):
+            pass
+
+    with deferred_interrupts():
+        run_split(loop, [None] * max(1, min(threads, K)))
+        check_interrupt()
+    X = np.concatenate([x0[:, :, None], out], axis=2)
+    for k in np.flatnonzero(done < nint):  # (NaN from the failure on, as a run alone)
+        X[k, :, done[k] + 1:] = np.nan
+    return X, _SteppedRuns(X, t, count, done, rtol)
+
+
+class _SteppedRuns:
+    """The runs of `run_stepped_many`: ``runs(k)`` run k's `Run` (as `run_stepped`'s),
+    ``steps (K,)`` each run's steps (accepted and rejected), ``ok (K,)`` those finished."""
+
+    def __init__(self, X, t, count, done, rtol):
+        self._X, self._t, self._count, self._done, self._rtol = X, t, count, done, rtol
+        self.steps = (count[:, 0] + count[:, 1]).astype(int)
+        self.ok = count[:, 2] == 0
+
+    def __call__(self, k: int) -> Run:
+        return _stepped_run(self._X[k], self._t, self._count[k], int(self._done[k]),
+                            self._rtol, True)
 
 
 def _first_step(problem: Problem, rtol: float, atol: np.ndarray) -> float:

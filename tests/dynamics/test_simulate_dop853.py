@@ -154,9 +154,10 @@ def test_a_batch_run_that_fails_is_said_and_the_others_answer():
 
 @pytest.mark.parametrize("case", ["body", "no inputs", "parameters"])
 def test_the_first_step_evaluates_the_model_as_its_rhs_does_to_the_bit(case):
-    """`estimates._xdot` (the buffered call `initial_step` makes) gives `Model.rhs`'s bits,
-    also for a model without controls or parameters; so a run's first step, and every step
-    after it, is what the dictionary call gave."""
+    """`estimates._xdot` (the buffered call `initial_step` makes, and its mapped call over
+    the rows of a batch) gives `Model.rhs`'s bits, also for a model without controls or
+    parameters; so a run's first step, and every step after it, is what the dictionary
+    call gave."""
     import casadi as ca
 
     from appdyn.dynamics import Model
@@ -175,4 +176,93 @@ def test_the_first_step_evaluates_the_model_as_its_rhs_does_to_the_bit(case):
     p = model.resolve_p(p)
     for _ in range(5):
         assert np.array_equal(_xdot(model, x, u, p), model.rhs(x, u, p))
+        rows = _xdot(model, np.stack([x, 2 * x]), np.stack([u, u]), np.stack([p, p]))
+        assert np.array_equal(rows[1], model.rhs(2 * x, u, p))
         x = x + 0.1 * rng.normal(size=x.size)
+
+
+@pytest.mark.parametrize("hold", ["linear", "zoh"])
+@pytest.mark.parametrize("threads", [1, 2])
+def test_a_batch_under_sampled_torques_is_its_runs_one_by_one_and_exact(hold, threads):
+    """Each run its own sampled torque (steps ending on the grid, the compiled stepper per
+    run, first steps found together): the bits of its single call on any number of
+    threads, and on a sphere J = 2 E the closed form w = w0 + (1/2) integral of the torque
+    (linear samples: the trapezoid; held: the left sums)."""
+    model, x0 = sphere_case()
+    t = np.linspace(0.0, 4.0, 9)
+    K = 7
+    rng = np.random.default_rng(11)
+    X0 = np.tile(x0[:, None], (1, K))
+    X0[4:] += rng.normal(size=(3, K))
+    U = rng.normal(size=(3, t.size, K))
+    res = simulate(model, X0, t, u=U, hold=hold, method="dop853", rtol=1e-11, atol=1e-13,
+                   threads=threads)
+    assert res.all_success and "compiled stepper" in res.message
+    h = np.diff(t)[None, :, None]
+    steps = (U[:, :-1] + U[:, 1:]) / 2 * h if hold == "linear" else U[:, :-1] * h
+    exact = X0[4:, None, :] + np.concatenate([np.zeros((3, 1, K)), np.cumsum(steps, axis=1)],
+                                             axis=1) / 2
+    np.testing.assert_allclose(res.x[4:], exact, rtol=0, atol=1e-10)
+    for k in (0, 3, K - 1):
+        one = simulate(model, X0[:, k], t, u=U[:, :, k], hold=hold, method="dop853",
+                       rtol=1e-11, atol=1e-13)
+        np.testing.assert_array_equal(res.x[:, :, k], one.x)
+
+
+def test_a_sampled_batch_run_that_blows_up_fails_alone_with_its_cause():
+    """x' = x^2 + u: the run from 2 blows up before t = 0.5, the others answer as alone."""
+    import casadi as ca
+
+    from appdyn.dynamics import Model
+
+    s, u = ca.SX.sym("s"), ca.SX.sym("u")
+    model = Model.from_expressions({"s": s}, {"s": s ** 2 + u}, controls={"u": u})
+    t = np.linspace(0.0, 0.9, 10)
+    x0 = np.array([[0.1, 2.0, -0.3]])
+    U = 0.01 * np.sin(np.arange(3 * t.size)).reshape(1, t.size, 3)
+    res = simulate(model, x0, t, u=U, method="dop853", rtol=1e-10, atol=1e-12)
+    assert res.success.tolist() == [True, False, True] and res.status[1] == FAILED
+    assert "1 failed" in res.message
+    assert np.isnan(res.x[0, -1, 1]) and np.isfinite(res.x[0, 0, 1])
+    for k in (0, 2):
+        one = simulate(model, x0[:, k], t, u=U[:, :, k], method="dop853", rtol=1e-10,
+                       atol=1e-12)
+        np.testing.assert_array_equal(res.x[:, :, k], one.x)
+    alone = simulate(model, x0[:, 1], t, u=U[:, :, 1], method="dop853", rtol=1e-10,
+                     atol=1e-12)
+    assert alone.message.split(": ", 1)[1] in res.message
+
+
+@pytest.mark.parametrize("threads", [1, 2])
+def test_a_ctrl_c_stops_the_stepped_loops_from_taking_runs(threads, monkeypatch):
+    """A Ctrl-C while a sampled `dop853` batch runs (`stepcontrol.run_stepped_many`) is
+    deferred and raised (KeyboardInterrupt) once the runs taken have finished: a loop that
+    sees it takes no further run (here it arrives as the loops start: none is taken), and
+    the next call is whole."""
+    import os
+    import signal
+
+    from appdyn.dynamics.integrate import stepcontrol
+    from appdyn.dynamics.integrate.cpass import pass_library
+
+    if signal.getsignal(signal.SIGINT) is not signal.default_int_handler:
+        pytest.skip("SIGINT has a handler of its own here")
+    model, x0 = sphere_case()
+    t, K = np.linspace(0.0, 1.0, 5), 300
+    X0 = np.tile(x0[:, None], (1, K))
+    U = np.random.default_rng(2).normal(size=(3, t.size, K))
+    lib, calls = pass_library(model), []
+    many, split = lib.stepper_many, stepcontrol.run_split
+    monkeypatch.setattr(lib, "stepper_many", lambda *a: calls.append(1) or many(*a))
+
+    def interrupted_split(fun, tasks):  # (inside the deferral: the loops are about to start)
+        os.kill(os.getpid(), signal.SIGINT)
+        return split(fun, tasks)
+
+    monkeypatch.setattr(stepcontrol, "run_split", interrupted_split)
+    with pytest.raises(KeyboardInterrupt):
+        simulate(model, X0, t, u=U, method="dop853", threads=threads)
+    assert not calls
+    monkeypatch.setattr(stepcontrol, "run_split", split)
+    res = simulate(model, X0[:, :20], t, u=U[:, :, :20], method="dop853", threads=threads)
+    assert res.all_success and calls
