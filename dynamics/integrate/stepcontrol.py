@@ -131,10 +131,14 @@ def run_stepped_many(model, x0: np.ndarray, t: np.ndarray, ua: np.ndarray, ub: n
                      p: np.ndarray, rtol: float, atol: np.ndarray, max_steps: int, *,
                      threads: int = 1):
     """`run_stepped` of K runs on one grid, each the same bits as alone: their first steps
-    found together (`estimates.initial_steps`), then each run's compiled stepper, the runs
-    handed out one at a time to ``threads`` threads (the caller's and those of
-    `executors.worker_pool`: the stepper releases the GIL); Ctrl-C (deferred) stops the
-    threads taking runs.
+    found together (`estimates.initial_steps`), then every run stepped inside one compiled
+    loop over the runs (`cpass` ``rk8_adaptive_many``: the calls of the stepper a run alone
+    makes, `_intervals`), on ``threads`` threads (the caller's and those of
+    `executors.worker_pool`) that take the runs one at a time through a shared counter; each
+    loop returns after about `STEPPED_BUDGET` steps, so that a deferred Ctrl-C stops the
+    threads taking runs (raised once the runs taken have finished). No Python runs per run:
+    a loop that called the stepper once per run from Python took 41.6 ms for 1,000
+    rigid-body runs on one thread and 56 ms on two, the threads waiting on the GIL.
 
     Parameters
     ----------
