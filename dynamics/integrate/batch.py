@@ -117,14 +117,17 @@ def simulate_batch(batch: Batch, options: RunOptions, *, start: float) -> "Batch
                                    batch.p.T, rtol, atol, max_steps,
                                    threads=batch_threads(options.threads)) \
             if plain is None and method == "dop853" and compile_ else None
-        if plain is not None:  # (one compiled loop over the runs)
-            x, ok, n_steps, failed = plain
-            compiled, how = True, "in one compiled loop"
-        elif stepped is not None:  # (the compiled stepper per run, steps ending on the grid)
-            X, runs = stepped
-            x, ok, n_steps = X.transpose(1, 2, 0), runs.ok, int(runs.steps.max())
-            failed = "" if ok.all() else runs(int(np.argmin(ok))).message
-            compiled, how = True, "each by the compiled stepper, its steps ending on the grid"
+        if plain is not None or stepped is not None:
+            if plain is not None:  # (one compiled loop over the runs)
+                x, ok, each, failed = plain
+                how = "in one compiled loop"
+            else:  # (the compiled stepper per run, in one loop: steps ending on the grid)
+                X, runs = stepped
+                x, ok, each = X.transpose(1, 2, 0), runs.ok, runs.steps
+                failed = "" if ok.all() else runs(int(np.argmin(ok))).message
+                how = "each by the compiled stepper, its steps ending on the grid"
+            compiled, n_steps = True, int(each.max())
+            progress.step(int(each.sum()), 1.0)  # (the loops tell no one: once, at the end)
         else:
             runs = [run_cvodes(batch.problem(k), rtol, atol, cvodes_options) if method == "cvodes"
                     else run_dop853(batch.problem(k), rtol, atol, max_steps, compiled=compile_,
@@ -293,8 +296,8 @@ def dop853_dense_batch(batch: Batch, rtol: float, atol: np.ndarray, max_steps: i
     """``method='dop853'`` on a batch whose runs each hold one control throughout: every
     run's DOP853 answer alone (`stepcontrol.plain_run`'s, no check) in one compiled loop
     over the runs (`dense.dense_many` with ``check=False``), spread over ``threads`` as
-    `auto_dense_batch` spreads its runs. Returns ``(x (nx, n, K), ok (K,), n_steps (the
-    most of a run), failed)``: a run that failed is made again alone by
+    `auto_dense_batch` spreads its runs. Returns ``(x (nx, n, K), ok (K,), steps (K,) each
+    run's, failed)``: a run that failed is made again alone by
     `stepcontrol.run_dop853` (NaN from where it stopped), and ``failed`` is the first such
     run's message ("" for none); or None (no compiled pass, a control that varies within a
     run)."""
@@ -314,7 +317,7 @@ def dop853_dense_batch(batch: Batch, rtol: float, atol: np.ndarray, max_steps: i
     for k in np.flatnonzero(~ok):  # (alone: where and why)
         run = run_dop853(batch.problem(int(k)), rtol, atol, max_steps)
         X[k], steps[k], failed = run.x, run.n_steps, failed or run.message
-    return X.transpose(1, 2, 0), ok, int(steps.max()), failed
+    return X.transpose(1, 2, 0), ok, steps, failed
 
 
 #: Runs of a dense batch from which its vector-lane step is compiled (`lanes.dense_lanes`:

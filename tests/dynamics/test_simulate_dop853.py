@@ -266,3 +266,21 @@ def test_a_ctrl_c_stops_the_stepped_loops_from_taking_runs(threads, monkeypatch)
     monkeypatch.setattr(stepcontrol, "run_split", split)
     res = simulate(model, X0[:, :20], t, u=U[:, :, :20], method="dop853", threads=threads)
     assert res.all_success and calls
+
+
+@pytest.mark.parametrize("sampled", [False, True])
+def test_a_dop853_batch_tells_progress_its_steps(sampled):
+    """The compiled loops of a `dop853` batch (constant or sampled controls) tell a progress
+    callback every run's steps (accepted and rejected) once they are done: the last call
+    is (total, total), the total the runs' own steps, as single calls count them."""
+    model, x0 = sphere_case()
+    t, K = np.linspace(0.0, 2.0, 5), 6
+    X0 = np.tile(x0[:, None], (1, K))
+    X0[4:] += np.random.default_rng(4).normal(size=(3, K))
+    U = (np.random.default_rng(5).normal(size=(3, t.size, K)) if sampled
+         else np.array([0.1, 0.0, -0.2]))
+    calls = []
+    res = simulate(model, X0, t, u=U, method="dop853", progress=lambda d, n: calls.append((d, n)))
+    single = sum(simulate(model, X0[:, k], t, u=U[:, :, k] if sampled else U,
+                          method="dop853").n_steps for k in range(K))
+    assert res.all_success and calls and calls[-1] == (single, single)
