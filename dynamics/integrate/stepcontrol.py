@@ -175,7 +175,7 @@ def run_stepped_many(model, x0: np.ndarray, t: np.ndarray, ua: np.ndarray, ub: n
     u0 = ua[:, 0]
     first = initial_steps(model, x, p, rtol, at, 8, t0, H0,
                           lambda tt: u0 + ((tt - t0) / H0)[:, None] * (ub[:, 0] - u0))[0]
-    h = np.array([v if v is not None and v > 0 else H0 / 100.0 for v in first])
+    h = np.array([_proposal(v, H0) for v in first])
     out = np.full((K, x.shape[1], nint), np.nan)
     longest = np.zeros((K, nint))
     count = np.tile([0.0, 0.0, 0.0, math.inf], (K, 1))
@@ -215,9 +215,15 @@ class _SteppedRuns:
 
 def _first_step(problem: Problem, rtol: float, atol: np.ndarray) -> float:
     """The first step proposed [s]: Hairer's heuristic (`estimates.initial_step`), or a
-    hundredth of the first interval where it is degenerate."""
-    h0 = initial_step(problem, rtol, atol, 8)[0]
-    return h0 if h0 is not None and h0 > 0 else float(problem.t[1] - problem.t[0]) / 100.0
+    hundredth of the first interval where it is degenerate (`_proposal`)."""
+    return _proposal(initial_step(problem, rtol, atol, 8)[0],
+                     float(problem.t[1] - problem.t[0]))
+
+
+def _proposal(h0: float | None, H0: float) -> float:
+    """A run's first proposed step [s] from Hairer's heuristic ``h0`` (None: degenerate)
+    and its first output interval ``H0``: ``h0``, else ``H0 / 100``."""
+    return h0 if h0 is not None and h0 > 0 else H0 / 100.0
 
 
 def _stepped_run(X: np.ndarray, t: np.ndarray, count, done: int, rtol: float,
