@@ -16,12 +16,13 @@ import threading
 from concurrent.futures import FIRST_COMPLETED, Executor, ThreadPoolExecutor, wait
 from typing import TYPE_CHECKING, Callable, Sequence
 
-from .interrupts import check_interrupt
+from .interrupts import check_interrupt, deferred_interrupts, stop_requested
 
 if TYPE_CHECKING:
     from concurrent.futures import ProcessPoolExecutor
 
-__all__ = ["check_executor", "gather", "worker_pool", "run_split", "process_pool", "POLL"]
+__all__ = ["check_executor", "gather", "worker_pool", "run_split", "run_claiming", "process_pool",
+           "POLL"]
 
 POLL = 0.1  # [s] how often the wait on an executor looks for a deferred Ctrl-C
 
@@ -163,3 +164,19 @@ def run_split(fun: Callable, tasks: Sequence) -> None:
         wait(futures)
     for fut in futures:
         fut.result()
+
+
+def run_claiming(call: Callable, args: tuple, threads: int, runs: int) -> None:
+    """The compiled loop ``call(*args)`` over a batch's ``runs`` on ``threads`` threads (at
+    most one per run: the caller's and those of `worker_pool`), each calling it again until
+    it returns true: every run handed out through the counter the loops share (`cpass`'s
+    ``rk8_adaptive_many``, ``rk8_pass_many``; a loop returns false once its runs made its
+    step budget). Ctrl-C is deferred: a thread that sees it takes no further run, and it
+    is raised once every loop has finished."""
+    def loop(_):
+        while not stop_requested() and not call(*args):
+            pass
+
+    with deferred_interrupts():
+        run_split(loop, [None] * max(1, min(threads, runs)))
+        check_interrupt()

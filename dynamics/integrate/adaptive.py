@@ -31,12 +31,13 @@ from typing import NamedTuple
 
 import numpy as np
 
+from ..executors import run_claiming
 from ..interrupts import check_interrupt, deferred_interrupts
 from .cpass import BMAX, NOISE, pass_library
 from .estimates import signs, table
 from .inputs import Problem
 
-__all__ = ["INTERVALS", "Pass", "run_pass"]
+__all__ = ["INTERVALS", "Pass", "run_pass", "run_pass_many"]
 
 #: Output intervals per call of the compiled pass (Ctrl-C is looked at between calls).
 INTERVALS = 256
@@ -177,23 +178,91 @@ def run_pass(problem: Problem, rtol: float, atol: np.ndarray, theta: float, max_
             if progress.fun is not None:
                 progress.step(int(state[2] - before), (done + got) / nint)
             done += got
-            if state[7]:
-                reason = _REASONS[int(state[7])]
-            elif state[2] > max_steps:
-                reason = f"more than max_steps = {max_steps} steps"
+            reason = _stop_reason(state[7], state[2], max_steps)
             if reason:
                 break
-    x, xcheck = XX[0], XX[1]
+    out = _pass_of(XX[0], XX[1], state, stats.reshape(nint, 4), done, reason)
+    _return_work(work)
+    return out
+
+
+def _pass_of(x: np.ndarray, xcheck: np.ndarray, state: np.ndarray, stats: np.ndarray,
+             done: int, reason: str) -> Pass:
+    """The `Pass` of a pass that did ``done`` intervals: its answer and check ``x``,
+    ``xcheck (nx, n)`` (made NaN past a stop, in place), the C ``state`` and ``stats (nint,
+    4)`` (copied), ``reason`` why it stopped ("" when it finished)."""
+    nx = x.shape[0]
     if reason:
         x[:, done + 1:] = np.nan
         xcheck[:, done + 1:] = np.nan
     st = state[:_ST].tolist()
-    out = Pass(x, xcheck, stats.reshape(nint, 4)[:done].copy(), int(st[2]), int(st[10]),
-               (int(st[8]), int(st[9])), st[11], st[3], st[6], (int(st[4]), int(st[5])),
-               _EPS * st[12], state[_ST + nx:_ST + 2 * nx].copy(), state[_ST + 2 * nx:].copy(),
-               not reason, reason)
-    _return_work(work)
-    return out
+    return Pass(x, xcheck, stats[:done].copy(), int(st[2]), int(st[10]),
+                (int(st[8]), int(st[9])), st[11], st[3], st[6], (int(st[4]), int(st[5])),
+                _EPS * st[12], state[_ST + nx:_ST + 2 * nx].copy(), state[_ST + 2 * nx:].copy(),
+                not reason, reason)
+
+
+def _stop_reason(flag: float, steps: float, max_steps: int) -> str:
+    """Why a pass stopped after a call: its C flag, or more than ``max_steps`` steps; ""
+    when it goes on."""
+    if flag:
+        return _REASONS[int(flag)]
+    return f"more than max_steps = {max_steps} steps" if steps > max_steps else ""
+
+
+#: Steps after which a loop of `run_pass_many` takes no further run (it returns, the
+#: caller looks at Ctrl-C and calls it again).
+PASSES_BUDGET = 200_000
+
+
+def run_pass_many(model, x0: np.ndarray, t: np.ndarray, ua: np.ndarray, ub: np.ndarray,
+                  p: np.ndarray, rtol: float, atol: np.ndarray, theta: float, max_steps: int,
+                  *, ulps: float = math.inf, threads: int = 1) -> list[Pass] | None:
+    """`run_pass` (``bmin`` 1) of K runs on one grid, each the same bits as alone, every
+    run inside one compiled loop over the runs (`cpass` ``rk8_pass_many``: the calls of
+    the pass a run alone makes, `INTERVALS` intervals to a call) on ``threads`` threads (the
+    caller's and those of `executors.worker_pool`) that take the runs one at a time through
+    a shared counter; each loop returns after about `PASSES_BUDGET` steps, so that a
+    deferred Ctrl-C stops the threads taking runs (raised once the runs taken have finished).
+
+    The inputs are `stepcontrol.run_stepped_many`'s (``x0 (K, nx)``, the grid ``t (n,)``,
+    each run's controls at the ends of its intervals ``ua, ub (K, n - 1, nu)``, varying
+    over the run: a run under one value takes the dense pass; ``p (K, np)``, ``atol
+    (nx,)``), with ``theta``, ``max_steps`` and ``ulps`` as `run_pass`'s. Returns each
+    run's `Pass`, or None without the model's compiled pass.
+    """
+    fun = pass_library(model)
+    if fun is None:
+        return None
+    K, nx, nu, nint = len(x0), model.nx, model.nu, t.size - 1
+    nctl = nu * nint
+    sizes = (nx, nx, _ST + 3 * nx, nint, nctl, nctl, model.np, nx, 4 * nint, nx, 8)
+    ends = np.cumsum((0,) + sizes)
+    W = np.zeros((K, int(ends[-1])))
+    xf, _, state, H, uas, uds, ps, at, stats, sg, par = (
+        W[:, ends[i]:ends[i + 1]] for i in range(len(sizes)))
+    xf[:], ps[:], at[:], sg[:] = x0, p, atol, signs(1, nx)
+    state[:] = _state0(nx)
+    state[:, 0] = 1  # (bmin)
+    np.abs(x0, out=state[:, _ST:_ST + nx])
+    step = np.subtract(t[1:], t[:-1])
+    H[:] = step
+    uas[:] = ua.reshape(K, nctl)
+    uds[:] = ((ub - ua) / step[None, :, None]).reshape(K, nctl)  # (as `_controls`)
+    par[:] = (rtol, theta, BMAX, 1, NOISE * _EPS / rtol,
+              math.inf if ulps == math.inf else 1.0 / (_EPS * ulps), nu, nint + 1)
+    off = np.array(ends[:-1], dtype=np.int64)
+    XX = np.empty((K, 2, nx, nint + 1))
+    done = np.zeros(K, dtype=np.int64)
+    cursor = np.zeros(1, np.int64)  # (the next run, shared by the threads' compiled loops)
+    args = (K, cursor.ctypes.data, PASSES_BUDGET, W.ctypes.data, W.shape[1], off.ctypes.data,
+            nint, INTERVALS, float(max_steps), XX.ctypes.data,
+            XX.ctypes.data + 8 * nx * (nint + 1), 2 * nx * (nint + 1), done.ctypes.data)
+    run_claiming(fun.pass_many, args, threads, K)
+    stats = stats.reshape(K, nint, 4)
+    flags, steps = state[:, 7].tolist(), state[:, 2].tolist()
+    return [_pass_of(XX[k, 0], XX[k, 1], state[k], stats[k], int(done[k]),
+                     _stop_reason(flags[k], steps[k], max_steps)) for k in range(K)]
 
 def _controls(ctrl, H: np.ndarray, nu: int) -> tuple[np.ndarray, np.ndarray, int]:
     """The pass's controls over the intervals of lengths ``H``: ``(ua, ud, stride)``, each

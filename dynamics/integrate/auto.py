@@ -34,10 +34,10 @@ _AUTO_CONFIRM = 1024   # below this many steps a trusted triple must be confirme
 STIFF_STEPS = 1e6     # explicit steps for stability alone beyond which auto uses cvodes
 _CVODES_RTOL_MIN = 1e-14  # tightest local rtol auto asks cvodes for
 _RK8_STABILITY = 6.0   # DOP853's stability interval on the negative real axis is about [-6, 0]
-_PASS_THETA = 1.0      # the check run's embedded estimates over the horizon, in tolerances
+PASS_THETA = 1.0      # the check run's embedded estimates over the horizon, in tolerances
 _PASS_TRIES = 3        # passes (each aimed tighter) before the multi-run search
-_PASS_ULPS = 10 ** 4   # the one-pass path needs the tolerance this many ulps above the state
-_PASS_MEASURED = 10 ** 6  # and below this many it measures the model's rounding (`measured_floor`)
+PASS_ULPS = 10 ** 4   # the one-pass path needs the tolerance this many ulps above the state
+PASS_MEASURED = 10 ** 6  # and below this many it measures the model's rounding (`measured_floor`)
 _ORDER_LOSS = 100.0    # differences this many times the modelled round-off: not round-off
 
 
@@ -310,7 +310,7 @@ def one_pass(problem: Problem, rtol, atol, max_steps, jit_pref, progress, *,
       accurate as the check: ``e <= d``), every check step measured being within DOP853's
       local tolerance.
 
-    Within `_PASS_MEASURED` ulps of a state's size, the tolerance may meet the rounding of
+    Within `PASS_MEASURED` ulps of a state's size, the tolerance may meet the rounding of
     the model's own formulas, which both runs share: the pass measures it (the change of
     ``f`` when its state moves by one ulp) and `measured_floor`'s screening bound, carried over the
     horizon with the spectral radius at ``x0``, must be below 0.05 (it is added to the
@@ -325,68 +325,94 @@ def one_pass(problem: Problem, rtol, atol, max_steps, jit_pref, progress, *,
     1, or left to the multi-run search.
 
     Not accepted, the pass is repeated aimed tighter (`_PASS_TRIES` in all). Not taken: a
-    callable control, no compiled pass, a tolerance within `_PASS_ULPS` ulps of a state, a
+    callable control, no compiled pass, a tolerance within `PASS_ULPS` ulps of a state, a
     non-finite state or an interval that needs more than ``2 cpass.BMAX + 1`` steps.
     """
     if problem.control.mode != "linear" or not auto_jit(jit_pref):
         return None, math.nan, 0
-    if _size_over_tolerance(problem, rtol, atol) * EPS * _PASS_ULPS > 1.0:
+    if sizes_over_tolerance(problem.model, problem.x0[None], rtol, atol)[0] * EPS * \
+            PASS_ULPS > 1.0:
         return None, math.nan, 0  # (the states' sizes put the tolerance near round-off)
     horizon = float(problem.t[-1] - problem.t[0])
-    theta = _PASS_THETA / horizon
+    theta = PASS_THETA / horizon
     spent, bmin = 0, 1
     for _ in range(_PASS_TRIES):
         got = run_pass(problem, rtol, atol, theta, max_steps - spent, progress, bmin=bmin,
-                       ulps=_PASS_ULPS)
+                       ulps=PASS_ULPS)
         if got is None:
             return None, math.nan, spent
         spent += got.n_steps
-        if not got.ok:
+        estimate, extra, factor = pass_verdict(problem, got, rtol, atol, rounding, progress)
+        spent += extra
+        if estimate is not None:
+            return pass_run(got, spent, estimate), estimate, spent
+        if factor is None:
             return None, math.nan, spent
-        d, ulps = got.d, max(got.ulp * FLOOR_ULPS, rounding)
-        if got.ulp * _PASS_MEASURED > 1.0:  # near round-off: the model's rounding, measured
-            lipschitz = Single(problem).spectrum(rtol, atol)[0]
-            bound = screen(carried(got.rounding, horizon, lipschitz), got.smin, horizon,
-                            lipschitz)
-            if not bound <= 0.1 * AUTO_ACCEPT:
-                return None, math.nan, spent  # (the multi-run search measures the flow's)
-            ulps = max(ulps, bound)
-        shown, measured = got.orders
-        richardson = d / (got.ratio ** 6 - 1)
-        if measured == 0 and got.stats.shape[0] >= 3 * CHECK_EVERY:
-            # the answer's own estimates are all at the rounding level: its truncation is
-            # at most that level per step, added up over its steps
-            richardson += got.answer_steps * NOISE * EPS / rtol
-            trusted = True
-        else:
-            trusted = measured >= 3 and 2 * shown >= measured
-        if trusted and richardson + ulps <= AUTO_ACCEPT:
-            estimate = richardson + ulps
-            if 2 * d + ulps > 1.0:  # (the Richardson division decides: measured, `_amplified`)
-                floor, extra = _amplified(problem, got, rtol, atol, progress)
-                spent += extra
-                if not richardson + max(floor, ulps) <= 1.0:
-                    return None, math.nan, spent  # (the multi-run search says what it is)
-                estimate = richardson + max(floor, ulps)
-        elif got.ec <= 1.0 and 2 * d + ulps <= 1.0:
-            estimate = 2 * d + ulps
-        else:
-            if not math.isfinite(d):
-                return None, math.nan, spent
-            # aim at an estimate of 0.05 (d ~ h^8, the embedded estimate ~ h^7)
-            factor = max(1.1, ((richardson if trusted else 2 * d) / 0.05) ** (1 / 8))
-            theta /= factor ** 7
-            bmin = max(bmin, math.ceil(factor * (got.stats[:, 3] - got.stats[:, 0]).mean()))
-            if bmin > BMAX:
-                return None, math.nan, spent
-            continue
-        lo, hi = got.n_range
-        message = (f"auto: rk8 with embedded error control: {got.answer_steps} steps ({lo}-{hi} "
-                   "per output interval), checked against a run with fewer than half the steps; "
-                   f"estimated error {estimate:.2g} of tolerance")
-        run = Run.new(got.x, spent, DOP853.stages * spent, hi, True, True, message)
-        return run, estimate, spent
+        theta /= factor ** 7
+        bmin = max(bmin, math.ceil(factor * (got.stats[:, 3] - got.stats[:, 0]).mean()))
+        if bmin > BMAX:
+            return None, math.nan, spent
     return None, math.nan, spent
+
+
+def pass_verdict(problem: Problem, got, rtol, atol, rounding, progress, *,
+                 bound: float | None = None) -> tuple[float | None, int, float | None]:
+    """`one_pass`'s verdict on its pass ``got`` over ``problem`` (see there):
+    ``(estimate, extra, factor)``, ``estimate`` the accepted answer's (None: not accepted),
+    ``extra`` the steps `_amplified` made, ``factor`` (not accepted) how much finer the
+    next pass's steps are aimed, None when the problem is left to the multi-run search.
+    ``bound``: `rounding_bound`'s, when known (a batch finds its runs' at once)."""
+    if not got.ok:
+        return None, 0, None
+    d, ulps = got.d, max(got.ulp * FLOOR_ULPS, rounding)
+    if got.ulp * PASS_MEASURED > 1.0:  # near round-off: the model's rounding, measured
+        if bound is None:
+            bound = rounding_bound(problem, got, rtol, atol)
+        if not bound <= 0.1 * AUTO_ACCEPT:
+            return None, 0, None  # (the multi-run search measures the flow's)
+        ulps = max(ulps, bound)
+    shown, measured = got.orders
+    richardson = d / (got.ratio ** 6 - 1)
+    if measured == 0 and got.stats.shape[0] >= 3 * CHECK_EVERY:
+        # the answer's own estimates are all at the rounding level: its truncation is
+        # at most that level per step, added up over its steps
+        richardson += got.answer_steps * NOISE * EPS / rtol
+        trusted = True
+    else:
+        trusted = measured >= 3 and 2 * shown >= measured
+    if trusted and richardson + ulps <= AUTO_ACCEPT:
+        if 2 * d + ulps <= 1.0:
+            return richardson + ulps, 0, None
+        # (the Richardson division decides: what the check's start made of it, measured)
+        floor, extra = _amplified(problem, got, rtol, atol, progress)
+        if not richardson + max(floor, ulps) <= 1.0:
+            return None, extra, None  # (the multi-run search says what it is)
+        return richardson + max(floor, ulps), extra, None
+    if got.ec <= 1.0 and 2 * d + ulps <= 1.0:
+        return 2 * d + ulps, 0, None
+    if not math.isfinite(d):
+        return None, 0, None
+    # aim at an estimate of 0.05 (d ~ h^8, the embedded estimate ~ h^7)
+    return None, 0, max(1.1, ((richardson if trusted else 2 * d) / 0.05) ** (1 / 8))
+
+
+def rounding_bound(problem: Problem, got, rtol, atol) -> float:
+    """The screening bound (`estimates.screen`) of the model's rounding that the pass
+    ``got`` measured, carried over the horizon with the spectral radius at ``x0``
+    (`Single.spectrum`): how much of the tolerance it may take."""
+    horizon = float(problem.t[-1] - problem.t[0])
+    lipschitz = Single(problem).spectrum(rtol, atol)[0]
+    return screen(carried(got.rounding, horizon, lipschitz), got.smin, horizon, lipschitz)
+
+
+def pass_run(got, spent: int, estimate: float) -> Run:
+    """The `Run` of `one_pass`'s accepted pass ``got`` (``spent`` the steps of every pass
+    and measurement made, ``estimate`` its verdict's)."""
+    lo, hi = got.n_range
+    message = (f"auto: rk8 with embedded error control: {got.answer_steps} steps ({lo}-{hi} "
+               "per output interval), checked against a run with fewer than half the steps; "
+               f"estimated error {estimate:.2g} of tolerance")
+    return Run.new(got.x, spent, DOP853.stages * spent, hi, True, True, message)
 
 
 def _amplified(problem: Problem, got, rtol, atol, progress) -> tuple[float, int]:
@@ -420,7 +446,7 @@ def dense_pass(problem: Problem, rtol, atol, max_steps, progress):
     stability alone; no compiled library, a control that varies, a requested tolerance below
     one ulp of a state's size, a failed run, or no verdict after `dense.TRIES` answers).
 
-    Within `_PASS_MEASURED` ulps of a state's size the rounding the answer measured on its
+    Within `PASS_MEASURED` ulps of a state's size the rounding the answer measured on its
     way, carried over the horizon, is added; where it is not small, the floor measured by the
     answer repeated with each step's rounding emulated at random (one or two draws: `dense`),
     in the same call.
@@ -493,20 +519,21 @@ def dense_message(got: DenseAuto, rtol: float) -> str:
                "included)" if got.floor > 0 else ""))
 
 
-def _size_over_tolerance(problem: Problem, rtol: float, atol: np.ndarray) -> float:
-    """The largest ``|x0_i| / (atol_i + rtol |x0_i|)`` (inf for a zero tolerance); a unit
-    quaternion's parts (``model.attitude``) count at its norm over ``atol`` (they reach
-    both). In Python floats: a few microseconds less than numpy for a small state."""
-    size = [abs(v) for v in problem.x0.tolist()]
-    a = atol.tolist()
-    least = [ai + rtol * si for ai, si in zip(a, size)]
-    if problem.model.attitude is not None:
-        iq = problem.model.attitude[0]
-        norm = math.sqrt(sum(v * v for v in size[iq:iq + 4]))
-        size[iq:iq + 4] = [norm] * 4
-        least[iq:iq + 4] = a[iq:iq + 4]
-    return max((si / li if li > 0 else math.inf for si, li in zip(size, least) if si > 0),
-               default=0.0)
+def sizes_over_tolerance(model, x0: np.ndarray, rtol: float, atol: np.ndarray) -> np.ndarray:
+    """The largest ``|x0_i| / (atol_i + rtol |x0_i|)`` of each run ``x0 (K, nx)`` (shape
+    ``(K,)``; inf for a zero tolerance of a nonzero state); a unit quaternion's parts
+    (``model.attitude``) count at its norm over ``atol`` (they reach both)."""
+    size = np.abs(x0)
+    least = atol + rtol * size
+    if model.attitude is not None:
+        iq = model.attitude[0]
+        q = size[:, iq:iq + 4]
+        size[:, iq:iq + 4] = np.sqrt(q[:, 0] * q[:, 0] + q[:, 1] * q[:, 1] + q[:, 2] * q[:, 2]
+                                     + q[:, 3] * q[:, 3])[:, None]
+        least[:, iq:iq + 4] = atol[iq:iq + 4]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        ratio = np.where(least > 0, size / least, np.inf)
+    return np.where(size > 0, ratio, 0.0).max(axis=1, initial=0.0)
 
 
 def nonsmooth_causes(problem: Problem, *, operations: tuple | None = None) -> tuple[str, ...]:

@@ -15,8 +15,11 @@ two rounds (`dense_rounds`, each spread over the batch), the first round's runs 
 call's answers to the last bit, the second round's first answers at the local tolerance
 the first round's runs show to cost the fewest steps (`first_factor`: over-delivery weighed
 against retries), each of its runs the single call's answer at that first tolerance;
-otherwise auto's multi-run error control over the whole batch (one step count for all
-runs; a stiff or non-smooth batch goes run by run as single runs do). The fixed-step
+under controls that vary within a run, every run's one-pass answer and check (the single
+call's `auto.one_pass`) in one compiled loop over the runs (`auto_pass_batch`), each judged
+as its single call judges it, a run not answered there alone as a single call; otherwise
+auto's multi-run error control over the whole batch (one step count for all runs; a stiff
+or non-smooth batch goes run by run as single runs do). The fixed-step
 methods: under constant controls, compiled rk8 is a plain C loop over each run's steps
 (`lanes`: four runs per vector step where the model's step allows); otherwise the model's
 compiled chunk loop mapped over the parts (`dynamics.integrate.batch_fixed`). ``cvodes``
@@ -34,14 +37,16 @@ import numpy as np
 from .. import cache
 from ..model import Model
 from ..validate import integer
-from .auto import STIFF_STEPS, Single, auto_jit, auto_runs, dense_outcome, solve_auto
+from .adaptive import run_pass_many
+from .auto import (PASS_MEASURED, PASS_THETA, PASS_ULPS, STIFF_STEPS, Single, auto_jit,
+                   auto_runs, dense_outcome, pass_verdict, sizes_over_tolerance, solve_auto)
 from .batch_fixed import (BATCH_THREADS, batch_threads, fixed_batch, fixed_message,
                           run_fixed_batch)
 from .cvodes import run_cvodes
 from .dense import HEADER as DENSE_HEADER
 from .dense import FIELDS as DENSE_FIELDS
 from .dense import FIRST, TRIES, dense_many, outcome_of
-from .estimates import jacobian_x, rho_sigma
+from .estimates import EPS, carried, jacobian_x, rho_sigma, screens
 from .evaluate import map_eval
 from .inputs import Batch, RunOptions, check_batch
 from .lanes import dense_lanes
@@ -76,9 +81,9 @@ class BatchTarget:
 
     def spectrum(self, rtol, atol):
         b = self.batch
-        J = map_eval(jacobian_x(b.model), [b.x0, b.ua[:, 0].T, b.p])  # (nx nx, K)
         nx = b.model.nx
-        found = rho_sigma(J.T.reshape(b.K, nx, nx).transpose(0, 2, 1)) if np.all(np.isfinite(J)) else None
+        J = _jacobians(b, np.arange(b.K))
+        found = rho_sigma(J) if np.all(np.isfinite(J)) else None
         if found is not None:
             return found
         return max(Single(b.problem(k)).spectrum(rtol, atol[k * nx:(k + 1) * nx])[0]
@@ -144,8 +149,11 @@ def simulate_batch(batch: Batch, options: RunOptions, *, start: float) -> "Batch
             status, message = _sane(batch, x, ok, status, message, method)
     else:
         target = BatchTarget(batch, options.threads)
-        dense = None if target.nonsmooth else auto_dense_batch(
-            batch, rtol, atol, max_steps, jit, cvodes_options, progress, threads=options.threads)
+        dense = None if target.nonsmooth else (
+            auto_dense_batch(batch, rtol, atol, max_steps, jit, cvodes_options, progress,
+                             threads=options.threads)
+            or auto_pass_batch(batch, rtol, atol, max_steps, jit, cvodes_options, progress,
+                               threads=options.threads))
         if dense is not None:
             x, ok, status, estimate, used, n_steps, message = dense
             compiled = True
@@ -271,6 +279,113 @@ def auto_dense_batch(batch: Batch, rtol: float, atol: np.ndarray, max_steps: int
         message += (f"; {floored} run(s) not verified: the tolerance lies below the round-off "
                     "floor of double precision for their states (see `status`)")
     return x, ok, status, estimate, ", ".join(sorted(used)), int(steps.max()), message
+
+
+def auto_pass_batch(batch: Batch, rtol: float, atol: np.ndarray, max_steps: int, jit,
+                    cvodes_options, progress: Progress, *, threads: int | None = None):
+    """``auto`` on a batch of smooth runs whose controls vary within a run: the single call's
+    one-pass path (`auto.one_pass`: the rk8 answer under DOP853's embedded error control
+    beside its check run) for every run in one compiled loop over the runs
+    (`adaptive.run_pass_many`, on ``threads`` threads taking the runs one at a time), each
+    pass judged as a single call judges its first (`auto.pass_verdict`; the rounding bounds
+    it needs near the states' round-off found at once, `_bounds`). A run
+    under one control throughout (the dense pass's), one whose tolerance lies near its
+    states' round-off, and one whose first pass is not accepted go alone through
+    `solve_auto`, as their single calls: every run's answer is its single call's. Returns
+    as `auto_dense_batch`, or None (no compiled pass, jit off, or no run for the pass: the
+    multi-run search then takes the batch)."""
+    if not auto_jit(jit):
+        return None
+    K, model, t = batch.K, batch.model, batch.t
+    ua, ub = batch.ua, batch.ub
+    x0 = np.ascontiguousarray(batch.x0.T)
+    held = (ua == ua[:, :1]).all(axis=(1, 2)) & (ub == ua[:, :1]).all(axis=(1, 2))
+    near = sizes_over_tolerance(model, x0, rtol, atol) * EPS * PASS_ULPS > 1.0
+    runs = np.flatnonzero(~held & ~near)
+    if not runs.size:
+        return None
+    horizon = float(t[-1] - t[0])
+    passes = run_pass_many(model, x0[runs], t, ua[runs], ub[runs],
+                           np.ascontiguousarray(batch.p.T[runs]), rtol, atol,
+                           PASS_THETA / horizon, max_steps, ulps=PASS_ULPS,
+                           threads=batch_threads(threads))
+    if passes is None:
+        return None
+    progress.step(sum(got.n_steps for got in passes), 1.0)  # (the loop tells no one: once)
+    bounds = _bounds(batch, runs, passes, rtol, atol)
+    X = np.empty((K, model.nx, t.size))
+    status, estimate = np.full(K, OK), np.full(K, math.nan)
+    steps = np.zeros(K, dtype=int)
+    alone = np.flatnonzero(held | near).tolist()
+    for k, got, bound in zip(runs.tolist(), passes, bounds):
+        est, extra, _ = pass_verdict(batch.problem(k), got, rtol, atol, 0.0, progress,
+                                     bound=bound)
+        if est is None:
+            alone.append(k)
+            continue
+        X[k], estimate[k], steps[k] = got.x, est, got.n_steps + extra
+    used = {"rk8"} if len(alone) < K else set()
+    failed = ""
+    for k in sorted(alone):  # (not answered by its first pass: alone, as a single call)
+        run, method, st, est = solve_auto(batch.problem(k), rtol, atol, max_steps, jit,
+                                          cvodes_options, progress)
+        X[k], estimate[k], steps[k] = run.x, est, run.n_steps
+        status[k] = st if run.ok else FAILED
+        used.add(method)
+        if not failed and status[k] not in (OK, OK_STIFF):
+            failed = f"; run {k}: {run.message}"
+    ok = np.ones(K, bool)
+    ok[alone] = np.isfinite(X[alone]).all(axis=(1, 2))  # (a pass answers finite states)
+    status = np.where(ok, status, FAILED)
+    worst = np.max(estimate[status == OK], initial=-math.inf)
+    message = (f"auto: rk8 with embedded error control per run ({K} runs in one compiled "
+               f"loop, each checked against a run with fewer than half the steps): "
+               f"{steps.min()}-{steps.max()} steps per run; estimated error up to "
+               f"{worst if worst > -math.inf else math.nan:.2g} of tolerance"
+               + (f"; {len(alone)} run(s) alone through auto's other paths" if alone else "")
+               + failed)
+    return X.transpose(1, 2, 0), ok, status, estimate, ", ".join(sorted(used)), \
+        int(steps.max()), message
+
+
+def _bounds(batch: Batch, runs: np.ndarray, passes: list, rtol: float,
+            atol: np.ndarray) -> list:
+    """`auto.rounding_bound` of each run ``runs[j]`` whose pass ``passes[j]`` lies near its
+    states' round-off (where `auto.pass_verdict` needs it), the same bits, the spectral
+    radii at ``x0`` found at once (the Jacobians `_jacobians`, their eigenvalues in one
+    call; a run where they are not finite alone, as `Single.spectrum`); None for the
+    others."""
+    out = [None] * len(runs)
+    need = [j for j, got in enumerate(passes) if got.ok and got.ulp * PASS_MEASURED > 1.0]
+    if not need:
+        return out
+    J = _jacobians(batch, runs[need])
+    good = np.isfinite(J).all(axis=(1, 2))
+    try:
+        lam = np.linalg.eigvals(np.where(good[:, None, None], J, 0.0))
+        good &= np.isfinite(lam).all(axis=1)
+        radius = np.max(np.abs(lam), axis=1, initial=0.0)
+    except np.linalg.LinAlgError:
+        good[:] = False
+        radius = np.zeros(len(need))
+    for i in np.flatnonzero(~good):
+        radius[i] = Single(batch.problem(int(runs[need[i]]))).spectrum(rtol, atol)[0]
+    horizon = float(batch.t[-1] - batch.t[0])
+    rounding = np.array([passes[j].rounding for j in need])
+    smin = np.array([passes[j].smin for j in need])
+    bound = screens(carried(rounding, horizon, radius), smin, horizon, radius)
+    for j, b in zip(need, bound.tolist()):
+        out[j] = b
+    return out
+
+
+def _jacobians(batch: Batch, runs: np.ndarray) -> np.ndarray:
+    """``df/dx`` at the runs' ``x0``, first control and parameters, shape ``(len(runs), nx,
+    nx)`` (`estimates.jacobian_x` mapped over the runs)."""
+    nx = batch.model.nx
+    J = map_eval(jacobian_x(batch.model), [batch.x0[:, runs], batch.ua[runs, 0].T,
+                                           batch.p[:, runs]])  # (nx nx, m)
+    return J.T.reshape(len(runs), nx, nx).transpose(0, 2, 1)
 
 
 def _constant_inputs(batch: Batch):

@@ -270,6 +270,48 @@ int rk8_pass_ws(casadi_real* ws, const long long* off, int done, int k, casadi_r
                   ws + off[8] + 4 * done);
 }
 
+/* The next run of a batch for a thread's compiled loop over its runs (`rk8_pass_many`,
+   `rk8_adaptive_many`), handed out through the counter *cursor the loops of every thread
+   share (atomic, as `au_claim`); -1 when every run is handed out, -2 when the runs this
+   loop did have made `budget` steps (0: no limit; the caller looks at Ctrl-C and calls
+   again). */
+static long long pass_next(long long n, long long* cursor, double budget, double spent) {
+  long long k;
+  if (budget > 0 && spent >= budget) return -2;
+  k = __atomic_fetch_add(cursor, 1, __ATOMIC_RELAXED);
+  return k < n ? k : -1;
+}
+
+/* `rk8_pass_ws` for the runs of a batch on one grid, each run's calls as a run alone makes
+   them (`adaptive.run_pass`: `chunk` intervals to a call, none after a call that set
+   ST_FLAG or passed `max_steps` steps), the runs handed out through the shared `cursor`
+   (`pass_next`) to the threads that call this: run k on its own workspace
+   ws + k stride (the layout `off`), its states into X + k xstride and XC + k xstride, its
+   intervals done into done[k]. No run is taken once the runs done have made `budget`
+   steps (0: no limit). Returns 1 when every run is handed out, else 0. */
+int rk8_pass_many(long long n, long long* cursor, double budget, casadi_real* ws,
+                  long long stride, const long long* off, int nint, int chunk,
+                  casadi_real max_steps, casadi_real* X, casadi_real* XC, long long xstride,
+                  long long* done) {
+  long long k;
+  int d, m;
+  double spent = 0;
+  while ((k = pass_next(n, cursor, budget, spent)) >= 0) {
+    {
+      casadi_real* w = ws + k * stride;
+      const casadi_real* st = w + off[2];
+      for (d = 0; d < nint;) {
+        m = nint - d < chunk ? nint - d : chunk;
+        d += rk8_pass_ws(w, off, d, m, X + k * xstride, XC + k * xstride);
+        if (st[ST_FLAG] || st[ST_STEPS] > max_steps) break;
+      }
+      done[k] = d;
+      spent += st[ST_STEPS];
+    }
+  }
+  return k == -1;
+}
+
 /* The check run of `rk8_pass` replayed from x (in/out) on its own steps: interval k of
    length H[k] in b[k] rk8 steps (`pass_steps`, the pass's arithmetic; controls ua + tau ud
    of stride `ustride`), the states into X (nx, ldx) from column 1; returns the intervals
@@ -358,7 +400,7 @@ int rk8_adaptive(casadi_real* x, casadi_real* hio, int nint, const casadi_real* 
 
 /* `rk8_adaptive` for the runs of a batch on one grid, each run's calls as a run alone
    makes them (`stepcontrol._intervals`: `chunk` intervals to a call), the runs handed out
-   through the shared `cursor` (atomic, as `au_claim`) to the threads that call this: run k
+   through the shared `cursor` (`pass_next`) to the threads that call this: run k
    from x + k nx (updated in place) with the proposal h[k], controls ua, ud + k nint nu
    (stride nu), parameters p + k pstride, its outputs into X + k nx nint (nx, nint), hbig +
    k nint and count + 4 k, its intervals done into done[k]. No run is taken once the runs
@@ -373,9 +415,7 @@ int rk8_adaptive_many(long long n, long long* cursor, double budget, int nint, i
   long long k;
   int d, m;
   double spent = 0;
-  while (!(budget > 0 && spent >= budget)) {
-    k = __atomic_fetch_add(cursor, 1, __ATOMIC_RELAXED);
-    if (k >= n) return 1;
+  while ((k = pass_next(n, cursor, budget, spent)) >= 0) {
     {
       casadi_real *c = count + 4 * k, *xk = x + k * PASS_NX, *Xk = X + k * PASS_NX * nint;
       const casadi_real *uak = ua + k * nint * nu, *udk = ud + k * nint * nu;
@@ -389,7 +429,7 @@ int rk8_adaptive_many(long long n, long long* cursor, double budget, int nint, i
       spent += c[0] + c[1];
     }
   }
-  return 0;
+  return k == -1;
 }
 """
 
@@ -971,7 +1011,7 @@ _AUTO = r"""
 #define AU_HDR 36
 #define AU_ACCEPT 0.5        /* estimates.AUTO_ACCEPT */
 #define AU_FLOOR_ULPS 1000.0 /* estimates.FLOOR_ULPS */
-#define AU_MEASURED 1e6      /* auto's _PASS_MEASURED */
+#define AU_MEASURED 1e6      /* auto's PASS_MEASURED */
 #define AU_DEEP 1e4          /* a retry whose local tolerance lies within this many ulps of
                                 the states' size measures the rounding floor: per step the
                                 rounding is an ulp against the truncation's AU_DEEP, so it is
@@ -1177,7 +1217,7 @@ static int au_step(casadi_real* w, casadi_real factor, casadi_real* Y, int* budg
   return j >= nout || count[2] != 0;
 }
 
-/* the largest |x_i| / (atol_i + rtol |x_i|) at x0 (`auto._size_over_tolerance`) */
+/* the largest |x_i| / (atol_i + rtol |x_i|) at x0 (`auto.sizes_over_tolerance`) */
 static casadi_real au_size(const casadi_real* w) {
   const casadi_real* x0 = AU_X0(w);
   const casadi_real* at = AU_ATOL(w);
@@ -2085,6 +2125,11 @@ def _loaded(lib, lanes: bool):
                         i32, ptr, ptr]
     stepper.restype = i32
     fun.stepper = stepper  # (`dynamics.integrate.stepcontrol`)
+    passes = lib.rk8_pass_many
+    passes.argtypes = [ctypes.c_longlong, ptr, f64, ptr, ctypes.c_longlong, ptr, i32, i32, f64,
+                       ptr, ptr, ctypes.c_longlong, ptr]
+    passes.restype = i32
+    fun.pass_many = passes  # (`adaptive.run_pass_many`)
     many = lib.rk8_adaptive_many
     i64 = ctypes.c_longlong
     many.argtypes = [i64, ptr, f64, i32, i32, ptr, ptr, ptr, ptr, ptr, i32, ptr, i32, f64, ptr,

@@ -16,7 +16,7 @@ from .result import Run
 
 __all__ = ["AUTO_ACCEPT", "EPS", "FLOOR_ULPS", "carried", "floor_signs", "initial_step",
            "jacobian_x", "measured_floor", "perturbed", "rho_sigma", "roundoff", "scaled_diff",
-           "screen", "signs", "spectrum", "table", "tightened"]
+           "screen", "screens", "signs", "spectrum", "table", "tightened"]
 
 EPS = np.finfo(float).eps
 AUTO_ACCEPT = 0.5     # accept a trusted estimate (truncation + round-off) below this
@@ -276,10 +276,16 @@ def measured_floor(target, run: Run, rtol, atol, lipschitz: float, jit: bool,
     return max(local, ulps, scaled_diff(check.x[:, 1:], x[:, 1:], scale)), check.n_steps
 
 
-def carried(noise: np.ndarray, horizon: float, lipschitz: float) -> np.ndarray:
+def carried(noise: np.ndarray, horizon: float, lipschitz) -> np.ndarray:
     """`measured_floor`'s rounding error ``2 sqrt(T min(T, 1 / L)) noise`` carried over the horizon
     ``T`` from the right-hand side's rounding ``noise`` per state (``L`` the spectral
-    radius)."""
+    radius): ``noise (nx,)`` with a float ``lipschitz``, or the runs' ``(R, nx)`` with
+    theirs ``(R,)``."""
+    if np.ndim(lipschitz):
+        L = np.asarray(lipschitz, dtype=float)
+        with np.errstate(divide="ignore"):
+            tau = np.where(L <= 0, horizon, np.minimum(horizon, 1.0 / L))
+        return 2 * np.sqrt(horizon * tau)[:, None] * noise
     tau = horizon if lipschitz <= 0 else min(horizon, 1.0 / lipschitz)
     return 2 * math.sqrt(horizon * tau) * noise
 
@@ -290,10 +296,17 @@ def screen(e: np.ndarray, smin: np.ndarray, horizon: float, lipschitz: float,
     ``smin`` of each state: the flow may carry the noise of any state into any other (the
     spin-rate noise of a flat body into the phase of its transverse rates), so across the
     states of each run (the runs of a batch do not share noise), the largest over the runs,
-    grown by ``1 + L T``."""
-    top, least = np.max(e.reshape(runs, -1), axis=1), np.min(smin.reshape(runs, -1), axis=1)
+    grown by ``1 + L T`` (`screens`, one run's each)."""
+    return float(np.max(screens(e.reshape(runs, -1), smin.reshape(runs, -1), horizon,
+                                lipschitz)))
+
+
+def screens(e: np.ndarray, smin: np.ndarray, horizon: float, lipschitz) -> np.ndarray:
+    """`screen`'s bound of each run: ``e``, ``smin`` of shape ``(R, nx)``, ``lipschitz`` a
+    float or the runs' ``(R,)``; shape ``(R,)``."""
+    top, least = np.max(e, axis=1), np.min(smin, axis=1)
     worst = np.divide(top, least, out=np.where(top > 0, np.inf, 0.0), where=least > 0)
-    return float(np.max(worst)) * (1 + lipschitz * horizon)
+    return worst * (1 + np.asarray(lipschitz) * horizon)
 
 
 def perturbed(x0: np.ndarray, m: int) -> np.ndarray:

@@ -37,8 +37,8 @@ import casadi as ca
 import numpy as np
 
 from .. import cache
-from ..executors import run_split
-from ..interrupts import check_interrupt, deferred_interrupts, stop_requested
+from ..executors import run_claiming
+from ..interrupts import check_interrupt, deferred_interrupts
 from .adaptive import INTERVALS
 from .cpass import pass_library
 from .dense import constant_control, dense_run
@@ -185,14 +185,7 @@ def run_stepped_many(model, x0: np.ndarray, t: np.ndarray, ua: np.ndarray, ub: n
             x.ctypes.data, h.ctypes.data, ua.ctypes.data, ud.ctypes.data, ua.shape[2],
             p.ctypes.data, p.shape[1], rtol, at.ctypes.data, float(max_steps),
             out.ctypes.data, longest.ctypes.data, count.ctypes.data, done.ctypes.data)
-
-    def loop(_):  # (until every run is handed out; between calls Ctrl-C is looked at)
-        while not stop_requested() and not lib.stepper_many(*args):
-            pass
-
-    with deferred_interrupts():
-        run_split(loop, [None] * max(1, min(threads, K)))
-        check_interrupt()
+    run_claiming(lib.stepper_many, args, threads, K)
     X = np.concatenate([x0[:, :, None], out], axis=2)
     for k in np.flatnonzero(done < nint):  # (NaN from the failure on, as a run alone)
         X[k, :, done[k] + 1:] = np.nan

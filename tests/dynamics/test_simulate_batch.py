@@ -137,6 +137,70 @@ def test_an_auto_run_that_blows_up_fails_alone_among_verified_runs():
                                rtol=1e-7)
 
 
+def _sphere_runs(K, hold, seed=11):
+    """K runs on a sphere J = 2 E, each its own rates and sampled torque (run 2 one torque
+    throughout), and the closed form of the rates: w = w0 + (1/2) integral of the torque
+    (linear samples: the trapezoid; held: the left sums)."""
+    t = np.linspace(0.0, 4.0, 9)
+    rng = np.random.default_rng(seed)
+    X0 = np.tile(np.r_[0.0, 0.0, 0.0, 1.0, 0.3, -0.2, 0.1][:, None], (1, K))
+    X0[4:] += rng.normal(size=(3, K))
+    U = rng.normal(size=(3, t.size, K))
+    U[:, :, 2] = [[0.2], [-0.1], [0.3]]
+    h = np.diff(t)[None, :, None]
+    steps = (U[:, :-1] + U[:, 1:]) / 2 * h if hold == "linear" else U[:, :-1] * h
+    exact = X0[4:, None, :] + np.concatenate([np.zeros((3, 1, K)), np.cumsum(steps, axis=1)],
+                                             axis=1) / 2
+    return rigid_body([2.0, 2.0, 2.0]), t, X0, U, exact
+
+
+@pytest.mark.parametrize("hold", ["linear", "zoh"])
+@pytest.mark.parametrize("threads", [1, 2])
+def test_an_auto_batch_under_sampled_torques_is_its_single_calls_and_exact(hold, threads):
+    """``auto`` on runs whose torques vary within a run: each run's one-pass answer in one
+    compiled loop over the runs, judged as its single call judges it; every run (the one
+    under a single torque, which takes the dense pass, too) is its single call to the bit
+    (states, status, estimate, steps) on any number of threads, within the tolerance of the
+    closed form, and a progress callback hears every step the single calls count (and the
+    first passes of the runs redone alone)."""
+    K = 9
+    model, t, X0, U, exact = _sphere_runs(K, hold)
+    calls = []
+    res = simulate(model, X0, t, u=U, hold=hold, threads=threads,
+                   progress=lambda d, n: calls.append((d, n)))
+    assert res.all_success and "one compiled loop" in res.message
+    assert "run(s) alone" in res.message  # (run 2 at least: the dense pass, as its single call)
+    scale = 1e-10 + 1e-8 * np.abs(exact)
+    assert np.all(np.abs(res.x[4:] - exact) <= scale)
+    total = 0
+    for k in range(K):
+        one = simulate(model, X0[:, k], t, u=U[:, :, k], hold=hold)
+        np.testing.assert_array_equal(res.x[:, :, k], one.x)
+        assert (res.status[k], res.error_estimate[k]) == (one.status, one.error_estimate)
+        total += one.n_steps
+        assert ("embedded error control" in one.message) == (k != 2)
+    assert calls[-1][0] == calls[-1][1] >= total
+
+
+def test_an_auto_batch_under_sampled_controls_leaves_a_blown_up_run_alone():
+    """x' = x^2 + u with each run's own sampled u: the run from 2 blows up before t = 0.5
+    and fails alone with the cause its single call gives; the others are their single calls."""
+    s, u = ca.SX.sym("s"), ca.SX.sym("u")
+    model = Model.from_expressions({"s": s}, {"s": s ** 2 + u}, controls={"u": u})
+    t = np.linspace(0.0, 0.9, 10)
+    x0 = np.array([[0.1, 2.0, -0.3]])
+    U = 0.01 * np.sin(np.arange(3 * t.size)).reshape(1, t.size, 3)
+    res = simulate(model, x0, t, u=U)
+    assert res.success.tolist() == [True, False, True] and res.status[1] == -1
+    assert "one compiled loop" in res.message
+    for k in range(3):
+        one = simulate(model, x0[:, k], t, u=U[:, :, k])
+        np.testing.assert_array_equal(res.x[:, :, k], one.x)
+        assert res.status[k] == one.status
+    alone = simulate(model, x0[:, 1], t, u=U[:, :, 1])
+    assert alone.message in res.message
+
+
 def test_progress_counts_the_steps_of_a_batch():
     calls = []
     _, X0 = _rates(3)

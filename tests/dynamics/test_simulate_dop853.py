@@ -242,7 +242,7 @@ def test_a_ctrl_c_stops_the_stepped_loops_from_taking_runs(threads, monkeypatch)
     import os
     import signal
 
-    from appdyn.dynamics.integrate import stepcontrol
+    from appdyn.dynamics import executors
     from appdyn.dynamics.integrate.cpass import pass_library
 
     if signal.getsignal(signal.SIGINT) is not signal.default_int_handler:
@@ -252,18 +252,18 @@ def test_a_ctrl_c_stops_the_stepped_loops_from_taking_runs(threads, monkeypatch)
     X0 = np.tile(x0[:, None], (1, K))
     U = np.random.default_rng(2).normal(size=(3, t.size, K))
     lib, calls = pass_library(model), []
-    many, split = lib.stepper_many, stepcontrol.run_split
+    many, split = lib.stepper_many, executors.run_split
     monkeypatch.setattr(lib, "stepper_many", lambda *a: calls.append(1) or many(*a))
 
     def interrupted_split(fun, tasks):  # (inside the deferral: the loops are about to start)
         os.kill(os.getpid(), signal.SIGINT)
         return split(fun, tasks)
 
-    monkeypatch.setattr(stepcontrol, "run_split", interrupted_split)
+    monkeypatch.setattr(executors, "run_split", interrupted_split)
     with pytest.raises(KeyboardInterrupt):
         simulate(model, X0, t, u=U, method="dop853", threads=threads)
     assert not calls
-    monkeypatch.setattr(stepcontrol, "run_split", split)
+    monkeypatch.setattr(executors, "run_split", split)
     res = simulate(model, X0[:, :20], t, u=U[:, :, :20], method="dop853", threads=threads)
     assert res.all_success and calls
 
