@@ -37,7 +37,7 @@ from .cpass import BMAX, NOISE, pass_library
 from .estimates import signs, table
 from .inputs import Problem
 
-__all__ = ["INTERVALS", "Pass", "run_pass", "run_pass_many"]
+__all__ = ["INTERVALS", "Pass", "PassBatch", "run_pass", "run_pass_many"]
 
 #: Output intervals per call of the compiled pass (Ctrl-C is looked at between calls).
 INTERVALS = 256
@@ -217,7 +217,7 @@ PASSES_BUDGET = 200_000
 
 def run_pass_many(model, x0: np.ndarray, t: np.ndarray, ua: np.ndarray, ub: np.ndarray,
                   p: np.ndarray, rtol: float, atol: np.ndarray, theta: float, max_steps: int,
-                  *, ulps: float = math.inf, threads: int = 1) -> list[Pass] | None:
+                  *, ulps: float = math.inf, threads: int = 1) -> "PassBatch | None":
     """`run_pass` (``bmin`` 1) of K runs on one grid, each the same bits as alone, every
     run inside one compiled loop over the runs (`cpass` ``rk8_pass_many``: the calls of
     the pass a run alone makes, `INTERVALS` intervals to a call) on ``threads`` threads (the
@@ -228,8 +228,8 @@ def run_pass_many(model, x0: np.ndarray, t: np.ndarray, ua: np.ndarray, ub: np.n
     The inputs are `stepcontrol.run_stepped_many`'s (``x0 (K, nx)``, the grid ``t (n,)``,
     each run's controls at the ends of its intervals ``ua, ub (K, n - 1, nu)``, varying
     over the run: a run under one value takes the dense pass; ``p (K, np)``, ``atol
-    (nx,)``), with ``theta``, ``max_steps`` and ``ulps`` as `run_pass`'s. Returns each
-    run's `Pass`, or None without the model's compiled pass.
+    (nx,)``), with ``theta``, ``max_steps`` and ``ulps`` as `run_pass`'s. Returns the runs'
+    `PassBatch`, or None without the model's compiled pass.
     """
     fun = pass_library(model)
     if fun is None:
@@ -261,8 +261,34 @@ def run_pass_many(model, x0: np.ndarray, t: np.ndarray, ua: np.ndarray, ub: np.n
     run_claiming(fun.pass_many, args, threads, K)
     stats = stats.reshape(K, nint, 4)
     flags, steps = state[:, 7].tolist(), state[:, 2].tolist()
-    return [_pass_of(XX[k, 0], XX[k, 1], state[k], stats[k], int(done[k]),
-                     _stop_reason(flags[k], steps[k], max_steps)) for k in range(K)]
+    return PassBatch([_pass_of(XX[k, 0], XX[k, 1], state[k], stats[k], int(done[k]),
+                               _stop_reason(flags[k], steps[k], max_steps)) for k in range(K)],
+                     (fun, W, off, XX, stats, threads))
+
+
+class PassBatch:
+    """The passes of `run_pass_many`: ``passes[k]`` run k's `Pass`, and `replay_checks`."""
+
+    def __init__(self, passes: list, work: tuple):
+        self.passes = passes
+        self._work = work  # (the library, workspaces, layout, states, stats, threads)
+
+    def replay_checks(self, runs) -> np.ndarray:
+        """`replay_check` of the finished passes ``runs`` (indices), the same bits: ``(len(runs),
+        nx, n)``, NaN past a non-finite state, in one compiled loop over them (`cpass`
+        ``rk8_replay_many``) on the batch's threads."""
+        fun, W, off, XX, stats, threads = self._work
+        runs = np.asarray(runs, dtype=np.int64)
+        m, nx, n = runs.size, XX.shape[2], XX.shape[3]
+        B = np.ascontiguousarray(_check_steps(stats[runs, :, 0]))
+        R = np.full((m, nx, n), np.nan)
+        if m:
+            cursor = np.zeros(1, np.int64)
+            run_claiming(fun.replay_many, (m, cursor.ctypes.data, runs.ctypes.data,
+                                           W.ctypes.data, W.shape[1], off.ctypes.data, n - 1,
+                                           B.ctypes.data, XX.ctypes.data, 2 * nx * n,
+                                           R.ctypes.data), threads, m)
+        return R
 
 def _controls(ctrl, H: np.ndarray, nu: int) -> tuple[np.ndarray, np.ndarray, int]:
     """The pass's controls over the intervals of lengths ``H``: ``(ua, ud, stride)``, each
@@ -278,7 +304,11 @@ def _controls(ctrl, H: np.ndarray, nu: int) -> tuple[np.ndarray, np.ndarray, int
 def check_steps(got: Pass) -> np.ndarray:
     """The check run's steps ``b`` per interval of the pass ``got`` (from the answer's
     ``n = 2 b + 1``, or 2 for ``b = 1``), as floats."""
-    n = got.stats[:, 0]
+    return _check_steps(got.stats[:, 0])
+
+
+def _check_steps(n: np.ndarray) -> np.ndarray:
+    """The check run's steps ``b`` from the answer's ``n = 2 b + 1`` (or 2 for ``b = 1``)."""
     return np.where(n <= 2, 1.0, (n - 1) // 2)
 
 

@@ -356,12 +356,14 @@ def one_pass(problem: Problem, rtol, atol, max_steps, jit_pref, progress, *,
 
 
 def pass_verdict(problem: Problem, got, rtol, atol, rounding, progress, *,
-                 bound: float | None = None) -> tuple[float | None, int, float | None]:
+                 bound: float | None = None,
+                 replayed: np.ndarray | None = None) -> tuple[float | None, int, float | None]:
     """`one_pass`'s verdict on its pass ``got`` over ``problem`` (see there):
     ``(estimate, extra, factor)``, ``estimate`` the accepted answer's (None: not accepted),
     ``extra`` the steps `_amplified` made, ``factor`` (not accepted) how much finer the
     next pass's steps are aimed, None when the problem is left to the multi-run search.
-    ``bound``: `rounding_bound`'s, when known (a batch finds its runs' at once)."""
+    ``bound``: `rounding_bound`'s, and ``replayed``: the check replayed from the exact start
+    (`adaptive.replay_check`'s), when known (a batch finds its runs' at once)."""
     if not got.ok:
         return None, 0, None
     d, ulps = got.d, max(got.ulp * FLOOR_ULPS, rounding)
@@ -384,7 +386,7 @@ def pass_verdict(problem: Problem, got, rtol, atol, rounding, progress, *,
         if 2 * d + ulps <= 1.0:
             return richardson + ulps, 0, None
         # (the Richardson division decides: what the check's start made of it, measured)
-        floor, extra = _amplified(problem, got, rtol, atol, progress)
+        floor, extra = _amplified(problem, got, rtol, atol, progress, replayed)
         if not richardson + max(floor, ulps) <= 1.0:
             return None, extra, None  # (the multi-run search says what it is)
         return richardson + max(floor, ulps), extra, None
@@ -415,13 +417,15 @@ def pass_run(got, spent: int, estimate: float) -> Run:
     return Run.new(got.x, spent, DOP853.stages * spent, hi, True, True, message)
 
 
-def _amplified(problem: Problem, got, rtol, atol, progress) -> tuple[float, int]:
+def _amplified(problem: Problem, got, rtol, atol, progress,
+               replayed: np.ndarray | None = None) -> tuple[float, int]:
     """`one_pass`'s measure of what the flow made of its check's start, 2 ulp away:
     ``(floor, steps)``, twice the scaled difference of the check ``got.xc`` from its own
-    steps replayed from the exact start (`adaptive.replay_check`: the same truncation, so
-    the difference is the amplified start alone; twice: one start is one draw of the
-    rounding, as `cpass`'s ``AU_JITTER_SPREAD`` measures), inf when the replay fails."""
-    x = replay_check(problem, got)
+    steps replayed from the exact start (`adaptive.replay_check`, or ``replayed`` when made
+    before: the same truncation, so the difference is the amplified start alone; twice:
+    one start is one draw of the rounding, as `cpass`'s ``AU_JITTER_SPREAD`` measures), inf
+    when the replay fails."""
+    x = replay_check(problem, got) if replayed is None else replayed
     steps = int(check_steps(got).sum())
     if x is None:
         return math.inf, 0

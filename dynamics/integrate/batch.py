@@ -46,7 +46,8 @@ from .cvodes import run_cvodes
 from .dense import HEADER as DENSE_HEADER
 from .dense import FIELDS as DENSE_FIELDS
 from .dense import FIRST, TRIES, dense_many, outcome_of
-from .estimates import EPS, carried, jacobian_x, rho_sigma, screens
+from .estimates import (AUTO_ACCEPT, EPS, FLOOR_ULPS, carried, jacobian_x, rho_sigma,
+                        screens)
 from .evaluate import map_eval
 from .inputs import Batch, RunOptions, check_batch
 from .lanes import dense_lanes
@@ -288,7 +289,8 @@ def auto_pass_batch(batch: Batch, rtol: float, atol: np.ndarray, max_steps: int,
     beside its check run) for every run in one compiled loop over the runs
     (`adaptive.run_pass_many`, on ``threads`` threads taking the runs one at a time), each
     pass judged as a single call judges its first (`auto.pass_verdict`; the rounding bounds
-    it needs near the states' round-off found at once, `_bounds`). A run
+    it needs near the states' round-off, `_bounds`, and the checks it divides replayed from
+    their exact starts, `adaptive.PassBatch.replay_checks`, made for all runs at once). A run
     under one control throughout (the dense pass's), one whose tolerance lies near its
     states' round-off, and one whose first pass is not accepted go alone through
     `solve_auto`, as their single calls: every run's answer is its single call's. Returns
@@ -305,38 +307,43 @@ def auto_pass_batch(batch: Batch, rtol: float, atol: np.ndarray, max_steps: int,
     if not runs.size:
         return None
     horizon = float(t[-1] - t[0])
-    passes = run_pass_many(model, x0[runs], t, ua[runs], ub[runs],
-                           np.ascontiguousarray(batch.p.T[runs]), rtol, atol,
-                           PASS_THETA / horizon, max_steps, ulps=PASS_ULPS,
-                           threads=batch_threads(threads))
-    if passes is None:
+    made = run_pass_many(model, x0[runs], t, ua[runs], ub[runs],
+                         np.ascontiguousarray(batch.p.T[runs]), rtol, atol,
+                         PASS_THETA / horizon, max_steps, ulps=PASS_ULPS,
+                         threads=batch_threads(threads))
+    if made is None:
         return None
+    passes = made.passes
     progress.step(sum(got.n_steps for got in passes), 1.0)  # (the loop tells no one: once)
     bounds = _bounds(batch, runs, passes, rtol, atol)
+    # the checks a verdict may need replayed from the exact start (`auto._amplified`: where
+    # the Richardson division decides), replayed at once; a run missed here replays alone
+    amplify = [j for j, (got, bound) in enumerate(zip(passes, bounds)) if got.ok
+               and 2 * got.d + max(got.ulp * FLOOR_ULPS, bound or 0.0) > 1.0
+               and got.d / (got.ratio ** 6 - 1) <= AUTO_ACCEPT]
+    replayed = dict(zip(amplify, made.replay_checks(amplify)))
     X = np.empty((K, model.nx, t.size))
     status, estimate = np.full(K, OK), np.full(K, math.nan)
     steps = np.zeros(K, dtype=int)
     alone = np.flatnonzero(held | near).tolist()
-    for k, got, bound in zip(runs.tolist(), passes, bounds):
+    for j, (k, got, bound) in enumerate(zip(runs.tolist(), passes, bounds)):
         est, extra, _ = pass_verdict(batch.problem(k), got, rtol, atol, 0.0, progress,
-                                     bound=bound)
+                                     bound=bound, replayed=replayed.get(j))
         if est is None:
             alone.append(k)
             continue
         X[k], estimate[k], steps[k] = got.x, est, got.n_steps + extra
     used = {"rk8"} if len(alone) < K else set()
     failed = ""
+    ok = np.ones(K, bool)  # (a pass answers finite states)
     for k in sorted(alone):  # (not answered by its first pass: alone, as a single call)
         run, method, st, est = solve_auto(batch.problem(k), rtol, atol, max_steps, jit,
                                           cvodes_options, progress)
-        X[k], estimate[k], steps[k] = run.x, est, run.n_steps
+        X[k], estimate[k], steps[k], ok[k] = run.x, est, run.n_steps, run.ok
         status[k] = st if run.ok else FAILED
         used.add(method)
         if not failed and status[k] not in (OK, OK_STIFF):
             failed = f"; run {k}: {run.message}"
-    ok = np.ones(K, bool)
-    ok[alone] = np.isfinite(X[alone]).all(axis=(1, 2))  # (a pass answers finite states)
-    status = np.where(ok, status, FAILED)
     worst = np.max(estimate[status == OK], initial=-math.inf)
     message = (f"auto: rk8 with embedded error control per run ({K} runs in one compiled "
                f"loop, each checked against a run with fewer than half the steps): "

@@ -336,6 +336,30 @@ int rk8_replay(casadi_real* x, int nint, const casadi_real* H, const casadi_real
   }
   return nint;
 }
+
+/* `rk8_replay` of the check run of each pass of `rk8_pass_many` that `runs` names (runs[0
+   ... n - 1], handed out through the shared `cursor`, `pass_next`): run k's intervals,
+   controls and parameters from its workspace ws + k stride (the layout `off`), its check
+   steps per interval from B + i nint, from its exact start (column 0 of X + k xstride,
+   (nx, nint + 1)) into R + i nx (nint + 1) (its column 0 the start; columns after a
+   non-finite state not written). Returns 1. */
+int rk8_replay_many(long long n, long long* cursor, const long long* runs,
+                    const casadi_real* ws, long long stride, const long long* off, int nint,
+                    const casadi_real* B, const casadi_real* X, long long xstride,
+                    casadi_real* R) {
+  casadi_real x[PASS_NX];
+  long long i;
+  int j, ldx = nint + 1;
+  while ((i = pass_next(n, cursor, 0, 0)) >= 0) {
+    const casadi_real* w = ws + runs[i] * stride;
+    const casadi_real* x0 = X + runs[i] * xstride;
+    casadi_real* r = R + i * PASS_NX * ldx;
+    for (j = 0; j < PASS_NX; ++j) r[j * ldx] = x[j] = x0[j * ldx];
+    rk8_replay(x, nint, w + off[3], w + off[4], w + off[5], (int) w[off[10] + 6], w + off[6],
+               w + off[7], B + i * nint, r, ldx);
+  }
+  return 1;
+}
 """
 
 
@@ -2167,6 +2191,11 @@ def _loaded(lib, lanes: bool):
     replay.argtypes = [ptr, i32, ptr, ptr, ptr, i32, ptr, ptr, ptr, ptr, i32]
     replay.restype = i32
     fun.replay = replay  # (`adaptive.replay_check`)
+    replays = lib.rk8_replay_many
+    replays.argtypes = [ctypes.c_longlong, ptr, ptr, ptr, ctypes.c_longlong, ptr, i32, ptr, ptr,
+                        ctypes.c_longlong, ptr]
+    replays.restype = i32
+    fun.replay_many = replays  # (`adaptive.replay_checks`)
     fun.path = lib._name  # (`pass_chunk`)
     return fun
 

@@ -201,6 +201,18 @@ def test_an_auto_batch_under_sampled_controls_leaves_a_blown_up_run_alone():
     assert alone.message in res.message
 
 
+def test_an_auto_batch_under_sampled_torques_says_what_max_steps_stopped_as_its_runs_do():
+    """Too few ``max_steps`` for any run's pass: each run goes alone and says what its single
+    call says (status 3, not verified; no run made), not a failure."""
+    model, t, X0, U, _ = _sphere_runs(4, "linear")
+    res = simulate(model, X0, t, u=U, max_steps=10)
+    for k in range(4):
+        one = simulate(model, X0[:, k], t, u=U[:, :, k], max_steps=10)
+        assert (res.status[k], res.success[k]) == (one.status, one.success) == (3, False)
+        np.testing.assert_array_equal(res.x[:, :, k], one.x)
+    assert "max_steps" in res.message
+
+
 def test_progress_counts_the_steps_of_a_batch():
     calls = []
     _, X0 = _rates(3)

@@ -225,3 +225,33 @@ def test_the_check_replayed_from_the_exact_start_is_its_own_steps():
     assert np.max(np.abs(x[:, 1:] - got.xc[:, 1:]) / scale) < 1e-3
     moved = replay_check(dataclasses.replace(problem, x0=got.xc[:, 0].copy()), got)
     np.testing.assert_array_equal(moved, got.xc)
+
+
+@pytest.mark.parametrize("threads", [1, 2])
+def test_a_batch_of_passes_is_its_runs_passes_and_replays_to_the_bit(threads):
+    """`adaptive.run_pass_many` (one compiled loop over the runs) gives each run the `Pass`
+    `run_pass` gives it alone, and `PassBatch.replay_checks` the check replayed from its
+    exact start as `replay_check` makes it, every array and count to the bit, on any number
+    of threads; a run whose spin the pass cannot follow stops as it does alone."""
+    from appdyn.dynamics.integrate.adaptive import replay_check, run_pass, run_pass_many
+    from appdyn.dynamics.integrate.inputs import check_batch
+    model, t, K = rigid_body(INERTIA), np.linspace(0.0, 20.0, 21), 6
+    rng = np.random.default_rng(3)
+    X = np.tile(X0[:, None], (1, K))
+    X[4:] += 0.3 * rng.normal(size=(3, K))
+    X[4:, 5] = [40.0, 0.0, 0.0]  # (a spin the pass cannot follow in 2 BMAX + 1 steps)
+    U = 0.05 * rng.normal(size=(3, t.size, K))
+    batch = check_batch(model, X, t, U, None)
+    atol = np.full(7, 1e-10)
+    made = run_pass_many(model, batch.x0.T, t, batch.ua, batch.ub, batch.p.T, 1e-8, atol,
+                         1.0 / 20.0, 10 ** 8, ulps=1e4, threads=threads)
+    replays = made.replay_checks([k for k in range(K) if made.passes[k].ok])
+    assert not made.passes[5].ok and len(replays) == K - 1
+    for k in range(K):
+        problem = batch.problem(k)
+        alone = run_pass(problem, 1e-8, atol, 1.0 / 20.0, 10 ** 8, Progress(None), ulps=1e4)
+        got = made.passes[k]
+        for name, value in zip(got._fields, got):
+            np.testing.assert_array_equal(value, getattr(alone, name), err_msg=name)
+        if got.ok:
+            np.testing.assert_array_equal(replays[k], replay_check(problem, alone))
