@@ -68,13 +68,17 @@ GLANCE = (
          "appdyn dop853 (not verified): speed-up vs numbalsoda dop853, interpolated at the "
          "target error")),
     ("1,000-run Monte Carlo at the defaults (every run verified), 1 thread",
-     "numbalsoda njit loop", "integrate_peers",
-     lambda c, m: "njit loop (one thread), defaults" in m and m.endswith("on 1 thread(s)")),
+     "numbalsoda njit loop", "integrate_peers", lambda c, m: "torque-free" in c
+     and "njit loop (one thread), defaults" in m and m.endswith("on 1 thread(s)")),
     ("1,000-run Monte Carlo at the defaults (every run verified), 2 threads",
-     "numbalsoda njit loop", "integrate_peers",
-     lambda c, m: "njit loop (one thread), defaults" in m and m.endswith("on 2 thread(s)")),
+     "numbalsoda njit loop", "integrate_peers", lambda c, m: "torque-free" in c
+     and "njit loop (one thread), defaults" in m and m.endswith("on 2 thread(s)")),
     ("1,000-run Monte Carlo, fixed-step rk8, 1 thread", "numbalsoda njit loop",
-     "integrate_peers", lambda c, m: "fixed-step rk8" in m and m.endswith("on 1 thread(s)")),
+     "integrate_peers", lambda c, m: "torque-free" in c and "fixed-step rk8" in m
+     and m.endswith("on 1 thread(s)")),
+    ("1,000-run Monte Carlo under sampled torques at the defaults, 1 and 2 threads",
+     "numbalsoda njit loop", "integrate_peers", lambda c, m: "sampled torques" in c
+     and "njit loop (one thread), defaults" in m),
     ("torque-free body, `auto`", "scipy DOP853", "simulate",
      lambda c, m: m == "speed-up of auto vs scipy DOP853"),
     ("every model with a truth, `auto`", "scipy", "workprecision",

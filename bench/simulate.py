@@ -195,13 +195,18 @@ def numbalsoda(job):
     return json.loads(proc.stdout)
 
 
-def numbalsoda_batch(x0s, t, rtol, repeats=3):
+def numbalsoda_batch(x0s, t, rtol, repeats=3, u=None, restart=False):
     """numbalsoda's dop853 in a numba-jitted loop over the runs ``x0s (K, 7)`` of the
-    benchmark body: its answer (``w (K, n, 3)``, ``times``, ``success``), or None."""
+    benchmark body (``u (K, n, 3)``: each run's torques sampled on the uniform grid ``t``,
+    linear between; ``restart``: each run restarted at every output time): its answer (``w
+    (K, n, 3)``, ``times``, ``success``), or None."""
+    batch = dict(x0s=np.asarray(x0s).tolist(), t=np.asarray(t).tolist(), rtol=rtol,
+                 restart=restart)
+    if u is not None:
+        batch["u"] = np.asarray(u).tolist()
     ans = numbalsoda(dict(inertia=INERTIA.tolist(), t=np.asarray(t).tolist(),
                           x0=np.asarray(x0s[0]).tolist(), tols=[], repeats=repeats,
-                          batch=dict(x0s=np.asarray(x0s).tolist(), t=np.asarray(t).tolist(),
-                                     rtol=rtol)))
+                          batch=batch))
     return None if ans is None else ans["batch"]
 
 
