@@ -166,17 +166,22 @@ def run_split(fun: Callable, tasks: Sequence) -> None:
         fut.result()
 
 
-def run_claiming(call: Callable, args: tuple, threads: int, runs: int) -> None:
+def run_claiming(call: Callable, args: tuple, threads: int, runs: int, *,
+                 meanwhile: Callable[[], None] | None = None) -> None:
     """The compiled loop ``call(*args)`` over a batch's ``runs`` on ``threads`` threads (at
     most one per run: the caller's and those of `worker_pool`), each calling it again until
     it returns true: every run handed out through the counter the loops share (`cpass`'s
     ``rk8_adaptive_many``, ``rk8_pass_many``; a loop returns false once its runs made its
-    step budget). Ctrl-C is deferred: a thread that sees it takes no further run, and it
-    is raised once every loop has finished."""
-    def loop(_):
+    step budget). ``meanwhile``: Python the calling thread runs first, while the other
+    threads take runs (the loops release the GIL), before it takes runs too. Ctrl-C is
+    deferred: a thread that sees it takes no further run, and it is raised once every loop
+    has finished."""
+    def loop(first):
+        if first and meanwhile is not None:
+            meanwhile()
         while not stop_requested() and not call(*args):
             pass
 
     with deferred_interrupts():
-        run_split(loop, [None] * max(1, min(threads, runs)))
+        run_split(loop, [True] + [False] * (max(1, min(threads, runs)) - 1))
         check_interrupt()

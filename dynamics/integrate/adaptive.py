@@ -217,7 +217,8 @@ PASSES_BUDGET = 200_000
 
 def run_pass_many(model, x0: np.ndarray, t: np.ndarray, ua: np.ndarray, ub: np.ndarray,
                   p: np.ndarray, rtol: float, atol: np.ndarray, theta: float, max_steps: int,
-                  *, ulps: float = math.inf, threads: int = 1) -> "PassBatch | None":
+                  *, ulps: float = math.inf, threads: int = 1,
+                  meanwhile=None) -> "PassBatch | None":
     """`run_pass` (``bmin`` 1) of K runs on one grid, each the same bits as alone, every
     run inside one compiled loop over the runs (`cpass` ``rk8_pass_many``: the calls of
     the pass a run alone makes, `INTERVALS` intervals to a call) on ``threads`` threads (the
@@ -228,8 +229,9 @@ def run_pass_many(model, x0: np.ndarray, t: np.ndarray, ua: np.ndarray, ub: np.n
     The inputs are `stepcontrol.run_stepped_many`'s (``x0 (K, nx)``, the grid ``t (n,)``,
     each run's controls at the ends of its intervals ``ua, ub (K, n - 1, nu)``, varying
     over the run: a run under one value takes the dense pass; ``p (K, np)``, ``atol
-    (nx,)``), with ``theta``, ``max_steps`` and ``ulps`` as `run_pass`'s. Returns the runs'
-    `PassBatch`, or None without the model's compiled pass.
+    (nx,)``), with ``theta``, ``max_steps`` and ``ulps`` as `run_pass`'s; ``meanwhile``
+    Python for the calling thread while the others step (`executors.run_claiming`). Returns
+    the runs' `PassBatch`, or None without the model's compiled pass.
     """
     fun = pass_library(model)
     if fun is None:
@@ -258,7 +260,7 @@ def run_pass_many(model, x0: np.ndarray, t: np.ndarray, ua: np.ndarray, ub: np.n
     args = (K, cursor.ctypes.data, PASSES_BUDGET, W.ctypes.data, W.shape[1], off.ctypes.data,
             nint, INTERVALS, float(max_steps), XX.ctypes.data,
             XX.ctypes.data + 8 * nx * (nint + 1), 2 * nx * (nint + 1), done.ctypes.data)
-    run_claiming(fun.pass_many, args, threads, K)
+    run_claiming(fun.pass_many, args, threads, K, meanwhile=meanwhile)
     stats = stats.reshape(K, nint, 4)
     flags, steps = state[:, 7].tolist(), state[:, 2].tolist()
     return PassBatch([_pass_of(XX[k, 0], XX[k, 1], state[k], stats[k], int(done[k]),
@@ -273,11 +275,12 @@ class PassBatch:
         self.passes = passes
         self._work = work  # (the library, workspaces, layout, states, stats, threads)
 
-    def replay_checks(self, runs) -> np.ndarray:
+    def replay_checks(self, runs, *, threads: int | None = None) -> np.ndarray:
         """`replay_check` of the finished passes ``runs`` (indices), the same bits: ``(len(runs),
         nx, n)``, NaN past a non-finite state, in one compiled loop over them (`cpass`
-        ``rk8_replay_many``) on the batch's threads."""
-        fun, W, off, XX, stats, threads = self._work
+        ``rk8_replay_many``) on ``threads`` threads (None: the batch's)."""
+        fun, W, off, XX, stats, mine = self._work
+        threads = mine if threads is None else threads
         runs = np.asarray(runs, dtype=np.int64)
         m, nx, n = runs.size, XX.shape[2], XX.shape[3]
         B = np.ascontiguousarray(_check_steps(stats[runs, :, 0]))

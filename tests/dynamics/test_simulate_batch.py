@@ -182,6 +182,29 @@ def test_an_auto_batch_under_sampled_torques_is_its_single_calls_and_exact(hold,
     assert calls[-1][0] == calls[-1][1] >= total
 
 
+@pytest.mark.parametrize("threads", [1, 2])
+def test_an_auto_batch_under_sampled_torques_in_groups_is_its_single_calls(threads,
+                                                                          monkeypatch):
+    """The runs in groups, each group judged while the other thread steps the next
+    (`batch.PASS_GROUPS`, here groups of 5 runs): every run is still its single call to
+    the bit, and the answers are those of one group."""
+    from appdyn.dynamics.integrate import batch as batch_module
+
+    K = 20
+    model, t, X0, U, exact = _sphere_runs(K, "linear", seed=5)
+    one_group = simulate(model, X0, t, u=U, threads=threads)
+    monkeypatch.setattr(batch_module, "PASS_GROUP_MIN", 5)
+    res = simulate(model, X0, t, u=U, threads=threads)
+    assert res.all_success and "one compiled loop" in res.message
+    np.testing.assert_array_equal(res.x, one_group.x)
+    np.testing.assert_array_equal(res.error_estimate, one_group.error_estimate)
+    assert np.all(np.abs(res.x[4:] - exact) <= 1e-10 + 1e-8 * np.abs(exact))
+    for k in range(0, K, 3):
+        one = simulate(model, X0[:, k], t, u=U[:, :, k])
+        np.testing.assert_array_equal(res.x[:, :, k], one.x)
+        assert (res.status[k], res.error_estimate[k]) == (one.status, one.error_estimate)
+
+
 def test_an_auto_batch_under_sampled_controls_leaves_a_blown_up_run_alone():
     """x' = x^2 + u with each run's own sampled u: the run from 2 blows up before t = 0.5
     and fails alone with the cause its single call gives; the others are their single calls."""
