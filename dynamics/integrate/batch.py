@@ -320,9 +320,10 @@ def auto_pass_batch(batch: Batch, rtol: float, atol: np.ndarray, max_steps: int,
     alone = np.flatnonzero(held | near).tolist()
     cores = batch_threads(threads)
 
-    def judge(group, made):  # (the verdicts of a group of runs: its answers into X, ...)
+    def judge(group, made, fraction):  # (the verdicts of a group: its answers into X, ...)
         passes = made.passes
-        progress.step(sum(got.n_steps for got in passes), 1.0)  # (the loop tells no one)
+        # (the loop tells no one: once a group, ``fraction`` of the runs stepped)
+        progress.step(sum(got.n_steps for got in passes), fraction)
         bounds = _bounds(batch, group, passes, rtol, atol)
         # the checks a verdict may need replayed from the exact start (`auto._amplified`:
         # where the Richardson division decides), replayed at once (on this thread: the
@@ -343,7 +344,7 @@ def auto_pass_batch(batch: Batch, rtol: float, atol: np.ndarray, max_steps: int,
     # step the next group (`executors.run_claiming`'s ``meanwhile``)
     groups = np.array_split(runs, min(PASS_GROUPS, max(1, runs.size // PASS_GROUP_MIN))
                             if cores > 1 else 1)
-    pending = None
+    pending, stepped = None, 0
     for group in groups:
         made = run_pass_many(model, x0[group], t, ua[group], ub[group],
                              np.ascontiguousarray(batch.p.T[group]), rtol, atol,
@@ -351,7 +352,8 @@ def auto_pass_batch(batch: Batch, rtol: float, atol: np.ndarray, max_steps: int,
                              meanwhile=pending)
         if made is None:
             return None
-        pending = partial(judge, group, made)
+        stepped += group.size
+        pending = partial(judge, group, made, stepped / runs.size)
     pending()
     used = {"rk8"} if len(alone) < K else set()
     failed = ""
