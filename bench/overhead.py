@@ -26,6 +26,7 @@ import numpy as np
 
 from appdyn.dynamics import rigid_body, simulate
 from appdyn.dynamics.integrate import dense, evaluate
+from appdyn.dynamics.integrate.api import call_plan
 from appdyn.dynamics.integrate.loops import CHUNK, _chunk_shapes, chunk_function
 
 from _common import Row, script_main, write_csv
@@ -86,7 +87,7 @@ def dense_pass_call(model, x0, t):
     t)`` at the defaults makes, captured and replayed with the workspace as `simulate`
     filled it (restored before each call: one copy of ~100 doubles): the floor no Python
     wrapper can go under. Returns ``(call, True)``."""
-    plan = dense._plan(model)
+    plan = dense.pass_plan(model)
     work = dense._workspace(plan, len(t) - 1)  # (this thread's: the one `simulate` fills)
     seen = []
 
@@ -96,15 +97,17 @@ def dense_pass_call(model, x0, t):
             return fun(*args)
         return spy
 
-    real, vector = dense._plan, plan.single[1]  # (the vector lanes, once loaded)
-    dense._plan = lambda m: plan._replace(auto=spying(plan.auto)) if m is model else real(m)
+    simulate(model, x0, t)  # (the common call keeps the plan in the model's `call_plan`)
+    slots = call_plan(model).passes
+    real, vector = slots[0], plan.single[1]  # (the vector lanes, once loaded)
+    slots[0] = plan._replace(auto=spying(plan.auto))
     if vector is not None:
         plan.single[1] = SimpleNamespace(address=vector.address, cont=vector.cont,
                                          auto_v=spying(vector.auto_v))
     try:
         res = simulate(model, x0, t)
     finally:
-        dense._plan, plan.single[1] = real, vector
+        slots[0], plan.single[1] = real, vector
     fun, args, filled = seen[-1]
     ws = work.ws
 

@@ -48,7 +48,7 @@ from .dense import HEADER as DENSE_HEADER
 from .dense import FIELDS as DENSE_FIELDS
 from .dense import FIRST, TRIES, dense_many, outcome_of
 from .estimates import (AUTO_ACCEPT, EPS, FLOOR_ULPS, carried, jacobian_x, rho_sigma,
-                        screens)
+                        screens, spectra)
 from .evaluate import map_eval
 from .inputs import Batch, RunOptions, check_batch
 from .lanes import dense_lanes
@@ -85,7 +85,7 @@ class BatchTarget:
         b = self.batch
         nx = b.model.nx
         J = _jacobians(b, np.arange(b.K))
-        found = rho_sigma(J) if np.all(np.isfinite(J)) else None
+        found = rho_sigma(J)
         if found is not None:
             return found
         return max(Single(b.problem(k)).spectrum(rtol, atol[k * nx:(k + 1) * nx])[0]
@@ -381,23 +381,15 @@ def _bounds(batch: Batch, runs: np.ndarray, passes: list, rtol: float,
             atol: np.ndarray) -> list:
     """`auto.rounding_bound` of each run ``runs[j]`` whose pass ``passes[j]`` lies near its
     states' round-off (where `auto.pass_verdict` needs it), the same bits, the spectral
-    radii at ``x0`` found at once (the Jacobians `_jacobians`, their eigenvalues in one
-    call; a run where they are not finite alone, as `Single.spectrum`); None for the
-    others."""
+    radii at ``x0`` found at once (the Jacobians `_jacobians`, their eigenvalues by
+    `estimates.spectra`, as `Single.spectrum`'s; a run where they are not finite alone);
+    None for the others."""
     out = [None] * len(runs)
     need = [j for j, got in enumerate(passes) if got.ok and got.ulp * PASS_MEASURED > 1.0]
     if not need:
         return out
-    J = _jacobians(batch, runs[need])
-    good = np.isfinite(J).all(axis=(1, 2))
-    try:
-        lam = np.linalg.eigvals(np.where(good[:, None, None], J, 0.0))
-        good &= np.isfinite(lam).all(axis=1)
-        radius = np.max(np.abs(lam), axis=1, initial=0.0)
-    except np.linalg.LinAlgError:
-        good[:] = False
-        radius = np.zeros(len(need))
-    for i in np.flatnonzero(~good):
+    radius = spectra(_jacobians(batch, runs[need]))[0]  # (`Single.spectrum`'s: the same bits)
+    for i in np.flatnonzero(np.isnan(radius)):
         radius[i] = Single(batch.problem(int(runs[need[i]]))).spectrum(rtol, atol)[0]
     horizon = float(batch.t[-1] - batch.t[0])
     rounding = np.array([passes[j].rounding for j in need])

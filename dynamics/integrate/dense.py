@@ -77,6 +77,7 @@ from .lanes import LANES, dense_lanes
 from .inputs import Problem
 
 __all__ = ["FIELDS", "HEADER", "FIRST", "CHECK", "TRIES", "DenseAuto", "dense_auto", "dense_run",
+           "pass_plan",
            "dense_many",
            "outcome_of", "constant_control"]
 
@@ -184,8 +185,9 @@ class _Plan(NamedTuple):
     iq: int
 
 
-def _plan(model) -> _Plan | None:
-    """The model's call plan (cached with its compiled pass); None without one."""
+def pass_plan(model) -> _Plan | None:
+    """The model's call plan (cached with its compiled pass); None without one. (`simulate`'s
+    common call keeps it in the model's `api.CallPlan`, and hands it to `dense_run`.)"""
     def build():
         lib = pass_library(model)
         return None if lib is None else _Plan(
@@ -312,7 +314,7 @@ def dense_auto(problem: Problem, rtol: float, atol: np.ndarray, max_steps: float
 
 def dense_run(model, x0: np.ndarray, t: np.ndarray, rtol: float, atol, max_steps: float,
               stiff_steps: float, *, u=None, p=None, progress=None,
-              check: bool = True) -> DenseAuto | None:
+              check: bool = True, plan: _Plan | None = None) -> DenseAuto | None:
     """`dense_auto` of checked inputs: ``x0 (nx,)``, the grid ``t (n,)``, ``atol`` a float or
     ``(nx,)``, the constant control ``u (nu,)`` (None: zero) and ``p (np,)``; None without a
     compiled pass, or for a grid ``t`` that is not finite and strictly increasing (the pass
@@ -321,6 +323,7 @@ def dense_run(model, x0: np.ndarray, t: np.ndarray, rtol: float, atol, max_steps
     ``ctypes`` call with arguments built with the workspace, the answer copied out.
     ``check`` False: DOP853's answer alone at the tolerance asked, no check and no verdict
     (``result`` 2; ``method='dop853'``); a failed run's outputs after ``filled`` are NaN.
+    ``plan``: the model's `pass_plan` when the caller has it (else looked up).
 
     Examples
     --------
@@ -333,9 +336,10 @@ def dense_run(model, x0: np.ndarray, t: np.ndarray, rtol: float, atol, max_steps
     >>> got.result, got.x.shape
     (1, (7, 2))
     """
-    plan = _plan(model)
     if plan is None:
-        return None
+        plan = pass_plan(model)
+        if plan is None:
+            return None
     nout = t.size - 1
     work = _workspace(plan, nout)
     ws = work.ws
@@ -446,7 +450,7 @@ def dense_many(model, x0: np.ndarray, t: np.ndarray, u: np.ndarray, p: np.ndarra
     >>> [r.result for r in runs]  # (each verified by its own check run)
     [1, 1]
     """
-    plan = _plan(model)
+    plan = pass_plan(model)
     if plan is None:
         return None
     nout, K = t.size - 1, len(x0)

@@ -369,7 +369,7 @@ def run_dop853(problem: Problem, rtol: float, atol: np.ndarray, max_steps: int, 
 
 
 def plain_run(model, x0: np.ndarray, t: np.ndarray, rtol: float, atol, max_steps: int, *,
-              u=None, p=None, progress=None) -> Run | None:
+              u=None, p=None, progress=None, plan=None) -> Run | None:
     """DOP853's answer alone under a control constant over the run (``u (nu,)``, None:
     zero), its steps by the error estimate, the outputs from the continuous extension: the
     compiled call of ``auto``'s dense path without its check (`dense.dense_run` with
@@ -377,7 +377,7 @@ def plain_run(model, x0: np.ndarray, t: np.ndarray, rtol: float, atol, max_steps
     without the model's compiled pass. The run's ``substeps`` is the longest output interval
     over the smallest step taken (but a last one cut short): equal steps of that many per
     interval are no longer than any the run took (`dynamics.integrate.events` re-integrates
-    with them).
+    with them). ``plan``: the model's `dense.pass_plan` when the caller has it.
 
     Examples
     --------
@@ -393,7 +393,7 @@ def plain_run(model, x0: np.ndarray, t: np.ndarray, rtol: float, atol, max_steps
     True
     """
     got = dense_run(model, x0, t, rtol, atol, float(max_steps), math.inf, u=u, p=p,
-                    progress=progress, check=False)
+                    progress=progress, check=False, plan=plan)
     return None if got is None else plain_answer(got, t, rtol)
 
 

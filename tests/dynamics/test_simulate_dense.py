@@ -569,7 +569,7 @@ def test_the_floor_draws_are_keyed_by_the_step_so_a_run_cut_anywhere_agrees(lane
     whole = run()
     assert whole.result == 1 and whole.draws == 2 and whole.floor > 0 \
         and whole.factor < dense.FIRST
-    plan = dense._plan(model)  # (where the draws ran: alongside the retried answer or not)
+    plan = dense.pass_plan(model)  # (where the draws ran: alongside the retried answer or not)
     assert (dense._workspace(plan, t.size - 1).ws[dense._alongside(plan, t.size - 1)] == 2) \
         == lanes
     again = run()

@@ -332,7 +332,7 @@ def test_the_first_pass_has_no_lane_driver_and_the_lanes_bring_theirs():
     assert vector.driver is cpass.pass_library(model, lanes=True) and vector.driver is not first
     assert vector.auto_v is vector.driver.auto_v and vector.auto_lanes is not None
     x0, t = np.r_[0.0, 0.0, 0.0, 1.0, 0.3, 1.1, -0.4], np.linspace(0.0, 15.0, 31)
-    plan = dense._plan(model)
+    plan = dense.pass_plan(model)
     plan.single[1] = None  # (the scalar call of the first build)
     scalar = dense.dense_run(model, x0, t, 1e-9, 1e-11, 1e8, 1e6, p=model.p_default)
     plan.single[1] = vector  # (its check in a lane of the lanes build's driver)
@@ -358,7 +358,7 @@ def test_the_lanes_build_takes_the_first_builds_steps_from_the_cache(tmp_path):
         vector = lanes.dense_lanes(model, wait=True)
         assert vector is not None and diskcache.info().reused == before + len(objects)
         x0, t = np.r_[0.0, 0.0, 0.0, 1.0, 0.3, 1.1, -0.4], np.linspace(0.0, 15.0, 31)
-        plan = dense._plan(model)
+        plan = dense.pass_plan(model)
         plan.single[1] = None
         scalar = dense.dense_run(model, x0, t, 1e-9, 1e-11, 1e8, 1e6, p=model.p_default)
         plan.single[1] = vector
