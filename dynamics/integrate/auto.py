@@ -621,8 +621,9 @@ def solve_auto(problem: Problem, rtol, atol, max_steps, jit, cvodes_options, pro
         run, estimate, spent = one_pass(problem, rtol, atol, max_steps, jit, progress,
                                         rounding=rounding)
         if run is not None:  # (the steps of every path tried are counted)
-            return replace(run, n_steps=run.n_steps + tried,
-                           n_rhs=run.n_rhs + DOP853.stages * tried), "rk8", OK, estimate
+            return Run.new(run.x, run.n_steps + tried, run.n_rhs + DOP853.stages * tried,
+                           run.substeps, run.compiled, run.ok, run.message,
+                           quat_off=run.quat_off), "rk8", OK, estimate
     run, estimate, status, reason, n_steps, n_rhs = auto_runs(Single(problem), rtol, atol,
                                                           max_steps - spent, jit, progress,
                                                           rounding=rounding)
