@@ -67,6 +67,9 @@ GLANCE = (
      "numbalsoda dop853", "integrate_peers", lambda c, m: m == (
          "appdyn dop853 (not verified): speed-up vs numbalsoda dop853, interpolated at the "
          "target error")),
+    ("single run, `method='dop853'`, cost per second of a long run (the same method and "
+     "tolerance: the steps' cost alone)", "numbalsoda dop853", "integrate_peers",
+     lambda c, m: m == "cost per second of horizon: numbalsoda over appdyn"),
     ("1,000-run Monte Carlo at the defaults (every run verified), 1 thread",
      "numbalsoda njit loop", "integrate_peers", lambda c, m: "torque-free" in c
      and "njit loop (one thread), defaults" in m and m.endswith("on 1 thread(s)")),

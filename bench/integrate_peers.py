@@ -288,6 +288,56 @@ def two_point_call(calls: int, rounds: int) -> tuple[float, float, float]:
     return paired_per_call(lambda: simulate(model, x0, t), floor, calls, rounds)
 
 
+#: The horizons of `fixed_and_step_costs` [s]: a call of one step, then 10 to 1,000 s.
+COST_HORIZONS = (1e-3, 10.0, 100.0, 1000.0)
+
+
+def fixed_and_step_costs(quick: bool) -> list[Row]:
+    """What a single ``method='dop853'`` call costs on its own and per second of horizon,
+    against numbalsoda's ``dop853`` at the same tolerance (rtol 1e-10, atol 1e-12: the same
+    method, so about the same steps) on the bench body over 2-point grids of `COST_HORIZONS`:
+    each side's medians (201 runs after `_common.WARM` s, the sides alternating twice, each
+    time the faster of its two). The fixed cost is a call of one step (T = 1e-3 s: the
+    call's own Python and set-up, the first step's choice and the step), the slope the
+    steps' between the longest two horizons (appdyn's per step: over its steps there): what
+    separates the two on short runs, and what does not on long ones."""
+    horizons = COST_HORIZONS[:3] if quick else COST_HORIZONS
+    model, x0 = rigid_body([1.0, 2.0, 3.0]), np.r_[0.0, 0.0, 0.0, 1.0, 1.0, 0.1, 0.8]
+    repeats = 21 if quick else 201
+    mine, peer, steps = [], [], []
+    for T in horizons:
+        t = np.array([0.0, T])
+        call = (lambda t=t: simulate(model, x0, t, method="dop853", rtol=1e-10, atol=1e-12))
+        job = dict(inertia=[1.0, 2.0, 3.0], t=t.tolist(), x0=x0.tolist(), tols=[1e-10],
+                   repeats=repeats, solvers=["dop853"], warm=WARM)
+        runs = []
+        for _ in range(2):  # (alternating: the VM's speed drifts)
+            ans = numbalsoda(job)
+            runs.append(math.inf if ans is None else statistics.median(ans["runs"][0]["times"]))
+            runs.append(median_time(call, repeats))
+        peer.append(min(runs[0::2]))
+        mine.append(min(runs[1::2]))
+        steps.append(call().n_steps)
+    # the fixed cost: a call of one step (its step ~0.2 us); the slope: between the longest two
+    fixed, slope = mine[0], (mine[-1] - mine[-2]) / (horizons[-1] - horizons[-2])
+    per_step = slope * (horizons[-1] - horizons[-2]) / (steps[-1] - steps[-2])
+    case = "single call cost, dop853 rtol 1e-10 (bench body)"
+    rows = [Row("integrate_peers", case, "appdyn call of one step (T = 1e-3 s)", fixed * 1e6,
+                "us", f"numbalsoda {peer[0] * 1e6:.3g} us" if math.isfinite(peer[0]) else
+                "numbalsoda not run")]
+    if all(map(math.isfinite, peer)):
+        pslope = (peer[-1] - peer[-2]) / (horizons[-1] - horizons[-2])
+        rows.append(Row("integrate_peers", case, "cost per second of horizon: numbalsoda over "
+                        "appdyn", pslope / slope, "x",
+                        f"appdyn {slope * 1e6:.3g} us/s ({per_step * 1e6:.3g} us a step), "
+                        f"numbalsoda {pslope * 1e6:.3g} us/s (between T = {horizons[-2]:g} and "
+                        f"{horizons[-1]:g} s)"))
+    print("fixed_and_step_costs: T", horizons, "appdyn [us]",
+          [round(v * 1e6, 1) for v in mine], "steps", steps, "numbalsoda [us]",
+          [round(v * 1e6, 1) for v in peer])
+    return rows
+
+
 #: Interleaved timings of each batch job, one thread and the default (the minimum is kept):
 #: ~50 ms each, and this VM's second core ran 25-35 % slower for seconds at a time, which
 #: five timings did not always outlast (two threads 19.8 and 23.1 ms between two runs).
@@ -478,6 +528,7 @@ def run(quick: bool, out: Path) -> list[Row]:
                        f"goal <= 20 us; its compiled pass alone {floor * 1e6:.3g} us, Python "
                        f"around it {around * 1e6:.3g} us (medians of {rounds} interleaved "
                        "rounds of 1,000 calls)"))
+    summary += fixed_and_step_costs(quick)
     summary += monte_carlo(quick, detail)
     write_csv(detail, out / "integrate_peers.csv")
     return summary

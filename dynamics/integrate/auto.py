@@ -14,8 +14,9 @@ from .adaptive import check_steps, replay_check, run_pass
 from .cpass import BMAX, CHECK_EVERY, NOISE
 from .cvodes import run_cvodes
 from .dense import DenseAuto, dense_auto
-from .estimates import (AUTO_ACCEPT, EPS, FLOOR_ULPS, carried, initial_step, measured_floor,
-                        perturbed, roundoff, scaled_diff, screen, spectrum, tightened)
+from .estimates import (AUTO_ACCEPT, EPS, FLOOR_ULPS, carried, initial_step, jacobian_at,
+                        measured_floor, norm_bounds, perturbed, roundoff, scaled_diff,
+                        screen, spectrum, tightened)
 from .evaluate import map_eval
 from .inputs import Problem
 from .loops import Progress, run_fixed
@@ -167,10 +168,10 @@ class Single:
         """``m`` rk8 steps per output interval from ``x0``."""
         return run_fixed(replace(self.problem, x0=x0), "rk8", m, jit, progress=progress)
 
-    def spectrum(self, rtol, atol):
+    def spectrum(self, rtol, atol, *, J: np.ndarray | None = None):
         """``(rho, sigma)`` as `estimates.spectrum` (``(L, 0)`` from `initial_step` when that
-        fails)."""
-        found = spectrum(self.problem)
+        fails); ``J`` its Jacobian at ``x0`` when known."""
+        found = spectrum(self.problem, J=J)
         return (initial_step(self.problem, rtol, atol, 8)[1], 0.0) if found is None else found
 
     def rhs(self, X: np.ndarray, cols: np.ndarray) -> np.ndarray:
@@ -369,7 +370,8 @@ def pass_verdict(problem: Problem, got, rtol, atol, rounding, progress, *,
     d, ulps = got.d, max(got.ulp * FLOOR_ULPS, rounding)
     if got.ulp * PASS_MEASURED > 1.0:  # near round-off: the model's rounding, measured
         if bound is None:
-            bound = rounding_bound(problem, got, rtol, atol)
+            bound = rounding_bound(problem, got, rtol, atol,
+                                   below=min(ulps, 0.1 * AUTO_ACCEPT))
         if not bound <= 0.1 * AUTO_ACCEPT:
             return None, 0, None  # (the multi-run search measures the flow's)
         ulps = max(ulps, bound)
@@ -398,12 +400,26 @@ def pass_verdict(problem: Problem, got, rtol, atol, rounding, progress, *,
     return None, 0, max(1.1, ((richardson if trusted else 2 * d) / 0.05) ** (1 / 8))
 
 
-def rounding_bound(problem: Problem, got, rtol, atol) -> float:
+def rounding_bound(problem: Problem, got, rtol, atol, *, below: float = 0.0) -> float:
     """The screening bound (`estimates.screen`) of the model's rounding that the pass
     ``got`` measured, carried over the horizon with the spectral radius at ``x0``
-    (`Single.spectrum`): how much of the tolerance it may take."""
+    (`Single.spectrum`): how much of the tolerance it may take.
+
+    ``below``: a level under which the bound's value decides nothing (`pass_verdict` adds
+    the larger of it and the states' ulps, and refuses a bound above 0.05: the least of
+    those). The bound grows with the rate it is carried with, so the same bound with
+    ``|J|_inf`` for the spectral radius (`estimates.norm_bounds`: at least it) is an upper
+    bound of it; when that lies under ``below`` (a margin of 1e-9 for the rounding of both),
+    it is returned, and the eigenvalues (half of the bound's cost) are not computed: the
+    verdict is the same to the bit."""
     horizon = float(problem.t[-1] - problem.t[0])
-    lipschitz = Single(problem).spectrum(rtol, atol)[0]
+    J = jacobian_at(problem)
+    if J is not None and below > 0:
+        upper = float(norm_bounds(J))
+        found = screen(carried(got.rounding, horizon, upper), got.smin, horizon, upper)
+        if found <= below * (1 - 1e-9):
+            return found
+    lipschitz = Single(problem).spectrum(rtol, atol, J=J)[0]
     return screen(carried(got.rounding, horizon, lipschitz), got.smin, horizon, lipschitz)
 
 

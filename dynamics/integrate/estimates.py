@@ -15,7 +15,7 @@ from .inputs import Problem
 from .result import Run
 
 __all__ = ["AUTO_ACCEPT", "EPS", "FLOOR_ULPS", "carried", "floor_signs", "initial_step",
-           "jacobian_x", "measured_floor", "perturbed", "rho_sigma", "roundoff", "scaled_diff",
+           "jacobian_at", "jacobian_x", "measured_floor", "norm_bounds", "perturbed", "rho_sigma", "roundoff", "scaled_diff",
            "screen", "screens", "signs", "spectra", "spectrum", "table", "tightened"]
 
 EPS = np.finfo(float).eps
@@ -176,20 +176,35 @@ def _xdot(model, x: np.ndarray, u: np.ndarray, p: np.ndarray) -> np.ndarray:
     return map_eval(model.f, [x.T, u.T, p.T]).T
 
 
-def spectrum(problem: Problem) -> tuple[float, float] | None:
+def spectrum(problem: Problem, *, J: np.ndarray | None = None) -> tuple[float, float] | None:
     """``(rho, sigma)`` [1/s] from the eigenvalues ``lam`` of ``df/dx`` at ``x0``: the
     spectral radius ``max |lam|`` (what explicit stability must resolve) and the fastest
     decay that only an implicit method steps over cheaply, ``max(-Re lam)`` over the
     eigenvalues with ``Re lam < 0`` and ``|Im lam| <= |Re lam|`` (oscillatory modes must be
-    resolved by any method, so they do not count). None when it cannot be evaluated."""
+    resolved by any method, so they do not count). None when it cannot be evaluated.
+    ``J``: `jacobian_at`'s, when the caller has it."""
+    J = jacobian_at(problem) if J is None else J
+    return None if J is None else rho_sigma(J[None])
+
+
+def jacobian_at(problem: Problem) -> np.ndarray | None:
+    """``df/dx (nx, nx)`` at ``x0``, the control at ``t[0]`` and ``p``; None when it cannot
+    be evaluated."""
     t0, H0 = float(problem.t[0]), float(problem.t[1] - problem.t[0])
     u0 = problem.control.at(t0, 0, t0, H0)
     try:
-        nx = problem.model.nx  # (a C-ordered (nx, nx) buffer holds J^T: same eigenvalues)
-        J = call_buffered(jacobian_x(problem.model), [problem.x0, u0, problem.p], (nx, nx)).T
+        nx = problem.model.nx  # (a C-ordered (nx, nx) buffer holds J^T)
+        return call_buffered(jacobian_x(problem.model), [problem.x0, u0, problem.p],
+                             (nx, nx)).T
     except RuntimeError:
         return None
-    return rho_sigma(J[None])
+
+
+def norm_bounds(J: np.ndarray) -> np.ndarray:
+    """``|J|_inf`` (the largest row sum of ``|J_ij|``) of each matrix ``J (..., n, n)``: at
+    least its spectral radius (every induced norm is), without its eigenvalues; NaN where
+    ``J`` is not finite."""
+    return np.abs(J).sum(axis=-1).max(axis=-1, initial=0.0)
 
 
 def jacobian_x(model) -> ca.Function:

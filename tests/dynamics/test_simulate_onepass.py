@@ -255,3 +255,48 @@ def test_a_batch_of_passes_is_its_runs_passes_and_replays_to_the_bit(threads):
             np.testing.assert_array_equal(value, getattr(alone, name), err_msg=name)
         if got.ok:
             np.testing.assert_array_equal(replays[k], replay_check(problem, alone))
+
+
+def test_the_norm_bound_of_the_rounding_decides_nothing_the_spectrum_would_not():
+    """`auto.rounding_bound` with ``below``: the bound carried with ``|J|_inf`` (at least the
+    spectral radius) is an upper bound of the bound carried with the spectral radius, and
+    is taken only under ``below``; the verdict of `auto.pass_verdict` (which asks with its
+    states' ulps as ``below``) is then the one the exact bound gives, to the bit. Under a
+    torque sampled on the grid at rtol 1e-8 (the one-pass path near the states' round-off,
+    where the bound is asked for)."""
+    from appdyn.dynamics.integrate.auto import pass_verdict, rounding_bound
+    from appdyn.dynamics.integrate.estimates import (FLOOR_ULPS, jacobian_at, norm_bounds,
+                                                     spectra)
+    model, t = rigid_body(INERTIA), np.linspace(0.0, 20.0, 121)
+    u = 0.01 * np.sin(np.outer([0.7, 1.3, 1.9], t) + np.array([[0.1], [0.5], [1.0]]))
+    problem = Problem.new(model, X0, t, check_u(u, model.nu, t), np.zeros(0))
+    atol = np.full(7, 1e-10)
+    got = adaptive.run_pass(problem, 1e-8, atol, 1.0 / 20.0, 10 ** 8, Progress(None))
+    assert got.ok and got.ulp * 1e6 > 1.0  # (the bound is asked for)
+    J = jacobian_at(problem)
+    assert norm_bounds(J) >= spectra(J[None])[0][0]
+    exact = rounding_bound(problem, got, 1e-8, atol)
+    upper = rounding_bound(problem, got, 1e-8, atol, below=1.0)
+    assert exact < upper <= 1.0  # (here |J|_inf is larger than the spectral radius)
+    assert rounding_bound(problem, got, 1e-8, atol, below=exact) == exact  # (not under it)
+    ulps = got.ulp * FLOOR_ULPS
+    assert upper < ulps  # (so the verdict adds the ulps, whichever bound it has)
+    mine = pass_verdict(problem, got, 1e-8, atol, 0.0, Progress(None))
+    theirs = pass_verdict(problem, got, 1e-8, atol, 0.0, Progress(None), bound=exact)
+    assert mine == theirs and mine[0] is not None
+
+
+def test_norm_bounds_hold_the_spectral_radius_of_any_matrix():
+    """`estimates.norm_bounds` (``|J|_inf``) is at least `estimates.spectra`'s spectral
+    radius, which is each matrix's largest ``|eigenvalue|`` (numpy's, to rounding); NaN
+    for a matrix that is not finite."""
+    from appdyn.dynamics.integrate.estimates import norm_bounds, spectra
+    J = np.random.default_rng(3).normal(size=(200, 6, 6)) * np.logspace(-3, 3, 200)[:, None, None]
+    rho, sigma = spectra(J)
+    lam = np.linalg.eigvals(J)
+    np.testing.assert_allclose(rho, np.abs(lam).max(axis=1), rtol=1e-12)
+    assert np.all(norm_bounds(J) >= rho * (1 - 1e-12))
+    decay = np.where((lam.real < 0) & (np.abs(lam.imag) <= -lam.real), -lam.real, 0.0)
+    np.testing.assert_allclose(sigma, decay.max(axis=1), rtol=1e-12)
+    J[7, 2, 3] = np.nan
+    assert np.isnan(norm_bounds(J)[7]) and np.isnan(spectra(J)[0][7])
