@@ -77,9 +77,7 @@ from .lanes import LANES, dense_lanes
 from .inputs import Problem
 
 __all__ = ["FIELDS", "HEADER", "FIRST", "CHECK", "TRIES", "DenseAuto", "dense_auto", "dense_run",
-           "pass_plan",
-           "dense_many",
-           "outcome_of", "constant_control"]
+           "pass_plan", "dense_many", "outcome_of", "constant_control"]
 
 #: The first answer's local tolerance over the requested one. Its global error, in units
 #: of the requested tolerance, was 10-1500 times this on the torque-free bodies and 300 on

@@ -15,8 +15,9 @@ from .inputs import Problem
 from .result import Run
 
 __all__ = ["AUTO_ACCEPT", "EPS", "FLOOR_ULPS", "carried", "floor_signs", "initial_step",
-           "jacobian_at", "jacobian_x", "measured_floor", "norm_bounds", "perturbed", "rho_sigma", "roundoff", "scaled_diff",
-           "screen", "screens", "signs", "spectra", "spectrum", "table", "tightened"]
+           "jacobian_at", "jacobian_x", "measured_floor", "norm_bounds", "perturbed",
+           "rho_sigma", "roundoff", "scaled_diff", "screen", "screens", "signs", "spectra",
+           "spectrum", "table", "tightened"]
 
 EPS = np.finfo(float).eps
 AUTO_ACCEPT = 0.5     # accept a trusted estimate (truncation + round-off) below this
