@@ -16,7 +16,7 @@ from .cvodes import run_cvodes
 from .dense import DenseAuto, dense_auto
 from .estimates import (AUTO_ACCEPT, EPS, FLOOR_ULPS, carried, initial_step, jacobian_at,
                         measured_floor, norm_bounds, perturbed, roundoff, scaled_diff,
-                        screen, spectrum, tightened)
+                        screen, screens, spectra, spectrum, tightened)
 from .evaluate import map_eval
 from .inputs import Problem
 from .loops import Progress, run_fixed
@@ -26,7 +26,8 @@ from .stepcontrol import LOCAL_RTOL_MIN, solve_stepped
 from .tableaux import DOP853
 
 __all__ = ["solve_auto", "auto_jit", "STIFF_STEPS", "Single", "auto_runs", "dense_pass",
-           "dense_outcome", "dense_answer", "dense_message", "one_pass", "nonsmooth_causes"]
+           "dense_outcome", "dense_answer", "dense_message", "one_pass", "nonsmooth_causes",
+           "rounding_bound", "rounding_bounds"]
 
 _AUTO_AIM = 0.1        # predict the step count for this estimated scaled error
 _AUTO_RUNS = 8         # give up (status 3) after this many fixed-step runs
@@ -403,24 +404,43 @@ def pass_verdict(problem: Problem, got, rtol, atol, rounding, progress, *,
 def rounding_bound(problem: Problem, got, rtol, atol, *, below: float = 0.0) -> float:
     """The screening bound (`estimates.screen`) of the model's rounding that the pass
     ``got`` measured, carried over the horizon with the spectral radius at ``x0``
-    (`Single.spectrum`): how much of the tolerance it may take.
-
-    ``below``: a level under which the bound's value decides nothing (`pass_verdict` adds
-    the larger of it and the states' ulps, and refuses a bound above 0.05: the least of
-    those). The bound grows with the rate it is carried with, so the same bound with
-    ``|J|_inf`` for the spectral radius (`estimates.norm_bounds`: at least it) is an upper
-    bound of it; when that lies under ``below`` (a margin of 1e-9 for the rounding of both),
-    it is returned, and the eigenvalues (half of the bound's cost) are not computed: the
-    verdict is the same to the bit."""
+    (`Single.spectrum`): how much of the tolerance it may take; ``below`` as
+    `rounding_bounds` takes it (`pass_verdict` gives the least of the states' ulps, which
+    it adds anyway, and the 0.05 it refuses above)."""
     horizon = float(problem.t[-1] - problem.t[0])
     J = jacobian_at(problem)
-    if J is not None and below > 0:
-        upper = float(norm_bounds(J))
-        found = screen(carried(got.rounding, horizon, upper), got.smin, horizon, upper)
-        if found <= below * (1 - 1e-9):
-            return found
-    lipschitz = Single(problem).spectrum(rtol, atol, J=J)[0]
-    return screen(carried(got.rounding, horizon, lipschitz), got.smin, horizon, lipschitz)
+    spectral = lambda _: Single(problem).spectrum(rtol, atol, J=J)[0]  # noqa: E731
+    if J is None:
+        lipschitz = spectral(0)
+        return screen(carried(got.rounding, horizon, lipschitz), got.smin, horizon, lipschitz)
+    return float(rounding_bounds(J[None], got.rounding[None], got.smin[None], horizon,
+                                 np.array([below]), spectral)[0])
+
+
+def rounding_bounds(J: np.ndarray, rounding: np.ndarray, smin: np.ndarray, horizon: float,
+                    below: np.ndarray, spectral) -> np.ndarray:
+    """`rounding_bound` of R runs at once (a single call's, R = 1, and a sampled batch's,
+    `batch._bounds`: one place, the same bits): their Jacobians at ``x0`` ``J (R, nx,
+    nx)``, the rounding their passes measured and their least tolerances ``(R, nx)``;
+    shape ``(R,)``.
+
+    ``below (R,)``: a level under which a run's bound decides nothing. The bound grows with
+    the rate it is carried with, and ``|J|_inf`` (`estimates.norm_bounds`) is at least the
+    spectral radius, so the bound with it is an upper bound; where that lies under
+    ``below`` (a margin of 1e-9 for the rounding of both) it is taken and the eigenvalues
+    (half of the bound's cost on the rigid body) are not computed: a verdict that adds the
+    larger of the bound and ``below`` is the same to the bit. Elsewhere the spectral radius
+    (`estimates.spectra`), or ``spectral(i)`` for run ``i`` where that is not finite."""
+    upper = norm_bounds(J)
+    bound = screens(carried(rounding, horizon, upper), smin, horizon, upper)
+    exact = np.flatnonzero(~(bound <= below * (1 - 1e-9)))
+    if exact.size:
+        radius = spectra(J[exact])[0]
+        for i in np.flatnonzero(np.isnan(radius)).tolist():
+            radius[i] = spectral(int(exact[i]))
+        bound[exact] = screens(carried(rounding[exact], horizon, radius), smin[exact],
+                               horizon, radius)
+    return bound
 
 
 def pass_run(got, spent: int, estimate: float) -> Run:

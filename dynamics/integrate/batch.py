@@ -40,15 +40,15 @@ from ..model import Model
 from ..validate import integer
 from .adaptive import run_pass_many
 from .auto import (PASS_MEASURED, PASS_THETA, PASS_ULPS, STIFF_STEPS, Single, auto_jit,
-                   auto_runs, dense_outcome, pass_verdict, sizes_over_tolerance, solve_auto)
+                   auto_runs, dense_outcome, pass_verdict, rounding_bounds,
+                   sizes_over_tolerance, solve_auto)
 from .batch_fixed import (BATCH_THREADS, batch_threads, fixed_batch, fixed_message,
                           run_fixed_batch)
 from .cvodes import run_cvodes
 from .dense import HEADER as DENSE_HEADER
 from .dense import FIELDS as DENSE_FIELDS
 from .dense import FIRST, TRIES, dense_many, outcome_of
-from .estimates import (AUTO_ACCEPT, EPS, FLOOR_ULPS, carried, jacobian_x, norm_bounds,
-                        rho_sigma, screens, spectra)
+from .estimates import AUTO_ACCEPT, EPS, FLOOR_ULPS, jacobian_x, rho_sigma
 from .evaluate import map_eval
 from .inputs import Batch, RunOptions, check_batch
 from .lanes import dense_lanes
@@ -380,30 +380,20 @@ def auto_pass_batch(batch: Batch, rtol: float, atol: np.ndarray, max_steps: int,
 def _bounds(batch: Batch, runs: np.ndarray, passes: list, rtol: float,
             atol: np.ndarray) -> list:
     """`auto.rounding_bound` of each run ``runs[j]`` whose pass ``passes[j]`` lies near its
-    states' round-off (where `auto.pass_verdict` needs it), the same verdicts: the
-    Jacobians at ``x0`` found at once (`_jacobians`), the bound with each one's
-    ``|J|_inf`` where that decides nothing (`rounding_bound`'s ``below``), else with its
-    spectral radius (`estimates.spectra`, as `Single.spectrum`'s; a run where it is not
-    finite alone); None for the others."""
+    states' round-off (where `auto.pass_verdict` needs it), the same bits: the Jacobians
+    at ``x0`` found at once (`_jacobians`), the bounds by `auto.rounding_bounds` with what
+    each verdict adds anyway as ``below`` (a run whose spectral radius is not finite alone,
+    as `Single.spectrum`); None for the others."""
     out = [None] * len(runs)
     need = [j for j, got in enumerate(passes) if got.ok and got.ulp * PASS_MEASURED > 1.0]
     if not need:
         return out
-    J = _jacobians(batch, runs[need])
     horizon = float(batch.t[-1] - batch.t[0])
-    rounding = np.array([passes[j].rounding for j in need])
-    smin = np.array([passes[j].smin for j in need])
-    upper = norm_bounds(J)
-    bound = screens(carried(rounding, horizon, upper), smin, horizon, upper)
-    below = np.minimum([passes[j].ulp * FLOOR_ULPS for j in need], 0.1 * AUTO_ACCEPT)
-    exact = np.flatnonzero(~(bound <= below * (1 - 1e-9)))
-    if exact.size:
-        radius = spectra(J[exact])[0]  # (`Single.spectrum`'s: the same bits)
-        for i in np.flatnonzero(np.isnan(radius)):
-            radius[i] = Single(batch.problem(int(runs[need[exact[i]]]))).spectrum(rtol,
-                                                                                 atol)[0]
-        bound[exact] = screens(carried(rounding[exact], horizon, radius), smin[exact], horizon,
-                               radius)
+    bound = rounding_bounds(
+        _jacobians(batch, runs[need]), np.array([passes[j].rounding for j in need]),
+        np.array([passes[j].smin for j in need]), horizon,
+        np.minimum([passes[j].ulp * FLOOR_ULPS for j in need], 0.1 * AUTO_ACCEPT),
+        lambda i: Single(batch.problem(int(runs[need[i]]))).spectrum(rtol, atol)[0])
     for j, b in zip(need, bound.tolist()):
         out[j] = b
     return out
